@@ -1,0 +1,235 @@
+//! Diagnostics: what every front-end, analysis and rule hands to the report layer.
+//!
+//! Positions are 1-based line/column pairs in a named file, because that is what
+//! SPIR-V debug info carries (`OpLine`, `DebugLine`). The report layer turns them
+//! back into byte ranges when it can read the file.
+
+use std::fmt;
+use std::path::{Path, PathBuf};
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, serde::Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Severity {
+    Note,
+    Warning,
+    Error,
+}
+
+impl Severity {
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Severity::Note => "note",
+            Severity::Warning => "warning",
+            Severity::Error => "error",
+        }
+    }
+}
+
+impl fmt::Display for Severity {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.as_str())
+    }
+}
+
+/// A place in a source file. Lines and columns are 1-based; a column of 0 means
+/// "the whole line" (debug info without columns).
+#[derive(Clone, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub struct Location {
+    pub path: PathBuf,
+    pub line: u32,
+    pub column: u32,
+    pub end_line: u32,
+    pub end_column: u32,
+}
+
+impl Location {
+    pub fn point(path: impl Into<PathBuf>, line: u32, column: u32) -> Self {
+        Location {
+            path: path.into(),
+            line,
+            column,
+            end_line: line,
+            end_column: column,
+        }
+    }
+
+    /// A location spanning `len` columns from `column` on one line.
+    pub fn span(path: impl Into<PathBuf>, line: u32, column: u32, len: u32) -> Self {
+        Location {
+            path: path.into(),
+            line,
+            column,
+            end_line: line,
+            end_column: column + len,
+        }
+    }
+}
+
+impl fmt::Display for Location {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        if self.column > 0 {
+            write!(f, "{}:{}:{}", self.path.display(), self.line, self.column)
+        } else {
+            write!(f, "{}:{}", self.path.display(), self.line)
+        }
+    }
+}
+
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Label {
+    pub location: Location,
+    pub message: String,
+}
+
+impl Label {
+    pub fn new(location: Location, message: impl Into<String>) -> Self {
+        Label {
+            location,
+            message: message.into(),
+        }
+    }
+}
+
+/// One finding or one input error.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Diagnostic {
+    /// `RT001` for rule findings; `None` for input errors.
+    pub code: Option<&'static str>,
+    /// The rule's kebab-case name, or the class of input error.
+    pub name: &'static str,
+    pub severity: Severity,
+    /// One sentence: the fact, with the measured value and the limit.
+    pub message: String,
+    /// The file that was analysed (a `.spv` may point into its GLSL source).
+    pub file: PathBuf,
+    /// Where the claim is made; `None` when the module has no debug info.
+    pub primary: Option<Label>,
+    /// Evidence: declarations, call sites, config lines.
+    pub secondary: Vec<Label>,
+    /// Names the object when there is no source position (entry point, type, member).
+    pub subject: Option<String>,
+    pub notes: Vec<String>,
+    pub help: Option<String>,
+    /// A mechanical fix, as replacement text (e.g. a reordered struct).
+    pub fix: Option<String>,
+}
+
+impl Diagnostic {
+    pub fn new(
+        severity: Severity,
+        name: &'static str,
+        file: &Path,
+        message: impl Into<String>,
+    ) -> Self {
+        Diagnostic {
+            code: None,
+            name,
+            severity,
+            message: message.into(),
+            file: file.to_path_buf(),
+            primary: None,
+            secondary: Vec::new(),
+            subject: None,
+            notes: Vec::new(),
+            help: None,
+            fix: None,
+        }
+    }
+
+    pub fn with_code(mut self, code: &'static str) -> Self {
+        self.code = Some(code);
+        self
+    }
+
+    pub fn with_primary(mut self, location: Option<Location>, message: impl Into<String>) -> Self {
+        self.primary = location.map(|l| Label::new(l, message));
+        self
+    }
+
+    pub fn with_secondary(
+        mut self,
+        location: Option<Location>,
+        message: impl Into<String>,
+    ) -> Self {
+        if let Some(l) = location {
+            self.secondary.push(Label::new(l, message));
+        }
+        self
+    }
+
+    pub fn with_subject(mut self, subject: impl Into<String>) -> Self {
+        self.subject = Some(subject.into());
+        self
+    }
+
+    pub fn with_note(mut self, note: impl Into<String>) -> Self {
+        self.notes.push(note.into());
+        self
+    }
+
+    pub fn with_help(mut self, help: impl Into<String>) -> Self {
+        self.help = Some(help.into());
+        self
+    }
+
+    pub fn with_fix(mut self, fix: impl Into<String>) -> Self {
+        self.fix = Some(fix.into());
+        self
+    }
+
+    /// The position reported in one-line formats: the primary label, else the file.
+    pub fn position(&self) -> (&Path, u32, u32, u32, u32) {
+        match &self.primary {
+            Some(l) => (
+                &l.location.path,
+                l.location.line,
+                l.location.column,
+                l.location.end_line,
+                l.location.end_column,
+            ),
+            None => (&self.file, 0, 0, 0, 0),
+        }
+    }
+}
+
+/// Bad input: an unreadable file, invalid SPIR-V, source a front-end rejects.
+/// Always exit code 2; carries a diagnostic that names the file and position.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct InputError(pub Box<Diagnostic>);
+
+impl InputError {
+    pub fn new(name: &'static str, file: &Path, message: impl Into<String>) -> Self {
+        InputError(Box::new(Diagnostic::new(
+            Severity::Error,
+            name,
+            file,
+            message,
+        )))
+    }
+
+    pub fn at(mut self, location: Location, label: impl Into<String>) -> Self {
+        self.0.primary = Some(Label::new(location, label));
+        self
+    }
+
+    pub fn with_note(mut self, note: impl Into<String>) -> Self {
+        self.0.notes.push(note.into());
+        self
+    }
+
+    pub fn diagnostic(&self) -> &Diagnostic {
+        &self.0
+    }
+}
+
+impl fmt::Display for InputError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let d = &self.0;
+        match &d.primary {
+            Some(l) => write!(f, "{}: {}", l.location, d.message),
+            None => write!(f, "{}: {}", d.file.display(), d.message),
+        }
+    }
+}
+
+impl std::error::Error for InputError {}

@@ -1,0 +1,125 @@
+//! Front-ends: every input language ends as SPIR-V words whose debug info
+//! (`OpString`/`OpLine`, or `NonSemantic.Shader.DebugInfo.100`) leads back to the
+//! original source.
+
+pub mod spirv;
+pub mod wgsl;
+
+use crate::diag::{InputError, Location};
+use std::path::{Path, PathBuf};
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Language {
+    Wgsl,
+    Spirv,
+    Hlsl,
+    Glsl,
+}
+
+impl Language {
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Language::Wgsl => "wgsl",
+            Language::Spirv => "spirv",
+            Language::Hlsl => "hlsl",
+            Language::Glsl => "glsl",
+        }
+    }
+
+    /// The language a file holds, judged by its extension.
+    pub fn from_path(path: &Path) -> Option<Language> {
+        match path.extension()?.to_str()?.to_ascii_lowercase().as_str() {
+            "wgsl" => Some(Language::Wgsl),
+            "spv" | "spirv" => Some(Language::Spirv),
+            "hlsl" | "hlsli" => Some(Language::Hlsl),
+            _ => None,
+        }
+    }
+
+    pub fn parse(name: &str) -> Option<Language> {
+        match name.to_ascii_lowercase().as_str() {
+            "wgsl" => Some(Language::Wgsl),
+            "spirv" | "spv" => Some(Language::Spirv),
+            "hlsl" => Some(Language::Hlsl),
+            "glsl" => Some(Language::Glsl),
+            _ => None,
+        }
+    }
+}
+
+/// One SPIR-V module produced from one input file.
+#[derive(Clone, Debug)]
+pub struct Compiled {
+    /// The input file as the user named it.
+    pub path: PathBuf,
+    /// The language the module was written in (for a `.spv`, the language its
+    /// `OpSource` names, when it names one we know).
+    pub language: Language,
+    /// The language of the input file itself.
+    pub input_language: Language,
+    pub words: Vec<u32>,
+    /// Declaration positions the SPIR-V's own debug info lacks.
+    pub decls: Vec<(wgsl::NamedDecl, Location)>,
+}
+
+/// Reads and compiles one file to SPIR-V.
+pub fn compile_path(path: &Path, language: Language) -> Result<Compiled, InputError> {
+    match language {
+        Language::Wgsl => {
+            let text = read_text(path)?;
+            let (module, info) = wgsl::parse(&text, path)?;
+            let words = wgsl::write_spirv(&module, &info, &text, path)?;
+            Ok(Compiled {
+                path: path.to_path_buf(),
+                language: Language::Wgsl,
+                input_language: Language::Wgsl,
+                words,
+                decls: wgsl::declarations(&module, &text, path),
+            })
+        }
+        Language::Spirv => {
+            let bytes = std::fs::read(path).map_err(|e| io_error(path, &e))?;
+            let words = spirv::words_from_bytes(&bytes, path)?;
+            Ok(Compiled {
+                path: path.to_path_buf(),
+                language: Language::Spirv,
+                input_language: Language::Spirv,
+                words,
+                decls: Vec::new(),
+            })
+        }
+        Language::Hlsl | Language::Glsl => Err(InputError::new(
+            "unsupported-language",
+            path,
+            format!(
+                "{} input is not supported by this build of rtlint",
+                language.as_str()
+            ),
+        )),
+    }
+}
+
+/// Compiles one file and builds its [`Program`](crate::spirv::Program).
+pub fn load(path: &Path, language: Language) -> Result<crate::spirv::Program, InputError> {
+    let c = compile_path(path, language)?;
+    let mut program = crate::spirv::parse(&c.words, &c.path, c.language)?;
+    program.attach_named_decls(&c.decls);
+    Ok(program)
+}
+
+pub fn read_text(path: &Path) -> Result<String, InputError> {
+    let bytes = std::fs::read(path).map_err(|e| io_error(path, &e))?;
+    String::from_utf8(bytes).map_err(|e| {
+        let offset = e.utf8_error().valid_up_to();
+        InputError::new(
+            "invalid-utf8",
+            path,
+            format!("file is not valid UTF-8 (byte offset {offset})"),
+        )
+    })
+}
+
+pub fn io_error(path: &Path, e: &std::io::Error) -> InputError {
+    InputError::new("unreadable-file", path, format!("cannot read file: {e}"))
+}

@@ -1,0 +1,264 @@
+//! WGSL through naga: parse, validate with every capability, write SPIR-V with
+//! debug info so each instruction carries its WGSL line and column.
+
+use crate::diag::{InputError, Location};
+use naga::back::spv;
+use naga::valid::{Capabilities, ValidationFlags, Validator};
+use std::path::Path;
+
+/// SPIR-V version written for WGSL input: 1.4 is the floor for ray tracing.
+const SPIRV_VERSION: (u8, u8) = (1, 4);
+
+pub fn parse(
+    source: &str,
+    path: &Path,
+) -> Result<(naga::Module, naga::valid::ModuleInfo), InputError> {
+    let module = naga::front::wgsl::parse_str(source).map_err(|e| {
+        let mut err = InputError::new("wgsl-parse", path, e.message().to_string());
+        let mut labels = e.labels();
+        if let Some((span, label)) = labels.next() {
+            err = err.at(span_location(path, source, span), label);
+        }
+        for (span, label) in labels {
+            err.0.secondary.push(crate::diag::Label::new(
+                span_location(path, source, span),
+                label,
+            ));
+        }
+        for note in e.notes() {
+            err = err.with_note(note);
+        }
+        err
+    })?;
+    let info = Validator::new(ValidationFlags::all(), Capabilities::all())
+        .validate(&module)
+        .map_err(|e| validation_error(path, source, &e))?;
+    Ok((module, info))
+}
+
+/// Compiles WGSL source to SPIR-V words with `OpString`/`OpLine` debug info.
+pub fn compile(source: &str, path: &Path) -> Result<Vec<u32>, InputError> {
+    let (module, info) = parse(source, path)?;
+    write_spirv(&module, &info, source, path)
+}
+
+/// Source positions of named declarations, which naga's SPIR-V writer does not
+/// emit: structs and their members, globals, functions.
+pub fn declarations(
+    module: &naga::Module,
+    source: &str,
+    path: &Path,
+) -> Vec<(NamedDecl, Location)> {
+    let mut out = Vec::new();
+    for (handle, ty) in module.types.iter() {
+        let (Some(name), naga::TypeInner::Struct { members, .. }) = (&ty.name, &ty.inner) else {
+            continue;
+        };
+        let span = module.types.get_span(handle);
+        let Some(range) = span.to_range() else {
+            continue;
+        };
+        let at = find_ident(source, range.start, range.end, name).unwrap_or(range.start);
+        out.push((
+            NamedDecl::Type(name.clone()),
+            name_location(path, source, at, name),
+        ));
+        // Members are found by name inside the struct's body, in order.
+        let mut from = source[range.clone()]
+            .find('{')
+            .map(|b| range.start + b)
+            .unwrap_or(range.start);
+        for (k, m) in members.iter().enumerate() {
+            let Some(mname) = &m.name else { continue };
+            if let Some(at) = find_ident(source, from, range.end, mname) {
+                out.push((
+                    NamedDecl::Member(name.clone(), k as u32),
+                    name_location(path, source, at, mname),
+                ));
+                from = at + mname.len();
+            }
+        }
+    }
+    for (handle, g) in module.global_variables.iter() {
+        if let (Some(name), Some(range)) =
+            (&g.name, module.global_variables.get_span(handle).to_range())
+        {
+            let at = find_ident(source, range.start, range.end, name).unwrap_or(range.start);
+            out.push((
+                NamedDecl::Global(name.clone()),
+                name_location(path, source, at, name),
+            ));
+        }
+    }
+    for (handle, f) in module.functions.iter() {
+        if let (Some(name), Some(range)) = (&f.name, module.functions.get_span(handle).to_range()) {
+            let at = find_ident(source, range.start, range.end, name).unwrap_or(range.start);
+            out.push((
+                NamedDecl::Function(name.clone()),
+                name_location(path, source, at, name),
+            ));
+        }
+    }
+    for ep in &module.entry_points {
+        if let Some(at) = find_fn(source, &ep.name) {
+            out.push((
+                NamedDecl::Function(ep.name.clone()),
+                name_location(path, source, at, &ep.name),
+            ));
+        }
+    }
+    out
+}
+
+/// A declaration named in source, matched to SPIR-V ids through `OpName`.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum NamedDecl {
+    Type(String),
+    Member(String, u32),
+    Global(String),
+    Function(String),
+}
+
+fn name_location(path: &Path, source: &str, at: usize, name: &str) -> Location {
+    span_location(
+        path,
+        source,
+        naga::Span::new(at as u32, (at + name.len()) as u32),
+    )
+}
+
+fn is_ident_byte(b: u8) -> bool {
+    b.is_ascii_alphanumeric() || b == b'_'
+}
+
+/// Byte offset of `name` as a whole identifier in `source[from..to]`.
+fn find_ident(source: &str, from: usize, to: usize, name: &str) -> Option<usize> {
+    let bytes = source.as_bytes();
+    let to = to.min(source.len());
+    let mut start = from;
+    while start < to {
+        let rel = source.get(start..to)?.find(name)?;
+        let at = start + rel;
+        let end = at + name.len();
+        let before_ok = at == 0 || !is_ident_byte(bytes[at - 1]);
+        let after_ok = end >= bytes.len() || !is_ident_byte(bytes[end]);
+        if before_ok && after_ok {
+            return Some(at);
+        }
+        start = at + 1;
+    }
+    None
+}
+
+/// Byte offset of the name in `fn name(`.
+fn find_fn(source: &str, name: &str) -> Option<usize> {
+    let mut from = 0;
+    while let Some(at) = find_ident(source, from, source.len(), "fn") {
+        let rest = &source[at + 2..];
+        let trimmed = rest.trim_start();
+        if trimmed.starts_with(name)
+            && !trimmed[name.len()..].starts_with(|c: char| c.is_alphanumeric() || c == '_')
+        {
+            return Some(at + 2 + (rest.len() - trimmed.len()));
+        }
+        from = at + 2;
+    }
+    None
+}
+
+pub fn write_spirv(
+    module: &naga::Module,
+    info: &naga::valid::ModuleInfo,
+    source: &str,
+    path: &Path,
+) -> Result<Vec<u32>, InputError> {
+    let file_name = path.to_string_lossy();
+    let options = spv::Options {
+        lang_version: SPIRV_VERSION,
+        flags: spv::WriterFlags::DEBUG | spv::WriterFlags::LABEL_VARYINGS,
+        debug_info: Some(spv::DebugInfo {
+            source_code: source,
+            file_name: &file_name,
+            language: naga::back::spv::SourceLanguage::WGSL,
+        }),
+        // The checks naga wraps around each trace hide the trace's own source
+        // position and add a function to every call chain; rtlint analyses what
+        // the author wrote.
+        trace_ray_argument_validation: false,
+        ..Default::default()
+    };
+    spv::write_vec(module, info, &options, None).map_err(|e| {
+        InputError::new(
+            "wgsl-spirv-out",
+            path,
+            format!("naga could not write SPIR-V for this module: {e}"),
+        )
+    })
+}
+
+fn validation_error(
+    path: &Path,
+    source: &str,
+    e: &naga::WithSpan<naga::valid::ValidationError>,
+) -> InputError {
+    // naga's own chain of causes is the most precise message it has.
+    let mut message = e.as_inner().to_string();
+    let mut cause = std::error::Error::source(e.as_inner());
+    while let Some(c) = cause {
+        message.push_str(": ");
+        message.push_str(&c.to_string());
+        cause = c.source();
+    }
+    let mut err = InputError::new(
+        "wgsl-validation",
+        path,
+        format!("invalid WGSL module: {message}"),
+    );
+    let mut spans = e.spans();
+    if let Some((span, label)) = spans.next() {
+        err = err.at(span_location(path, source, *span), label.clone());
+    }
+    for (span, label) in spans {
+        err.0.secondary.push(crate::diag::Label::new(
+            span_location(path, source, *span),
+            label.clone(),
+        ));
+    }
+    err
+}
+
+/// Converts a naga byte span into a line/column location.
+pub fn span_location(path: &Path, source: &str, span: naga::Span) -> Location {
+    let start = span
+        .to_range()
+        .map(|r| r.start)
+        .unwrap_or(0)
+        .min(source.len());
+    let end = span
+        .to_range()
+        .map(|r| r.end)
+        .unwrap_or(start)
+        .clamp(start, source.len());
+    let (line, column) = line_col(source, start);
+    let (end_line, end_column) = line_col(source, end);
+    Location {
+        path: path.to_path_buf(),
+        line,
+        column,
+        end_line,
+        end_column,
+    }
+}
+
+/// 1-based line and column (in characters) of a byte offset.
+pub fn line_col(source: &str, offset: usize) -> (u32, u32) {
+    let mut offset = offset.min(source.len());
+    while !source.is_char_boundary(offset) {
+        offset -= 1;
+    }
+    let before = &source[..offset];
+    let line = before.matches('\n').count() as u32 + 1;
+    let line_start = before.rfind('\n').map(|i| i + 1).unwrap_or(0);
+    let column = source[line_start..offset].chars().count() as u32 + 1;
+    (line, column)
+}

@@ -1,0 +1,919 @@
+//! Building a [`Program`] from SPIR-V words. Every malformed input becomes an
+//! [`InputError`] naming the file and the word offset; nothing here panics on
+//! bad input (ids are looked up, never assumed).
+
+use super::debug::resolve_path;
+use super::*;
+use crate::diag::InputError;
+use rspirv::binary::{Consumer, ParseAction};
+use rspirv::dr::{self, ModuleHeader};
+use std::path::Path;
+
+/// `NonSemantic.Shader.DebugInfo.100` instruction numbers we read.
+mod dbg {
+    pub const TYPE_COMPOSITE: u32 = 10;
+    pub const TYPE_MEMBER: u32 = 11;
+    pub const GLOBAL_VARIABLE: u32 = 18;
+    pub const FUNCTION: u32 = 20;
+    pub const LOCAL_VARIABLE: u32 = 26;
+    pub const DECLARE: u32 = 28;
+    pub const SOURCE: u32 = 35;
+    pub const FUNCTION_DEFINITION: u32 = 101;
+    pub const SOURCE_CONTINUED: u32 = 102;
+    pub const LINE: u32 = 103;
+    pub const NO_LINE: u32 = 104;
+}
+
+struct Collect {
+    header: Option<ModuleHeader>,
+    insts: Vec<dr::Instruction>,
+}
+
+impl Consumer for Collect {
+    fn initialize(&mut self) -> ParseAction {
+        ParseAction::Continue
+    }
+    fn finalize(&mut self) -> ParseAction {
+        ParseAction::Continue
+    }
+    fn consume_header(&mut self, module: ModuleHeader) -> ParseAction {
+        self.header = Some(module);
+        ParseAction::Continue
+    }
+    fn consume_instruction(&mut self, inst: dr::Instruction) -> ParseAction {
+        self.insts.push(inst);
+        ParseAction::Continue
+    }
+}
+
+fn err(path: &Path, msg: impl Into<String>) -> InputError {
+    InputError::new("invalid-spirv", path, msg)
+}
+
+/// Parses and checks a module. `language` is the front-end's language; a
+/// `.spv` takes the one its `OpSource` names.
+pub fn parse(words: &[u32], path: &Path, language: Language) -> Result<Program, InputError> {
+    if words.len() < 5 {
+        return Err(err(path, "SPIR-V module is shorter than the 5-word header"));
+    }
+    if words[0] != crate::front::spirv::MAGIC {
+        return Err(err(
+            path,
+            format!("not a SPIR-V module: word 0 is {:#010x}", words[0]),
+        ));
+    }
+    let bound = words[3];
+    // Our own pass over the instruction stream first: it gives every
+    // instruction's word offset and catches what the parser reports vaguely.
+    let mut offsets = Vec::new();
+    let mut i = 5usize;
+    while i < words.len() {
+        let count = (words[i] >> 16) as usize;
+        if count == 0 {
+            return Err(err(
+                path,
+                format!("instruction at word {i} has a word count of 0"),
+            ));
+        }
+        if i + count > words.len() {
+            return Err(err(
+                path,
+                format!(
+                    "module is truncated: the instruction at word {i} needs {count} words, {} remain",
+                    words.len() - i
+                ),
+            ));
+        }
+        offsets.push(i as u32);
+        i += count;
+    }
+    let mut c = Collect {
+        header: None,
+        insts: Vec::new(),
+    };
+    if let Err(e) = rspirv::binary::parse_words(words, &mut c) {
+        use rspirv::binary::ParseState as S;
+        let at = |n: usize| offsets.get(n).copied().unwrap_or(words.len() as u32);
+        let msg = match e {
+            S::OpcodeUnknown(_, n, op) => format!("unknown opcode {op} at word {}", at(n)),
+            S::OperandExpected(_, n) => format!(
+                "instruction at word {} ({}) is missing operands",
+                at(n),
+                opname(words, at(n))
+            ),
+            S::OperandExceeded(_, n) => format!(
+                "instruction at word {} ({}) has more operands than its opcode takes",
+                at(n),
+                opname(words, at(n))
+            ),
+            S::TypeUnsupported(_, n) => format!(
+                "instruction at word {} ({}) uses an undeclared or unsupported type",
+                at(n),
+                opname(words, at(n))
+            ),
+            S::WordCountZero(_, n) => {
+                format!("instruction at word {} has a word count of 0", at(n))
+            }
+            S::OperandError(d) => {
+                format!("bad operand after word {}: {d}", at(c.insts.len()))
+            }
+            other => format!("{other} (near word {})", at(c.insts.len())),
+        };
+        return Err(err(path, msg));
+    }
+    let header = c.header.unwrap_or_else(|| ModuleHeader::new(bound));
+    let (major, minor) = header.version();
+    let mut b = Builder {
+        path,
+        p: Program {
+            path: path.to_path_buf(),
+            language,
+            version: (major, minor),
+            insts: c.insts,
+            offsets,
+            locs: Vec::new(),
+            files: Vec::new(),
+            types: HashMap::new(),
+            names: HashMap::new(),
+            member_names: HashMap::new(),
+            decorations: HashMap::new(),
+            member_decorations: HashMap::new(),
+            constants: HashMap::new(),
+            spec_constants: HashMap::new(),
+            globals: Vec::new(),
+            entry_points: Vec::new(),
+            functions: Vec::new(),
+            sites: Vec::new(),
+            decl_pos: HashMap::new(),
+            defs: HashMap::new(),
+            debug_info_set: None,
+        },
+        strings: HashMap::new(),
+        file_of_string: HashMap::new(),
+        dbg_sources: HashMap::new(),
+        dbg_members: HashMap::new(),
+        dbg_composites: Vec::new(),
+        dbg_functions: HashMap::new(),
+        dbg_locals: HashMap::new(),
+    };
+    b.check_ids(bound)?;
+    b.collect()?;
+    b.functions()?;
+    b.link_debug_composites();
+    b.sites();
+    Ok(b.p)
+}
+
+fn opname(words: &[u32], offset: u32) -> String {
+    let w = words.get(offset as usize).copied().unwrap_or(0);
+    match Op::from_u32(w & 0xffff) {
+        Some(op) => format!("Op{op:?}"),
+        None => format!("opcode {}", w & 0xffff),
+    }
+}
+
+struct Builder<'a> {
+    path: &'a Path,
+    p: Program,
+    strings: HashMap<Id, String>,
+    /// File index for each `OpString` naming a source file.
+    file_of_string: HashMap<Id, u32>,
+    /// `DebugSource` result id → file index.
+    dbg_sources: HashMap<Id, u32>,
+    /// `DebugTypeMember` result id → its position.
+    dbg_members: HashMap<Id, SrcPos>,
+    /// `DebugTypeComposite`: name, position, member ids.
+    dbg_composites: Vec<(String, SrcPos, Vec<Id>)>,
+    dbg_functions: HashMap<Id, SrcPos>,
+    dbg_locals: HashMap<Id, SrcPos>,
+}
+
+fn id_at(inst: &dr::Instruction, i: usize) -> Option<Id> {
+    match inst.operands.get(i)? {
+        Operand::IdRef(x) | Operand::IdScope(x) | Operand::IdMemorySemantics(x) => Some(*x),
+        _ => None,
+    }
+}
+
+fn lit_at(inst: &dr::Instruction, i: usize) -> Option<u32> {
+    match inst.operands.get(i)? {
+        Operand::LiteralBit32(x) | Operand::LiteralExtInstInteger(x) => Some(*x),
+        _ => None,
+    }
+}
+
+fn str_at(inst: &dr::Instruction, i: usize) -> Option<&str> {
+    match inst.operands.get(i)? {
+        Operand::LiteralString(s) => Some(s),
+        _ => None,
+    }
+}
+
+impl Builder<'_> {
+    fn word(&self, inst: usize) -> u32 {
+        self.p.offsets.get(inst).copied().unwrap_or(0)
+    }
+
+    fn at(&self, inst: usize, msg: impl std::fmt::Display) -> InputError {
+        err(
+            self.path,
+            format!(
+                "{msg} (instruction Op{:?} at word {})",
+                self.p.insts[inst].class.opcode,
+                self.word(inst)
+            ),
+        )
+    }
+
+    /// Every id used must be defined somewhere in the module and below the bound.
+    fn check_ids(&mut self, bound: u32) -> Result<(), InputError> {
+        for (i, inst) in self.p.insts.iter().enumerate() {
+            if let Some(r) = inst.result_id {
+                if r == 0 || r >= bound {
+                    return Err(
+                        self.at(i, format!("result id %{r} is outside the id bound {bound}"))
+                    );
+                }
+                if self.p.defs.insert(r, i).is_some() {
+                    return Err(self.at(i, format!("id %{r} is defined twice")));
+                }
+            }
+        }
+        for (i, inst) in self.p.insts.iter().enumerate() {
+            let used = inst
+                .result_type
+                .into_iter()
+                .chain(inst.operands.iter().filter_map(|o| match o {
+                    Operand::IdRef(x) | Operand::IdScope(x) | Operand::IdMemorySemantics(x) => {
+                        Some(*x)
+                    }
+                    _ => None,
+                }));
+            for id in used {
+                if !self.p.defs.contains_key(&id) {
+                    return Err(self.at(i, format!("id %{id} is used but never defined")));
+                }
+            }
+        }
+        Ok(())
+    }
+
+    fn add_file(&mut self, named: &str) -> u32 {
+        let path = resolve_path(named, self.path);
+        if let Some(i) = self.p.files.iter().position(|f| f.path == path) {
+            return i as u32;
+        }
+        self.p.files.push(SourceFile { path, text: None });
+        (self.p.files.len() - 1) as u32
+    }
+
+    fn file_for_string(&mut self, id: Id) -> Option<u32> {
+        if let Some(f) = self.file_of_string.get(&id) {
+            return Some(*f);
+        }
+        let name = self.strings.get(&id)?.clone();
+        let f = self.add_file(&name);
+        self.file_of_string.insert(id, f);
+        Some(f)
+    }
+
+    fn const_u32(&self, id: Option<Id>) -> u32 {
+        id.and_then(|id| self.p.const_u64(id)).unwrap_or(0) as u32
+    }
+
+    /// Position from a debug instruction's (source, line, column) operands.
+    fn dbg_pos(
+        &self,
+        inst: &dr::Instruction,
+        source: usize,
+        line: usize,
+        col: usize,
+    ) -> Option<SrcPos> {
+        let file = *self.dbg_sources.get(&id_at(inst, source)?)?;
+        let line = self.const_u32(id_at(inst, line));
+        let column = self.const_u32(id_at(inst, col));
+        Some(SrcPos {
+            file,
+            line,
+            column,
+            end_line: line,
+            end_column: column,
+        })
+    }
+
+    /// Module-level pass: names, decorations, types, constants, globals, entry
+    /// points, debug info, and the source position of every instruction.
+    fn collect(&mut self) -> Result<(), InputError> {
+        let n = self.p.insts.len();
+        self.p.locs = vec![None; n];
+        let mut cur: Option<SrcPos> = None;
+        let mut last_source_file: Option<u32> = None;
+        for i in 0..n {
+            let inst = self.p.insts[i].clone();
+            let op = inst.class.opcode;
+            match op {
+                Op::String => {
+                    if let (Some(r), Some(s)) = (inst.result_id, str_at(&inst, 0)) {
+                        self.strings.insert(r, s.to_string());
+                    }
+                }
+                Op::Source => {
+                    if let Some(Operand::SourceLanguage(l)) = inst.operands.first() {
+                        if self.p.language == Language::Spirv {
+                            self.p.language = match l {
+                                spirv::SourceLanguage::GLSL | spirv::SourceLanguage::ESSL => {
+                                    Language::Glsl
+                                }
+                                spirv::SourceLanguage::HLSL => Language::Hlsl,
+                                spirv::SourceLanguage::WGSL => Language::Wgsl,
+                                _ => Language::Spirv,
+                            };
+                        }
+                    }
+                    if let Some(file_id) = id_at(&inst, 2) {
+                        let f = self.file_for_string(file_id);
+                        if let (Some(f), Some(text)) = (f, str_at(&inst, 3)) {
+                            self.p.files[f as usize].text = Some(text.to_string());
+                        }
+                        last_source_file = f;
+                    }
+                }
+                Op::SourceContinued => {
+                    if let (Some(f), Some(s)) = (last_source_file, str_at(&inst, 0)) {
+                        if let Some(t) = &mut self.p.files[f as usize].text {
+                            t.push_str(s);
+                        }
+                    }
+                }
+                Op::Name => {
+                    if let (Some(id), Some(s)) = (id_at(&inst, 0), str_at(&inst, 1)) {
+                        self.p.names.insert(id, s.to_string());
+                    }
+                }
+                Op::MemberName => {
+                    if let (Some(id), Some(m), Some(s)) =
+                        (id_at(&inst, 0), lit_at(&inst, 1), str_at(&inst, 2))
+                    {
+                        self.p.member_names.insert((id, m), s.to_string());
+                    }
+                }
+                Op::Decorate => {
+                    if let (Some(id), Some(Operand::Decoration(d))) =
+                        (id_at(&inst, 0), inst.operands.get(1))
+                    {
+                        let lits = inst.operands[2..].iter().filter_map(lit_of).collect();
+                        self.p.decorations.entry(id).or_default().push((*d, lits));
+                    }
+                }
+                Op::MemberDecorate => {
+                    if let (Some(id), Some(m), Some(Operand::Decoration(d))) =
+                        (id_at(&inst, 0), lit_at(&inst, 1), inst.operands.get(2))
+                    {
+                        let lits = inst.operands[3..].iter().filter_map(lit_of).collect();
+                        self.p
+                            .member_decorations
+                            .entry((id, m))
+                            .or_default()
+                            .push((*d, lits));
+                    }
+                }
+                Op::ExtInstImport => {
+                    if str_at(&inst, 0) == Some("NonSemantic.Shader.DebugInfo.100") {
+                        self.p.debug_info_set = inst.result_id;
+                    }
+                }
+                Op::EntryPoint => {
+                    let model = match inst.operands.first() {
+                        Some(Operand::ExecutionModel(m)) => *m,
+                        _ => return Err(self.at(i, "entry point without an execution model")),
+                    };
+                    let function = id_at(&inst, 1)
+                        .ok_or_else(|| self.at(i, "entry point without a function"))?;
+                    let name = str_at(&inst, 2).unwrap_or("").to_string();
+                    let interface = inst.operands[3..]
+                        .iter()
+                        .filter_map(|o| match o {
+                            Operand::IdRef(x) => Some(*x),
+                            _ => None,
+                        })
+                        .collect();
+                    self.p.entry_points.push(EntryPoint {
+                        function,
+                        name,
+                        stage: Stage::from_model(model),
+                        interface,
+                    });
+                }
+                Op::Line => {
+                    let file = id_at(&inst, 0).and_then(|f| self.file_for_string(f));
+                    if let (Some(file), Some(line), Some(column)) =
+                        (file, lit_at(&inst, 1), lit_at(&inst, 2))
+                    {
+                        cur = Some(SrcPos {
+                            file,
+                            line,
+                            column,
+                            end_line: line,
+                            end_column: column,
+                        });
+                    }
+                }
+                Op::NoLine | Op::Label | Op::FunctionEnd => cur = None,
+                Op::ExtInst
+                    if id_at(&inst, 0) == self.p.debug_info_set
+                        && self.p.debug_info_set.is_some() =>
+                {
+                    self.debug_ext_inst(i, &inst, &mut cur);
+                }
+                _ => {
+                    self.type_or_constant(i, &inst)?;
+                }
+            }
+            // OpLine applies to the instructions after it, up to the block's end.
+            if !matches!(op, Op::Line | Op::NoLine) {
+                self.p.locs[i] = cur;
+            }
+            if is_terminator(op) {
+                cur = None;
+            }
+        }
+        Ok(())
+    }
+
+    fn debug_ext_inst(&mut self, i: usize, inst: &dr::Instruction, cur: &mut Option<SrcPos>) {
+        let Some(which) = lit_at(inst, 1) else { return };
+        // Operands after (set, instruction) are ids; shift by 2.
+        let r = inst.result_id.unwrap_or(0);
+        match which {
+            dbg::SOURCE => {
+                if let Some(f) = id_at(inst, 2).and_then(|s| self.file_for_string(s)) {
+                    if let Some(text) = id_at(inst, 3).and_then(|t| self.strings.get(&t)).cloned() {
+                        self.p.files[f as usize].text = Some(text);
+                    }
+                    self.dbg_sources.insert(r, f);
+                }
+            }
+            dbg::SOURCE_CONTINUED => {
+                // Appends to the most recent DebugSource's text.
+                if let Some(text) = id_at(inst, 2).and_then(|t| self.strings.get(&t)).cloned() {
+                    if let Some(f) = self.dbg_sources.values().max().copied() {
+                        if let Some(t) = &mut self.p.files[f as usize].text {
+                            t.push_str(&text);
+                        }
+                    }
+                }
+            }
+            dbg::LINE => {
+                if let Some(file) = id_at(inst, 2)
+                    .and_then(|s| self.dbg_sources.get(&s))
+                    .copied()
+                {
+                    let line = self.const_u32(id_at(inst, 3));
+                    let end_line = self.const_u32(id_at(inst, 4));
+                    let column = self.const_u32(id_at(inst, 5));
+                    let end_column = self.const_u32(id_at(inst, 6));
+                    *cur = Some(SrcPos {
+                        file,
+                        line,
+                        column,
+                        end_line,
+                        end_column,
+                    });
+                }
+            }
+            dbg::NO_LINE => *cur = None,
+            dbg::TYPE_MEMBER => {
+                if let Some(pos) = self.dbg_pos(inst, 4, 5, 6) {
+                    self.dbg_members.insert(r, pos);
+                }
+            }
+            dbg::TYPE_COMPOSITE => {
+                let name = id_at(inst, 2).and_then(|s| self.strings.get(&s)).cloned();
+                if let (Some(name), Some(pos)) = (name, self.dbg_pos(inst, 4, 5, 6)) {
+                    let members = inst.operands.iter().skip(11).filter_map(|o| match o {
+                        Operand::IdRef(x) => Some(*x),
+                        _ => None,
+                    });
+                    self.dbg_composites.push((name, pos, members.collect()));
+                }
+            }
+            dbg::GLOBAL_VARIABLE => {
+                if let (Some(pos), Some(var)) = (self.dbg_pos(inst, 4, 5, 6), id_at(inst, 9)) {
+                    self.p.decl_pos.insert(Decl::Var(var), pos);
+                }
+            }
+            dbg::FUNCTION => {
+                if let Some(pos) = self.dbg_pos(inst, 4, 5, 6) {
+                    self.dbg_functions.insert(r, pos);
+                }
+            }
+            dbg::FUNCTION_DEFINITION => {
+                if let (Some(df), Some(f)) = (id_at(inst, 2), id_at(inst, 3)) {
+                    if let Some(pos) = self.dbg_functions.get(&df) {
+                        self.p.decl_pos.insert(Decl::Func(f), *pos);
+                    }
+                }
+            }
+            dbg::LOCAL_VARIABLE => {
+                if let Some(pos) = self.dbg_pos(inst, 4, 5, 6) {
+                    self.dbg_locals.insert(r, pos);
+                }
+            }
+            dbg::DECLARE => {
+                if let (Some(local), Some(var)) = (id_at(inst, 2), id_at(inst, 3)) {
+                    if let Some(pos) = self.dbg_locals.get(&local) {
+                        self.p.decl_pos.insert(Decl::Var(var), *pos);
+                    }
+                }
+            }
+            _ => {}
+        }
+        let _ = i;
+    }
+
+    /// Links `DebugTypeComposite`s to `OpTypeStruct`s by name.
+    fn link_debug_composites(&mut self) {
+        let composites = std::mem::take(&mut self.dbg_composites);
+        for (name, pos, members) in composites {
+            let structs: Vec<Id> = self
+                .p
+                .types
+                .iter()
+                .filter(|(id, t)| {
+                    matches!(t, Type::Struct { .. }) && self.p.names.get(id) == Some(&name)
+                })
+                .map(|(id, _)| *id)
+                .collect();
+            for s in structs {
+                self.p.decl_pos.insert(Decl::Type(s), pos);
+                for (k, m) in members.iter().enumerate() {
+                    if let Some(mp) = self.dbg_members.get(m) {
+                        self.p.decl_pos.insert(Decl::Member(s, k as u32), *mp);
+                    }
+                }
+            }
+        }
+    }
+
+    fn type_or_constant(&mut self, i: usize, inst: &dr::Instruction) -> Result<(), InputError> {
+        let op = inst.class.opcode;
+        let r = inst.result_id.unwrap_or(0);
+        let ty = match op {
+            Op::TypeVoid => Some(Type::Void),
+            Op::TypeBool => Some(Type::Bool),
+            Op::TypeInt => Some(Type::Int {
+                width: lit_at(inst, 0).unwrap_or(32),
+                signed: lit_at(inst, 1).unwrap_or(0) != 0,
+            }),
+            Op::TypeFloat => Some(Type::Float {
+                width: lit_at(inst, 0).unwrap_or(32),
+            }),
+            Op::TypeVector => Some(Type::Vector {
+                elem: self.type_operand(i, inst, 0)?,
+                count: lit_at(inst, 1).unwrap_or(0),
+            }),
+            Op::TypeMatrix => Some(Type::Matrix {
+                column: self.type_operand(i, inst, 0)?,
+                columns: lit_at(inst, 1).unwrap_or(0),
+            }),
+            Op::TypeArray => {
+                let elem = self.type_operand(i, inst, 0)?;
+                let len_id = id_at(inst, 1).ok_or_else(|| self.at(i, "array without a length"))?;
+                let len = match (
+                    self.p.constants.get(&len_id),
+                    self.p.spec_constants.get(&len_id),
+                ) {
+                    (Some(Constant::Int(v)), _) => ArrayLen::Const(*v),
+                    (_, Some(Constant::Int(v))) => ArrayLen::Spec(len_id, Some(*v)),
+                    _ => ArrayLen::Spec(len_id, None),
+                };
+                Some(Type::Array { elem, len })
+            }
+            Op::TypeRuntimeArray => Some(Type::RuntimeArray {
+                elem: self.type_operand(i, inst, 0)?,
+            }),
+            Op::TypeStruct => {
+                let mut members = Vec::new();
+                for k in 0..inst.operands.len() {
+                    members.push(self.type_operand(i, inst, k)?);
+                }
+                Some(Type::Struct { members })
+            }
+            Op::TypePointer => {
+                let storage = match inst.operands.first() {
+                    Some(Operand::StorageClass(s)) => *s,
+                    _ => return Err(self.at(i, "pointer type without a storage class")),
+                };
+                // The pointee may be forward-declared (OpTypeForwardPointer).
+                let pointee =
+                    id_at(inst, 1).ok_or_else(|| self.at(i, "pointer type without a pointee"))?;
+                Some(Type::Pointer { storage, pointee })
+            }
+            Op::TypeFunction => {
+                let ret = self.type_operand(i, inst, 0)?;
+                let mut params = Vec::new();
+                for k in 1..inst.operands.len() {
+                    params.push(self.type_operand(i, inst, k)?);
+                }
+                Some(Type::Function { ret, params })
+            }
+            Op::TypeAccelerationStructureKHR => Some(Type::AccelerationStructure),
+            Op::TypeRayQueryKHR => Some(Type::RayQuery),
+            Op::TypeImage => Some(Type::Image),
+            Op::TypeSampler => Some(Type::Sampler),
+            Op::TypeSampledImage => Some(Type::SampledImage),
+            Op::TypeOpaque
+            | Op::TypeEvent
+            | Op::TypeDeviceEvent
+            | Op::TypeReserveId
+            | Op::TypeQueue
+            | Op::TypePipe => Some(Type::Other("opaque")),
+            _ => None,
+        };
+        if let Some(t) = ty {
+            self.p.types.insert(r, t);
+            return Ok(());
+        }
+        let constant = |b: &Self| -> Option<Constant> {
+            Some(match op {
+                Op::Constant | Op::SpecConstant => {
+                    let ty = b.p.types.get(&inst.result_type?)?;
+                    match (ty, inst.operands.first()?) {
+                        (Type::Float { width: 32 }, Operand::LiteralBit32(v)) => {
+                            Constant::Float(f32::from_bits(*v) as f64)
+                        }
+                        (Type::Float { width: 64 }, Operand::LiteralBit64(v)) => {
+                            Constant::Float(f64::from_bits(*v))
+                        }
+                        (Type::Float { .. }, _) => Constant::Float(f64::NAN),
+                        (_, Operand::LiteralBit32(v)) => Constant::Int(*v as u64),
+                        (_, Operand::LiteralBit64(v)) => Constant::Int(*v),
+                        _ => return None,
+                    }
+                }
+                Op::ConstantTrue | Op::SpecConstantTrue => Constant::Bool(true),
+                Op::ConstantFalse | Op::SpecConstantFalse => Constant::Bool(false),
+                Op::ConstantNull => Constant::Null,
+                Op::ConstantComposite | Op::SpecConstantComposite => Constant::Composite(
+                    inst.operands
+                        .iter()
+                        .filter_map(|o| match o {
+                            Operand::IdRef(x) => Some(*x),
+                            _ => None,
+                        })
+                        .collect(),
+                ),
+                _ => return None,
+            })
+        };
+        if let Some(c) = constant(self) {
+            let spec = matches!(
+                op,
+                Op::SpecConstant
+                    | Op::SpecConstantTrue
+                    | Op::SpecConstantFalse
+                    | Op::SpecConstantComposite
+            );
+            if spec {
+                self.p.spec_constants.insert(r, c);
+            } else {
+                self.p.constants.insert(r, c);
+            }
+            return Ok(());
+        }
+        if op == Op::Variable && !self.in_function(i) {
+            let storage = match inst.operands.first() {
+                Some(Operand::StorageClass(s)) => *s,
+                _ => return Err(self.at(i, "variable without a storage class")),
+            };
+            let ptr = inst.result_type.unwrap_or(0);
+            let ty = match self.p.types.get(&ptr) {
+                Some(Type::Pointer { pointee, .. }) => *pointee,
+                _ => return Err(self.at(i, format!("variable %{r} does not have a pointer type"))),
+            };
+            let set = self
+                .p
+                .decoration(r, spirv::Decoration::DescriptorSet)
+                .and_then(|v| v.first().copied());
+            let binding = self
+                .p
+                .decoration(r, spirv::Decoration::Binding)
+                .and_then(|v| v.first().copied());
+            self.p.globals.push(Global {
+                id: r,
+                name: self.p.names.get(&r).cloned(),
+                storage,
+                ty,
+                set,
+                binding,
+                inst: i,
+            });
+        }
+        Ok(())
+    }
+
+    fn in_function(&self, i: usize) -> bool {
+        // Module-scope variables come before the first OpFunction.
+        self.p.insts[..i]
+            .iter()
+            .any(|x| x.class.opcode == Op::Function)
+    }
+
+    fn type_operand(&self, i: usize, inst: &dr::Instruction, k: usize) -> Result<Id, InputError> {
+        let id = id_at(inst, k).ok_or_else(|| self.at(i, format!("operand {k} is not an id")))?;
+        if !self.p.types.contains_key(&id) {
+            return Err(self.at(
+                i,
+                format!("operand %{id} is not a type declared before its use"),
+            ));
+        }
+        Ok(id)
+    }
+
+    /// Splits the instruction stream into functions and blocks with successors.
+    fn functions(&mut self) -> Result<(), InputError> {
+        let n = self.p.insts.len();
+        let mut i = 0;
+        while i < n {
+            if self.p.insts[i].class.opcode != Op::Function {
+                i += 1;
+                continue;
+            }
+            let id = self.p.insts[i].result_id.unwrap_or(0);
+            let start = i;
+            let mut params = Vec::new();
+            let mut blocks: Vec<Block> = Vec::new();
+            let mut block_start: Option<usize> = None;
+            i += 1;
+            loop {
+                if i >= n {
+                    return Err(self.at(start, "function has no OpFunctionEnd"));
+                }
+                let op = self.p.insts[i].class.opcode;
+                match op {
+                    Op::FunctionParameter => params.push(self.p.insts[i].result_id.unwrap_or(0)),
+                    Op::Label => {
+                        if block_start.is_some() {
+                            return Err(self.at(i, "block starts before the previous one ends"));
+                        }
+                        block_start = Some(i);
+                    }
+                    Op::FunctionEnd => break,
+                    Op::Function => {
+                        return Err(self.at(i, "function starts inside another function"))
+                    }
+                    _ if is_terminator(op) => {
+                        let s = block_start
+                            .take()
+                            .ok_or_else(|| self.at(i, "terminator outside a block"))?;
+                        blocks.push(Block {
+                            label: self.p.insts[s].result_id.unwrap_or(0),
+                            start: s,
+                            end: i,
+                            succs: Vec::new(),
+                        });
+                    }
+                    _ => {}
+                }
+                i += 1;
+            }
+            if block_start.is_some() {
+                return Err(self.at(i, "block has no terminator"));
+            }
+            // Successors by label.
+            for b in 0..blocks.len() {
+                let term = &self.p.insts[blocks[b].end];
+                let targets: Vec<Id> = match term.class.opcode {
+                    Op::Branch => id_at(term, 0).into_iter().collect(),
+                    Op::BranchConditional => [id_at(term, 1), id_at(term, 2)]
+                        .into_iter()
+                        .flatten()
+                        .collect(),
+                    Op::Switch => term
+                        .operands
+                        .iter()
+                        .enumerate()
+                        .filter_map(|(k, o)| match o {
+                            Operand::IdRef(x) if k != 0 => Some(*x),
+                            _ => None,
+                        })
+                        .collect(),
+                    _ => Vec::new(),
+                };
+                let mut succs = Vec::new();
+                for t in targets {
+                    match blocks.iter().position(|x| x.label == t) {
+                        Some(s) => {
+                            if !succs.contains(&s) {
+                                succs.push(s)
+                            }
+                        }
+                        None => {
+                            return Err(self.at(
+                                blocks[b].end,
+                                format!("branch target %{t} is not a block of this function"),
+                            ));
+                        }
+                    }
+                }
+                blocks[b].succs = succs;
+            }
+            self.p.functions.push(Function {
+                id,
+                name: self.p.names.get(&id).cloned(),
+                params,
+                start,
+                end: i,
+                blocks,
+            });
+            i += 1;
+        }
+        for e in &self.p.entry_points {
+            if self.p.function(e.function).is_none() {
+                return Err(err(
+                    self.path,
+                    format!(
+                        "entry point `{}` names %{}, which is not a function",
+                        e.name, e.function
+                    ),
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    fn sites(&mut self) {
+        let mut sites = Vec::new();
+        for (fi, f) in self.p.functions.iter().enumerate() {
+            for k in f.start..=f.end {
+                let inst = &self.p.insts[k];
+                let op = inst.class.opcode;
+                let kind = match op {
+                    Op::TraceRayKHR => SiteKind::TraceRay,
+                    Op::ExecuteCallableKHR => SiteKind::ExecuteCallable,
+                    Op::ReportIntersectionKHR => SiteKind::ReportIntersection,
+                    Op::IgnoreIntersectionKHR => SiteKind::IgnoreIntersection,
+                    Op::TerminateRayKHR => SiteKind::TerminateRay,
+                    _ if format!("{op:?}").starts_with("RayQuery") => SiteKind::RayQuery,
+                    _ => continue,
+                };
+                let o = |n| {
+                    id_at(inst, n)
+                        .map(|id| self.p.operandish(id))
+                        .unwrap_or(Operandish::Dynamic(0))
+                };
+                let (trace, payload, sbt_index) = match kind {
+                    SiteKind::TraceRay => (
+                        Some(TraceOperands {
+                            ray_flags: o(1),
+                            cull_mask: o(2),
+                            sbt_offset: o(3),
+                            sbt_stride: o(4),
+                            miss_index: o(5),
+                        }),
+                        id_at(inst, 10),
+                        None,
+                    ),
+                    SiteKind::ExecuteCallable => (None, id_at(inst, 1), Some(o(0))),
+                    SiteKind::RayQuery => (None, id_at(inst, 0), None),
+                    _ => (None, None, None),
+                };
+                sites.push(RtSite {
+                    kind,
+                    op,
+                    function: fi,
+                    inst: k,
+                    trace,
+                    payload,
+                    sbt_index,
+                });
+            }
+        }
+        self.p.sites = sites;
+    }
+}
+
+fn lit_of(o: &Operand) -> Option<u32> {
+    match o {
+        Operand::LiteralBit32(x) => Some(*x),
+        Operand::IdRef(x) => Some(*x),
+        Operand::BuiltIn(b) => Some(*b as u32),
+        _ => None,
+    }
+}
+
+pub fn is_terminator(op: Op) -> bool {
+    matches!(
+        op,
+        Op::Branch
+            | Op::BranchConditional
+            | Op::Switch
+            | Op::Return
+            | Op::ReturnValue
+            | Op::Kill
+            | Op::Unreachable
+            | Op::TerminateInvocation
+            | Op::IgnoreIntersectionKHR
+            | Op::TerminateRayKHR
+    )
+}

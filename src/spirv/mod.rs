@@ -1,0 +1,537 @@
+//! The Program: one SPIR-V module parsed once into what every analysis reads.
+//!
+//! Instructions stay in one flat vector in module order (with their word offset
+//! and source position); everything else refers to them by index or by SPIR-V
+//! id, which already is a dense handle. Structure that the analyses need —
+//! types, globals, entry points, functions with their CFG, ray-tracing sites,
+//! and the source position of declarations — is derived once in [`build`].
+
+mod build;
+pub mod debug;
+pub mod types;
+
+pub use build::parse;
+pub use types::{ArrayLen, Type};
+
+use crate::diag::Location;
+use crate::front::Language;
+use rspirv::dr::{Instruction, Operand};
+use spirv::{Op, StorageClass};
+use std::collections::HashMap;
+use std::path::PathBuf;
+
+pub type Id = u32;
+
+/// A position in one of the module's debug-info source files.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct SrcPos {
+    /// Index into [`Program::files`].
+    pub file: u32,
+    pub line: u32,
+    /// 0 when the debug info has no column.
+    pub column: u32,
+    pub end_line: u32,
+    pub end_column: u32,
+}
+
+/// A source file named by the module's debug info.
+#[derive(Clone, Debug)]
+pub struct SourceFile {
+    /// As resolved on this machine (see [`debug::resolve_path`]).
+    pub path: PathBuf,
+    /// The text embedded in the module (`OpSource`, `DebugSource`), if any.
+    pub text: Option<String>,
+}
+
+/// Declarations whose source position debug info can give.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Decl {
+    Type(Id),
+    Member(Id, u32),
+    Var(Id),
+    Func(Id),
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Stage {
+    RayGeneration,
+    Intersection,
+    AnyHit,
+    ClosestHit,
+    Miss,
+    Callable,
+    Compute,
+    Vertex,
+    Fragment,
+    Other,
+}
+
+impl Stage {
+    pub fn from_model(model: spirv::ExecutionModel) -> Stage {
+        use spirv::ExecutionModel as M;
+        match model {
+            M::RayGenerationKHR => Stage::RayGeneration,
+            M::IntersectionKHR => Stage::Intersection,
+            M::AnyHitKHR => Stage::AnyHit,
+            M::ClosestHitKHR => Stage::ClosestHit,
+            M::MissKHR => Stage::Miss,
+            M::CallableKHR => Stage::Callable,
+            M::GLCompute => Stage::Compute,
+            M::Vertex => Stage::Vertex,
+            M::Fragment => Stage::Fragment,
+            _ => Stage::Other,
+        }
+    }
+
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Stage::RayGeneration => "raygeneration",
+            Stage::Intersection => "intersection",
+            Stage::AnyHit => "anyhit",
+            Stage::ClosestHit => "closesthit",
+            Stage::Miss => "miss",
+            Stage::Callable => "callable",
+            Stage::Compute => "compute",
+            Stage::Vertex => "vertex",
+            Stage::Fragment => "fragment",
+            Stage::Other => "other",
+        }
+    }
+
+    pub fn is_ray_tracing(self) -> bool {
+        matches!(
+            self,
+            Stage::RayGeneration
+                | Stage::Intersection
+                | Stage::AnyHit
+                | Stage::ClosestHit
+                | Stage::Miss
+                | Stage::Callable
+        )
+    }
+}
+
+#[derive(Clone, Debug)]
+pub struct EntryPoint {
+    pub function: Id,
+    pub name: String,
+    pub stage: Stage,
+    pub interface: Vec<Id>,
+}
+
+#[derive(Clone, Debug)]
+pub struct Global {
+    pub id: Id,
+    pub name: Option<String>,
+    pub storage: StorageClass,
+    /// The pointee type (the variable's value type).
+    pub ty: Id,
+    pub set: Option<u32>,
+    pub binding: Option<u32>,
+    /// Index of the `OpVariable` in [`Program::insts`].
+    pub inst: usize,
+}
+
+#[derive(Clone, Debug)]
+pub struct Block {
+    pub label: Id,
+    /// Instruction indices from the `OpLabel` to the terminator, inclusive.
+    pub start: usize,
+    pub end: usize,
+    /// Successor block indices within the function.
+    pub succs: Vec<usize>,
+}
+
+#[derive(Clone, Debug)]
+pub struct Function {
+    pub id: Id,
+    pub name: Option<String>,
+    pub params: Vec<Id>,
+    /// Index of `OpFunction` and of `OpFunctionEnd`.
+    pub start: usize,
+    pub end: usize,
+    pub blocks: Vec<Block>,
+}
+
+impl Function {
+    /// Index of the block holding instruction `inst`.
+    pub fn block_of(&self, inst: usize) -> Option<usize> {
+        self.blocks
+            .iter()
+            .position(|b| b.start <= inst && inst <= b.end)
+    }
+
+    pub fn block_by_label(&self, label: Id) -> Option<usize> {
+        self.blocks.iter().position(|b| b.label == label)
+    }
+}
+
+/// A value that is a constant when the module makes it one.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Operandish {
+    Const(u64),
+    /// A specialization constant with its default value.
+    Spec {
+        id: Id,
+        default: u64,
+    },
+    Dynamic(Id),
+}
+
+impl Operandish {
+    pub fn constant(&self) -> Option<u64> {
+        match self {
+            Operandish::Const(v) => Some(*v),
+            _ => None,
+        }
+    }
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SiteKind {
+    TraceRay,
+    ExecuteCallable,
+    ReportIntersection,
+    IgnoreIntersection,
+    TerminateRay,
+    RayQuery,
+}
+
+/// One ray-tracing instruction with its operands resolved where constant.
+#[derive(Clone, Debug)]
+pub struct RtSite {
+    pub kind: SiteKind,
+    pub op: Op,
+    /// Index into [`Program::functions`].
+    pub function: usize,
+    pub inst: usize,
+    /// `OpTraceRayKHR`: ray flags, cull mask, SBT offset, SBT stride, miss index.
+    pub trace: Option<TraceOperands>,
+    /// The payload / callable-data variable, or the ray-query object.
+    pub payload: Option<Id>,
+    /// `OpExecuteCallableKHR`: the SBT index.
+    pub sbt_index: Option<Operandish>,
+}
+
+#[derive(Clone, Copy, Debug, serde::Serialize)]
+pub struct TraceOperands {
+    pub ray_flags: Operandish,
+    pub cull_mask: Operandish,
+    pub sbt_offset: Operandish,
+    pub sbt_stride: Operandish,
+    pub miss_index: Operandish,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub enum Constant {
+    /// Integer bits, zero-extended; see the type for signedness.
+    Int(u64),
+    Float(f64),
+    Bool(bool),
+    Null,
+    Composite(Vec<Id>),
+}
+
+#[derive(Debug)]
+pub struct Program {
+    /// The file the module came from.
+    pub path: PathBuf,
+    /// The language of the original source, from `OpSource` or the front-end.
+    pub language: Language,
+    pub version: (u8, u8),
+    pub insts: Vec<Instruction>,
+    /// Word offset of each instruction in the binary.
+    pub offsets: Vec<u32>,
+    /// Source position in effect at each instruction.
+    pub locs: Vec<Option<SrcPos>>,
+    pub files: Vec<SourceFile>,
+    pub types: HashMap<Id, Type>,
+    pub names: HashMap<Id, String>,
+    pub member_names: HashMap<(Id, u32), String>,
+    /// `OpDecorate` on ids: decoration and its literal operands.
+    pub decorations: HashMap<Id, Vec<(spirv::Decoration, Vec<u32>)>>,
+    pub member_decorations: HashMap<(Id, u32), Vec<(spirv::Decoration, Vec<u32>)>>,
+    pub constants: HashMap<Id, Constant>,
+    /// Default values of specialization constants.
+    pub spec_constants: HashMap<Id, Constant>,
+    pub globals: Vec<Global>,
+    pub entry_points: Vec<EntryPoint>,
+    pub functions: Vec<Function>,
+    pub sites: Vec<RtSite>,
+    pub decl_pos: HashMap<Decl, SrcPos>,
+    /// Instruction index defining each result id.
+    pub defs: HashMap<Id, usize>,
+    /// The id of the `NonSemantic.Shader.DebugInfo.100` import, if any.
+    pub debug_info_set: Option<Id>,
+}
+
+impl Program {
+    pub fn name(&self, id: Id) -> Option<&str> {
+        self.names.get(&id).map(String::as_str)
+    }
+
+    /// The name of an id for messages: its `OpName`, else `%id`.
+    pub fn display_name(&self, id: Id) -> String {
+        match self.names.get(&id) {
+            Some(n) if !n.is_empty() => n.clone(),
+            _ => format!("%{id}"),
+        }
+    }
+
+    pub fn member_name(&self, ty: Id, index: u32) -> String {
+        match self.member_names.get(&(ty, index)) {
+            Some(n) if !n.is_empty() => n.clone(),
+            _ => format!("member{index}"),
+        }
+    }
+
+    pub fn ty(&self, id: Id) -> Option<&Type> {
+        self.types.get(&id)
+    }
+
+    pub fn def(&self, id: Id) -> Option<&Instruction> {
+        self.defs.get(&id).map(|&i| &self.insts[i])
+    }
+
+    pub fn decoration(&self, id: Id, d: spirv::Decoration) -> Option<&[u32]> {
+        self.decorations
+            .get(&id)?
+            .iter()
+            .find(|(k, _)| *k == d)
+            .map(|(_, v)| v.as_slice())
+    }
+
+    pub fn member_decoration(&self, ty: Id, index: u32, d: spirv::Decoration) -> Option<&[u32]> {
+        self.member_decorations
+            .get(&(ty, index))?
+            .iter()
+            .find(|(k, _)| *k == d)
+            .map(|(_, v)| v.as_slice())
+    }
+
+    /// An integer constant's value (not a specialization constant).
+    pub fn const_u64(&self, id: Id) -> Option<u64> {
+        match self.constants.get(&id)? {
+            Constant::Int(v) => Some(*v),
+            Constant::Bool(b) => Some(*b as u64),
+            Constant::Null => Some(0),
+            _ => None,
+        }
+    }
+
+    pub fn operandish(&self, id: Id) -> Operandish {
+        if let Some(v) = self.const_u64(id) {
+            return Operandish::Const(v);
+        }
+        if let Some(Constant::Int(v)) = self.spec_constants.get(&id) {
+            return Operandish::Spec { id, default: *v };
+        }
+        Operandish::Dynamic(id)
+    }
+
+    /// Converts a debug-info position to a diagnostic location.
+    pub fn location(&self, pos: SrcPos) -> Location {
+        let path = self
+            .files
+            .get(pos.file as usize)
+            .map(|f| f.path.clone())
+            .unwrap_or_else(|| self.path.clone());
+        Location {
+            path,
+            line: pos.line,
+            column: pos.column,
+            end_line: pos.end_line.max(pos.line),
+            end_column: pos.end_column,
+        }
+    }
+
+    pub fn decl_location(&self, decl: Decl) -> Option<Location> {
+        self.decl_pos.get(&decl).map(|p| self.location(*p))
+    }
+
+    pub fn inst_location(&self, inst: usize) -> Option<Location> {
+        self.locs
+            .get(inst)
+            .copied()
+            .flatten()
+            .map(|p| self.location(p))
+    }
+
+    /// Instruction indices of the `OpFunctionCall`s that call function `f`.
+    pub fn callers(&self, f: Id) -> Vec<usize> {
+        self.insts
+            .iter()
+            .enumerate()
+            .filter(|(_, inst)| {
+                inst.class.opcode == Op::FunctionCall
+                    && matches!(inst.operands.first(), Some(Operand::IdRef(x)) if *x == f)
+            })
+            .map(|(i, _)| i)
+            .collect()
+    }
+
+    /// The function (index into `functions`) containing instruction `inst`.
+    pub fn function_of(&self, inst: usize) -> Option<usize> {
+        self.functions
+            .iter()
+            .position(|f| f.start <= inst && inst <= f.end)
+    }
+
+    /// An instruction's position; for one without (code a compiler generated,
+    /// such as naga's wrapper around each `traceRay`), the position of the
+    /// first call that reaches its function.
+    pub fn site_location(&self, inst: usize) -> Option<Location> {
+        let mut inst = inst;
+        let mut seen = Vec::new();
+        loop {
+            if let Some(l) = self.inst_location(inst) {
+                return Some(l);
+            }
+            let f = self.functions.get(self.function_of(inst)?)?.id;
+            if seen.contains(&f) {
+                return None;
+            }
+            seen.push(f);
+            inst = *self.callers(f).first()?;
+        }
+    }
+
+    /// The location of a variable: its declaration, else the first instruction
+    /// with a position that uses it.
+    pub fn var_location(&self, var: Id) -> Option<Location> {
+        if let Some(l) = self.decl_location(Decl::Var(var)) {
+            return Some(l);
+        }
+        self.insts.iter().enumerate().find_map(|(i, inst)| {
+            let uses = inst
+                .operands
+                .iter()
+                .any(|o| matches!(o, Operand::IdRef(x) if *x == var));
+            if uses && inst.class.opcode != Op::Name && inst.class.opcode != Op::Decorate {
+                self.inst_location(i)
+            } else {
+                None
+            }
+        })
+    }
+
+    /// The entry points whose call graph reaches function `f`.
+    pub fn entry_points_reaching(&self, f: Id) -> Vec<&EntryPoint> {
+        self.entry_points
+            .iter()
+            .filter(|e| self.reachable_functions(e.function).contains(&f))
+            .collect()
+    }
+
+    /// Function ids reachable from `root` through `OpFunctionCall`, `root` first.
+    pub fn reachable_functions(&self, root: Id) -> Vec<Id> {
+        let mut seen = vec![root];
+        let mut i = 0;
+        while i < seen.len() {
+            if let Some(f) = self.function(seen[i]) {
+                for inst in &self.insts[f.start..=f.end] {
+                    if inst.class.opcode == Op::FunctionCall {
+                        if let Some(Operand::IdRef(callee)) = inst.operands.first() {
+                            if !seen.contains(callee) {
+                                seen.push(*callee);
+                            }
+                        }
+                    }
+                }
+            }
+            i += 1;
+        }
+        seen
+    }
+
+    pub fn function(&self, id: Id) -> Option<&Function> {
+        self.functions.iter().find(|f| f.id == id)
+    }
+
+    pub fn function_index(&self, id: Id) -> Option<usize> {
+        self.functions.iter().position(|f| f.id == id)
+    }
+
+    /// The global variables of one storage class.
+    pub fn globals_in(&self, storage: StorageClass) -> impl Iterator<Item = &Global> {
+        self.globals.iter().filter(move |g| g.storage == storage)
+    }
+
+    /// Adds declaration positions a front-end knows by name (WGSL: naga keeps
+    /// spans that its SPIR-V writer does not emit), matched through `OpName`.
+    pub fn attach_named_decls(&mut self, decls: &[(crate::front::wgsl::NamedDecl, Location)]) {
+        use crate::front::wgsl::NamedDecl as N;
+        for (decl, loc) in decls {
+            let file = match self.files.iter().position(|f| f.path == loc.path) {
+                Some(i) => i as u32,
+                None => {
+                    self.files.push(SourceFile {
+                        path: loc.path.clone(),
+                        text: None,
+                    });
+                    (self.files.len() - 1) as u32
+                }
+            };
+            let pos = SrcPos {
+                file,
+                line: loc.line,
+                column: loc.column,
+                end_line: loc.end_line,
+                end_column: loc.end_column,
+            };
+            let named = |name: &str| -> Vec<Id> {
+                let mut ids: Vec<Id> = self
+                    .names
+                    .iter()
+                    .filter(|(_, n)| *n == name)
+                    .map(|(id, _)| *id)
+                    .collect();
+                ids.sort_unstable();
+                ids
+            };
+            match decl {
+                N::Type(name) => {
+                    for id in named(name) {
+                        if matches!(self.types.get(&id), Some(Type::Struct { .. })) {
+                            self.decl_pos.insert(Decl::Type(id), pos);
+                        }
+                    }
+                }
+                N::Member(name, k) => {
+                    for id in named(name) {
+                        if matches!(self.types.get(&id), Some(Type::Struct { .. })) {
+                            self.decl_pos.insert(Decl::Member(id, *k), pos);
+                        }
+                    }
+                }
+                N::Global(name) => {
+                    for g in self
+                        .globals
+                        .iter()
+                        .filter(|g| g.name.as_deref() == Some(name.as_str()))
+                    {
+                        self.decl_pos.insert(Decl::Var(g.id), pos);
+                    }
+                }
+                N::Function(name) => {
+                    for f in self
+                        .functions
+                        .iter()
+                        .filter(|f| f.name.as_deref() == Some(name.as_str()))
+                    {
+                        self.decl_pos.insert(Decl::Func(f.id), pos);
+                    }
+                }
+            }
+        }
+    }
+
+    /// A short type name for messages (`vec3<f32>`-neutral: `float3`-like HLSL
+    /// spelling, since that is what most ray-tracing shaders are written in).
+    pub fn type_name(&self, id: Id) -> String {
+        debug::type_name(self, id, self.language)
+    }
+}
