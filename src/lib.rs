@@ -3,6 +3,7 @@
 //! Data flow: front-ends → SPIR-V → [`spirv::Program`] → analyses → rules →
 //! [`diag::Diagnostic`]s → reports. See `docs/architecture.md`.
 
+pub mod analysis;
 pub mod diag;
 pub mod front;
 pub mod spirv;

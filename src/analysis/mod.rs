@@ -1,0 +1,3 @@
+//! Analyses: pure functions over a [`Program`](crate::spirv::Program).
+
+pub mod layout;
