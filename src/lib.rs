@@ -4,6 +4,10 @@
 //! [`diag::Diagnostic`]s → reports. See `docs/architecture.md`.
 
 pub mod analysis;
+pub mod config;
 pub mod diag;
 pub mod front;
+pub mod lint;
+pub mod report;
+pub mod rules;
 pub mod spirv;

@@ -571,6 +571,132 @@ pub fn interface_layouts(program: &Program) -> Vec<TypeLayout> {
     out
 }
 
+/// The layouts of one file, as `rtlint layout` prints them.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct FileLayouts {
+    pub path: String,
+    pub language: crate::front::Language,
+    pub types: Vec<TypeLayout>,
+}
+
+impl FileLayouts {
+    pub fn new(program: &Program) -> Self {
+        FileLayouts {
+            path: program.path.display().to_string(),
+            language: program.language,
+            types: interface_layouts(program),
+        }
+    }
+
+    pub fn render_human(&self) -> String {
+        let mut s = format!("{} ({})\n", self.path, self.language.as_str());
+        if self.types.is_empty() {
+            s.push_str(
+                "  no payload, attribute, callable-data, shader-record or push-constant types\n\n",
+            );
+        }
+        for t in &self.types {
+            let roles: Vec<String> = t
+                .roles
+                .iter()
+                .map(|r| {
+                    serde_json::to_value(r)
+                        .ok()
+                        .and_then(|v| v.as_str().map(String::from))
+                        .unwrap_or_default()
+                })
+                .collect();
+            s.push_str(&format!(
+                "  {}  [{}]  variables: {}\n",
+                t.name,
+                roles.join(", "),
+                t.variables.join(", ")
+            ));
+            let mut sizes = format!(
+                "    scalar {} B · HLSL 16-byte packed {} B in {} row{} ({} B padding)",
+                t.scalar_size,
+                t.hlsl_packed_size,
+                t.hlsl_rows,
+                if t.hlsl_rows == 1 { "" } else { "s" },
+                t.hlsl_padding
+            );
+            if let Some(w) = t.wgsl_size {
+                sizes.push_str(&format!(" · WGSL {w} B"));
+            }
+            s.push_str(&sizes);
+            s.push('\n');
+            let wgsl = t.wgsl_size.is_some();
+            let name_w = t
+                .members
+                .iter()
+                .map(|m| m.name.len())
+                .max()
+                .unwrap_or(4)
+                .max(6);
+            let ty_w = t
+                .members
+                .iter()
+                .map(|m| m.ty.len())
+                .max()
+                .unwrap_or(4)
+                .max(4);
+            s.push_str(&format!(
+                "    {:<name_w$}  {:<ty_w$}  {:>4}  {:>6}  {:>6}  {:>3}{}  straddles\n",
+                "member",
+                "type",
+                "size",
+                "scalar",
+                "packed",
+                "row",
+                if wgsl { "    wgsl" } else { "" }
+            ));
+            for m in &t.members {
+                s.push_str(&format!(
+                    "    {:<name_w$}  {:<ty_w$}  {:>4}  {:>6}  {:>6}  {:>3}{}  {}\n",
+                    m.name,
+                    m.ty,
+                    m.size,
+                    m.scalar_offset,
+                    m.hlsl_packed_offset,
+                    m.row,
+                    m.wgsl_offset
+                        .map(|o| format!("  {o:>6}"))
+                        .unwrap_or_default(),
+                    if m.straddles { "yes" } else { "" }
+                ));
+            }
+            match (
+                &t.optimal_order,
+                t.optimal_hlsl_packed_size,
+                t.optimal_hlsl_rows,
+            ) {
+                (Some(order), Some(size), Some(rows)) if t.is_struct => {
+                    if size < t.hlsl_packed_size {
+                        s.push_str(&format!(
+                            "    optimal order: {} → {size} B in {rows} row{}\n",
+                            order.join(", "),
+                            if rows == 1 { "" } else { "s" }
+                        ));
+                        if let Some(d) = &t.optimal_declaration {
+                            for line in d.lines() {
+                                s.push_str(&format!("      {line}\n"));
+                            }
+                        }
+                    } else {
+                        s.push_str("    optimal order: as declared\n");
+                    }
+                }
+                (None, _, _) if t.is_struct => s.push_str(&format!(
+                    "    optimal order: not searched (more than {EXACT_ORDER_LIMIT} members)\n"
+                )),
+                _ => {}
+            }
+            s.push('\n');
+        }
+        s
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

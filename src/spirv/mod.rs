@@ -8,6 +8,7 @@
 
 mod build;
 pub mod debug;
+mod textdecl;
 pub mod types;
 
 pub use build::parse;

@@ -1,0 +1,150 @@
+//! Rules: one file per rule, one registry table. Rules read the Program and
+//! analysis facts and return typed [`Diagnostic`]s; the report layer makes text.
+
+mod rt001_payload_over_budget;
+mod rt002_payload_packing_waste;
+mod rt003_member_straddles_row;
+mod rt004_hit_attributes_over_limit;
+mod rt005_ray_query_null_constant;
+
+use crate::analysis::layout::{self, TypeLayout};
+use crate::config::Config;
+use crate::diag::{Diagnostic, Location, Severity};
+use crate::spirv::{Decl, Id, Program, SiteKind};
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Group {
+    /// Guaranteed failure: invalid modules, limits exceeded.
+    Correctness,
+    /// Costs the GPU time or memory.
+    Perf,
+}
+
+/// What a rule reads.
+#[derive(Clone, Copy)]
+pub enum Kind {
+    /// One module at a time.
+    Module(fn(&Context) -> Vec<Diagnostic>),
+    /// A whole described pipeline (recursion depth, stack size).
+    Pipeline,
+}
+
+pub struct Rule {
+    pub code: &'static str,
+    pub name: &'static str,
+    pub group: Group,
+    pub level: Severity,
+    /// One line, for `rtlint rules`.
+    pub summary: &'static str,
+    /// The rule's page under `rules/`: the single source of its documentation.
+    pub doc: &'static str,
+    pub kind: Kind,
+}
+
+/// Every rule, in code order.
+pub static RULES: &[&Rule] = &[
+    &rt001_payload_over_budget::RULE,
+    &rt002_payload_packing_waste::RULE,
+    &rt003_member_straddles_row::RULE,
+    &rt004_hit_attributes_over_limit::RULE,
+    &rt005_ray_query_null_constant::RULE,
+];
+
+/// A rule by code (`RT001`, any case) or name.
+pub fn find(key: &str) -> Option<&'static Rule> {
+    RULES
+        .iter()
+        .copied()
+        .find(|r| r.code.eq_ignore_ascii_case(key) || r.name == key)
+}
+
+/// What module rules read: the Program and the facts computed once for it.
+pub struct Context<'a> {
+    pub program: &'a Program,
+    pub config: &'a Config,
+    pub layouts: Vec<TypeLayout>,
+}
+
+impl<'a> Context<'a> {
+    pub fn new(program: &'a Program, config: &'a Config) -> Self {
+        Context {
+            program,
+            config,
+            layouts: layout::interface_layouts(program),
+        }
+    }
+
+    /// Where a type is declared, if debug info says.
+    pub fn type_location(&self, t: &TypeLayout) -> Option<Location> {
+        if t.is_struct {
+            self.program.decl_location(Decl::Type(t.id))
+        } else {
+            t.variable_ids
+                .iter()
+                .find_map(|v| self.program.var_location(*v))
+        }
+    }
+
+    pub fn member_location(&self, t: &TypeLayout, k: usize) -> Option<Location> {
+        if t.is_struct {
+            self.program.decl_location(Decl::Member(t.id, k as u32))
+        } else {
+            self.type_location(t)
+        }
+    }
+
+    /// Trace (or callable) sites that pass one of these variables.
+    pub fn sites_using(&self, vars: &[Id]) -> Vec<Location> {
+        self.program
+            .sites
+            .iter()
+            .filter(|s| matches!(s.kind, SiteKind::TraceRay | SiteKind::ExecuteCallable))
+            .filter(|s| s.payload.is_some_and(|p| vars.contains(&p)))
+            .filter_map(|s| self.program.site_location(s.inst))
+            .collect()
+    }
+
+    /// Names the object when there is no source position.
+    pub fn subject(&self, t: &TypeLayout) -> String {
+        let vars = t.variables.join("`, `");
+        if t.is_struct {
+            format!("type `{}` (variable `{vars}`)", t.name)
+        } else {
+            format!("variable `{vars}`")
+        }
+    }
+
+    pub fn diagnostic(&self, rule: &'static Rule, message: impl Into<String>) -> Diagnostic {
+        Diagnostic::new(rule.level, rule.name, &self.program.path, message).with_code(rule.code)
+    }
+}
+
+/// Runs every module rule on one Program and applies the configured levels.
+pub fn check_program(program: &Program, config: &Config) -> Vec<Diagnostic> {
+    let ctx = Context::new(program, config);
+    let mut out = Vec::new();
+    for rule in RULES {
+        let Kind::Module(check) = rule.kind else {
+            continue;
+        };
+        let level = match config.level(rule.code, rule.name) {
+            Some(l) => l.severity(),
+            None => Some(rule.level),
+        };
+        let Some(severity) = level else { continue };
+        for mut d in check(&ctx) {
+            d.severity = severity;
+            out.push(d);
+        }
+    }
+    out
+}
+
+/// Renders the struct in the help text's indentation.
+pub(crate) fn indent(text: &str) -> String {
+    text.lines()
+        .map(|l| format!("    {l}"))
+        .collect::<Vec<_>>()
+        .join("\n")
+}
