@@ -85,6 +85,10 @@ pub fn parse(words: &[u32], path: &Path, language: Language) -> Result<Program, 
                 ),
             ));
         }
+        let opcode = words[i] & 0xffff;
+        if Op::from_u32(opcode).is_none() {
+            return Err(err(path, format!("unknown opcode {opcode} at word {i}")));
+        }
         offsets.push(i as u32);
         i += count;
     }
