@@ -303,9 +303,7 @@ pub fn optimal_order(members: &[Shape]) -> Option<Vec<usize>> {
     let full = (1usize << n) - 1;
     // best[mask * 16 + phase]: smallest growth to place every member in `mask`.
     let mut best = vec![u64::MAX; (full + 1) * ROW as usize];
-    for phase in 0..ROW as usize {
-        best[phase] = 0;
-    }
+    best[..ROW as usize].fill(0);
     for mask in 1..=full {
         for phase in 0..ROW {
             let mut b = u64::MAX;
@@ -778,7 +776,7 @@ mod tests {
             vectors: 4,
         };
         assert_eq!(packed_size(&m43), 60);
-        assert_eq!(scalar_layout(&[m43.clone()]).1, 48);
+        assert_eq!(scalar_layout(std::slice::from_ref(&m43)).1, 48);
         // A float after it fills the last row.
         assert_eq!(packed_members(&[m43, F]).1, 64);
         // A matrix starts a new row.

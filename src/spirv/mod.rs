@@ -23,6 +23,9 @@ use std::path::PathBuf;
 
 pub type Id = u32;
 
+/// Decorations with their literal operands.
+pub type Decorations = Vec<(spirv::Decoration, Vec<u32>)>;
+
 /// A position in one of the module's debug-info source files.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct SrcPos {
@@ -253,8 +256,8 @@ pub struct Program {
     pub names: HashMap<Id, String>,
     pub member_names: HashMap<(Id, u32), String>,
     /// `OpDecorate` on ids: decoration and its literal operands.
-    pub decorations: HashMap<Id, Vec<(spirv::Decoration, Vec<u32>)>>,
-    pub member_decorations: HashMap<(Id, u32), Vec<(spirv::Decoration, Vec<u32>)>>,
+    pub decorations: HashMap<Id, Decorations>,
+    pub member_decorations: HashMap<(Id, u32), Decorations>,
     pub constants: HashMap<Id, Constant>,
     /// Default values of specialization constants.
     pub spec_constants: HashMap<Id, Constant>,

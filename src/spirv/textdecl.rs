@@ -26,9 +26,8 @@ fn strip_comments(text: &str) -> Vec<u8> {
                 }
                 i += 1;
             }
-            for k in i..(i + 2).min(b.len()) {
-                out[k] = b' ';
-            }
+            let close = (i + 2).min(b.len());
+            out[i..close].fill(b' ');
             i += 2;
         } else {
             i += 1;
