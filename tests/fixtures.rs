@@ -95,6 +95,9 @@ fn findings_match_markers_and_snapshots() {
                 (p.location.line, d.code.unwrap().to_string())
             })
             .collect();
+        for d in &checked.diagnostics {
+            style_problems(d, &mut failures);
+        }
         let expected = markers(&source);
         if actual != expected {
             failures.push(format!(
@@ -178,6 +181,29 @@ fn wgsl_fixtures_compile_to_valid_spirv_except_the_null_ray_query() {
             assert!(err.contains("null"), "{err}");
         } else {
             valid.unwrap_or_else(|e| panic!("{}: {e}", p.display()));
+        }
+    }
+}
+
+/// Messages are matter of fact (clippy's habit): lowercase first word, no
+/// final period; help is one imperative suggestion.
+fn style_problems(d: &rtlint::diag::Diagnostic, out: &mut Vec<String>) {
+    let m = &d.message;
+    let first = m.split_whitespace().next().unwrap_or("");
+    if first.chars().next().is_some_and(|c| c.is_uppercase()) && !first.starts_with('`') {
+        out.push(format!("message starts with a capital: {m}"));
+    }
+    if m.ends_with('.') {
+        out.push(format!("message ends with a period: {m}"));
+    }
+    if let Some(h) = &d.help {
+        let lower = h.to_lowercase();
+        if lower.starts_with("try")
+            || lower.starts_with("consider")
+            || lower.starts_with("you ")
+            || h.ends_with('.')
+        {
+            out.push(format!("help is not one imperative suggestion: {h}"));
         }
     }
 }

@@ -148,3 +148,71 @@ pub(crate) fn indent(text: &str) -> String {
         .collect::<Vec<_>>()
         .join("\n")
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_rule_is_documented() {
+        for r in RULES {
+            assert!(
+                r.doc.starts_with(&format!("# {} `{}`", r.code, r.name)),
+                "{}: page must start with its code and name",
+                r.code
+            );
+            for section in [
+                "## What it does",
+                "## Why is this bad?",
+                "## Example",
+                "## How to fix",
+            ] {
+                assert!(
+                    r.doc.contains(section),
+                    "{}: page lacks `{section}`",
+                    r.code
+                );
+            }
+            assert!(
+                r.doc
+                    .contains(&format!("Default level: {}.", r.level.as_str())),
+                "{}: page must state the default level",
+                r.code
+            );
+        }
+    }
+
+    /// Codes never change silently: this list is the contract.
+    #[test]
+    fn code_list() {
+        let list: Vec<String> = RULES
+            .iter()
+            .map(|r| format!("{} {}", r.code, r.name))
+            .collect();
+        assert_eq!(
+            list,
+            [
+                "RT001 payload-over-budget",
+                "RT002 payload-packing-waste",
+                "RT003 member-straddles-row",
+                "RT004 hit-attributes-over-limit",
+                "RT005 ray-query-null-constant",
+            ]
+        );
+    }
+
+    #[test]
+    fn codes_and_names_are_unique_and_well_formed() {
+        for (i, a) in RULES.iter().enumerate() {
+            assert!(a.code.len() == 5 && a.code.starts_with("RT"), "{}", a.code);
+            assert!(
+                a.name.chars().all(|c| c.is_ascii_lowercase() || c == '-'),
+                "{} is not kebab-case",
+                a.name
+            );
+            for b in &RULES[i + 1..] {
+                assert!(a.code != b.code && a.name != b.name);
+            }
+        }
+    }
+}
