@@ -3,6 +3,9 @@
 //! Data flow: front-ends → SPIR-V → [`spirv::Program`] → analyses → rules →
 //! [`diag::Diagnostic`]s → reports. See `docs/architecture.md`.
 
+pub mod analysis;
 pub mod diag;
 pub mod front;
+pub mod pipeline;
+pub mod rules;
 pub mod spirv;

@@ -1,0 +1,8 @@
+//! Analyses: pure functions over a [`Program`](crate::spirv::Program) (and a
+//! [`Pipeline`](crate::pipeline::Pipeline) where the scene matters).
+
+pub mod callgraph;
+pub mod liveness;
+pub mod recursion;
+pub mod scalar;
+pub mod stack;
