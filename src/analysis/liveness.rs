@@ -419,14 +419,8 @@ impl FnLiveness {
                     }
                 }
             }
-            Op::Variable => {
-                // An initializer writes the whole variable.
-                if inst.operands.len() > 1 {
-                    if let Some(r) = inst.result_id {
-                        live.remove(&r);
-                    }
-                }
-            }
+            // An initializer writes the whole variable; the result id was
+            // removed above.
             _ => {}
         }
         let derives = matches!(

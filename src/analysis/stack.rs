@@ -152,7 +152,7 @@ pub fn driver_model(stage: Stage, b: &Breakdown) -> u64 {
     match stage {
         // Measured: 0 B for small payloads, 160 B with a 256-byte payload.
         Stage::RayGeneration => {
-            b.outgoing_payload.saturating_sub(96).max(0) * u64::from(b.outgoing_payload > 128)
+            b.outgoing_payload.saturating_sub(96) * u64::from(b.outgoing_payload > 128)
         }
         Stage::ClosestHit => 32.max(passed_on(b.outgoing_payload)),
         Stage::Miss => passed_on(b.outgoing_payload),
