@@ -337,7 +337,7 @@ struct Cx<'a> {
 impl Cx<'_> {
     fn loc(&self, span: Range<usize>) -> Location {
         let start = span.start.min(self.text.len());
-        let before = &self.text[..start];
+        let before = self.text.get(..start).unwrap_or("");
         let line = before.matches('\n').count() as u32 + 1;
         let col = before
             .rfind('\n')
@@ -345,7 +345,10 @@ impl Cx<'_> {
             as u32
             + 1;
         // Keep a multi-line span (a table) to its first line.
-        let first = self.text[start..span.end.min(self.text.len())]
+        let first = self
+            .text
+            .get(start..span.end.min(self.text.len()))
+            .unwrap_or("")
             .lines()
             .next()
             .unwrap_or("");

@@ -199,7 +199,18 @@ pub fn recursion(pipeline: &Pipeline) -> RecursionReport {
                 continue;
             }
             let from = scc_of[e.from];
+            // A guarded trace that closes the cycle stops tracing at the
+            // cycle's last level; other traces (shadow rays) leave from it.
+            let closes_cycle = cycles.iter().any(|cy: &Cycle| {
+                cy.nodes.contains(&e.from)
+                    && cy
+                        .sites
+                        .iter()
+                        .any(|s| s.program == e.program && s.inst == e.inst)
+            });
             let top = match (entry[from], extra[from]) {
+                (Lv::At(_), Some(0)) if closes_cycle => Lv::Unreached,
+                (Lv::At(l), Some(x)) if closes_cycle => Lv::At(l + x),
                 (Lv::At(l), Some(x)) => Lv::At(l + x + 1),
                 (Lv::Unreached, _) => Lv::Unreached,
                 _ => Lv::Unbounded,
@@ -676,21 +687,26 @@ fn relations(program: &Program, cond: Id, want: bool, out: &mut Vec<Rel>, depth:
 /// Immediate dominators by block index (Cooper, Harvey, Kennedy).
 pub fn dominators(f: &Function) -> Vec<Option<usize>> {
     let n = f.blocks.len();
-    let mut order = Vec::new();
-    let mut seen = vec![false; n];
-    fn dfs(f: &Function, b: usize, seen: &mut [bool], order: &mut Vec<usize>) {
-        seen[b] = true;
-        for &s in &f.blocks[b].succs {
-            if !seen[s] {
-                dfs(f, s, seen, order);
-            }
-        }
-        order.push(b);
-    }
     if n == 0 {
         return Vec::new();
     }
-    dfs(f, 0, &mut seen, &mut order);
+    // Post-order by an explicit stack: shader CFGs can be large.
+    let mut order = Vec::new();
+    let mut seen = vec![false; n];
+    let mut stack = vec![(0usize, 0usize)];
+    seen[0] = true;
+    while let Some((b, k)) = stack.pop() {
+        match f.blocks[b].succs.get(k) {
+            Some(&s) => {
+                stack.push((b, k + 1));
+                if !seen[s] {
+                    seen[s] = true;
+                    stack.push((s, 0));
+                }
+            }
+            None => order.push(b),
+        }
+    }
     order.reverse();
     let mut rpo = vec![usize::MAX; n];
     for (i, &b) in order.iter().enumerate() {

@@ -738,4 +738,55 @@ mod tests {
         );
         assert!(r.assumptions.is_empty(), "{:?}", r.assumptions);
     }
+
+    #[test]
+    fn big_payload_pipeline_matches_nvidia() {
+        let r = report("fixtures/RT025/bad.pipeline.toml");
+        assert_eq!(r.required_depth, Some(31));
+        let sizes: Vec<(Stage, u64, u64)> = r
+            .shaders
+            .iter()
+            .map(|s| (s.stage, s.driver_model_bytes, s.model_bytes))
+            .collect();
+        assert_eq!(
+            sizes,
+            [
+                (Stage::RayGeneration, 160, 160),
+                (Stage::Miss, 0, 0),
+                (Stage::ClosestHit, 544, 544)
+            ]
+        );
+        assert_eq!(r.vulkan_default, Some(17_024));
+        assert_eq!(r.exact_call_chain, Some(17_024));
+        let good = report("fixtures/RT025/good.pipeline.toml");
+        assert_eq!(good.driver_comparable.vulkan_default, Some(4_512));
+    }
+
+    #[test]
+    fn no_description_and_no_panics() {
+        // Every shader module in the repository, as one conservative pipeline
+        // each, through every analysis.
+        let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+        let mut files = Vec::new();
+        let mut dirs = vec![root.join("fixtures"), root.join("shaders")];
+        while let Some(d) = dirs.pop() {
+            for e in std::fs::read_dir(&d).unwrap().flatten() {
+                let p = e.path();
+                if p.is_dir() {
+                    dirs.push(p);
+                } else if matches!(p.extension().and_then(|x| x.to_str()), Some("spv" | "wgsl")) {
+                    files.push(p);
+                }
+            }
+        }
+        assert!(files.len() >= 20, "{}", files.len());
+        for f in &files {
+            let lang = crate::front::Language::from_path(f).unwrap();
+            let program = crate::front::load(f, lang).unwrap();
+            let p = Pipeline::from_programs(vec![program]);
+            let r = stack_report(&p);
+            assert!(render_human(&r).contains("no pipeline description"));
+            let _ = super::super::liveness::live_report(&p.programs);
+        }
+    }
 }
