@@ -50,7 +50,12 @@ pub fn check(pipeline: &Pipeline, stack: &StackReport, limit_bytes: u64) -> Vec<
                     stack.depth_chain.clone()
                 }
             ));
-            format!("set the stack explicitly: vkCmdSetRayTracingPipelineStackSizeKHR(cmd, {v}) or SetPipelineStackSize({v})")
+            if v <= limit_bytes {
+                format!("set the stack explicitly: vkCmdSetRayTracingPipelineStackSizeKHR(cmd, {v}) or SetPipelineStackSize({v})")
+            } else {
+                // The scene itself needs more than is known to run.
+                "reduce the recursion depth or the payload until the call chain fits, then set the stack explicitly".into()
+            }
         }
         None => "declare the depth the pipeline needs and set the stack size explicitly".into(),
     };
@@ -78,12 +83,23 @@ mod tests {
             d[0].message,
             "default pipeline stack of 17024 bytes per thread is above the 5056 bytes known to run"
         );
-        assert!(d[0]
-            .help
-            .as_ref()
-            .unwrap()
-            .contains("vkCmdSetRayTracingPipelineStackSizeKHR(cmd, "));
+        // 30 reflections really need 17,024 bytes: setting it would not help.
+        assert_eq!(
+            d[0].help.as_deref(),
+            Some("reduce the recursion depth or the payload until the call chain fits, then set the stack explicitly")
+        );
         // Depth 8: 160 + 8 × 544 = 4512.
         assert!(run("fixtures/RT025/good.pipeline.toml").is_empty());
+        // Declared 31 but the guard allows 2 reflections: the exact chain
+        // (160 + 3 × 544 = 1,792) is safe to set.
+        let mut p =
+            load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/RT025/bad.pipeline.toml"))
+                .unwrap();
+        p.constants.get_mut("pushConst.maxDepth").unwrap().value = 2;
+        let d = check(&p, &stack_report(&p), DEFAULT_LIMIT_BYTES);
+        assert_eq!(
+            d[0].help.as_deref(),
+            Some("set the stack explicitly: vkCmdSetRayTracingPipelineStackSizeKHR(cmd, 1792) or SetPipelineStackSize(1792)")
+        );
     }
 }
