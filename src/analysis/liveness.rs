@@ -983,4 +983,22 @@ mod tests {
         assert_eq!(json["sites"][0]["values"][0]["name"], "b");
         assert!(render_human(&r).contains("28 bytes live"));
     }
+
+    #[test]
+    fn execute_callable_site() {
+        let p = program("fixtures/pipelines/callable/sky.rgen.spv");
+        let sites = live_sites(&p);
+        assert_eq!(sites.len(), 2);
+        let call = sites
+            .iter()
+            .find(|s| s.kind == LiveSiteKind::ExecuteCallable)
+            .unwrap();
+        assert_eq!(names(call), [("uv", 8, true), ("weight", 4, false)]);
+        assert_eq!(call.payload.as_ref().unwrap().name, "sky");
+        let trace = sites
+            .iter()
+            .find(|s| s.kind == LiveSiteKind::TraceRay)
+            .unwrap();
+        assert_eq!(names(trace), [("uv", 8, true)]);
+    }
 }

@@ -16,7 +16,7 @@
 //! are in `docs/stack.md`.
 
 use super::callgraph::{EdgeKind, Slot};
-use super::liveness::live_sites;
+use super::liveness::{live_sites, LiveSite};
 use super::recursion::{recursion, RecursionReport};
 use super::scalar::scalar_size;
 use crate::pipeline::Pipeline;
@@ -172,6 +172,11 @@ fn global_size(program: &Program, id: u32) -> u64 {
 
 /// Breakdown of one entry point of a program.
 pub fn breakdown(program: &Program, entry: &str) -> Breakdown {
+    breakdown_with(program, entry, &live_sites(program))
+}
+
+/// [`breakdown`] with the program's live sites already computed.
+pub fn breakdown_with(program: &Program, entry: &str, sites: &[LiveSite]) -> Breakdown {
     let mut b = Breakdown::default();
     let Some(e) = program.entry_points.iter().find(|e| e.name == entry) else {
         return b;
@@ -243,7 +248,7 @@ pub fn breakdown(program: &Program, entry: &str) -> Breakdown {
             }
         }
     }
-    for site in live_sites(program).iter().filter(|s| s.entry == entry) {
+    for site in sites.iter().filter(|s| s.entry == entry) {
         b.live_state_total = b.live_state_total.max(site.live_bytes);
         b.live_state = b
             .live_state
@@ -382,16 +387,15 @@ pub fn exact_call_chain(rec: &RecursionReport, sizes: &[u64]) -> Option<u64> {
 pub fn stack_report(pipeline: &Pipeline) -> StackReport {
     let rec = recursion(pipeline);
     let mut cache: HashMap<(usize, String), Breakdown> = HashMap::new();
+    let sites: Vec<Vec<LiveSite>> = pipeline.programs.iter().map(live_sites).collect();
     let mut shaders = Vec::new();
     for node in &rec.graph.nodes {
         let s = &node.shader;
         let b = cache
             .entry((s.program, s.entry.clone()))
-            .or_insert_with(|| {
-                pipeline
-                    .program(s)
-                    .map(|p| breakdown(p, &s.entry))
-                    .unwrap_or_default()
+            .or_insert_with(|| match (pipeline.program(s), sites.get(s.program)) {
+                (Some(p), Some(sites)) => breakdown_with(p, &s.entry, sites),
+                _ => Breakdown::default(),
             })
             .clone();
         let driver_model_bytes = driver_model(s.stage, &b);
@@ -788,5 +792,31 @@ mod tests {
             assert!(render_human(&r).contains("no pipeline description"));
             let _ = super::super::liveness::live_report(&p.programs);
         }
+    }
+
+    #[test]
+    fn callables_stack_on_their_caller() {
+        let r = report("fixtures/pipelines/callable.pipeline.toml");
+        let sizes: Vec<(&str, u64)> = r
+            .shaders
+            .iter()
+            .map(|s| (s.group.as_str(), s.model_bytes))
+            .collect();
+        // raygen: `weight` (4 B) across the callable; flat.rcall: a local
+        // float[16] (64 B).
+        assert_eq!(
+            sizes,
+            [
+                ("raygen 0", 4),
+                ("miss 0", 0),
+                ("callable 0", 0),
+                ("callable 1", 64)
+            ]
+        );
+        // 4 + 1 × max(0, 0, 0) + 0 + 2 × 64.
+        assert_eq!(r.vulkan_default, Some(132));
+        // The raygen calls SBT index 1 only: 4 + 64.
+        assert_eq!(r.exact_call_chain, Some(68));
+        assert_eq!(r.recommended, Some(80));
     }
 }
