@@ -1258,4 +1258,22 @@ mod tests {
             "the loop runs while `bounce` is below uniform value `params.max_bounces`, which the pipeline description does not give"
         );
     }
+
+    #[test]
+    fn wgsl_guard_at_the_helper_call() {
+        // naga puts the trace in a helper: the guard dominates the call.
+        let r = recursion(&pipeline(
+            "fixtures/pipelines/reflect_recursive_wgsl.pipeline.toml",
+        ));
+        assert_eq!(r.required_depth, Some(5));
+        let g = r.cycles[0].sites[0].guard.as_ref().unwrap();
+        assert_eq!(
+            (g.counter.as_str(), g.bound, g.traces),
+            ("incoming.depth", 4, 4)
+        );
+        assert_eq!(
+            g.bound_source,
+            "uniform value `params.max_depth` = 4 from the description"
+        );
+    }
 }
