@@ -338,4 +338,36 @@ mod tests {
         assert_eq!(g.edges.len(), 3);
         assert_eq!(g.assumptions.len(), 1);
     }
+
+    #[test]
+    fn instances_any_hit_and_opaque_geometry() {
+        let mut p = pipeline("fixtures/pipelines/procedural.pipeline.toml");
+        // Instance offsets 0 and 1 with stride 1 reach both groups; the ray
+        // is not opaque, so the alpha test runs.
+        let stages = |g: &TraceGraph| {
+            let mut v: Vec<&str> = g
+                .edges
+                .iter()
+                .map(|e| g.nodes[e.to].shader.stage.as_str())
+                .collect();
+            v.sort();
+            v
+        };
+        let g = trace_graph(&p);
+        assert_eq!(
+            stages(&g),
+            ["anyhit", "closesthit", "closesthit", "intersection", "miss"]
+        );
+        p.all_geometry_opaque = true;
+        assert_eq!(
+            stages(&trace_graph(&p)),
+            ["closesthit", "closesthit", "intersection", "miss"]
+        );
+        p.instance_sbt_offsets = vec![0];
+        assert_eq!(stages(&trace_graph(&p)), ["closesthit", "miss"]);
+        p.instance_sbt_offsets = vec![5];
+        let g = trace_graph(&p);
+        assert_eq!(stages(&g), ["miss"]);
+        assert_eq!(g.out_of_range.len(), 1);
+    }
 }

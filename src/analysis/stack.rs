@@ -819,4 +819,26 @@ mod tests {
         assert_eq!(r.exact_call_chain, Some(68));
         assert_eq!(r.recommended, Some(80));
     }
+
+    #[test]
+    fn procedural_group_attributes() {
+        let r = report("fixtures/pipelines/procedural.pipeline.toml");
+        let attrs: Vec<(Stage, u64)> = r
+            .shaders
+            .iter()
+            .map(|s| (s.stage, s.breakdown.hit_attributes))
+            .collect();
+        assert_eq!(
+            attrs,
+            [
+                (Stage::RayGeneration, 0),
+                (Stage::Miss, 0),
+                (Stage::ClosestHit, 8),
+                (Stage::ClosestHit, 16),
+                (Stage::AnyHit, 16),
+                (Stage::Intersection, 16)
+            ]
+        );
+        assert_eq!(r.exact_call_chain, Some(32));
+    }
 }
