@@ -471,6 +471,25 @@ pub fn stack_report(pipeline: &Pipeline) -> StackReport {
     }
 }
 
+/// Adds a driver's own per-shader sizes (`vkGetRayTracingShaderGroupStackSizeKHR`,
+/// one per entry of `report.shaders`, in the same order) and the formulas
+/// computed from them. Sizes beyond `report.shaders` are ignored; missing
+/// ones leave the shader without a driver figure and count as 0.
+pub fn attach_driver(report: &mut StackReport, pipeline: &Pipeline, driver: &[Option<u64>]) {
+    for (s, d) in report.shaders.iter_mut().zip(driver) {
+        s.driver_bytes = *d;
+    }
+    let rec = recursion(pipeline);
+    let sizes: Vec<u64> = report
+        .shaders
+        .iter()
+        .map(|s| s.driver_bytes.unwrap_or(0))
+        .collect();
+    if sizes.len() == rec.graph.nodes.len() {
+        report.driver = Some(formulas(pipeline, &rec, &sizes));
+    }
+}
+
 fn formula_text(m: &StageMax, depth: u32) -> String {
     format!(
         "{} + min(1, {depth}) × max({}, {}, {} + {}) + max(0, {depth} − 1) × max({}, {}) + 2 × {} = {}",
@@ -840,5 +859,23 @@ mod tests {
             ]
         );
         assert_eq!(r.exact_call_chain, Some(32));
+    }
+
+    #[test]
+    fn driver_numbers_beside_the_model() {
+        let p = load(
+            &Path::new(env!("CARGO_MANIFEST_DIR"))
+                .join("fixtures/pipelines/reflect_iterative.pipeline.toml"),
+        )
+        .unwrap();
+        let mut r = stack_report(&p);
+        // lavapipe answers 4 for every group and stage.
+        attach_driver(&mut r, &p, &[Some(4); 4]);
+        let d = r.driver.as_ref().unwrap();
+        assert_eq!(d.vulkan_default, Some(4 + 4 + 4));
+        assert_eq!(d.exact_call_chain, Some(12));
+        assert!(render_human(&r).contains("driver's own numbers"));
+        let json = serde_json::to_value(&r).unwrap();
+        assert_eq!(json["shaders"][0]["driver_bytes"], 4);
     }
 }
