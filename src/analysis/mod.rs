@@ -6,3 +6,7 @@ pub mod liveness;
 pub mod recursion;
 pub mod scalar;
 pub mod stack;
+
+pub use liveness::{live_report, LiveReport};
+pub use recursion::{recursion, RecursionReport};
+pub use stack::{stack_report, StackReport};
