@@ -558,6 +558,16 @@ mod tests {
             "{HEAD}file = \"recursive/reflect.rgen.spv\"\n[constants]\nx = 1.5\n"
         ));
         assert_eq!(msg, "constant `x` must be an integer, found float");
+        let (msg, line, _) = bad(&format!(
+            "{HEAD}file = \"recursive/reflect.rgen.spv\"\n[[hit_group]]\nclosest_hit = {{ file = \"recursive/reflect.rchit.spv\", entyr = \"main\" }}\n"
+        ));
+        assert!(msg.contains("unknown field `entyr`"), "{msg}");
+        assert_eq!(line, 5);
+        let (msg, line, _) = bad(&format!(
+            "{HEAD}file = \"recursive/reflect.rgen.spv\"\n[[hit_group]]\ntype = \"aabbs\"\n"
+        ));
+        assert!(msg.starts_with("unknown hit group type `aabbs`"), "{msg}");
+        assert_eq!(line, 5);
     }
 
     #[test]
