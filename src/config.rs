@@ -33,6 +33,10 @@ pub struct Config {
     /// RT010: bytes of state live across one trace call.
     #[serde(default = "default_live_state_budget")]
     pub live_state_budget: u64,
+    /// RT025: the largest default pipeline stack (bytes per thread) a device
+    /// is known to run.
+    #[serde(default = "default_stack_limit")]
+    pub stack_limit: u64,
     /// Warnings fail the run too.
     #[serde(default)]
     pub deny_warnings: bool,
@@ -52,7 +56,11 @@ fn default_payload_budget() -> u64 {
 }
 
 fn default_live_state_budget() -> u64 {
-    64
+    crate::rules::rt010_live_state_over_budget::DEFAULT_BUDGET_BYTES
+}
+
+fn default_stack_limit() -> u64 {
+    crate::analysis::stack::NVIDIA_KNOWN_SAFE_STACK_BYTES
 }
 
 impl Default for Config {
@@ -60,6 +68,7 @@ impl Default for Config {
         Config {
             payload_budget: default_payload_budget(),
             live_state_budget: default_live_state_budget(),
+            stack_limit: default_stack_limit(),
             deny_warnings: false,
             rules: BTreeMap::new(),
             languages: BTreeMap::new(),

@@ -8,6 +8,7 @@ pub mod config;
 pub mod diag;
 pub mod front;
 pub mod lint;
+pub mod pipeline;
 pub mod report;
 pub mod rules;
 pub mod spirv;

@@ -6,6 +6,13 @@ mod rt002_payload_packing_waste;
 mod rt003_member_straddles_row;
 mod rt004_hit_attributes_over_limit;
 mod rt005_ray_query_null_constant;
+pub mod rt010_live_state_over_budget;
+pub mod rt020_recursive_trace;
+pub mod rt021_depth_exceeds_declared;
+pub mod rt022_depth_overdeclared;
+pub mod rt023_depth_exceeds_device_limit;
+pub mod rt024_unbounded_bounce_loop;
+pub mod rt025_default_stack_unsafe;
 
 use crate::analysis::layout::{self, TypeLayout};
 use crate::config::Config;
@@ -27,7 +34,7 @@ pub enum Kind {
     /// One module at a time.
     Module(fn(&Context) -> Vec<Diagnostic>),
     /// A whole described pipeline (recursion depth, stack size).
-    Pipeline,
+    Pipeline(fn(&PipelineContext) -> Vec<Diagnostic>),
 }
 
 pub struct Rule {
@@ -49,6 +56,13 @@ pub static RULES: &[&Rule] = &[
     &rt003_member_straddles_row::RULE,
     &rt004_hit_attributes_over_limit::RULE,
     &rt005_ray_query_null_constant::RULE,
+    &rt010_live_state_over_budget::RULE,
+    &rt020_recursive_trace::RULE,
+    &rt021_depth_exceeds_declared::RULE,
+    &rt022_depth_overdeclared::RULE,
+    &rt023_depth_exceeds_device_limit::RULE,
+    &rt024_unbounded_bounce_loop::RULE,
+    &rt025_default_stack_unsafe::RULE,
 ];
 
 /// A rule by code (`RT001`, any case) or name.
@@ -120,20 +134,58 @@ impl<'a> Context<'a> {
     }
 }
 
+/// What pipeline rules read: the description and the analyses of it,
+/// computed once.
+pub struct PipelineContext<'a> {
+    pub pipeline: &'a crate::pipeline::Pipeline,
+    pub config: &'a Config,
+    pub recursion: crate::analysis::RecursionReport,
+    pub stack: crate::analysis::StackReport,
+}
+
+impl<'a> PipelineContext<'a> {
+    pub fn new(pipeline: &'a crate::pipeline::Pipeline, config: &'a Config) -> Self {
+        PipelineContext {
+            pipeline,
+            config,
+            recursion: crate::analysis::recursion(pipeline),
+            stack: crate::analysis::stack_report(pipeline),
+        }
+    }
+}
+
+/// The severity a rule reports at under `config`, or `None` when allowed.
+fn configured(rule: &Rule, config: &Config) -> Option<Severity> {
+    match config.level(rule.code, rule.name) {
+        Some(l) => l.severity(),
+        None => Some(rule.level),
+    }
+}
+
 /// Runs every module rule on one Program and applies the configured levels.
 pub fn check_program(program: &Program, config: &Config) -> Vec<Diagnostic> {
     let ctx = Context::new(program, config);
     let mut out = Vec::new();
     for rule in RULES {
-        let Kind::Module(check) = rule.kind else {
+        let (Kind::Module(check), Some(severity)) = (rule.kind, configured(rule, config)) else {
             continue;
         };
-        let level = match config.level(rule.code, rule.name) {
-            Some(l) => l.severity(),
-            None => Some(rule.level),
-        };
-        let Some(severity) = level else { continue };
         for mut d in check(&ctx) {
+            d.severity = severity;
+            out.push(d);
+        }
+    }
+    out
+}
+
+/// Runs every pipeline rule on a described pipeline.
+pub fn check_pipeline(ctx: &PipelineContext) -> Vec<Diagnostic> {
+    let mut out = Vec::new();
+    for rule in RULES {
+        let (Kind::Pipeline(check), Some(severity)) = (rule.kind, configured(rule, ctx.config)) else {
+            continue;
+        };
+        for mut d in check(ctx) {
             d.severity = severity;
             out.push(d);
         }
@@ -197,6 +249,13 @@ mod tests {
                 "RT003 member-straddles-row",
                 "RT004 hit-attributes-over-limit",
                 "RT005 ray-query-null-constant",
+                "RT010 live-state-over-budget",
+                "RT020 recursive-trace",
+                "RT021 depth-exceeds-declared",
+                "RT022 depth-overdeclared",
+                "RT023 depth-exceeds-device-limit",
+                "RT024 unbounded-bounce-loop",
+                "RT025 default-stack-unsafe",
             ]
         );
     }
