@@ -6,3 +6,5 @@
 pub mod diag;
 pub mod front;
 pub mod spirv;
+#[cfg(feature = "vulkan")]
+pub mod vk;

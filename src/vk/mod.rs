@@ -1,0 +1,38 @@
+//! A small Vulkan harness (ash) for running ray-tracing shaders on a real
+//! driver: device selection, buffers with device addresses, acceleration
+//! structures, ray-tracing and compute pipelines, the shader binding table,
+//! dispatch with a bounded wait, readback, and the driver's per-group stack
+//! sizes.
+//!
+//! Every object holds a reference to the device it was made on, so drop order
+//! does not matter; every submission waits on a fence with a finite timeout,
+//! so a resource is never freed while the GPU uses it.
+//!
+//! ```no_run
+//! use rtlint::vk::*;
+//! let ctx = Context::new()?;
+//! println!("{}: max recursion {}", ctx.info().name, ctx.limits().max_ray_recursion_depth);
+//! # Ok::<(), rtlint::vk::Error>(())
+//! ```
+
+mod accel;
+mod buffer;
+mod child;
+mod context;
+mod descriptors;
+mod error;
+mod pipeline;
+
+pub use accel::{Aabb, AccelerationStructure, Geometry, Instance, IDENTITY};
+pub use buffer::{bytes_of, Buffer, Pod};
+pub use child::{run_in_child, ChildOutcome, CHILD_ENV};
+pub use context::{Context, ContextOptions, DeviceInfo, RayTracingLimits};
+pub use descriptors::{Binding, BindingKind, Resource};
+pub use error::{Error, Result};
+pub use pipeline::{
+    ComputePipeline, Group, GroupStackSizes, RayTracingPipeline, RayTracingPipelineDesc, SbtLayout,
+    SbtRegion, ShaderBindingTable, ShaderStage, Stage,
+};
+
+/// The raw Vulkan types (`ash::vk`), for flags and handles the harness passes through.
+pub use ash::vk as raw;
