@@ -5,6 +5,7 @@
 
 pub mod diag;
 pub mod front;
+pub mod reference;
 pub mod spirv;
 #[cfg(feature = "vulkan")]
 pub mod vk;
