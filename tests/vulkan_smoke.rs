@@ -89,7 +89,7 @@ const GROUPS: [Group; 3] = [
     },
 ];
 
-fn create_pipeline(ctx: &Context, spirv: &[u32]) -> RayTracingPipeline {
+fn create_pipeline(ctx: &Context, spirv: &[u32], stack_size: Option<u32>) -> RayTracingPipeline {
     RayTracingPipeline::new(
         ctx,
         &RayTracingPipelineDesc {
@@ -98,7 +98,7 @@ fn create_pipeline(ctx: &Context, spirv: &[u32]) -> RayTracingPipeline {
             // The bounce loop lives in raygen; hit and miss shaders never trace.
             max_recursion_depth: 1,
             bindings: &bindings(),
-            stack_size: None,
+            stack_size,
         },
     )
     .expect("pipeline creation")
@@ -109,7 +109,13 @@ struct Rendered {
     timings: Vec<(&'static str, Duration)>,
 }
 
-fn render_on_gpu(ctx: &Context, spirv: &[u32], scene: &Scene, params: Params) -> Rendered {
+fn render_on_gpu(
+    ctx: &Context,
+    spirv: &[u32],
+    scene: &Scene,
+    params: Params,
+    stack_size: Option<u32>,
+) -> Rendered {
     let mut timings = Vec::new();
     let mut last = Instant::now();
     let mut lap = |what: &'static str, timings: &mut Vec<_>| {
@@ -129,8 +135,9 @@ fn render_on_gpu(ctx: &Context, spirv: &[u32], scene: &Scene, params: Params) ->
         .expect("top-level build");
     lap("acceleration structures", &mut timings);
 
-    let pipeline = create_pipeline(ctx, spirv);
+    let pipeline = create_pipeline(ctx, spirv, stack_size);
     lap("pipeline", &mut timings);
+    check_sbt(ctx, &pipeline);
 
     let pixels = u64::from(params.width * params.height);
     let image = Buffer::new(ctx, pixels * 4, raw::BufferUsageFlags::STORAGE_BUFFER, 1).unwrap();
@@ -172,6 +179,65 @@ fn channel_diff(a: u32, b: u32) -> u8 {
     (0..4).map(|i| a[i].abs_diff(b[i])).max().unwrap()
 }
 
+/// How a GPU image compares with the CPU reference.
+#[derive(Debug)]
+struct Comparison {
+    max_diff: u8,
+    differing: usize,
+    near_edge: usize,
+}
+
+fn compare(scene: &Scene, gpu: &[u32], cpu: &[u32]) -> Comparison {
+    let w = PARAMS.width;
+    let mut c = Comparison {
+        max_diff: 0,
+        differing: 0,
+        near_edge: 0,
+    };
+    for y in 0..PARAMS.height {
+        for x in 0..w {
+            let i = (y * w + x) as usize;
+            let d = channel_diff(gpu[i], cpu[i]);
+            let path = reference::trace_pixel(scene, PARAMS, x, y);
+            let margin = path
+                .segments
+                .iter()
+                .map(|s| s.edge_margin)
+                .fold(f32::INFINITY, f32::min);
+            if margin < EDGE_EPSILON {
+                eprintln!(
+                    "  pixel ({x}, {y}) passes {margin:e} from an edge: gpu {:08x} cpu {:08x}",
+                    gpu[i], cpu[i]
+                );
+                c.near_edge += 1;
+                continue;
+            }
+            if d > MAX_CHANNEL_DIFF {
+                eprintln!("  pixel ({x}, {y}): gpu {:08x} cpu {:08x}", gpu[i], cpu[i]);
+            }
+            c.differing += usize::from(d > 0);
+            c.max_diff = c.max_diff.max(d);
+        }
+    }
+    c
+}
+
+fn assert_matches(c: &Comparison) {
+    assert!(
+        c.max_diff <= MAX_CHANNEL_DIFF,
+        "GPU and CPU images differ by {}/255 in some channel",
+        c.max_diff
+    );
+    // The scene is laid out so that no pixel centre's path comes near an open
+    // edge (0 at 64 × 64); a few may after edits, many would mean the
+    // criterion is hiding a real disagreement.
+    assert!(
+        c.near_edge <= 4,
+        "{} pixels pass within {EDGE_EPSILON} of an edge",
+        c.near_edge
+    );
+}
+
 #[test]
 fn reflection_pipeline_matches_cpu_reference() {
     let start = Instant::now();
@@ -179,8 +245,10 @@ fn reflection_pipeline_matches_cpu_reference() {
     let device_time = start.elapsed();
     let spirv = compile_shader();
     let scene = Scene::reflection();
-    let gpu = render_on_gpu(&ctx, &spirv, &scene, PARAMS);
+    let gpu = render_on_gpu(&ctx, &spirv, &scene, PARAMS, None);
+    let start = Instant::now();
     let cpu = reference::render(&scene, PARAMS);
+    let cpu_time = start.elapsed();
 
     eprintln!(
         "device: {} (Vulkan {:?})",
@@ -191,61 +259,63 @@ fn reflection_pipeline_matches_cpu_reference() {
     for (what, t) in &gpu.timings {
         eprintln!("  {what}: {t:.2?}");
     }
-
-    let w = PARAMS.width;
-    let (mut max_diff, mut differing, mut near_edge, mut near_edge_max) = (0u8, 0, 0, 0u8);
-    for y in 0..PARAMS.height {
-        for x in 0..w {
-            let i = (y * w + x) as usize;
-            let d = channel_diff(gpu.image[i], cpu[i]);
-            let path = reference::trace_pixel(&scene, PARAMS, x, y);
-            let margin = path
-                .segments
-                .iter()
-                .map(|s| s.edge_margin)
-                .fold(f32::INFINITY, f32::min);
-            if margin < EDGE_EPSILON {
-                eprintln!(
-                    "  pixel ({x}, {y}) passes {margin:e} from an edge: gpu {:08x} cpu {:08x}",
-                    gpu.image[i], cpu[i]
-                );
-                near_edge += 1;
-                near_edge_max = near_edge_max.max(d);
-                continue;
-            }
-            if d > 0 {
-                differing += 1;
-            }
-            if d > MAX_CHANNEL_DIFF {
-                eprintln!(
-                    "  pixel ({x}, {y}): gpu {:08x} cpu {:08x}, edge margin {margin:e}",
-                    gpu.image[i], cpu[i]
-                );
-            }
-            max_diff = max_diff.max(d);
-        }
-    }
+    eprintln!("  CPU reference: {cpu_time:.2?}");
+    let c = compare(&scene, &gpu.image, &cpu);
     eprintln!(
-        "  compared {} pixels: max channel difference {max_diff}, {differing} differ; \
-         {near_edge} near an edge (max difference there {near_edge_max})",
-        w * PARAMS.height - near_edge
+        "  {} pixels compared: max channel difference {}, {} differ; {} near an edge, not compared",
+        PARAMS.width * PARAMS.height - c.near_edge as u32,
+        c.max_diff,
+        c.differing,
+        c.near_edge
     );
-    assert!(
-        max_diff <= MAX_CHANNEL_DIFF,
-        "GPU and CPU images differ by {max_diff}/255 in some channel"
-    );
-    // The scene is laid out so that no pixel centre's path comes near an open
-    // edge (0 at 64 × 64); a few may after edits, many would mean the
-    // criterion is hiding a real disagreement.
-    assert!(
-        near_edge <= 4,
-        "{near_edge} pixels pass within {EDGE_EPSILON} of an edge"
-    );
+    assert_matches(&c);
     if let Some(path) = std::env::var_os("RTLINT_SMOKE_PPM") {
         write_ppm(Path::new(&path), &gpu.image, PARAMS.width, PARAMS.height);
     }
-
     check_semantics(&scene, &gpu.image);
+}
+
+/// The same image with the stack size as dynamic state: the explicit size
+/// path creates and traces (a depth-1 pipeline needs little stack; 1 KiB is
+/// ample on every driver measured).
+#[test]
+fn explicit_stack_size_renders_the_same() {
+    let ctx = open_device();
+    let spirv = compile_shader();
+    let scene = Scene::reflection();
+    let gpu = render_on_gpu(&ctx, &spirv, &scene, PARAMS, Some(1024));
+    let c = compare(&scene, &gpu.image, &reference::render(&scene, PARAMS));
+    assert_matches(&c);
+}
+
+/// The table follows the rules FIELD-NOTES lists: stride = handle size
+/// aligned to the handle alignment, every region on the base alignment, and
+/// a raygen region exactly one stride long.
+fn check_sbt(ctx: &Context, pipeline: &RayTracingPipeline) {
+    let limits = ctx.limits();
+    let sbt = pipeline.sbt();
+    let stride = u64::from(limits.shader_group_handle_size)
+        .next_multiple_of(u64::from(limits.shader_group_handle_alignment));
+    let base = u64::from(limits.shader_group_base_alignment);
+    assert_eq!(sbt.raygen.len(), 1);
+    let rg = &sbt.raygen[0];
+    assert_eq!(
+        (rg.size, rg.stride, rg.groups.as_slice()),
+        (stride, stride, &[0][..])
+    );
+    assert_eq!(
+        (sbt.miss.stride, sbt.miss.groups.as_slice()),
+        (stride, &[1][..])
+    );
+    assert_eq!(
+        (sbt.hit.stride, sbt.hit.groups.as_slice()),
+        (stride, &[2][..])
+    );
+    assert_eq!((sbt.callable.address, sbt.callable.size), (0, 0));
+    for region in [rg, &sbt.miss, &sbt.hit] {
+        assert_eq!(region.address % base, 0, "{region:?}");
+        assert_eq!(region.size, region.groups.len() as u64 * stride);
+    }
 }
 
 /// Facts about the picture that hold whatever the renderer: sky where nothing
@@ -317,7 +387,7 @@ fn check_semantics(scene: &Scene, image: &[u32]) {
 fn group_stack_size_query() {
     let ctx = open_device();
     let spirv = compile_shader();
-    let pipeline = create_pipeline(&ctx, &spirv);
+    let pipeline = create_pipeline(&ctx, &spirv, None);
     let sizes = pipeline.group_stack_sizes();
     eprintln!("{}: {sizes:?}", ctx.info().name);
     assert_eq!(sizes.len(), 3);

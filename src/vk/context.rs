@@ -185,9 +185,7 @@ fn create_instance(entry: &ash::Entry, validation: bool) -> Result<ash::Instance
         .enabled_layer_names(&layers);
     // SAFETY: the create info points at locals that outlive the call.
     unsafe { entry.create_instance(&create, None) }.map_err(|result| match result {
-        vk::Result::ERROR_INCOMPATIBLE_DRIVER => Error::NoDevice(vec![
-            "no Vulkan driver (ICD) is installed or none supports Vulkan 1.3".into(),
-        ]),
+        vk::Result::ERROR_INCOMPATIBLE_DRIVER => Error::NoDriver,
         result => Error::Vk {
             call: "vkCreateInstance",
             result,

@@ -8,6 +8,8 @@ use std::fmt;
 pub enum Error {
     /// The Vulkan loader library could not be opened.
     Loader(String),
+    /// The loader found no driver, or none for Vulkan 1.3.
+    NoDriver,
     /// No physical device has what the harness needs; one line per device
     /// says what it lacks.
     NoDevice(Vec<String>),
@@ -28,6 +30,9 @@ impl fmt::Display for Error {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
             Error::Loader(msg) => write!(f, "cannot load the Vulkan loader: {msg}"),
+            Error::NoDriver => {
+                f.write_str("no Vulkan driver is installed, or none supports Vulkan 1.3")
+            }
             Error::NoDevice(reasons) if reasons.is_empty() => {
                 f.write_str("no Vulkan physical device found")
             }

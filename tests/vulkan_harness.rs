@@ -1,0 +1,371 @@
+//! The Vulkan harness itself: device errors, acceleration structures of both
+//! kinds with instance transforms, masks, custom indices and SBT offsets
+//! (read back through ray queries in a compute pipeline), and the child
+//! process runner.
+//!
+//! Like the smoke test, these fail rather than skip when there is no
+//! ray-tracing device.
+
+#![cfg(feature = "vulkan")]
+
+use rtlint::reference::{self, Params, Scene};
+use rtlint::vk::{
+    raw, run_in_child, Aabb, AccelerationStructure, Binding, BindingKind, Buffer, ComputePipeline,
+    Context, ContextOptions, Error, Geometry, Instance, Resource,
+};
+use std::path::Path;
+
+/// `RayQueryIntersection` values as naga's WGSL names them.
+const NONE: u32 = 0;
+const TRIANGLE: u32 = 1;
+
+const SCENE_CUSTOM: u32 = 7;
+const BOX_CUSTOM: u32 = 9;
+const BOX_SBT_OFFSET: u32 = 3;
+const SCENE_MASK: u8 = 0x01;
+const BOX_MASK: u8 = 0x02;
+/// The box instance: object box [-1, 1]³ scaled by 2 in x, moved to
+/// (10, 1, -3), so it covers x 8..12, y 0..2, z -4..-2 in the world.
+const BOX_TRANSFORM: [[f32; 4]; 3] = [
+    [2.0, 0.0, 0.0, 10.0],
+    [0.0, 1.0, 0.0, 1.0],
+    [0.0, 0.0, 1.0, -3.0],
+];
+
+fn open_device() -> Context {
+    match Context::new() {
+        Ok(ctx) => ctx,
+        Err(e) => panic!("no usable ray-tracing device (install lavapipe with scripts/setup): {e}"),
+    }
+}
+
+#[test]
+fn missing_device_is_an_error_naming_what_is_missing() {
+    let options = ContextOptions {
+        device_name: Some("no such device".into()),
+        ..ContextOptions::default()
+    };
+    let err = Context::with_options(&options).expect_err("no device has that name");
+    let Error::NoDevice(reasons) = &err else {
+        panic!("expected NoDevice, got {err:?}");
+    };
+    // Every device present is named with the reason it was passed over.
+    let real = open_device();
+    assert!(
+        reasons
+            .iter()
+            .any(|r| r.contains(&real.info().name) && r.contains("no such device")),
+        "{reasons:?}"
+    );
+    assert!(err
+        .to_string()
+        .starts_with("no Vulkan device supports ray tracing pipelines:"));
+}
+
+/// One ray as the probe shader reads it (48 bytes).
+#[derive(Clone, Copy, Debug)]
+struct Ray {
+    origin: [f32; 3],
+    dir: [f32; 3],
+    t_min: f32,
+    t_max: f32,
+    mask: u8,
+}
+
+impl Ray {
+    fn new(origin: [f32; 3], dir: [f32; 3]) -> Ray {
+        Ray {
+            origin,
+            dir,
+            t_min: reference::T_MIN,
+            t_max: reference::T_MAX,
+            mask: 0xFF,
+        }
+    }
+
+    fn words(&self) -> [u32; 12] {
+        let f = |x: f32| x.to_bits();
+        let (o, d) = (self.origin, self.dir);
+        [
+            f(o[0]),
+            f(o[1]),
+            f(o[2]),
+            f(self.t_min),
+            f(d[0]),
+            f(d[1]),
+            f(d[2]),
+            f(self.t_max),
+            0, // no ray flags: opacity comes from the geometry
+            u32::from(self.mask),
+            0,
+            0,
+        ]
+    }
+}
+
+/// What the probe shader reported for one ray.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Probe {
+    kind: u32,
+    primitive: u32,
+    custom: u32,
+    instance: u32,
+    geometry: u32,
+    sbt_offset: u32,
+    t: f32,
+    aabb_candidates: u32,
+    aabb_custom: u32,
+    aabb_sbt_offset: u32,
+}
+
+fn probe(ctx: &Context, tlas: &AccelerationStructure, rays: &[Ray]) -> Vec<Probe> {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/shaders/ray_probe.wgsl");
+    let source = std::fs::read_to_string(&path).unwrap();
+    let spirv = rtlint::front::wgsl::compile(&source, &path).expect("the probe shader compiles");
+    let bindings = [
+        Binding::new(0, BindingKind::AccelerationStructure),
+        Binding::new(1, BindingKind::StorageBuffer),
+        Binding::new(2, BindingKind::StorageBuffer),
+        Binding::new(3, BindingKind::UniformBuffer),
+    ];
+    let pipeline = ComputePipeline::new(ctx, &spirv, "main", &bindings).expect("compute pipeline");
+    let words: Vec<u32> = rays.iter().flat_map(Ray::words).collect();
+    let storage = raw::BufferUsageFlags::STORAGE_BUFFER;
+    let ray_buf = Buffer::from_data(ctx, storage, &words).unwrap();
+    let out = Buffer::new(ctx, rays.len() as u64 * 48, storage, 1).unwrap();
+    let count = rays.len() as u32;
+    let params = Buffer::from_data(
+        ctx,
+        raw::BufferUsageFlags::UNIFORM_BUFFER,
+        &[count, 0, 0, 0],
+    )
+    .unwrap();
+    pipeline
+        .dispatch(
+            &[
+                (0, Resource::AccelerationStructure(tlas)),
+                (1, Resource::Buffer(&ray_buf)),
+                (2, Resource::Buffer(&out)),
+                (3, Resource::Buffer(&params)),
+            ],
+            count.div_ceil(64),
+            1,
+            1,
+        )
+        .expect("dispatch");
+    out.read_u32()
+        .chunks_exact(12)
+        .map(|w| Probe {
+            kind: w[0],
+            primitive: w[1],
+            custom: w[2],
+            instance: w[3],
+            geometry: w[4],
+            sbt_offset: w[5],
+            aabb_candidates: w[6],
+            aabb_custom: w[7],
+            t: f32::from_bits(w[8]),
+            aabb_sbt_offset: w[9],
+        })
+        .collect()
+}
+
+/// Builds the reflection scene and the box as two instances, casts camera
+/// rays, rays past and through the box, and masked rays, and checks every
+/// field the acceleration structures feed back.
+#[test]
+fn ray_queries_see_triangles_aabbs_transforms_and_masks() {
+    let ctx = open_device();
+    if !ctx.info().ray_query {
+        // NVIDIA's driver (FIELD-NOTES) has ray-tracing pipelines but not
+        // VK_KHR_ray_query; this test has nothing to run there.
+        eprintln!("{} has no VK_KHR_ray_query", ctx.info().name);
+        return;
+    }
+    let scene = Scene::reflection();
+    let triangles = AccelerationStructure::bottom_level(
+        &ctx,
+        &[Geometry::Triangles {
+            positions: &scene.positions,
+            indices: &scene.indices,
+            opaque: true,
+        }],
+    )
+    .unwrap();
+    let boxes = [Aabb {
+        min: [-1.0; 3],
+        max: [1.0; 3],
+    }];
+    let procedural = AccelerationStructure::bottom_level(
+        &ctx,
+        &[Geometry::Aabbs {
+            boxes: &boxes,
+            opaque: false,
+        }],
+    )
+    .unwrap();
+    let instances = [
+        Instance {
+            custom_index: SCENE_CUSTOM,
+            mask: SCENE_MASK,
+            ..Instance::identity(&triangles)
+        },
+        Instance {
+            transform: BOX_TRANSFORM,
+            custom_index: BOX_CUSTOM,
+            mask: BOX_MASK,
+            sbt_record_offset: BOX_SBT_OFFSET,
+            ..Instance::identity(&procedural)
+        },
+    ];
+    let tlas = AccelerationStructure::top_level(&ctx, &instances).unwrap();
+    // The top level keeps the bottom levels alive.
+    drop((triangles, procedural));
+
+    // 1. Camera rays against the CPU intersection of the same scene.
+    let params = Params {
+        width: 32,
+        height: 32,
+        max_bounces: 0,
+    };
+    let mut rays = Vec::new();
+    for y in 0..params.height {
+        for x in 0..params.width {
+            rays.push(Ray::new(
+                reference::CAMERA_ORIGIN,
+                reference::camera_dir(params, x, y),
+            ));
+        }
+    }
+    let camera_rays = rays.len();
+    // 2. Horizontal rays along -z at y = 1 across the box's x extent 8..12.
+    let box_xs = [7.0, 7.5, 8.25, 9.0, 10.0, 11.0, 11.75, 12.5, 13.0];
+    for x in box_xs {
+        rays.push(Ray::new([x, 1.0, 5.0], [0.0, 0.0, -1.0]));
+    }
+    // 3. Masks: the box ray with the scene's mask, a floor ray with each mask.
+    let masked = rays.len();
+    rays.push(Ray {
+        mask: SCENE_MASK,
+        ..Ray::new([10.0, 1.0, 5.0], [0.0, 0.0, -1.0])
+    });
+    let floor_ray = |mask| Ray {
+        mask,
+        ..Ray::new([0.5, 0.5, 0.5], [0.0, -1.0, 0.0])
+    };
+    rays.push(floor_ray(SCENE_MASK));
+    rays.push(floor_ray(BOX_MASK));
+    // 4. The t range: the floor is 0.5 away, past t_max 0.4.
+    rays.push(Ray {
+        t_max: 0.4,
+        ..floor_ray(0xFF)
+    });
+
+    let hits = probe(&ctx, &tlas, &rays);
+
+    let mut compared = 0;
+    for (ray, hit) in rays[..camera_rays].iter().zip(&hits) {
+        let (cpu, margin) = reference::intersect(&scene, ray.origin, ray.dir, ray.t_min, ray.t_max);
+        assert_eq!(hit.aabb_candidates, 0, "camera rays pass far from the box");
+        if margin < 1e-4 {
+            continue; // see EDGE_EPSILON in vulkan_smoke.rs
+        }
+        compared += 1;
+        match cpu {
+            None => assert_eq!(hit.kind, NONE, "{ray:?}: {hit:?}"),
+            Some(cpu) => {
+                assert_eq!(hit.kind, TRIANGLE, "{ray:?}: {hit:?}");
+                assert_eq!(hit.primitive, cpu.primitive, "{ray:?}");
+                assert!(
+                    (hit.t - cpu.t).abs() <= 1e-5 * cpu.t,
+                    "{ray:?}: {} vs {}",
+                    hit.t,
+                    cpu.t
+                );
+                assert_eq!(
+                    (hit.custom, hit.instance, hit.geometry, hit.sbt_offset),
+                    (SCENE_CUSTOM, 0, 0, 0)
+                );
+            }
+        }
+    }
+    assert!(
+        compared > camera_rays - 8,
+        "{compared} of {camera_rays} rays compared"
+    );
+
+    for (x, hit) in box_xs.iter().zip(&hits[camera_rays..]) {
+        assert_eq!(
+            hit.kind, NONE,
+            "an unconfirmed AABB candidate is not committed"
+        );
+        // Implementations may offer AABBs conservatively, so only rays
+        // clearly inside (≥ 0.25 in) or clearly outside (≥ 0.5 off) count.
+        if (8.25..=11.75).contains(x) {
+            assert_eq!(hit.aabb_candidates, 1, "x = {x}");
+            assert_eq!(
+                (hit.aabb_custom, hit.aabb_sbt_offset),
+                (BOX_CUSTOM, BOX_SBT_OFFSET)
+            );
+        } else {
+            assert_eq!(hit.aabb_candidates, 0, "x = {x}: outside the scaled box");
+        }
+    }
+    let [box_masked, floor_scene, floor_box, floor_short] = &hits[masked..] else {
+        unreachable!()
+    };
+    assert_eq!(
+        box_masked.aabb_candidates, 0,
+        "the box instance is masked out"
+    );
+    assert_eq!((floor_scene.kind, floor_scene.t), (TRIANGLE, 0.5));
+    assert_eq!(floor_box.kind, NONE, "the scene instance is masked out");
+    assert_eq!(floor_short.kind, NONE, "the floor is beyond t_max");
+}
+
+/// A child that dies of a signal is reported, not fatal to the test run:
+/// what deep-recursion tests need on lavapipe.
+#[test]
+fn child_process_reports_a_crash() {
+    if let Some(outcome) = run_in_child("child_process_reports_a_crash") {
+        #[cfg(unix)]
+        assert_eq!(outcome.signal, Some(6), "SIGABRT expected: {outcome:?}");
+        assert!(!outcome.success());
+        assert!(
+            outcome.stderr.contains("child about to abort"),
+            "{outcome:?}"
+        );
+        return;
+    }
+    eprintln!("child about to abort");
+    std::process::abort();
+}
+
+/// A child that does GPU work and exits normally reports success, so GPU work
+/// can be moved into children without losing results.
+#[test]
+fn child_process_runs_gpu_work() {
+    if let Some(outcome) = run_in_child("child_process_runs_gpu_work") {
+        assert!(outcome.success(), "{outcome:?}");
+        assert!(
+            outcome
+                .stdout
+                .contains("child built acceleration structures"),
+            "{outcome:?}"
+        );
+        return;
+    }
+    let ctx = open_device();
+    let scene = Scene::reflection();
+    let blas = AccelerationStructure::bottom_level(
+        &ctx,
+        &[Geometry::Triangles {
+            positions: &scene.positions,
+            indices: &scene.indices,
+            opaque: true,
+        }],
+    )
+    .unwrap();
+    AccelerationStructure::top_level(&ctx, &[Instance::identity(&blas)]).unwrap();
+    println!("child built acceleration structures");
+}
