@@ -689,3 +689,48 @@ impl Drop for ComputePipeline {
         unsafe { self.shared.device.destroy_pipeline(self.pipeline, None) };
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::vk::RayTracingLimits;
+
+    fn limits(handle: u32, handle_align: u32, base: u32) -> RayTracingLimits {
+        RayTracingLimits {
+            shader_group_handle_size: handle,
+            shader_group_handle_alignment: handle_align,
+            shader_group_base_alignment: base,
+            max_shader_group_stride: 4096,
+            max_ray_recursion_depth: 31,
+            max_ray_dispatch_invocation_count: 1 << 30,
+            max_ray_hit_attribute_size: 32,
+            min_acceleration_structure_scratch_offset_alignment: 128,
+        }
+    }
+
+    #[test]
+    fn lavapipe_layout_packs_regions_on_32_bytes() {
+        // lavapipe: handle 32, handle alignment 16, base alignment 32.
+        let l = SbtLayout::new(&limits(32, 16, 32));
+        assert_eq!((l.stride, l.base_alignment), (32, 32));
+        assert_eq!(l.offsets(1, 1, 1, 0), (vec![0, 32, 64, 96], 96));
+    }
+
+    #[test]
+    fn nvidia_layout_starts_each_region_on_64_bytes() {
+        // NVIDIA H100: handle 32, handle alignment 32, base alignment 64.
+        let l = SbtLayout::new(&limits(32, 32, 64));
+        assert_eq!(l.stride, 32);
+        // Two miss records share one 64-byte region; three hit records need 96.
+        assert_eq!(l.offsets(1, 2, 3, 0), (vec![0, 64, 128, 256], 256));
+        assert_eq!(l.offsets(2, 1, 1, 1), (vec![0, 64, 128, 192, 256], 320));
+    }
+
+    #[test]
+    fn stride_rounds_handle_size_up_to_handle_alignment() {
+        let l = SbtLayout::new(&limits(24, 16, 64));
+        assert_eq!(l.stride, 32);
+        // An empty table still has one aligned block (buffers cannot be empty).
+        assert_eq!(l.offsets(0, 0, 0, 0), (vec![0, 0, 0], 64));
+    }
+}
