@@ -1,6 +1,7 @@
 //! Instance, device selection, queue and one-shot command submission.
 
 use super::error::{vk_err, Error, Result};
+use super::validation::{Validation, ValidationMessage, LAYER};
 use ash::vk;
 use std::ffi::CStr;
 use std::sync::{Arc, Mutex};
@@ -18,8 +19,10 @@ const REQUIRED_EXTENSIONS: [&CStr; 3] = [
 pub struct ContextOptions {
     /// Only devices whose name contains this text are considered.
     pub device_name: Option<String>,
-    /// Enable `VK_LAYER_KHRONOS_validation` when it is installed; it logs to
-    /// stdout without a messenger.
+    /// Enable `VK_LAYER_KHRONOS_validation` when it is installed, collecting
+    /// its messages (see [`Context::validation_messages`]). The default is
+    /// on when the environment variable `RTLINT_VK_VALIDATION` is set to
+    /// anything but `0`.
     pub validation: bool,
     /// How long a submission may run before [`Error::Timeout`]. A lost or hung
     /// device must end a test, not stall it.
@@ -30,7 +33,7 @@ impl Default for ContextOptions {
     fn default() -> Self {
         ContextOptions {
             device_name: None,
-            validation: false,
+            validation: std::env::var_os("RTLINT_VK_VALIDATION").is_some_and(|v| v != "0"),
             fence_timeout: Duration::from_secs(30),
         }
     }
@@ -75,6 +78,7 @@ pub struct DeviceInfo {
 pub(crate) struct Shared {
     _entry: ash::Entry,
     instance: ash::Instance,
+    validation: Option<Validation>,
     pub(crate) device: ash::Device,
     pub(crate) accel: ash::khr::acceleration_structure::Device,
     pub(crate) rt: ash::khr::ray_tracing_pipeline::Device,
@@ -94,6 +98,9 @@ impl Drop for Shared {
             let _ = self.device.device_wait_idle();
             self.device.destroy_command_pool(self.command_pool, None);
             self.device.destroy_device(None);
+            if let Some(v) = &self.validation {
+                v.destroy();
+            }
             self.instance.destroy_instance(None);
         }
     }
@@ -131,14 +138,34 @@ impl Context {
         // SAFETY: loading the system's Vulkan loader runs its initialisers,
         // which is what any Vulkan program does.
         let entry = unsafe { ash::Entry::load() }.map_err(|e| Error::Loader(e.to_string()))?;
-        let instance = create_instance(&entry, options.validation)?;
+        let (instance, validating) = create_instance(&entry, options.validation)?;
+        let validation = if validating {
+            match Validation::new(&entry, &instance) {
+                Ok(v) => Some(v),
+                Err(e) => {
+                    // SAFETY: nothing was created from the instance.
+                    unsafe { instance.destroy_instance(None) };
+                    return Err(e);
+                }
+            }
+        } else {
+            None
+        };
         match open_device(&entry, &instance, options) {
-            Ok(shared) => Ok(Context {
-                shared: Arc::new(shared),
-            }),
+            Ok(mut shared) => {
+                shared.validation = validation;
+                Ok(Context {
+                    shared: Arc::new(shared),
+                })
+            }
             Err(e) => {
-                // SAFETY: nothing created from the instance is left.
-                unsafe { instance.destroy_instance(None) };
+                // SAFETY: nothing else created from the instance is left.
+                unsafe {
+                    if let Some(v) = &validation {
+                        v.destroy();
+                    }
+                    instance.destroy_instance(None);
+                }
                 Err(e)
             }
         }
@@ -160,37 +187,65 @@ impl Context {
     pub fn fence_timeout(&self) -> Duration {
         self.shared.fence_timeout
     }
+
+    /// Whether the validation layer is active (asked for and installed).
+    pub fn validation_enabled(&self) -> bool {
+        self.shared.validation.is_some()
+    }
+
+    /// Every validation error and warning so far (empty without validation).
+    pub fn validation_messages(&self) -> Vec<ValidationMessage> {
+        self.shared
+            .validation
+            .as_ref()
+            .map(Validation::messages)
+            .unwrap_or_default()
+    }
+
+    /// The validation errors so far, as text.
+    pub fn validation_errors(&self) -> Vec<String> {
+        self.validation_messages()
+            .into_iter()
+            .filter(|m| m.error)
+            .map(|m| m.text)
+            .collect()
+    }
 }
 
-fn create_instance(entry: &ash::Entry, validation: bool) -> Result<ash::Instance> {
+/// The instance, and whether the validation layer (with debug utils) is on.
+fn create_instance(entry: &ash::Entry, validation: bool) -> Result<(ash::Instance, bool)> {
     let app = vk::ApplicationInfo::default()
         .application_name(c"rtlint")
         .engine_name(c"rtlint")
         .api_version(vk::API_VERSION_1_3);
-    let validation_layer = c"VK_LAYER_KHRONOS_validation";
     let mut layers = Vec::new();
+    let mut extensions = Vec::new();
     if validation {
         // SAFETY: plain query.
         let available = unsafe { entry.enumerate_instance_layer_properties() }
             .map_err(vk_err("vkEnumerateInstanceLayerProperties"))?;
         if available
             .iter()
-            .any(|l| l.layer_name_as_c_str() == Ok(validation_layer))
+            .any(|l| l.layer_name_as_c_str() == Ok(LAYER))
         {
-            layers.push(validation_layer.as_ptr());
+            layers.push(LAYER.as_ptr());
+            extensions.push(vk::EXT_DEBUG_UTILS_NAME.as_ptr());
         }
     }
     let create = vk::InstanceCreateInfo::default()
         .application_info(&app)
-        .enabled_layer_names(&layers);
+        .enabled_layer_names(&layers)
+        .enabled_extension_names(&extensions);
     // SAFETY: the create info points at locals that outlive the call.
-    unsafe { entry.create_instance(&create, None) }.map_err(|result| match result {
-        vk::Result::ERROR_INCOMPATIBLE_DRIVER => Error::NoDriver,
-        result => Error::Vk {
-            call: "vkCreateInstance",
-            result,
-        },
-    })
+    let instance =
+        unsafe { entry.create_instance(&create, None) }.map_err(|result| match result {
+            vk::Result::ERROR_INCOMPATIBLE_DRIVER => Error::NoDriver,
+            result => Error::Vk {
+                call: "vkCreateInstance",
+                result,
+            },
+        })?;
+    Ok((instance, !layers.is_empty()))
 }
 
 /// Opens the device; on error everything it made is destroyed, and the
@@ -223,6 +278,7 @@ fn open_device(
         accel: ash::khr::acceleration_structure::Device::new(instance, &device),
         rt: ash::khr::ray_tracing_pipeline::Device::new(instance, &device),
         instance: instance.clone(),
+        validation: None,
         device,
         queue,
         command_pool,

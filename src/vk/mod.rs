@@ -22,6 +22,7 @@ mod context;
 mod descriptors;
 mod error;
 mod pipeline;
+mod validation;
 
 pub use accel::{Aabb, AccelerationStructure, Geometry, Instance, IDENTITY};
 pub use buffer::{bytes_of, Buffer, Pod};
@@ -33,6 +34,7 @@ pub use pipeline::{
     ComputePipeline, Group, GroupStackSizes, RayTracingPipeline, RayTracingPipelineDesc, SbtLayout,
     SbtRegion, ShaderBindingTable, ShaderStage, Stage,
 };
+pub use validation::ValidationMessage;
 
 /// The raw Vulkan types (`ash::vk`), for flags and handles the harness passes through.
 pub use ash::vk as raw;
