@@ -10,11 +10,12 @@
 
 use rtlint::reference::{self, Params, Scene};
 use rtlint::vk::{
-    raw, run_in_child, Aabb, AccelerationStructure, Binding, BindingKind, Buffer, ComputePipeline,
-    Context, ContextOptions, Error, Geometry, Group, Instance, RayTracingPipeline,
-    RayTracingPipelineDesc, Resource, ShaderStage, Stage,
+    raw, run_in_child, run_in_child_with_timeout, Aabb, AccelerationStructure, Binding,
+    BindingKind, Buffer, ComputePipeline, Context, ContextOptions, Error, Geometry, Group,
+    Instance, RayTracingPipeline, RayTracingPipelineDesc, Resource, ShaderStage, Stage,
 };
 use std::path::Path;
+use std::time::{Duration, Instant};
 
 /// `RayQueryIntersection` values as naga's WGSL names them.
 const NONE: u32 = 0;
@@ -593,6 +594,64 @@ fn procedural_and_any_hit_groups_trace_as_the_geometry_says() {
         "miss/triangle/sphere rays: {counts:?}"
     );
     assert_valid(&ctx);
+}
+
+/// A dispatch that outruns the fence timeout is an `Error::Timeout`, and
+/// the context can then be dropped without waiting for the GPU. In a child:
+/// lavapipe goes on computing until the process ends.
+#[test]
+fn fence_timeout_is_an_error_not_a_hang() {
+    if let Some(outcome) = run_in_child_with_timeout(
+        "fence_timeout_is_an_error_not_a_hang",
+        Duration::from_secs(120),
+    ) {
+        assert!(outcome.success(), "{outcome:?}");
+        assert!(
+            outcome.stdout.contains("timed out as expected"),
+            "{outcome:?}"
+        );
+        return;
+    }
+    let ctx = Context::with_options(&ContextOptions {
+        fence_timeout: Duration::from_millis(100),
+        ..ContextOptions::default()
+    })
+    .unwrap();
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/shaders/spin.wgsl");
+    let source = std::fs::read_to_string(&path).unwrap();
+    let spirv = for_validation(&ctx, rtlint::front::wgsl::compile(&source, &path).unwrap());
+    let bindings = [
+        Binding::new(0, BindingKind::StorageBuffer),
+        Binding::new(1, BindingKind::UniformBuffer),
+    ];
+    let pipeline = ComputePipeline::new(&ctx, &spirv, "main", &bindings).unwrap();
+    let out = Buffer::new(&ctx, 64 * 4, raw::BufferUsageFlags::STORAGE_BUFFER, 1).unwrap();
+    let run = |iterations: u32| {
+        let params = Buffer::from_data(
+            &ctx,
+            raw::BufferUsageFlags::UNIFORM_BUFFER,
+            &[iterations, 0, 0, 0],
+        )
+        .unwrap();
+        let resources = [(0, Resource::Buffer(&out)), (1, Resource::Buffer(&params))];
+        pipeline.dispatch(&resources, 1, 1, 1)
+    };
+    // A short run finishes and computes what the CPU computes.
+    run(1000).expect("a short dispatch finishes in time");
+    let lcg = |mut x: u32| {
+        for _ in 0..1000 {
+            x = x.wrapping_mul(1664525).wrapping_add(1013904223);
+        }
+        x
+    };
+    assert_eq!(out.read_u32(), (0..64).map(lcg).collect::<Vec<_>>());
+    // About 2^32 steps per thread: minutes on lavapipe.
+    let start = Instant::now();
+    let err = run(u32::MAX).expect_err("a four-billion-step loop outruns 100 ms");
+    assert!(matches!(err, Error::Timeout { .. }), "{err}");
+    assert!(start.elapsed() < Duration::from_secs(10));
+    drop((pipeline, out, ctx));
+    println!("timed out as expected: {err}");
 }
 
 /// A child that dies of a signal is reported, not fatal to the test run:

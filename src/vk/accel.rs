@@ -75,6 +75,9 @@ struct Inner {
 
 impl Drop for Inner {
     fn drop(&mut self) {
+        if self.shared.hung() {
+            return;
+        }
         // SAFETY: submissions are waited for, so the structure is idle.
         unsafe {
             self.shared

@@ -233,6 +233,9 @@ impl Buffer {
 
 impl Drop for Buffer {
     fn drop(&mut self) {
+        if self.shared.hung() {
+            return;
+        }
         // SAFETY: every harness submission waits for completion, so the
         // buffer is idle; unmapping happens with the free.
         unsafe {

@@ -4,6 +4,7 @@ use super::error::{vk_err, Error, Result};
 use super::validation::{Validation, ValidationMessage, LAYER};
 use ash::vk;
 use std::ffi::CStr;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
@@ -25,7 +26,8 @@ pub struct ContextOptions {
     /// anything but `0`.
     pub validation: bool,
     /// How long a submission may run before [`Error::Timeout`]. A lost or hung
-    /// device must end a test, not stall it.
+    /// device must end a test, not stall it. After a timeout the context
+    /// leaks its objects instead of destroying what the GPU may still use.
     pub fence_timeout: Duration,
 }
 
@@ -57,6 +59,9 @@ pub struct RayTracingLimits {
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct DeviceInfo {
     pub name: String,
+    /// Driver name and version text (`VkPhysicalDeviceDriverProperties`),
+    /// e.g. "llvmpipe, Mesa 25.0.7-1~bpo12+1 (LLVM 15.0.6)".
+    pub driver: String,
     /// `(major, minor, patch)` of the device's Vulkan version.
     pub api_version: (u32, u32, u32),
     pub driver_version: u32,
@@ -89,10 +94,17 @@ pub(crate) struct Shared {
     pub(crate) fence_timeout: Duration,
     /// The command pool and queue need external synchronisation.
     pub(crate) submit_lock: Mutex<()>,
+    /// A submission outlived its fence timeout and may still be running.
+    timed_out: AtomicBool,
 }
 
 impl Drop for Shared {
     fn drop(&mut self) {
+        if self.hung() {
+            // Waiting for idle could block forever and destroying a busy
+            // device is undefined; the process is expected to end soon.
+            return;
+        }
         // SAFETY: every other object holds an Arc<Shared>, so none is left.
         unsafe {
             let _ = self.device.device_wait_idle();
@@ -286,6 +298,7 @@ fn open_device(
         info: candidate.info,
         fence_timeout: options.fence_timeout,
         submit_lock: Mutex::new(()),
+        timed_out: AtomicBool::new(false),
     })
 }
 
@@ -389,9 +402,11 @@ fn examine(
 
     let mut rt_props = vk::PhysicalDeviceRayTracingPipelinePropertiesKHR::default();
     let mut as_props = vk::PhysicalDeviceAccelerationStructurePropertiesKHR::default();
+    let mut driver_props = vk::PhysicalDeviceDriverProperties::default();
     let mut props2 = vk::PhysicalDeviceProperties2::default()
         .push_next(&mut rt_props)
-        .push_next(&mut as_props);
+        .push_next(&mut as_props)
+        .push_next(&mut driver_props);
     // SAFETY: as above.
     unsafe { instance.get_physical_device_properties2(physical, &mut props2) };
 
@@ -407,6 +422,11 @@ fn examine(
         queue_family,
         info: DeviceInfo {
             name,
+            driver: format!(
+                "{}, {}",
+                c_text(driver_props.driver_name_as_c_str()),
+                c_text(driver_props.driver_info_as_c_str())
+            ),
             api_version: (
                 vk::api_version_major(api),
                 vk::api_version_minor(api),
@@ -559,8 +579,9 @@ impl Shared {
             });
         match result {
             // A timed-out submission may still be running: leak its command
-            // buffer and fence rather than free objects in use.
-            Err(Error::Timeout { .. }) => {}
+            // buffer and fence, and from now on every object, rather than
+            // free what the GPU may use.
+            Err(Error::Timeout { .. }) => self.timed_out.store(true, Ordering::SeqCst),
             _ => unsafe {
                 // SAFETY: the submission finished (or never started).
                 self.device.destroy_fence(fence, None);
@@ -568,6 +589,12 @@ impl Shared {
             },
         }
         result
+    }
+
+    /// Whether a submission timed out; objects then leak instead of being
+    /// destroyed under the GPU.
+    pub(crate) fn hung(&self) -> bool {
+        self.timed_out.load(Ordering::SeqCst)
     }
 
     /// A memory type with all of `flags` among `type_bits`.
@@ -583,4 +610,9 @@ impl Shared {
                     .contains(flags)
         })
     }
+}
+
+fn c_text(s: std::result::Result<&CStr, std::ffi::FromBytesUntilNulError>) -> String {
+    s.map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default()
 }

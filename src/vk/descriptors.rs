@@ -233,6 +233,9 @@ impl Descriptors {
 
 impl Drop for Descriptors {
     fn drop(&mut self) {
+        if self.shared.hung() {
+            return;
+        }
         // SAFETY: destroying null handles is allowed; nothing is in use.
         unsafe {
             let d = &self.shared.device;

@@ -463,6 +463,9 @@ impl RayTracingPipeline {
 
 impl Drop for RayTracingPipeline {
     fn drop(&mut self) {
+        if self.shared.hung() {
+            return;
+        }
         // SAFETY: submissions are waited for, so the pipeline is idle.
         unsafe { self.shared.device.destroy_pipeline(self.pipeline, None) };
     }
@@ -685,6 +688,9 @@ impl ComputePipeline {
 
 impl Drop for ComputePipeline {
     fn drop(&mut self) {
+        if self.shared.hung() {
+            return;
+        }
         // SAFETY: submissions are waited for, so the pipeline is idle.
         unsafe { self.shared.device.destroy_pipeline(self.pipeline, None) };
     }
