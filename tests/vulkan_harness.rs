@@ -118,6 +118,56 @@ fn validation_layer_reports_misuse() {
     assert!(errors.iter().any(|e| e.contains("00912")), "{errors:#?}");
 }
 
+/// Dropping the harness's objects in any order destroys everything: the
+/// layer's object tracker reports whatever is left at vkDestroyDevice, as the
+/// deliberately leaked buffer shows. Needs the layer, like the test above.
+#[test]
+fn teardown_leaves_no_objects_behind() {
+    let open = || {
+        Context::with_options(&ContextOptions {
+            validation: true,
+            ..ContextOptions::default()
+        })
+        .expect("a device opens with validation asked for")
+    };
+    let ctx = open();
+    let Some(log) = ctx.validation_log() else {
+        eprintln!("VK_LAYER_KHRONOS_validation is not installed");
+        return;
+    };
+    let scene = Scene::reflection();
+    let blas = AccelerationStructure::bottom_level(
+        &ctx,
+        &[Geometry::Triangles {
+            positions: &scene.positions,
+            indices: &scene.indices,
+            opaque: true,
+        }],
+    )
+    .unwrap();
+    let tlas = AccelerationStructure::top_level(&ctx, &[Instance::identity(&blas)]).unwrap();
+    let rays = [Ray::new([0.5, 0.5, 0.5], [0.0, -1.0, 0.0])];
+    assert_eq!(probe(&ctx, &tlas, &rays)[0].kind, TRIANGLE);
+    // The context first, then what was made from it.
+    drop(ctx);
+    drop((blas, tlas));
+    assert_eq!(log.errors(), Vec::<String>::new());
+
+    let ctx = open();
+    let log = ctx.validation_log().unwrap();
+    let info = raw::BufferCreateInfo::default()
+        .size(64)
+        .usage(raw::BufferUsageFlags::STORAGE_BUFFER);
+    // SAFETY: a valid buffer, leaked on purpose.
+    unsafe { ctx.device().create_buffer(&info, None) }.unwrap();
+    drop(ctx);
+    let errors = log.errors();
+    assert!(
+        errors.iter().any(|e| e.contains("VkBuffer")),
+        "the leaked buffer is reported: {errors:#?}"
+    );
+}
+
 /// One ray as the probe shader reads it (48 bytes).
 #[derive(Clone, Copy, Debug)]
 struct Ray {

@@ -6,7 +6,7 @@
 //! within one 8-bit step; ray/triangle tests use the shader's `t` range and
 //! treat every triangle as opaque, as `RAY_FLAG_OPAQUE` does.
 
-mod math;
+pub mod math;
 pub mod scene;
 
 pub use math::{cross, dot, normalize, reflect, Vec3};

@@ -1,7 +1,7 @@
 //! Instance, device selection, queue and one-shot command submission.
 
 use super::error::{vk_err, Error, Result};
-use super::validation::{Validation, ValidationMessage, LAYER};
+use super::validation::{Validation, ValidationLog, ValidationMessage, LAYER};
 use ash::vk;
 use std::ffi::CStr;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -205,22 +205,24 @@ impl Context {
         self.shared.validation.is_some()
     }
 
+    /// The validation layer's messages, readable after the context is gone;
+    /// `None` without validation.
+    pub fn validation_log(&self) -> Option<ValidationLog> {
+        self.shared.validation.as_ref().map(Validation::log)
+    }
+
     /// Every validation error and warning so far (empty without validation).
     pub fn validation_messages(&self) -> Vec<ValidationMessage> {
-        self.shared
-            .validation
-            .as_ref()
-            .map(Validation::messages)
+        self.validation_log()
+            .map(|l| l.messages())
             .unwrap_or_default()
     }
 
     /// The validation errors so far, as text.
     pub fn validation_errors(&self) -> Vec<String> {
-        self.validation_messages()
-            .into_iter()
-            .filter(|m| m.error)
-            .map(|m| m.text)
-            .collect()
+        self.validation_log()
+            .map(|l| l.errors())
+            .unwrap_or_default()
     }
 }
 

@@ -36,7 +36,7 @@ pub use pipeline::{
     ComputePipeline, Group, GroupStackSizes, RayTracingPipeline, RayTracingPipelineDesc, SbtLayout,
     SbtRegion, ShaderBindingTable, ShaderStage, Stage,
 };
-pub use validation::ValidationMessage;
+pub use validation::{ValidationLog, ValidationMessage};
 
 /// The raw Vulkan types (`ash::vk`), for flags and handles the harness passes through.
 pub use ash::vk as raw;

@@ -15,6 +15,26 @@ pub struct ValidationMessage {
     pub text: String,
 }
 
+/// The messages of one context's validation layer; it stays readable after
+/// the context is dropped, so leaks reported at device destruction are seen.
+#[derive(Clone, Debug, Default)]
+pub struct ValidationLog(Arc<Mutex<Vec<ValidationMessage>>>);
+
+impl ValidationLog {
+    pub fn messages(&self) -> Vec<ValidationMessage> {
+        self.0.lock().unwrap_or_else(|p| p.into_inner()).clone()
+    }
+
+    /// The error messages, as text.
+    pub fn errors(&self) -> Vec<String> {
+        self.messages()
+            .into_iter()
+            .filter(|m| m.error)
+            .map(|m| m.text)
+            .collect()
+    }
+}
+
 pub(crate) struct Validation {
     loader: ash::ext::debug_utils::Instance,
     messenger: vk::DebugUtilsMessengerEXT,
@@ -49,8 +69,8 @@ impl Validation {
         })
     }
 
-    pub(crate) fn messages(&self) -> Vec<ValidationMessage> {
-        self.log.lock().unwrap_or_else(|p| p.into_inner()).clone()
+    pub(crate) fn log(&self) -> ValidationLog {
+        ValidationLog(self.log.clone())
     }
 
     /// # Safety
