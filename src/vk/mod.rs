@@ -8,6 +8,11 @@
 //! does not matter; every submission waits on a fence with a finite timeout,
 //! so a resource is never freed while the GPU uses it.
 //!
+//! Set `RTLINT_VK_VALIDATION=1` to run under the Khronos validation layer
+//! (when installed); [`Context::validation_errors`] then lists what it
+//! reported. Work that may crash the process (lavapipe dies on recursion past
+//! the declared depth) belongs in a child process: see [`run_in_child`].
+//!
 //! ```no_run
 //! use rtlint::vk::*;
 //! let ctx = Context::new()?;

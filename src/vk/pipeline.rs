@@ -616,6 +616,12 @@ pub struct ComputePipeline {
     descriptors: Descriptors,
 }
 
+impl std::fmt::Debug for ComputePipeline {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("ComputePipeline").finish_non_exhaustive()
+    }
+}
+
 impl ComputePipeline {
     pub fn new(
         ctx: &Context,
