@@ -9,6 +9,9 @@ pub mod diag;
 pub mod front;
 pub mod lint;
 pub mod pipeline;
+pub mod reference;
 pub mod report;
 pub mod rules;
 pub mod spirv;
+#[cfg(feature = "vulkan")]
+pub mod vk;
