@@ -17,6 +17,8 @@ pub struct Input {
 #[derive(Debug, Default)]
 pub struct Inputs {
     pub files: Vec<Input>,
+    /// Pipeline descriptions (`*.pipeline.toml`).
+    pub pipelines: Vec<PathBuf>,
     /// Paths that could not be used (missing, unknown language when named).
     pub errors: Vec<InputError>,
     /// Files skipped inside directories, for `--verbose`.
@@ -37,6 +39,8 @@ pub fn collect_inputs(paths: &[PathBuf], config: &Config, forced: Option<Languag
         };
         if meta.is_dir() {
             walk(p, config, forced, &mut inputs);
+        } else if is_pipeline(p) {
+            inputs.pipelines.push(p.clone());
         } else {
             match language_of(p, config, forced) {
                 Some(language) => inputs.files.push(Input {
@@ -70,6 +74,8 @@ fn walk(dir: &Path, config: &Config, forced: Option<Language>, inputs: &mut Inpu
         }
         if p.is_dir() {
             walk(&p, config, forced, inputs);
+        } else if is_pipeline(&p) {
+            inputs.pipelines.push(p);
         } else if let Some(language) =
             language_of(&p, config, None).or(forced.filter(|_| is_shader_like(&p)))
         {
@@ -78,6 +84,12 @@ fn walk(dir: &Path, config: &Config, forced: Option<Language>, inputs: &mut Inpu
             inputs.skipped.push(p);
         }
     }
+}
+
+pub fn is_pipeline(p: &Path) -> bool {
+    p.file_name()
+        .and_then(|n| n.to_str())
+        .is_some_and(|n| n.ends_with(".pipeline.toml"))
 }
 
 /// `--lang` applies to named files; inside directories only to files that are
@@ -116,6 +128,25 @@ pub fn check_input(input: &Input, config: &Config) -> Checked {
         }
         Err(e) => Checked {
             path: input.path.clone(),
+            program: None,
+            diagnostics: vec![*e.0],
+        },
+    }
+}
+
+/// Loads a pipeline description and runs the pipeline rules on it.
+pub fn check_pipeline(path: &Path, config: &Config) -> Checked {
+    match crate::pipeline::load(path) {
+        Ok(pipeline) => {
+            let ctx = crate::rules::PipelineContext::new(&pipeline, config);
+            Checked {
+                path: path.to_path_buf(),
+                program: None,
+                diagnostics: crate::rules::check_pipeline(&ctx),
+            }
+        }
+        Err(e) => Checked {
+            path: path.to_path_buf(),
             program: None,
             diagnostics: vec![*e.0],
         },

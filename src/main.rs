@@ -53,6 +53,25 @@ enum Command {
         /// Warnings fail the run (exit 1) too.
         #[arg(long)]
         deny_warnings: bool,
+        /// Also apply this pipeline description (`*.pipeline.toml` files in
+        /// the walked directories are applied too).
+        #[arg(long)]
+        pipeline: Vec<PathBuf>,
+    },
+    /// Values kept alive across each trace, callable and ray-query site.
+    Live {
+        #[command(flatten)]
+        common: Common,
+    },
+    /// Recursion depth and stack size of a described pipeline (or of loose
+    /// shaders, assuming every trace reaches every shader).
+    Stack {
+        #[command(flatten)]
+        common: Common,
+        /// Create the pipeline on the Vulkan device and show what the driver
+        /// reports (`vkGetRayTracingShaderGroupStackSizeKHR`) beside the model.
+        #[arg(long)]
+        driver: bool,
     },
     /// Print payload, attribute and shader-record layouts with the best member order.
     Layout {
@@ -95,7 +114,10 @@ fn run(cli: Cli) -> Result<u8, String> {
             common,
             payload_budget,
             deny_warnings,
-        } => check(common, payload_budget, deny_warnings),
+            pipeline,
+        } => check(common, payload_budget, deny_warnings, pipeline),
+        Command::Live { common } => live(common),
+        Command::Stack { common, driver } => stack(common, driver),
         Command::Layout { common } => layout(common),
         Command::Rules => {
             let mut out = std::io::stdout().lock();
@@ -168,13 +190,19 @@ fn setup(common: &Common) -> Result<Setup, String> {
     })
 }
 
-fn check(common: Common, payload_budget: Option<u64>, deny_warnings: bool) -> Result<u8, String> {
+fn check(
+    common: Common,
+    payload_budget: Option<u64>,
+    deny_warnings: bool,
+    pipelines: Vec<PathBuf>,
+) -> Result<u8, String> {
     let Setup {
         format,
         mut config,
-        inputs,
+        mut inputs,
         errors,
     } = setup(&common)?;
+    inputs.pipelines.extend(pipelines);
     if let Some(b) = payload_budget {
         config.payload_budget = b;
     }
@@ -189,7 +217,10 @@ fn check(common: Common, payload_budget: Option<u64>, deny_warnings: bool) -> Re
         }
         diagnostics.extend(checked.diagnostics);
     }
-    let summary = Summary::count(inputs.files.len(), &diagnostics);
+    for p in &inputs.pipelines {
+        diagnostics.extend(lint::check_pipeline(p, &config).diagnostics);
+    }
+    let summary = Summary::count(inputs.files.len() + inputs.pipelines.len(), &diagnostics);
     emit(
         format,
         &diagnostics,
@@ -286,6 +317,140 @@ fn layout(common: Common) -> Result<u8, String> {
             let mut sources = Sources::default();
             report::human::render(&problems, &mut sources, &mut out).map_err(|e| e.to_string())?;
         }
+    }
+    Ok(if problems.is_empty() { 0 } else { 2 })
+}
+
+fn live(common: Common) -> Result<u8, String> {
+    let Setup {
+        format,
+        inputs,
+        errors,
+        ..
+    } = setup(&common)?;
+    let mut problems: Vec<Diagnostic> = errors;
+    problems.extend(inputs.errors.iter().map(|e| (*e.0).clone()));
+    let mut programs = Vec::new();
+    for input in &inputs.files {
+        match rtlint::front::load(&input.path, input.language) {
+            Ok(p) => programs.push(p),
+            Err(InputError(d)) => problems.push(*d),
+        }
+    }
+    let report = rtlint::analysis::live_report(&programs);
+    print_report(
+        format,
+        &report,
+        rtlint::analysis::liveness::render_human(&report),
+        &problems,
+    )
+}
+
+fn stack(common: Common, driver: bool) -> Result<u8, String> {
+    let Setup {
+        format,
+        inputs,
+        errors,
+        ..
+    } = setup(&common)?;
+    let mut problems: Vec<Diagnostic> = errors;
+    problems.extend(inputs.errors.iter().map(|e| (*e.0).clone()));
+    let mut pipelines = Vec::new();
+    for p in &inputs.pipelines {
+        match rtlint::pipeline::load(p) {
+            Ok(p) => pipelines.push(p),
+            Err(InputError(d)) => problems.push(*d),
+        }
+    }
+    // Loose shaders: one conservative pipeline over all of them.
+    if !inputs.files.is_empty() {
+        let mut programs = Vec::new();
+        for input in &inputs.files {
+            match rtlint::front::load(&input.path, input.language) {
+                Ok(p) => programs.push(p),
+                Err(InputError(d)) => problems.push(*d),
+            }
+        }
+        if !programs.is_empty() {
+            pipelines.push(rtlint::pipeline::Pipeline::from_programs(programs));
+        }
+    }
+    #[cfg(feature = "vulkan")]
+    let device = if driver {
+        Some(rtlint::vk::Context::new().map_err(|e| format!("--driver: {e}"))?)
+    } else {
+        None
+    };
+    #[cfg(not(feature = "vulkan"))]
+    if driver {
+        return Err("--driver needs rtlint built with the `vulkan` feature".into());
+    }
+    let mut reports = Vec::new();
+    for p in &pipelines {
+        #[allow(unused_mut)]
+        let mut r = rtlint::analysis::stack_report(p);
+        #[cfg(feature = "vulkan")]
+        if let Some(ctx) = &device {
+            let sizes = rtlint::vk::driver_stack_sizes(ctx, p).map_err(|e| {
+                format!(
+                    "--driver: creating the pipeline on {} failed: {e}",
+                    ctx.info().name
+                )
+            })?;
+            rtlint::analysis::stack::attach_driver(&mut r, p, &sizes);
+            r.assumptions.push(format!(
+                "driver: {} ({})",
+                ctx.info().name,
+                ctx.info().driver
+            ));
+        }
+        reports.push(r);
+    }
+    let human: String = reports
+        .iter()
+        .map(rtlint::analysis::stack::render_human)
+        .collect::<Vec<_>>()
+        .join("\n");
+    let value = if reports.len() == 1 {
+        serde_json::to_value(&reports[0])
+    } else {
+        serde_json::to_value(&reports)
+    }
+    .map_err(|e| e.to_string())?;
+    print_report(format, &value, human, &problems)
+}
+
+/// Prints a report as JSON or text, then any input errors; exit 2 on errors.
+fn print_report<T: serde::Serialize>(
+    format: Format,
+    value: &T,
+    human: String,
+    problems: &[Diagnostic],
+) -> Result<u8, String> {
+    match format {
+        Format::Json => {
+            let mut v = serde_json::to_value(value).map_err(|e| e.to_string())?;
+            if let Some(obj) = v.as_object_mut() {
+                obj.insert(
+                    "errors".into(),
+                    serde_json::to_value(
+                        problems
+                            .iter()
+                            .map(report::json::diagnostic)
+                            .collect::<Vec<_>>(),
+                    )
+                    .map_err(|e| e.to_string())?,
+                );
+            }
+            println!("{}", serde_json::to_string_pretty(&v).unwrap_or_default());
+        }
+        Format::Human => {
+            let mut out = StandardStream::stdout(color_choice());
+            write!(out, "{human}").map_err(|e| e.to_string())?;
+            report::human::render(problems, &mut Sources::default(), &mut out)
+                .map_err(|e| e.to_string())?;
+        }
+        _ => return Err("this command prints human or json".into()),
     }
     Ok(if problems.is_empty() { 0 } else { 2 })
 }

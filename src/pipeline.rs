@@ -379,7 +379,7 @@ impl Loader<'_> {
         let cx = self.cx;
         let r = raw.get_ref();
         let dir = cx.path.parent().unwrap_or(Path::new(""));
-        let file = dir.join(r.file.get_ref());
+        let file = crate::spirv::debug::normalize(&dir.join(r.file.get_ref()));
         let here = cx.loc(r.file.span());
         let lang = Language::from_path(&file).ok_or_else(|| {
             cx.error(

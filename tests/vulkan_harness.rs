@@ -488,6 +488,7 @@ fn procedural_and_any_hit_groups_trace_as_the_geometry_says() {
                 Binding::new(1, BindingKind::StorageBuffer),
                 Binding::new(2, BindingKind::StorageBuffer),
             ],
+            push_constant_size: 0,
             stack_size: None,
         },
     )

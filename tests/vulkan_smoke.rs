@@ -124,6 +124,7 @@ fn create_pipeline(ctx: &Context, spirv: &[u32], stack_size: Option<u32>) -> Ray
             // The bounce loop lives in raygen; hit and miss shaders never trace.
             max_recursion_depth: 1,
             bindings: &bindings(),
+            push_constant_size: 0,
             stack_size,
         },
     )

@@ -182,7 +182,8 @@ pub fn check_program(program: &Program, config: &Config) -> Vec<Diagnostic> {
 pub fn check_pipeline(ctx: &PipelineContext) -> Vec<Diagnostic> {
     let mut out = Vec::new();
     for rule in RULES {
-        let (Kind::Pipeline(check), Some(severity)) = (rule.kind, configured(rule, ctx.config)) else {
+        let (Kind::Pipeline(check), Some(severity)) = (rule.kind, configured(rule, ctx.config))
+        else {
             continue;
         };
         for mut d in check(ctx) {

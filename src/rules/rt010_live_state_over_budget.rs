@@ -12,11 +12,16 @@ pub const LEVEL: Severity = Severity::Warning;
 /// step twice over.
 pub const DEFAULT_BUDGET_BYTES: u64 = 64;
 
-/// One finding per site whose state that cannot be recomputed (live bytes
-/// minus rematerializable bytes) exceeds `budget_bytes`.
+/// One finding per trace or callable site whose state that cannot be
+/// recomputed (live bytes minus rematerializable bytes) exceeds
+/// `budget_bytes`. Ray-query loops are left out: an inline query is no shader
+/// call, so its live values stay in registers rather than on a ray stack
+/// (`rtlint live` still lists them).
 pub fn check(program: &Program, sites: &[LiveSite], budget_bytes: u64) -> Vec<Diagnostic> {
     let mut out = Vec::new();
-    for site in sites.iter().filter(|s| s.path == program.path) {
+    for site in sites.iter().filter(|s| {
+        s.path == program.path && s.kind != crate::analysis::liveness::LiveSiteKind::RayQuery
+    }) {
         let kept = site.live_bytes - site.rematerializable_bytes;
         if kept <= budget_bytes {
             continue;
@@ -117,5 +122,9 @@ pub static RULE: super::Rule = super::Rule {
 };
 
 fn run(ctx: &super::Context) -> Vec<Diagnostic> {
-    check(ctx.program, &crate::analysis::liveness::live_sites(ctx.program), ctx.config.live_state_budget)
+    check(
+        ctx.program,
+        &crate::analysis::liveness::live_sites(ctx.program),
+        ctx.config.live_state_budget,
+    )
 }

@@ -98,5 +98,9 @@ pub static RULE: super::Rule = super::Rule {
 };
 
 fn run(ctx: &super::PipelineContext) -> Vec<Diagnostic> {
-    check(ctx.pipeline, &ctx.recursion, ctx.pipeline.device_max_recursion_depth)
+    check(
+        ctx.pipeline,
+        &ctx.recursion,
+        ctx.pipeline.device_max_recursion_depth,
+    )
 }

@@ -8,6 +8,29 @@ use std::path::{Path, PathBuf};
 /// exists, else beside the module, else its file name beside the module, else
 /// as written (the report then shows no snippet).
 pub fn resolve_path(named: &str, module_path: &Path) -> PathBuf {
+    normalize(&resolve_unnormalized(named, module_path))
+}
+
+/// Removes `.` and `name/..` lexically, so messages show `a/c` for `a/b/../c`.
+pub fn normalize(p: &Path) -> PathBuf {
+    use std::path::Component;
+    let mut out: Vec<Component> = Vec::new();
+    for c in p.components() {
+        match c {
+            Component::CurDir => {}
+            Component::ParentDir if matches!(out.last(), Some(Component::Normal(_))) => {
+                out.pop();
+            }
+            c => out.push(c),
+        }
+    }
+    if out.is_empty() {
+        return PathBuf::from(".");
+    }
+    out.iter().collect()
+}
+
+fn resolve_unnormalized(named: &str, module_path: &Path) -> PathBuf {
     let p = Path::new(named);
     if p.is_absolute() && p.exists() {
         return p.to_path_buf();

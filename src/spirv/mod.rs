@@ -246,6 +246,8 @@ pub struct Program {
     /// The language of the original source, from `OpSource` or the front-end.
     pub language: Language,
     pub version: (u8, u8),
+    /// The module as read, for handing to a driver.
+    pub words: Vec<u32>,
     pub insts: Vec<Instruction>,
     /// Word offset of each instruction in the binary.
     pub offsets: Vec<u32>,

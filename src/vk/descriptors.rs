@@ -62,7 +62,11 @@ pub(crate) struct Descriptors {
 }
 
 impl Descriptors {
-    pub(crate) fn new(shared: &Arc<Shared>, bindings: &[Binding]) -> Result<Self> {
+    pub(crate) fn new(
+        shared: &Arc<Shared>,
+        bindings: &[Binding],
+        push_constant_size: u32,
+    ) -> Result<Self> {
         for (k, b) in bindings.iter().enumerate() {
             if bindings[..k].iter().any(|o| o.binding == b.binding) {
                 return Err(Error::Invalid(format!(
@@ -100,9 +104,19 @@ impl Descriptors {
                 )
                 .map_err(vk_err("vkCreateDescriptorSetLayout"))?;
             let layouts = [this.set_layout];
+            let ranges = [vk::PushConstantRange::default()
+                .stage_flags(vk::ShaderStageFlags::ALL)
+                .size(push_constant_size)];
+            let ranges = if push_constant_size > 0 {
+                &ranges[..]
+            } else {
+                &[]
+            };
             this.pipeline_layout = device
                 .create_pipeline_layout(
-                    &vk::PipelineLayoutCreateInfo::default().set_layouts(&layouts),
+                    &vk::PipelineLayoutCreateInfo::default()
+                        .set_layouts(&layouts)
+                        .push_constant_ranges(ranges),
                     None,
                 )
                 .map_err(vk_err("vkCreatePipelineLayout"))?;

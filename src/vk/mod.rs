@@ -27,6 +27,7 @@ mod context;
 mod descriptors;
 mod error;
 mod pipeline;
+mod stack_query;
 mod validation;
 
 pub use accel::{Aabb, AccelerationStructure, Geometry, Instance, IDENTITY};
@@ -41,6 +42,7 @@ pub use pipeline::{
     ComputePipeline, Group, GroupStackSizes, RayTracingPipeline, RayTracingPipelineDesc, SbtLayout,
     SbtRegion, ShaderBindingTable, ShaderStage, Stage,
 };
+pub use stack_query::driver_stack_sizes;
 pub use validation::{ValidationLog, ValidationMessage};
 
 /// The raw Vulkan types (`ash::vk`), for flags and handles the harness passes through.

@@ -66,6 +66,8 @@ pub struct RayTracingPipelineDesc<'a> {
     pub max_recursion_depth: u32,
     /// Descriptor set 0.
     pub bindings: &'a [Binding],
+    /// Bytes of push constants the shaders read (0 for none).
+    pub push_constant_size: u32,
     /// When set, the stack size is dynamic state and every trace sets this
     /// many bytes (`vkCmdSetRayTracingPipelineStackSizeKHR`) instead of the
     /// driver's default.
@@ -216,7 +218,7 @@ impl RayTracingPipeline {
             )));
         }
         check_groups(desc)?;
-        let descriptors = Descriptors::new(shared, desc.bindings)?;
+        let descriptors = Descriptors::new(shared, desc.bindings, desc.push_constant_size)?;
 
         let mut modules = Modules {
             shared,
@@ -630,7 +632,7 @@ impl ComputePipeline {
         bindings: &[Binding],
     ) -> Result<Self> {
         let shared = &ctx.shared;
-        let descriptors = Descriptors::new(shared, bindings)?;
+        let descriptors = Descriptors::new(shared, bindings, 0)?;
         let mut modules = Modules {
             shared,
             modules: Vec::new(),
