@@ -12,14 +12,38 @@ use rtlint::report::{human, Sources};
 use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
 
-/// (line, code) pairs marked in a source file.
+/// (line, code) pairs marked in a source file (`//~ CODE` or `#~ CODE`).
 fn markers(source: &Path) -> BTreeSet<(u32, String)> {
+    placed_markers(source)
+        .into_iter()
+        .filter(|(p, _, _)| p == source)
+        .map(|(_, l, c)| (l, c))
+        .collect()
+}
+
+/// Markers with their file: `#~ CODE` on a line marks that line;
+/// `#~ CODE @ rel/path:LINE` marks a line of another file (a shader a
+/// pipeline description uses), relative to the marking file.
+fn placed_markers(source: &Path) -> BTreeSet<(PathBuf, u32, String)> {
     let text = std::fs::read_to_string(source).unwrap();
     let mut out = BTreeSet::new();
     for (i, line) in text.lines().enumerate() {
-        if let Some(at) = line.find("//~") {
-            for code in line[at + 3..].split_whitespace() {
-                out.insert((i as u32 + 1, code.to_string()));
+        let Some(at) = line.find("//~").or_else(|| line.find("#~")) else {
+            continue;
+        };
+        let rest = line[at..].trim_start_matches(['/', '#', '~']);
+        match rest.split_once('@') {
+            Some((codes, place)) => {
+                let (file, l) = place.trim().rsplit_once(':').unwrap();
+                let path = rtlint::spirv::debug::normalize(&source.parent().unwrap().join(file));
+                for code in codes.split_whitespace() {
+                    out.insert((path.clone(), l.parse().unwrap(), code.to_string()));
+                }
+            }
+            None => {
+                for code in rest.split_whitespace() {
+                    out.insert((source.to_path_buf(), i as u32 + 1, code.to_string()));
+                }
             }
         }
     }
@@ -29,7 +53,7 @@ fn markers(source: &Path) -> BTreeSet<(u32, String)> {
 /// Each module to check with the source holding its markers.
 fn cases() -> Vec<(PathBuf, PathBuf)> {
     let mut cases = Vec::new();
-    for dir in ["fixtures/wgsl", "fixtures/glsl"] {
+    for dir in ["fixtures/wgsl", "fixtures/glsl", "fixtures/RT010"] {
         let mut entries: Vec<PathBuf> = std::fs::read_dir(root().join(dir))
             .unwrap()
             .map(|e| e.unwrap().path())
@@ -42,6 +66,7 @@ fn cases() -> Vec<(PathBuf, PathBuf)> {
             } else if let Some(src) = name
                 .strip_suffix(".g.spv")
                 .or_else(|| name.strip_suffix(".gV.spv"))
+                .or_else(|| name.strip_suffix(".spv"))
             {
                 cases.push((p.clone(), p.with_file_name(src)));
             }
@@ -118,14 +143,77 @@ fn findings_match_markers_and_snapshots() {
     assert!(failures.is_empty(), "{}", failures.join("\n"));
 }
 
+/// Pipeline descriptions under fixtures/RT0xx: findings match their markers,
+/// wherever they land, and the rendered output matches its snapshot.
 #[test]
-fn every_module_rule_has_bad_and_good_fixtures() {
-    for rule in rtlint::rules::RULES {
-        if !matches!(rule.kind, rtlint::rules::Kind::Module(_)) {
-            continue;
+fn pipeline_findings_match_markers_and_snapshots() {
+    std::env::set_current_dir(root()).unwrap();
+    let config = Config::default();
+    let mut tomls: Vec<PathBuf> = std::fs::read_dir("fixtures")
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|d| d.file_name().unwrap().to_str().unwrap().starts_with("RT"))
+        .flat_map(|d| std::fs::read_dir(d).unwrap().map(|e| e.unwrap().path()))
+        .filter(|p| rtlint::lint::is_pipeline(p))
+        .collect();
+    tomls.sort();
+    assert!(tomls.len() >= 12, "{tomls:?}");
+    let mut failures = Vec::new();
+    for toml in tomls {
+        let checked = rtlint::lint::check_pipeline(&toml, &config);
+        let actual: BTreeSet<(PathBuf, u32, String)> = checked
+            .diagnostics
+            .iter()
+            .map(|d| {
+                assert!(d.code.is_some(), "{}: {d:?}", toml.display());
+                let p = d
+                    .primary
+                    .as_ref()
+                    .unwrap_or_else(|| panic!("{}: no position: {d:?}", toml.display()));
+                (
+                    p.location.path.clone(),
+                    p.location.line,
+                    d.code.unwrap().to_string(),
+                )
+            })
+            .collect();
+        for d in &checked.diagnostics {
+            style_problems(d, &mut failures);
         }
+        let expected = placed_markers(&toml);
+        if actual != expected {
+            failures.push(format!(
+                "{}: expected {expected:?}, got {actual:?}",
+                toml.display()
+            ));
+        }
+        let mut buf = codespan_reporting::term::termcolor::NoColor::new(Vec::new());
+        human::render(&checked.diagnostics, &mut Sources::default(), &mut buf).unwrap();
+        let name = toml.to_string_lossy().replace(['/', '\\'], "__");
+        common::snapshot(&name, &String::from_utf8(buf.into_inner()).unwrap());
+    }
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
+
+#[test]
+fn every_rule_has_bad_and_good_fixtures() {
+    for rule in rtlint::rules::RULES {
         let mut bad = false;
         let mut good = false;
+        // Per-rule folders: fixtures/RT0xx/bad.* and good.*.
+        if let Ok(rd) = std::fs::read_dir(root().join("fixtures").join(rule.code)) {
+            for e in rd {
+                let p = e.unwrap().path();
+                let name = p.file_name().unwrap().to_str().unwrap().to_string();
+                if name.ends_with(".spv") || name.ends_with(".sh") {
+                    continue;
+                }
+                if name.starts_with("bad") {
+                    bad |= placed_markers(&p).iter().any(|(_, _, c)| c == rule.code);
+                }
+                good |= name.starts_with("good");
+            }
+        }
         for dir in ["fixtures/wgsl", "fixtures/glsl"] {
             for e in std::fs::read_dir(root().join(dir)).unwrap() {
                 let p = e.unwrap().path();
