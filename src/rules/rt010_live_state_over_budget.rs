@@ -79,6 +79,24 @@ pub fn check(program: &Program, sites: &[LiveSite], budget_bytes: u64) -> Vec<Di
     out
 }
 
+pub static RULE: super::Rule = super::Rule {
+    code: CODE,
+    name: NAME,
+    group: super::Group::Perf,
+    level: LEVEL,
+    summary: "state kept alive across a trace call above the budget",
+    doc: include_str!("../../rules/RT010.md"),
+    kind: super::Kind::Module(run),
+};
+
+fn run(ctx: &super::Context) -> Vec<Diagnostic> {
+    check(
+        ctx.program,
+        &crate::analysis::liveness::live_sites(ctx.program),
+        ctx.config.live_state_budget,
+    )
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -109,22 +127,4 @@ mod tests {
         assert_eq!(run("fixtures/live/seed.rchit.spv", 11).len(), 1);
         assert!(run("fixtures/live/seed.rchit.spv", 12).is_empty());
     }
-}
-
-pub static RULE: super::Rule = super::Rule {
-    code: CODE,
-    name: NAME,
-    group: super::Group::Perf,
-    level: LEVEL,
-    summary: "state kept alive across a trace call above the budget",
-    doc: include_str!("../../rules/RT010.md"),
-    kind: super::Kind::Module(run),
-};
-
-fn run(ctx: &super::Context) -> Vec<Diagnostic> {
-    check(
-        ctx.program,
-        &crate::analysis::liveness::live_sites(ctx.program),
-        ctx.config.live_state_budget,
-    )
 }

@@ -65,6 +65,20 @@ pub fn check(pipeline: &Pipeline, rec: &RecursionReport) -> Vec<Diagnostic> {
     out
 }
 
+pub static RULE: super::Rule = super::Rule {
+    code: CODE,
+    name: NAME,
+    group: super::Group::Perf,
+    level: LEVEL,
+    summary: "trace call from a closest-hit or miss shader",
+    doc: include_str!("../../rules/RT020.md"),
+    kind: super::Kind::Pipeline(run),
+};
+
+fn run(ctx: &super::PipelineContext) -> Vec<Diagnostic> {
+    check(ctx.pipeline, &ctx.recursion)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -90,18 +104,4 @@ mod tests {
         // The iterative pipeline's closest-hit shader traces only a shadow ray.
         assert!(run("fixtures/RT020/good.pipeline.toml").is_empty());
     }
-}
-
-pub static RULE: super::Rule = super::Rule {
-    code: CODE,
-    name: NAME,
-    group: super::Group::Perf,
-    level: LEVEL,
-    summary: "trace call from a closest-hit or miss shader",
-    doc: include_str!("../../rules/RT020.md"),
-    kind: super::Kind::Pipeline(run),
-};
-
-fn run(ctx: &super::PipelineContext) -> Vec<Diagnostic> {
-    check(ctx.pipeline, &ctx.recursion)
 }

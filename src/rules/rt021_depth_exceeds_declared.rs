@@ -47,6 +47,20 @@ pub fn check(pipeline: &Pipeline, rec: &RecursionReport) -> Vec<Diagnostic> {
     .with_help(format!("set `max_recursion_depth = {required}` (maxPipelineRayRecursionDepth)"))]
 }
 
+pub static RULE: super::Rule = super::Rule {
+    code: CODE,
+    name: NAME,
+    group: super::Group::Correctness,
+    level: LEVEL,
+    summary: "pipeline needs more recursion than it declares",
+    doc: include_str!("../../rules/RT021.md"),
+    kind: super::Kind::Pipeline(run),
+};
+
+fn run(ctx: &super::PipelineContext) -> Vec<Diagnostic> {
+    check(ctx.pipeline, &ctx.recursion)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -72,18 +86,4 @@ mod tests {
         assert_eq!(d[0].secondary.len(), 1);
         assert!(run("fixtures/RT021/good.pipeline.toml").is_empty());
     }
-}
-
-pub static RULE: super::Rule = super::Rule {
-    code: CODE,
-    name: NAME,
-    group: super::Group::Correctness,
-    level: LEVEL,
-    summary: "pipeline needs more recursion than it declares",
-    doc: include_str!("../../rules/RT021.md"),
-    kind: super::Kind::Pipeline(run),
-};
-
-fn run(ctx: &super::PipelineContext) -> Vec<Diagnostic> {
-    check(ctx.pipeline, &ctx.recursion)
 }

@@ -44,6 +44,20 @@ pub fn check(pipeline: &Pipeline, rec: &RecursionReport, stack: &StackReport) ->
     ))]
 }
 
+pub static RULE: super::Rule = super::Rule {
+    code: CODE,
+    name: NAME,
+    group: super::Group::Perf,
+    level: LEVEL,
+    summary: "declared recursion depth above what the pipeline needs",
+    doc: include_str!("../../rules/RT022.md"),
+    kind: super::Kind::Pipeline(run),
+};
+
+fn run(ctx: &super::PipelineContext) -> Vec<Diagnostic> {
+    check(ctx.pipeline, &ctx.recursion, &ctx.stack)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -72,18 +86,4 @@ mod tests {
         );
         assert!(run("fixtures/RT022/good.pipeline.toml").is_empty());
     }
-}
-
-pub static RULE: super::Rule = super::Rule {
-    code: CODE,
-    name: NAME,
-    group: super::Group::Perf,
-    level: LEVEL,
-    summary: "declared recursion depth above what the pipeline needs",
-    doc: include_str!("../../rules/RT022.md"),
-    kind: super::Kind::Pipeline(run),
-};
-
-fn run(ctx: &super::PipelineContext) -> Vec<Diagnostic> {
-    check(ctx.pipeline, &ctx.recursion, &ctx.stack)
 }

@@ -58,6 +58,24 @@ pub fn check(pipeline: &Pipeline, rec: &RecursionReport, device_limit: u32) -> V
     out
 }
 
+pub static RULE: super::Rule = super::Rule {
+    code: CODE,
+    name: NAME,
+    group: super::Group::Correctness,
+    level: LEVEL,
+    summary: "recursion depth above the device limit",
+    doc: include_str!("../../rules/RT023.md"),
+    kind: super::Kind::Pipeline(run),
+};
+
+fn run(ctx: &super::PipelineContext) -> Vec<Diagnostic> {
+    check(
+        ctx.pipeline,
+        &ctx.recursion,
+        ctx.pipeline.device_max_recursion_depth,
+    )
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -85,22 +103,4 @@ mod tests {
         assert!(run("fixtures/RT023/good.pipeline.toml").is_empty());
         assert_eq!(DEFAULT_DEVICE_MAX_RECURSION_DEPTH, 31);
     }
-}
-
-pub static RULE: super::Rule = super::Rule {
-    code: CODE,
-    name: NAME,
-    group: super::Group::Correctness,
-    level: LEVEL,
-    summary: "recursion depth above the device limit",
-    doc: include_str!("../../rules/RT023.md"),
-    kind: super::Kind::Pipeline(run),
-};
-
-fn run(ctx: &super::PipelineContext) -> Vec<Diagnostic> {
-    check(
-        ctx.pipeline,
-        &ctx.recursion,
-        ctx.pipeline.device_max_recursion_depth,
-    )
 }

@@ -72,6 +72,20 @@ pub fn check(pipeline: &Pipeline, rec: &RecursionReport) -> Vec<Diagnostic> {
     out
 }
 
+pub static RULE: super::Rule = super::Rule {
+    code: CODE,
+    name: NAME,
+    group: super::Group::Perf,
+    level: LEVEL,
+    summary: "bounce loop or recursion with no bound known at compile time",
+    doc: include_str!("../../rules/RT024.md"),
+    kind: super::Kind::Pipeline(run),
+};
+
+fn run(ctx: &super::PipelineContext) -> Vec<Diagnostic> {
+    check(ctx.pipeline, &ctx.recursion)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -106,18 +120,4 @@ mod tests {
         // The reference pipeline's loop is bounded by its description.
         assert!(run("shaders/reflect_iterative.pipeline.toml").is_empty());
     }
-}
-
-pub static RULE: super::Rule = super::Rule {
-    code: CODE,
-    name: NAME,
-    group: super::Group::Perf,
-    level: LEVEL,
-    summary: "bounce loop or recursion with no bound known at compile time",
-    doc: include_str!("../../rules/RT024.md"),
-    kind: super::Kind::Pipeline(run),
-};
-
-fn run(ctx: &super::PipelineContext) -> Vec<Diagnostic> {
-    check(ctx.pipeline, &ctx.recursion)
 }

@@ -62,6 +62,20 @@ pub fn check(pipeline: &Pipeline, stack: &StackReport, limit_bytes: u64) -> Vec<
     vec![d.with_help(help)]
 }
 
+pub static RULE: super::Rule = super::Rule {
+    code: CODE,
+    name: NAME,
+    group: super::Group::Correctness,
+    level: LEVEL,
+    summary: "default pipeline stack above what the device is known to survive",
+    doc: include_str!("../../rules/RT025.md"),
+    kind: super::Kind::Pipeline(run),
+};
+
+fn run(ctx: &super::PipelineContext) -> Vec<Diagnostic> {
+    check(ctx.pipeline, &ctx.stack, ctx.config.stack_limit)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -102,18 +116,4 @@ mod tests {
             Some("set the stack explicitly: vkCmdSetRayTracingPipelineStackSizeKHR(cmd, 1792) or SetPipelineStackSize(1792)")
         );
     }
-}
-
-pub static RULE: super::Rule = super::Rule {
-    code: CODE,
-    name: NAME,
-    group: super::Group::Correctness,
-    level: LEVEL,
-    summary: "default pipeline stack above what the device is known to survive",
-    doc: include_str!("../../rules/RT025.md"),
-    kind: super::Kind::Pipeline(run),
-};
-
-fn run(ctx: &super::PipelineContext) -> Vec<Diagnostic> {
-    check(ctx.pipeline, &ctx.stack, ctx.config.stack_limit)
 }
