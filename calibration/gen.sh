@@ -1,0 +1,79 @@
+#!/usr/bin/env bash
+# Generates the stack-calibration pipelines: for each payload size, a leaf
+# pipeline (closest-hit writes the payload) and a recursive one (closest-hit
+# traces once more with the same payload, guarded by a constant depth), as
+# GLSL, SPIR-V (glslang) and *.pipeline.toml. `rtlint stack --driver` on the
+# NVIDIA machine compares the model with the driver on each (see README.md).
+set -euo pipefail
+cd "$(dirname "$0")"
+rm -f *.rgen *.rchit *.rmiss *.spv *.pipeline.toml
+for bytes in 4 8 16 32 48 64 96 128 192 256; do
+    words=$((bytes / 4))
+    payload="struct Payload { uint data[$words]; };"
+    cat >p$bytes.rgen <<EOF
+#version 460
+#extension GL_EXT_ray_tracing : require
+$payload
+layout(location = 0) rayPayloadEXT Payload payload;
+layout(set = 0, binding = 0) uniform accelerationStructureEXT tlas;
+layout(set = 0, binding = 1) buffer Out { uint value[]; } result;
+void main() {
+    payload.data[0] = 0u;
+    traceRayEXT(tlas, gl_RayFlagsOpaqueEXT, 0xFF, 0, 0, 0, vec3(0.0, 1.0, 4.0), 0.001, vec3(0.0, 0.0, -1.0), 100.0, 0);
+    result.value[gl_LaunchIDEXT.y * gl_LaunchSizeEXT.x + gl_LaunchIDEXT.x] = payload.data[$words - 1] + payload.data[0];
+}
+EOF
+    cat >p$bytes.rmiss <<EOF
+#version 460
+#extension GL_EXT_ray_tracing : require
+$payload
+layout(location = 0) rayPayloadInEXT Payload payload;
+void main() {
+    for (uint i = 0u; i < $words; i++) { payload.data[i] = 7u; }
+}
+EOF
+    cat >p$bytes.leaf.rchit <<EOF
+#version 460
+#extension GL_EXT_ray_tracing : require
+$payload
+layout(location = 0) rayPayloadInEXT Payload payload;
+void main() {
+    for (uint i = 0u; i < $words; i++) { payload.data[i] = i + 1u; }
+}
+EOF
+    cat >p$bytes.pass.rchit <<EOF
+#version 460
+#extension GL_EXT_ray_tracing : require
+$payload
+layout(location = 0) rayPayloadInEXT Payload payload;
+layout(location = 1) rayPayloadEXT Payload next;
+layout(set = 0, binding = 0) uniform accelerationStructureEXT tlas;
+void main() {
+    // Depth is kept in data[0]; one more level at most.
+    if (payload.data[0] < 1u) {
+        next.data[0] = payload.data[0] + 1u;
+        traceRayEXT(tlas, gl_RayFlagsOpaqueEXT, 0xFF, 0, 0, 0, gl_WorldRayOriginEXT, 0.001, gl_WorldRayDirectionEXT, 100.0, 1);
+        payload.data[$words - 1] = next.data[$words - 1] + 1u;
+    }
+}
+EOF
+    for kind in leaf pass; do
+        cat >p$bytes.$kind.pipeline.toml <<EOF
+# Calibration: $bytes-byte payload, closest-hit $kind.
+max_recursion_depth = $([ $kind = pass ] && echo 2 || echo 1)
+
+[[raygen]]
+file = "p$bytes.rgen.spv"
+
+[[miss]]
+file = "p$bytes.rmiss.spv"
+
+[[hit_group]]
+closest_hit = { file = "p$bytes.$kind.rchit.spv" }
+EOF
+    done
+done
+for f in *.rgen *.rchit *.rmiss; do
+    glslangValidator --target-env vulkan1.2 -V -g "$f" -o "$f.spv" >/dev/null
+done
+echo "generated $(ls *.pipeline.toml | wc -l) pipelines"
