@@ -10,5 +10,8 @@ void main() {
         next.data[0] = payload.data[0] + 1u;
         traceRayEXT(tlas, gl_RayFlagsOpaqueEXT, 0xFF, 0, 0, 0, gl_WorldRayOriginEXT, 0.001, gl_WorldRayDirectionEXT, 100.0, 1);
         payload.data[64 - 1] = next.data[64 - 1] + 1u;
+    } else {
+        // The deepest level: the result is 1000 + the levels above it.
+        payload.data[64 - 1] = 1000u;
     }
 }

@@ -2,7 +2,9 @@
 //! size, to find where a driver's default stack stops running (rule RT025).
 //! Run each trial in its own process: a lost device does not come back.
 //!
-//! `cargo run --release --example stack_probe -- PIPELINE.toml DEPTH STACK|default [WIDTH HEIGHT]`
+//! `cargo run --release --example stack_probe -- PIPELINE.toml DEPTH STACK|default [WIDTH HEIGHT [EXPECT]]`
+//! With EXPECT, also counts the pixels whose value is EXPECT (the calibration
+//! pipelines write 1000 + the number of recursion levels).
 //! Prints one line `depth=D stack=S default_model=M result=ok|lost|error:...` and
 //! exits 0 when the trace ran, 3 when the device was lost, 1 otherwise.
 
@@ -22,6 +24,7 @@ fn main() {
     let stack: Option<u32> = (a[3] != "default").then(|| a[3].parse().expect("stack bytes"));
     let width: u32 = a.get(4).map_or(512, |s| s.parse().unwrap());
     let height: u32 = a.get(5).map_or(512, |s| s.parse().unwrap());
+    let expect: Option<u32> = a.get(6).map(|s| s.parse().unwrap());
     let pipeline = rtlint::pipeline::load(Path::new(&a[1])).unwrap_or_else(|e| panic!("{e}"));
     let program = |s: &rtlint::pipeline::ShaderRef| &pipeline.program(s).expect("program").words;
     let (rg, ms, ch) = (
@@ -128,7 +131,14 @@ fn main() {
         Ok(t) => {
             let v = out.read_u32();
             let nonzero = v.iter().filter(|x| **x != 0).count();
-            line(&format!("ok gpu_ms={:.3} nonzero={nonzero}/{}", t.as_secs_f64() * 1e3, v.len()));
+            let correct = expect.map_or(String::new(), |e| {
+                format!(" correct={}/{}", v.iter().filter(|x| **x == e).count(), v.len())
+            });
+            line(&format!(
+                "ok gpu_ms={:.3} nonzero={nonzero}/{}{correct}",
+                t.as_secs_f64() * 1e3,
+                v.len()
+            ));
         }
         Err(e) => {
             let lost = e.to_string().contains("DEVICE_LOST");
