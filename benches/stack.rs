@@ -58,7 +58,10 @@ fn main() {
     if let Some(c) = &ctx {
         println!("device: {} ({})", c.info().name, c.info().driver);
     }
-    println!("{:<48} {:>10} {:>12} {:>9}", "pipeline", "model ms", "driver ms", "ratio");
+    println!(
+        "{:<48} {:>10} {:>12} {:>9}",
+        "pipeline", "model ms", "driver ms", "ratio"
+    );
     let (mut tm, mut td) = (Duration::ZERO, Duration::ZERO);
     for p in &paths {
         let pipeline = rtlint::pipeline::load(p).unwrap_or_else(|e| panic!("{e}"));
@@ -77,7 +80,10 @@ fn main() {
             p.display(),
             model.as_secs_f64() * 1e3,
             driver.map_or("-".into(), |d| format!("{:.3}", d.as_secs_f64() * 1e3)),
-            driver.map_or("-".into(), |d| format!("{:.1}x", d.as_secs_f64() / model.as_secs_f64()))
+            driver.map_or("-".into(), |d| format!(
+                "{:.1}x",
+                d.as_secs_f64() / model.as_secs_f64()
+            ))
         );
     }
     if ctx.is_some() {

@@ -9,8 +9,8 @@
 //! exits 0 when the trace ran, 3 when the device was lost, 1 otherwise.
 
 use rtlint::vk::{
-    raw, AccelerationStructure, Buffer, Context, Geometry, Group, Instance, RayTracingPipeline, RayTracingPipelineDesc,
-    Resource, ShaderStage, Stage,
+    raw, AccelerationStructure, Buffer, Context, Geometry, Group, Instance, RayTracingPipeline,
+    RayTracingPipelineDesc, Resource, ShaderStage, Stage,
 };
 use std::path::Path;
 
@@ -30,7 +30,10 @@ fn main() {
     let (rg, ms, ch) = (
         &pipeline.raygen[0],
         &pipeline.miss[0],
-        pipeline.hit_groups[0].closest_hit.as_ref().expect("closest hit"),
+        pipeline.hit_groups[0]
+            .closest_hit
+            .as_ref()
+            .expect("closest hit"),
     );
     // What the model says the driver's default would be at this depth.
     let model = rtlint::analysis::stack_report(&pipeline);
@@ -62,7 +65,12 @@ fn main() {
         std::process::exit(1)
     });
     // A quad in front of the camera so every ray hits and recurses once.
-    let positions = [[-50.0, -50.0, 0.0], [50.0, -50.0, 0.0], [50.0, 50.0, 0.0], [-50.0, 50.0, 0.0]];
+    let positions = [
+        [-50.0, -50.0, 0.0],
+        [50.0, -50.0, 0.0],
+        [50.0, 50.0, 0.0],
+        [-50.0, 50.0, 0.0],
+    ];
     let indices = [0, 1, 2, 0, 2, 3];
     let blas = AccelerationStructure::bottom_level(
         &ctx,
@@ -126,13 +134,20 @@ fn main() {
         1,
     )
     .expect("buffer");
-    let resources = [(0, Resource::AccelerationStructure(&tlas)), (1, Resource::Buffer(&out))];
+    let resources = [
+        (0, Resource::AccelerationStructure(&tlas)),
+        (1, Resource::Buffer(&out)),
+    ];
     match rt.trace_rays(&resources, width, height, 1) {
         Ok(t) => {
             let v = out.read_u32();
             let nonzero = v.iter().filter(|x| **x != 0).count();
             let correct = expect.map_or(String::new(), |e| {
-                format!(" correct={}/{}", v.iter().filter(|x| **x == e).count(), v.len())
+                format!(
+                    " correct={}/{}",
+                    v.iter().filter(|x| **x == e).count(),
+                    v.len()
+                )
             });
             line(&format!(
                 "ok gpu_ms={:.3} nonzero={nonzero}/{}{correct}",
@@ -142,7 +157,11 @@ fn main() {
         }
         Err(e) => {
             let lost = e.to_string().contains("DEVICE_LOST");
-            line(&if lost { format!("lost ({e})") } else { format!("error:{e}") });
+            line(&if lost {
+                format!("lost ({e})")
+            } else {
+                format!("error:{e}")
+            });
             std::process::exit(if lost { 3 } else { 1 });
         }
     }

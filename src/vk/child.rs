@@ -4,7 +4,7 @@
 //!
 //! The child is the current test binary re-run on one test:
 //!
-//! ```ignore
+//! ```text
 //! #[test]
 //! fn deep_recursion() {
 //!     if let Some(outcome) = rtlint::vk::run_in_child("deep_recursion") {
