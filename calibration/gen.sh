@@ -124,6 +124,41 @@ EOF
     printf '# Calibration: %s floats live across the trace in closest-hit.\nmax_recursion_depth = 2\n\n[[raygen]]\nfile = "p16.rgen.spv"\n\n[[miss]]\nfile = "p16.rmiss.spv"\n\n[[hit_group]]\nclosest_hit = { file = "c%s.rchit.spv" }\n' "$k" "$k" >"c$k.pipeline.toml"
 done
 
+# Live state of K independent values in ray generation: each comes from its
+# own word of a 128-byte payload, so no compiler can recompute it from fewer.
+# m*: across a second trace; n*: carried around a bounce loop.
+for k in 6 9 10 11 12 13 14 16 20 24 32; do
+    decl=""; use=""; upd=""; init=""
+    for i in $(seq 0 $((k - 1))); do
+        decl="$decl    float v$i = float(payload.data[$i]) * $i.5;
+"
+        init="$init    float v$i = 0.0;
+"
+        upd="$upd        v$i = v$i * 0.5 + float(payload.data[$i]);
+"
+        use="$use + v$i"
+    done
+    head=$(cat <<EOF
+#version 460
+#extension GL_EXT_ray_tracing : require
+struct Payload { uint data[32]; };
+layout(location = 0) rayPayloadEXT Payload payload;
+layout(set = 0, binding = 0) uniform accelerationStructureEXT tlas;
+layout(set = 0, binding = 1) buffer Out { uint value[]; } result;
+EOF
+)
+    trace='traceRayEXT(tlas, gl_RayFlagsOpaqueEXT, 0xFF, 0, 0, 0, vec3(0.0, 1.0, 4.0), 0.001, vec3(0.0, 0.0, -1.0), 100.0, 0);'
+    store='result.value[gl_LaunchIDEXT.y * gl_LaunchSizeEXT.x + gl_LaunchIDEXT.x]'
+    printf '%s\nvoid main() {\n    payload.data[0] = 0u;\n    %s\n%s    %s\n    %s = uint(0.0%s) + payload.data[1];\n}\n' \
+        "$head" "$trace" "$decl" "$trace" "$store" "$use" >m$k.rgen
+    printf '%s\nvoid main() {\n%s    for (uint bounce = 0u; bounce < 3u; bounce++) {\n        payload.data[0] = bounce;\n        %s\n%s    }\n    %s = uint(0.0%s);\n}\n' \
+        "$head" "$init" "$trace" "$upd" "$store" "$use" >n$k.rgen
+    for kind in m n; do
+        printf '# Calibration: %s independent values live in raygen (%s).\nmax_recursion_depth = 1\n\n[[raygen]]\nfile = "%s%s.rgen.spv"\n\n[[miss]]\nfile = "p128.rmiss.spv"\n\n[[hit_group]]\nclosest_hit = { file = "p128.leaf.rchit.spv" }\n' \
+            "$k" "$([ $kind = m ] && echo 'across a second trace' || echo 'carried around a loop')" "$kind" "$k" >"$kind$k.pipeline.toml"
+    done
+done
+
 for f in *.rgen *.rchit *.rmiss; do
     glslangValidator --target-env vulkan1.2 -V -g "$f" -o "$f.spv" >/dev/null
 done
