@@ -1066,7 +1066,8 @@ pub fn trace_loops(
 }
 
 /// Natural loops: header block and body blocks, one per back edge target.
-fn natural_loops(f: &Function) -> Vec<(usize, HashSet<usize>)> {
+/// Natural loops of a function: header block and body blocks.
+pub(crate) fn natural_loops(f: &Function) -> Vec<(usize, HashSet<usize>)> {
     let idom = dominators(f);
     let mut preds = vec![Vec::new(); f.blocks.len()];
     for (b, block) in f.blocks.iter().enumerate() {

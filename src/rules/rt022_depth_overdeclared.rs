@@ -79,10 +79,10 @@ mod tests {
             d[0].message,
             "declared recursion depth 8 is above the 2 the pipeline needs"
         );
-        // 32 + 1 × 32 + 7 × 32 against 32 + 1 × 32 + 1 × 32.
+        // 64 + 1 × 32 + 7 × 32 against 64 + 1 × 32 + 1 × 32.
         assert_eq!(
             d[0].notes[1],
-            "the default stack is 288 bytes per thread at depth 8 and 96 at depth 2 (driver-comparable model)"
+            "the default stack is 320 bytes per thread at depth 8 and 128 at depth 2 (driver-comparable model)"
         );
         assert!(run("fixtures/RT022/good.pipeline.toml").is_empty());
     }
