@@ -661,8 +661,11 @@ fn fence_timeout_is_an_error_not_a_hang() {
         );
         return;
     }
+    // Headroom for the short run, whose first dispatch includes Mesa's shader
+    // compile (up to a second on a loaded 2-core machine); the long run needs
+    // minutes.
     let ctx = Context::with_options(&ContextOptions {
-        fence_timeout: Duration::from_millis(100),
+        fence_timeout: Duration::from_secs(5),
         ..ContextOptions::default()
     })
     .unwrap();
@@ -696,9 +699,10 @@ fn fence_timeout_is_an_error_not_a_hang() {
     assert_eq!(out.read_u32(), (0..64).map(lcg).collect::<Vec<_>>());
     // About 2^32 steps per thread: minutes on lavapipe.
     let start = Instant::now();
-    let err = run(u32::MAX).expect_err("a four-billion-step loop outruns 100 ms");
+    let err = run(u32::MAX).expect_err("a four-billion-step loop outruns 5 s");
     assert!(matches!(err, Error::Timeout { .. }), "{err}");
-    assert!(start.elapsed() < Duration::from_secs(10));
+    // The wait ends at the timeout, not when the GPU finishes.
+    assert!(start.elapsed() < Duration::from_secs(60));
     drop((pipeline, out, ctx));
     println!("timed out as expected: {err}");
 }
