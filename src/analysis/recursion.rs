@@ -649,6 +649,43 @@ fn relations(program: &Program, cond: Id, want: bool, out: &mut Vec<Rel>, depth:
     let Some(inst) = program.def(cond) else {
         return;
     };
+    if inst.class.opcode == Op::Load {
+        // A bool kept in a local: naga lowers `a && b` to `if a { t = b }
+        // else { t = false }` and branches on `t`. Where exactly one store
+        // can give the wanted value, the branch implies that stored value.
+        let Some(ptr) = ids(inst).next() else { return };
+        let Some(var) = program.def(ptr).filter(|d| {
+            d.class.opcode == Op::Variable
+                && matches!(
+                    d.operands.first(),
+                    Some(rspirv::dr::Operand::StorageClass(
+                        spirv::StorageClass::Function
+                    ))
+                )
+        }) else {
+            return;
+        };
+        let initializer = ids(var).next();
+        let stores = program.insts.iter().filter_map(|i| {
+            let mut o = ids(i);
+            (i.class.opcode == Op::Store && o.next() == Some(ptr))
+                .then(|| o.next())
+                .flatten()
+        });
+        let possible: Vec<Id> = stores
+            .chain(initializer)
+            .filter(|v| {
+                // A null bool is false.
+                let c = program.constants.get(v);
+                c != Some(&crate::spirv::Constant::Bool(!want))
+                    && !(want && c == Some(&crate::spirv::Constant::Null))
+            })
+            .collect();
+        if let [only] = possible.as_slice() {
+            relations(program, *only, want, out, depth + 1);
+        }
+        return;
+    }
     let v: Vec<Id> = ids(inst).collect();
     let (a, b) = match v.as_slice() {
         [a, b] => (*a, *b),
@@ -1257,6 +1294,20 @@ mod tests {
         assert_eq!(
             none[0].bound.as_ref().unwrap_err(),
             "the loop runs while `bounce` is below uniform value `params.max_bounces`, which the pipeline description does not give"
+        );
+    }
+
+    #[test]
+    fn guard_behind_a_short_circuit_and() {
+        // `if reflectivity > 0.0 && incoming.depth < params.max_bounces`:
+        // naga stores the second comparison (or `false`) in a local bool and
+        // branches on it; the branch still implies the comparison.
+        let r = recursion(&pipeline("shaders/reflect_recursive.pipeline.toml"));
+        assert_eq!(r.required_depth, Some(4));
+        let g = r.cycles[0].sites[0].guard.as_ref().unwrap();
+        assert_eq!(
+            (g.counter.as_str(), g.bound, g.traces),
+            ("incoming.depth", 3, 3)
         );
     }
 
