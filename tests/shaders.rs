@@ -21,13 +21,27 @@ fn bundled_wgsl_shaders_are_valid_and_clean() {
     assert!(n >= 3, "expected the reference shaders, found {n}");
 }
 
+/// The README's first command: the three shaders and two pipeline
+/// descriptions lint with one finding, the recursion the recursive
+/// reference exists to show (its depth guard recognised: depth 4).
 #[test]
-fn main_job_runs_clean() {
+fn main_job_reports_the_recursive_reference() {
     let o = common::rtlint()
-        .args(["check", "shaders/"])
+        .args(["check", "--format", "json", "shaders/"])
         .output()
         .unwrap();
-    let text = String::from_utf8_lossy(&o.stdout);
-    assert_eq!(o.status.code(), Some(0), "{text}");
-    assert!(text.contains("0 errors, 0 warnings in"), "{text}");
+    assert_eq!(o.status.code(), Some(0));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let found: Vec<(&str, &str)> = v["diagnostics"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|d| (d["code"].as_str().unwrap(), d["path"].as_str().unwrap()))
+        .collect();
+    assert_eq!(found, [("RT020", "shaders/reflect_recursive.wgsl")]);
+    assert!(v["diagnostics"][0]["notes"][0]
+        .as_str()
+        .unwrap()
+        .contains("needs recursion depth 4"));
+    assert_eq!(v["summary"]["files"], 5);
 }
