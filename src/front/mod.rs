@@ -2,6 +2,7 @@
 //! (`OpString`/`OpLine`, or `NonSemantic.Shader.DebugInfo.100`) leads back to the
 //! original source.
 
+pub mod hlsl;
 pub mod spirv;
 pub mod wgsl;
 
