@@ -1,0 +1,88 @@
+//! Compiles the HLSL test shaders under tests/hlsl/ and validates every module
+//! with `spirv-val --target-env vulkan1.2`.
+
+use rtlint::front::hlsl::{self, HlslOptions, Stage};
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+fn shader(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/hlsl")
+        .join(name)
+}
+
+/// Runs spirv-val on `words`; skips (unless CI=true) when spirv-val is missing.
+fn validate(words: &[u32], what: &str) {
+    let dir = std::env::temp_dir().join(format!("rtlint-hlsl-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join(format!("{}.spv", what.replace(['/', ':'], "_")));
+    let bytes: Vec<u8> = words.iter().flat_map(|w| w.to_le_bytes()).collect();
+    std::fs::write(&file, bytes).unwrap();
+    let out = match Command::new("spirv-val")
+        .args(["--target-env", "vulkan1.2"])
+        .arg(&file)
+        .output()
+    {
+        Ok(o) => o,
+        Err(e) => {
+            assert!(
+                std::env::var("CI").as_deref() != Ok("true"),
+                "spirv-val is required in CI: {e}"
+            );
+            eprintln!("spirv-val not found; skipping validation of {what}");
+            return;
+        }
+    };
+    if !out.status.success() {
+        let dis = Command::new("spirv-dis")
+            .arg(&file)
+            .output()
+            .map(|o| String::from_utf8_lossy(&o.stdout).into_owned())
+            .unwrap_or_default();
+        panic!(
+            "spirv-val rejected {what}:\n{}{}\n{dis}",
+            String::from_utf8_lossy(&out.stdout),
+            String::from_utf8_lossy(&out.stderr)
+        );
+    }
+}
+
+/// Compiles `name` per entry point and as a whole file; validates all modules.
+fn compile_all(name: &str) -> Vec<(String, Stage)> {
+    let path = shader(name);
+    let opts = HlslOptions::default();
+    let entries = hlsl::compile(&path, &opts).unwrap_or_else(|e| panic!("{name}: {e}"));
+    for e in &entries {
+        validate(&e.words, &format!("{name}-{}", e.name));
+    }
+    let whole = hlsl::compile_file(&path, &opts).unwrap_or_else(|e| panic!("{name}: {e}"));
+    validate(&whole.words, &format!("{name}-all"));
+    entries.into_iter().map(|e| (e.name, e.stage)).collect()
+}
+
+#[test]
+fn pipeline_raygen_miss_closesthit() {
+    let entries = compile_all("pipeline.hlsl");
+    assert_eq!(
+        entries,
+        vec![
+            ("RayGen".to_string(), Stage::RayGeneration),
+            ("Miss".to_string(), Stage::Miss),
+            ("ShadowMiss".to_string(), Stage::Miss),
+            ("ClosestHit".to_string(), Stage::ClosestHit),
+        ]
+    );
+}
+
+/// `RTLINT_DUMP=path.hlsl cargo test --test hlsl_compile dump -- --nocapture`
+/// writes the whole-file module to /tmp/rtlint-dump.spv for inspection.
+#[test]
+fn dump() {
+    let Ok(p) = std::env::var("RTLINT_DUMP") else {
+        return;
+    };
+    let m = hlsl::compile_file(Path::new(&p), &HlslOptions::default())
+        .unwrap_or_else(|e| panic!("{e}"));
+    let bytes: Vec<u8> = m.words.iter().flat_map(|w| w.to_le_bytes()).collect();
+    std::fs::write("/tmp/rtlint-dump.spv", bytes).unwrap();
+}
