@@ -86,3 +86,36 @@ fn dump() {
     let bytes: Vec<u8> = m.words.iter().flat_map(|w| w.to_le_bytes()).collect();
     std::fs::write("/tmp/rtlint-dump.spv", bytes).unwrap();
 }
+
+#[test]
+fn anyhit_alpha_test() {
+    let entries = compile_all("anyhit_alpha.hlsl");
+    assert_eq!(entries[0], ("AlphaTest".to_string(), Stage::AnyHit));
+    assert_eq!(entries[1], ("Shade".to_string(), Stage::ClosestHit));
+}
+
+#[test]
+fn intersection_sphere_with_attributes() {
+    let entries = compile_all("intersection_sphere.hlsl");
+    assert_eq!(
+        entries[0],
+        ("SphereIntersection".to_string(), Stage::Intersection)
+    );
+    assert_eq!(entries[1], ("SphereHit".to_string(), Stage::ClosestHit));
+}
+
+#[test]
+fn callable_shaders() {
+    let entries = compile_all("callable.hlsl");
+    assert_eq!(entries.len(), 3);
+    assert_eq!(entries[1], ("Checker".to_string(), Stage::Callable));
+}
+
+#[test]
+fn ray_query_in_compute() {
+    let entries = compile_all("rayquery.hlsl");
+    assert_eq!(
+        entries,
+        vec![("AmbientOcclusion".to_string(), Stage::Compute)]
+    );
+}

@@ -90,7 +90,17 @@ pub fn compile_path(path: &Path, language: Language) -> Result<Compiled, InputEr
                 decls: Vec::new(),
             })
         }
-        Language::Hlsl | Language::Glsl => Err(InputError::new(
+        Language::Hlsl => {
+            let m = hlsl::compile_file(path, &hlsl::HlslOptions::default())?;
+            Ok(Compiled {
+                path: path.to_path_buf(),
+                language: Language::Hlsl,
+                input_language: Language::Hlsl,
+                words: m.words,
+                decls: m.decls,
+            })
+        }
+        Language::Glsl => Err(InputError::new(
             "unsupported-language",
             path,
             format!(

@@ -182,6 +182,8 @@ pub struct Lowerer<'a> {
     cbuffer_members: HashMap<String, (Id, Ty, u32, Layout, StorageClass)>,
     /// Scalar constants known at compile time (enums, `static const`), for array sizes.
     const_items: HashMap<String, CVal>,
+    /// Scalar constant id → its bits.
+    const_ids: HashMap<Id, u32>,
 }
 
 const RAY_DESC: u32 = 0;
@@ -407,6 +409,7 @@ impl<'a> Lowerer<'a> {
             nonuniform: HashSet::new(),
             cbuffer_members: HashMap::new(),
             const_items: HashMap::new(),
+            const_ids: HashMap::new(),
         }
     }
 
@@ -1360,7 +1363,61 @@ impl<'a> Lowerer<'a> {
         }
         let id = self.b.constant_bit32(ty, bits);
         self.consts.insert((ty, bits), id);
+        self.const_ids.insert(id, bits);
         id
+    }
+
+    /// The value of a scalar constant made by this lowerer, as (scalar, bits).
+    fn known(&self, v: &Val) -> Option<(Sc, u32)> {
+        match v.ty {
+            Ty::Sc(s @ (Sc::Int | Sc::Uint | Sc::Float)) => {
+                self.const_ids.get(&v.id).map(|b| (s, *b))
+            }
+            _ => None,
+        }
+    }
+
+    /// Folds an operator on two scalar constants, so trace operands, flags and
+    /// SBT indices written as expressions stay constants in the module.
+    fn fold(&mut self, op: BinOp, a: (Sc, u32), b: (Sc, u32)) -> Option<Val> {
+        use BinOp::*;
+        let (s, x, y) = (a.0, a.1, b.1);
+        if s != b.0 {
+            return None;
+        }
+        let v = match s {
+            Sc::Float => {
+                let (x, y) = (f32::from_bits(x), f32::from_bits(y));
+                let r = match op {
+                    Add => x + y,
+                    Sub => x - y,
+                    Mul => x * y,
+                    Div => x / y,
+                    _ => return None,
+                };
+                return Some(Val {
+                    id: self.const_f32(r),
+                    ty: Ty::Sc(Sc::Float),
+                });
+            }
+            _ => match op {
+                Add => x.wrapping_add(y),
+                Sub => x.wrapping_sub(y),
+                Mul => x.wrapping_mul(y),
+                BitAnd => x & y,
+                BitOr => x | y,
+                BitXor => x ^ y,
+                Shl if y < 32 => x << y,
+                Shr if y < 32 && s == Sc::Uint => x >> y,
+                Shr if y < 32 => ((x as i32) >> y) as u32,
+                _ => return None,
+            },
+        };
+        let t = self.sc_id(s);
+        Some(Val {
+            id: self.const_bits(t, v),
+            ty: Ty::Sc(s),
+        })
     }
 
     fn const_u32(&mut self, v: u32) -> Id {
@@ -3255,6 +3312,25 @@ impl<'a> Lowerer<'a> {
     }
 
     fn convert_scalar(&mut self, id: Id, from: Sc, to: Sc, to_ty: &Ty) -> Result<Val> {
+        if let (Ty::Sc(_), Some(bits)) = (to_ty, self.const_ids.get(&id).copied()) {
+            if from != Sc::Bool && to != Sc::Bool && from != to {
+                let (f, i) = match from {
+                    Sc::Float => (f32::from_bits(bits) as f64, f32::from_bits(bits) as i64),
+                    Sc::Int => (bits as i32 as f64, bits as i32 as i64),
+                    _ => (bits as f64, bits as i64),
+                };
+                // Int <-> uint keeps the bits; float conversions convert the value.
+                let i = if from != Sc::Float && to != Sc::Float {
+                    bits as i64
+                } else {
+                    i
+                };
+                return Ok(Val {
+                    id: self.const_scalar(to, f, i),
+                    ty: to_ty.clone(),
+                });
+            }
+        }
         let tid = self.ty_id(to_ty)?;
         let from_ty = to_ty.with_scalar(from);
         let id = match (from, to) {
@@ -3331,6 +3407,11 @@ impl<'a> Lowerer<'a> {
         }
         let a = self.convert(a, &ct, pos, true)?;
         let b = self.convert(b, &ct, pos, true)?;
+        if let (Some(x), Some(y)) = (self.known(&a), self.known(&b)) {
+            if let Some(v) = self.fold(op, x, y) {
+                return Ok(v);
+            }
+        }
         if let Ty::Mat(s, r, c) = ct {
             // Matrix operators are component-wise: one row at a time.
             let row = Ty::Vec(s, c);

@@ -1098,7 +1098,8 @@ impl<'t> Parser<'t> {
         loop {
             let pos = self.pos();
             if self.eat(".") {
-                let (name, _) = self.ident()?;
+                // Member and method expressions point at the name after the dot.
+                let (name, pos) = self.ident()?;
                 if self.is("(") {
                     let args = self.args()?;
                     e = Expr {
