@@ -119,3 +119,9 @@ fn ray_query_in_compute() {
         vec![("AmbientOcclusion".to_string(), Stage::Compute)]
     );
 }
+
+#[test]
+fn language_features() {
+    let entries = compile_all("language.hlsl");
+    assert_eq!(entries, vec![("Main".to_string(), Stage::Compute)]);
+}

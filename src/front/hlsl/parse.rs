@@ -1013,6 +1013,14 @@ impl<'t> Parser<'t> {
         Ok(lhs)
     }
 
+    fn enum_value_ahead(&self) -> bool {
+        let mut k = 1;
+        while self.is_at(k, "::") && self.peek_at(k + 1).and_then(Token::ident).is_some() {
+            k += 2;
+        }
+        k > 1 && !self.is_at(k, "(") && !self.is_at(k, "<")
+    }
+
     /// At `(`: a cast when a type and `)` follow.
     fn cast_ahead(&self) -> bool {
         if !self.is("(") || !self.type_at(1) {
@@ -1164,7 +1172,8 @@ impl<'t> Parser<'t> {
                 self.i += 1;
                 ExprKind::Bool(&**k == "true")
             }
-            Tok::Ident(_) if self.type_at(0) => {
+            // `Enum::Value` names a value even though `Enum` is a type.
+            Tok::Ident(_) if self.type_at(0) && !self.enum_value_ahead() => {
                 let ty = self.type_ref()?;
                 if !self.is("(") {
                     return Err(self.unexpected("`(` after a type name in an expression"));

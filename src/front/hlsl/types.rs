@@ -138,24 +138,17 @@ pub fn size_align(ty: &Ty, layout: Layout, structs: &[StructDef]) -> (u32, u32) 
         (Ty::Vec(_, n), _) => (4 * *n as u32, if *n == 2 { 8 } else { 16 }),
         (Ty::Mat(..), _) => {
             let (count, stride, n) = matrix_layout(ty, false, layout);
-            (
-                stride * (count - 1) + 4 * n,
-                if layout == Layout::CBuffer {
-                    16
-                } else {
-                    stride.min(16)
-                },
-            )
+            matrix_size_align(count, stride, n, layout)
         }
         (Ty::Array(e, len), _) => {
             let stride = array_stride(e, layout, structs);
             let (esize, ealign) = size_align(e, layout, structs);
-            let align = if layout == Layout::CBuffer {
-                16
+            if layout == Layout::CBuffer {
+                // HLSL packing: the last element is not padded to a row.
+                (stride * len.saturating_sub(1) + esize, 16)
             } else {
-                ealign
-            };
-            (stride * len.saturating_sub(1) + esize, align)
+                (stride * len, ealign)
+            }
         }
         (Ty::Struct(k), _) => {
             let offsets = struct_offsets(*k, layout, structs);
@@ -175,6 +168,14 @@ pub fn size_align(ty: &Ty, layout: Layout, structs: &[StructDef]) -> (u32, u32) 
             }
         }
         _ => (0, 4),
+    }
+}
+
+fn matrix_size_align(count: u32, stride: u32, n: u32, layout: Layout) -> (u32, u32) {
+    if layout == Layout::CBuffer {
+        (stride * (count - 1) + 4 * n, 16)
+    } else {
+        (stride * count, stride.min(16))
     }
 }
 
@@ -220,12 +221,7 @@ pub fn struct_offsets(k: u32, layout: Layout, structs: &[StructDef]) -> Vec<u32>
     for f in &def.fields {
         let (size, align) = if let Ty::Mat(..) = f.ty {
             let (count, stride, n) = matrix_layout(&f.ty, f.row_major, layout);
-            let a = if layout == Layout::CBuffer {
-                16
-            } else {
-                stride.min(16)
-            };
-            (stride * (count - 1) + 4 * n, a)
+            matrix_size_align(count, stride, n, layout)
         } else {
             size_align(&f.ty, layout, structs)
         };
