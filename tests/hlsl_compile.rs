@@ -13,6 +13,10 @@ fn shader(name: &str) -> PathBuf {
 
 /// Runs spirv-val on `words`; skips (unless CI=true) when spirv-val is missing.
 fn validate(words: &[u32], what: &str) {
+    validate_with(words, what, &[]);
+}
+
+fn validate_with(words: &[u32], what: &str, extra: &[&str]) {
     let dir = std::env::temp_dir().join(format!("rtlint-hlsl-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let file = dir.join(format!("{}.spv", what.replace(['/', ':'], "_")));
@@ -20,6 +24,7 @@ fn validate(words: &[u32], what: &str) {
     std::fs::write(&file, bytes).unwrap();
     let out = match Command::new("spirv-val")
         .args(["--target-env", "vulkan1.2"])
+        .args(extra)
         .arg(&file)
         .output()
     {
@@ -124,4 +129,50 @@ fn ray_query_in_compute() {
 fn language_features() {
     let entries = compile_all("language.hlsl");
     assert_eq!(entries, vec![("Main".to_string(), Stage::Compute)]);
+}
+
+#[test]
+fn resources_bindless_images_records() {
+    let entries = compile_all("resources.hlsl");
+    assert_eq!(entries.len(), 3);
+}
+
+/// Offsets of a cbuffer's members as the module declares them.
+fn member_offsets(words: &[u32], struct_name: &str) -> Vec<u32> {
+    let module = rspirv::dr::load_words(words).unwrap();
+    let id = module
+        .debug_names
+        .iter()
+        .find(|i| matches!(i.operands.get(1), Some(rspirv::dr::Operand::LiteralString(s)) if s == struct_name))
+        .and_then(|i| match i.operands[0] {
+            rspirv::dr::Operand::IdRef(id) => Some(id),
+            _ => None,
+        })
+        .unwrap();
+    let mut offsets: Vec<(u32, u32)> = module
+        .annotations
+        .iter()
+        .filter(|i| i.class.opcode == spirv::Op::MemberDecorate)
+        .filter(|i| i.operands[0] == rspirv::dr::Operand::IdRef(id))
+        .filter(|i| i.operands[2] == rspirv::dr::Operand::Decoration(spirv::Decoration::Offset))
+        .map(|i| match (&i.operands[1], &i.operands[3]) {
+            (rspirv::dr::Operand::LiteralBit32(m), rspirv::dr::Operand::LiteralBit32(o)) => {
+                (*m, *o)
+            }
+            _ => panic!(),
+        })
+        .collect();
+    offsets.sort_unstable();
+    offsets.into_iter().map(|(_, o)| o).collect()
+}
+
+#[test]
+fn cbuffer_uses_hlsl_packing() {
+    let path = shader("cbuffer_packing.hlsl");
+    let m = hlsl::compile_file(&path, &HlslOptions::default()).unwrap();
+    assert_eq!(
+        member_offsets(&m.words, "type.Packed"),
+        vec![0, 12, 16, 52, 56, 64, 108]
+    );
+    validate_with(&m.words, "cbuffer_packing", &["--scalar-block-layout"]);
 }

@@ -1267,6 +1267,9 @@ impl<'a> Lowerer<'a> {
                 } else {
                     spirv::ImageFormat::Unknown
                 };
+                if *rw && *n == 2 {
+                    self.cap(Capability::StorageImageExtendedFormats);
+                }
                 if *rw && format == spirv::ImageFormat::Unknown {
                     self.cap(Capability::StorageImageReadWithoutFormat);
                     self.cap(Capability::StorageImageWriteWithoutFormat);
@@ -2458,6 +2461,17 @@ impl<'a> Lowerer<'a> {
                     self.extract_dynamic(v, index, const_index, elem, pos)
                 }
             },
+            // A component of a storage-image texel stays writable.
+            texel @ Place::Texel { .. }
+                if const_index.is_some() && matches!(texel.ty(), Ty::Vec(..)) =>
+            {
+                let k = const_index.unwrap_or_default();
+                Ok(Place::Swizzle {
+                    base: Box::new(texel),
+                    comps: vec![k],
+                    ty: elem,
+                })
+            }
             other => {
                 let v = self.read(&other)?;
                 self.extract_dynamic(v, index, const_index, elem, pos)
