@@ -894,6 +894,13 @@ impl<'t> Parser<'t> {
                 pos,
             });
         }
+        // `Name name` can only be a declaration: the type is unknown.
+        if let (Some(a), Some(_)) = (
+            self.peek().and_then(Token::ident),
+            self.peek_at(1).and_then(Token::ident),
+        ) {
+            return Err(Error::new(pos, format!("unknown type `{a}`")).len(a.len() as u32));
+        }
         let e = self.expr()?;
         self.expect(";")?;
         Ok(Stmt {
