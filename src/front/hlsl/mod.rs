@@ -67,6 +67,15 @@ pub fn parse_source(
     loader: &mut dyn pp::FileLoader,
     options: &HlslOptions,
 ) -> Result<(Vec<ast::Item>, Vec<PathBuf>), InputError> {
+    with_stack(|| parse_source_inner(path, text, loader, options))
+}
+
+fn parse_source_inner(
+    path: &Path,
+    text: &str,
+    loader: &mut dyn pp::FileLoader,
+    options: &HlslOptions,
+) -> Result<(Vec<ast::Item>, Vec<PathBuf>), InputError> {
     let out = pp::preprocess(path, text, loader, &options.include_dirs, &options.defines)
         .map_err(|(e, files)| e.into_input_error(&files, path))?;
     let items = parse::parse(&out.tokens).map_err(|e| e.into_input_error(&out.files, path))?;
@@ -103,13 +112,42 @@ fn entry_indices(
     Ok(picked)
 }
 
+/// Runs `f` on a thread with a large stack: parsing and lowering recurse
+/// over the syntax tree, whose depth the input controls (up to the parser's
+/// nesting limit), and debug builds use big frames.
+fn with_stack<T: Send>(f: impl FnOnce() -> Result<T, InputError> + Send) -> Result<T, InputError> {
+    std::thread::scope(|s| {
+        std::thread::Builder::new()
+            .stack_size(64 << 20)
+            .spawn_scoped(s, f)
+            .map_err(|e| {
+                InputError::new(
+                    "hlsl-error",
+                    Path::new(""),
+                    format!("cannot start the compiler thread: {e}"),
+                )
+            })?
+            .join()
+            .unwrap_or_else(|p| std::panic::resume_unwind(p))
+    })
+}
+
 pub fn compile_source(
     path: &Path,
     text: &str,
     loader: &mut dyn pp::FileLoader,
     options: &HlslOptions,
 ) -> Result<Vec<CompiledEntry>, InputError> {
-    let (items, files) = parse_source(path, text, loader, options)?;
+    with_stack(|| compile_source_inner(path, text, loader, options))
+}
+
+fn compile_source_inner(
+    path: &Path,
+    text: &str,
+    loader: &mut dyn pp::FileLoader,
+    options: &HlslOptions,
+) -> Result<Vec<CompiledEntry>, InputError> {
+    let (items, files) = parse_source_inner(path, text, loader, options)?;
     let mut probe = lower::Lowerer::new(&items, &files);
     let picked = entry_indices(&mut probe, path, &files, options)?;
     let mut out = Vec::new();
@@ -135,7 +173,16 @@ pub fn compile_source_whole(
     loader: &mut dyn pp::FileLoader,
     options: &HlslOptions,
 ) -> Result<CompiledModule, InputError> {
-    let (items, files) = parse_source(path, text, loader, options)?;
+    with_stack(|| compile_source_whole_inner(path, text, loader, options))
+}
+
+fn compile_source_whole_inner(
+    path: &Path,
+    text: &str,
+    loader: &mut dyn pp::FileLoader,
+    options: &HlslOptions,
+) -> Result<CompiledModule, InputError> {
+    let (items, files) = parse_source_inner(path, text, loader, options)?;
     let mut l = lower::Lowerer::new(&items, &files);
     let picked = entry_indices(&mut l, path, &files, options)?;
     let ks: Vec<usize> = picked

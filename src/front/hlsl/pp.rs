@@ -11,7 +11,7 @@ use std::path::{Path, PathBuf};
 use std::rc::Rc;
 
 /// Where `#include` looks for files; tests and fuzzers read from memory.
-pub trait FileLoader {
+pub trait FileLoader: Send {
     fn read(&mut self, path: &Path) -> Option<String>;
 }
 
