@@ -112,7 +112,7 @@ fn intersection_sphere_with_attributes() {
 #[test]
 fn callable_shaders() {
     let entries = compile_all("callable.hlsl");
-    assert_eq!(entries.len(), 3);
+    assert_eq!(entries.len(), 4);
     assert_eq!(entries[1], ("Checker".to_string(), Stage::Callable));
 }
 

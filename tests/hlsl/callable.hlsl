@@ -30,3 +30,19 @@ void Tint(inout Material m)
 {
     m.albedo.rb = m.albedo.br * float2(0.9, 1.1);
 }
+
+[[vk::constant_id(3)]] const bool USE_TINT = true;
+[[vk::constant_id(4)]] const uint TINT_SHADER = 1;
+[[vk::constant_id(5)]] const float STRENGTH = 0.5;
+
+[shader("raygeneration")]
+void GenSpecialized()
+{
+    uint2 id = DispatchRaysIndex().xy;
+    Material m;
+    m.albedo = STRENGTH;
+    m.kind = 0;
+    if (USE_TINT)
+        CallShader(TINT_SHADER, m);
+    image[id] = float4(m.albedo, 1);
+}

@@ -1131,6 +1131,9 @@ impl<'a> Lowerer<'a> {
             );
             return Ok(());
         }
+        if let Some(a) = v.attrs.iter().find(|a| a.name == "vk::constant_id") {
+            return self.spec_constant(v, a, &t);
+        }
         if !v.mods.is_static {
             return Err(unsupported(
                 v.pos,
@@ -1179,6 +1182,65 @@ impl<'a> Lowerer<'a> {
                 class: StorageClass::Private,
             }),
         );
+        Ok(())
+    }
+
+    /// `[[vk::constant_id(N)]] const T name = default;`: a specialization constant.
+    fn spec_constant(&mut self, v: &VarDecl, a: &Attr, t: &Ty) -> Result<()> {
+        let id_expr = a
+            .args
+            .first()
+            .ok_or_else(|| Error::new(a.pos, "vk::constant_id needs an id"))?;
+        let spec_id = self.const_int(id_expr)? as u32;
+        let Ty::Sc(s) = t else {
+            return Err(unsupported(
+                v.pos,
+                "specialization constants that are not scalars",
+            ));
+        };
+        let default = match &v.init {
+            Some(e) => self.const_eval(e)?.ok_or_else(|| {
+                Error::new(e.pos, "a specialization constant needs a constant default")
+            })?,
+            None => {
+                return Err(Error::new(
+                    v.pos,
+                    "a specialization constant needs a default value",
+                ))
+            }
+        };
+        let tid = self.sc_id(*s);
+        let id = match s {
+            Sc::Bool => {
+                let on = default.as_f64() != 0.0;
+                let id = self.b.id();
+                let op = if on {
+                    Op::SpecConstantTrue
+                } else {
+                    Op::SpecConstantFalse
+                };
+                self.b.insert_types_global_values(
+                    InsertPoint::End,
+                    Instruction::new(op, Some(tid), Some(id), vec![]),
+                );
+                id
+            }
+            Sc::Float => self
+                .b
+                .spec_constant_bit32(tid, (default.as_f64() as f32).to_bits()),
+            _ => {
+                let i = match default {
+                    CVal::I(i) => i,
+                    CVal::F(f) => f as i64,
+                };
+                self.b.spec_constant_bit32(tid, i as u32)
+            }
+        };
+        self.b
+            .decorate(id, Decoration::SpecId, [Operand::LiteralBit32(spec_id)]);
+        self.b.name(id, v.name.clone());
+        self.globals
+            .insert(v.name.clone(), Global::Const(Val { id, ty: t.clone() }));
         Ok(())
     }
 
