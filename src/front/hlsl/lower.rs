@@ -186,6 +186,9 @@ pub struct Lowerer<'a> {
     const_ids: HashMap<Id, u32>,
 }
 
+/// Source positions of named declarations (the side table `Program` reads).
+pub type Decls = Vec<(NamedDecl, Location)>;
+
 const RAY_DESC: u32 = 0;
 const TRI_ATTRS: u32 = 1;
 
@@ -1750,7 +1753,7 @@ impl<'a> Lowerer<'a> {
     // ---- functions -----------------------------------------------------
 
     /// Lowers the given entry points and everything they call; returns the module.
-    pub fn finish(mut self, entries: &[usize]) -> Result<(Vec<u32>, Vec<(NamedDecl, Location)>)> {
+    pub fn finish(mut self, entries: &[usize]) -> Result<(Vec<u32>, Decls)> {
         for &e in entries {
             if !self.lowered.contains(&e) {
                 self.pending.push(e);

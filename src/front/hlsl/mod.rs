@@ -77,7 +77,7 @@ fn parse_source_inner(
     options: &HlslOptions,
 ) -> Result<(Vec<ast::Item>, Vec<PathBuf>), InputError> {
     let out = pp::preprocess(path, text, loader, &options.include_dirs, &options.defines)
-        .map_err(|(e, files)| e.into_input_error(&files, path))?;
+        .map_err(|f| f.error.into_input_error(&f.files, path))?;
     let items = parse::parse(&out.tokens).map_err(|e| e.into_input_error(&out.files, path))?;
     Ok((items, out.files))
 }

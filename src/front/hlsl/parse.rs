@@ -21,6 +21,9 @@ pub struct Parser<'t> {
 /// fuzzer's `((((...` cannot overflow the stack.
 const MAX_DEPTH: usize = 96;
 
+/// What may follow a declarator: a semantic and a register binding.
+type PostDecl = (Option<(String, Pos)>, Option<Register>);
+
 const SCALARS: &[&str] = &[
     "bool",
     "int",
@@ -527,7 +530,7 @@ impl<'t> Parser<'t> {
     }
 
     /// `: SEMANTIC`, `: register(...)`, payload access qualifiers; in any order.
-    fn post_decl(&mut self) -> Result<(Option<(String, Pos)>, Option<Register>)> {
+    fn post_decl(&mut self) -> Result<PostDecl> {
         let mut semantic = None;
         let mut register = None;
         while self.eat(":") {
@@ -645,7 +648,7 @@ impl<'t> Parser<'t> {
     ) -> Result<Function> {
         self.expect("(")?;
         let mut params = Vec::new();
-        if !self.is(")") && !(self.is_kw("void") && self.is_at(1, ")")) {
+        if !(self.is(")") || self.is_kw("void") && self.is_at(1, ")")) {
             loop {
                 let pattrs = self.attrs()?;
                 let mods = self.mods();
@@ -979,10 +982,7 @@ impl<'t> Parser<'t> {
     /// Precedence climbing; `in_template` stops at `>` (template argument lists).
     fn binary(&mut self, min: u8, in_template: bool) -> Result<Expr> {
         let mut lhs = self.unary()?;
-        loop {
-            let Some(Tok::Punct(p)) = self.peek().map(|t| &t.tok) else {
-                break;
-            };
+        while let Some(Tok::Punct(p)) = self.peek().map(|t| &t.tok) {
             let (prec, op) = match *p {
                 "||" => (1, BinOp::Or),
                 "&&" => (2, BinOp::And),

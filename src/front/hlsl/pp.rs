@@ -805,10 +805,7 @@ impl CondExpr<'_> {
     }
     fn binary(&mut self, min: u8) -> Result<i64> {
         let mut lhs = self.unary()?;
-        loop {
-            let Some(Tok::Punct(op)) = self.t.get(self.i).map(|t| &t.tok) else {
-                break;
-            };
+        while let Some(Tok::Punct(op)) = self.t.get(self.i).map(|t| &t.tok) {
             let prec = match *op {
                 "||" => 1,
                 "&&" => 2,
@@ -890,6 +887,12 @@ impl CondExpr<'_> {
     }
 }
 
+/// A preprocessing error and the file table its position indexes.
+pub struct Failure {
+    pub error: Error,
+    pub files: Vec<PathBuf>,
+}
+
 /// Preprocesses `text` (the contents of `path`).
 pub fn preprocess(
     path: &Path,
@@ -897,10 +900,15 @@ pub fn preprocess(
     loader: &mut dyn FileLoader,
     include_dirs: &[PathBuf],
     defines: &[(String, String)],
-) -> std::result::Result<Output, (Error, Vec<PathBuf>)> {
+) -> std::result::Result<Output, Box<Failure>> {
     let pp = match Preprocessor::new(loader, include_dirs, defines) {
         Ok(p) => p,
-        Err(e) => return Err((e, Vec::new())),
+        Err(error) => {
+            return Err(Box::new(Failure {
+                error,
+                files: Vec::new(),
+            }))
+        }
     };
     // The file table is needed to render an error, so keep it on failure.
     let mut pp = pp;
@@ -909,7 +917,10 @@ pub fn preprocess(
             tokens: pp.out,
             files: pp.files,
         }),
-        Err(e) => Err((e, pp.files)),
+        Err(error) => Err(Box::new(Failure {
+            error,
+            files: pp.files,
+        })),
     }
 }
 
@@ -945,12 +956,12 @@ mod tests {
                 .map(Token::spelling)
                 .collect::<Vec<_>>()
                 .join(" ")),
-            Err((e, _)) => Err(format!(
+            Err(f) => Err(format!(
                 "{}:{}: {} | {}",
-                e.pos.line,
-                e.pos.col,
-                e.message,
-                e.notes.join(" | ")
+                f.error.pos.line,
+                f.error.pos.col,
+                f.error.message,
+                f.error.notes.join(" | ")
             )),
         }
     }
