@@ -224,3 +224,15 @@ fn missing_entry_point() {
     .unwrap_err();
     assert!(e.to_string().contains("no entry point named `nope`"), "{e}");
 }
+
+#[test]
+fn layout_changing_constructs_are_refused() {
+    assert_eq!(
+        err("#pragma pack_matrix(row_major)\n"),
+        "main.hlsl:1:2: not supported: #pragma pack_matrix(row_major)\n  note: declare matrices `row_major` one by one instead"
+    );
+    assert_eq!(
+        err("StructuredBuffer<float4x4> m;\n[numthreads(1,1,1)] void f() {}"),
+        "main.hlsl:1:1: not supported: StructuredBuffer of a matrix; wrap the matrix in a struct"
+    );
+}

@@ -309,7 +309,7 @@ impl V {
 
 /// The `Inputs` cbuffer of exec_compute.hlsl under HLSL packing.
 fn inputs() -> Vec<u8> {
-    let mut b = vec![0u8; 112];
+    let mut b = vec![0u8; 128];
     let mut put = |off: usize, v: f32| b[off..off + 4].copy_from_slice(&v.to_le_bytes());
     for (k, v) in [1.0, 2.0, 3.0].iter().enumerate() {
         put(k * 4, *v);
@@ -328,6 +328,7 @@ fn inputs() -> Vec<u8> {
         }
     }
     put(108, 11.0);
+    b[112] = 1;
     b
 }
 
@@ -398,6 +399,7 @@ fn compute_semantics_on_the_driver() {
         U(1),
         I(6),
         F(8.0),
+        I(1),
     ];
     let got = unsafe { gpu.run(&entries[0].words, "Main", expected.len() + 4, &inputs()) };
     let mut wrong = Vec::new();

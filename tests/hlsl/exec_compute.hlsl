@@ -11,6 +11,7 @@ cbuffer Inputs : register(b1)
     float2 e2;    // (9, 10)
     float3x3 m;   // m[r][c] = 10 r + c
     float tail;   // 11
+    bool flag;    // true, stored as a uint
 };
 
 enum Mode { MODE_A, MODE_B = 5, MODE_C };
@@ -156,4 +157,6 @@ void Main()
     put(0x80000000u >> 31);
     put((int)MODE_C);
     put(util::twice(b1));
+    // 60: a bool read from a constant buffer
+    put(flag ? 1 : 2);
 }

@@ -16,7 +16,16 @@ struct PushData
 {
     float4 tint;
     uint frame;
+    bool2 enabled;
 };
+
+struct Flags
+{
+    bool visible;
+    float weight;
+    bool sides[2];
+};
+RWStructuredBuffer<Flags> flags : register(u7);
 
 Texture2D<float4> materials[] : register(t0, space1);
 Texture2D textures8[8] : register(t0, space2);
@@ -64,4 +73,9 @@ void Resolve(uint3 id : SV_DispatchThreadID)
     noFormat[id.xy] = float3(1, 2, 3);
     float3 prev = noFormat.Load(int2(id.xy));
     noFormat[id.xy].y = prev.x;
+    Flags f = flags[id.x];
+    if (f.visible && push.enabled.y)
+        f.sides[1] = !f.sides[0];
+    flags[id.x] = f;
+    flags[id.y].visible = false;
 }

@@ -702,6 +702,12 @@ impl<'a> Lowerer<'a> {
                 if e == Ty::Void || e.is_resource() {
                     return Err(Error::new(t.pos, format!("{name} needs an element type")));
                 }
+                if let Ty::Mat(..) = e {
+                    return Err(unsupported(
+                        t.pos,
+                        format!("{name} of a matrix; wrap the matrix in a struct"),
+                    ));
+                }
                 Ty::StructuredBuffer(Box::new(e), name.starts_with("RW"))
             }
             "ConstantBuffer" => match targ_ty(self, 0, Ty::Void)? {
@@ -1266,6 +1272,10 @@ impl<'a> Lowerer<'a> {
     fn spv(&mut self, t: &Ty, layout: Layout) -> Result<Id> {
         let layout = match t {
             Ty::Struct(_) | Ty::Array(..) => layout,
+            // Buffers hold no bools (Vulkan forbids them there); DXC stores uints.
+            Ty::Sc(Sc::Bool) | Ty::Vec(Sc::Bool, _) if layout != Layout::None => {
+                return self.spv(&t.with_scalar(Sc::Uint), Layout::None);
+            }
             _ => Layout::None,
         };
         let key = (t.clone(), layout, false);
@@ -2813,13 +2823,19 @@ impl<'a> Lowerer<'a> {
     fn read(&mut self, p: &Place) -> Result<Val> {
         match p {
             Place::Ptr {
-                ptr, ty, layout, ..
+                ptr,
+                ty,
+                layout,
+                class,
             } => {
                 if ty.is_resource() || matches!(ty, Ty::RayQuery(_)) {
                     return Ok(Val {
                         id: *ptr,
                         ty: ty.clone(),
                     });
+                }
+                if *layout != Layout::None && self.has_bool(ty) {
+                    return self.load_bools(*ptr, ty, *layout, *class);
                 }
                 let tid = self.spv(ty, *layout)?;
                 if self.term {
@@ -2871,6 +2887,106 @@ impl<'a> Lowerer<'a> {
         }
     }
 
+    fn has_bool(&self, t: &Ty) -> bool {
+        match t {
+            Ty::Sc(Sc::Bool) | Ty::Vec(Sc::Bool, _) => true,
+            Ty::Array(e, _) | Ty::RtArray(e) => self.has_bool(e),
+            Ty::Struct(k) => self.structs[*k as usize]
+                .fields
+                .iter()
+                .any(|f| self.has_bool(&f.ty)),
+            _ => false,
+        }
+    }
+
+    /// Parts of an aggregate with their indices and types.
+    fn parts(&self, t: &Ty) -> Vec<(u32, Ty)> {
+        match t {
+            Ty::Struct(k) => self.structs[*k as usize]
+                .fields
+                .iter()
+                .enumerate()
+                .map(|(i, f)| (i as u32, f.ty.clone()))
+                .collect(),
+            Ty::Array(e, n) => (0..*n).map(|i| (i, (**e).clone())).collect(),
+            _ => Vec::new(),
+        }
+    }
+
+    /// Loads a value holding bools from a buffer, where they are stored as uints.
+    fn load_bools(&mut self, ptr: Id, t: &Ty, layout: Layout, class: StorageClass) -> Result<Val> {
+        if let Ty::Sc(_) | Ty::Vec(..) = t {
+            let ut = self.spv(t, layout)?;
+            let raw = self.b.load(ut, None, ptr, None, [])?;
+            return self.convert_scalar(raw, Sc::Uint, Sc::Bool, t);
+        }
+        let mut ids = Vec::new();
+        for (i, pt) in self.parts(t) {
+            let c = self.const_u32(i);
+            let et = self.spv(&pt, layout)?;
+            let pty = self.b.type_pointer(None, class, et);
+            let p = self.inst(
+                Op::AccessChain,
+                Some(pty),
+                vec![Operand::IdRef(ptr), Operand::IdRef(c)],
+            )?;
+            let v = if self.has_bool(&pt) {
+                self.load_bools(p, &pt, layout, class)?
+            } else {
+                self.read(&Place::Ptr {
+                    ptr: p,
+                    ty: pt.clone(),
+                    layout,
+                    class,
+                })?
+            };
+            ids.push(v.id);
+        }
+        let tid = self.ty_id(t)?;
+        let id = self.op(Op::CompositeConstruct, tid, &ids)?;
+        Ok(Val { id, ty: t.clone() })
+    }
+
+    fn store_bools(&mut self, ptr: Id, v: Val, layout: Layout, class: StorageClass) -> Result<()> {
+        if let Ty::Sc(_) | Ty::Vec(..) = v.ty {
+            let ut = v.ty.with_scalar(Sc::Uint);
+            let raw = self.convert_scalar(v.id, Sc::Bool, Sc::Uint, &ut)?;
+            self.b.store(ptr, raw.id, None, [])?;
+            return Ok(());
+        }
+        for (i, pt) in self.parts(&v.ty) {
+            let c = self.const_u32(i);
+            let et = self.spv(&pt, layout)?;
+            let pty = self.b.type_pointer(None, class, et);
+            let p = self.inst(
+                Op::AccessChain,
+                Some(pty),
+                vec![Operand::IdRef(ptr), Operand::IdRef(c)],
+            )?;
+            let ptid = self.ty_id(&pt)?;
+            let part = self.inst(
+                Op::CompositeExtract,
+                Some(ptid),
+                vec![Operand::IdRef(v.id), Operand::LiteralBit32(i)],
+            )?;
+            let pv = Val {
+                id: part,
+                ty: pt.clone(),
+            };
+            self.write(
+                &Place::Ptr {
+                    ptr: p,
+                    ty: pt,
+                    layout,
+                    class,
+                },
+                pv,
+                Pos::default(),
+            )?;
+        }
+        Ok(())
+    }
+
     /// A 4-vector cut down to `to` (scalar or narrower vector).
     fn shrink(&mut self, v: Val, to: &Ty) -> Result<Val> {
         if &v.ty == to {
@@ -2914,6 +3030,9 @@ impl<'a> Lowerer<'a> {
                         pos,
                         "cannot assign to a read-only value (constant buffer or input)",
                     ));
+                }
+                if *layout != Layout::None && self.has_bool(ty) {
+                    return self.store_bools(*ptr, v, *layout, *class);
                 }
                 let mut id = v.id;
                 if *layout != Layout::None && ty.is_aggregate() {

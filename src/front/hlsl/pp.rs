@@ -243,6 +243,17 @@ impl<'a> Preprocessor<'a> {
             }
             "include" => self.include(pos, rest),
             "pragma" => {
+                if rest.first().and_then(Token::ident) == Some("pack_matrix") {
+                    // Changing the default matrix packing would change every layout.
+                    let arg = rest.get(2).and_then(Token::ident).unwrap_or("");
+                    if arg != "column_major" {
+                        return Err(Error::new(
+                            pos,
+                            format!("not supported: #pragma pack_matrix({arg})"),
+                        )
+                        .note("declare matrices `row_major` one by one instead"));
+                    }
+                }
                 if rest.first().and_then(Token::ident) == Some("once") {
                     let file = self.stack.last().map(|s| s.0).unwrap_or(0);
                     let path = self.files[file as usize].clone();
