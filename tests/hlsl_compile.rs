@@ -176,3 +176,31 @@ fn cbuffer_uses_hlsl_packing() {
     );
     validate_with(&m.words, "cbuffer_packing", &["--scalar-block-layout"]);
 }
+
+/// `rtlint check` reads HLSL through `front::load`: declarations (struct
+/// members included) must carry their own source lines.
+#[test]
+fn program_sees_hlsl_declaration_positions() {
+    use rtlint::front::{load, Language};
+    use rtlint::spirv::Decl;
+    let path = shader("pipeline.hlsl");
+    let program = load(&path, Language::Hlsl).unwrap();
+    let id_named = |name: &str| {
+        program
+            .names
+            .iter()
+            .filter(|(_, n)| n.as_str() == name)
+            .map(|(id, _)| *id)
+            .min()
+            .unwrap()
+    };
+    let payload = id_named("Payload");
+    let at = |d: Decl| program.decl_location(d).map(|l| (l.line, l.column));
+    assert_eq!(at(Decl::Type(payload)), Some((14, 21)));
+    assert_eq!(at(Decl::Member(payload, 0)), Some((16, 12)));
+    assert_eq!(at(Decl::Member(payload, 1)), Some((17, 10)));
+    let sky = id_named("sky");
+    let loc = program.decl_location(Decl::Func(sky)).unwrap();
+    assert!(loc.path.ends_with("common.hlsli"), "{loc:?}");
+    assert_eq!((loc.line, loc.column), (8, 8));
+}
