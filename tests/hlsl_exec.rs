@@ -400,6 +400,8 @@ fn compute_semantics_on_the_driver() {
         I(6),
         F(8.0),
         I(1),
+        F(0.8),
+        F(8.0),
     ];
     let got = unsafe { gpu.run(&entries[0].words, "Main", expected.len() + 4, &inputs()) };
     let mut wrong = Vec::new();

@@ -23,6 +23,8 @@ namespace util
 
 static uint slot = 0;
 static const uint table[4] = { 10, 20, 30, 40 };
+static const float3 UNIT = normalize(float3(3, 0, 4));
+static float fromBuffer = b1 * 2;
 
 void put(uint v) { results[slot] = v; slot += 1; }
 void put(int v) { put(asuint(v)); }
@@ -159,4 +161,7 @@ void Main()
     put(util::twice(b1));
     // 60: a bool read from a constant buffer
     put(flag ? 1 : 2);
+    // 61..62: static globals with computed initializers
+    put(UNIT.z);
+    put(fromBuffer);
 }

@@ -184,6 +184,10 @@ pub struct Lowerer<'a> {
     const_items: HashMap<String, CVal>,
     /// Scalar constant id → its bits.
     const_ids: HashMap<Id, u32>,
+    /// Static globals whose initializers run at the start of each entry point.
+    deferred_inits: Vec<(Id, Ty, &'a Expr)>,
+    /// Pointers into resource arrays indexed with `NonUniformResourceIndex`.
+    nonuniform_ptrs: HashSet<Id>,
 }
 
 /// Source positions of named declarations (the side table `Program` reads).
@@ -413,6 +417,8 @@ impl<'a> Lowerer<'a> {
             cbuffer_members: HashMap::new(),
             const_items: HashMap::new(),
             const_ids: HashMap::new(),
+            deferred_inits: Vec::new(),
+            nonuniform_ptrs: HashSet::new(),
         }
     }
 
@@ -1150,10 +1156,16 @@ impl<'a> Lowerer<'a> {
             )
             .len(v.name.len() as u32));
         }
+        let mut deferred = None;
         let init = match &v.init {
-            Some(e) => Some(self.const_value(e, &t)?.ok_or_else(|| {
-                unsupported(e.pos, "non-constant initializer of a static global")
-            })?),
+            Some(e) => {
+                let c = self.const_value(e, &t)?;
+                if c.is_none() {
+                    // Computed at the start of every entry point, as DXC does.
+                    deferred = Some(e);
+                }
+                c
+            }
             None => None,
         };
         // Scalars and vectors that never change are used as constants directly.
@@ -1182,6 +1194,9 @@ impl<'a> Lowerer<'a> {
         };
         let var = self.global_var(pty, StorageClass::Private, Some(init));
         self.b.name(var, &v.name);
+        if let Some(e) = deferred {
+            self.deferred_inits.push((var, t.clone(), e));
+        }
         self.globals.insert(
             v.name.clone(),
             Global::Place(Place::Ptr {
@@ -1874,6 +1889,15 @@ impl<'a> Lowerer<'a> {
             self.start_block(None)?;
             self.line(f.pos);
             self.bind_entry_params(f, &sig, stage)?;
+            for (var, t, e) in self.deferred_inits.clone() {
+                self.line(e.pos);
+                let v = self.expr_as(e, &t)?;
+                self.use_global(var);
+                if self.term {
+                    self.start_block(None)?;
+                }
+                self.b.store(var, v.id, None, [])?;
+            }
         } else {
             let mut ptys = Vec::new();
             for p in &sig.params {
@@ -2513,6 +2537,7 @@ impl<'a> Lowerer<'a> {
                 )?;
                 if nu {
                     self.b.decorate(ptr, Decoration::NonUniform, []);
+                    self.nonuniform_ptrs.insert(ptr);
                 }
                 Ok(Place::Ptr {
                     ptr,

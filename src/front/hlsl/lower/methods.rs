@@ -210,11 +210,7 @@ impl<'a> Lowerer<'a> {
     }
 
     fn nonuniform_ptr(&self, ptr: Id) -> bool {
-        self.b.module_ref().annotations.iter().any(|a| {
-            a.class.opcode == Op::Decorate
-                && a.operands.first() == Some(&Operand::IdRef(ptr))
-                && a.operands.get(1) == Some(&Operand::Decoration(Decoration::NonUniform))
-        })
+        self.nonuniform_ptrs.contains(&ptr)
     }
 
     pub(super) fn fetch(&mut self, ptr: Id, t: &Ty, coord: Id, lod: Option<Id>) -> Result<Val> {
