@@ -204,3 +204,40 @@ fn program_sees_hlsl_declaration_positions() {
     assert!(loc.path.ends_with("common.hlsli"), "{loc:?}");
     assert_eq!((loc.line, loc.column), (8, 8));
 }
+
+/// Every shader under tests/hlsl/ (the executed ones too) validates, per
+/// entry point and as a whole file.
+#[test]
+fn every_test_shader_validates() {
+    // HLSL cbuffer packing beyond std140 needs scalar block layout.
+    const NEEDS_SCALAR: &[&str] = &["cbuffer_packing.hlsl", "exec_compute.hlsl"];
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/hlsl");
+    let mut count = 0;
+    let mut names: Vec<String> = std::fs::read_dir(&dir)
+        .unwrap()
+        .filter_map(|e| e.ok()?.file_name().into_string().ok())
+        .filter(|n| n.ends_with(".hlsl"))
+        .collect();
+    names.sort();
+    for name in &names {
+        let extra: &[&str] = if NEEDS_SCALAR.contains(&name.as_str()) {
+            &["--scalar-block-layout"]
+        } else {
+            &[]
+        };
+        let path = shader(name);
+        let opts = HlslOptions::default();
+        for e in hlsl::compile(&path, &opts).unwrap_or_else(|e| panic!("{e}")) {
+            validate_with(&e.words, &format!("{name}-{}", e.name), extra);
+            count += 1;
+        }
+        let whole = hlsl::compile_file(&path, &opts).unwrap();
+        validate_with(&whole.words, &format!("{name}-all"), extra);
+        count += 1;
+    }
+    assert!(count >= 40, "only {count} modules validated");
+    eprintln!(
+        "{count} modules from {} shaders passed spirv-val",
+        names.len()
+    );
+}

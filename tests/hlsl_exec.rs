@@ -17,6 +17,8 @@ struct Gpu {
     physical: vk::PhysicalDevice,
     /// Buffers get device addresses (ray tracing needs them).
     bda: bool,
+    /// VK_KHR_ray_query is enabled.
+    ray_query: bool,
 }
 
 impl Drop for Gpu {
@@ -73,11 +75,22 @@ fn gpu(rt: bool) -> Option<Gpu> {
             .acceleration_structure(true);
         let mut rtp =
             vk::PhysicalDeviceRayTracingPipelineFeaturesKHR::default().ray_tracing_pipeline(true);
-        let exts = [
+        let mut exts = vec![
             ash::khr::acceleration_structure::NAME.as_ptr(),
             ash::khr::ray_tracing_pipeline::NAME.as_ptr(),
             ash::khr::deferred_host_operations::NAME.as_ptr(),
         ];
+        let available = instance
+            .enumerate_device_extension_properties(pd)
+            .unwrap_or_default();
+        let ray_query = rt
+            && available
+                .iter()
+                .any(|e| e.extension_name_as_c_str() == Ok(ash::khr::ray_query::NAME));
+        let mut rq = vk::PhysicalDeviceRayQueryFeaturesKHR::default().ray_query(true);
+        if ray_query {
+            exts.push(ash::khr::ray_query::NAME.as_ptr());
+        }
         let mut info = vk::DeviceCreateInfo::default()
             .queue_create_infos(&qinfo)
             .push_next(&mut v12);
@@ -86,6 +99,9 @@ fn gpu(rt: bool) -> Option<Gpu> {
                 .enabled_extension_names(&exts)
                 .push_next(&mut accel)
                 .push_next(&mut rtp);
+            if ray_query {
+                info = info.push_next(&mut rq);
+            }
         }
         let device = match instance.create_device(pd, &info, None) {
             Ok(d) => d,
@@ -105,6 +121,7 @@ fn gpu(rt: bool) -> Option<Gpu> {
             memory,
             physical: pd,
             bda: rt,
+            ray_query,
         })
     }
 }
@@ -453,6 +470,25 @@ fn align_up(x: u64, a: u64) -> u64 {
     x.div_ceil(a) * a
 }
 
+enum Bind<'b> {
+    Accel(vk::AccelerationStructureKHR),
+    Storage(&'b Buffer),
+}
+
+/// Geometry of the one-instance test scenes.
+enum Geom {
+    /// A triangle in the z = 1 plane; its hypotenuse is x + y = 0.
+    Triangle,
+    /// The box around a sphere of radius 0.5 at (0, 0, 1).
+    SphereBox,
+}
+
+struct Scene {
+    tlas: vk::AccelerationStructureKHR,
+    blas: vk::AccelerationStructureKHR,
+    buffers: Vec<Buffer>,
+}
+
 impl Gpu {
     unsafe fn address(&self, b: &Buffer) -> u64 {
         self.device
@@ -493,14 +529,17 @@ impl Gpu {
         d.destroy_command_pool(pool, None);
     }
 
+    fn accel_ext(&self) -> ash::khr::acceleration_structure::Device {
+        ash::khr::acceleration_structure::Device::new(&self.instance, &self.device)
+    }
+
     /// Builds an acceleration structure from one geometry; returns it and its buffer.
     unsafe fn build_as(
         &self,
-        ext: &ash::khr::acceleration_structure::Device,
         ty: vk::AccelerationStructureTypeKHR,
         geometry: vk::AccelerationStructureGeometryKHR,
-        count: u32,
     ) -> (vk::AccelerationStructureKHR, Buffer) {
+        let ext = self.accel_ext();
         let geoms = [geometry];
         let mut info = vk::AccelerationStructureBuildGeometryInfoKHR::default()
             .ty(ty)
@@ -510,7 +549,7 @@ impl Gpu {
         ext.get_acceleration_structure_build_sizes(
             vk::AccelerationStructureBuildTypeKHR::DEVICE,
             &info,
-            &[count],
+            &[1],
             &mut sizes,
         );
         let storage = self.buffer(
@@ -535,48 +574,46 @@ impl Gpu {
             .scratch_data(vk::DeviceOrHostAddressKHR {
                 device_address: align_up(self.address(&scratch), 256),
             });
-        let range = [vk::AccelerationStructureBuildRangeInfoKHR::default().primitive_count(count)];
+        let range = [vk::AccelerationStructureBuildRangeInfoKHR::default().primitive_count(1)];
         self.submit(|cb| ext.cmd_build_acceleration_structures(cb, &[info], &[&range]));
         self.free(scratch);
         (accel, storage)
     }
-}
 
-#[test]
-fn ray_tracing_pipeline_on_the_driver() {
-    let Some(gpu) = gpu(true) else { return };
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/hlsl/exec_pipeline.hlsl");
-    let module =
-        hlsl::compile_file(&path, &HlslOptions::default()).unwrap_or_else(|e| panic!("{e}"));
-    unsafe {
-        let d = &gpu.device;
-        let accel_ext = ash::khr::acceleration_structure::Device::new(&gpu.instance, d);
-        let rt_ext = ash::khr::ray_tracing_pipeline::Device::new(&gpu.instance, d);
+    /// One instance of one non-opaque geometry (any-hit shaders run).
+    unsafe fn scene(&self, geom: Geom) -> Scene {
         let input = vk::BufferUsageFlags::ACCELERATION_STRUCTURE_BUILD_INPUT_READ_ONLY_KHR;
-
-        // One triangle in the z = 1 plane; its hypotenuse is x + y = 0.
-        let verts: [f32; 9] = [-0.9, -0.9, 1.0, 0.9, -0.9, 1.0, -0.9, 0.9, 1.0];
-        let vb = gpu.buffer(36, input);
-        std::ptr::copy_nonoverlapping(verts.as_ptr() as *const u8, vb.ptr, 36);
-        let tri = vk::AccelerationStructureGeometryKHR::default()
-            .geometry_type(vk::GeometryTypeKHR::TRIANGLES)
-            .geometry(vk::AccelerationStructureGeometryDataKHR {
-                triangles: vk::AccelerationStructureGeometryTrianglesDataKHR::default()
-                    .vertex_format(vk::Format::R32G32B32_SFLOAT)
-                    .vertex_data(vk::DeviceOrHostAddressConstKHR {
-                        device_address: gpu.address(&vb),
-                    })
-                    .vertex_stride(12)
-                    .max_vertex(2)
-                    .index_type(vk::IndexType::NONE_KHR),
-            });
-        let (blas, blas_buf) = gpu.build_as(
-            &accel_ext,
-            vk::AccelerationStructureTypeKHR::BOTTOM_LEVEL,
-            tri,
-            1,
-        );
-        let blas_addr = accel_ext.get_acceleration_structure_device_address(
+        let data: Vec<f32> = match geom {
+            Geom::Triangle => vec![-0.9, -0.9, 1.0, 0.9, -0.9, 1.0, -0.9, 0.9, 1.0],
+            Geom::SphereBox => vec![-0.5, -0.5, 0.5, 0.5, 0.5, 1.5],
+        };
+        let vb = self.buffer(data.len() * 4, input);
+        std::ptr::copy_nonoverlapping(data.as_ptr() as *const u8, vb.ptr, data.len() * 4);
+        let addr = vk::DeviceOrHostAddressConstKHR {
+            device_address: self.address(&vb),
+        };
+        let geometry = match geom {
+            Geom::Triangle => vk::AccelerationStructureGeometryKHR::default()
+                .geometry_type(vk::GeometryTypeKHR::TRIANGLES)
+                .geometry(vk::AccelerationStructureGeometryDataKHR {
+                    triangles: vk::AccelerationStructureGeometryTrianglesDataKHR::default()
+                        .vertex_format(vk::Format::R32G32B32_SFLOAT)
+                        .vertex_data(addr)
+                        .vertex_stride(12)
+                        .max_vertex(2)
+                        .index_type(vk::IndexType::NONE_KHR),
+                }),
+            Geom::SphereBox => vk::AccelerationStructureGeometryKHR::default()
+                .geometry_type(vk::GeometryTypeKHR::AABBS)
+                .geometry(vk::AccelerationStructureGeometryDataKHR {
+                    aabbs: vk::AccelerationStructureGeometryAabbsDataKHR::default()
+                        .data(addr)
+                        .stride(24),
+                }),
+        };
+        let (blas, blas_buf) =
+            self.build_as(vk::AccelerationStructureTypeKHR::BOTTOM_LEVEL, geometry);
+        let blas_addr = self.accel_ext().get_acceleration_structure_device_address(
             &vk::AccelerationStructureDeviceAddressInfoKHR::default().acceleration_structure(blas),
         );
         let instance = vk::AccelerationStructureInstanceKHR {
@@ -589,93 +626,151 @@ fn ray_tracing_pipeline_on_the_driver() {
                 device_handle: blas_addr,
             },
         };
-        let ib = gpu.buffer(std::mem::size_of_val(&instance), input);
-        std::ptr::copy_nonoverlapping(
-            &instance as *const _ as *const u8,
-            ib.ptr,
-            std::mem::size_of_val(&instance),
-        );
+        let size = std::mem::size_of_val(&instance);
+        let ib = self.buffer(size, input);
+        std::ptr::copy_nonoverlapping(&instance as *const _ as *const u8, ib.ptr, size);
         let inst_geom = vk::AccelerationStructureGeometryKHR::default()
             .geometry_type(vk::GeometryTypeKHR::INSTANCES)
             .geometry(vk::AccelerationStructureGeometryDataKHR {
                 instances: vk::AccelerationStructureGeometryInstancesDataKHR::default().data(
                     vk::DeviceOrHostAddressConstKHR {
-                        device_address: gpu.address(&ib),
+                        device_address: self.address(&ib),
                     },
                 ),
             });
-        let (tlas, tlas_buf) = gpu.build_as(
-            &accel_ext,
-            vk::AccelerationStructureTypeKHR::TOP_LEVEL,
-            inst_geom,
-            1,
-        );
+        let (tlas, tlas_buf) =
+            self.build_as(vk::AccelerationStructureTypeKHR::TOP_LEVEL, inst_geom);
+        Scene {
+            tlas,
+            blas,
+            buffers: vec![vb, blas_buf, ib, tlas_buf],
+        }
+    }
 
-        // Pipeline: raygen, miss 0, miss 1, hit group (closest hit + any hit).
-        let shader = d
-            .create_shader_module(
-                &vk::ShaderModuleCreateInfo::default().code(&module.words),
-                None,
-            )
-            .unwrap();
-        let names: Vec<std::ffi::CString> = ["RG", "MissColor", "MissProbe", "Hit", "Filter"]
+    unsafe fn drop_scene(&self, scene: Scene) {
+        let ext = self.accel_ext();
+        ext.destroy_acceleration_structure(scene.tlas, None);
+        ext.destroy_acceleration_structure(scene.blas, None);
+        for b in scene.buffers {
+            self.free(b);
+        }
+    }
+
+    /// A descriptor set (set 0) with `binds` at bindings 0, 1, ...
+    unsafe fn descriptors(
+        &self,
+        binds: &[Bind],
+        stages: vk::ShaderStageFlags,
+    ) -> (
+        vk::DescriptorSetLayout,
+        vk::DescriptorPool,
+        vk::DescriptorSet,
+    ) {
+        let d = &self.device;
+        let ty = |b: &Bind| match b {
+            Bind::Accel(_) => vk::DescriptorType::ACCELERATION_STRUCTURE_KHR,
+            Bind::Storage(_) => vk::DescriptorType::STORAGE_BUFFER,
+        };
+        let bindings: Vec<_> = binds
             .iter()
-            .map(|n| std::ffi::CString::new(*n).unwrap())
-            .collect();
-        let kinds = [
-            vk::ShaderStageFlags::RAYGEN_KHR,
-            vk::ShaderStageFlags::MISS_KHR,
-            vk::ShaderStageFlags::MISS_KHR,
-            vk::ShaderStageFlags::CLOSEST_HIT_KHR,
-            vk::ShaderStageFlags::ANY_HIT_KHR,
-        ];
-        let stages: Vec<_> = names
-            .iter()
-            .zip(kinds)
-            .map(|(n, k)| {
-                vk::PipelineShaderStageCreateInfo::default()
-                    .stage(k)
-                    .module(shader)
-                    .name(n)
+            .enumerate()
+            .map(|(i, b)| {
+                vk::DescriptorSetLayoutBinding::default()
+                    .binding(i as u32)
+                    .descriptor_type(ty(b))
+                    .descriptor_count(1)
+                    .stage_flags(stages)
             })
             .collect();
-        let general = |i: u32| {
-            vk::RayTracingShaderGroupCreateInfoKHR::default()
-                .ty(vk::RayTracingShaderGroupTypeKHR::GENERAL)
-                .general_shader(i)
-                .closest_hit_shader(vk::SHADER_UNUSED_KHR)
-                .any_hit_shader(vk::SHADER_UNUSED_KHR)
-                .intersection_shader(vk::SHADER_UNUSED_KHR)
-        };
-        let groups = [
-            general(0),
-            general(1),
-            general(2),
-            vk::RayTracingShaderGroupCreateInfoKHR::default()
-                .ty(vk::RayTracingShaderGroupTypeKHR::TRIANGLES_HIT_GROUP)
-                .general_shader(vk::SHADER_UNUSED_KHR)
-                .closest_hit_shader(3)
-                .any_hit_shader(4)
-                .intersection_shader(vk::SHADER_UNUSED_KHR),
-        ];
-        let bindings = [
-            vk::DescriptorSetLayoutBinding::default()
-                .binding(0)
-                .descriptor_type(vk::DescriptorType::ACCELERATION_STRUCTURE_KHR)
-                .descriptor_count(1)
-                .stage_flags(vk::ShaderStageFlags::RAYGEN_KHR),
-            vk::DescriptorSetLayoutBinding::default()
-                .binding(1)
-                .descriptor_type(vk::DescriptorType::STORAGE_BUFFER)
-                .descriptor_count(1)
-                .stage_flags(vk::ShaderStageFlags::RAYGEN_KHR),
-        ];
-        let set_layout = d
+        let layout = d
             .create_descriptor_set_layout(
                 &vk::DescriptorSetLayoutCreateInfo::default().bindings(&bindings),
                 None,
             )
             .unwrap();
+        let sizes: Vec<_> = binds
+            .iter()
+            .map(|b| vk::DescriptorPoolSize {
+                ty: ty(b),
+                descriptor_count: 1,
+            })
+            .collect();
+        let pool = d
+            .create_descriptor_pool(
+                &vk::DescriptorPoolCreateInfo::default()
+                    .max_sets(1)
+                    .pool_sizes(&sizes),
+                None,
+            )
+            .unwrap();
+        let layouts = [layout];
+        let set = d
+            .allocate_descriptor_sets(
+                &vk::DescriptorSetAllocateInfo::default()
+                    .descriptor_pool(pool)
+                    .set_layouts(&layouts),
+            )
+            .unwrap()[0];
+        for (i, b) in binds.iter().enumerate() {
+            let w = vk::WriteDescriptorSet::default()
+                .dst_set(set)
+                .dst_binding(i as u32)
+                .descriptor_type(ty(b))
+                .descriptor_count(1);
+            match b {
+                Bind::Accel(a) => {
+                    let list = [*a];
+                    let mut aw = vk::WriteDescriptorSetAccelerationStructureKHR::default()
+                        .acceleration_structures(&list);
+                    d.update_descriptor_sets(&[w.push_next(&mut aw)], &[]);
+                }
+                Bind::Storage(buf) => {
+                    let info = [vk::DescriptorBufferInfo {
+                        buffer: buf.buffer,
+                        offset: 0,
+                        range: vk::WHOLE_SIZE,
+                    }];
+                    d.update_descriptor_sets(&[w.buffer_info(&info)], &[]);
+                }
+            }
+        }
+        (layout, pool, set)
+    }
+
+    /// Builds a ray-tracing pipeline from `module`'s entry points and traces
+    /// a `w`×`h` launch. `tables` lists the group indices of the raygen, miss,
+    /// hit and callable regions of the shader binding table.
+    #[allow(clippy::too_many_arguments)]
+    unsafe fn trace(
+        &self,
+        words: &[u32],
+        stages: &[(&str, vk::ShaderStageFlags)],
+        groups: &[vk::RayTracingShaderGroupCreateInfoKHR],
+        tables: [&[u32]; 4],
+        binds: &[Bind],
+        w: u32,
+        h: u32,
+    ) {
+        let d = &self.device;
+        let rt_ext = ash::khr::ray_tracing_pipeline::Device::new(&self.instance, d);
+        let shader = d
+            .create_shader_module(&vk::ShaderModuleCreateInfo::default().code(words), None)
+            .unwrap();
+        let names: Vec<std::ffi::CString> = stages
+            .iter()
+            .map(|(n, _)| std::ffi::CString::new(*n).unwrap())
+            .collect();
+        let infos: Vec<_> = names
+            .iter()
+            .zip(stages)
+            .map(|(n, (_, k))| {
+                vk::PipelineShaderStageCreateInfo::default()
+                    .stage(*k)
+                    .module(shader)
+                    .name(n)
+            })
+            .collect();
+        let (set_layout, pool, set) = self.descriptors(binds, vk::ShaderStageFlags::ALL);
         let layouts = [set_layout];
         let pipeline_layout = d
             .create_pipeline_layout(
@@ -688,108 +783,54 @@ fn ray_tracing_pipeline_on_the_driver() {
                 vk::DeferredOperationKHR::null(),
                 vk::PipelineCache::null(),
                 &[vk::RayTracingPipelineCreateInfoKHR::default()
-                    .stages(&stages)
-                    .groups(&groups)
+                    .stages(&infos)
+                    .groups(groups)
                     .max_pipeline_ray_recursion_depth(1)
                     .layout(pipeline_layout)],
                 None,
             )
             .map_err(|e| e.1)
             .unwrap()[0];
-
         // Shader binding table: one region per kind, each on the base alignment.
         let mut props = vk::PhysicalDeviceRayTracingPipelinePropertiesKHR::default();
         let mut props2 = vk::PhysicalDeviceProperties2::default().push_next(&mut props);
-        gpu.instance
-            .get_physical_device_properties2(gpu.physical, &mut props2);
+        self.instance
+            .get_physical_device_properties2(self.physical, &mut props2);
         let handle = props.shader_group_handle_size as usize;
         let stride = align_up(handle as u64, props.shader_group_handle_alignment as u64);
         let base = props.shader_group_base_alignment as u64;
         let handles = rt_ext
-            .get_ray_tracing_shader_group_handles(pipeline, 0, 4, 4 * handle)
+            .get_ray_tracing_shader_group_handles(
+                pipeline,
+                0,
+                groups.len() as u32,
+                groups.len() * handle,
+            )
             .unwrap();
-        let regions = [
-            (0u64, 1usize, 0usize),
-            (base, 2, 1),
-            (2 * base + align_up(2 * stride, base), 1, 3),
-        ];
-        let sbt = gpu.buffer(
-            8 * base as usize,
+        let region_size = align_up(stride * 8, base);
+        let sbt = self.buffer(
+            (4 * region_size + base) as usize,
             vk::BufferUsageFlags::SHADER_BINDING_TABLE_KHR,
         );
-        let sbt_addr = align_up(gpu.address(&sbt), base);
-        let shift = (sbt_addr - gpu.address(&sbt)) as usize;
-        for (offset, count, first) in regions {
-            for k in 0..count {
-                let src = &handles[(first + k) * handle..(first + k + 1) * handle];
+        let sbt_addr = align_up(self.address(&sbt), base);
+        let shift = (sbt_addr - self.address(&sbt)) as usize;
+        let mut regions = [vk::StridedDeviceAddressRegionKHR::default(); 4];
+        for (r, list) in tables.iter().enumerate() {
+            let offset = r as u64 * region_size;
+            for (k, g) in list.iter().enumerate() {
+                let src = &handles[*g as usize * handle..(*g as usize + 1) * handle];
                 let dst = sbt.ptr.add(shift + offset as usize + k * stride as usize);
                 std::ptr::copy_nonoverlapping(src.as_ptr(), dst, handle);
             }
-        }
-        let region = |(offset, count, _): (u64, usize, usize), raygen: bool| {
-            vk::StridedDeviceAddressRegionKHR {
-                device_address: sbt_addr + offset,
-                stride,
-                size: if raygen {
-                    stride
-                } else {
-                    stride * count as u64
-                },
+            if !list.is_empty() {
+                regions[r] = vk::StridedDeviceAddressRegionKHR {
+                    device_address: sbt_addr + offset,
+                    stride,
+                    size: stride * list.len() as u64,
+                };
             }
-        };
-
-        let (w, h) = (4u32, 4u32);
-        let out = gpu.buffer((w * h * 16) as usize, vk::BufferUsageFlags::STORAGE_BUFFER);
-        let sizes = [
-            vk::DescriptorPoolSize {
-                ty: vk::DescriptorType::ACCELERATION_STRUCTURE_KHR,
-                descriptor_count: 1,
-            },
-            vk::DescriptorPoolSize {
-                ty: vk::DescriptorType::STORAGE_BUFFER,
-                descriptor_count: 1,
-            },
-        ];
-        let pool = d
-            .create_descriptor_pool(
-                &vk::DescriptorPoolCreateInfo::default()
-                    .max_sets(1)
-                    .pool_sizes(&sizes),
-                None,
-            )
-            .unwrap();
-        let set = d
-            .allocate_descriptor_sets(
-                &vk::DescriptorSetAllocateInfo::default()
-                    .descriptor_pool(pool)
-                    .set_layouts(&layouts),
-            )
-            .unwrap()[0];
-        let tlases = [tlas];
-        let mut as_write = vk::WriteDescriptorSetAccelerationStructureKHR::default()
-            .acceleration_structures(&tlases);
-        let oinfo = [vk::DescriptorBufferInfo {
-            buffer: out.buffer,
-            offset: 0,
-            range: vk::WHOLE_SIZE,
-        }];
-        d.update_descriptor_sets(
-            &[
-                vk::WriteDescriptorSet::default()
-                    .dst_set(set)
-                    .dst_binding(0)
-                    .descriptor_type(vk::DescriptorType::ACCELERATION_STRUCTURE_KHR)
-                    .descriptor_count(1)
-                    .push_next(&mut as_write),
-                vk::WriteDescriptorSet::default()
-                    .dst_set(set)
-                    .dst_binding(1)
-                    .descriptor_type(vk::DescriptorType::STORAGE_BUFFER)
-                    .buffer_info(&oinfo),
-            ],
-            &[],
-        );
-        gpu.submit(|cb| {
+        }
+        self.submit(|cb| {
             d.cmd_bind_pipeline(cb, vk::PipelineBindPoint::RAY_TRACING_KHR, pipeline);
             d.cmd_bind_descriptor_sets(
                 cb,
@@ -801,51 +842,262 @@ fn ray_tracing_pipeline_on_the_driver() {
             );
             rt_ext.cmd_trace_rays(
                 cb,
-                &region(regions[0], true),
-                &region(regions[1], false),
-                &region(regions[2], false),
-                &vk::StridedDeviceAddressRegionKHR::default(),
+                &regions[0],
+                &regions[1],
+                &regions[2],
+                &regions[3],
                 w,
                 h,
                 1,
             );
         });
-        let mut got = vec![[0f32; 4]; (w * h) as usize];
-        std::ptr::copy_nonoverlapping(out.ptr as *const [f32; 4], got.as_mut_ptr(), got.len());
-
-        let mut wrong = Vec::new();
-        for y in 0..h {
-            for x in 0..w {
-                let px = (x as f32 + 0.5) / w as f32 * 2.0 - 1.0 + 0.1;
-                let py = (y as f32 + 0.5) / h as f32 * 2.0 - 1.0;
-                let (u, v) = ((px + 0.9) / 1.8, (py + 0.9) / 1.8);
-                let inside = px + py < 0.0;
-                // The any-hit shader ignores hits with u > 0.5; the second ray
-                // always reaches miss shader 1, which adds 10.
-                let want = if inside && u <= 0.5 {
-                    [u, v, 2.0, 11.0]
-                } else {
-                    [0.0, 0.0, 1.0, 10.0]
-                };
-                let g = got[(y * w + x) as usize];
-                if g.iter().zip(want).any(|(a, b)| (a - b).abs() > 1e-4) {
-                    wrong.push(format!("pixel ({x}, {y}): got {g:?}, want {want:?}"));
-                }
-            }
-        }
-        assert!(wrong.is_empty(), "{}", wrong.join("\n"));
-        // Both outcomes occur, and both hit filters matter.
-        assert!(got.iter().any(|g| g[3] == 11.0) && got.iter().any(|g| g[3] == 10.0));
-
+        self.free(sbt);
         d.destroy_descriptor_pool(pool, None);
         d.destroy_pipeline(pipeline, None);
         d.destroy_pipeline_layout(pipeline_layout, None);
         d.destroy_descriptor_set_layout(set_layout, None);
         d.destroy_shader_module(shader, None);
-        accel_ext.destroy_acceleration_structure(tlas, None);
-        accel_ext.destroy_acceleration_structure(blas, None);
-        for b in [out, sbt, ib, vb, tlas_buf, blas_buf] {
-            gpu.free(b);
+    }
+
+    /// Runs compute entry `entry` with `binds`, `groups` workgroups along x.
+    unsafe fn dispatch(&self, words: &[u32], entry: &str, binds: &[Bind], groups: u32) {
+        let d = &self.device;
+        let shader = d
+            .create_shader_module(&vk::ShaderModuleCreateInfo::default().code(words), None)
+            .unwrap();
+        let (set_layout, pool, set) = self.descriptors(binds, vk::ShaderStageFlags::COMPUTE);
+        let layouts = [set_layout];
+        let pipeline_layout = d
+            .create_pipeline_layout(
+                &vk::PipelineLayoutCreateInfo::default().set_layouts(&layouts),
+                None,
+            )
+            .unwrap();
+        let name = std::ffi::CString::new(entry).unwrap();
+        let stage = vk::PipelineShaderStageCreateInfo::default()
+            .stage(vk::ShaderStageFlags::COMPUTE)
+            .module(shader)
+            .name(&name);
+        let pipeline = d
+            .create_compute_pipelines(
+                vk::PipelineCache::null(),
+                &[vk::ComputePipelineCreateInfo::default()
+                    .stage(stage)
+                    .layout(pipeline_layout)],
+                None,
+            )
+            .map_err(|e| e.1)
+            .unwrap()[0];
+        self.submit(|cb| {
+            d.cmd_bind_pipeline(cb, vk::PipelineBindPoint::COMPUTE, pipeline);
+            d.cmd_bind_descriptor_sets(
+                cb,
+                vk::PipelineBindPoint::COMPUTE,
+                pipeline_layout,
+                0,
+                &[set],
+                &[],
+            );
+            d.cmd_dispatch(cb, groups, 1, 1);
+        });
+        d.destroy_descriptor_pool(pool, None);
+        d.destroy_pipeline(pipeline, None);
+        d.destroy_pipeline_layout(pipeline_layout, None);
+        d.destroy_descriptor_set_layout(set_layout, None);
+        d.destroy_shader_module(shader, None);
+    }
+}
+
+fn general(i: u32) -> vk::RayTracingShaderGroupCreateInfoKHR<'static> {
+    vk::RayTracingShaderGroupCreateInfoKHR::default()
+        .ty(vk::RayTracingShaderGroupTypeKHR::GENERAL)
+        .general_shader(i)
+        .closest_hit_shader(vk::SHADER_UNUSED_KHR)
+        .any_hit_shader(vk::SHADER_UNUSED_KHR)
+        .intersection_shader(vk::SHADER_UNUSED_KHR)
+}
+
+fn hit_group(
+    ty: vk::RayTracingShaderGroupTypeKHR,
+    closest: u32,
+    any: u32,
+    intersection: u32,
+) -> vk::RayTracingShaderGroupCreateInfoKHR<'static> {
+    vk::RayTracingShaderGroupCreateInfoKHR::default()
+        .ty(ty)
+        .general_shader(vk::SHADER_UNUSED_KHR)
+        .closest_hit_shader(closest)
+        .any_hit_shader(any)
+        .intersection_shader(intersection)
+}
+
+/// Pixel centers of the 4×4 launches, shifted so none lies on an edge.
+fn pixel(x: u32, y: u32) -> (f32, f32) {
+    (
+        (x as f32 + 0.5) / 4.0 * 2.0 - 1.0 + 0.1,
+        (y as f32 + 0.5) / 4.0 * 2.0 - 1.0,
+    )
+}
+
+/// Expected triangle result: barycentrics and t where the (any-hit filtered)
+/// triangle is hit, else the miss value.
+fn triangle_expectation(x: u32, y: u32, hit_w: f32, miss: [f32; 4]) -> [f32; 4] {
+    let (px, py) = pixel(x, y);
+    let (u, v) = ((px + 0.9) / 1.8, (py + 0.9) / 1.8);
+    if px + py < 0.0 && u <= 0.5 {
+        [u, v, 2.0, hit_w]
+    } else {
+        miss
+    }
+}
+
+fn compare(got: &[[f32; 4]], want: impl Fn(u32, u32) -> [f32; 4]) {
+    let mut wrong = Vec::new();
+    for y in 0..4 {
+        for x in 0..4 {
+            let g = got[(y * 4 + x) as usize];
+            let w = want(x, y);
+            if g.iter().zip(w).any(|(a, b)| (a - b).abs() > 1e-4) {
+                wrong.push(format!("pixel ({x}, {y}): got {g:?}, want {w:?}"));
+            }
         }
+    }
+    assert!(wrong.is_empty(), "{}", wrong.join("\n"));
+}
+
+unsafe fn read4(b: &Buffer, n: usize) -> Vec<[f32; 4]> {
+    let mut got = vec![[0f32; 4]; n];
+    std::ptr::copy_nonoverlapping(b.ptr as *const [f32; 4], got.as_mut_ptr(), n);
+    got
+}
+
+fn compile_whole(name: &str) -> Vec<u32> {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/hlsl")
+        .join(name);
+    hlsl::compile_file(&path, &HlslOptions::default())
+        .unwrap_or_else(|e| panic!("{e}"))
+        .words
+}
+
+#[test]
+fn ray_tracing_pipeline_on_the_driver() {
+    let Some(gpu) = gpu(true) else { return };
+    let words = compile_whole("exec_pipeline.hlsl");
+    unsafe {
+        let scene = gpu.scene(Geom::Triangle);
+        let out = gpu.buffer(16 * 16, vk::BufferUsageFlags::STORAGE_BUFFER);
+        use vk::ShaderStageFlags as S;
+        gpu.trace(
+            &words,
+            &[
+                ("RG", S::RAYGEN_KHR),
+                ("MissColor", S::MISS_KHR),
+                ("MissProbe", S::MISS_KHR),
+                ("Hit", S::CLOSEST_HIT_KHR),
+                ("Filter", S::ANY_HIT_KHR),
+            ],
+            &[
+                general(0),
+                general(1),
+                general(2),
+                hit_group(
+                    vk::RayTracingShaderGroupTypeKHR::TRIANGLES_HIT_GROUP,
+                    3,
+                    4,
+                    vk::SHADER_UNUSED_KHR,
+                ),
+            ],
+            [&[0], &[1, 2], &[3], &[]],
+            &[Bind::Accel(scene.tlas), Bind::Storage(&out)],
+            4,
+            4,
+        );
+        let got = read4(&out, 16);
+        // The any-hit shader ignores hits with u > 0.5; the second ray always
+        // reaches miss shader 1, which adds 10.
+        compare(&got, |x, y| {
+            triangle_expectation(x, y, 11.0, [0.0, 0.0, 1.0, 10.0])
+        });
+        assert!(got.iter().any(|g| g[3] == 11.0) && got.iter().any(|g| g[3] == 10.0));
+        gpu.free(out);
+        gpu.drop_scene(scene);
+    }
+}
+
+#[test]
+fn intersection_and_callable_on_the_driver() {
+    let Some(gpu) = gpu(true) else { return };
+    let words = compile_whole("exec_procedural.hlsl");
+    unsafe {
+        let scene = gpu.scene(Geom::SphereBox);
+        let out = gpu.buffer(16 * 16, vk::BufferUsageFlags::STORAGE_BUFFER);
+        use vk::ShaderStageFlags as S;
+        gpu.trace(
+            &words,
+            &[
+                ("Gen", S::RAYGEN_KHR),
+                ("Miss", S::MISS_KHR),
+                ("SphereHit", S::CLOSEST_HIT_KHR),
+                ("Sphere", S::INTERSECTION_KHR),
+                ("Twice", S::CALLABLE_KHR),
+            ],
+            &[
+                general(0),
+                general(1),
+                hit_group(
+                    vk::RayTracingShaderGroupTypeKHR::PROCEDURAL_HIT_GROUP,
+                    2,
+                    vk::SHADER_UNUSED_KHR,
+                    3,
+                ),
+                general(4),
+            ],
+            [&[0], &[1], &[2], &[3]],
+            &[Bind::Accel(scene.tlas), Bind::Storage(&out)],
+            4,
+            4,
+        );
+        let got = read4(&out, 16);
+        compare(&got, |x, y| {
+            let (px, py) = pixel(x, y);
+            let called = 2.0 * x as f32 + 1.0;
+            let disc = 0.25 - (px * px + py * py);
+            if disc > 0.0 {
+                let s = disc.sqrt();
+                [-2.0 * s, 2.0 - s, 7.0, called]
+            } else {
+                [0.0, 0.0, 0.0, 100.0 + called]
+            }
+        });
+        assert!(got.iter().any(|g| g[2] == 7.0), "no sphere hits: {got:?}");
+        gpu.free(out);
+        gpu.drop_scene(scene);
+    }
+}
+
+#[test]
+fn ray_query_on_the_driver() {
+    let Some(gpu) = gpu(true) else { return };
+    if !gpu.ray_query {
+        eprintln!("no VK_KHR_ray_query; skipping");
+        return;
+    }
+    let words = compile_whole("exec_rayquery.hlsl");
+    unsafe {
+        let scene = gpu.scene(Geom::Triangle);
+        let out = gpu.buffer(16 * 16, vk::BufferUsageFlags::STORAGE_BUFFER);
+        gpu.dispatch(
+            &words,
+            "Query",
+            &[Bind::Accel(scene.tlas), Bind::Storage(&out)],
+            1,
+        );
+        let got = read4(&out, 16);
+        compare(&got, |x, y| {
+            triangle_expectation(x, y, 1.0, [0.0, 0.0, 1.0, 0.0])
+        });
+        gpu.free(out);
+        gpu.drop_scene(scene);
     }
 }
