@@ -449,6 +449,8 @@ fn compute_semantics_on_the_driver() {
         I(1),
         F(0.8),
         F(8.0),
+        F(1.0),
+        F(2.5),
     ];
     let got = unsafe { gpu.run(&entries[0].words, "Main", expected.len() + 4, &inputs()) };
     let mut wrong = Vec::new();

@@ -164,4 +164,7 @@ void Main()
     // 61..62: static globals with computed initializers
     put(UNIT.z);
     put(fromBuffer);
+    // 63: a ternary takes the common type of its sides
+    put(b1 > 0 ? 1 : 2.5);
+    put(b1 < 0 ? 1 : 2.5);
 }

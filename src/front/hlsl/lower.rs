@@ -3868,33 +3868,41 @@ impl<'a> Lowerer<'a> {
             return Ok(Val { id, ty: t });
         }
         let cb = self.convert(cv, &Ty::Sc(Sc::Bool), c.pos, false)?;
+        // Only the chosen side runs. Each side leaves its value in a temporary
+        // of its own type; the result, in the common type of both, is selected
+        // after the merge (the unchosen temporary is never observed).
         let (la, lb, merge) = (self.b.id(), self.b.id(), self.b.id());
         self.b
             .selection_merge(merge, spirv::SelectionControl::NONE)?;
         self.b.branch_conditional(cb.id, la, lb, [])?;
-        self.start_block(Some(la))?;
-        let av = self.expr(a)?;
-        // The result takes the first branch's type; the second converts to it.
-        let t = av.ty.clone();
-        let ea = self.cur_label;
-        self.branch(merge)?;
-        self.start_block(Some(lb))?;
-        let bv = self.expr(b)?;
-        let bv = self.convert(bv, &t, b.pos, false)?;
-        let eb = self.cur_label;
-        self.branch(merge)?;
+        let mut side = |this: &mut Self, label: Id, e: &'a Expr| -> Result<(Id, Ty)> {
+            this.start_block(Some(label))?;
+            let v = this.expr(e)?;
+            let tmp = this.local_var(&v.ty, "")?;
+            if this.term {
+                this.start_block(None)?;
+            }
+            this.b.store(tmp, v.id, None, [])?;
+            this.branch(merge)?;
+            Ok((tmp, v.ty))
+        };
+        let (ta, tya) = side(self, la, a)?;
+        let (tb, tyb) = side(self, lb, b)?;
         self.start_block(Some(merge))?;
+        let t = if tya == tyb {
+            tya.clone()
+        } else {
+            self.common(&tya, &tyb, pos)?
+        };
+        let load = |this: &mut Self, tmp: Id, ty: &Ty, at: Pos| -> Result<Val> {
+            let tid = this.ty_id(ty)?;
+            let id = this.b.load(tid, None, tmp, None, [])?;
+            this.convert(Val { id, ty: ty.clone() }, &t, at, false)
+        };
+        let x = load(self, ta, &tya, a.pos)?;
+        let y = load(self, tb, &tyb, b.pos)?;
         let tid = self.ty_id(&t)?;
-        let id = self.inst(
-            Op::Phi,
-            Some(tid),
-            vec![
-                Operand::IdRef(av.id),
-                Operand::IdRef(ea),
-                Operand::IdRef(bv.id),
-                Operand::IdRef(eb),
-            ],
-        )?;
+        let id = self.op(Op::Select, tid, &[cb.id, x.id, y.id])?;
         Ok(Val { id, ty: t })
     }
 
