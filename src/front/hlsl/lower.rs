@@ -3875,7 +3875,7 @@ impl<'a> Lowerer<'a> {
         self.b
             .selection_merge(merge, spirv::SelectionControl::NONE)?;
         self.b.branch_conditional(cb.id, la, lb, [])?;
-        let mut side = |this: &mut Self, label: Id, e: &'a Expr| -> Result<(Id, Ty)> {
+        let side = |this: &mut Self, label: Id, e: &'a Expr| -> Result<(Id, Ty)> {
             this.start_block(Some(label))?;
             let v = this.expr(e)?;
             let tmp = this.local_var(&v.ty, "")?;
