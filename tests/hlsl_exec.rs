@@ -1103,3 +1103,38 @@ fn ray_query_on_the_driver() {
         gpu.drop_scene(scene);
     }
 }
+
+#[test]
+fn groupshared_atomics_and_byte_address_buffers_on_the_driver() {
+    let Some(gpu) = gpu(false) else { return };
+    let words = compile_whole("exec_memory.hlsl");
+    unsafe {
+        let raw = gpu.buffer(1024, vk::BufferUsageFlags::STORAGE_BUFFER);
+        let init: Vec<u32> = (0..64).map(|i| 1000 + i).collect();
+        std::ptr::copy_nonoverlapping(init.as_ptr() as *const u8, raw.ptr, 256);
+        let counts = gpu.buffer(16, vk::BufferUsageFlags::STORAGE_BUFFER);
+        gpu.dispatch(
+            &words,
+            "Main",
+            &[Bind::Storage(&raw), Bind::Storage(&counts)],
+            1,
+        );
+        let mut r = vec![0u32; 256];
+        std::ptr::copy_nonoverlapping(raw.ptr as *const u32, r.as_mut_ptr(), 256);
+        for i in 0..64u32 {
+            assert_eq!(
+                r[64 + i as usize],
+                1000 + i + 2 * (63 - i),
+                "word {}",
+                64 + i
+            );
+        }
+        assert_eq!(&r[128..130], &[2016, 7]);
+        assert_eq!(&r[132..136], &[1003, 1002, 1001, 1000]);
+        let mut c = [0u32; 4];
+        std::ptr::copy_nonoverlapping(counts.ptr as *const u32, c.as_mut_ptr(), 4);
+        assert_eq!(&c[..3], &[63, 64, u32::MAX]);
+        gpu.free(raw);
+        gpu.free(counts);
+    }
+}
