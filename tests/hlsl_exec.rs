@@ -475,6 +475,9 @@ fn align_up(x: u64, a: u64) -> u64 {
 enum Bind<'b> {
     Accel(vk::AccelerationStructureKHR),
     Storage(&'b Buffer),
+    StorageImage(vk::ImageView),
+    SampledImage(vk::ImageView),
+    Sampler(vk::Sampler),
 }
 
 /// Geometry of the one-instance test scenes.
@@ -672,6 +675,9 @@ impl Gpu {
         let ty = |b: &Bind| match b {
             Bind::Accel(_) => vk::DescriptorType::ACCELERATION_STRUCTURE_KHR,
             Bind::Storage(_) => vk::DescriptorType::STORAGE_BUFFER,
+            Bind::StorageImage(_) => vk::DescriptorType::STORAGE_IMAGE,
+            Bind::SampledImage(_) => vk::DescriptorType::SAMPLED_IMAGE,
+            Bind::Sampler(_) => vk::DescriptorType::SAMPLER,
         };
         let bindings: Vec<_> = binds
             .iter()
@@ -725,6 +731,16 @@ impl Gpu {
                     let mut aw = vk::WriteDescriptorSetAccelerationStructureKHR::default()
                         .acceleration_structures(&list);
                     d.update_descriptor_sets(&[w.push_next(&mut aw)], &[]);
+                }
+                Bind::StorageImage(v) | Bind::SampledImage(v) => {
+                    let info = [vk::DescriptorImageInfo::default()
+                        .image_view(*v)
+                        .image_layout(vk::ImageLayout::GENERAL)];
+                    d.update_descriptor_sets(&[w.image_info(&info)], &[]);
+                }
+                Bind::Sampler(smp) => {
+                    let info = [vk::DescriptorImageInfo::default().sampler(*smp)];
+                    d.update_descriptor_sets(&[w.image_info(&info)], &[]);
                 }
                 Bind::Storage(buf) => {
                     let info = [vk::DescriptorBufferInfo {
@@ -1136,5 +1152,186 @@ fn groupshared_atomics_and_byte_address_buffers_on_the_driver() {
         assert_eq!(&c[..3], &[63, 64, u32::MAX]);
         gpu.free(raw);
         gpu.free(counts);
+    }
+}
+
+struct Image {
+    image: vk::Image,
+    memory: vk::DeviceMemory,
+    view: vk::ImageView,
+}
+
+impl Gpu {
+    /// A linear, host-visible RGBA32F image in GENERAL layout, filled with `texels`.
+    unsafe fn image(
+        &self,
+        w: u32,
+        h: u32,
+        usage: vk::ImageUsageFlags,
+        texels: &[[f32; 4]],
+    ) -> Image {
+        let d = &self.device;
+        let format = vk::Format::R32G32B32A32_SFLOAT;
+        let image = d
+            .create_image(
+                &vk::ImageCreateInfo::default()
+                    .image_type(vk::ImageType::TYPE_2D)
+                    .format(format)
+                    .extent(vk::Extent3D {
+                        width: w,
+                        height: h,
+                        depth: 1,
+                    })
+                    .mip_levels(1)
+                    .array_layers(1)
+                    .samples(vk::SampleCountFlags::TYPE_1)
+                    .tiling(vk::ImageTiling::LINEAR)
+                    .usage(usage)
+                    .initial_layout(vk::ImageLayout::PREINITIALIZED),
+                None,
+            )
+            .unwrap();
+        let req = d.get_image_memory_requirements(image);
+        let want = vk::MemoryPropertyFlags::HOST_VISIBLE | vk::MemoryPropertyFlags::HOST_COHERENT;
+        let ty = (0..self.memory.memory_type_count)
+            .find(|&i| {
+                req.memory_type_bits & (1 << i) != 0
+                    && self.memory.memory_types[i as usize]
+                        .property_flags
+                        .contains(want)
+            })
+            .unwrap();
+        let memory = d
+            .allocate_memory(
+                &vk::MemoryAllocateInfo::default()
+                    .allocation_size(req.size)
+                    .memory_type_index(ty),
+                None,
+            )
+            .unwrap();
+        d.bind_image_memory(image, memory, 0).unwrap();
+        let layout = d.get_image_subresource_layout(
+            image,
+            vk::ImageSubresource {
+                aspect_mask: vk::ImageAspectFlags::COLOR,
+                mip_level: 0,
+                array_layer: 0,
+            },
+        );
+        let ptr = d
+            .map_memory(memory, 0, vk::WHOLE_SIZE, vk::MemoryMapFlags::empty())
+            .unwrap() as *mut u8;
+        for y in 0..h as usize {
+            for x in 0..w as usize {
+                if let Some(t) = texels.get(y * w as usize + x) {
+                    let at =
+                        ptr.add(layout.offset as usize + y * layout.row_pitch as usize + x * 16);
+                    std::ptr::copy_nonoverlapping(t.as_ptr() as *const u8, at, 16);
+                }
+            }
+        }
+        d.unmap_memory(memory);
+        let range = vk::ImageSubresourceRange {
+            aspect_mask: vk::ImageAspectFlags::COLOR,
+            base_mip_level: 0,
+            level_count: 1,
+            base_array_layer: 0,
+            layer_count: 1,
+        };
+        self.submit(|cb| {
+            let barrier = vk::ImageMemoryBarrier::default()
+                .old_layout(vk::ImageLayout::PREINITIALIZED)
+                .new_layout(vk::ImageLayout::GENERAL)
+                .src_access_mask(vk::AccessFlags::HOST_WRITE)
+                .dst_access_mask(vk::AccessFlags::SHADER_READ | vk::AccessFlags::SHADER_WRITE)
+                .image(image)
+                .subresource_range(range);
+            d.cmd_pipeline_barrier(
+                cb,
+                vk::PipelineStageFlags::HOST,
+                vk::PipelineStageFlags::ALL_COMMANDS,
+                vk::DependencyFlags::empty(),
+                &[],
+                &[],
+                &[barrier],
+            );
+        });
+        let view = d
+            .create_image_view(
+                &vk::ImageViewCreateInfo::default()
+                    .image(image)
+                    .view_type(vk::ImageViewType::TYPE_2D)
+                    .format(format)
+                    .subresource_range(range),
+                None,
+            )
+            .unwrap();
+        Image {
+            image,
+            memory,
+            view,
+        }
+    }
+
+    unsafe fn free_image(&self, i: Image) {
+        self.device.destroy_image_view(i.view, None);
+        self.device.destroy_image(i.image, None);
+        self.device.free_memory(i.memory, None);
+    }
+}
+
+#[test]
+fn textures_and_storage_images_on_the_driver() {
+    let Some(gpu) = gpu(false) else { return };
+    let words = compile_whole("exec_textures.hlsl");
+    unsafe {
+        let d = &gpu.device;
+        let texels = [
+            [1.0, 0.0, 0.0, 1.0],
+            [0.0, 2.0, 0.0, 1.0],
+            [0.0, 0.0, 3.0, 1.0],
+            [4.0, 4.0, 4.0, 1.0],
+        ];
+        let tex = gpu.image(2, 2, vk::ImageUsageFlags::SAMPLED, &texels);
+        let img = gpu.image(4, 4, vk::ImageUsageFlags::STORAGE, &[]);
+        let sampler = d
+            .create_sampler(
+                &vk::SamplerCreateInfo::default()
+                    .mag_filter(vk::Filter::NEAREST)
+                    .min_filter(vk::Filter::NEAREST)
+                    .address_mode_u(vk::SamplerAddressMode::CLAMP_TO_EDGE)
+                    .address_mode_v(vk::SamplerAddressMode::CLAMP_TO_EDGE),
+                None,
+            )
+            .unwrap();
+        let out = gpu.buffer(16 * 16, vk::BufferUsageFlags::STORAGE_BUFFER);
+        gpu.dispatch(
+            &words,
+            "Main",
+            &[
+                Bind::SampledImage(tex.view),
+                Bind::Sampler(sampler),
+                Bind::StorageImage(img.view),
+                Bind::Storage(&out),
+            ],
+            1,
+        );
+        let got = read4(&out, 16);
+        for i in 0..16usize {
+            let (x, y) = (i % 4, i / 4);
+            // Nearest sampling of the 2x2 texture at the 4x4 pixel centers,
+            // plus a texel fetch, plus what the storage image read back.
+            let sampled = texels[(y / 2) * 2 + x / 2];
+            let fetched = texels[(y % 2) * 2 + x % 2];
+            let stored = [x as f32, y as f32, 0.5, 1.0];
+            let want: Vec<f32> = (0..4)
+                .map(|c| sampled[c] + 10.0 * fetched[c] + 100.0 * stored[c])
+                .collect();
+            assert_eq!(got[i].to_vec(), want, "pixel {i}");
+        }
+        d.destroy_sampler(sampler, None);
+        gpu.free(out);
+        gpu.free_image(tex);
+        gpu.free_image(img);
     }
 }
