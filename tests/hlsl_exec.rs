@@ -1317,7 +1317,7 @@ fn textures_and_storage_images_on_the_driver() {
             1,
         );
         let got = read4(&out, 16);
-        for i in 0..16usize {
+        for (i, g) in got.iter().enumerate() {
             let (x, y) = (i % 4, i / 4);
             // Nearest sampling of the 2x2 texture at the 4x4 pixel centers,
             // plus a texel fetch, plus what the storage image read back.
@@ -1327,7 +1327,7 @@ fn textures_and_storage_images_on_the_driver() {
             let want: Vec<f32> = (0..4)
                 .map(|c| sampled[c] + 10.0 * fetched[c] + 100.0 * stored[c])
                 .collect();
-            assert_eq!(got[i].to_vec(), want, "pixel {i}");
+            assert_eq!(g.to_vec(), want, "pixel {i}");
         }
         d.destroy_sampler(sampler, None);
         gpu.free(out);
