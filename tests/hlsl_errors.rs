@@ -106,8 +106,8 @@ fn unsupported_constructs_are_named() {
         "main.hlsl:1:1: not supported: templates"
     );
     assert_eq!(
-        err("float g;\n[numthreads(1,1,1)]\nvoid m() {}"),
-        "main.hlsl:1:7: not supported: global variables outside a cbuffer (the implicit $Globals buffer); declare it `static` or put it in a cbuffer"
+        err("float g = 2;\n[numthreads(1,1,1)]\nvoid m() {}"),
+        "main.hlsl:1:11: not supported: initializers of constant-buffer members (declare the global `static const`)"
     );
     assert_eq!(
         err("Texture2D t;\nSamplerState s;\n[shader(\"raygeneration\")]\nvoid rg()\n{\n    float4 c = t.Sample(s, float2(0, 0));\n}"),

@@ -13,8 +13,14 @@ cbuffer Packed : register(b0)
 
 RWStructuredBuffer<float> outBuf : register(u1);
 
+// Plain globals go to the implicit $Globals constant buffer.
+float3 globalTint;
+float globalScale;
+uint globalCount;
+
 [numthreads(1, 1, 1)]
 void Main()
 {
     outBuf[0] = a.x + b + c[2] + d + e.y + m[2][2] + tail;
+    outBuf[1] = globalTint.y * globalScale + (float)globalCount;
 }

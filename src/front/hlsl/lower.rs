@@ -842,6 +842,7 @@ impl<'a> Lowerer<'a> {
             }
         }
         let mut next_auto = 0u32;
+        let mut globals_members: Vec<&VarDecl> = Vec::new();
         for item in items {
             match item {
                 Item::CBuffer {
@@ -851,55 +852,98 @@ impl<'a> Lowerer<'a> {
                     register,
                     members,
                 } => {
-                    let mut fields = Vec::new();
-                    for m in members {
-                        let t = self.resolve_ty(&m.ty, "")?;
-                        let t = self.apply_dims(t, &m.dims, m.pos, false)?;
-                        if t.is_resource() {
-                            return Err(unsupported(m.pos, "resources inside cbuffer"));
-                        }
-                        fields.push(Field {
-                            name: m.name.clone(),
-                            ty: t,
-                            pos: m.pos,
-                            row_major: m.mods.row_major,
-                        });
-                    }
-                    let k = self.structs.len() as u32;
-                    self.structs.push(StructDef {
-                        name: format!("type.{name}"),
-                        fields: fields.clone(),
-                        pos: *pos,
-                    });
-                    self.decls.push((
-                        NamedDecl::Type(format!("type.{name}")),
-                        self.loc(*pos, name.len() as u32),
-                    ));
-                    for (i, f) in fields.iter().enumerate() {
-                        self.decls.push((
-                            NamedDecl::Member(format!("type.{name}"), i as u32),
-                            self.loc(f.pos, f.name.len() as u32),
-                        ));
-                    }
                     let binding = match explicit(attrs, register, self)? {
                         Some(sb) => Some(sb),
                         None if attrs.iter().any(|a| a.name == "vk::push_constant") => None,
                         None => Some(self.auto_binding(&mut used, &mut next_auto)),
                     };
-                    let var = self.resource_var(&Ty::ConstantBuffer(k), attrs, binding, name)?;
-                    self.decls.push((
-                        NamedDecl::Global(name.clone()),
-                        self.loc(*pos, name.len() as u32),
-                    ));
-                    let (layout, class) = self.cbuffer_class(attrs);
-                    for (i, f) in fields.iter().enumerate() {
-                        self.cbuffer_members
-                            .insert(f.name.clone(), (var, f.ty.clone(), i as u32, layout, class));
-                    }
+                    let members: Vec<&VarDecl> = members.iter().collect();
+                    self.declare_cbuffer(attrs, name, *pos, binding, &members)?;
                 }
+                Item::Var(v) if self.in_implicit_globals(v)? => globals_members.push(v),
                 Item::Var(v) => self.declare_global_var(v, &mut used, &mut next_auto)?,
                 _ => {}
             }
+        }
+        if let Some(first) = globals_members.first() {
+            // Plain globals live in the implicit `$Globals` constant buffer, as in DXC.
+            let pos = first.pos;
+            let binding = self.auto_binding(&mut used, &mut next_auto);
+            self.declare_cbuffer(&[], "$Globals", pos, Some(binding), &globals_members)?;
+        }
+        Ok(())
+    }
+
+    /// Whether a global belongs in `$Globals`: not static, groupshared, a
+    /// resource or a specialization constant.
+    fn in_implicit_globals(&mut self, v: &VarDecl) -> Result<bool> {
+        if v.mods.is_static
+            || v.mods.groupshared
+            || v.attrs.iter().any(|a| a.name == "vk::constant_id")
+        {
+            return Ok(false);
+        }
+        let t = self.resolve_ty(&v.ty, "")?;
+        Ok(
+            !t.is_resource()
+                && !matches!(t, Ty::RayQuery(_))
+                && !v.dims.iter().any(Option::is_none),
+        )
+    }
+
+    fn declare_cbuffer(
+        &mut self,
+        attrs: &[Attr],
+        name: &str,
+        pos: Pos,
+        binding: Option<(u32, u32)>,
+        members: &[&VarDecl],
+    ) -> Result<()> {
+        let mut fields = Vec::new();
+        for m in members {
+            if let Some(init) = &m.init {
+                return Err(unsupported(
+                    init.pos,
+                    "initializers of constant-buffer members (declare the global `static const`)",
+                ));
+            }
+            let t = self.resolve_ty(&m.ty, "")?;
+            let t = self.apply_dims(t, &m.dims, m.pos, false)?;
+            if t.is_resource() {
+                return Err(unsupported(m.pos, "resources inside cbuffer"));
+            }
+            fields.push(Field {
+                name: m.name.clone(),
+                ty: t,
+                pos: m.pos,
+                row_major: m.mods.row_major,
+            });
+        }
+        let k = self.structs.len() as u32;
+        self.structs.push(StructDef {
+            name: format!("type.{name}"),
+            fields: fields.clone(),
+            pos,
+        });
+        self.decls.push((
+            NamedDecl::Type(format!("type.{name}")),
+            self.loc(pos, name.len() as u32),
+        ));
+        for (i, f) in fields.iter().enumerate() {
+            self.decls.push((
+                NamedDecl::Member(format!("type.{name}"), i as u32),
+                self.loc(f.pos, f.name.len() as u32),
+            ));
+        }
+        let var = self.resource_var(&Ty::ConstantBuffer(k), attrs, binding, name)?;
+        self.decls.push((
+            NamedDecl::Global(name.to_string()),
+            self.loc(pos, name.len() as u32),
+        ));
+        let (layout, class) = self.cbuffer_class(attrs);
+        for (i, f) in fields.iter().enumerate() {
+            self.cbuffer_members
+                .insert(f.name.clone(), (var, f.ty.clone(), i as u32, layout, class));
         }
         Ok(())
     }
