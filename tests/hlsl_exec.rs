@@ -451,6 +451,10 @@ fn compute_semantics_on_the_driver() {
         F(8.0),
         F(1.0),
         F(2.5),
+        U(4),
+        F(4.0),
+        U(0),
+        F(0.5),
     ];
     let got = unsafe { gpu.run(&entries[0].words, "Main", expected.len() + 4, &inputs()) };
     let mut wrong = Vec::new();

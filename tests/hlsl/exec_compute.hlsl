@@ -42,6 +42,16 @@ void split(float4 v, out float3 rgb, out float a)
     a = v.a;
 }
 
+struct Counter
+{
+    uint count;
+    float scale;
+    void add(uint n) { count += n; }
+    float scaled() { return (float)count * scale; }
+    float twiceScaled() { return scaled() * 2.0; }
+    void reset() { this.count = 0; }
+};
+
 int scale(int x) { return x * 5; }
 float scale(float x) { return x * 3.0; }
 
@@ -167,4 +177,14 @@ void Main()
     // 63: a ternary takes the common type of its sides
     put(b1 > 0 ? 1 : 2.5);
     put(b1 < 0 ? 1 : 2.5);
+    // 65..68: struct methods
+    Counter ctr;
+    ctr.count = 1;
+    ctr.scale = 0.5;
+    ctr.add(3);
+    put(ctr.count);
+    put(ctr.twiceScaled());
+    ctr.reset();
+    put(ctr.count);
+    put(ctr.scale);
 }

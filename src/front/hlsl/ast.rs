@@ -78,6 +78,8 @@ pub struct StructDecl {
     pub name: String,
     pub pos: Pos,
     pub fields: Vec<VarDecl>,
+    /// Methods: functions with an implicit `inout` `this`.
+    pub methods: Vec<Function>,
 }
 
 #[derive(Clone, Debug)]

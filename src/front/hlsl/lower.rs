@@ -123,12 +123,14 @@ struct Param {
 }
 
 #[derive(Clone, Debug)]
-struct FnSig {
+struct FnSig<'a> {
     name: String,
     params: Vec<Param>,
     ret: Ty,
     id: Id,
-    item: usize,
+    func: &'a Function,
+    /// For methods: the struct whose `this` is the first parameter.
+    this: Option<u32>,
     stage: Option<Stage>,
     numthreads: [u32; 3],
 }
@@ -152,7 +154,7 @@ pub struct Lowerer<'a> {
     struct_names: HashMap<String, u32>,
     typedefs: HashMap<String, Ty>,
     globals: HashMap<String, Global>,
-    funcs: Vec<FnSig>,
+    funcs: Vec<FnSig<'a>>,
     fn_by_name: HashMap<String, Vec<usize>>,
     ty_cache: HashMap<(Ty, Layout, bool), Id>,
     consts: HashMap<(Id, u32), Id>,
@@ -188,6 +190,8 @@ pub struct Lowerer<'a> {
     deferred_inits: Vec<(Id, Ty, &'a Expr)>,
     /// Pointers into resource arrays indexed with `NonUniformResourceIndex`.
     nonuniform_ptrs: HashSet<Id>,
+    /// `this` of the method being lowered; its members resolve by bare name.
+    this_place: Option<Place>,
 }
 
 /// Source positions of named declarations (the side table `Program` reads).
@@ -419,6 +423,7 @@ impl<'a> Lowerer<'a> {
             const_ids: HashMap::new(),
             deferred_inits: Vec::new(),
             nonuniform_ptrs: HashSet::new(),
+            this_place: None,
         }
     }
 
@@ -502,7 +507,11 @@ impl<'a> Lowerer<'a> {
         }
         self.declare_globals()?;
         let mut entries = Vec::new();
-        for (k, item) in items.iter().enumerate() {
+        for item in items {
+            if let Item::Struct(sd) = item {
+                self.declare_methods(sd)?;
+                continue;
+            }
             let Item::Function(f) = item else { continue };
             let mut stage = None;
             let mut numthreads = [1, 1, 1];
@@ -552,7 +561,8 @@ impl<'a> Lowerer<'a> {
                 params,
                 ret,
                 id,
-                item: k,
+                func: f,
+                this: None,
                 stage,
                 numthreads,
             });
@@ -569,6 +579,51 @@ impl<'a> Lowerer<'a> {
             }
         }
         Ok(entries)
+    }
+
+    fn declare_methods(&mut self, sd: &'a StructDecl) -> Result<()> {
+        let Some(&k) = self.struct_names.get(&sd.name) else {
+            return Ok(());
+        };
+        for f in &sd.methods {
+            let ret = self.resolve_ty(&f.ret, &f.ns)?;
+            let mut params = vec![Param {
+                ty: Ty::Struct(k),
+                out: true,
+                input: true,
+            }];
+            for p in &f.params {
+                let t = self.resolve_ty(&p.ty, &f.ns)?;
+                let t = self.apply_dims(t, &p.dims, p.pos, false)?;
+                if t.is_resource() {
+                    return Err(unsupported(p.pos, "resource function parameters"));
+                }
+                params.push(Param {
+                    ty: t,
+                    out: p.mods.output,
+                    input: p.mods.input || !p.mods.output,
+                });
+            }
+            let name = format!("{}::{}", sd.name, f.name);
+            let idx = self.funcs.len();
+            let id = self.b.id();
+            self.funcs.push(FnSig {
+                name: name.clone(),
+                params,
+                ret,
+                id,
+                func: f,
+                this: Some(k),
+                stage: None,
+                numthreads: [1, 1, 1],
+            });
+            self.fn_by_name.entry(name.clone()).or_default().push(idx);
+            self.decls.push((
+                NamedDecl::Function(name),
+                self.loc(f.pos, f.name.len() as u32),
+            ));
+        }
+        Ok(())
     }
 
     fn declare_struct(&mut self, s: &StructDecl) -> Result<()> {
@@ -1890,8 +1945,7 @@ impl<'a> Lowerer<'a> {
         keys.sort_unstable();
         for k in keys {
             if let Some(r) = visit(k, &self.fn_calls, &mut state) {
-                let f = &self.items[self.funcs[r].item];
-                let Item::Function(f) = f else { continue };
+                let f = self.funcs[r].func;
                 return Err(Error::new(
                     f.pos,
                     format!(
@@ -1907,10 +1961,7 @@ impl<'a> Lowerer<'a> {
 
     fn lower_function(&mut self, k: usize) -> Result<()> {
         let sig = self.funcs[k].clone();
-        let items = self.items;
-        let Item::Function(f) = &items[sig.item] else {
-            return Ok(());
-        };
+        let f = sig.func;
         self.cur_fn = k;
         self.cur_ns = f.ns.clone();
         self.cur_stage = sig.stage;
@@ -1932,6 +1983,7 @@ impl<'a> Lowerer<'a> {
             self.b.name(sig.id, f.name.clone());
             self.start_block(None)?;
             self.line(f.pos);
+            self.this_place = None;
             self.bind_entry_params(f, &sig, stage)?;
             for (var, t, e) in self.deferred_inits.clone() {
                 self.line(e.pos);
@@ -1954,8 +2006,27 @@ impl<'a> Lowerer<'a> {
             let fty = self.b.type_function(ret_id, ptys.clone());
             self.b
                 .begin_function(ret_id, Some(sig.id), spirv::FunctionControl::NONE, fty)?;
-            self.b.name(sig.id, f.name.clone());
-            for ((p, decl), pty) in sig.params.iter().zip(&f.params).zip(ptys) {
+            self.b.name(sig.id, sig.name.clone());
+            let mut ptys = ptys.into_iter();
+            let mut params = sig.params.iter();
+            if let Some(k) = sig.this {
+                // `this`, and each member by its bare name.
+                let pty = ptys.next().unwrap_or_default();
+                let p = params.next().map(|p| p.ty.clone()).unwrap_or(Ty::Struct(k));
+                let id = self.b.function_parameter(pty)?;
+                self.b.name(id, "this");
+                let this = Place::Ptr {
+                    ptr: id,
+                    ty: p,
+                    layout: Layout::None,
+                    class: StorageClass::Function,
+                };
+                self.scopes[0].insert("this".to_string(), this.clone());
+                self.this_place = Some(this);
+            } else {
+                self.this_place = None;
+            }
+            for ((p, decl), pty) in params.zip(&f.params).zip(ptys) {
                 let id = self.b.function_parameter(pty)?;
                 self.b.name(id, decl.name.clone());
                 self.scopes[0].insert(
@@ -2505,6 +2576,17 @@ impl<'a> Lowerer<'a> {
         for s in self.scopes.iter().rev() {
             if let Some(p) = s.get(name) {
                 return Ok(p.clone());
+            }
+        }
+        if let Some(this) = self.this_place.clone() {
+            if let Ty::Struct(k) = this.ty() {
+                if self.structs[*k as usize]
+                    .fields
+                    .iter()
+                    .any(|f| f.name == name)
+                {
+                    return self.member(this, name, pos);
+                }
             }
         }
         let candidates = if self.cur_ns.is_empty() {

@@ -493,6 +493,7 @@ impl<'t> Parser<'t> {
         }
         self.expect("{")?;
         let mut fields = Vec::new();
+        let mut methods = Vec::new();
         while !self.is("}") {
             if self.peek().is_none() {
                 return Err(self.unexpected("`}`"));
@@ -504,7 +505,23 @@ impl<'t> Parser<'t> {
             }
             let ty = self.type_ref()?;
             if self.peek().and_then(Token::ident).is_some() && self.is_at(1, "(") {
-                return Err(Error::new(self.pos(), "not supported: struct methods"));
+                if mods.is_static {
+                    return Err(Error::new(
+                        self.pos(),
+                        "not supported: static struct methods",
+                    ));
+                }
+                let (mname, mpos) = self.ident()?;
+                let mut f = self.function(fattrs, ty, mname.clone(), mpos)?;
+                if f.body.is_none() {
+                    return Err(Error::new(
+                        mpos,
+                        "not supported: struct method declared without a body",
+                    ));
+                }
+                f.name = mname;
+                methods.push(f);
+                continue;
             }
             self.declarators(fattrs, mods, ty, &mut fields)?;
         }
@@ -513,6 +530,7 @@ impl<'t> Parser<'t> {
             name: self.qualify(&name),
             pos,
             fields,
+            methods,
         })
     }
 

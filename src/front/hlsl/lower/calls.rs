@@ -61,6 +61,21 @@ mod g {
     pub const FIND_UMSB: u32 = 75;
 }
 
+/// A call argument: an expression, or a place already evaluated (`this`).
+pub(super) enum Arg<'a> {
+    Expr(&'a Expr),
+    Place(Place, Pos),
+}
+
+impl Arg<'_> {
+    fn pos(&self) -> Pos {
+        match self {
+            Arg::Expr(e) => e.pos,
+            Arg::Place(_, p) => *p,
+        }
+    }
+}
+
 const RG_CH_MISS: &[Stage] = &[Stage::RayGeneration, Stage::ClosestHit, Stage::Miss];
 
 impl<'a> Lowerer<'a> {
@@ -147,8 +162,18 @@ impl<'a> Lowerer<'a> {
     }
 
     fn call(&mut self, name: &str, args: &'a [Expr], pos: Pos) -> Result<Option<Val>> {
+        if let Some(this) = self.this_place.clone() {
+            if let Ty::Struct(k) = this.ty() {
+                let qualified = format!("{}::{name}", self.structs[*k as usize].name);
+                if let Some(c) = self.fn_by_name.get(&qualified).cloned() {
+                    let mut all = vec![Arg::Place(this, pos)];
+                    all.extend(args.iter().map(Arg::Expr));
+                    return self.call_user(name, c, all, pos);
+                }
+            }
+        }
         if let Some(c) = self.find_user(name) {
-            return self.call_user(name, c, args, pos);
+            return self.call_user(name, c, args.iter().map(Arg::Expr).collect(), pos);
         }
         if let Some((bi, ty, stages)) = system_value(name) {
             self.arity(name, args, 0, pos)?;
@@ -869,11 +894,11 @@ impl<'a> Lowerer<'a> {
         self.write(&p, Val { id: back, ty: t }, args[7].pos)
     }
 
-    fn call_user(
+    pub(super) fn call_user(
         &mut self,
         name: &str,
         cands: Vec<usize>,
-        args: &'a [Expr],
+        args: Vec<Arg<'a>>,
         pos: Pos,
     ) -> Result<Option<Val>> {
         let cands: Vec<usize> = cands
@@ -891,6 +916,15 @@ impl<'a> Lowerer<'a> {
         let mut argv: Vec<(Option<Place>, Val)> = Vec::new();
         for (i, a) in args.iter().enumerate() {
             let is_out = cands.iter().any(|k| self.funcs[*k].params[i].out);
+            if let Arg::Place(p, _) = a {
+                let v = Val {
+                    id: 0,
+                    ty: p.ty().clone(),
+                };
+                argv.push((Some(p.clone()), v));
+                continue;
+            }
+            let Arg::Expr(a) = *a else { unreachable!() };
             if is_out {
                 let p = self.place(a)?;
                 if matches!(p, Place::Value(_)) {
@@ -946,14 +980,14 @@ impl<'a> Lowerer<'a> {
             return Err(unsupported(pos, "calling an entry point function"));
         }
         let mut temps = Vec::new();
-        for ((p, (place, v)), a) in sig.params.iter().zip(&argv).zip(args) {
+        for ((p, (place, v)), a) in sig.params.iter().zip(&argv).zip(&args) {
             let tmp = self.local_var(&p.ty, "")?;
             if p.input {
                 let val = match place {
                     Some(pl) => self.read(pl)?,
                     None => v.clone(),
                 };
-                let val = self.convert(val, &p.ty, a.pos, false)?;
+                let val = self.convert(val, &p.ty, a.pos(), false)?;
                 self.b.store(tmp, val.id, None, [])?;
             }
             temps.push(tmp);
@@ -967,7 +1001,7 @@ impl<'a> Lowerer<'a> {
         if !self.lowered.contains(&k) && !self.pending.contains(&k) {
             self.pending.push(k);
         }
-        for ((p, (place, _)), (tmp, a)) in sig.params.iter().zip(&argv).zip(temps.iter().zip(args))
+        for ((p, (place, _)), (tmp, a)) in sig.params.iter().zip(&argv).zip(temps.iter().zip(&args))
         {
             if p.out {
                 let tid = self.ty_id(&p.ty)?;
@@ -980,10 +1014,10 @@ impl<'a> Lowerer<'a> {
                         ty: p.ty.clone(),
                     },
                     &want,
-                    a.pos,
+                    a.pos(),
                     true,
                 )?;
-                self.write(pl, v, a.pos)?;
+                self.write(pl, v, a.pos())?;
             }
         }
         Ok(if sig.ret == Ty::Void {

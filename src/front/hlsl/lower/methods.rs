@@ -13,6 +13,33 @@ impl<'a> Lowerer<'a> {
         let p = self.place(obj)?;
         let t = p.ty().clone();
         match &t {
+            Ty::Struct(k) => {
+                let qualified = format!("{}::{name}", self.structs[*k as usize].name);
+                let Some(c) = self.fn_by_name.get(&qualified).cloned() else {
+                    return Err(Error::new(
+                        pos,
+                        format!("`{}` has no method `{name}`", self.ty_name(&t)),
+                    )
+                    .len(name.len() as u32));
+                };
+                // A method of an rvalue works on a copy.
+                let this = match p {
+                    Place::Value(v) => {
+                        let tmp = self.local_var(&v.ty, "")?;
+                        self.b.store(tmp, v.id, None, [])?;
+                        Place::Ptr {
+                            ptr: tmp,
+                            ty: v.ty,
+                            layout: Layout::None,
+                            class: StorageClass::Function,
+                        }
+                    }
+                    other => other,
+                };
+                let mut all = vec![super::calls::Arg::Place(this, obj.pos)];
+                all.extend(args.iter().map(super::calls::Arg::Expr));
+                self.call_user(name, c, all, pos)
+            }
             Ty::RayQuery(flags) => {
                 let Place::Ptr { ptr, .. } = p else {
                     return Err(Error::new(obj.pos, "a RayQuery must be a local variable"));
