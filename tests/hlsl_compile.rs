@@ -241,3 +241,48 @@ fn every_test_shader_validates() {
         names.len()
     );
 }
+
+/// Per-entry modules declare only what their entry point uses.
+#[test]
+fn entry_modules_hold_only_their_globals() {
+    let entries = hlsl::compile(&shader("pipeline.hlsl"), &HlslOptions::default()).unwrap();
+    let globals = |words: &[u32]| -> Vec<String> {
+        let m = rspirv::dr::load_words(words).unwrap();
+        let vars: Vec<u32> = m
+            .types_global_values
+            .iter()
+            .filter(|i| i.class.opcode == spirv::Op::Variable)
+            .filter_map(|i| i.result_id)
+            .collect();
+        let mut names: Vec<String> = m
+            .debug_names
+            .iter()
+            .filter(
+                |i| matches!(i.operands[0], rspirv::dr::Operand::IdRef(id) if vars.contains(&id)),
+            )
+            .filter_map(|i| match &i.operands[1] {
+                rspirv::dr::Operand::LiteralString(s) => Some(s.clone()),
+                _ => None,
+            })
+            .collect();
+        names.sort();
+        names
+    };
+    let miss = entries.iter().find(|e| e.name == "Miss").unwrap();
+    assert_eq!(
+        globals(&miss.words),
+        vec!["WorldRayDirectionKHR", "incoming.payload"]
+    );
+    let gen = entries.iter().find(|e| e.name == "RayGen").unwrap();
+    assert_eq!(
+        globals(&gen.words),
+        vec![
+            "Camera",
+            "LaunchIdKHR",
+            "LaunchSizeKHR",
+            "output",
+            "payload",
+            "scene"
+        ]
+    );
+}

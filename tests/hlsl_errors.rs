@@ -236,3 +236,17 @@ fn layout_changing_constructs_are_refused() {
         "main.hlsl:1:1: not supported: StructuredBuffer of a matrix; wrap the matrix in a struct"
     );
 }
+
+#[test]
+fn entry_parameters_follow_dxr_positions() {
+    let e = err("struct P { float x; };\nstruct A { float2 b; };\n[shader(\"closesthit\")]\nvoid ch(in A a, inout P p)\n{\n}");
+    assert!(
+        e.starts_with("main.hlsl:4:14: not supported: this parameter in a closesthit entry point"),
+        "{e}"
+    );
+    let e = err("struct P { float x; };\n[shader(\"miss\")]\nvoid m(in P p)\n{\n}");
+    assert!(
+        e.starts_with("main.hlsl:3:13: not supported: this parameter in a miss entry point"),
+        "{e}"
+    );
+}

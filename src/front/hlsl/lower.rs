@@ -1915,6 +1915,7 @@ impl<'a> Lowerer<'a> {
         }
         let mut module = self.b.module();
         hoist_variables(&mut module);
+        drop_unused_globals(&mut module);
         use rspirv::binary::Assemble;
         Ok((module.assemble(), self.decls))
     }
@@ -2055,16 +2056,20 @@ impl<'a> Lowerer<'a> {
     }
 
     fn bind_entry_params(&mut self, f: &'a Function, sig: &FnSig, stage: Stage) -> Result<()> {
-        for (p, decl) in sig.params.iter().zip(&f.params) {
+        for (i, (p, decl)) in sig.params.iter().zip(&f.params).enumerate() {
             let is_struct = matches!(p.ty, Ty::Struct(_));
-            let class = match stage {
-                Stage::ClosestHit | Stage::AnyHit | Stage::Miss if is_struct && p.out => {
+            // DXR fixes the parameters by position: payload (or callable data)
+            // first, `inout`; hit attributes second, `in`.
+            let class = match (stage, i) {
+                (Stage::ClosestHit | Stage::AnyHit | Stage::Miss, 0)
+                    if is_struct && p.out && p.input =>
+                {
                     Some(StorageClass::IncomingRayPayloadKHR)
                 }
-                Stage::ClosestHit | Stage::AnyHit if is_struct && !p.out => {
+                (Stage::ClosestHit | Stage::AnyHit, 1) if is_struct && !p.out => {
                     Some(StorageClass::HitAttributeKHR)
                 }
-                Stage::Callable if is_struct && p.out => {
+                (Stage::Callable, 0) if is_struct && p.out && p.input => {
                     Some(StorageClass::IncomingCallableDataKHR)
                 }
                 _ => None,
@@ -4109,6 +4114,46 @@ impl CVal {
             CVal::F(f) => *f,
         }
     }
+}
+
+/// Removes module-scope variables no function touches (with their names and
+/// decorations): a module holds the resources its entry points use, as DXC's do.
+fn drop_unused_globals(module: &mut dr::Module) {
+    let mut used = HashSet::new();
+    for e in &module.entry_points {
+        for op in &e.operands {
+            if let Operand::IdRef(id) = op {
+                used.insert(*id);
+            }
+        }
+    }
+    for f in &module.functions {
+        for b in &f.blocks {
+            for i in &b.instructions {
+                for op in &i.operands {
+                    if let Operand::IdRef(id) = op {
+                        used.insert(*id);
+                    }
+                }
+            }
+        }
+    }
+    let dead: HashSet<Id> = module
+        .types_global_values
+        .iter()
+        .filter(|i| i.class.opcode == Op::Variable)
+        .filter_map(|i| i.result_id)
+        .filter(|id| !used.contains(id))
+        .collect();
+    if dead.is_empty() {
+        return;
+    }
+    module
+        .types_global_values
+        .retain(|i| !i.result_id.is_some_and(|id| dead.contains(&id)));
+    let targets_dead = |i: &Instruction| matches!(i.operands.first(), Some(Operand::IdRef(id)) if dead.contains(id));
+    module.debug_names.retain(|i| !targets_dead(i));
+    module.annotations.retain(|i| !targets_dead(i));
 }
 
 /// Moves every function's `OpVariable`s to the top of its entry block, where
