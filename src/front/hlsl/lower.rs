@@ -4185,3 +4185,67 @@ impl Lowerer<'_> {
             .position(|f| f.name == name && f.stage.is_some())
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn swizzles_and_matrix_elements() {
+        assert_eq!(swizzle_comps("xyzw"), Some(vec![0, 1, 2, 3]));
+        assert_eq!(swizzle_comps("bgr"), Some(vec![2, 1, 0]));
+        assert_eq!(swizzle_comps("xr"), None);
+        assert_eq!(swizzle_comps("xyzwx"), None);
+        assert_eq!(matrix_comps("_m01_m10"), Some(vec![(0, 1), (1, 0)]));
+        assert_eq!(matrix_comps("_11_44"), Some(vec![(0, 0), (3, 3)]));
+        assert_eq!(matrix_comps("_00"), None);
+        assert_eq!(matrix_comps("m00"), None);
+    }
+
+    #[test]
+    fn system_values_follow_dxc() {
+        let (b, t, stages) = system_value("RayTCurrent").unwrap();
+        assert_eq!((b, t), (BuiltIn::RayTmaxKHR, Ty::Sc(Sc::Float)));
+        assert!(!stages.contains(&Stage::RayGeneration));
+        assert_eq!(
+            system_value("InstanceIndex").unwrap().0,
+            BuiltIn::InstanceId
+        );
+        assert_eq!(
+            system_value("InstanceID").unwrap().0,
+            BuiltIn::InstanceCustomIndexKHR
+        );
+        assert_eq!(
+            system_value("ObjectToWorld4x3").unwrap().1,
+            Ty::Mat(Sc::Float, 4, 3)
+        );
+        assert_eq!(
+            builtin_constant("RAY_FLAG_SKIP_PROCEDURAL_PRIMITIVES"),
+            Some(0x200)
+        );
+        assert_eq!(Stage::from_name("intersection"), Some(Stage::Intersection));
+        assert_eq!(Stage::ClosestHit.model(), ExecutionModel::ClosestHitKHR);
+    }
+
+    #[test]
+    fn constants_fold_through_conversions() {
+        let items = Vec::new();
+        let files = Vec::new();
+        let mut l = Lowerer::new(&items, &files);
+        let a = Val {
+            id: l.const_i32(6),
+            ty: Ty::Sc(Sc::Int),
+        };
+        let b = Val {
+            id: l.const_u32(1),
+            ty: Ty::Sc(Sc::Uint),
+        };
+        let v = l.binary(BinOp::BitOr, a, b, Pos::default()).unwrap();
+        assert_eq!(v.ty, Ty::Sc(Sc::Uint));
+        assert_eq!(l.known(&v), Some((Sc::Uint, 7)));
+        let f = l
+            .convert(v, &Ty::Sc(Sc::Float), Pos::default(), false)
+            .unwrap();
+        assert_eq!(l.known(&f), Some((Sc::Float, 7.0f32.to_bits())));
+    }
+}
