@@ -455,6 +455,10 @@ fn compute_semantics_on_the_driver() {
         F(4.0),
         U(0),
         F(0.5),
+        F(2.0),
+        F(-0.75),
+        F(-2.0),
+        F(12.0),
     ];
     let got = unsafe { gpu.run(&entries[0].words, "Main", expected.len() + 4, &inputs()) };
     let mut wrong = Vec::new();
@@ -1154,6 +1158,8 @@ fn groupshared_atomics_and_byte_address_buffers_on_the_driver() {
         let mut c = [0u32; 4];
         std::ptr::copy_nonoverlapping(counts.ptr as *const u32, c.as_mut_ptr(), 4);
         assert_eq!(&c[..3], &[63, 64, u32::MAX]);
+        assert!((1..=64).contains(&c[3]), "compare-exchange stored {}", c[3]);
+        assert_eq!(&r[192..194], &[128, 189]);
         gpu.free(raw);
         gpu.free(counts);
     }

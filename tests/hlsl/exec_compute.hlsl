@@ -187,4 +187,12 @@ void Main()
     ctr.reset();
     put(ctr.count);
     put(ctr.scale);
+    // 69..72: sincos, modf, ldexp
+    float sn, cs;
+    sincos(0.0, sn, cs);
+    put(sn + 2.0 * cs);
+    float whole;
+    put(modf(-2.75, whole));
+    put(whole);
+    put(ldexp(1.5, 3.0));
 }

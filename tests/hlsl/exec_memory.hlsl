@@ -27,4 +27,10 @@ void Main(uint gi : SV_GroupIndex)
     InterlockedMax(counts[0], gi);
     InterlockedAdd(counts[1], 1, before);
     InterlockedOr(counts[2], 1u << (gi % 32));
+    // Only the thread that sees 0 swaps in its index + 1.
+    uint seen;
+    InterlockedCompareExchange(counts[3], 0u, gi + 1, seen);
+    raw.InterlockedAdd(768, 2);
+    uint prior;
+    raw.InterlockedMax(772, gi * 3, prior);
 }

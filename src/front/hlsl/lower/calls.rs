@@ -152,6 +152,14 @@ impl<'a> Lowerer<'a> {
         Ok((t, ids))
     }
 
+    /// Writes `v` to an `out` argument, converting to its type.
+    fn store_out(&mut self, a: &'a Expr, v: Val) -> Result<()> {
+        let p = self.place(a)?;
+        let t = p.ty().clone();
+        let v = self.convert(v, &t, a.pos, true)?;
+        self.write(&p, v, a.pos)
+    }
+
     fn find_user(&self, name: &str) -> Option<Vec<usize>> {
         if !self.cur_ns.is_empty() {
             if let Some(v) = self.fn_by_name.get(&format!("{}{name}", self.cur_ns)) {
@@ -343,6 +351,46 @@ impl<'a> Lowerer<'a> {
         }
         if name.starts_with("Interlocked") {
             return self.interlocked(name, args, pos);
+        }
+        match name {
+            "sincos" => {
+                self.arity(name, args, 3, pos)?;
+                let x = self.expr(&args[0])?;
+                let (t, ids) = self.unify(vec![x], true, pos)?;
+                let sn = self.glsl(g::SIN, &t, &ids)?;
+                let cs = self.glsl(g::COS, &t, &ids)?;
+                self.store_out(&args[1], sn)?;
+                self.store_out(&args[2], cs)?;
+                return Ok(None);
+            }
+            "modf" => {
+                // modf(x, out ip): the integer part truncates toward zero.
+                self.arity(name, args, 2, pos)?;
+                let x = self.expr(&args[0])?;
+                let (t, ids) = self.unify(vec![x], true, pos)?;
+                let ip = self.glsl(g::TRUNC, &t, &ids)?;
+                let frac = self.binary(
+                    BinOp::Sub,
+                    Val {
+                        id: ids[0],
+                        ty: t.clone(),
+                    },
+                    ip.clone(),
+                    pos,
+                )?;
+                self.store_out(&args[1], ip)?;
+                return Ok(Some(frac));
+            }
+            "ldexp" => {
+                self.arity(name, args, 2, pos)?;
+                let vals = self.args(args)?;
+                let (t, ids) = self.unify(vals, true, pos)?;
+                let p = self.glsl(g::EXP2, &t, &ids[1..])?;
+                return self
+                    .binary(BinOp::Mul, Val { id: ids[0], ty: t }, p, pos)
+                    .map(Some);
+            }
+            _ => {}
         }
         let vals = match name {
             "dot" | "cross" | "length" | "distance" | "reflect" | "refract" | "faceforward"
@@ -784,56 +832,84 @@ impl<'a> Lowerer<'a> {
     }
 
     fn interlocked(&mut self, name: &str, args: &'a [Expr], pos: Pos) -> Result<Option<Val>> {
-        let op = match name {
-            "InterlockedAdd" => Op::AtomicIAdd,
-            "InterlockedAnd" => Op::AtomicAnd,
-            "InterlockedOr" => Op::AtomicOr,
-            "InterlockedXor" => Op::AtomicXor,
-            "InterlockedExchange" => Op::AtomicExchange,
-            "InterlockedMin" | "InterlockedMax" => Op::Nop,
-            _ => return Err(unsupported(pos, format!("`{name}`")).len(name.len() as u32)),
+        let Some(first) = args.first() else {
+            return Err(Error::new(pos, format!("`{name}` needs a destination")));
         };
-        if args.len() != 2 && args.len() != 3 {
-            return Err(Error::new(pos, format!("`{name}` takes 2 or 3 arguments")));
-        }
-        let dest = self.place(&args[0])?;
+        let dest = self.place(first)?;
+        self.atomic(name, dest, first.pos, &args[1..], pos)
+    }
+
+    /// An atomic on `dest` (an int or uint in a buffer or groupshared memory);
+    /// `rest` are the operands after the destination, an `out` original last.
+    pub(super) fn atomic(
+        &mut self,
+        name: &str,
+        dest: Place,
+        dest_pos: Pos,
+        rest: &'a [Expr],
+        pos: Pos,
+    ) -> Result<Option<Val>> {
+        let bad = || {
+            Error::new(
+                dest_pos,
+                format!("`{name}` needs an int or uint in a buffer or groupshared memory"),
+            )
+        };
         let Place::Ptr {
             ptr,
             ty: Ty::Sc(s @ (Sc::Int | Sc::Uint)),
-            class,
+            class: class @ (StorageClass::StorageBuffer | StorageClass::Workgroup),
             ..
-        } = dest.clone()
+        } = dest
         else {
-            return Err(Error::new(
-                args[0].pos,
-                format!("`{name}` needs an int or uint in a buffer or groupshared memory"),
-            ));
+            return Err(bad());
         };
-        if !matches!(class, StorageClass::StorageBuffer | StorageClass::Workgroup) {
+        let op = match (name.trim_start_matches("Interlocked"), s) {
+            ("Add", _) => Op::AtomicIAdd,
+            ("And", _) => Op::AtomicAnd,
+            ("Or", _) => Op::AtomicOr,
+            ("Xor", _) => Op::AtomicXor,
+            ("Exchange", _) => Op::AtomicExchange,
+            ("Min", Sc::Int) => Op::AtomicSMin,
+            ("Min", _) => Op::AtomicUMin,
+            ("Max", Sc::Int) => Op::AtomicSMax,
+            ("Max", _) => Op::AtomicUMax,
+            ("CompareExchange" | "CompareStore", _) => Op::AtomicCompareExchange,
+            _ => return Err(unsupported(pos, format!("`{name}`")).len(name.len() as u32)),
+        };
+        let cmp = op == Op::AtomicCompareExchange;
+        let (min, max) = match name {
+            "InterlockedCompareExchange" => (3, 3),
+            "InterlockedCompareStore" => (2, 2),
+            _ => (1, 2),
+        };
+        if rest.len() < min || rest.len() > max {
             return Err(Error::new(
-                args[0].pos,
-                format!("`{name}` needs an int or uint in a buffer or groupshared memory"),
+                pos,
+                format!("`{name}` takes {} to {} arguments", min + 1, max + 1),
             ));
         }
-        let op = match (op, name, s) {
-            (Op::Nop, "InterlockedMin", Sc::Int) => Op::AtomicSMin,
-            (Op::Nop, "InterlockedMin", _) => Op::AtomicUMin,
-            (Op::Nop, _, Sc::Int) => Op::AtomicSMax,
-            (Op::Nop, _, _) => Op::AtomicUMax,
-            (op, _, _) => op,
-        };
         let t = Ty::Sc(s);
-        let v = self.expr(&args[1])?;
-        let v = self.convert(v, &t, args[1].pos, false)?;
+        let mut vals = Vec::new();
+        for e in &rest[..if cmp { 2 } else { 1 }] {
+            let v = self.expr(e)?;
+            vals.push(self.convert(v, &t, e.pos, false)?.id);
+        }
         let scope = self.const_u32(if class == StorageClass::Workgroup {
             2
         } else {
             1
         });
-        let sem = self.const_u32(0);
+        let relaxed = self.const_u32(0);
         let tid = self.ty_id(&t)?;
-        let old = self.op(op, tid, &[ptr, scope, sem, v.id])?;
-        if let Some(o) = args.get(2) {
+        let old = if cmp {
+            // HLSL gives (compare, value); SPIR-V takes (value, comparator).
+            self.op(op, tid, &[ptr, scope, relaxed, relaxed, vals[1], vals[0]])?
+        } else {
+            self.op(op, tid, &[ptr, scope, relaxed, vals[0]])?
+        };
+        let out_at = if cmp { 2 } else { 1 };
+        if let Some(o) = rest.get(out_at) {
             let p = self.place(o)?;
             let ot = p.ty().clone();
             let ov = self.convert(Val { id: old, ty: t }, &ot, o.pos, true)?;

@@ -127,6 +127,41 @@ impl<'a> Lowerer<'a> {
         let u = Ty::Sc(Sc::Uint);
         let ut = self.ty_id(&u)?;
         let pty = self.b.type_pointer(None, StorageClass::StorageBuffer, ut);
+        if let Some(op) = name.strip_prefix("Interlocked") {
+            if !rw {
+                return Err(Error::new(
+                    pos,
+                    "a ByteAddressBuffer is read-only; use RWByteAddressBuffer",
+                ));
+            }
+            let Some(addr) = args.first() else {
+                return Err(Error::new(pos, format!("`{name}` needs a byte address")));
+            };
+            let a = self.expr(addr)?;
+            let a = self.convert(a, &u, addr.pos, false)?;
+            let two = Val {
+                id: self.const_u32(2),
+                ty: u.clone(),
+            };
+            let word = self.binary(BinOp::Shr, a, two, pos)?;
+            let zero = self.const_u32(0);
+            let ptr = self.inst(
+                Op::AccessChain,
+                Some(pty),
+                vec![
+                    Operand::IdRef(var),
+                    Operand::IdRef(zero),
+                    Operand::IdRef(word.id),
+                ],
+            )?;
+            let dest = Place::Ptr {
+                ptr,
+                ty: u,
+                layout: Layout::Std430,
+                class: StorageClass::StorageBuffer,
+            };
+            return self.atomic(&format!("Interlocked{op}"), dest, addr.pos, &args[1..], pos);
+        }
         let n = match name {
             "Load" | "Store" => 1,
             "Load2" | "Store2" => 2,
