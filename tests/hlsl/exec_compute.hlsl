@@ -195,4 +195,22 @@ void Main()
     put(modf(-2.75, whole));
     put(whole);
     put(ldexp(1.5, 3.0));
+    // 73: continue and break inside a switch inside a loop
+    int acc2 = 0;
+    for (int s2 = 0; s2 < 6; s2++)
+    {
+        switch (s2)
+        {
+        case 1:
+            continue;
+        case 4:
+            break;
+        default:
+            acc2 += 10;
+        }
+        acc2 += 1;
+        if (s2 > 4)
+            break;
+    }
+    put(acc2);
 }

@@ -130,6 +130,22 @@ void Main(uint3 dtid : SV_DispatchThreadID, uint3 gtid : SV_GroupThreadID, uint3
     }
     int w = 0;
     while (w < 3) { w++; }
+    for (int s = 0; s < 6; s++)
+    {
+        switch (s)
+        {
+        case 1:
+            continue;
+        case 4:
+            break;
+        default:
+            if (s == 5)
+                return;
+            acc += 0.5;
+        }
+        if (s > 3)
+            break;
+    }
     do { w--; } while (w > 0);
     switch (i % 4)
     {
