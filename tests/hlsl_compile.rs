@@ -137,30 +137,42 @@ fn resources_bindless_images_records() {
     assert_eq!(entries.len(), 3);
 }
 
+/// The module's instructions as (opcode, operand words); rspirv's loader
+/// rejects module-scope `OpExtInst` (the debug info), so this reads words.
+fn instructions(words: &[u32]) -> Vec<(u32, Vec<u32>)> {
+    let mut out = Vec::new();
+    let mut i = 5;
+    while i < words.len() {
+        let n = (words[i] >> 16) as usize;
+        out.push((words[i] & 0xffff, words[i + 1..i + n.max(1)].to_vec()));
+        i += n.max(1);
+    }
+    out
+}
+
+fn string_at(ops: &[u32]) -> String {
+    let bytes: Vec<u8> = ops.iter().flat_map(|w| w.to_le_bytes()).collect();
+    let end = bytes.iter().position(|b| *b == 0).unwrap_or(bytes.len());
+    String::from_utf8_lossy(&bytes[..end]).into_owned()
+}
+
+/// Ids named `name` by OpName.
+fn named(words: &[u32], name: &str) -> Vec<u32> {
+    instructions(words)
+        .into_iter()
+        .filter(|(op, ops)| *op == 5 && string_at(&ops[1..]) == name)
+        .map(|(_, ops)| ops[0])
+        .collect()
+}
+
 /// Offsets of a cbuffer's members as the module declares them.
 fn member_offsets(words: &[u32], struct_name: &str) -> Vec<u32> {
-    let module = rspirv::dr::load_words(words).unwrap();
-    let id = module
-        .debug_names
-        .iter()
-        .find(|i| matches!(i.operands.get(1), Some(rspirv::dr::Operand::LiteralString(s)) if s == struct_name))
-        .and_then(|i| match i.operands[0] {
-            rspirv::dr::Operand::IdRef(id) => Some(id),
-            _ => None,
-        })
-        .unwrap();
-    let mut offsets: Vec<(u32, u32)> = module
-        .annotations
-        .iter()
-        .filter(|i| i.class.opcode == spirv::Op::MemberDecorate)
-        .filter(|i| i.operands[0] == rspirv::dr::Operand::IdRef(id))
-        .filter(|i| i.operands[2] == rspirv::dr::Operand::Decoration(spirv::Decoration::Offset))
-        .map(|i| match (&i.operands[1], &i.operands[3]) {
-            (rspirv::dr::Operand::LiteralBit32(m), rspirv::dr::Operand::LiteralBit32(o)) => {
-                (*m, *o)
-            }
-            _ => panic!(),
-        })
+    let id = named(words, struct_name)[0];
+    // OpMemberDecorate (72) struct member Offset (35) value.
+    let mut offsets: Vec<(u32, u32)> = instructions(words)
+        .into_iter()
+        .filter(|(op, ops)| *op == 72 && ops[0] == id && ops[2] == 35)
+        .map(|(_, ops)| (ops[1], ops[3]))
         .collect();
     offsets.sort_unstable();
     offsets.into_iter().map(|(_, o)| o).collect()
@@ -247,23 +259,17 @@ fn every_test_shader_validates() {
 fn entry_modules_hold_only_their_globals() {
     let entries = hlsl::compile(&shader("pipeline.hlsl"), &HlslOptions::default()).unwrap();
     let globals = |words: &[u32]| -> Vec<String> {
-        let m = rspirv::dr::load_words(words).unwrap();
-        let vars: Vec<u32> = m
-            .types_global_values
+        let insts = instructions(words);
+        // OpVariable (59) at module scope: storage class is not Function (7).
+        let vars: Vec<u32> = insts
             .iter()
-            .filter(|i| i.class.opcode == spirv::Op::Variable)
-            .filter_map(|i| i.result_id)
+            .filter(|(op, ops)| *op == 59 && ops[2] != 7)
+            .map(|(_, ops)| ops[1])
             .collect();
-        let mut names: Vec<String> = m
-            .debug_names
+        let mut names: Vec<String> = insts
             .iter()
-            .filter(
-                |i| matches!(i.operands[0], rspirv::dr::Operand::IdRef(id) if vars.contains(&id)),
-            )
-            .filter_map(|i| match &i.operands[1] {
-                rspirv::dr::Operand::LiteralString(s) => Some(s.clone()),
-                _ => None,
-            })
+            .filter(|(op, ops)| *op == 5 && vars.contains(&ops[0]))
+            .map(|(_, ops)| string_at(&ops[1..]))
             .collect();
         names.sort();
         names
@@ -285,4 +291,31 @@ fn entry_modules_hold_only_their_globals() {
             "scene"
         ]
     );
+}
+
+/// A module on its own (as `rtlint compile` writes it) carries declaration
+/// positions in NonSemantic.Shader.DebugInfo.100.
+#[test]
+fn entry_modules_carry_debug_info() {
+    use rtlint::front::Language;
+    use rtlint::spirv::Decl;
+    let path = shader("pipeline.hlsl");
+    let entries = hlsl::compile(&path, &HlslOptions::default()).unwrap();
+    let gen = entries.iter().find(|e| e.name == "RayGen").unwrap();
+    let program = rtlint::spirv::parse(&gen.words, &path, Language::Hlsl).unwrap();
+    let id = |name: &str| {
+        program
+            .names
+            .iter()
+            .filter(|(_, n)| n.as_str() == name)
+            .map(|(id, _)| *id)
+            .min()
+            .unwrap()
+    };
+    let at = |d: Decl| program.decl_location(d).map(|l| (l.line, l.column));
+    let payload = id("Payload");
+    assert_eq!(at(Decl::Type(payload)), Some((14, 21)));
+    assert_eq!(at(Decl::Member(payload, 1)), Some((17, 10)));
+    assert_eq!(at(Decl::Var(id("Camera"))), Some((7, 9)));
+    assert_eq!(at(Decl::Func(id("RayGen"))), Some((26, 6)));
 }

@@ -6,6 +6,7 @@
 //! descriptor-set variables with `Binding`/`DescriptorSet`.
 
 mod calls;
+mod debug;
 mod methods;
 
 use super::ast::*;
@@ -192,6 +193,8 @@ pub struct Lowerer<'a> {
     nonuniform_ptrs: HashSet<Id>,
     /// `this` of the method being lowered; its members resolve by bare name.
     this_place: Option<Place>,
+    /// Globals with source positions, for debug info: (variable, name, type, position).
+    global_decls: Vec<(Id, String, Ty, Pos)>,
 }
 
 /// Source positions of named declarations (the side table `Program` reads).
@@ -424,6 +427,7 @@ impl<'a> Lowerer<'a> {
             deferred_inits: Vec::new(),
             nonuniform_ptrs: HashSet::new(),
             this_place: None,
+            global_decls: Vec::new(),
         }
     }
 
@@ -991,6 +995,8 @@ impl<'a> Lowerer<'a> {
             ));
         }
         let var = self.resource_var(&Ty::ConstantBuffer(k), attrs, binding, name)?;
+        self.global_decls
+            .push((var, name.to_string(), Ty::Struct(k), pos));
         self.decls.push((
             NamedDecl::Global(name.to_string()),
             self.loc(pos, name.len() as u32),
@@ -1187,6 +1193,11 @@ impl<'a> Lowerer<'a> {
                 },
             };
             let var = self.resource_var(&t, &v.attrs, binding, &v.name)?;
+            let shown = match &t {
+                Ty::ConstantBuffer(k) => Ty::Struct(*k),
+                other => other.clone(),
+            };
+            self.global_decls.push((var, v.name.clone(), shown, v.pos));
             let (layout, class) = match &t {
                 Ty::ConstantBuffer(_) => self.cbuffer_class(&v.attrs),
                 Ty::StructuredBuffer(..) | Ty::ByteAddress(_) => {
@@ -1228,6 +1239,8 @@ impl<'a> Lowerer<'a> {
             let pty = self.b.type_pointer(None, StorageClass::Workgroup, tid);
             let var = self.global_var(pty, StorageClass::Workgroup, None);
             self.b.name(var, &v.name);
+            self.global_decls
+                .push((var, v.name.clone(), t.clone(), v.pos));
             if v.init.is_some() {
                 return Err(Error::new(
                     v.pos,
@@ -1293,6 +1306,8 @@ impl<'a> Lowerer<'a> {
         };
         let var = self.global_var(pty, StorageClass::Private, Some(init));
         self.b.name(var, &v.name);
+        self.global_decls
+            .push((var, v.name.clone(), t.clone(), v.pos));
         if let Some(e) = deferred {
             self.deferred_inits.push((var, t.clone(), e));
         }
@@ -1913,8 +1928,12 @@ impl<'a> Lowerer<'a> {
                 self.ray_tracing_caps();
             }
         }
+        let debug = self.emit_debug_info();
         let mut module = self.b.module();
         hoist_variables(&mut module);
+        if let Some(d) = &debug {
+            Self::place_definitions(&mut module, d);
+        }
         drop_unused_globals(&mut module);
         use rspirv::binary::Assemble;
         Ok((module.assemble(), self.decls))
@@ -4148,9 +4167,14 @@ fn drop_unused_globals(module: &mut dr::Module) {
     if dead.is_empty() {
         return;
     }
-    module
-        .types_global_values
-        .retain(|i| !i.result_id.is_some_and(|id| dead.contains(&id)));
+    // Debug info describing a dropped variable goes with it.
+    module.types_global_values.retain(|i| {
+        !i.result_id.is_some_and(|id| dead.contains(&id))
+            && !i
+                .operands
+                .iter()
+                .any(|o| matches!(o, Operand::IdRef(id) if dead.contains(id)))
+    });
     let targets_dead = |i: &Instruction| matches!(i.operands.first(), Some(Operand::IdRef(id)) if dead.contains(id));
     module.debug_names.retain(|i| !targets_dead(i));
     module.annotations.retain(|i| !targets_dead(i));
