@@ -5,6 +5,7 @@
 //! entry point, runs both builds with the same scene and bindings through
 //! `rtlint::vk`, and compares the outputs (floats within 1/255, integers
 //! exactly). Fails, never skips, without Slang or a ray-tracing device.
+//! `RTLINT_DIFF_DUMP=1` prints both readbacks of every case.
 
 mod common;
 
@@ -84,6 +85,12 @@ struct Case {
     shape: Shape,
     scene: SceneKind,
     resources: Vec<Res>,
+    /// Constant buffers use HLSL packing where it differs from std140, as
+    /// rtlint always does: Slang gets `-fvk-use-dx-layout` (which also packs
+    /// structured buffers tighter than DXC's default, so only for cases
+    /// without structs in them), spirv-val `--scalar-block-layout` (the
+    /// device has scalarBlockLayout on).
+    dx_layout: bool,
 }
 
 fn zeros(bytes: usize) -> Data {
@@ -131,6 +138,15 @@ const QUAD: [[f32; 3]; 4] = [
 ];
 const QUAD_INDICES: [u32; 6] = [0, 1, 2, 0, 2, 3];
 
+/// `n` words, each the float value of its own index: a constant read back
+/// names the word it was read from.
+fn index_words(n: u32) -> Data {
+    Data::Uniform(f32_bytes(&(0..n).map(|i| i as f32).collect::<Vec<_>>()))
+}
+
+/// Where both compilers put cbuffer_packing.hlsl's implicit `$Globals`.
+const GLOBALS_BINDING: u32 = 2;
+
 fn cases() -> Vec<Case> {
     use Stage::*;
     let gen = Group::General;
@@ -160,6 +176,7 @@ fn cases() -> Vec<Case> {
                 out(1, 32 * 32 * 16, Format::F32x4),
                 input(2, Data::Uniform(f32_bytes(&[0.4, 1.0, 0.3, 0.2]))),
             ],
+            dx_layout: false,
         },
         Case {
             name: "alpha",
@@ -185,6 +202,7 @@ fn cases() -> Vec<Case> {
                 ),
                 out(3, 24 * 24 * 2 * 16, Format::F32x4),
             ],
+            dx_layout: false,
         },
         Case {
             name: "triangle-anyhit",
@@ -203,6 +221,7 @@ fn cases() -> Vec<Case> {
             },
             scene: SceneKind::Triangle,
             resources: vec![input(0, Data::Scene), out(1, 16 * 16 * 16, Format::F32x4)],
+            dx_layout: false,
         },
         Case {
             name: "procedural-callable",
@@ -231,6 +250,7 @@ fn cases() -> Vec<Case> {
             },
             scene: SceneKind::SphereBox,
             resources: vec![input(0, Data::Scene), out(1, 4 * 16 * 16, Format::F32x4)],
+            dx_layout: false,
         },
         Case {
             name: "rayquery-triangle",
@@ -239,6 +259,7 @@ fn cases() -> Vec<Case> {
             shape: Shape::Compute { groups: [1, 1, 1] },
             scene: SceneKind::Triangle,
             resources: vec![input(0, Data::Scene), out(1, 16 * 16, Format::F32x4)],
+            dx_layout: false,
         },
         Case {
             name: "rayquery-occlusion",
@@ -264,6 +285,7 @@ fn cases() -> Vec<Case> {
                     ])),
                 ),
             ],
+            dx_layout: false,
         },
         Case {
             name: "compute-math",
@@ -272,6 +294,7 @@ fn cases() -> Vec<Case> {
             shape: Shape::Compute { groups: [1, 1, 1] },
             scene: SceneKind::None,
             resources: vec![out(0, 64 * 10 * 16, Format::F32x4)],
+            dx_layout: false,
         },
         Case {
             name: "compute-memory",
@@ -287,6 +310,29 @@ fn cases() -> Vec<Case> {
                 },
                 out(1, 16, Format::U32),
             ],
+            dx_layout: false,
+        },
+        Case {
+            name: "cbuffer-offsets",
+            file: "diff_cbuffer.hlsl",
+            entries: vec![("Main", Compute)],
+            shape: Shape::Compute { groups: [1, 1, 1] },
+            scene: SceneKind::None,
+            resources: vec![input(0, index_words(80)), out(1, 40 * 4, Format::F32)],
+            dx_layout: true,
+        },
+        Case {
+            name: "cbuffer-globals",
+            file: "cbuffer_packing.hlsl",
+            entries: vec![("Main", Compute)],
+            shape: Shape::Compute { groups: [1, 1, 1] },
+            scene: SceneKind::None,
+            resources: vec![
+                input(0, index_words(32)),
+                out(1, 2 * 4, Format::F32),
+                input(GLOBALS_BINDING, index_words(8)),
+            ],
+            dx_layout: true,
         },
     ]
 }
@@ -300,7 +346,6 @@ const NOT_RUN: &[(&str, &str)] = &[
     ("anyhit_alpha.hlsl", "samples a texture and has no ray generation shader; diff_alpha.hlsl is the alpha test over buffers"),
     ("intersection_sphere.hlsl", "has no ray generation shader and binds set 1 (rtlint::vk binds set 0); exec_procedural.hlsl runs ReportHit with attributes"),
     ("resources.hlsl", "a binding and layout test: textures, samplers and unbounded arrays"),
-    ("cbuffer_packing.hlsl", "a layout test without a runnable entry point"),
     ("language.hlsl", "a front-end test without a runnable entry point"),
     ("exec_compute.hlsl", "Slang 2026.12 rejects it: a struct method assigns `this.count` without `[mutating]`, `(float2)q` truncates a float4, and unscoped enum constants (`MODE_C`) are not in scope; diff_math.hlsl covers arithmetic and intrinsics"),
     ("common.hlsli", "an include file"),
@@ -639,10 +684,6 @@ fn rtlint_and_slang_agree_on_the_driver() {
         );
     }
 
-    let slang_args: Vec<String> = ["-fvk-use-entrypoint-name"]
-        .iter()
-        .map(|s| s.to_string())
-        .collect();
     let (mut validated_ours, mut validated_slang, mut compared, mut facts) = (0, 0, 0, 0);
     let (mut pixels, mut max_all) = (0usize, 0f32);
     let mut failures = String::new();
@@ -652,6 +693,17 @@ fn rtlint_and_slang_agree_on_the_driver() {
             .unwrap_or_else(|e| panic!("{}: rtlint: {e}", case.file));
         let mut ours_modules = Vec::new();
         let mut slang_modules = Vec::new();
+        // Slang names every SPIR-V entry point `main` unless told otherwise,
+        // and lays matrices out row-major unless told HLSL's default.
+        let mut slang_args = vec![
+            "-fvk-use-entrypoint-name".to_string(),
+            "-matrix-layout-column-major".to_string(),
+        ];
+        let mut val_args: Vec<&str> = Vec::new();
+        if case.dx_layout {
+            slang_args.push("-fvk-use-dx-layout".into());
+            val_args.push("--scalar-block-layout");
+        }
         for (name, stage) in &case.entries {
             let mine = ours
                 .iter()
@@ -662,11 +714,11 @@ fn rtlint_and_slang_agree_on_the_driver() {
             let theirs = slang
                 .compile_hlsl(&path, name, stage_name(*stage), &slang_args)
                 .unwrap_or_else(|e| panic!("{}: Slang: {e}", case.file));
-            if let Err(e) = common::spirv_val(&mine) {
+            if let Err(e) = common::spirv_val_with(&mine, &val_args) {
                 let _ = writeln!(failures, "{}:{name}: rtlint module invalid: {e}", case.file);
             }
             validated_ours += 1;
-            if let Err(e) = common::spirv_val(&theirs) {
+            if let Err(e) = common::spirv_val_with(&theirs, &val_args) {
                 let _ = writeln!(failures, "{}:{name}: Slang module invalid: {e}", case.file);
             }
             validated_slang += 1;
@@ -700,6 +752,21 @@ fn rtlint_and_slang_agree_on_the_driver() {
                 r.binding
             );
             let (cn, cbad, cmax) = diff(r.compare.unwrap(), a, b);
+            if std::env::var_os("RTLINT_DIFF_DUMP").is_some() {
+                // Both readbacks as floats, to see where a difference lies.
+                let floats = |x: &[u8]| -> Vec<f32> {
+                    x.chunks_exact(4)
+                        .map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]]))
+                        .collect()
+                };
+                eprintln!(
+                    "{} binding {}\n  rtlint {:?}\n  Slang  {:?}",
+                    case.name,
+                    r.binding,
+                    floats(a),
+                    floats(b)
+                );
+            }
             n += cn;
             bad += cbad;
             max = max.max(cmax);
