@@ -17,7 +17,7 @@ use rtlint::spirv::{Program, Stage};
 use rtlint::vk::{
     raw, Aabb, AccelerationStructure, Binding, BindingKind, Buffer, ComputePipeline, Context,
     Geometry, Group, Instance, RayTracingPipeline, RayTracingPipelineDesc, Resource, ShaderStage,
-    IDENTITY,
+    StorageImage, IDENTITY,
 };
 use std::collections::BTreeSet;
 use std::fmt::Write as _;
@@ -57,6 +57,8 @@ enum Data {
     Scene,
     Storage(Vec<u8>),
     Uniform(Vec<u8>),
+    /// An `rgba32f` storage image of this width and height, cleared to zero.
+    Image(u32, u32),
 }
 
 struct Res {
@@ -205,6 +207,82 @@ fn cases() -> Vec<Case> {
             dx_layout: false,
         },
         Case {
+            name: "camera-shadow",
+            file: "pipeline.hlsl",
+            entries: vec![
+                ("RayGen", RayGeneration),
+                ("Miss", Miss),
+                ("ShadowMiss", Miss),
+                ("ClosestHit", ClosestHit),
+            ],
+            shape: Shape::Pipeline {
+                groups: vec![gen(0), gen(1), gen(2), tri(Some(3), None), tri(None, None)],
+                depth: 2,
+                launch: [32, 32],
+            },
+            scene: SceneKind::Shadow,
+            resources: vec![
+                input(0, Data::Scene),
+                Res {
+                    binding: 1,
+                    data: Data::Image(32, 32),
+                    compare: Some(Format::F32x4),
+                },
+                // Camera: viewInverse (column-major: one row per column, the
+                // last holding the translation), lightDir, tMax.
+                input(
+                    2,
+                    Data::Uniform(f32_bytes(&[
+                        1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 1.0, 3.0,
+                        1.0, -0.4, -1.0, -0.3, 100.0,
+                    ])),
+                ),
+            ],
+            dx_layout: false,
+        },
+        Case {
+            name: "callable",
+            file: "callable.hlsl",
+            entries: vec![
+                ("Gen", RayGeneration),
+                ("Checker", Callable),
+                ("Tint", Callable),
+            ],
+            shape: Shape::Pipeline {
+                groups: vec![gen(0), gen(1), gen(2)],
+                depth: 1,
+                launch: [32, 16],
+            },
+            scene: SceneKind::None,
+            resources: vec![Res {
+                binding: 0,
+                data: Data::Image(32, 16),
+                compare: Some(Format::F32x4),
+            }],
+            dx_layout: false,
+        },
+        Case {
+            name: "callable-specialized",
+            file: "callable.hlsl",
+            entries: vec![
+                ("GenSpecialized", RayGeneration),
+                ("Checker", Callable),
+                ("Tint", Callable),
+            ],
+            shape: Shape::Pipeline {
+                groups: vec![gen(0), gen(1), gen(2)],
+                depth: 1,
+                launch: [8, 8],
+            },
+            scene: SceneKind::None,
+            resources: vec![Res {
+                binding: 0,
+                data: Data::Image(8, 8),
+                compare: Some(Format::F32x4),
+            }],
+            dx_layout: false,
+        },
+        Case {
             name: "triangle-anyhit",
             file: "exec_pipeline.hlsl",
             entries: vec![
@@ -340,8 +418,6 @@ fn cases() -> Vec<Case> {
 /// HLSL test shaders the differential test does not run, and why. Every
 /// file in tests/hlsl must be in a case or here.
 const NOT_RUN: &[(&str, &str)] = &[
-    ("pipeline.hlsl", "writes a RWTexture2D: rtlint::vk creates no images; diff_shadow.hlsl is the same pipeline shape writing a buffer"),
-    ("callable.hlsl", "writes a RWTexture2D: rtlint::vk creates no images; exec_procedural.hlsl runs a callable"),
     ("exec_textures.hlsl", "samples textures: rtlint::vk creates no images or samplers"),
     ("anyhit_alpha.hlsl", "samples a texture and has no ray generation shader; diff_alpha.hlsl is the alpha test over buffers"),
     ("intersection_sphere.hlsl", "has no ray generation shader and binds set 1 (rtlint::vk binds set 0); exec_procedural.hlsl runs ReportHit with attributes"),
@@ -469,10 +545,16 @@ fn run(ctx: &Context, case: &Case, modules: &[Vec<u32>]) -> Vec<Vec<u8>> {
     let scene = build_scene(ctx, case.scene);
     let mut bindings = Vec::new();
     let mut buffers = Vec::new();
+    let mut images = Vec::new();
     for r in &case.resources {
         let (kind, usage, bytes) = match &r.data {
             Data::Scene => {
                 bindings.push(Binding::new(r.binding, BindingKind::AccelerationStructure));
+                continue;
+            }
+            Data::Image(w, h) => {
+                bindings.push(Binding::new(r.binding, BindingKind::StorageImage));
+                images.push((r, StorageImage::new(ctx, *w, *h).unwrap()));
                 continue;
             }
             Data::Storage(b) => (
@@ -492,6 +574,11 @@ fn run(ctx: &Context, case: &Case, modules: &[Vec<u32>]) -> Vec<Vec<u8>> {
     let mut resources: Vec<(u32, Resource<'_>)> = buffers
         .iter()
         .map(|(r, b)| (r.binding, Resource::Buffer(b)))
+        .chain(
+            images
+                .iter()
+                .map(|(r, i)| (r.binding, Resource::StorageImage(i.view()))),
+        )
         .collect();
     if let Some(s) = &scene {
         let at = case
@@ -537,10 +624,23 @@ fn run(ctx: &Context, case: &Case, modules: &[Vec<u32>]) -> Vec<Vec<u8>> {
             p.trace_rays(&resources, launch[0], launch[1], 1).unwrap();
         }
     }
-    buffers
+    // In resource order, as the caller pairs them with the resources.
+    case.resources
         .iter()
-        .filter(|(r, _)| r.compare.is_some())
-        .map(|(_, b)| b.read())
+        .filter(|r| r.compare.is_some())
+        .map(|r| {
+            if let Some((_, b)) = buffers.iter().find(|(b, _)| b.binding == r.binding) {
+                b.read()
+            } else {
+                let (_, i) = images.iter().find(|(i, _)| i.binding == r.binding).unwrap();
+                let texels = i.read(ctx).unwrap();
+                texels
+                    .iter()
+                    .flatten()
+                    .flat_map(|x| x.to_le_bytes())
+                    .collect()
+            }
+        })
         .collect()
 }
 
