@@ -89,8 +89,8 @@ struct Case {
     resources: Vec<Res>,
     /// Constant buffers use HLSL packing where it differs from std140, as
     /// rtlint always does: Slang gets `-fvk-use-dx-layout` (which also packs
-    /// structured buffers tighter than DXC's default, so only for cases
-    /// without structs in them), spirv-val `--scalar-block-layout` (the
+    /// structs in structured buffers tighter than DXC's default std430, so
+    /// only where there are none), spirv-val `--scalar-block-layout` (the
     /// device has scalarBlockLayout on).
     dx_layout: bool,
 }
@@ -418,12 +418,35 @@ fn cases() -> Vec<Case> {
 /// HLSL test shaders the differential test does not run, and why. Every
 /// file in tests/hlsl must be in a case or here.
 const NOT_RUN: &[(&str, &str)] = &[
-    ("exec_textures.hlsl", "samples textures: rtlint::vk creates no images or samplers"),
-    ("anyhit_alpha.hlsl", "samples a texture and has no ray generation shader; diff_alpha.hlsl is the alpha test over buffers"),
-    ("intersection_sphere.hlsl", "has no ray generation shader and binds set 1 (rtlint::vk binds set 0); exec_procedural.hlsl runs ReportHit with attributes"),
-    ("resources.hlsl", "a binding and layout test: textures, samplers and unbounded arrays"),
-    ("language.hlsl", "a front-end test without a runnable entry point"),
-    ("exec_compute.hlsl", "Slang 2026.12 rejects it: a struct method assigns `this.count` without `[mutating]`, `(float2)q` truncates a float4, and unscoped enum constants (`MODE_C`) are not in scope; diff_math.hlsl covers arithmetic and intrinsics"),
+    (
+        "exec_compute.hlsl",
+        "Slang 2026.12 rejects valid HLSL in it: a method assigns `this.count` without \
+         `[mutating]`, the `(float2)q` truncating cast, unscoped enum constants (`MODE_C`); \
+         diff_math.hlsl covers arithmetic and intrinsics, tests/hlsl_exec.rs runs it",
+    ),
+    (
+        "language.hlsl",
+        "Slang 2026.12 rejects the `(float3)c4` truncating cast, and it reads push \
+         constants, which `ComputePipeline` does not set",
+    ),
+    (
+        "exec_textures.hlsl",
+        "samples a texture: rtlint::vk makes storage images only, no sampled images or samplers",
+    ),
+    (
+        "anyhit_alpha.hlsl",
+        "samples a texture and has no ray generation shader; diff_alpha.hlsl is the \
+         alpha test over buffers",
+    ),
+    (
+        "intersection_sphere.hlsl",
+        "no ray generation shader, and it binds set 1 (rtlint::vk binds set 0); \
+         exec_procedural.hlsl runs ReportHit with an attribute struct",
+    ),
+    (
+        "resources.hlsl",
+        "sampled textures, samplers, unbounded descriptor arrays and sets 1 and 2",
+    ),
     ("common.hlsli", "an include file"),
 ];
 
