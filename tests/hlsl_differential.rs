@@ -5,7 +5,8 @@
 //! entry point, runs both builds with the same scene and bindings through
 //! `rtlint::vk`, and compares the outputs (floats within 1/255, integers
 //! exactly). Fails, never skips, without Slang or a ray-tracing device.
-//! `RTLINT_DIFF_DUMP=1` prints both readbacks of every case.
+//! `RTLINT_DIFF_DUMP=1` prints both readbacks of every case and writes every
+//! module to `$TMPDIR/rtlint-diff/`.
 
 mod common;
 
@@ -738,6 +739,20 @@ fn interface(words: &[u32], file: &str) -> Interface {
     i
 }
 
+/// Debian's validation layer (1.3.239) predates Slang's OpSource language
+/// (11) and rejects the whole module for it; the driver ignores OpSource, so
+/// under validation it is set to Unknown.
+fn unknown_source_language(words: &mut [u32]) {
+    let mut at = 5;
+    while at < words.len() {
+        let count = (words[at] >> 16) as usize;
+        if words[at] & 0xffff == spirv::Op::Source as u32 && count > 1 {
+            words[at + 1] = 0;
+        }
+        at += count.max(1);
+    }
+}
+
 /// Differences between two readbacks: (elements compared, elements that
 /// differ, largest channel difference; `f32::INFINITY` for an unequal word).
 fn diff(format: Format, a: &[u8], b: &[u8]) -> (usize, usize, f32) {
@@ -855,11 +870,37 @@ fn rtlint_and_slang_agree_on_the_driver() {
                 );
             }
             facts += 2 + a.resources.len() + a.storage.len() + a.blocks.len();
+            if std::env::var_os("RTLINT_DIFF_DUMP").is_some() {
+                let dir = std::env::temp_dir().join("rtlint-diff");
+                std::fs::create_dir_all(&dir).unwrap();
+                for (who, w) in [("rtlint", &mine), ("slang", &theirs)] {
+                    let bytes: Vec<u8> = w.iter().flat_map(|x| x.to_le_bytes()).collect();
+                    std::fs::write(dir.join(format!("{}-{name}-{who}.spv", case.name)), bytes)
+                        .unwrap();
+                }
+            }
             ours_modules.push(mine);
             slang_modules.push(theirs);
         }
+        if ctx.validation_enabled() {
+            for m in ours_modules.iter_mut().chain(&mut slang_modules) {
+                unknown_source_language(m);
+            }
+        }
+        // Under RTLINT_VK_VALIDATION=1 the Khronos layer checks each build's
+        // modules and use: rtlint's must be clean; Slang's findings are
+        // printed (its f32tof16 declares Float16 and Int16 capabilities
+        // without the features, which lavapipe tolerates).
+        let before = ctx.validation_errors().len();
         let got_ours = run(&ctx, case, &ours_modules);
+        for e in &ctx.validation_errors()[before..] {
+            let _ = writeln!(failures, "{}: rtlint build: {e}", case.name);
+        }
+        let before = ctx.validation_errors().len();
         let got_slang = run(&ctx, case, &slang_modules);
+        for e in &ctx.validation_errors()[before..] {
+            println!("  {}: Slang build, validation layer: {e}", case.name);
+        }
         let (mut n, mut bad, mut max) = (0, 0, 0f32);
         for ((r, a), b) in case
             .resources
