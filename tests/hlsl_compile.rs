@@ -222,7 +222,11 @@ fn program_sees_hlsl_declaration_positions() {
 #[test]
 fn every_test_shader_validates() {
     // HLSL cbuffer packing beyond std140 needs scalar block layout.
-    const NEEDS_SCALAR: &[&str] = &["cbuffer_packing.hlsl", "exec_compute.hlsl"];
+    const NEEDS_SCALAR: &[&str] = &[
+        "cbuffer_packing.hlsl",
+        "diff_cbuffer.hlsl",
+        "exec_compute.hlsl",
+    ];
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/hlsl");
     let mut count = 0;
     let mut names: Vec<String> = std::fs::read_dir(&dir)
