@@ -2,6 +2,7 @@
 //! (`OpString`/`OpLine`, or `NonSemantic.Shader.DebugInfo.100`) leads back to the
 //! original source.
 
+pub mod hlsl;
 pub mod slang;
 pub mod spirv;
 pub mod wgsl;
@@ -90,7 +91,17 @@ pub fn compile_path(path: &Path, language: Language) -> Result<Compiled, InputEr
                 decls: Vec::new(),
             })
         }
-        Language::Hlsl | Language::Glsl => Err(InputError::new(
+        Language::Hlsl => {
+            let m = hlsl::compile_file(path, &hlsl::HlslOptions::default())?;
+            Ok(Compiled {
+                path: path.to_path_buf(),
+                language: Language::Hlsl,
+                input_language: Language::Hlsl,
+                words: m.words,
+                decls: m.decls,
+            })
+        }
+        Language::Glsl => Err(InputError::new(
             "unsupported-language",
             path,
             format!(

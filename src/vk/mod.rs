@@ -1,8 +1,8 @@
 //! A small Vulkan harness (ash) for running ray-tracing shaders on a real
 //! driver: device selection, buffers with device addresses, acceleration
 //! structures, ray-tracing and compute pipelines, the shader binding table,
-//! dispatch with a bounded wait, readback, and the driver's per-group stack
-//! sizes.
+//! dispatch with a bounded wait, readback of buffers and storage images, and
+//! the driver's per-group stack sizes.
 //!
 //! Every object holds a reference to the device it was made on, so drop order
 //! does not matter; every submission waits on a fence with a finite timeout,
@@ -26,6 +26,7 @@ mod child;
 mod context;
 mod descriptors;
 mod error;
+mod image;
 mod pipeline;
 mod stack_query;
 mod validation;
@@ -38,6 +39,7 @@ pub use child::{
 pub use context::{Context, ContextOptions, DeviceInfo, RayTracingLimits};
 pub use descriptors::{Binding, BindingKind, Resource};
 pub use error::{Error, Result};
+pub use image::StorageImage;
 pub use pipeline::{
     ComputePipeline, Group, GroupStackSizes, RayTracingPipeline, RayTracingPipelineDesc, SbtLayout,
     SbtRegion, ShaderBindingTable, ShaderStage, Stage,

@@ -18,6 +18,11 @@ pub fn in_ci() -> bool {
 /// is set to Unknown on a copy first. Panics when spirv-val is missing: the
 /// setup script installs it, and a validation test must not pass silently.
 pub fn spirv_val(words: &[u32]) -> Result<(), String> {
+    spirv_val_with(words, &[])
+}
+
+/// [`spirv_val`] with further options (`--scalar-block-layout`).
+pub fn spirv_val_with(words: &[u32], options: &[&str]) -> Result<(), String> {
     let mut w = words.to_vec();
     let mut i = 5;
     while i < w.len() {
@@ -37,6 +42,7 @@ pub fn spirv_val(words: &[u32]) -> Result<(), String> {
     .unwrap();
     let out = Command::new("spirv-val")
         .args(["--target-env", "vulkan1.2"])
+        .args(options)
         .arg(&file)
         .output()
         .expect("spirv-val not found: run scripts/setup");

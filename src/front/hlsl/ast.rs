@@ -1,0 +1,231 @@
+//! Syntax tree of the HLSL subset, every node with the position of its first token.
+
+use super::error::Pos;
+
+#[derive(Clone, Debug)]
+pub struct TypeRef {
+    /// As written; namespace-qualified names keep their `::`.
+    pub name: String,
+    pub args: Vec<TArg>,
+    pub pos: Pos,
+}
+
+#[derive(Clone, Debug)]
+pub enum TArg {
+    Type(TypeRef),
+    Expr(Expr),
+}
+
+#[derive(Clone, Debug)]
+pub struct Attr {
+    /// `shader`, `numthreads`, `vk::binding`, ...
+    pub name: String,
+    pub args: Vec<Expr>,
+    pub pos: Pos,
+}
+
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Mods {
+    pub is_static: bool,
+    pub is_const: bool,
+    pub groupshared: bool,
+    pub uniform: bool,
+    pub input: bool,
+    pub output: bool,
+    pub row_major: bool,
+    pub column_major: bool,
+    pub precise: bool,
+    pub nointerp: bool,
+}
+
+#[derive(Clone, Debug)]
+pub struct Register {
+    pub class: char,
+    pub index: u32,
+    pub space: u32,
+    pub pos: Pos,
+}
+
+#[derive(Clone, Debug)]
+pub struct VarDecl {
+    pub attrs: Vec<Attr>,
+    pub mods: Mods,
+    pub ty: TypeRef,
+    pub name: String,
+    pub pos: Pos,
+    /// Array dimensions outermost first; `None` for `[]`.
+    pub dims: Vec<Option<Expr>>,
+    pub semantic: Option<(String, Pos)>,
+    pub register: Option<Register>,
+    pub init: Option<Expr>,
+}
+
+#[derive(Clone, Debug)]
+pub struct Function {
+    pub attrs: Vec<Attr>,
+    pub ret: TypeRef,
+    pub name: String,
+    /// Enclosing namespace, `a::b::` or empty; unqualified names look here first.
+    pub ns: String,
+    pub pos: Pos,
+    pub params: Vec<VarDecl>,
+    pub semantic: Option<(String, Pos)>,
+    pub body: Option<Vec<Stmt>>,
+}
+
+#[derive(Clone, Debug)]
+pub struct StructDecl {
+    pub name: String,
+    pub pos: Pos,
+    pub fields: Vec<VarDecl>,
+    /// Methods: functions with an implicit `inout` `this`.
+    pub methods: Vec<Function>,
+}
+
+#[derive(Clone, Debug)]
+pub enum Item {
+    Struct(StructDecl),
+    Typedef {
+        ty: TypeRef,
+        dims: Vec<Option<Expr>>,
+        name: String,
+        pos: Pos,
+    },
+    Enum {
+        name: String,
+        scoped: bool,
+        underlying: Option<TypeRef>,
+        variants: Vec<(String, Pos, Option<Expr>)>,
+        pos: Pos,
+    },
+    Var(VarDecl),
+    CBuffer {
+        attrs: Vec<Attr>,
+        name: String,
+        pos: Pos,
+        register: Option<Register>,
+        members: Vec<VarDecl>,
+    },
+    Function(Function),
+}
+
+#[derive(Clone, Debug)]
+pub struct Expr {
+    pub kind: ExprKind,
+    pub pos: Pos,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum UnOp {
+    Neg,
+    Plus,
+    Not,
+    BitNot,
+    PreInc,
+    PreDec,
+    PostInc,
+    PostDec,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum BinOp {
+    Add,
+    Sub,
+    Mul,
+    Div,
+    Rem,
+    Shl,
+    Shr,
+    BitAnd,
+    BitOr,
+    BitXor,
+    And,
+    Or,
+    Eq,
+    Ne,
+    Lt,
+    Le,
+    Gt,
+    Ge,
+}
+
+impl BinOp {
+    pub fn as_str(self) -> &'static str {
+        use BinOp::*;
+        match self {
+            Add => "+",
+            Sub => "-",
+            Mul => "*",
+            Div => "/",
+            Rem => "%",
+            Shl => "<<",
+            Shr => ">>",
+            BitAnd => "&",
+            BitOr => "|",
+            BitXor => "^",
+            And => "&&",
+            Or => "||",
+            Eq => "==",
+            Ne => "!=",
+            Lt => "<",
+            Le => "<=",
+            Gt => ">",
+            Ge => ">=",
+        }
+    }
+}
+
+#[derive(Clone, Debug)]
+pub enum ExprKind {
+    Int(u64, bool),
+    Float(f64),
+    Bool(bool),
+    /// Only in attributes (`[shader("miss")]`).
+    Str(String),
+    Ident(String),
+    Unary(UnOp, Box<Expr>),
+    Binary(BinOp, Box<Expr>, Box<Expr>),
+    Assign(Option<BinOp>, Box<Expr>, Box<Expr>),
+    Ternary(Box<Expr>, Box<Expr>, Box<Expr>),
+    /// A call of a function or intrinsic by name.
+    Call(String, Vec<Expr>),
+    /// `float3(...)`, `RayDesc(...)`: a constructor.
+    Construct(TypeRef, Vec<Expr>),
+    Method(Box<Expr>, String, Vec<Expr>),
+    Member(Box<Expr>, String),
+    Index(Box<Expr>, Box<Expr>),
+    Cast(TypeRef, Box<Expr>),
+    InitList(Vec<Expr>),
+    Comma(Box<Expr>, Box<Expr>),
+}
+
+#[derive(Clone, Debug)]
+pub struct Stmt {
+    pub kind: StmtKind,
+    pub pos: Pos,
+}
+
+#[derive(Clone, Debug)]
+pub struct Case {
+    /// `None` is `default:`.
+    pub labels: Vec<Option<Expr>>,
+    pub body: Vec<Stmt>,
+    pub pos: Pos,
+}
+
+#[derive(Clone, Debug)]
+pub enum StmtKind {
+    Block(Vec<Stmt>),
+    Decl(Vec<VarDecl>),
+    Expr(Expr),
+    If(Expr, Box<Stmt>, Option<Box<Stmt>>),
+    For(Option<Box<Stmt>>, Option<Expr>, Option<Expr>, Box<Stmt>),
+    While(Expr, Box<Stmt>),
+    DoWhile(Box<Stmt>, Expr),
+    Switch(Expr, Vec<Case>),
+    Break,
+    Continue,
+    Return(Option<Expr>),
+    Discard,
+    Empty,
+}

@@ -1,0 +1,1105 @@
+//! Calls: user functions (overloads, `in`/`out`/`inout` by copy), intrinsics,
+//! ray-tracing operations and methods of resources and ray queries.
+
+use super::*;
+
+/// GLSL.std.450 instruction numbers used here.
+mod g {
+    pub const ROUND_EVEN: u32 = 2;
+    pub const TRUNC: u32 = 3;
+    pub const FABS: u32 = 4;
+    pub const SABS: u32 = 5;
+    pub const FSIGN: u32 = 6;
+    pub const SSIGN: u32 = 7;
+    pub const FLOOR: u32 = 8;
+    pub const CEIL: u32 = 9;
+    pub const FRACT: u32 = 10;
+    pub const RADIANS: u32 = 11;
+    pub const DEGREES: u32 = 12;
+    pub const SIN: u32 = 13;
+    pub const COS: u32 = 14;
+    pub const TAN: u32 = 15;
+    pub const ASIN: u32 = 16;
+    pub const ACOS: u32 = 17;
+    pub const ATAN: u32 = 18;
+    pub const SINH: u32 = 19;
+    pub const COSH: u32 = 20;
+    pub const TANH: u32 = 21;
+    pub const ATAN2: u32 = 25;
+    pub const POW: u32 = 26;
+    pub const EXP: u32 = 27;
+    pub const LOG: u32 = 28;
+    pub const EXP2: u32 = 29;
+    pub const LOG2: u32 = 30;
+    pub const SQRT: u32 = 31;
+    pub const INVERSE_SQRT: u32 = 32;
+    pub const DETERMINANT: u32 = 33;
+    pub const FMIN: u32 = 37;
+    pub const UMIN: u32 = 38;
+    pub const SMIN: u32 = 39;
+    pub const FMAX: u32 = 40;
+    pub const UMAX: u32 = 41;
+    pub const SMAX: u32 = 42;
+    pub const FCLAMP: u32 = 43;
+    pub const UCLAMP: u32 = 44;
+    pub const SCLAMP: u32 = 45;
+    pub const FMIX: u32 = 46;
+    pub const STEP: u32 = 48;
+    pub const SMOOTH_STEP: u32 = 49;
+    pub const FMA: u32 = 50;
+    pub const PACK_HALF_2X16: u32 = 58;
+    pub const UNPACK_HALF_2X16: u32 = 62;
+    pub const LENGTH: u32 = 66;
+    pub const DISTANCE: u32 = 67;
+    pub const CROSS: u32 = 68;
+    pub const NORMALIZE: u32 = 69;
+    pub const FACE_FORWARD: u32 = 70;
+    pub const REFLECT: u32 = 71;
+    pub const REFRACT: u32 = 72;
+    pub const FIND_ILSB: u32 = 73;
+    pub const FIND_SMSB: u32 = 74;
+    pub const FIND_UMSB: u32 = 75;
+}
+
+/// A call argument: an expression, or a place already evaluated (`this`).
+pub(super) enum Arg<'a> {
+    Expr(&'a Expr),
+    Place(Place, Pos),
+}
+
+impl Arg<'_> {
+    fn pos(&self) -> Pos {
+        match self {
+            Arg::Expr(e) => e.pos,
+            Arg::Place(_, p) => *p,
+        }
+    }
+}
+
+const RG_CH_MISS: &[Stage] = &[Stage::RayGeneration, Stage::ClosestHit, Stage::Miss];
+
+impl<'a> Lowerer<'a> {
+    pub(super) fn call_expr(&mut self, e: &'a Expr) -> Result<Option<Val>> {
+        self.line(e.pos);
+        match &e.kind {
+            ExprKind::Call(name, args) => self.call(name, args, e.pos),
+            ExprKind::Method(obj, name, args) => self.method(obj, name, args, e.pos),
+            _ => Ok(Some(self.expr(e)?)),
+        }
+    }
+
+    fn stage_check(&self, name: &str, allowed: &[Stage], pos: Pos) -> Result<()> {
+        if let Some(s) = self.cur_stage {
+            if !allowed.contains(&s) {
+                return Err(Error::new(
+                    pos,
+                    format!("`{name}` is not available in {} shaders", s.name()),
+                )
+                .len(name.len() as u32));
+            }
+        }
+        Ok(())
+    }
+
+    fn glsl(&mut self, inst: u32, ty: &Ty, args: &[Id]) -> Result<Val> {
+        let tid = self.ty_id(ty)?;
+        let mut ops = vec![
+            Operand::IdRef(self.glsl),
+            Operand::LiteralExtInstInteger(inst),
+        ];
+        ops.extend(args.iter().map(|a| Operand::IdRef(*a)));
+        let id = self.inst(Op::ExtInst, Some(tid), ops)?;
+        Ok(Val { id, ty: ty.clone() })
+    }
+
+    fn args(&mut self, args: &'a [Expr]) -> Result<Vec<Val>> {
+        args.iter().map(|a| self.expr(a)).collect()
+    }
+
+    pub(super) fn arity(&self, name: &str, args: &[Expr], n: usize, pos: Pos) -> Result<()> {
+        if args.len() != n {
+            return Err(Error::new(
+                pos,
+                format!("`{name}` takes {n} argument(s), {} given", args.len()),
+            )
+            .len(name.len() as u32));
+        }
+        Ok(())
+    }
+
+    /// Arguments converted to one common type (`float_only` forces float).
+    fn unify(&mut self, vals: Vec<Val>, float_only: bool, pos: Pos) -> Result<(Ty, Vec<Id>)> {
+        let mut t = vals
+            .first()
+            .map(|v| v.ty.clone())
+            .ok_or_else(|| Error::new(pos, "missing arguments"))?;
+        for v in &vals[1..] {
+            t = self.common(&t, &v.ty, pos)?;
+        }
+        if float_only || t.scalar() == Some(Sc::Bool) {
+            t = t.with_scalar(if float_only { Sc::Float } else { Sc::Int });
+        }
+        if !t.is_numeric() {
+            return Err(Error::new(
+                pos,
+                format!("expected numbers, found `{}`", self.ty_name(&t)),
+            ));
+        }
+        let mut ids = Vec::new();
+        for v in vals {
+            ids.push(self.convert(v, &t, pos, false)?.id);
+        }
+        Ok((t, ids))
+    }
+
+    /// Writes `v` to an `out` argument, converting to its type.
+    fn store_out(&mut self, a: &'a Expr, v: Val) -> Result<()> {
+        let p = self.place(a)?;
+        let t = p.ty().clone();
+        let v = self.convert(v, &t, a.pos, true)?;
+        self.write(&p, v, a.pos)
+    }
+
+    fn find_user(&self, name: &str) -> Option<Vec<usize>> {
+        if !self.cur_ns.is_empty() {
+            if let Some(v) = self.fn_by_name.get(&format!("{}{name}", self.cur_ns)) {
+                return Some(v.clone());
+            }
+        }
+        self.fn_by_name.get(name).cloned()
+    }
+
+    fn call(&mut self, name: &str, args: &'a [Expr], pos: Pos) -> Result<Option<Val>> {
+        if let Some(this) = self.this_place.clone() {
+            if let Ty::Struct(k) = this.ty() {
+                let qualified = format!("{}::{name}", self.structs[*k as usize].name);
+                if let Some(c) = self.fn_by_name.get(&qualified).cloned() {
+                    let mut all = vec![Arg::Place(this, pos)];
+                    all.extend(args.iter().map(Arg::Expr));
+                    return self.call_user(name, c, all, pos);
+                }
+            }
+        }
+        if let Some(c) = self.find_user(name) {
+            return self.call_user(name, c, args.iter().map(Arg::Expr).collect(), pos);
+        }
+        if let Some((bi, ty, stages)) = system_value(name) {
+            self.arity(name, args, 0, pos)?;
+            if self.cur_stage == Some(Stage::Compute) {
+                return Err(Error::new(
+                    pos,
+                    format!("`{name}` is not available in compute shaders"),
+                )
+                .len(name.len() as u32));
+            }
+            self.stage_check(name, stages, pos)?;
+            self.ray_tracing_caps();
+            let v = self.read_builtin(bi, &ty)?;
+            if name.ends_with("3x4") || name == "ObjectToWorld" || name == "WorldToObject" {
+                let t = Ty::Mat(Sc::Float, 3, 4);
+                let tid = self.ty_id(&t)?;
+                let id = self.op(Op::Transpose, tid, &[v.id])?;
+                return Ok(Some(Val { id, ty: t }));
+            }
+            return Ok(Some(v));
+        }
+        let f = Ty::Sc(Sc::Float);
+        let one_float = |this: &mut Self, inst: u32| -> Result<Option<Val>> {
+            this.arity(name, args, 1, pos)?;
+            let vals = this.args(args)?;
+            let (t, ids) = this.unify(vals, true, pos)?;
+            Ok(Some(this.glsl(inst, &t, &ids)?))
+        };
+        let unary_glsl = match name {
+            "sin" => Some(g::SIN),
+            "cos" => Some(g::COS),
+            "tan" => Some(g::TAN),
+            "asin" => Some(g::ASIN),
+            "acos" => Some(g::ACOS),
+            "atan" => Some(g::ATAN),
+            "sinh" => Some(g::SINH),
+            "cosh" => Some(g::COSH),
+            "tanh" => Some(g::TANH),
+            "exp" => Some(g::EXP),
+            "log" => Some(g::LOG),
+            "exp2" => Some(g::EXP2),
+            "log2" => Some(g::LOG2),
+            "sqrt" => Some(g::SQRT),
+            "rsqrt" => Some(g::INVERSE_SQRT),
+            "floor" => Some(g::FLOOR),
+            "ceil" => Some(g::CEIL),
+            "frac" => Some(g::FRACT),
+            "trunc" => Some(g::TRUNC),
+            "round" => Some(g::ROUND_EVEN),
+            "radians" => Some(g::RADIANS),
+            "degrees" => Some(g::DEGREES),
+            "normalize" => Some(g::NORMALIZE),
+            _ => None,
+        };
+        if let Some(inst) = unary_glsl {
+            return one_float(self, inst);
+        }
+        match name {
+            "TraceRay" => return self.trace_ray(args, pos).map(|_| None),
+            "CallShader" => {
+                self.arity(name, args, 2, pos)?;
+                self.stage_check(
+                    name,
+                    &[
+                        Stage::RayGeneration,
+                        Stage::ClosestHit,
+                        Stage::Miss,
+                        Stage::Callable,
+                    ],
+                    pos,
+                )?;
+                let idx = self.expr(&args[0])?;
+                let idx = self.convert(idx, &Ty::Sc(Sc::Uint), args[0].pos, false)?;
+                let p = self.place(&args[1])?;
+                let t = p.ty().clone();
+                if !matches!(t, Ty::Struct(_)) {
+                    return Err(Error::new(args[1].pos, "callable data must be a struct"));
+                }
+                let var = self.rt_var(StorageClass::CallableDataKHR, &t)?;
+                let v = self.read(&p)?;
+                self.b.store(var, v.id, None, [])?;
+                self.inst(
+                    Op::ExecuteCallableKHR,
+                    None,
+                    vec![Operand::IdRef(idx.id), Operand::IdRef(var)],
+                )?;
+                let tid = self.ty_id(&t)?;
+                let back = self.b.load(tid, None, var, None, [])?;
+                self.write(&p, Val { id: back, ty: t }, args[1].pos)?;
+                return Ok(None);
+            }
+            "ReportHit" => {
+                self.arity(name, args, 3, pos)?;
+                self.stage_check(name, &[Stage::Intersection], pos)?;
+                let t = self.expr(&args[0])?;
+                let t = self.convert(t, &f, args[0].pos, false)?;
+                let k = self.expr(&args[1])?;
+                let k = self.convert(k, &Ty::Sc(Sc::Uint), args[1].pos, false)?;
+                let a = self.expr(&args[2])?;
+                if !matches!(a.ty, Ty::Struct(_)) {
+                    return Err(Error::new(args[2].pos, "hit attributes must be a struct"));
+                }
+                let var = self.rt_var(StorageClass::HitAttributeKHR, &a.ty)?;
+                self.b.store(var, a.id, None, [])?;
+                let bt = self.ty_id(&Ty::Sc(Sc::Bool))?;
+                let id = self.op(Op::ReportIntersectionKHR, bt, &[t.id, k.id])?;
+                return Ok(Some(Val {
+                    id,
+                    ty: Ty::Sc(Sc::Bool),
+                }));
+            }
+            "IgnoreHit" | "AcceptHitAndEndSearch" => {
+                self.arity(name, args, 0, pos)?;
+                self.stage_check(name, &[Stage::AnyHit], pos)?;
+                self.ray_tracing_caps();
+                if self.term {
+                    self.start_block(None)?;
+                }
+                if name == "IgnoreHit" {
+                    self.b.ignore_intersection_khr()?;
+                } else {
+                    self.b.terminate_ray_khr()?;
+                }
+                self.term = true;
+                return Ok(None);
+            }
+            "NonUniformResourceIndex" => {
+                self.arity(name, args, 1, pos)?;
+                let v = self.expr(&args[0])?;
+                self.cap(Capability::ShaderNonUniform);
+                self.ext("SPV_EXT_descriptor_indexing");
+                self.nonuniform.insert(v.id);
+                return Ok(Some(v));
+            }
+            "GroupMemoryBarrierWithGroupSync"
+            | "GroupMemoryBarrier"
+            | "AllMemoryBarrierWithGroupSync"
+            | "DeviceMemoryBarrierWithGroupSync"
+            | "AllMemoryBarrier"
+            | "DeviceMemoryBarrier" => {
+                self.arity(name, args, 0, pos)?;
+                let group = name.starts_with("Group");
+                let mem = self.const_u32(if group { 2 } else { 1 });
+                // AcquireRelease | WorkgroupMemory (| UniformMemory | ImageMemory).
+                let sem = self.const_u32(if group {
+                    0x108
+                } else {
+                    0x8 | 0x40 | 0x100 | 0x800
+                });
+                if name.ends_with("WithGroupSync") {
+                    let wg = self.const_u32(2);
+                    self.inst(
+                        Op::ControlBarrier,
+                        None,
+                        vec![Operand::IdRef(wg), Operand::IdRef(mem), Operand::IdRef(sem)],
+                    )?;
+                } else {
+                    self.inst(
+                        Op::MemoryBarrier,
+                        None,
+                        vec![Operand::IdRef(mem), Operand::IdRef(sem)],
+                    )?;
+                }
+                return Ok(None);
+            }
+            _ => {}
+        }
+        if name.starts_with("Interlocked") {
+            return self.interlocked(name, args, pos);
+        }
+        match name {
+            "sincos" => {
+                self.arity(name, args, 3, pos)?;
+                let x = self.expr(&args[0])?;
+                let (t, ids) = self.unify(vec![x], true, pos)?;
+                let sn = self.glsl(g::SIN, &t, &ids)?;
+                let cs = self.glsl(g::COS, &t, &ids)?;
+                self.store_out(&args[1], sn)?;
+                self.store_out(&args[2], cs)?;
+                return Ok(None);
+            }
+            "modf" => {
+                // modf(x, out ip): the integer part truncates toward zero.
+                self.arity(name, args, 2, pos)?;
+                let x = self.expr(&args[0])?;
+                let (t, ids) = self.unify(vec![x], true, pos)?;
+                let ip = self.glsl(g::TRUNC, &t, &ids)?;
+                let frac = self.binary(
+                    BinOp::Sub,
+                    Val {
+                        id: ids[0],
+                        ty: t.clone(),
+                    },
+                    ip.clone(),
+                    pos,
+                )?;
+                self.store_out(&args[1], ip)?;
+                return Ok(Some(frac));
+            }
+            "ldexp" => {
+                self.arity(name, args, 2, pos)?;
+                let vals = self.args(args)?;
+                let (t, ids) = self.unify(vals, true, pos)?;
+                let p = self.glsl(g::EXP2, &t, &ids[1..])?;
+                return self
+                    .binary(BinOp::Mul, Val { id: ids[0], ty: t }, p, pos)
+                    .map(Some);
+            }
+            _ => {}
+        }
+        let vals = match name {
+            "dot" | "cross" | "length" | "distance" | "reflect" | "refract" | "faceforward"
+            | "lerp" | "saturate" | "clamp" | "min" | "max" | "abs" | "sign" | "pow" | "atan2"
+            | "step" | "smoothstep" | "fmod" | "mul" | "transpose" | "determinant" | "any"
+            | "all" | "asuint" | "asint" | "asfloat" | "f32tof16" | "f16tof32" | "countbits"
+            | "firstbithigh" | "firstbitlow" | "reversebits" | "isnan" | "isinf" | "isfinite"
+            | "mad" | "fma" | "rcp" | "log10" => self.args(args)?,
+            "ddx" | "ddy" | "ddx_fine" | "ddy_fine" | "ddx_coarse" | "ddy_coarse" | "fwidth"
+            | "clip" => {
+                return Err(unsupported(pos, format!("`{name}` (pixel shaders only)"))
+                    .len(name.len() as u32));
+            }
+            _ if name.starts_with("Wave") || name.starts_with("Quad") => {
+                return Err(
+                    unsupported(pos, format!("wave intrinsic `{name}`")).len(name.len() as u32)
+                );
+            }
+            _ => {
+                return Err(
+                    Error::new(pos, format!("unknown function `{name}`")).len(name.len() as u32)
+                )
+            }
+        };
+        let want = match name {
+            "length" | "saturate" | "abs" | "sign" | "transpose" | "determinant" | "any"
+            | "all" | "asuint" | "asint" | "asfloat" | "f32tof16" | "f16tof32" | "countbits"
+            | "firstbithigh" | "firstbitlow" | "reversebits" | "isnan" | "isinf" | "isfinite"
+            | "rcp" | "log10" => 1,
+            "lerp" | "clamp" | "refract" | "faceforward" | "smoothstep" | "mad" | "fma" => 3,
+            _ => 2,
+        };
+        self.arity(name, args, want, pos)?;
+        self.intrinsic(name, vals, pos).map(Some)
+    }
+
+    fn intrinsic(&mut self, name: &str, vals: Vec<Val>, pos: Pos) -> Result<Val> {
+        let f = Ty::Sc(Sc::Float);
+        match name {
+            "dot" => {
+                let (t, ids) = self.unify(vals, false, pos)?;
+                let s = t.scalar().unwrap_or(Sc::Float);
+                let st = Ty::Sc(s);
+                if let Ty::Sc(_) = t {
+                    return self.binary(
+                        BinOp::Mul,
+                        Val {
+                            id: ids[0],
+                            ty: t.clone(),
+                        },
+                        Val { id: ids[1], ty: t },
+                        pos,
+                    );
+                }
+                if s == Sc::Float {
+                    let tid = self.ty_id(&st)?;
+                    let id = self.op(Op::Dot, tid, &ids)?;
+                    return Ok(Val { id, ty: st });
+                }
+                // Integer dot products: multiply, then add the components.
+                let prod = self.binary(
+                    BinOp::Mul,
+                    Val {
+                        id: ids[0],
+                        ty: t.clone(),
+                    },
+                    Val {
+                        id: ids[1],
+                        ty: t.clone(),
+                    },
+                    pos,
+                )?;
+                let mut parts = Vec::new();
+                self.flatten(prod, &mut parts)?;
+                let mut acc = parts[0].clone();
+                for p in &parts[1..] {
+                    acc = self.binary(BinOp::Add, acc, p.clone(), pos)?;
+                }
+                Ok(acc)
+            }
+            "cross" => {
+                let (t, ids) = self.unify(vals, true, pos)?;
+                if t != Ty::Vec(Sc::Float, 3) {
+                    return Err(Error::new(pos, "`cross` needs float3 arguments"));
+                }
+                self.glsl(g::CROSS, &t, &ids)
+            }
+            "length" => {
+                let (_, ids) = self.unify(vals, true, pos)?;
+                self.glsl(g::LENGTH, &f, &ids)
+            }
+            "distance" => {
+                let (_, ids) = self.unify(vals, true, pos)?;
+                self.glsl(g::DISTANCE, &f, &ids)
+            }
+            "reflect" => {
+                let (t, ids) = self.unify(vals, true, pos)?;
+                self.glsl(g::REFLECT, &t, &ids)
+            }
+            "faceforward" => {
+                let (t, ids) = self.unify(vals, true, pos)?;
+                self.glsl(g::FACE_FORWARD, &t, &ids)
+            }
+            "refract" => {
+                let mut vals = vals;
+                let eta = vals.pop().unwrap_or_else(|| unreachable!());
+                let eta = self.convert(eta, &f, pos, false)?;
+                let (t, mut ids) = self.unify(vals, true, pos)?;
+                ids.push(eta.id);
+                self.glsl(g::REFRACT, &t, &ids)
+            }
+            "lerp" | "smoothstep" | "fma" => {
+                let (t, ids) = self.unify(vals, true, pos)?;
+                let inst = match name {
+                    "lerp" => g::FMIX,
+                    "fma" => g::FMA,
+                    _ => g::SMOOTH_STEP,
+                };
+                self.glsl(inst, &t, &ids)
+            }
+            "mad" => {
+                let mut it = vals.into_iter();
+                let (a, b, c) = (
+                    it.next().unwrap_or_else(|| unreachable!()),
+                    it.next().unwrap_or_else(|| unreachable!()),
+                    it.next().unwrap_or_else(|| unreachable!()),
+                );
+                let ab = self.binary(BinOp::Mul, a, b, pos)?;
+                self.binary(BinOp::Add, ab, c, pos)
+            }
+            "saturate" => {
+                let (t, ids) = self.unify(vals, true, pos)?;
+                let zero = self.const_splat(&t, 0.0)?;
+                let one = self.const_splat(&t, 1.0)?;
+                self.glsl(g::FCLAMP, &t, &[ids[0], zero, one])
+            }
+            "clamp" | "min" | "max" => {
+                let (t, ids) = self.unify(vals, false, pos)?;
+                let s = t.scalar().unwrap_or(Sc::Float);
+                let inst = match (name, s) {
+                    ("clamp", Sc::Float) => g::FCLAMP,
+                    ("clamp", Sc::Int) => g::SCLAMP,
+                    ("clamp", _) => g::UCLAMP,
+                    ("min", Sc::Float) => g::FMIN,
+                    ("min", Sc::Int) => g::SMIN,
+                    ("min", _) => g::UMIN,
+                    (_, Sc::Float) => g::FMAX,
+                    (_, Sc::Int) => g::SMAX,
+                    _ => g::UMAX,
+                };
+                self.glsl(inst, &t, &ids)
+            }
+            "abs" => {
+                let (t, ids) = self.unify(vals, false, pos)?;
+                match t.scalar() {
+                    Some(Sc::Float) => self.glsl(g::FABS, &t, &ids),
+                    Some(Sc::Int) => self.glsl(g::SABS, &t, &ids),
+                    _ => Ok(Val { id: ids[0], ty: t }),
+                }
+            }
+            "sign" => {
+                // HLSL's sign returns int components.
+                let (t, ids) = self.unify(vals, false, pos)?;
+                let it = t.with_scalar(Sc::Int);
+                match t.scalar() {
+                    Some(Sc::Float) => {
+                        let v = self.glsl(g::FSIGN, &t, &ids)?;
+                        self.convert(v, &it, pos, true)
+                    }
+                    Some(Sc::Int) => self.glsl(g::SSIGN, &t, &ids),
+                    _ => {
+                        let v = Val {
+                            id: ids[0],
+                            ty: t.clone(),
+                        };
+                        let b = self.convert(v, &t.with_scalar(Sc::Bool), pos, true)?;
+                        self.convert(b, &it, pos, true)
+                    }
+                }
+            }
+            "pow" | "atan2" | "step" => {
+                let (t, ids) = self.unify(vals, true, pos)?;
+                let inst = match name {
+                    "pow" => g::POW,
+                    "atan2" => g::ATAN2,
+                    _ => g::STEP,
+                };
+                self.glsl(inst, &t, &ids)
+            }
+            "fmod" => {
+                let (t, ids) = self.unify(vals, true, pos)?;
+                self.binary(
+                    BinOp::Rem,
+                    Val {
+                        id: ids[0],
+                        ty: t.clone(),
+                    },
+                    Val { id: ids[1], ty: t },
+                    pos,
+                )
+            }
+            "rcp" => {
+                let (t, ids) = self.unify(vals, true, pos)?;
+                let one = Val {
+                    id: self.const_splat(&t, 1.0)?,
+                    ty: t.clone(),
+                };
+                self.binary(BinOp::Div, one, Val { id: ids[0], ty: t }, pos)
+            }
+            "log10" => {
+                let (t, ids) = self.unify(vals, true, pos)?;
+                let l = self.glsl(g::LOG2, &t, &ids)?;
+                let k = Val {
+                    id: self.const_splat(&t, std::f64::consts::LOG10_2)?,
+                    ty: t,
+                };
+                self.binary(BinOp::Mul, l, k, pos)
+            }
+            "mul" => self.mul(vals, pos),
+            "transpose" => {
+                let v = vals.into_iter().next().unwrap_or_else(|| unreachable!());
+                let Ty::Mat(s, r, c) = v.ty else {
+                    return Err(Error::new(pos, "`transpose` needs a matrix"));
+                };
+                let t = Ty::Mat(s, c, r);
+                let tid = self.ty_id(&t)?;
+                let id = self.op(Op::Transpose, tid, &[v.id])?;
+                Ok(Val { id, ty: t })
+            }
+            "determinant" => {
+                let v = vals.into_iter().next().unwrap_or_else(|| unreachable!());
+                match v.ty {
+                    Ty::Mat(_, r, c) if r == c => self.glsl(g::DETERMINANT, &f, &[v.id]),
+                    _ => Err(Error::new(pos, "`determinant` needs a square matrix")),
+                }
+            }
+            "any" | "all" => {
+                let v = vals.into_iter().next().unwrap_or_else(|| unreachable!());
+                let bt = Ty::Sc(Sc::Bool);
+                match v.ty.clone() {
+                    Ty::Sc(_) => self.convert(v, &bt, pos, false),
+                    Ty::Vec(_, n) => {
+                        let b = self.convert(v, &Ty::Vec(Sc::Bool, n), pos, false)?;
+                        let tid = self.ty_id(&bt)?;
+                        let id =
+                            self.op(if name == "any" { Op::Any } else { Op::All }, tid, &[b.id])?;
+                        Ok(Val { id, ty: bt })
+                    }
+                    other => Err(Error::new(
+                        pos,
+                        format!(
+                            "`{name}` needs a scalar or vector, found `{}`",
+                            self.ty_name(&other)
+                        ),
+                    )),
+                }
+            }
+            "asuint" | "asint" | "asfloat" => {
+                let v = vals.into_iter().next().unwrap_or_else(|| unreachable!());
+                let s = match name {
+                    "asuint" => Sc::Uint,
+                    "asint" => Sc::Int,
+                    _ => Sc::Float,
+                };
+                if !matches!(v.ty, Ty::Sc(_) | Ty::Vec(..)) || v.ty.scalar() == Some(Sc::Bool) {
+                    return Err(Error::new(
+                        pos,
+                        format!("`{name}` needs a 32-bit scalar or vector"),
+                    ));
+                }
+                let t = v.ty.with_scalar(s);
+                if t == v.ty {
+                    return Ok(v);
+                }
+                let tid = self.ty_id(&t)?;
+                let id = self.op(Op::Bitcast, tid, &[v.id])?;
+                Ok(Val { id, ty: t })
+            }
+            "f32tof16" | "f16tof32" => {
+                let v = vals.into_iter().next().unwrap_or_else(|| unreachable!());
+                let to_half = name == "f32tof16";
+                let src = v.ty.with_scalar(if to_half { Sc::Float } else { Sc::Uint });
+                let v = self.convert(v, &src, pos, false)?;
+                let mut comps = Vec::new();
+                self.flatten(v, &mut comps)?;
+                let mut out = Vec::new();
+                for c in comps {
+                    if to_half {
+                        let zero = self.const_f32(0.0);
+                        let v2 = self.ty_id(&Ty::Vec(Sc::Float, 2))?;
+                        let pair = self.op(Op::CompositeConstruct, v2, &[c.id, zero])?;
+                        out.push(self.glsl(g::PACK_HALF_2X16, &Ty::Sc(Sc::Uint), &[pair])?);
+                    } else {
+                        let pair =
+                            self.glsl(g::UNPACK_HALF_2X16, &Ty::Vec(Sc::Float, 2), &[c.id])?;
+                        let ft = self.ty_id(&f)?;
+                        let id = self.inst(
+                            Op::CompositeExtract,
+                            Some(ft),
+                            vec![Operand::IdRef(pair.id), Operand::LiteralBit32(0)],
+                        )?;
+                        out.push(Val { id, ty: f.clone() });
+                    }
+                }
+                let t = src.with_scalar(if to_half { Sc::Uint } else { Sc::Float });
+                if out.len() == 1 {
+                    return Ok(out.pop().unwrap_or_else(|| unreachable!()));
+                }
+                let mut it = out.into_iter();
+                self.build(&t, &mut it, pos)
+            }
+            "countbits" | "reversebits" | "firstbithigh" | "firstbitlow" => {
+                let v = vals.into_iter().next().unwrap_or_else(|| unreachable!());
+                let s = v.ty.scalar();
+                if !matches!(s, Some(Sc::Int | Sc::Uint)) || matches!(v.ty, Ty::Mat(..)) {
+                    return Err(Error::new(
+                        pos,
+                        format!("`{name}` needs an integer scalar or vector"),
+                    ));
+                }
+                let t = v.ty.clone();
+                let r = match name {
+                    "countbits" => {
+                        let tid = self.ty_id(&t)?;
+                        Val {
+                            id: self.op(Op::BitCount, tid, &[v.id])?,
+                            ty: t.clone(),
+                        }
+                    }
+                    "reversebits" => {
+                        let tid = self.ty_id(&t)?;
+                        Val {
+                            id: self.op(Op::BitReverse, tid, &[v.id])?,
+                            ty: t.clone(),
+                        }
+                    }
+                    "firstbithigh" => self.glsl(
+                        if s == Some(Sc::Int) {
+                            g::FIND_SMSB
+                        } else {
+                            g::FIND_UMSB
+                        },
+                        &t,
+                        &[v.id],
+                    )?,
+                    _ => self.glsl(g::FIND_ILSB, &t, &[v.id])?,
+                };
+                // HLSL returns uint components for all four.
+                self.convert(r, &t.with_scalar(Sc::Uint), pos, true)
+            }
+            "isnan" | "isinf" | "isfinite" => {
+                let (t, ids) = self.unify(vals, true, pos)?;
+                let bt = t.with_scalar(Sc::Bool);
+                let tid = self.ty_id(&bt)?;
+                if name == "isfinite" {
+                    let a = self.op(Op::IsNan, tid, &ids)?;
+                    let b = self.op(Op::IsInf, tid, &ids)?;
+                    let o = self.op(Op::LogicalOr, tid, &[a, b])?;
+                    let id = self.op(Op::LogicalNot, tid, &[o])?;
+                    return Ok(Val { id, ty: bt });
+                }
+                let id = self.op(
+                    if name == "isnan" {
+                        Op::IsNan
+                    } else {
+                        Op::IsInf
+                    },
+                    tid,
+                    &ids,
+                )?;
+                Ok(Val { id, ty: bt })
+            }
+            _ => Err(Error::new(pos, format!("unknown function `{name}`"))),
+        }
+    }
+
+    /// `mul` in all its shapes (see the matrix note in `types`).
+    fn mul(&mut self, vals: Vec<Val>, pos: Pos) -> Result<Val> {
+        let mut it = vals.into_iter();
+        let (a, b) = (
+            it.next().unwrap_or_else(|| unreachable!()),
+            it.next().unwrap_or_else(|| unreachable!()),
+        );
+        let (at, bt) = (a.ty.clone(), b.ty.clone());
+        match (&at, &bt) {
+            (Ty::Sc(_), _) | (_, Ty::Sc(_)) => self.binary(BinOp::Mul, a, b, pos),
+            (Ty::Vec(..), Ty::Vec(..)) => self.intrinsic("dot", vec![a, b], pos),
+            (Ty::Mat(_, r, c), Ty::Vec(_, n)) => {
+                if n != c {
+                    return Err(Error::new(
+                        pos,
+                        format!("`mul` of a {r}x{c} matrix needs a {c}-vector, found a {n}-vector"),
+                    ));
+                }
+                let (r, c) = (*r, *c);
+                let v = self.convert(b, &Ty::Vec(Sc::Float, c), pos, false)?;
+                let t = Ty::Vec(Sc::Float, r);
+                let tid = self.ty_id(&t)?;
+                let id = self.op(Op::VectorTimesMatrix, tid, &[v.id, a.id])?;
+                Ok(Val { id, ty: t })
+            }
+            (Ty::Vec(_, n), Ty::Mat(_, r, c)) => {
+                if n != r {
+                    return Err(Error::new(
+                        pos,
+                        format!(
+                            "`mul` of a {n}-vector needs a matrix with {n} rows, found {r}x{c}"
+                        ),
+                    ));
+                }
+                let c = *c;
+                let v = self.convert(a, &Ty::Vec(Sc::Float, *n), pos, false)?;
+                let t = Ty::Vec(Sc::Float, c);
+                let tid = self.ty_id(&t)?;
+                let id = self.op(Op::MatrixTimesVector, tid, &[b.id, v.id])?;
+                Ok(Val { id, ty: t })
+            }
+            (Ty::Mat(_, r, k), Ty::Mat(_, k2, c)) => {
+                if k != k2 {
+                    return Err(Error::new(
+                        pos,
+                        format!("`mul` of {r}x{k} and {k2}x{c} matrices"),
+                    ));
+                }
+                let t = Ty::Mat(Sc::Float, *r, *c);
+                let tid = self.ty_id(&t)?;
+                let id = self.op(Op::MatrixTimesMatrix, tid, &[b.id, a.id])?;
+                Ok(Val { id, ty: t })
+            }
+            _ => Err(Error::new(
+                pos,
+                format!(
+                    "`mul` of `{}` and `{}`",
+                    self.ty_name(&a.ty),
+                    self.ty_name(&b.ty)
+                ),
+            )),
+        }
+    }
+
+    fn interlocked(&mut self, name: &str, args: &'a [Expr], pos: Pos) -> Result<Option<Val>> {
+        let Some(first) = args.first() else {
+            return Err(Error::new(pos, format!("`{name}` needs a destination")));
+        };
+        let dest = self.place(first)?;
+        self.atomic(name, dest, first.pos, &args[1..], pos)
+    }
+
+    /// An atomic on `dest` (an int or uint in a buffer or groupshared memory);
+    /// `rest` are the operands after the destination, an `out` original last.
+    pub(super) fn atomic(
+        &mut self,
+        name: &str,
+        dest: Place,
+        dest_pos: Pos,
+        rest: &'a [Expr],
+        pos: Pos,
+    ) -> Result<Option<Val>> {
+        let bad = || {
+            Error::new(
+                dest_pos,
+                format!("`{name}` needs an int or uint in a buffer or groupshared memory"),
+            )
+        };
+        let Place::Ptr {
+            ptr,
+            ty: Ty::Sc(s @ (Sc::Int | Sc::Uint)),
+            class: class @ (StorageClass::StorageBuffer | StorageClass::Workgroup),
+            ..
+        } = dest
+        else {
+            return Err(bad());
+        };
+        let op = match (name.trim_start_matches("Interlocked"), s) {
+            ("Add", _) => Op::AtomicIAdd,
+            ("And", _) => Op::AtomicAnd,
+            ("Or", _) => Op::AtomicOr,
+            ("Xor", _) => Op::AtomicXor,
+            ("Exchange", _) => Op::AtomicExchange,
+            ("Min", Sc::Int) => Op::AtomicSMin,
+            ("Min", _) => Op::AtomicUMin,
+            ("Max", Sc::Int) => Op::AtomicSMax,
+            ("Max", _) => Op::AtomicUMax,
+            ("CompareExchange" | "CompareStore", _) => Op::AtomicCompareExchange,
+            _ => return Err(unsupported(pos, format!("`{name}`")).len(name.len() as u32)),
+        };
+        let cmp = op == Op::AtomicCompareExchange;
+        let (min, max) = match name {
+            "InterlockedCompareExchange" => (3, 3),
+            "InterlockedCompareStore" => (2, 2),
+            _ => (1, 2),
+        };
+        if rest.len() < min || rest.len() > max {
+            return Err(Error::new(
+                pos,
+                format!("`{name}` takes {} to {} arguments", min + 1, max + 1),
+            ));
+        }
+        let t = Ty::Sc(s);
+        let mut vals = Vec::new();
+        for e in &rest[..if cmp { 2 } else { 1 }] {
+            let v = self.expr(e)?;
+            vals.push(self.convert(v, &t, e.pos, false)?.id);
+        }
+        let scope = self.const_u32(if class == StorageClass::Workgroup {
+            2
+        } else {
+            1
+        });
+        let relaxed = self.const_u32(0);
+        let tid = self.ty_id(&t)?;
+        let old = if cmp {
+            // HLSL gives (compare, value); SPIR-V takes (value, comparator).
+            self.op(op, tid, &[ptr, scope, relaxed, relaxed, vals[1], vals[0]])?
+        } else {
+            self.op(op, tid, &[ptr, scope, relaxed, vals[0]])?
+        };
+        let out_at = if cmp { 2 } else { 1 };
+        if let Some(o) = rest.get(out_at) {
+            let p = self.place(o)?;
+            let ot = p.ty().clone();
+            let ov = self.convert(Val { id: old, ty: t }, &ot, o.pos, true)?;
+            self.write(&p, ov, o.pos)?;
+        }
+        Ok(None)
+    }
+
+    fn trace_ray(&mut self, args: &'a [Expr], pos: Pos) -> Result<()> {
+        self.arity("TraceRay", args, 8, pos)?;
+        self.stage_check("TraceRay", RG_CH_MISS, pos)?;
+        let accel = self.expr(&args[0])?;
+        if accel.ty != Ty::Accel {
+            return Err(Error::new(
+                args[0].pos,
+                "TraceRay's first argument must be a RaytracingAccelerationStructure",
+            ));
+        }
+        let at = self.ty_id(&Ty::Accel)?;
+        let mut ids = Vec::new();
+        for a in &args[1..6] {
+            let v = self.expr(a)?;
+            ids.push(self.convert(v, &Ty::Sc(Sc::Uint), a.pos, false)?.id);
+        }
+        let ray = self.expr_as(&args[6], &Ty::Struct(RAY_DESC))?;
+        let mut parts = Vec::new();
+        for (i, t) in [
+            Ty::Vec(Sc::Float, 3),
+            Ty::Sc(Sc::Float),
+            Ty::Vec(Sc::Float, 3),
+            Ty::Sc(Sc::Float),
+        ]
+        .iter()
+        .enumerate()
+        {
+            let tid = self.ty_id(t)?;
+            parts.push(self.inst(
+                Op::CompositeExtract,
+                Some(tid),
+                vec![Operand::IdRef(ray.id), Operand::LiteralBit32(i as u32)],
+            )?);
+        }
+        let p = self.place(&args[7])?;
+        let t = p.ty().clone();
+        if !matches!(t, Ty::Struct(_)) {
+            return Err(Error::new(args[7].pos, "the ray payload must be a struct"));
+        }
+        let var = self.rt_var(StorageClass::RayPayloadKHR, &t)?;
+        let v = self.read(&p)?;
+        self.b.store(var, v.id, None, [])?;
+        let a = self.b.load(at, None, accel.id, None, [])?;
+        self.line(pos);
+        self.b.trace_ray_khr(
+            a, ids[0], ids[1], ids[2], ids[3], ids[4], parts[0], parts[1], parts[2], parts[3], var,
+        )?;
+        let tid = self.ty_id(&t)?;
+        let back = self.b.load(tid, None, var, None, [])?;
+        self.write(&p, Val { id: back, ty: t }, args[7].pos)
+    }
+
+    pub(super) fn call_user(
+        &mut self,
+        name: &str,
+        cands: Vec<usize>,
+        args: Vec<Arg<'a>>,
+        pos: Pos,
+    ) -> Result<Option<Val>> {
+        let cands: Vec<usize> = cands
+            .into_iter()
+            .filter(|k| self.funcs[*k].params.len() == args.len())
+            .collect();
+        if cands.is_empty() {
+            return Err(Error::new(
+                pos,
+                format!("no overload of `{name}` takes {} argument(s)", args.len()),
+            )
+            .len(name.len() as u32));
+        }
+        // Arguments for `out` parameters are places; the rest are values.
+        let mut argv: Vec<(Option<Place>, Val)> = Vec::new();
+        for (i, a) in args.iter().enumerate() {
+            let is_out = cands.iter().any(|k| self.funcs[*k].params[i].out);
+            if let Arg::Place(p, _) = a {
+                let v = Val {
+                    id: 0,
+                    ty: p.ty().clone(),
+                };
+                argv.push((Some(p.clone()), v));
+                continue;
+            }
+            let Arg::Expr(a) = *a else { unreachable!() };
+            if is_out {
+                let p = self.place(a)?;
+                if matches!(p, Place::Value(_)) {
+                    return Err(Error::new(a.pos, "an `out` argument must be assignable"));
+                }
+                let v = Val {
+                    id: 0,
+                    ty: p.ty().clone(),
+                };
+                argv.push((Some(p), v));
+            } else {
+                let v = self.expr(a)?;
+                argv.push((None, v));
+            }
+        }
+        let cost = |from: &Ty, to: &Ty| -> Option<u32> {
+            if from == to {
+                return Some(0);
+            }
+            match (from, to) {
+                (Ty::Sc(_), Ty::Sc(_)) => Some(1),
+                (Ty::Vec(_, n), Ty::Vec(_, m)) if n == m => Some(1),
+                (Ty::Sc(_), Ty::Vec(..) | Ty::Mat(..)) => Some(2),
+                (Ty::Vec(_, n), Ty::Vec(_, m)) if m < n => Some(3),
+                (Ty::Vec(..), Ty::Sc(_)) => Some(3),
+                _ => None,
+            }
+        };
+        let mut best: Option<(u32, usize)> = None;
+        for &k in &cands {
+            let mut total = 0;
+            let mut ok = true;
+            for (p, (_, v)) in self.funcs[k].params.iter().zip(&argv) {
+                match cost(&v.ty, &p.ty) {
+                    Some(c) => total += c,
+                    None => ok = false,
+                }
+            }
+            if ok && best.is_none_or(|(c, _)| total < c) {
+                best = Some((total, k));
+            }
+        }
+        let Some((_, k)) = best else {
+            let tys: Vec<String> = argv.iter().map(|(_, v)| self.ty_name(&v.ty)).collect();
+            return Err(Error::new(
+                pos,
+                format!("no overload of `{name}` takes ({})", tys.join(", ")),
+            )
+            .len(name.len() as u32));
+        };
+        let sig = self.funcs[k].clone();
+        if sig.stage.is_some() {
+            return Err(unsupported(pos, "calling an entry point function"));
+        }
+        let mut temps = Vec::new();
+        for ((p, (place, v)), a) in sig.params.iter().zip(&argv).zip(&args) {
+            let tmp = self.local_var(&p.ty, "")?;
+            if p.input {
+                let val = match place {
+                    Some(pl) => self.read(pl)?,
+                    None => v.clone(),
+                };
+                let val = self.convert(val, &p.ty, a.pos(), false)?;
+                self.b.store(tmp, val.id, None, [])?;
+            }
+            temps.push(tmp);
+        }
+        let rt = self.ty_id(&sig.ret)?;
+        if self.term {
+            self.start_block(None)?;
+        }
+        let id = self.b.function_call(rt, None, sig.id, temps.clone())?;
+        self.fn_calls.entry(self.cur_fn).or_default().insert(k);
+        if !self.lowered.contains(&k) && !self.pending.contains(&k) {
+            self.pending.push(k);
+        }
+        for ((p, (place, _)), (tmp, a)) in sig.params.iter().zip(&argv).zip(temps.iter().zip(&args))
+        {
+            if p.out {
+                let tid = self.ty_id(&p.ty)?;
+                let back = self.b.load(tid, None, *tmp, None, [])?;
+                let pl = place.as_ref().unwrap_or_else(|| unreachable!());
+                let want = pl.ty().clone();
+                let v = self.convert(
+                    Val {
+                        id: back,
+                        ty: p.ty.clone(),
+                    },
+                    &want,
+                    a.pos(),
+                    true,
+                )?;
+                self.write(pl, v, a.pos())?;
+            }
+        }
+        Ok(if sig.ret == Ty::Void {
+            None
+        } else {
+            Some(Val { id, ty: sig.ret })
+        })
+    }
+}

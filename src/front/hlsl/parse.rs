@@ -1,0 +1,1343 @@
+//! Parser: preprocessed tokens → [`ast::Item`]s.
+//!
+//! HLSL, like C, needs to know which names are types (`(T)x` is a cast, `T x;`
+//! a declaration), so the parser records struct, typedef and enum names as it
+//! meets them.
+
+use super::ast::*;
+use super::error::{Error, Pos, Result};
+use super::lex::{Tok, Token};
+use std::collections::HashSet;
+
+pub struct Parser<'t> {
+    t: &'t [Token],
+    i: usize,
+    types: HashSet<String>,
+    ns: Vec<String>,
+    depth: usize,
+}
+
+/// Nesting limit: deep enough for any real shader, shallow enough that a
+/// fuzzer's `((((...` cannot overflow the stack.
+const MAX_DEPTH: usize = 96;
+
+/// What may follow a declarator: a semantic and a register binding.
+type PostDecl = (Option<(String, Pos)>, Option<Register>);
+
+const SCALARS: &[&str] = &[
+    "bool",
+    "int",
+    "uint",
+    "dword",
+    "float",
+    "half",
+    "double",
+    "min16float",
+    "min10float",
+    "min16int",
+    "min12int",
+    "min16uint",
+    "int16_t",
+    "uint16_t",
+    "int32_t",
+    "uint32_t",
+    "int64_t",
+    "uint64_t",
+    "float16_t",
+    "float32_t",
+    "float64_t",
+];
+
+pub const TEMPLATE_TYPES: &[&str] = &[
+    "vector",
+    "matrix",
+    "RayQuery",
+    "StructuredBuffer",
+    "RWStructuredBuffer",
+    "ConstantBuffer",
+    "Texture1D",
+    "Texture2D",
+    "Texture3D",
+    "TextureCube",
+    "Texture2DArray",
+    "RWTexture1D",
+    "RWTexture2D",
+    "RWTexture3D",
+    "RWTexture2DArray",
+    "Buffer",
+    "RWBuffer",
+    "AppendStructuredBuffer",
+    "ConsumeStructuredBuffer",
+    "Texture2DMS",
+];
+
+const PLAIN_TYPES: &[&str] = &[
+    "void",
+    "RayDesc",
+    "BuiltInTriangleIntersectionAttributes",
+    "RaytracingAccelerationStructure",
+    "SamplerState",
+    "SamplerComparisonState",
+    "ByteAddressBuffer",
+    "RWByteAddressBuffer",
+    "string",
+    "HitObject",
+];
+
+/// Splits `float3x4` into (`float`, 3, 4); `float3` gives (`float`, 3, 0).
+pub fn split_numeric(name: &str) -> Option<(&'static str, u8, u8)> {
+    for s in SCALARS {
+        if let Some(rest) = name.strip_prefix(s) {
+            let b = rest.as_bytes();
+            let dim = |c: u8| (b'1'..=b'4').contains(&c).then_some(c - b'0');
+            return match b.len() {
+                0 => Some((s, 0, 0)),
+                1 => Some((s, dim(b[0])?, 0)),
+                3 if b[1] == b'x' => Some((s, dim(b[0])?, dim(b[2])?)),
+                _ => continue,
+            };
+        }
+    }
+    None
+}
+
+pub fn is_builtin_type(name: &str) -> bool {
+    split_numeric(name).is_some() || TEMPLATE_TYPES.contains(&name) || PLAIN_TYPES.contains(&name)
+}
+
+pub fn parse(tokens: &[Token]) -> Result<Vec<Item>> {
+    let mut p = Parser {
+        t: tokens,
+        i: 0,
+        types: HashSet::new(),
+        ns: Vec::new(),
+        depth: 0,
+    };
+    let mut items = Vec::new();
+    while p.i < p.t.len() {
+        p.item(&mut items)?;
+    }
+    Ok(items)
+}
+
+impl<'t> Parser<'t> {
+    fn peek(&self) -> Option<&'t Token> {
+        self.t.get(self.i)
+    }
+    fn peek_at(&self, k: usize) -> Option<&'t Token> {
+        self.t.get(self.i + k)
+    }
+    fn is(&self, p: &str) -> bool {
+        self.peek().is_some_and(|t| t.is(p))
+    }
+    fn is_at(&self, k: usize, p: &str) -> bool {
+        self.peek_at(k).is_some_and(|t| t.is(p))
+    }
+    fn is_kw(&self, k: &str) -> bool {
+        self.peek().and_then(Token::ident) == Some(k)
+    }
+    fn pos(&self) -> Pos {
+        self.peek()
+            .or_else(|| self.t.last())
+            .map(|t| t.pos)
+            .unwrap_or_default()
+    }
+    fn eat(&mut self, p: &str) -> bool {
+        if self.is(p) || self.is_kw(p) {
+            self.i += 1;
+            true
+        } else {
+            false
+        }
+    }
+    fn unexpected(&self, what: &str) -> Error {
+        match self.peek() {
+            Some(t) => {
+                let s = t.spelling();
+                Error::new(t.pos, format!("expected {what}, found `{s}`")).len(s.len() as u32)
+            }
+            None => Error::new(self.pos(), format!("expected {what}, found end of file")),
+        }
+    }
+    fn expect(&mut self, p: &str) -> Result<Pos> {
+        let pos = self.pos();
+        if self.eat(p) {
+            Ok(pos)
+        } else {
+            Err(self.unexpected(&format!("`{p}`")))
+        }
+    }
+    fn ident(&mut self) -> Result<(String, Pos)> {
+        match self.peek() {
+            Some(t) if t.ident().is_some() => {
+                self.i += 1;
+                let mut name = t.ident().unwrap_or_default().to_string();
+                // `a::b::c` reads as one qualified name.
+                while self.is("::") && self.peek_at(1).and_then(Token::ident).is_some() {
+                    name.push_str("::");
+                    name.push_str(self.peek_at(1).and_then(Token::ident).unwrap_or_default());
+                    self.i += 2;
+                }
+                Ok((name, t.pos))
+            }
+            _ => Err(self.unexpected("a name")),
+        }
+    }
+    fn enter(&mut self) -> Result<()> {
+        self.depth += 1;
+        if self.depth > MAX_DEPTH {
+            return Err(Error::new(self.pos(), "nesting too deep"));
+        }
+        Ok(())
+    }
+
+    /// Whether the identifier at `k` names a type.
+    fn type_at(&self, k: usize) -> bool {
+        let Some(name) = self.peek_at(k).and_then(Token::ident) else {
+            return false;
+        };
+        if is_builtin_type(name) || self.types.contains(name) {
+            return true;
+        }
+        // A qualified name whose last part is a known type.
+        let mut full = name.to_string();
+        let mut j = k + 1;
+        while self.is_at(j, "::") {
+            let Some(n) = self.peek_at(j + 1).and_then(Token::ident) else {
+                break;
+            };
+            full.push_str("::");
+            full.push_str(n);
+            j += 2;
+        }
+        self.types.contains(&full) || self.ns_qualified(&full).is_some()
+    }
+
+    fn ns_qualified(&self, name: &str) -> Option<String> {
+        let mut prefix = self.ns.join("::");
+        loop {
+            if prefix.is_empty() {
+                return None;
+            }
+            let q = format!("{prefix}::{name}");
+            if self.types.contains(&q) {
+                return Some(q);
+            }
+            match prefix.rfind("::") {
+                Some(k) => prefix.truncate(k),
+                None => prefix.clear(),
+            }
+        }
+    }
+
+    fn declare_type(&mut self, name: &str) {
+        let q = self.qualify(name);
+        self.types.insert(q);
+    }
+
+    fn qualify(&self, name: &str) -> String {
+        if self.ns.is_empty() {
+            name.to_string()
+        } else {
+            format!("{}::{name}", self.ns.join("::"))
+        }
+    }
+
+    fn type_ref(&mut self) -> Result<TypeRef> {
+        let (mut name, pos) = self.ident()?;
+        if !is_builtin_type(&name) && !self.types.contains(&name) {
+            if let Some(q) = self.ns_qualified(&name) {
+                name = q;
+            }
+        }
+        let mut args = Vec::new();
+        if TEMPLATE_TYPES.contains(&name.as_str()) && self.is("<") {
+            self.i += 1;
+            loop {
+                if self.type_at(0) {
+                    args.push(TArg::Type(self.type_ref()?));
+                } else {
+                    args.push(TArg::Expr(self.binary(0, true)?));
+                }
+                if self.eat(",") {
+                    continue;
+                }
+                // `>>` closing two template lists is not split here: `vector<vector<...>>` is not HLSL.
+                self.expect(">")?;
+                break;
+            }
+        }
+        Ok(TypeRef { name, args, pos })
+    }
+
+    fn attrs(&mut self) -> Result<Vec<Attr>> {
+        let mut out = Vec::new();
+        while self.is("[") {
+            let double = self.is_at(1, "[");
+            self.i += if double { 2 } else { 1 };
+            loop {
+                let (name, pos) = self.ident()?;
+                let mut args = Vec::new();
+                if self.eat("(") {
+                    if !self.is(")") {
+                        loop {
+                            args.push(self.assign()?);
+                            if !self.eat(",") {
+                                break;
+                            }
+                        }
+                    }
+                    self.expect(")")?;
+                }
+                out.push(Attr { name, args, pos });
+                if !self.eat(",") {
+                    break;
+                }
+            }
+            self.expect("]")?;
+            if double {
+                self.expect("]")?;
+            }
+        }
+        Ok(out)
+    }
+
+    fn mods(&mut self) -> Mods {
+        let mut m = Mods::default();
+        loop {
+            match self.peek().and_then(Token::ident) {
+                Some("static") => m.is_static = true,
+                Some("const") => m.is_const = true,
+                Some("groupshared") => m.groupshared = true,
+                Some("uniform") => m.uniform = true,
+                Some("in") => m.input = true,
+                Some("out") => m.output = true,
+                Some("inout") => {
+                    m.input = true;
+                    m.output = true
+                }
+                Some("row_major") => m.row_major = true,
+                Some("column_major") => m.column_major = true,
+                Some("precise") => m.precise = true,
+                Some("nointerpolation") => m.nointerp = true,
+                Some(
+                    "inline" | "extern" | "volatile" | "linear" | "snorm" | "unorm"
+                    | "globallycoherent",
+                ) => {}
+                _ => return m,
+            }
+            self.i += 1;
+        }
+    }
+
+    fn item(&mut self, items: &mut Vec<Item>) -> Result<()> {
+        if self.eat(";") {
+            return Ok(());
+        }
+        let attrs = self.attrs()?;
+        if self.is_kw("namespace") {
+            self.i += 1;
+            let (name, _) = self.ident()?;
+            self.expect("{")?;
+            self.ns.push(name);
+            while !self.is("}") {
+                if self.peek().is_none() {
+                    return Err(self.unexpected("`}`"));
+                }
+                self.item(items)?;
+            }
+            self.i += 1;
+            self.ns.pop();
+            return Ok(());
+        }
+        if self.is_kw("struct")
+            && (self.peek_at(2).is_some_and(|t| t.is("{")) || self.is_at(1, "["))
+        {
+            let s = self.struct_decl()?;
+            self.expect(";")?;
+            items.push(Item::Struct(s));
+            return Ok(());
+        }
+        if self.is_kw("typedef") {
+            self.i += 1;
+            let _ = self.mods();
+            let ty = self.type_ref()?;
+            let (name, pos) = self.ident()?;
+            let dims = self.dims()?;
+            self.expect(";")?;
+            self.declare_type(&name);
+            items.push(Item::Typedef {
+                ty,
+                dims,
+                name: self.qualify(&name),
+                pos,
+            });
+            return Ok(());
+        }
+        if self.is_kw("enum") {
+            self.i += 1;
+            let scoped = self.eat("class") || self.eat("struct");
+            let (name, pos) = self.ident()?;
+            let underlying = if self.eat(":") {
+                Some(self.type_ref()?)
+            } else {
+                None
+            };
+            self.expect("{")?;
+            let mut variants = Vec::new();
+            while !self.is("}") {
+                let (v, vp) = self.ident()?;
+                let value = if self.eat("=") {
+                    Some(self.ternary()?)
+                } else {
+                    None
+                };
+                variants.push((v, vp, value));
+                if !self.eat(",") {
+                    break;
+                }
+            }
+            self.expect("}")?;
+            self.expect(";")?;
+            self.declare_type(&name);
+            items.push(Item::Enum {
+                name: self.qualify(&name),
+                scoped,
+                underlying,
+                variants,
+                pos,
+            });
+            return Ok(());
+        }
+        if self.is_kw("cbuffer") || self.is_kw("tbuffer") {
+            let kw_pos = self.pos();
+            if self.is_kw("tbuffer") {
+                return Err(Error::new(kw_pos, "not supported: tbuffer").len(7));
+            }
+            self.i += 1;
+            let (name, pos) = self.ident()?;
+            let (_, register) = self.post_decl()?;
+            self.expect("{")?;
+            let mut members = Vec::new();
+            while !self.is("}") {
+                if self.peek().is_none() {
+                    return Err(self.unexpected("`}`"));
+                }
+                let mattrs = self.attrs()?;
+                let mods = self.mods();
+                let ty = self.type_ref()?;
+                self.declarators(mattrs, mods, ty, &mut members)?;
+            }
+            self.i += 1;
+            self.eat(";");
+            items.push(Item::CBuffer {
+                attrs,
+                name,
+                pos,
+                register,
+                members,
+            });
+            return Ok(());
+        }
+        let mods = self.mods();
+        if self.is_kw("struct") {
+            // `struct S { ... } s;` or `struct S s;`: not worth supporting.
+            return Err(Error::new(
+                self.pos(),
+                "not supported: struct declared inside a declaration",
+            )
+            .len(6));
+        }
+        if self.is_kw("template") {
+            return Err(Error::new(self.pos(), "not supported: templates").len(8));
+        }
+        if !self.type_at(0) {
+            return Err(self.unexpected("a declaration"));
+        }
+        let ty = self.type_ref()?;
+        // Function: type name `(`.
+        if self.peek().and_then(Token::ident).is_some() && {
+            let mut k = 1;
+            while self.is_at(k, "::") {
+                k += 2;
+            }
+            self.is_at(k, "(")
+        } {
+            let (name, pos) = self.ident()?;
+            if name.contains("::") {
+                return Err(Error::new(
+                    pos,
+                    "not supported: out-of-line member definition",
+                ));
+            }
+            let f = self.function(attrs, ty, name, pos)?;
+            items.push(Item::Function(f));
+            return Ok(());
+        }
+        let mut vars = Vec::new();
+        self.declarators(attrs, mods, ty, &mut vars)?;
+        items.extend(vars.into_iter().map(|mut v| {
+            v.name = self.qualify(&v.name);
+            Item::Var(v)
+        }));
+        Ok(())
+    }
+
+    fn struct_decl(&mut self) -> Result<StructDecl> {
+        self.expect("struct")?;
+        let _ = self.attrs()?; // `[raypayload]`
+        let (name, pos) = self.ident()?;
+        self.declare_type(&name);
+        if self.eat(":") {
+            return Err(Error::new(self.pos(), "not supported: struct inheritance"));
+        }
+        self.expect("{")?;
+        let mut fields = Vec::new();
+        let mut methods = Vec::new();
+        while !self.is("}") {
+            if self.peek().is_none() {
+                return Err(self.unexpected("`}`"));
+            }
+            let fattrs = self.attrs()?;
+            let mods = self.mods();
+            if self.is_kw("struct") {
+                return Err(Error::new(self.pos(), "not supported: nested struct").len(6));
+            }
+            let ty = self.type_ref()?;
+            if self.peek().and_then(Token::ident).is_some() && self.is_at(1, "(") {
+                if mods.is_static {
+                    return Err(Error::new(
+                        self.pos(),
+                        "not supported: static struct methods",
+                    ));
+                }
+                let (mname, mpos) = self.ident()?;
+                let mut f = self.function(fattrs, ty, mname.clone(), mpos)?;
+                if f.body.is_none() {
+                    return Err(Error::new(
+                        mpos,
+                        "not supported: struct method declared without a body",
+                    ));
+                }
+                f.name = mname;
+                methods.push(f);
+                continue;
+            }
+            self.declarators(fattrs, mods, ty, &mut fields)?;
+        }
+        self.i += 1;
+        Ok(StructDecl {
+            name: self.qualify(&name),
+            pos,
+            fields,
+            methods,
+        })
+    }
+
+    fn dims(&mut self) -> Result<Vec<Option<Expr>>> {
+        let mut dims = Vec::new();
+        while self.eat("[") {
+            if self.eat("]") {
+                dims.push(None);
+            } else {
+                dims.push(Some(self.ternary()?));
+                self.expect("]")?;
+            }
+        }
+        Ok(dims)
+    }
+
+    /// `: SEMANTIC`, `: register(...)`, payload access qualifiers; in any order.
+    fn post_decl(&mut self) -> Result<PostDecl> {
+        let mut semantic = None;
+        let mut register = None;
+        while self.eat(":") {
+            let (name, pos) = self.ident()?;
+            match name.as_str() {
+                "register" => {
+                    self.expect("(")?;
+                    let (r, rpos) = self.ident()?;
+                    let mut chars = r.chars();
+                    let class = chars.next().unwrap_or('?').to_ascii_lowercase();
+                    let index = chars
+                        .as_str()
+                        .parse::<u32>()
+                        .map_err(|_| Error::new(rpos, format!("malformed register `{r}`")))?;
+                    let mut space = 0;
+                    if self.eat(",") {
+                        let (s, spos) = self.ident()?;
+                        space = s
+                            .strip_prefix("space")
+                            .and_then(|n| n.parse().ok())
+                            .ok_or_else(|| {
+                                Error::new(spos, format!("malformed register space `{s}`"))
+                            })?;
+                    }
+                    self.expect(")")?;
+                    register = Some(Register {
+                        class,
+                        index,
+                        space,
+                        pos,
+                    });
+                }
+                "packoffset" => {
+                    return Err(Error::new(pos, "not supported: packoffset").len(10));
+                }
+                "read" | "write" => {
+                    // Payload access qualifiers: checked by DXC, no effect on SPIR-V.
+                    self.expect("(")?;
+                    while !self.eat(")") {
+                        if self.peek().is_none() {
+                            return Err(self.unexpected("`)`"));
+                        }
+                        self.i += 1;
+                    }
+                }
+                _ => semantic = Some((name, pos)),
+            }
+        }
+        Ok((semantic, register))
+    }
+
+    fn declarators(
+        &mut self,
+        attrs: Vec<Attr>,
+        mods: Mods,
+        ty: TypeRef,
+        out: &mut Vec<VarDecl>,
+    ) -> Result<()> {
+        loop {
+            let (name, pos) = self.ident()?;
+            let dims = self.dims()?;
+            let (semantic, register) = self.post_decl()?;
+            let init = if self.eat("=") {
+                Some(self.initializer()?)
+            } else {
+                None
+            };
+            out.push(VarDecl {
+                attrs: attrs.clone(),
+                mods,
+                ty: ty.clone(),
+                name,
+                pos,
+                dims,
+                semantic,
+                register,
+                init,
+            });
+            if !self.eat(",") {
+                break;
+            }
+        }
+        self.expect(";")?;
+        Ok(())
+    }
+
+    fn initializer(&mut self) -> Result<Expr> {
+        if self.is("{") {
+            let pos = self.pos();
+            self.enter()?;
+            self.i += 1;
+            let mut elems = Vec::new();
+            while !self.is("}") {
+                elems.push(self.initializer()?);
+                if !self.eat(",") {
+                    break;
+                }
+            }
+            self.expect("}")?;
+            self.depth -= 1;
+            return Ok(Expr {
+                kind: ExprKind::InitList(elems),
+                pos,
+            });
+        }
+        self.assign()
+    }
+
+    fn function(
+        &mut self,
+        attrs: Vec<Attr>,
+        ret: TypeRef,
+        name: String,
+        pos: Pos,
+    ) -> Result<Function> {
+        self.expect("(")?;
+        let mut params = Vec::new();
+        if !(self.is(")") || self.is_kw("void") && self.is_at(1, ")")) {
+            loop {
+                let pattrs = self.attrs()?;
+                let mods = self.mods();
+                if !self.type_at(0) {
+                    return Err(self.unexpected("a parameter type"));
+                }
+                let ty = self.type_ref()?;
+                let (pname, ppos) = self.ident()?;
+                let dims = self.dims()?;
+                let (semantic, register) = self.post_decl()?;
+                let init = if self.eat("=") {
+                    return Err(Error::new(
+                        self.pos(),
+                        "not supported: default parameter values",
+                    ));
+                } else {
+                    None
+                };
+                params.push(VarDecl {
+                    attrs: pattrs,
+                    mods,
+                    ty,
+                    name: pname,
+                    pos: ppos,
+                    dims,
+                    semantic,
+                    register,
+                    init,
+                });
+                if !self.eat(",") {
+                    break;
+                }
+            }
+        } else if self.is_kw("void") {
+            self.i += 1;
+        }
+        self.expect(")")?;
+        let (semantic, _) = self.post_decl()?;
+        let body = if self.eat(";") {
+            None
+        } else {
+            Some(self.block()?)
+        };
+        Ok(Function {
+            attrs,
+            ret,
+            name: self.qualify(&name),
+            ns: if self.ns.is_empty() {
+                String::new()
+            } else {
+                format!("{}::", self.ns.join("::"))
+            },
+            pos,
+            params,
+            semantic,
+            body,
+        })
+    }
+
+    fn block(&mut self) -> Result<Vec<Stmt>> {
+        self.expect("{")?;
+        let mut out = Vec::new();
+        while !self.is("}") {
+            if self.peek().is_none() {
+                return Err(self.unexpected("`}`"));
+            }
+            out.push(self.stmt()?);
+        }
+        self.i += 1;
+        Ok(out)
+    }
+
+    fn stmt(&mut self) -> Result<Stmt> {
+        self.enter()?;
+        let s = self.stmt_inner();
+        self.depth -= 1;
+        s
+    }
+
+    fn stmt_inner(&mut self) -> Result<Stmt> {
+        let _ = self.attrs()?; // [unroll], [loop], [branch], [flatten]: hints only
+        let pos = self.pos();
+        let kind = match self.peek().map(|t| &t.tok) {
+            None => return Err(self.unexpected("a statement")),
+            Some(Tok::Punct("{")) => StmtKind::Block(self.block()?),
+            Some(Tok::Punct(";")) => {
+                self.i += 1;
+                StmtKind::Empty
+            }
+            Some(Tok::Ident(k)) => match &**k {
+                "if" => {
+                    self.i += 1;
+                    self.expect("(")?;
+                    let c = self.expr()?;
+                    self.expect(")")?;
+                    let then = Box::new(self.stmt()?);
+                    let els = if self.eat("else") {
+                        Some(Box::new(self.stmt()?))
+                    } else {
+                        None
+                    };
+                    StmtKind::If(c, then, els)
+                }
+                "for" => {
+                    self.i += 1;
+                    self.expect("(")?;
+                    let init = if self.eat(";") {
+                        None
+                    } else {
+                        Some(Box::new(self.simple_stmt()?))
+                    };
+                    let cond = if self.is(";") {
+                        None
+                    } else {
+                        Some(self.expr()?)
+                    };
+                    self.expect(";")?;
+                    let step = if self.is(")") {
+                        None
+                    } else {
+                        Some(self.expr()?)
+                    };
+                    self.expect(")")?;
+                    StmtKind::For(init, cond, step, Box::new(self.stmt()?))
+                }
+                "while" => {
+                    self.i += 1;
+                    self.expect("(")?;
+                    let c = self.expr()?;
+                    self.expect(")")?;
+                    StmtKind::While(c, Box::new(self.stmt()?))
+                }
+                "do" => {
+                    self.i += 1;
+                    let body = Box::new(self.stmt()?);
+                    self.expect("while")?;
+                    self.expect("(")?;
+                    let c = self.expr()?;
+                    self.expect(")")?;
+                    self.expect(";")?;
+                    StmtKind::DoWhile(body, c)
+                }
+                "switch" => {
+                    self.i += 1;
+                    self.expect("(")?;
+                    let e = self.expr()?;
+                    self.expect(")")?;
+                    self.expect("{")?;
+                    let mut cases: Vec<Case> = Vec::new();
+                    while !self.eat("}") {
+                        let cpos = self.pos();
+                        let mut labels = Vec::new();
+                        loop {
+                            if self.eat("case") {
+                                labels.push(Some(self.ternary()?));
+                                self.expect(":")?;
+                            } else if self.eat("default") {
+                                labels.push(None);
+                                self.expect(":")?;
+                            } else {
+                                break;
+                            }
+                        }
+                        if labels.is_empty() {
+                            return Err(self.unexpected("`case` or `default`"));
+                        }
+                        let mut body = Vec::new();
+                        while !self.is_kw("case") && !self.is_kw("default") && !self.is("}") {
+                            if self.peek().is_none() {
+                                return Err(self.unexpected("`}`"));
+                            }
+                            body.push(self.stmt()?);
+                        }
+                        cases.push(Case {
+                            labels,
+                            body,
+                            pos: cpos,
+                        });
+                    }
+                    StmtKind::Switch(e, cases)
+                }
+                "break" => {
+                    self.i += 1;
+                    self.expect(";")?;
+                    StmtKind::Break
+                }
+                "continue" => {
+                    self.i += 1;
+                    self.expect(";")?;
+                    StmtKind::Continue
+                }
+                "discard" => {
+                    self.i += 1;
+                    self.expect(";")?;
+                    StmtKind::Discard
+                }
+                "return" => {
+                    self.i += 1;
+                    let v = if self.is(";") {
+                        None
+                    } else {
+                        Some(self.expr()?)
+                    };
+                    self.expect(";")?;
+                    StmtKind::Return(v)
+                }
+                _ => return self.simple_stmt(),
+            },
+            Some(_) => return self.simple_stmt(),
+        };
+        Ok(Stmt { kind, pos })
+    }
+
+    /// A declaration or expression statement, with its `;`.
+    fn simple_stmt(&mut self) -> Result<Stmt> {
+        let pos = self.pos();
+        let starts_decl = matches!(
+            self.peek().and_then(Token::ident),
+            Some(
+                "const"
+                    | "static"
+                    | "row_major"
+                    | "column_major"
+                    | "precise"
+                    | "groupshared"
+                    | "uniform"
+            )
+        ) || (self.type_at(0) && !self.is_at(1, "(") && !self.is_at(1, "::"))
+            || (self.type_at(0) && self.is_at(1, "::") && {
+                let mut k = 1;
+                while self.is_at(k, "::") {
+                    k += 2;
+                }
+                !self.is_at(k, "(")
+            });
+        if starts_decl {
+            if self.is_kw("struct") {
+                return Err(Error::new(pos, "not supported: local struct declaration"));
+            }
+            let mods = self.mods();
+            let ty = self.type_ref()?;
+            let mut vars = Vec::new();
+            self.declarators(Vec::new(), mods, ty, &mut vars)?;
+            return Ok(Stmt {
+                kind: StmtKind::Decl(vars),
+                pos,
+            });
+        }
+        // `Name name` can only be a declaration: the type is unknown.
+        if let (Some(a), Some(_)) = (
+            self.peek().and_then(Token::ident),
+            self.peek_at(1).and_then(Token::ident),
+        ) {
+            return Err(Error::new(pos, format!("unknown type `{a}`")).len(a.len() as u32));
+        }
+        let e = self.expr()?;
+        self.expect(";")?;
+        Ok(Stmt {
+            kind: StmtKind::Expr(e),
+            pos,
+        })
+    }
+
+    pub fn expr(&mut self) -> Result<Expr> {
+        let mut e = self.assign()?;
+        while self.is(",") {
+            let pos = self.pos();
+            self.i += 1;
+            let r = self.assign()?;
+            e = Expr {
+                kind: ExprKind::Comma(Box::new(e), Box::new(r)),
+                pos,
+            };
+        }
+        Ok(e)
+    }
+
+    fn assign(&mut self) -> Result<Expr> {
+        self.enter()?;
+        let lhs = self.ternary()?;
+        let op = match self.peek().map(|t| &t.tok) {
+            Some(Tok::Punct("=")) => Some(None),
+            Some(Tok::Punct(p)) => match *p {
+                "+=" => Some(Some(BinOp::Add)),
+                "-=" => Some(Some(BinOp::Sub)),
+                "*=" => Some(Some(BinOp::Mul)),
+                "/=" => Some(Some(BinOp::Div)),
+                "%=" => Some(Some(BinOp::Rem)),
+                "<<=" => Some(Some(BinOp::Shl)),
+                ">>=" => Some(Some(BinOp::Shr)),
+                "&=" => Some(Some(BinOp::BitAnd)),
+                "|=" => Some(Some(BinOp::BitOr)),
+                "^=" => Some(Some(BinOp::BitXor)),
+                _ => None,
+            },
+            _ => None,
+        };
+        let out = if let Some(op) = op {
+            let pos = self.pos();
+            self.i += 1;
+            let rhs = self.assign()?;
+            Expr {
+                kind: ExprKind::Assign(op, Box::new(lhs), Box::new(rhs)),
+                pos,
+            }
+        } else {
+            lhs
+        };
+        self.depth -= 1;
+        Ok(out)
+    }
+
+    fn ternary(&mut self) -> Result<Expr> {
+        let c = self.binary(0, false)?;
+        if self.is("?") {
+            let pos = self.pos();
+            self.i += 1;
+            self.enter()?;
+            let a = self.assign()?;
+            self.expect(":")?;
+            let b = self.assign()?;
+            self.depth -= 1;
+            return Ok(Expr {
+                kind: ExprKind::Ternary(Box::new(c), Box::new(a), Box::new(b)),
+                pos,
+            });
+        }
+        Ok(c)
+    }
+
+    /// Precedence climbing; `in_template` stops at `>` (template argument lists).
+    fn binary(&mut self, min: u8, in_template: bool) -> Result<Expr> {
+        let mut lhs = self.unary()?;
+        while let Some(Tok::Punct(p)) = self.peek().map(|t| &t.tok) {
+            let (prec, op) = match *p {
+                "||" => (1, BinOp::Or),
+                "&&" => (2, BinOp::And),
+                "|" => (3, BinOp::BitOr),
+                "^" => (4, BinOp::BitXor),
+                "&" => (5, BinOp::BitAnd),
+                "==" => (6, BinOp::Eq),
+                "!=" => (6, BinOp::Ne),
+                "<" => (7, BinOp::Lt),
+                ">" if !in_template => (7, BinOp::Gt),
+                "<=" => (7, BinOp::Le),
+                ">=" => (7, BinOp::Ge),
+                "<<" => (8, BinOp::Shl),
+                ">>" if !in_template => (8, BinOp::Shr),
+                "+" => (9, BinOp::Add),
+                "-" => (9, BinOp::Sub),
+                "*" => (10, BinOp::Mul),
+                "/" => (10, BinOp::Div),
+                "%" => (10, BinOp::Rem),
+                _ => break,
+            };
+            if prec <= min {
+                break;
+            }
+            let pos = self.pos();
+            self.i += 1;
+            self.enter()?;
+            let rhs = self.binary(prec, in_template)?;
+            self.depth -= 1;
+            lhs = Expr {
+                kind: ExprKind::Binary(op, Box::new(lhs), Box::new(rhs)),
+                pos,
+            };
+        }
+        Ok(lhs)
+    }
+
+    fn enum_value_ahead(&self) -> bool {
+        let mut k = 1;
+        while self.is_at(k, "::") && self.peek_at(k + 1).and_then(Token::ident).is_some() {
+            k += 2;
+        }
+        k > 1 && !self.is_at(k, "(") && !self.is_at(k, "<")
+    }
+
+    /// At `(`: a cast when a type and `)` follow.
+    fn cast_ahead(&self) -> bool {
+        if !self.is("(") || !self.type_at(1) {
+            return false;
+        }
+        // Skip the type (with a template list) and look for `)`.
+        let mut k = 2;
+        while self.is_at(k, "::") {
+            k += 2;
+        }
+        if self.is_at(k, "<") {
+            let mut depth = 0;
+            while let Some(t) = self.peek_at(k) {
+                if t.is("<") {
+                    depth += 1;
+                } else if t.is(">") {
+                    depth -= 1;
+                    if depth == 0 {
+                        break;
+                    }
+                } else if t.is(";") {
+                    return false;
+                }
+                k += 1;
+            }
+            k += 1;
+        }
+        self.is_at(k, ")")
+    }
+
+    fn unary(&mut self) -> Result<Expr> {
+        self.enter()?;
+        let pos = self.pos();
+        let op = match self.peek().map(|t| &t.tok) {
+            Some(Tok::Punct("-")) => Some(UnOp::Neg),
+            Some(Tok::Punct("+")) => Some(UnOp::Plus),
+            Some(Tok::Punct("!")) => Some(UnOp::Not),
+            Some(Tok::Punct("~")) => Some(UnOp::BitNot),
+            Some(Tok::Punct("++")) => Some(UnOp::PreInc),
+            Some(Tok::Punct("--")) => Some(UnOp::PreDec),
+            _ => None,
+        };
+        let e = if let Some(op) = op {
+            self.i += 1;
+            let e = self.unary()?;
+            Expr {
+                kind: ExprKind::Unary(op, Box::new(e)),
+                pos,
+            }
+        } else if self.cast_ahead() {
+            self.i += 1;
+            let ty = self.type_ref()?;
+            self.expect(")")?;
+            let e = self.unary()?;
+            Expr {
+                kind: ExprKind::Cast(ty, Box::new(e)),
+                pos,
+            }
+        } else {
+            self.postfix()?
+        };
+        self.depth -= 1;
+        Ok(e)
+    }
+
+    fn args(&mut self) -> Result<Vec<Expr>> {
+        self.expect("(")?;
+        let mut args = Vec::new();
+        if !self.is(")") {
+            loop {
+                args.push(self.assign()?);
+                if !self.eat(",") {
+                    break;
+                }
+            }
+        }
+        self.expect(")")?;
+        Ok(args)
+    }
+
+    fn postfix(&mut self) -> Result<Expr> {
+        let mut e = self.primary()?;
+        loop {
+            let pos = self.pos();
+            if self.eat(".") {
+                // Member and method expressions point at the name after the dot.
+                let (name, pos) = self.ident()?;
+                if self.is("(") {
+                    let args = self.args()?;
+                    e = Expr {
+                        kind: ExprKind::Method(Box::new(e), name, args),
+                        pos,
+                    };
+                } else {
+                    e = Expr {
+                        kind: ExprKind::Member(Box::new(e), name),
+                        pos,
+                    };
+                }
+            } else if self.eat("[") {
+                let idx = self.expr()?;
+                self.expect("]")?;
+                e = Expr {
+                    kind: ExprKind::Index(Box::new(e), Box::new(idx)),
+                    pos,
+                };
+            } else if self.is("++") || self.is("--") {
+                let op = if self.is("++") {
+                    UnOp::PostInc
+                } else {
+                    UnOp::PostDec
+                };
+                self.i += 1;
+                e = Expr {
+                    kind: ExprKind::Unary(op, Box::new(e)),
+                    pos,
+                };
+            } else {
+                return Ok(e);
+            }
+        }
+    }
+
+    fn primary(&mut self) -> Result<Expr> {
+        let pos = self.pos();
+        let Some(t) = self.peek() else {
+            return Err(self.unexpected("an expression"));
+        };
+        let kind = match &t.tok {
+            Tok::Int(v, u) => {
+                self.i += 1;
+                ExprKind::Int(*v, *u)
+            }
+            Tok::Float(f) => {
+                self.i += 1;
+                ExprKind::Float(*f)
+            }
+            Tok::Str(s) => {
+                self.i += 1;
+                ExprKind::Str(s.to_string())
+            }
+            Tok::Punct("(") => {
+                self.i += 1;
+                let e = self.expr()?;
+                self.expect(")")?;
+                return Ok(e);
+            }
+            Tok::Ident(k) if &**k == "true" || &**k == "false" => {
+                self.i += 1;
+                ExprKind::Bool(&**k == "true")
+            }
+            // `Enum::Value` names a value even though `Enum` is a type.
+            Tok::Ident(_) if self.type_at(0) && !self.enum_value_ahead() => {
+                let ty = self.type_ref()?;
+                if !self.is("(") {
+                    return Err(self.unexpected("`(` after a type name in an expression"));
+                }
+                let args = self.args()?;
+                ExprKind::Construct(ty, args)
+            }
+            Tok::Ident(_) => {
+                let (name, _) = self.ident()?;
+                if self.is("(") {
+                    let args = self.args()?;
+                    ExprKind::Call(name, args)
+                } else {
+                    ExprKind::Ident(name)
+                }
+            }
+            _ => return Err(self.unexpected("an expression")),
+        };
+        Ok(Expr { kind, pos })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::front::hlsl::lex::lex;
+
+    fn items(s: &str) -> Vec<Item> {
+        parse(&lex(s, 0).unwrap()).unwrap()
+    }
+
+    fn err(s: &str) -> (u32, u32, String) {
+        let e = parse(&lex(s, 0).unwrap()).unwrap_err();
+        (e.pos.line, e.pos.col, e.message)
+    }
+
+    #[test]
+    fn numeric_type_names() {
+        assert_eq!(split_numeric("float3x4"), Some(("float", 3, 4)));
+        assert_eq!(split_numeric("uint2"), Some(("uint", 2, 0)));
+        assert_eq!(split_numeric("min16float"), Some(("min16float", 0, 0)));
+        assert_eq!(split_numeric("float5"), None);
+        assert_eq!(split_numeric("floaty"), None);
+    }
+
+    #[test]
+    fn declarations() {
+        let it = items(
+            "struct P { float3 c : COLOR; uint d[2]; };\n\
+             typedef float4 F4;\n\
+             enum class E { A, B = 3 };\n\
+             cbuffer C : register(b1, space2) { float4x4 m; F4 v; };\n\
+             RaytracingAccelerationStructure s : register(t0);\n\
+             [[vk::binding(3, 1)]] RWTexture2D<float4> img;\n\
+             static const float k[2] = { 1.0, 2.0 };\n\
+             namespace N { float f(float x) { return x; } }\n\
+             [shader(\"raygeneration\")] void rg() { P p; p.c.xy = (float2)N::f(1); }",
+        );
+        assert_eq!(it.len(), 9);
+        match &it[3] {
+            Item::CBuffer {
+                register: Some(r),
+                members,
+                ..
+            } => {
+                assert_eq!((r.class, r.index, r.space), ('b', 1, 2));
+                assert_eq!(members.len(), 2);
+            }
+            other => panic!("{other:?}"),
+        }
+        match &it[5] {
+            Item::Var(v) => {
+                assert_eq!(v.ty.name, "RWTexture2D");
+                assert_eq!(v.attrs[0].name, "vk::binding");
+            }
+            other => panic!("{other:?}"),
+        }
+        match &it[7] {
+            Item::Function(f) => assert_eq!(f.name, "N::f"),
+            other => panic!("{other:?}"),
+        }
+        match &it[8] {
+            Item::Function(f) => {
+                assert_eq!(f.attrs[0].name, "shader");
+                let body = f.body.as_ref().unwrap();
+                assert!(matches!(body[0].kind, StmtKind::Decl(_)));
+                let StmtKind::Expr(e) = &body[1].kind else {
+                    panic!()
+                };
+                let ExprKind::Assign(None, _, rhs) = &e.kind else {
+                    panic!()
+                };
+                assert!(matches!(rhs.kind, ExprKind::Cast(..)));
+            }
+            other => panic!("{other:?}"),
+        }
+    }
+
+    #[test]
+    fn precedence_and_templates() {
+        let it = items("RayQuery<RAY_FLAG_NONE | RAY_FLAG_FORCE_OPAQUE> q; int f() { return 1 + 2 * 3 << 1 > 2 ? a : b; }");
+        match &it[0] {
+            Item::Var(v) => assert!(matches!(v.ty.args[0], TArg::Expr(_))),
+            other => panic!("{other:?}"),
+        }
+        let Item::Function(f) = &it[1] else { panic!() };
+        let StmtKind::Return(Some(e)) = &f.body.as_ref().unwrap()[0].kind else {
+            panic!()
+        };
+        let ExprKind::Ternary(c, ..) = &e.kind else {
+            panic!()
+        };
+        let ExprKind::Binary(BinOp::Gt, l, _) = &c.kind else {
+            panic!()
+        };
+        assert!(matches!(l.kind, ExprKind::Binary(BinOp::Shl, ..)));
+    }
+
+    #[test]
+    fn errors_point_at_the_token() {
+        assert_eq!(
+            err("void f() {\n  x = ;\n}"),
+            (2, 7, "expected an expression, found `;`".into())
+        );
+        assert_eq!(
+            err("struct S { float a }"),
+            (1, 20, "expected `;`, found `}`".into())
+        );
+        assert!(err("template<typename T> void f() {}")
+            .2
+            .starts_with("not supported: templates"));
+        assert!(err("cbuffer C { float a : packoffset(c0); }")
+            .2
+            .starts_with("not supported: packoffset"));
+        let deep = format!(
+            "void f() {{ x = {}1{}; }}",
+            "(".repeat(1000),
+            ")".repeat(1000)
+        );
+        assert_eq!(err(&deep).2, "nesting too deep");
+    }
+}

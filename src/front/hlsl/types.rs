@@ -1,0 +1,308 @@
+//! Semantic types and memory layouts.
+//!
+//! Matrices follow DXC's mapping: HLSL `floatRxC` is a SPIR-V matrix of R
+//! column vectors of C floats, so `m[i]` (HLSL row i) is SPIR-V column i and
+//! `mul` swaps its operands.
+
+use super::error::Pos;
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum Sc {
+    Bool,
+    Int,
+    Uint,
+    Float,
+}
+
+impl Sc {
+    pub fn name(self) -> &'static str {
+        match self {
+            Sc::Bool => "bool",
+            Sc::Int => "int",
+            Sc::Uint => "uint",
+            Sc::Float => "float",
+        }
+    }
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Dim {
+    D1,
+    D2,
+    D3,
+    Cube,
+    D2Array,
+}
+
+#[derive(Clone, Debug, PartialEq, Eq, Hash)]
+pub enum Ty {
+    Void,
+    Sc(Sc),
+    Vec(Sc, u8),
+    /// HLSL rows, columns.
+    Mat(Sc, u8, u8),
+    Array(Box<Ty>, u32),
+    /// Unbounded arrays: resources only.
+    RtArray(Box<Ty>),
+    Struct(u32),
+    Accel,
+    RayQuery(u32),
+    Sampler,
+    Texture {
+        dim: Dim,
+        sc: Sc,
+        n: u8,
+        rw: bool,
+    },
+    StructuredBuffer(Box<Ty>, bool),
+    ByteAddress(bool),
+    ConstantBuffer(u32),
+}
+
+impl Ty {
+    pub fn scalar(&self) -> Option<Sc> {
+        match self {
+            Ty::Sc(s) | Ty::Vec(s, _) | Ty::Mat(s, _, _) => Some(*s),
+            _ => None,
+        }
+    }
+    pub fn is_numeric(&self) -> bool {
+        matches!(self, Ty::Sc(_) | Ty::Vec(..) | Ty::Mat(..))
+    }
+    /// Components of a scalar or vector.
+    pub fn width(&self) -> u8 {
+        match self {
+            Ty::Vec(_, n) => *n,
+            _ => 1,
+        }
+    }
+    pub fn with_scalar(&self, s: Sc) -> Ty {
+        match self {
+            Ty::Sc(_) => Ty::Sc(s),
+            Ty::Vec(_, n) => Ty::Vec(s, *n),
+            Ty::Mat(_, r, c) => Ty::Mat(s, *r, *c),
+            other => other.clone(),
+        }
+    }
+    pub fn is_resource(&self) -> bool {
+        match self {
+            Ty::Accel
+            | Ty::Sampler
+            | Ty::Texture { .. }
+            | Ty::StructuredBuffer(..)
+            | Ty::ByteAddress(_)
+            | Ty::ConstantBuffer(_) => true,
+            Ty::Array(e, _) | Ty::RtArray(e) => e.is_resource(),
+            _ => false,
+        }
+    }
+    pub fn is_aggregate(&self) -> bool {
+        matches!(self, Ty::Array(..) | Ty::Struct(_))
+    }
+}
+
+#[derive(Clone, Debug)]
+pub struct Field {
+    pub name: String,
+    pub ty: Ty,
+    pub pos: Pos,
+    pub row_major: bool,
+}
+
+#[derive(Clone, Debug)]
+pub struct StructDef {
+    pub name: String,
+    pub fields: Vec<Field>,
+    pub pos: Pos,
+}
+
+/// How a type is laid out in memory: not at all (function/private/payload
+/// variables), HLSL constant-buffer packing, or DXC's default relaxed std430
+/// for structured, push-constant and shader-record buffers.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Layout {
+    None,
+    CBuffer,
+    Std430,
+}
+
+fn round_up(x: u32, a: u32) -> u32 {
+    x.div_ceil(a.max(1)) * a.max(1)
+}
+
+/// Size and alignment of `ty` under `layout` (scalars are 32-bit).
+pub fn size_align(ty: &Ty, layout: Layout, structs: &[StructDef]) -> (u32, u32) {
+    match (ty, layout) {
+        (Ty::Sc(_), _) => (4, 4),
+        (Ty::Vec(_, n), Layout::CBuffer) => (4 * *n as u32, 4),
+        (Ty::Vec(_, n), _) => (4 * *n as u32, if *n == 2 { 8 } else { 16 }),
+        (Ty::Mat(..), _) => {
+            let (count, stride, n) = matrix_layout(ty, false, layout);
+            matrix_size_align(count, stride, n, layout)
+        }
+        (Ty::Array(e, len), _) => {
+            let stride = array_stride(e, layout, structs);
+            let (esize, ealign) = size_align(e, layout, structs);
+            if layout == Layout::CBuffer {
+                // HLSL packing: the last element is not padded to a row.
+                (stride * len.saturating_sub(1) + esize, 16)
+            } else {
+                (stride * len, ealign)
+            }
+        }
+        (Ty::Struct(k), _) => {
+            let offsets = struct_offsets(*k, layout, structs);
+            let def = &structs[*k as usize];
+            let mut end = 0;
+            let mut align = 4;
+            for (f, off) in def.fields.iter().zip(&offsets) {
+                let (s, a) = size_align(&f.ty, layout, structs);
+                end = off + s;
+                align = align.max(a);
+            }
+            if layout == Layout::CBuffer {
+                // HLSL packing: a struct starts a row and is not padded at its end.
+                (end, 16)
+            } else {
+                (round_up(end, align), align)
+            }
+        }
+        _ => (0, 4),
+    }
+}
+
+fn matrix_size_align(count: u32, stride: u32, n: u32, layout: Layout) -> (u32, u32) {
+    if layout == Layout::CBuffer {
+        (stride * (count - 1) + 4 * n, 16)
+    } else {
+        (stride * count, stride.min(16))
+    }
+}
+
+pub fn array_stride(elem: &Ty, layout: Layout, structs: &[StructDef]) -> u32 {
+    let (s, a) = size_align(elem, layout, structs);
+    match layout {
+        Layout::CBuffer => round_up(s, 16),
+        _ => round_up(s, a),
+    }
+}
+
+/// A matrix in memory: (vector count, stride, vector length). Default HLSL
+/// (column-major) packing stores HLSL columns; in SPIR-V terms that is RowMajor.
+pub fn matrix_layout(ty: &Ty, row_major: bool, layout: Layout) -> (u32, u32, u32) {
+    let Ty::Mat(_, r, c) = ty else {
+        return (1, 16, 4);
+    };
+    let (count, n) = if row_major {
+        (*r as u32, *c as u32)
+    } else {
+        (*c as u32, *r as u32)
+    };
+    let stride = match layout {
+        Layout::CBuffer => 16,
+        _ => {
+            if n == 2 {
+                8
+            } else if n == 1 {
+                4
+            } else {
+                16
+            }
+        }
+    };
+    (count, stride, n)
+}
+
+/// Byte offsets of a struct's fields under `layout`.
+pub fn struct_offsets(k: u32, layout: Layout, structs: &[StructDef]) -> Vec<u32> {
+    let def = &structs[k as usize];
+    let mut off = 0u32;
+    let mut out = Vec::with_capacity(def.fields.len());
+    for f in &def.fields {
+        let (size, align) = if let Ty::Mat(..) = f.ty {
+            let (count, stride, n) = matrix_layout(&f.ty, f.row_major, layout);
+            matrix_size_align(count, stride, n, layout)
+        } else {
+            size_align(&f.ty, layout, structs)
+        };
+        off = match (layout, &f.ty) {
+            // Vectors may sit at scalar alignment unless they would cross a
+            // 16-byte row (HLSL packing, and DXC's relaxed std430).
+            (_, Ty::Vec(..)) | (Layout::CBuffer, Ty::Sc(_)) => {
+                let o = round_up(off, 4);
+                if o % 16 + size > 16 {
+                    round_up(o, 16)
+                } else {
+                    o
+                }
+            }
+            _ => round_up(off, align),
+        };
+        out.push(off);
+        off += size;
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn st(fields: Vec<Ty>) -> Vec<StructDef> {
+        vec![StructDef {
+            name: "S".into(),
+            fields: fields
+                .into_iter()
+                .enumerate()
+                .map(|(i, ty)| Field {
+                    name: format!("f{i}"),
+                    ty,
+                    pos: Pos::default(),
+                    row_major: false,
+                })
+                .collect(),
+            pos: Pos::default(),
+        }]
+    }
+
+    #[test]
+    fn cbuffer_packing() {
+        let f = Ty::Sc(Sc::Float);
+        let f3 = Ty::Vec(Sc::Float, 3);
+        let f2 = Ty::Vec(Sc::Float, 2);
+        // float3 then float shares a row; float2 after float3 starts a new row.
+        let s = st(vec![f3.clone(), f.clone(), f2.clone(), f3.clone()]);
+        assert_eq!(struct_offsets(0, Layout::CBuffer, &s), vec![0, 12, 16, 32]);
+        // Arrays start a row, stride 16, trailing element not padded.
+        let s = st(vec![
+            f.clone(),
+            Ty::Array(Box::new(f.clone()), 3),
+            f.clone(),
+        ]);
+        assert_eq!(struct_offsets(0, Layout::CBuffer, &s), vec![0, 16, 52]);
+        assert_eq!(
+            size_align(
+                &Ty::Array(Box::new(Ty::Sc(Sc::Uint)), 256),
+                Layout::CBuffer,
+                &s
+            )
+            .0,
+            4084
+        );
+        // float4x4 and float3x4 (HLSL columns are 3 long, 4 of them).
+        let s = st(vec![f.clone(), Ty::Mat(Sc::Float, 3, 4), f.clone()]);
+        assert_eq!(struct_offsets(0, Layout::CBuffer, &s), vec![0, 16, 76]);
+    }
+
+    #[test]
+    fn std430_relaxed() {
+        let f = Ty::Sc(Sc::Float);
+        let f3 = Ty::Vec(Sc::Float, 3);
+        let s = st(vec![f.clone(), f3.clone(), f.clone()]);
+        assert_eq!(struct_offsets(0, Layout::Std430, &s), vec![0, 4, 16]);
+        assert_eq!(size_align(&Ty::Struct(0), Layout::Std430, &s), (32, 16));
+        let s = st(vec![f3.clone(), f.clone()]);
+        assert_eq!(size_align(&Ty::Struct(0), Layout::Std430, &s), (16, 16));
+        assert_eq!(array_stride(&f, Layout::Std430, &s), 4);
+    }
+}

@@ -1,0 +1,325 @@
+//! Compiles the HLSL test shaders under tests/hlsl/ and validates every module
+//! with `spirv-val --target-env vulkan1.2`.
+
+use rtlint::front::hlsl::{self, HlslOptions, Stage};
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+fn shader(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/hlsl")
+        .join(name)
+}
+
+/// Runs spirv-val on `words`; skips (unless CI=true) when spirv-val is missing.
+fn validate(words: &[u32], what: &str) {
+    validate_with(words, what, &[]);
+}
+
+fn validate_with(words: &[u32], what: &str, extra: &[&str]) {
+    let dir = std::env::temp_dir().join(format!("rtlint-hlsl-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join(format!("{}.spv", what.replace(['/', ':'], "_")));
+    let bytes: Vec<u8> = words.iter().flat_map(|w| w.to_le_bytes()).collect();
+    std::fs::write(&file, bytes).unwrap();
+    let out = match Command::new("spirv-val")
+        .args(["--target-env", "vulkan1.2"])
+        .args(extra)
+        .arg(&file)
+        .output()
+    {
+        Ok(o) => o,
+        Err(e) => {
+            assert!(
+                std::env::var("CI").as_deref() != Ok("true"),
+                "spirv-val is required in CI: {e}"
+            );
+            eprintln!("spirv-val not found; skipping validation of {what}");
+            return;
+        }
+    };
+    if !out.status.success() {
+        let dis = Command::new("spirv-dis")
+            .arg(&file)
+            .output()
+            .map(|o| String::from_utf8_lossy(&o.stdout).into_owned())
+            .unwrap_or_default();
+        panic!(
+            "spirv-val rejected {what}:\n{}{}\n{dis}",
+            String::from_utf8_lossy(&out.stdout),
+            String::from_utf8_lossy(&out.stderr)
+        );
+    }
+}
+
+/// Compiles `name` per entry point and as a whole file; validates all modules.
+fn compile_all(name: &str) -> Vec<(String, Stage)> {
+    let path = shader(name);
+    let opts = HlslOptions::default();
+    let entries = hlsl::compile(&path, &opts).unwrap_or_else(|e| panic!("{name}: {e}"));
+    for e in &entries {
+        validate(&e.words, &format!("{name}-{}", e.name));
+    }
+    let whole = hlsl::compile_file(&path, &opts).unwrap_or_else(|e| panic!("{name}: {e}"));
+    validate(&whole.words, &format!("{name}-all"));
+    entries.into_iter().map(|e| (e.name, e.stage)).collect()
+}
+
+#[test]
+fn pipeline_raygen_miss_closesthit() {
+    let entries = compile_all("pipeline.hlsl");
+    assert_eq!(
+        entries,
+        vec![
+            ("RayGen".to_string(), Stage::RayGeneration),
+            ("Miss".to_string(), Stage::Miss),
+            ("ShadowMiss".to_string(), Stage::Miss),
+            ("ClosestHit".to_string(), Stage::ClosestHit),
+        ]
+    );
+}
+
+/// `RTLINT_DUMP=path.hlsl cargo test --test hlsl_compile dump -- --nocapture`
+/// writes the whole-file module to /tmp/rtlint-dump.spv for inspection.
+#[test]
+fn dump() {
+    let Ok(p) = std::env::var("RTLINT_DUMP") else {
+        return;
+    };
+    let m = hlsl::compile_file(Path::new(&p), &HlslOptions::default())
+        .unwrap_or_else(|e| panic!("{e}"));
+    let bytes: Vec<u8> = m.words.iter().flat_map(|w| w.to_le_bytes()).collect();
+    std::fs::write("/tmp/rtlint-dump.spv", bytes).unwrap();
+}
+
+#[test]
+fn anyhit_alpha_test() {
+    let entries = compile_all("anyhit_alpha.hlsl");
+    assert_eq!(entries[0], ("AlphaTest".to_string(), Stage::AnyHit));
+    assert_eq!(entries[1], ("Shade".to_string(), Stage::ClosestHit));
+}
+
+#[test]
+fn intersection_sphere_with_attributes() {
+    let entries = compile_all("intersection_sphere.hlsl");
+    assert_eq!(
+        entries[0],
+        ("SphereIntersection".to_string(), Stage::Intersection)
+    );
+    assert_eq!(entries[1], ("SphereHit".to_string(), Stage::ClosestHit));
+}
+
+#[test]
+fn callable_shaders() {
+    let entries = compile_all("callable.hlsl");
+    assert_eq!(entries.len(), 4);
+    assert_eq!(entries[1], ("Checker".to_string(), Stage::Callable));
+}
+
+#[test]
+fn ray_query_in_compute() {
+    let entries = compile_all("rayquery.hlsl");
+    assert_eq!(
+        entries,
+        vec![("AmbientOcclusion".to_string(), Stage::Compute)]
+    );
+}
+
+#[test]
+fn language_features() {
+    let entries = compile_all("language.hlsl");
+    assert_eq!(entries, vec![("Main".to_string(), Stage::Compute)]);
+}
+
+#[test]
+fn resources_bindless_images_records() {
+    let entries = compile_all("resources.hlsl");
+    assert_eq!(entries.len(), 3);
+}
+
+/// The module's instructions as (opcode, operand words); rspirv's loader
+/// rejects module-scope `OpExtInst` (the debug info), so this reads words.
+fn instructions(words: &[u32]) -> Vec<(u32, Vec<u32>)> {
+    let mut out = Vec::new();
+    let mut i = 5;
+    while i < words.len() {
+        let n = (words[i] >> 16) as usize;
+        out.push((words[i] & 0xffff, words[i + 1..i + n.max(1)].to_vec()));
+        i += n.max(1);
+    }
+    out
+}
+
+fn string_at(ops: &[u32]) -> String {
+    let bytes: Vec<u8> = ops.iter().flat_map(|w| w.to_le_bytes()).collect();
+    let end = bytes.iter().position(|b| *b == 0).unwrap_or(bytes.len());
+    String::from_utf8_lossy(&bytes[..end]).into_owned()
+}
+
+/// Ids named `name` by OpName.
+fn named(words: &[u32], name: &str) -> Vec<u32> {
+    instructions(words)
+        .into_iter()
+        .filter(|(op, ops)| *op == 5 && string_at(&ops[1..]) == name)
+        .map(|(_, ops)| ops[0])
+        .collect()
+}
+
+/// Offsets of a cbuffer's members as the module declares them.
+fn member_offsets(words: &[u32], struct_name: &str) -> Vec<u32> {
+    let id = named(words, struct_name)[0];
+    // OpMemberDecorate (72) struct member Offset (35) value.
+    let mut offsets: Vec<(u32, u32)> = instructions(words)
+        .into_iter()
+        .filter(|(op, ops)| *op == 72 && ops[0] == id && ops[2] == 35)
+        .map(|(_, ops)| (ops[1], ops[3]))
+        .collect();
+    offsets.sort_unstable();
+    offsets.into_iter().map(|(_, o)| o).collect()
+}
+
+#[test]
+fn cbuffer_uses_hlsl_packing() {
+    let path = shader("cbuffer_packing.hlsl");
+    let m = hlsl::compile_file(&path, &HlslOptions::default()).unwrap();
+    assert_eq!(
+        member_offsets(&m.words, "type.Packed"),
+        vec![0, 12, 16, 52, 56, 64, 108]
+    );
+    validate_with(&m.words, "cbuffer_packing", &["--scalar-block-layout"]);
+}
+
+/// `rtlint check` reads HLSL through `front::load`: declarations (struct
+/// members included) must carry their own source lines.
+#[test]
+fn program_sees_hlsl_declaration_positions() {
+    use rtlint::front::{load, Language};
+    use rtlint::spirv::Decl;
+    let path = shader("pipeline.hlsl");
+    let program = load(&path, Language::Hlsl).unwrap();
+    let id_named = |name: &str| {
+        program
+            .names
+            .iter()
+            .filter(|(_, n)| n.as_str() == name)
+            .map(|(id, _)| *id)
+            .min()
+            .unwrap()
+    };
+    let payload = id_named("Payload");
+    let at = |d: Decl| program.decl_location(d).map(|l| (l.line, l.column));
+    assert_eq!(at(Decl::Type(payload)), Some((14, 21)));
+    assert_eq!(at(Decl::Member(payload, 0)), Some((16, 12)));
+    assert_eq!(at(Decl::Member(payload, 1)), Some((17, 10)));
+    let sky = id_named("sky");
+    let loc = program.decl_location(Decl::Func(sky)).unwrap();
+    assert!(loc.path.ends_with("common.hlsli"), "{loc:?}");
+    assert_eq!((loc.line, loc.column), (8, 8));
+}
+
+/// Every shader under tests/hlsl/ (the executed ones too) validates, per
+/// entry point and as a whole file.
+#[test]
+fn every_test_shader_validates() {
+    // HLSL cbuffer packing beyond std140 needs scalar block layout.
+    const NEEDS_SCALAR: &[&str] = &[
+        "cbuffer_packing.hlsl",
+        "diff_cbuffer.hlsl",
+        "exec_compute.hlsl",
+    ];
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/hlsl");
+    let mut count = 0;
+    let mut names: Vec<String> = std::fs::read_dir(&dir)
+        .unwrap()
+        .filter_map(|e| e.ok()?.file_name().into_string().ok())
+        .filter(|n| n.ends_with(".hlsl"))
+        .collect();
+    names.sort();
+    for name in &names {
+        let extra: &[&str] = if NEEDS_SCALAR.contains(&name.as_str()) {
+            &["--scalar-block-layout"]
+        } else {
+            &[]
+        };
+        let path = shader(name);
+        let opts = HlslOptions::default();
+        for e in hlsl::compile(&path, &opts).unwrap_or_else(|e| panic!("{e}")) {
+            validate_with(&e.words, &format!("{name}-{}", e.name), extra);
+            count += 1;
+        }
+        let whole = hlsl::compile_file(&path, &opts).unwrap();
+        validate_with(&whole.words, &format!("{name}-all"), extra);
+        count += 1;
+    }
+    assert!(count >= 40, "only {count} modules validated");
+    eprintln!(
+        "{count} modules from {} shaders passed spirv-val",
+        names.len()
+    );
+}
+
+/// Per-entry modules declare only what their entry point uses.
+#[test]
+fn entry_modules_hold_only_their_globals() {
+    let entries = hlsl::compile(&shader("pipeline.hlsl"), &HlslOptions::default()).unwrap();
+    let globals = |words: &[u32]| -> Vec<String> {
+        let insts = instructions(words);
+        // OpVariable (59) at module scope: storage class is not Function (7).
+        let vars: Vec<u32> = insts
+            .iter()
+            .filter(|(op, ops)| *op == 59 && ops[2] != 7)
+            .map(|(_, ops)| ops[1])
+            .collect();
+        let mut names: Vec<String> = insts
+            .iter()
+            .filter(|(op, ops)| *op == 5 && vars.contains(&ops[0]))
+            .map(|(_, ops)| string_at(&ops[1..]))
+            .collect();
+        names.sort();
+        names
+    };
+    let miss = entries.iter().find(|e| e.name == "Miss").unwrap();
+    assert_eq!(
+        globals(&miss.words),
+        vec!["WorldRayDirectionKHR", "incoming.payload"]
+    );
+    let gen = entries.iter().find(|e| e.name == "RayGen").unwrap();
+    assert_eq!(
+        globals(&gen.words),
+        vec![
+            "Camera",
+            "LaunchIdKHR",
+            "LaunchSizeKHR",
+            "output",
+            "payload",
+            "scene"
+        ]
+    );
+}
+
+/// A module on its own (as `rtlint compile` writes it) carries declaration
+/// positions in NonSemantic.Shader.DebugInfo.100.
+#[test]
+fn entry_modules_carry_debug_info() {
+    use rtlint::front::Language;
+    use rtlint::spirv::Decl;
+    let path = shader("pipeline.hlsl");
+    let entries = hlsl::compile(&path, &HlslOptions::default()).unwrap();
+    let gen = entries.iter().find(|e| e.name == "RayGen").unwrap();
+    let program = rtlint::spirv::parse(&gen.words, &path, Language::Hlsl).unwrap();
+    let id = |name: &str| {
+        program
+            .names
+            .iter()
+            .filter(|(_, n)| n.as_str() == name)
+            .map(|(id, _)| *id)
+            .min()
+            .unwrap()
+    };
+    let at = |d: Decl| program.decl_location(d).map(|l| (l.line, l.column));
+    let payload = id("Payload");
+    assert_eq!(at(Decl::Type(payload)), Some((14, 21)));
+    assert_eq!(at(Decl::Member(payload, 1)), Some((17, 10)));
+    assert_eq!(at(Decl::Var(id("Camera"))), Some((7, 9)));
+    assert_eq!(at(Decl::Func(id("RayGen"))), Some((26, 6)));
+}

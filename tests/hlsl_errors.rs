@@ -1,0 +1,252 @@
+//! Bad HLSL: every error names the file, line and column of the construct, and
+//! out-of-scope constructs say "not supported: ...". Nothing panics.
+
+use rtlint::front::hlsl::{self, pp::MemLoader, HlslOptions};
+use std::path::{Path, PathBuf};
+
+/// Compiles `main.hlsl` (plus extra in-memory files); returns "line:col: message".
+fn error_of(files: &[(&str, &str)]) -> String {
+    let mut loader = MemLoader(
+        files
+            .iter()
+            .map(|(p, t)| (PathBuf::from(p), t.to_string()))
+            .collect(),
+    );
+    let (path, text) = files[0];
+    let e = hlsl::compile_source(Path::new(path), text, &mut loader, &HlslOptions::default())
+        .err()
+        .unwrap_or_else(|| panic!("expected an error for:\n{text}"));
+    let d = e.diagnostic();
+    let l = &d.primary.as_ref().expect("error has a position").location;
+    let mut s = format!(
+        "{}:{}:{}: {}",
+        l.path.display(),
+        l.line,
+        l.column,
+        d.message
+    );
+    for n in &d.notes {
+        s.push_str(&format!("\n  note: {n}"));
+    }
+    s
+}
+
+fn err(src: &str) -> String {
+    error_of(&[("main.hlsl", src)])
+}
+
+const RG: &str = "[shader(\"raygeneration\")]\nvoid rg()\n{\n";
+
+#[test]
+fn unknown_names_and_types() {
+    assert_eq!(
+        err(&format!("{RG}    x = 1;\n}}")),
+        "main.hlsl:4:5: unknown name `x`"
+    );
+    assert_eq!(
+        err(&format!("{RG}    Foo f;\n}}")),
+        "main.hlsl:4:5: unknown type `Foo`"
+    );
+    assert_eq!(
+        err(&format!("{RG}    frobnicate(1);\n}}")),
+        "main.hlsl:4:5: unknown function `frobnicate`"
+    );
+}
+
+#[test]
+fn type_errors() {
+    assert_eq!(
+        err(&format!("{RG}    float3 v = float2(1, 2);\n}}")),
+        "main.hlsl:4:16: cannot convert `float2` to `float3`"
+    );
+    assert_eq!(
+        err(&format!("{RG}    float4 v = float4(1, 2, 3);\n}}")),
+        "main.hlsl:4:16: `float4` needs 4 components, 3 given"
+    );
+    assert_eq!(
+        err(&format!("{RG}    float2 v = 0;\n    v.z = 1;\n}}")),
+        "main.hlsl:5:7: swizzle `z` reaches past a float2"
+    );
+    assert_eq!(
+        err(&format!("{RG}    float a[2];\n    a[2] = 1;\n}}")),
+        "main.hlsl:5:7: index 2 is out of bounds for an array of 2"
+    );
+    assert_eq!(
+        err("cbuffer C { float k; };\n[numthreads(1,1,1)]\nvoid m()\n{\n    k = 1;\n}"),
+        "main.hlsl:5:5: cannot assign to a read-only value (constant buffer or input)"
+    );
+}
+
+#[test]
+fn stage_rules() {
+    let src = "RaytracingAccelerationStructure s;\nstruct P { float x; };\n[shader(\"anyhit\")]\nvoid ah(inout P p, in BuiltInTriangleIntersectionAttributes a)\n{\n    RayDesc r = (RayDesc)0;\n    TraceRay(s, 0, 0xff, 0, 1, 0, r, p);\n}";
+    assert_eq!(
+        err(src),
+        "main.hlsl:7:5: `TraceRay` is not available in anyhit shaders"
+    );
+    let src = "struct P { float x; };\n[shader(\"closesthit\")]\nvoid ch(inout P p, in BuiltInTriangleIntersectionAttributes a)\n{\n    IgnoreHit();\n}";
+    assert_eq!(
+        err(src),
+        "main.hlsl:5:5: `IgnoreHit` is not available in closesthit shaders"
+    );
+    assert_eq!(
+        err("[numthreads(1,1,1)]\nvoid m()\n{\n    uint3 i = DispatchRaysIndex();\n}"),
+        "main.hlsl:4:15: `DispatchRaysIndex` is not available in compute shaders"
+    );
+    assert_eq!(
+        err("[shader(\"miss\")]\nvoid m(float x)\n{\n}"),
+        "main.hlsl:2:14: not supported: this parameter in a miss entry point\n  note: ray-tracing entry points take `inout` payload / callable data and `in` hit attributes (structs)"
+    );
+}
+
+#[test]
+fn unsupported_constructs_are_named() {
+    assert_eq!(
+        err("template<typename T> T id(T x) { return x; }"),
+        "main.hlsl:1:1: not supported: templates"
+    );
+    assert_eq!(
+        err("float g = 2;\n[numthreads(1,1,1)]\nvoid m() {}"),
+        "main.hlsl:1:11: not supported: initializers of constant-buffer members (declare the global `static const`)"
+    );
+    assert_eq!(
+        err("Texture2D t;\nSamplerState s;\n[shader(\"raygeneration\")]\nvoid rg()\n{\n    float4 c = t.Sample(s, float2(0, 0));\n}"),
+        "main.hlsl:6:18: not supported: `Sample` (implicit level of detail) outside pixel shaders; use `SampleLevel`"
+    );
+    assert_eq!(
+        err(&format!("{RG}    float w = WaveActiveSum(1.0);\n}}")),
+        "main.hlsl:4:15: not supported: wave intrinsic `WaveActiveSum`"
+    );
+    assert_eq!(
+        err(&format!("{RG}    double d = 1;\n}}")),
+        "main.hlsl:4:5: not supported: type `double` (only 32-bit types)"
+    );
+    assert_eq!(
+        err("struct S { float f; static float get() { return 1; } };"),
+        "main.hlsl:1:34: not supported: static struct methods"
+    );
+}
+
+#[test]
+fn control_flow_errors() {
+    assert_eq!(
+        err(&format!("{RG}    break;\n}}")),
+        "main.hlsl:4:5: `break` outside a loop or switch"
+    );
+    assert_eq!(
+        err(&format!(
+            "{RG}    switch (1) {{ case 1: break; case 1: break; }}\n}}"
+        )),
+        "main.hlsl:4:38: duplicate case 1"
+    );
+    assert_eq!(
+        err("float f(float x) { return f(x); }\n[numthreads(1,1,1)]\nvoid m() { float y = f(1.0); }"),
+        "main.hlsl:1:7: function `f` is recursive; HLSL does not allow recursion"
+    );
+    assert_eq!(
+        err("float f() { }\n[shader(\"raygeneration\")]\nfloat rg() { return 1; }"),
+        "main.hlsl:3:1: not supported: raygeneration entry points returning a value"
+    );
+}
+
+#[test]
+fn parse_errors_point_at_the_token() {
+    assert_eq!(
+        err(&format!("{RG}    float x = (1 + ;\n}}")),
+        "main.hlsl:4:20: expected an expression, found `;`"
+    );
+    assert_eq!(
+        err("struct S { float a }"),
+        "main.hlsl:1:20: expected `;`, found `}`"
+    );
+}
+
+#[test]
+fn preprocessor_errors_show_the_include_chain() {
+    let e = error_of(&[
+        ("dir/main.hlsl", "#include \"a.hlsli\"\n"),
+        ("dir/a.hlsli", "\n#include \"missing.hlsli\"\n"),
+    ]);
+    assert_eq!(
+        e,
+        "dir/a.hlsli:2:2: cannot find include file `missing.hlsli`\n  note: `dir/a.hlsli` included from dir/main.hlsl:1\n  note: `dir/main.hlsl` is the file being compiled\n  note: no include directories were given (-I)"
+    );
+    let e = error_of(&[("m.hlsl", "#include \"m.hlsl\"\n")]);
+    assert!(
+        e.starts_with("m.hlsl:1:2: include cycle: `m.hlsl` includes itself"),
+        "{e}"
+    );
+    assert_eq!(
+        err("#if 1\n#error stop: no\n#endif"),
+        "main.hlsl:2:2: #error stop : no"
+    );
+}
+
+#[test]
+fn errors_in_macros_and_includes_point_at_the_real_file() {
+    // The macro is used on line 5; its body's bad name reports that use.
+    let e = err("#define BAD(x) (x + undefinedThing)\n[shader(\"raygeneration\")]\nvoid rg()\n{\n    float f = BAD(1.0);\n}");
+    assert_eq!(e, "main.hlsl:5:15: unknown name `undefinedThing`");
+    let e = error_of(&[
+        (
+            "main.hlsl",
+            "#include \"lib.hlsli\"\n[numthreads(1,1,1)]\nvoid m() { float y = helper(1.0); }",
+        ),
+        (
+            "lib.hlsli",
+            "float helper(float x)\n{\n    return x + nope;\n}",
+        ),
+    ]);
+    assert_eq!(e, "lib.hlsli:3:16: unknown name `nope`");
+}
+
+#[test]
+fn missing_entry_point() {
+    let mut loader = MemLoader::default();
+    let e = hlsl::compile_source(
+        Path::new("a.hlsl"),
+        "float f(float x) { return x; }",
+        &mut loader,
+        &HlslOptions::default(),
+    )
+    .unwrap_err();
+    assert!(e.to_string().contains("no entry points"), "{e}");
+    let opts = HlslOptions {
+        entry: Some("nope".into()),
+        ..Default::default()
+    };
+    let e = hlsl::compile_source(
+        Path::new("a.hlsl"),
+        "[numthreads(1,1,1)] void m() {}",
+        &mut loader,
+        &opts,
+    )
+    .unwrap_err();
+    assert!(e.to_string().contains("no entry point named `nope`"), "{e}");
+}
+
+#[test]
+fn layout_changing_constructs_are_refused() {
+    assert_eq!(
+        err("#pragma pack_matrix(row_major)\n"),
+        "main.hlsl:1:2: not supported: #pragma pack_matrix(row_major)\n  note: declare matrices `row_major` one by one instead"
+    );
+    assert_eq!(
+        err("StructuredBuffer<float4x4> m;\n[numthreads(1,1,1)] void f() {}"),
+        "main.hlsl:1:1: not supported: StructuredBuffer of a matrix; wrap the matrix in a struct"
+    );
+}
+
+#[test]
+fn entry_parameters_follow_dxr_positions() {
+    let e = err("struct P { float x; };\nstruct A { float2 b; };\n[shader(\"closesthit\")]\nvoid ch(in A a, inout P p)\n{\n}");
+    assert!(
+        e.starts_with("main.hlsl:4:14: not supported: this parameter in a closesthit entry point"),
+        "{e}"
+    );
+    let e = err("struct P { float x; };\n[shader(\"miss\")]\nvoid m(in P p)\n{\n}");
+    assert!(
+        e.starts_with("main.hlsl:3:13: not supported: this parameter in a miss entry point"),
+        "{e}"
+    );
+}
