@@ -78,6 +78,27 @@ enum Command {
         #[command(flatten)]
         common: Common,
     },
+    /// Compile HLSL to SPIR-V with rtlint's own compiler.
+    Compile {
+        /// The HLSL file.
+        file: PathBuf,
+        /// Compile only this entry point.
+        #[arg(short = 'E', long = "entry")]
+        entry: Option<String>,
+        /// Include directory (searched after the including file's folder).
+        #[arg(short = 'I', value_name = "DIR")]
+        include: Vec<PathBuf>,
+        /// Define a macro: NAME or NAME=VALUE.
+        #[arg(short = 'D', value_name = "NAME[=VALUE]")]
+        define: Vec<String>,
+        /// Output: a `.spv` file (one entry point, or with --whole every entry
+        /// point in one module), or a directory for one module per entry point.
+        #[arg(short = 'o', long = "output")]
+        output: PathBuf,
+        /// One module holding every entry point.
+        #[arg(long)]
+        whole: bool,
+    },
     /// List every rule.
     Rules,
     /// Print a rule's documentation.
@@ -119,6 +140,14 @@ fn run(cli: Cli) -> Result<u8, String> {
         Command::Live { common } => live(common),
         Command::Stack { common, driver } => stack(common, driver),
         Command::Layout { common } => layout(common),
+        Command::Compile {
+            file,
+            entry,
+            include,
+            define,
+            output,
+            whole,
+        } => compile(file, entry, include, define, output, whole),
         Command::Rules => {
             let mut out = std::io::stdout().lock();
             for r in rtlint::rules::RULES {
@@ -453,4 +482,71 @@ fn print_report<T: serde::Serialize>(
         _ => return Err("this command prints human or json".into()),
     }
     Ok(if problems.is_empty() { 0 } else { 2 })
+}
+
+fn compile(
+    file: PathBuf,
+    entry: Option<String>,
+    include: Vec<PathBuf>,
+    define: Vec<String>,
+    output: PathBuf,
+    whole: bool,
+) -> Result<u8, String> {
+    use rtlint::front::hlsl;
+    let options = hlsl::HlslOptions {
+        include_dirs: include,
+        defines: define
+            .iter()
+            .map(|d| match d.split_once('=') {
+                Some((n, v)) => (n.to_string(), v.to_string()),
+                None => (d.clone(), "1".to_string()),
+            })
+            .collect(),
+        entry,
+    };
+    let write = |path: &std::path::Path, words: &[u32]| -> Result<(), String> {
+        let bytes: Vec<u8> = words.iter().flat_map(|w| w.to_le_bytes()).collect();
+        std::fs::write(path, bytes).map_err(|e| format!("cannot write {}: {e}", path.display()))
+    };
+    let report = |e: InputError| -> Result<u8, String> {
+        let mut out = StandardStream::stderr(color_choice());
+        let mut sources = Sources::default();
+        report::human::render(&[*e.0], &mut sources, &mut out).map_err(|e| e.to_string())?;
+        Ok(2)
+    };
+    if whole {
+        return match hlsl::compile_file(&file, &options) {
+            Ok(m) => {
+                write(&output, &m.words)?;
+                eprintln!("{}: {} entry points", output.display(), m.entries.len());
+                Ok(0)
+            }
+            Err(e) => report(e),
+        };
+    }
+    let entries = match hlsl::compile(&file, &options) {
+        Ok(e) => e,
+        Err(e) => return report(e),
+    };
+    if entries.is_empty() {
+        return Err(format!("{}: no entry point to compile", file.display()));
+    }
+    if output.is_dir() {
+        for e in &entries {
+            let path = output.join(format!("{}.spv", e.name));
+            write(&path, &e.words)?;
+            eprintln!("{}", path.display());
+        }
+    } else if let [only] = entries.as_slice() {
+        write(&output, &only.words)?;
+    } else {
+        let names: Vec<&str> = entries.iter().map(|e| e.name.as_str()).collect();
+        return Err(format!(
+            "{} has {} entry points ({}): pick one with -E, write them to a directory, or use --whole",
+            file.display(),
+            entries.len(),
+            names.join(", ")
+        ));
+    }
+    Ok(0)
 }

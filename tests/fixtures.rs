@@ -53,7 +53,12 @@ fn placed_markers(source: &Path) -> BTreeSet<(PathBuf, u32, String)> {
 /// Each module to check with the source holding its markers.
 fn cases() -> Vec<(PathBuf, PathBuf)> {
     let mut cases = Vec::new();
-    for dir in ["fixtures/wgsl", "fixtures/glsl", "fixtures/RT010"] {
+    for dir in [
+        "fixtures/wgsl",
+        "fixtures/glsl",
+        "fixtures/hlsl",
+        "fixtures/RT010",
+    ] {
         let mut entries: Vec<PathBuf> = std::fs::read_dir(root().join(dir))
             .unwrap()
             .map(|e| e.unwrap().path())
@@ -61,7 +66,7 @@ fn cases() -> Vec<(PathBuf, PathBuf)> {
         entries.sort();
         for p in entries {
             let name = p.file_name().unwrap().to_str().unwrap().to_string();
-            if name.ends_with(".wgsl") {
+            if name.ends_with(".wgsl") || name.ends_with(".hlsl") {
                 cases.push((p.clone(), p));
             } else if let Some(src) = name
                 .strip_suffix(".g.spv")
