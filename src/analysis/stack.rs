@@ -172,18 +172,24 @@ pub fn driver_model(stage: Stage, b: &Breakdown) -> u64 {
             } else {
                 0
             };
-            let live = if b.loop_live_state > 0 {
-                align(b.loop_live_state, 32).max(32)
-            } else if b.live_state > 0 {
-                32
-            } else {
-                0
-            };
-            spill + live
+            spill + live_in_driver_model(stage, b)
         }
         Stage::ClosestHit | Stage::Miss => passed_on(b.outgoing_payload),
         Stage::Callable => passed_on(b.outgoing_payload.max(b.callable_data)),
         _ => 0,
+    }
+}
+
+/// The bytes of live state the driver-comparable size already holds.
+fn live_in_driver_model(stage: Stage, b: &Breakdown) -> u64 {
+    if stage != Stage::RayGeneration || (b.outgoing_payload == 0 && b.callable_data == 0) {
+        0
+    } else if b.loop_live_state > 0 {
+        align(b.loop_live_state, 32).max(32)
+    } else if b.live_state > 0 {
+        32
+    } else {
+        0
     }
 }
 
@@ -458,7 +464,11 @@ pub fn stack_report(pipeline: &Pipeline) -> StackReport {
             stage: s.stage,
             file: s.file.display().to_string(),
             group,
-            model_bytes: driver_model_bytes + b.live_state + b.local_arrays,
+            // Live state the driver-comparable part already holds is not added twice.
+            model_bytes: driver_model_bytes
+                + b.live_state
+                    .saturating_sub(live_in_driver_model(s.stage, &b))
+                + b.local_arrays,
             driver_model_bytes,
             driver_bytes: None,
             breakdown: b,
@@ -917,22 +927,22 @@ mod tests {
             .iter()
             .map(|s| (s.group.as_str(), s.model_bytes))
             .collect();
-        // raygen: `weight` (4 B) across the callable, and the 32-byte block
-        // the driver keeps for it; flat.rcall: a local float[16] (64 B).
+        // raygen: `weight` (4 B) across the callable, inside the 32-byte
+        // block the driver keeps for it; flat.rcall: a local float[16] (64 B).
         assert_eq!(
             sizes,
             [
-                ("raygen 0", 36),
+                ("raygen 0", 32),
                 ("miss 0", 0),
                 ("callable 0", 0),
                 ("callable 1", 64)
             ]
         );
-        // 36 + 1 × max(0, 0, 0) + 0 + 2 × 64.
-        assert_eq!(r.vulkan_default, Some(164));
-        // The raygen calls SBT index 1 only: 36 + 64.
-        assert_eq!(r.exact_call_chain, Some(100));
-        assert_eq!(r.recommended, Some(112));
+        // 32 + 1 × max(0, 0, 0) + 0 + 2 × 64.
+        assert_eq!(r.vulkan_default, Some(160));
+        // The raygen calls SBT index 1 only: 32 + 64.
+        assert_eq!(r.exact_call_chain, Some(96));
+        assert_eq!(r.recommended, Some(96));
     }
 
     #[test]
