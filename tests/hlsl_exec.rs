@@ -32,13 +32,10 @@ impl Drop for Gpu {
 
 /// A device; with `rt`, the ray-tracing extensions and buffer device addresses.
 fn gpu(rt: bool) -> Option<Gpu> {
+    // Like every driver test: no device is a failure, not a skip
+    // (scripts/setup installs lavapipe).
     let fail = |what: String| -> Option<Gpu> {
-        assert!(
-            std::env::var("CI").as_deref() != Ok("true"),
-            "Vulkan is required in CI: {what}"
-        );
-        eprintln!("no Vulkan driver ({what}); skipping");
-        None
+        panic!("no usable Vulkan device (run scripts/setup): {what}")
     };
     unsafe {
         let entry = match ash::Entry::load() {
@@ -53,7 +50,10 @@ fn gpu(rt: bool) -> Option<Gpu> {
             Ok(i) => i,
             Err(e) => return fail(e.to_string()),
         };
-        let pdevs = instance.enumerate_physical_devices().ok()?;
+        let pdevs = match instance.enumerate_physical_devices() {
+            Ok(p) => p,
+            Err(e) => return fail(e.to_string()),
+        };
         let Some(&pd) = pdevs.first() else {
             instance.destroy_instance(None);
             return fail("no physical device".into());
