@@ -318,4 +318,6 @@ fn entry_modules_carry_debug_info() {
     assert_eq!(at(Decl::Member(payload, 1)), Some((17, 10)));
     assert_eq!(at(Decl::Var(id("Camera"))), Some((7, 9)));
     assert_eq!(at(Decl::Func(id("RayGen"))), Some((26, 6)));
+    // Locals too (DebugLocalVariable + DebugDeclare).
+    assert_eq!(at(Decl::Var(id("ray"))), Some((32, 13)));
 }

@@ -195,6 +195,8 @@ pub struct Lowerer<'a> {
     this_place: Option<Place>,
     /// Globals with source positions, for debug info: (variable, name, type, position).
     global_decls: Vec<(Id, String, Ty, Pos)>,
+    /// Locals and parameters for debug info: (function, variable, name, type, position).
+    local_decls: Vec<(usize, Id, String, Ty, Pos)>,
 }
 
 /// Source positions of named declarations (the side table `Program` reads).
@@ -428,6 +430,7 @@ impl<'a> Lowerer<'a> {
             nonuniform_ptrs: HashSet::new(),
             this_place: None,
             global_decls: Vec::new(),
+            local_decls: Vec::new(),
         }
     }
 
@@ -2049,6 +2052,8 @@ impl<'a> Lowerer<'a> {
             for ((p, decl), pty) in params.zip(&f.params).zip(ptys) {
                 let id = self.b.function_parameter(pty)?;
                 self.b.name(id, decl.name.clone());
+                self.local_decls
+                    .push((self.cur_fn, id, decl.name.clone(), p.ty.clone(), decl.pos));
                 self.scopes[0].insert(
                     decl.name.clone(),
                     Place::Ptr {
@@ -2569,6 +2574,8 @@ impl<'a> Lowerer<'a> {
             return Ok(());
         }
         let var = self.local_var(&t, &v.name)?;
+        self.local_decls
+            .push((self.cur_fn, var, v.name.clone(), t.clone(), v.pos));
         if let Some(init) = &v.init {
             let val = self.expr_as(init, &t)?;
             if self.term {
