@@ -460,6 +460,8 @@ fn compute_semantics_on_the_driver() {
         F(-2.0),
         F(12.0),
         I(45),
+        I(-4),
+        U(6),
     ];
     let got = unsafe { gpu.run(&entries[0].words, "Main", expected.len() + 4, &inputs()) };
     let mut wrong = Vec::new();

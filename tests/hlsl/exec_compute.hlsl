@@ -213,4 +213,8 @@ void Main()
             break;
     }
     put(acc2);
+    // 74..75: a shift keeps its left operand's type
+    int negative = -8 * (int)(b1 / 4.0);
+    put(negative >> 1u);
+    put(3u << 1);
 }

@@ -3779,6 +3779,14 @@ impl<'a> Lowerer<'a> {
         if ct.scalar() == Some(Sc::Bool) && !(cmp && matches!(op, Eq | Ne)) {
             ct = ct.with_scalar(Sc::Int);
         }
+        if matches!(op, Shl | Shr) {
+            // A shift has its left operand's type (HLSL, like C).
+            let ls = match a.ty.scalar() {
+                Some(Sc::Bool) | None => Sc::Int,
+                Some(s) => s,
+            };
+            ct = ct.with_scalar(ls);
+        }
         if bits && ct.scalar() == Some(Sc::Float) {
             return Err(Error::new(
                 pos,
