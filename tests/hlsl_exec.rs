@@ -462,6 +462,7 @@ fn compute_semantics_on_the_driver() {
         I(45),
         I(-4),
         U(6),
+        I(3),
     ];
     let got = unsafe { gpu.run(&entries[0].words, "Main", expected.len() + 4, &inputs()) };
     let mut wrong = Vec::new();

@@ -217,4 +217,13 @@ void Main()
     int negative = -8 * (int)(b1 / 4.0);
     put(negative >> 1u);
     put(3u << 1);
+    // 76: && in a loop condition
+    int zc = 0;
+    bool gg = true;
+    for (int z = 0; z < 8 && gg; z++)
+    {
+        zc += 1;
+        gg = z < 2;
+    }
+    put(zc);
 }

@@ -147,6 +147,11 @@ void Main(uint3 dtid : SV_DispatchThreadID, uint3 gtid : SV_GroupThreadID, uint3
             break;
     }
     do { w--; } while (w > 0);
+    bool going = true;
+    for (int z = 0; z < 8 && going; z++)
+        going = acc < 50.0 || z == 0;
+    do { w++; } while (w < 4 && (going || acc > 1.0));
+    while (w > 0 && shared[w] >= 0.0 ? true : false) { w--; }
     switch (i % 4)
     {
     case 0:
