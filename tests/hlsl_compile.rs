@@ -321,3 +321,26 @@ fn entry_modules_carry_debug_info() {
     // Locals too (DebugLocalVariable + DebugDeclare).
     assert_eq!(at(Decl::Var(id("ray"))), Some((32, 13)));
 }
+
+/// Compile time per entry point over the test shaders (printed; run with
+/// `--ignored --nocapture`, in release for real figures).
+#[test]
+#[ignore]
+fn compile_speed() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/hlsl");
+    let mut names: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap()
+        .filter_map(|e| e.ok()?.file_name().into_string().ok())
+        .filter(|n| n.ends_with(".hlsl"))
+        .collect();
+    names.sort();
+    let start = std::time::Instant::now();
+    let mut entries = 0;
+    for _ in 0..10 {
+        for n in &names {
+            entries += hlsl::compile(&shader(n), &HlslOptions::default()).unwrap().len();
+        }
+    }
+    let per = start.elapsed().as_secs_f64() * 1000.0 / entries as f64;
+    eprintln!("{entries} entry points, {per:.3} ms per entry point");
+}
