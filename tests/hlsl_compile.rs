@@ -338,7 +338,9 @@ fn compile_speed() {
     let mut entries = 0;
     for _ in 0..10 {
         for n in &names {
-            entries += hlsl::compile(&shader(n), &HlslOptions::default()).unwrap().len();
+            entries += hlsl::compile(&shader(n), &HlslOptions::default())
+                .unwrap()
+                .len();
         }
     }
     let per = start.elapsed().as_secs_f64() * 1000.0 / entries as f64;

@@ -2342,14 +2342,14 @@ impl<'a> Lowerer<'a> {
                 }
                 self.start_block(Some(lm))?;
             }
-            StmtKind::While(c, body) => self.lower_loop(None, Some(c), None, body, false)?,
-            StmtKind::DoWhile(body, c) => self.lower_loop(None, Some(c), None, body, true)?,
+            StmtKind::While(c, body) => self.lower_loop(Some(c), None, body, false)?,
+            StmtKind::DoWhile(body, c) => self.lower_loop(Some(c), None, body, true)?,
             StmtKind::For(init, c, step, body) => {
                 self.scopes.push(HashMap::new());
                 if let Some(i) = init {
                     self.stmt(i)?;
                 }
-                self.lower_loop(None, c.as_ref(), step.as_ref(), body, false)?;
+                self.lower_loop(c.as_ref(), step.as_ref(), body, false)?;
                 self.scopes.pop();
             }
             StmtKind::Break => {
@@ -2385,7 +2385,7 @@ impl<'a> Lowerer<'a> {
                 self.term = true;
             }
             StmtKind::Discard => return Err(unsupported(s.pos, "`discard` (pixel shaders)").len(7)),
-            StmtKind::Switch(sel, cases) => self.lower_switch(sel, cases, s.pos)?,
+            StmtKind::Switch(sel, cases) => self.lower_switch(sel, cases)?,
         }
         Ok(())
     }
@@ -2399,7 +2399,6 @@ impl<'a> Lowerer<'a> {
 
     fn lower_loop(
         &mut self,
-        _init: Option<&'a Stmt>,
         cond: Option<&'a Expr>,
         step: Option<&'a Expr>,
         body: &'a Stmt,
@@ -2451,7 +2450,7 @@ impl<'a> Lowerer<'a> {
         Ok(())
     }
 
-    fn lower_switch(&mut self, sel: &'a Expr, cases: &'a [Case], pos: Pos) -> Result<()> {
+    fn lower_switch(&mut self, sel: &'a Expr, cases: &'a [Case]) -> Result<()> {
         let v = self.expr(sel)?;
         let v = match v.ty {
             Ty::Sc(Sc::Int) | Ty::Sc(Sc::Uint) => v,
@@ -2477,7 +2476,6 @@ impl<'a> Lowerer<'a> {
                 }
             }
         }
-        let _ = pos;
         self.b
             .selection_merge(merge, spirv::SelectionControl::NONE)?;
         self.b.switch(v.id, default, targets)?;
@@ -3800,6 +3798,9 @@ impl<'a> Lowerer<'a> {
                 return Ok(v);
             }
         }
+        if let (Ty::Mat(..), true) = (&ct, cmp) {
+            return Err(unsupported(pos, "comparing matrices"));
+        }
         if let Ty::Mat(s, r, c) = ct {
             // Matrix operators are component-wise: one row at a time.
             let row = Ty::Vec(s, c);
@@ -3829,14 +3830,9 @@ impl<'a> Lowerer<'a> {
                     pos,
                 )?);
             }
-            let rt = if cmp { Ty::Vec(Sc::Bool, c) } else { row };
-            if cmp {
-                return Err(unsupported(pos, "comparing matrices"));
-            }
             let mt = Ty::Mat(s, r, c);
             let tid = self.ty_id(&mt)?;
             let ids: Vec<Id> = rows.iter().map(|v| v.id).collect();
-            let _ = rt;
             let id = self.op(Op::CompositeConstruct, tid, &ids)?;
             return Ok(Val { id, ty: mt });
         }

@@ -154,11 +154,10 @@ fn compile_source_inner(
     for (_, name, stage) in picked {
         // A fresh module per entry point, holding only what it reaches.
         let mut l = lower::Lowerer::new(&items, &files);
-        let entries = l.declare().map_err(|e| e.into_input_error(&files, path))?;
+        l.declare().map_err(|e| e.into_input_error(&files, path))?;
         let k = l
             .entry_function(&name)
             .ok_or_else(|| InputError::new("hlsl-error", path, "entry point vanished"))?;
-        let _ = entries;
         let (words, _) = l
             .finish(&[k])
             .map_err(|e| e.into_input_error(&files, path))?;
