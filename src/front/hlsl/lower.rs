@@ -1060,64 +1060,7 @@ impl<'a> Lowerer<'a> {
             }
             (t.clone(), arrays)
         };
-        let (mut tid, class) = match &inner {
-            Ty::ConstantBuffer(k) => {
-                let (layout, class) = self.cbuffer_class(attrs);
-                (self.block_struct(*k, layout)?, class)
-            }
-            Ty::StructuredBuffer(e, rw) => {
-                let elem = self.spv(e, Layout::Std430)?;
-                let stride = array_stride(e, Layout::Std430, &self.structs);
-                let rt = self.b.id();
-                self.b.type_runtime_array_id(Some(rt), elem);
-                self.b
-                    .decorate(rt, Decoration::ArrayStride, [Operand::LiteralBit32(stride)]);
-                let st = self.b.id();
-                self.b.type_struct_id(Some(st), [rt]);
-                self.b.decorate(st, Decoration::Block, []);
-                self.b
-                    .member_decorate(st, 0, Decoration::Offset, [Operand::LiteralBit32(0)]);
-                if !rw {
-                    self.b.member_decorate(st, 0, Decoration::NonWritable, []);
-                }
-                let tn = if *rw {
-                    "type.RWStructuredBuffer"
-                } else {
-                    "type.StructuredBuffer"
-                };
-                self.b.name(st, tn);
-                (st, StorageClass::StorageBuffer)
-            }
-            Ty::ByteAddress(rw) => {
-                let u = self.spv(&Ty::Sc(Sc::Uint), Layout::None)?;
-                let rt = self.b.id();
-                self.b.type_runtime_array_id(Some(rt), u);
-                self.b
-                    .decorate(rt, Decoration::ArrayStride, [Operand::LiteralBit32(4)]);
-                let st = self.b.id();
-                self.b.type_struct_id(Some(st), [rt]);
-                self.b.decorate(st, Decoration::Block, []);
-                self.b
-                    .member_decorate(st, 0, Decoration::Offset, [Operand::LiteralBit32(0)]);
-                if !rw {
-                    self.b.member_decorate(st, 0, Decoration::NonWritable, []);
-                }
-                self.b.name(
-                    st,
-                    if *rw {
-                        "type.RWByteAddressBuffer"
-                    } else {
-                        "type.ByteAddressBuffer"
-                    },
-                );
-                (st, StorageClass::StorageBuffer)
-            }
-            Ty::Accel | Ty::Sampler | Ty::Texture { .. } => (
-                self.spv(&inner, Layout::None)?,
-                StorageClass::UniformConstant,
-            ),
-            _ => unreachable!("resource_var on a non-resource"),
-        };
+        let (mut tid, class) = self.descriptor_type(&inner, attrs)?;
         for n in arrays.iter().rev() {
             tid = match n {
                 Some(n) => {
@@ -1146,6 +1089,72 @@ impl<'a> Lowerer<'a> {
             }
         }
         Ok(var)
+    }
+
+    /// The SPIR-V type of one descriptor (or push-constant / shader-record
+    /// block) of `inner`, and its storage class; one id per kind, so arrays of
+    /// resources and their elements agree.
+    fn descriptor_type(&mut self, inner: &Ty, attrs: &[Attr]) -> Result<(Id, StorageClass)> {
+        if let Ty::ConstantBuffer(k) = inner {
+            let (layout, class) = self.cbuffer_class(attrs);
+            return Ok((self.block_struct(*k, layout)?, class));
+        }
+        if let Ty::Accel | Ty::Sampler | Ty::Texture { .. } = inner {
+            return Ok((
+                self.spv(inner, Layout::None)?,
+                StorageClass::UniformConstant,
+            ));
+        }
+        let key = (inner.clone(), Layout::Std430, true);
+        if let Some(id) = self.ty_cache.get(&key) {
+            return Ok((*id, StorageClass::StorageBuffer));
+        }
+        let (elem, stride, rw, name) = match inner {
+            Ty::StructuredBuffer(e, rw) => (
+                self.spv(e, Layout::Std430)?,
+                array_stride(e, Layout::Std430, &self.structs),
+                *rw,
+                if *rw {
+                    "type.RWStructuredBuffer"
+                } else {
+                    "type.StructuredBuffer"
+                },
+            ),
+            Ty::ByteAddress(rw) => (
+                self.spv(&Ty::Sc(Sc::Uint), Layout::None)?,
+                4,
+                *rw,
+                if *rw {
+                    "type.RWByteAddressBuffer"
+                } else {
+                    "type.ByteAddressBuffer"
+                },
+            ),
+            other => {
+                return Err(Error::new(
+                    Pos::default(),
+                    format!(
+                        "internal compiler error: `{}` is not a descriptor",
+                        self.ty_name(other)
+                    ),
+                ))
+            }
+        };
+        let rt = self.b.id();
+        self.b.type_runtime_array_id(Some(rt), elem);
+        self.b
+            .decorate(rt, Decoration::ArrayStride, [Operand::LiteralBit32(stride)]);
+        let st = self.b.id();
+        self.b.type_struct_id(Some(st), [rt]);
+        self.b.decorate(st, Decoration::Block, []);
+        self.b
+            .member_decorate(st, 0, Decoration::Offset, [Operand::LiteralBit32(0)]);
+        if !rw {
+            self.b.member_decorate(st, 0, Decoration::NonWritable, []);
+        }
+        self.b.name(st, name);
+        self.ty_cache.insert(key, st);
+        Ok((st, StorageClass::StorageBuffer))
     }
 
     /// A Block-decorated copy of struct `k` laid out for a buffer.
@@ -1484,11 +1493,8 @@ impl<'a> Lowerer<'a> {
                 self.b
                     .type_image(st, d, 0, arrayed, 0, if *rw { 2 } else { 1 }, format, None)
             }
-            _ => {
-                return Err(Error::new(
-                    Pos::default(),
-                    "internal compiler error: buffer type used as a value",
-                ))
+            Ty::StructuredBuffer(..) | Ty::ByteAddress(_) | Ty::ConstantBuffer(_) => {
+                return Ok(self.descriptor_type(t, &[])?.0);
             }
         };
         self.ty_cache.insert(key, id);
@@ -2258,8 +2264,18 @@ impl<'a> Lowerer<'a> {
             self.start_block(None)?;
         }
         let id = self.b.id();
+        // Pointers reached through a NonUniformResourceIndex stay NonUniform.
+        let nonuniform = op == Op::AccessChain
+            && operands.iter().enumerate().any(|(i, o)| {
+                matches!(o, Operand::IdRef(x)
+                    if (i == 0 && self.nonuniform_ptrs.contains(x)) || (i > 0 && self.nonuniform.contains(x)))
+            });
         let inst = Instruction::new(op, ty, ty.map(|_| id), operands);
         self.b.insert_into_block(InsertPoint::End, inst)?;
+        if nonuniform {
+            self.b.decorate(id, Decoration::NonUniform, []);
+            self.nonuniform_ptrs.insert(id);
+        }
         Ok(id)
     }
 
@@ -2684,15 +2700,30 @@ impl<'a> Lowerer<'a> {
             } => {
                 let t = self.spv(&elem, layout)?;
                 let pty = self.b.type_pointer(None, class, t);
-                let nu = self.nonuniform.contains(&index);
                 let ptr = self.inst(
                     Op::AccessChain,
                     Some(pty),
                     vec![Operand::IdRef(ptr), Operand::IdRef(index)],
                 )?;
-                if nu {
-                    self.b.decorate(ptr, Decoration::NonUniform, []);
-                    self.nonuniform_ptrs.insert(ptr);
+                if self.nonuniform_ptrs.contains(&ptr) {
+                    let cap = match &elem {
+                        Ty::Texture { rw: false, .. } => {
+                            Some(Capability::SampledImageArrayNonUniformIndexing)
+                        }
+                        Ty::Texture { rw: true, .. } => {
+                            Some(Capability::StorageImageArrayNonUniformIndexing)
+                        }
+                        Ty::StructuredBuffer(..) | Ty::ByteAddress(_) => {
+                            Some(Capability::StorageBufferArrayNonUniformIndexing)
+                        }
+                        Ty::ConstantBuffer(_) => {
+                            Some(Capability::UniformBufferArrayNonUniformIndexing)
+                        }
+                        _ => None,
+                    };
+                    if let Some(c) = cap {
+                        self.cap(c);
+                    }
                 }
                 Ok(Place::Ptr {
                     ptr,
@@ -3022,6 +3053,9 @@ impl<'a> Lowerer<'a> {
                     self.start_block(None)?;
                 }
                 let mut id = self.b.load(tid, None, *ptr, None, [])?;
+                if self.nonuniform_ptrs.contains(ptr) {
+                    self.b.decorate(id, Decoration::NonUniform, []);
+                }
                 if *layout != Layout::None && ty.is_aggregate() {
                     let plain = self.ty_id(ty)?;
                     id = self.op(Op::CopyLogical, plain, &[id])?;
