@@ -178,7 +178,7 @@ fn preprocessor_errors_show_the_include_chain() {
     );
     assert_eq!(
         err("#if 1\n#error stop: no\n#endif"),
-        "main.hlsl:2:2: #error stop : no"
+        "main.hlsl:2:2: #error stop: no"
     );
 }
 
