@@ -3,6 +3,15 @@
 //! Data flow: front-ends → SPIR-V → [`spirv::Program`] → analyses → rules →
 //! [`diag::Diagnostic`]s → reports. See `docs/architecture.md`.
 
+pub mod analysis;
+pub mod config;
 pub mod diag;
 pub mod front;
+pub mod lint;
+pub mod pipeline;
+pub mod reference;
+pub mod report;
+pub mod rules;
 pub mod spirv;
+#[cfg(feature = "vulkan")]
+pub mod vk;

@@ -1,30 +1,456 @@
-fn main() {
-    let path = std::path::PathBuf::from(std::env::args().nth(1).unwrap());
-    let lang = rtlint::front::Language::from_path(&path).unwrap();
-    let p = rtlint::front::load(&path, lang).unwrap();
-    for e in &p.entry_points {
-        println!("entry {} {:?}", e.name, e.stage);
+//! The `rtlint` command line.
+
+use clap::{Parser, Subcommand};
+use codespan_reporting::term::termcolor::{ColorChoice, StandardStream};
+use rtlint::config::Config;
+use rtlint::diag::{Diagnostic, InputError, Severity};
+use rtlint::front::Language;
+use rtlint::lint;
+use rtlint::report::{self, Format, Sources, Summary};
+use std::io::Write;
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+#[derive(Parser)]
+#[command(
+    name = "rtlint",
+    version,
+    about = "Linter and toolkit for ray-tracing shaders (HLSL, WGSL, SPIR-V)"
+)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(clap::Args, Clone)]
+struct Common {
+    /// Shader files or directories (walked recursively).
+    #[arg(required = true)]
+    paths: Vec<PathBuf>,
+    /// Output format: human, json, github or sarif.
+    #[arg(long, default_value = "human")]
+    format: String,
+    /// Read this config instead of the nearest rtlint.toml.
+    #[arg(long)]
+    config: Option<PathBuf>,
+    /// Treat every named file as this language (hlsl, wgsl, spirv).
+    #[arg(long)]
+    lang: Option<String>,
+    /// Also say which files were skipped.
+    #[arg(short, long)]
+    verbose: bool,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Lint shaders and report best-practice violations.
+    Check {
+        #[command(flatten)]
+        common: Common,
+        /// Ray payloads above this many bytes are reported (RT001).
+        #[arg(long)]
+        payload_budget: Option<u64>,
+        /// Warnings fail the run (exit 1) too.
+        #[arg(long)]
+        deny_warnings: bool,
+        /// Also apply this pipeline description (`*.pipeline.toml` files in
+        /// the walked directories are applied too).
+        #[arg(long)]
+        pipeline: Vec<PathBuf>,
+    },
+    /// Values kept alive across each trace, callable and ray-query site.
+    Live {
+        #[command(flatten)]
+        common: Common,
+    },
+    /// Recursion depth and stack size of a described pipeline (or of loose
+    /// shaders, assuming every trace reaches every shader).
+    Stack {
+        #[command(flatten)]
+        common: Common,
+        /// Create the pipeline on the Vulkan device and show what the driver
+        /// reports (`vkGetRayTracingShaderGroupStackSizeKHR`) beside the model.
+        #[arg(long)]
+        driver: bool,
+    },
+    /// Print payload, attribute and shader-record layouts with the best member order.
+    Layout {
+        #[command(flatten)]
+        common: Common,
+    },
+    /// List every rule.
+    Rules,
+    /// Print a rule's documentation.
+    Rule {
+        /// Code (RT001) or name (payload-over-budget).
+        code: String,
+    },
+}
+
+fn main() -> ExitCode {
+    let cli = match Cli::try_parse() {
+        Ok(c) => c,
+        Err(e) => {
+            let _ = e.print();
+            return if e.use_stderr() {
+                ExitCode::from(2)
+            } else {
+                ExitCode::SUCCESS
+            };
+        }
+    };
+    match run(cli) {
+        Ok(code) => ExitCode::from(code),
+        Err(msg) => {
+            eprintln!("error: {msg}");
+            ExitCode::from(2)
+        }
     }
-    for g in &p.globals {
-        println!(
-            "global {:?} {:?} ty={} loc={:?}",
-            g.name,
-            g.storage,
-            p.type_name(g.ty),
-            p.var_location(g.id).map(|l| l.to_string())
-        );
+}
+
+fn run(cli: Cli) -> Result<u8, String> {
+    match cli.command {
+        Command::Check {
+            common,
+            payload_budget,
+            deny_warnings,
+            pipeline,
+        } => check(common, payload_budget, deny_warnings, pipeline),
+        Command::Live { common } => live(common),
+        Command::Stack { common, driver } => stack(common, driver),
+        Command::Layout { common } => layout(common),
+        Command::Rules => {
+            let mut out = std::io::stdout().lock();
+            for r in rtlint::rules::RULES {
+                let _ = writeln!(
+                    out,
+                    "{}  {:<28} {:<8} {}",
+                    r.code,
+                    r.name,
+                    r.level.as_str(),
+                    r.summary
+                );
+            }
+            Ok(0)
+        }
+        Command::Rule { code } => match rtlint::rules::find(&code) {
+            Some(r) => {
+                print!("{}", r.doc);
+                Ok(0)
+            }
+            None => Err(format!("unknown rule `{code}` (`rtlint rules` lists them)")),
+        },
     }
-    for s in &p.sites {
-        println!(
-            "site {:?} {:?} {:?} payload={:?} loc={:?}",
-            s.kind,
-            p.functions[s.function].name,
-            s.trace,
-            s.payload,
-            p.site_location(s.inst).map(|l| l.to_string())
-        );
+}
+
+/// Settings shared by every subcommand that reads shaders.
+struct Setup {
+    format: Format,
+    config: Config,
+    inputs: lint::Inputs,
+    /// Input errors found before any file was read (bad config).
+    errors: Vec<Diagnostic>,
+}
+
+fn setup(common: &Common) -> Result<Setup, String> {
+    let format = Format::parse(&common.format).ok_or_else(|| {
+        format!(
+            "unknown format `{}` (expected human, json, github or sarif)",
+            common.format
+        )
+    })?;
+    let forced = match &common.lang {
+        Some(l) => Some(
+            Language::parse(l)
+                .ok_or_else(|| format!("unknown language `{l}` (expected hlsl, wgsl or spirv)"))?,
+        ),
+        None => None,
+    };
+    let mut errors = Vec::new();
+    let config_path = common
+        .config
+        .clone()
+        .or_else(|| common.paths.first().and_then(|p| Config::discover(p)));
+    let config = match config_path {
+        Some(p) => match Config::load(&p) {
+            Ok(c) => c,
+            Err(e) => {
+                errors.push(*e.0);
+                Config::default()
+            }
+        },
+        None => Config::default(),
+    };
+    let inputs = lint::collect_inputs(&common.paths, &config, forced);
+    Ok(Setup {
+        format,
+        config,
+        inputs,
+        errors,
+    })
+}
+
+fn check(
+    common: Common,
+    payload_budget: Option<u64>,
+    deny_warnings: bool,
+    pipelines: Vec<PathBuf>,
+) -> Result<u8, String> {
+    let Setup {
+        format,
+        mut config,
+        mut inputs,
+        errors,
+    } = setup(&common)?;
+    inputs.pipelines.extend(pipelines);
+    if let Some(b) = payload_budget {
+        config.payload_budget = b;
     }
-    for (d, pos) in &p.decl_pos {
-        println!("decl {:?} {}", d, p.location(*pos));
+    config.deny_warnings |= deny_warnings;
+    let mut diagnostics = errors;
+    diagnostics.extend(inputs.errors.iter().map(|e| (*e.0).clone()));
+    let mut sources = Sources::default();
+    for input in &inputs.files {
+        let checked = lint::check_input(input, &config);
+        if let Some(p) = &checked.program {
+            sources.add_program(p);
+        }
+        diagnostics.extend(checked.diagnostics);
     }
+    for p in &inputs.pipelines {
+        diagnostics.extend(lint::check_pipeline(p, &config).diagnostics);
+    }
+    let summary = Summary::count(inputs.files.len() + inputs.pipelines.len(), &diagnostics);
+    emit(
+        format,
+        &diagnostics,
+        &summary,
+        &mut sources,
+        common.verbose.then_some(&inputs.skipped),
+    )?;
+    Ok(exit_code(&diagnostics, &config))
+}
+
+fn exit_code(diagnostics: &[Diagnostic], config: &Config) -> u8 {
+    if diagnostics.iter().any(|d| d.code.is_none()) {
+        2
+    } else if diagnostics.iter().any(|d| {
+        d.severity == Severity::Error || (config.deny_warnings && d.severity == Severity::Warning)
+    }) {
+        1
+    } else {
+        0
+    }
+}
+
+fn emit(
+    format: Format,
+    diagnostics: &[Diagnostic],
+    summary: &Summary,
+    sources: &mut Sources,
+    skipped: Option<&Vec<PathBuf>>,
+) -> Result<(), String> {
+    let io = |e: std::io::Error| format!("cannot write output: {e}");
+    match format {
+        Format::Human => {
+            let mut out = StandardStream::stdout(color_choice());
+            if let Some(skipped) = skipped {
+                for p in skipped {
+                    writeln!(
+                        out,
+                        "note: skipped {} (not a shader extension)",
+                        p.display()
+                    )
+                    .map_err(io)?;
+                }
+            }
+            report::human::render(diagnostics, sources, &mut out).map_err(io)?;
+            writeln!(out, "{}", report::human::summary_line(summary)).map_err(io)?;
+        }
+        Format::Json => println!("{}", report::json::render(diagnostics, summary)),
+        Format::Github => print!("{}", report::github(diagnostics)),
+        Format::Sarif => println!("{}", report::sarif::render(diagnostics)),
+    }
+    Ok(())
+}
+
+fn color_choice() -> ColorChoice {
+    if std::env::var_os("NO_COLOR").is_some()
+        || !std::io::IsTerminal::is_terminal(&std::io::stdout())
+    {
+        ColorChoice::Never
+    } else {
+        ColorChoice::Auto
+    }
+}
+
+fn layout(common: Common) -> Result<u8, String> {
+    let Setup {
+        format,
+        inputs,
+        errors,
+        ..
+    } = setup(&common)?;
+    if matches!(format, Format::Github | Format::Sarif) {
+        return Err("`rtlint layout` prints human or json".into());
+    }
+    let mut problems: Vec<Diagnostic> = errors;
+    problems.extend(inputs.errors.iter().map(|e| (*e.0).clone()));
+    let mut files = Vec::new();
+    for input in &inputs.files {
+        match rtlint::front::load(&input.path, input.language) {
+            Ok(p) => files.push(rtlint::analysis::layout::FileLayouts::new(&p)),
+            Err(InputError(d)) => problems.push(*d),
+        }
+    }
+    match format {
+        Format::Json => {
+            let errors: Vec<_> = problems.iter().map(report::json::diagnostic).collect();
+            let v = serde_json::json!({ "files": files, "errors": errors });
+            println!("{}", serde_json::to_string_pretty(&v).unwrap_or_default());
+        }
+        _ => {
+            let mut out = StandardStream::stdout(color_choice());
+            for f in &files {
+                write!(out, "{}", f.render_human()).map_err(|e| e.to_string())?;
+            }
+            let mut sources = Sources::default();
+            report::human::render(&problems, &mut sources, &mut out).map_err(|e| e.to_string())?;
+        }
+    }
+    Ok(if problems.is_empty() { 0 } else { 2 })
+}
+
+fn live(common: Common) -> Result<u8, String> {
+    let Setup {
+        format,
+        inputs,
+        errors,
+        ..
+    } = setup(&common)?;
+    let mut problems: Vec<Diagnostic> = errors;
+    problems.extend(inputs.errors.iter().map(|e| (*e.0).clone()));
+    let mut programs = Vec::new();
+    for input in &inputs.files {
+        match rtlint::front::load(&input.path, input.language) {
+            Ok(p) => programs.push(p),
+            Err(InputError(d)) => problems.push(*d),
+        }
+    }
+    let report = rtlint::analysis::live_report(&programs);
+    print_report(
+        format,
+        &report,
+        rtlint::analysis::liveness::render_human(&report),
+        &problems,
+    )
+}
+
+fn stack(common: Common, driver: bool) -> Result<u8, String> {
+    let Setup {
+        format,
+        inputs,
+        errors,
+        ..
+    } = setup(&common)?;
+    let mut problems: Vec<Diagnostic> = errors;
+    problems.extend(inputs.errors.iter().map(|e| (*e.0).clone()));
+    let mut pipelines = Vec::new();
+    for p in &inputs.pipelines {
+        match rtlint::pipeline::load(p) {
+            Ok(p) => pipelines.push(p),
+            Err(InputError(d)) => problems.push(*d),
+        }
+    }
+    // Loose shaders: one conservative pipeline over all of them.
+    if !inputs.files.is_empty() {
+        let mut programs = Vec::new();
+        for input in &inputs.files {
+            match rtlint::front::load(&input.path, input.language) {
+                Ok(p) => programs.push(p),
+                Err(InputError(d)) => problems.push(*d),
+            }
+        }
+        if !programs.is_empty() {
+            pipelines.push(rtlint::pipeline::Pipeline::from_programs(programs));
+        }
+    }
+    #[cfg(feature = "vulkan")]
+    let device = if driver {
+        Some(rtlint::vk::Context::new().map_err(|e| format!("--driver: {e}"))?)
+    } else {
+        None
+    };
+    #[cfg(not(feature = "vulkan"))]
+    if driver {
+        return Err("--driver needs rtlint built with the `vulkan` feature".into());
+    }
+    let mut reports = Vec::new();
+    for p in &pipelines {
+        #[allow(unused_mut)]
+        let mut r = rtlint::analysis::stack_report(p);
+        #[cfg(feature = "vulkan")]
+        if let Some(ctx) = &device {
+            let sizes = rtlint::vk::driver_stack_sizes(ctx, p).map_err(|e| {
+                format!(
+                    "--driver: creating the pipeline on {} failed: {e}",
+                    ctx.info().name
+                )
+            })?;
+            rtlint::analysis::stack::attach_driver(&mut r, p, &sizes);
+            r.assumptions.push(format!(
+                "driver: {} ({})",
+                ctx.info().name,
+                ctx.info().driver
+            ));
+        }
+        reports.push(r);
+    }
+    let human: String = reports
+        .iter()
+        .map(rtlint::analysis::stack::render_human)
+        .collect::<Vec<_>>()
+        .join("\n");
+    let value = if reports.len() == 1 {
+        serde_json::to_value(&reports[0])
+    } else {
+        serde_json::to_value(&reports)
+    }
+    .map_err(|e| e.to_string())?;
+    print_report(format, &value, human, &problems)
+}
+
+/// Prints a report as JSON or text, then any input errors; exit 2 on errors.
+fn print_report<T: serde::Serialize>(
+    format: Format,
+    value: &T,
+    human: String,
+    problems: &[Diagnostic],
+) -> Result<u8, String> {
+    match format {
+        Format::Json => {
+            let mut v = serde_json::to_value(value).map_err(|e| e.to_string())?;
+            if let Some(obj) = v.as_object_mut() {
+                obj.insert(
+                    "errors".into(),
+                    serde_json::to_value(
+                        problems
+                            .iter()
+                            .map(report::json::diagnostic)
+                            .collect::<Vec<_>>(),
+                    )
+                    .map_err(|e| e.to_string())?,
+                );
+            }
+            println!("{}", serde_json::to_string_pretty(&v).unwrap_or_default());
+        }
+        Format::Human => {
+            let mut out = StandardStream::stdout(color_choice());
+            write!(out, "{human}").map_err(|e| e.to_string())?;
+            report::human::render(problems, &mut Sources::default(), &mut out)
+                .map_err(|e| e.to_string())?;
+        }
+        _ => return Err("this command prints human or json".into()),
+    }
+    Ok(if problems.is_empty() { 0 } else { 2 })
 }

@@ -3,6 +3,7 @@
 //! original source.
 
 pub mod hlsl;
+pub mod slang;
 pub mod spirv;
 pub mod wgsl;
 

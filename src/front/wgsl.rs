@@ -13,6 +13,34 @@ pub fn parse(
     source: &str,
     path: &Path,
 ) -> Result<(naga::Module, naga::valid::ModuleInfo), InputError> {
+    guard(path, "parse", || parse_unguarded(source, path))
+}
+
+/// Runs naga, turning a panic inside it into an input error: rtlint reports
+/// bad input, it does not crash on it.
+fn guard<T>(
+    path: &Path,
+    what: &str,
+    f: impl FnOnce() -> Result<T, InputError>,
+) -> Result<T, InputError> {
+    std::panic::catch_unwind(std::panic::AssertUnwindSafe(f)).unwrap_or_else(|payload| {
+        let msg = payload
+            .downcast_ref::<&str>()
+            .map(|s| s.to_string())
+            .or_else(|| payload.downcast_ref::<String>().cloned())
+            .unwrap_or_default();
+        Err(InputError::new(
+            "wgsl-internal",
+            path,
+            format!("naga failed to {what} this module (internal error: {msg})"),
+        ))
+    })
+}
+
+fn parse_unguarded(
+    source: &str,
+    path: &Path,
+) -> Result<(naga::Module, naga::valid::ModuleInfo), InputError> {
     let module = naga::front::wgsl::parse_str(source).map_err(|e| {
         let mut err = InputError::new("wgsl-parse", path, e.message().to_string());
         let mut labels = e.labels();
@@ -187,12 +215,14 @@ pub fn write_spirv(
         trace_ray_argument_validation: false,
         ..Default::default()
     };
-    spv::write_vec(module, info, &options, None).map_err(|e| {
-        InputError::new(
-            "wgsl-spirv-out",
-            path,
-            format!("naga could not write SPIR-V for this module: {e}"),
-        )
+    guard(path, "write SPIR-V for", || {
+        spv::write_vec(module, info, &options, None).map_err(|e| {
+            InputError::new(
+                "wgsl-spirv-out",
+                path,
+                format!("naga could not write SPIR-V for this module: {e}"),
+            )
+        })
     })
 }
 

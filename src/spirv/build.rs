@@ -11,6 +11,7 @@ use std::path::Path;
 
 /// `NonSemantic.Shader.DebugInfo.100` instruction numbers we read.
 mod dbg {
+    pub const COMPILATION_UNIT: u32 = 1;
     pub const TYPE_COMPOSITE: u32 = 10;
     pub const TYPE_MEMBER: u32 = 11;
     pub const GLOBAL_VARIABLE: u32 = 18;
@@ -84,6 +85,10 @@ pub fn parse(words: &[u32], path: &Path, language: Language) -> Result<Program, 
                 ),
             ));
         }
+        let opcode = words[i] & 0xffff;
+        if Op::from_u32(opcode).is_none() {
+            return Err(err(path, format!("unknown opcode {opcode} at word {i}")));
+        }
         offsets.push(i as u32);
         i += count;
     }
@@ -129,6 +134,7 @@ pub fn parse(words: &[u32], path: &Path, language: Language) -> Result<Program, 
             path: path.to_path_buf(),
             language,
             version: (major, minor),
+            words: words.to_vec(),
             insts: c.insts,
             offsets,
             locs: Vec::new(),
@@ -161,6 +167,7 @@ pub fn parse(words: &[u32], path: &Path, language: Language) -> Result<Program, 
     b.functions()?;
     b.link_debug_composites();
     b.sites();
+    super::textdecl::fill(&mut b.p);
     Ok(b.p)
 }
 
@@ -445,6 +452,18 @@ impl Builder<'_> {
         // Operands after (set, instruction) are ids; shift by 2.
         let r = inst.result_id.unwrap_or(0);
         match which {
+            dbg::COMPILATION_UNIT => {
+                // Version, DWARF version, source, language (a constant id).
+                let lang = self.const_u32(id_at(inst, 5));
+                if self.p.language == Language::Spirv {
+                    self.p.language = match lang {
+                        1 | 2 => Language::Glsl,
+                        5 => Language::Hlsl,
+                        10 => Language::Wgsl,
+                        _ => Language::Spirv,
+                    };
+                }
+            }
             dbg::SOURCE => {
                 if let Some(f) = id_at(inst, 2).and_then(|s| self.file_for_string(s)) {
                     if let Some(text) = id_at(inst, 3).and_then(|t| self.strings.get(&t)).cloned() {

@@ -8,6 +8,29 @@ use std::path::{Path, PathBuf};
 /// exists, else beside the module, else its file name beside the module, else
 /// as written (the report then shows no snippet).
 pub fn resolve_path(named: &str, module_path: &Path) -> PathBuf {
+    normalize(&resolve_unnormalized(named, module_path))
+}
+
+/// Removes `.` and `name/..` lexically, so messages show `a/c` for `a/b/../c`.
+pub fn normalize(p: &Path) -> PathBuf {
+    use std::path::Component;
+    let mut out: Vec<Component> = Vec::new();
+    for c in p.components() {
+        match c {
+            Component::CurDir => {}
+            Component::ParentDir if matches!(out.last(), Some(Component::Normal(_))) => {
+                out.pop();
+            }
+            c => out.push(c),
+        }
+    }
+    if out.is_empty() {
+        return PathBuf::from(".");
+    }
+    out.iter().collect()
+}
+
+fn resolve_unnormalized(named: &str, module_path: &Path) -> PathBuf {
     let p = Path::new(named);
     if p.is_absolute() && p.exists() {
         return p.to_path_buf();
@@ -29,6 +52,9 @@ pub fn resolve_path(named: &str, module_path: &Path) -> PathBuf {
 /// The name of a type in the source language's spelling.
 pub fn type_name(program: &Program, id: Id, lang: Language) -> String {
     let wgsl = lang == Language::Wgsl;
+    if lang == Language::Glsl {
+        return glsl_type_name(program, id);
+    }
     let scalar = |t: &Type| -> String {
         match (t, wgsl) {
             (Type::Bool, _) => "bool".into(),
@@ -173,5 +199,64 @@ pub fn type_name(program: &Program, id: Id, lang: Language) -> String {
             Type::Function { .. } => "function".into(),
             Type::Other(op) => (*op).into(),
         },
+    }
+}
+
+fn glsl_scalar(t: Option<&Type>) -> (&'static str, String) {
+    // (vector prefix, scalar name)
+    match t {
+        Some(Type::Bool) => ("b", "bool".into()),
+        Some(Type::Int {
+            width: 32,
+            signed: true,
+        }) => ("i", "int".into()),
+        Some(Type::Int {
+            width: 32,
+            signed: false,
+        }) => ("u", "uint".into()),
+        Some(Type::Int {
+            width,
+            signed: true,
+        }) => ("i", format!("int{width}_t")),
+        Some(Type::Int {
+            width,
+            signed: false,
+        }) => ("u", format!("uint{width}_t")),
+        Some(Type::Float { width: 32 }) => ("", "float".into()),
+        Some(Type::Float { width: 64 }) => ("d", "double".into()),
+        Some(Type::Float { width }) => ("", format!("float{width}_t")),
+        _ => ("", "?".into()),
+    }
+}
+
+fn glsl_type_name(program: &Program, id: Id) -> String {
+    match program.ty(id) {
+        Some(t @ (Type::Bool | Type::Int { .. } | Type::Float { .. })) => glsl_scalar(Some(t)).1,
+        Some(Type::Vector { elem, count }) => match program.ty(*elem) {
+            Some(Type::Float { width: 16 }) => format!("f16vec{count}"),
+            Some(Type::Int { width: 16, signed }) => {
+                format!("{}16vec{count}", if *signed { "i" } else { "u" })
+            }
+            e => format!("{}vec{count}", glsl_scalar(e).0),
+        },
+        Some(Type::Matrix { column, columns }) => {
+            let (prefix, rows) = match program.ty(*column) {
+                Some(Type::Vector { elem, count }) => (glsl_scalar(program.ty(*elem)).0, *count),
+                _ => ("", 0),
+            };
+            if rows == *columns {
+                format!("{prefix}mat{columns}")
+            } else {
+                format!("{prefix}mat{columns}x{rows}")
+            }
+        }
+        Some(Type::Array { elem, len }) => {
+            let n = len.value().map(|v| v.to_string()).unwrap_or_default();
+            format!("{}[{n}]", glsl_type_name(program, *elem))
+        }
+        Some(Type::RuntimeArray { elem }) => format!("{}[]", glsl_type_name(program, *elem)),
+        Some(Type::AccelerationStructure) => "accelerationStructureEXT".into(),
+        Some(Type::RayQuery) => "rayQueryEXT".into(),
+        _ => type_name(program, id, Language::Hlsl),
     }
 }

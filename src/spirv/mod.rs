@@ -8,6 +8,7 @@
 
 mod build;
 pub mod debug;
+mod textdecl;
 pub mod types;
 
 pub use build::parse;
@@ -21,6 +22,9 @@ use std::collections::HashMap;
 use std::path::PathBuf;
 
 pub type Id = u32;
+
+/// Decorations with their literal operands.
+pub type Decorations = Vec<(spirv::Decoration, Vec<u32>)>;
 
 /// A position in one of the module's debug-info source files.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -242,6 +246,8 @@ pub struct Program {
     /// The language of the original source, from `OpSource` or the front-end.
     pub language: Language,
     pub version: (u8, u8),
+    /// The module as read, for handing to a driver.
+    pub words: Vec<u32>,
     pub insts: Vec<Instruction>,
     /// Word offset of each instruction in the binary.
     pub offsets: Vec<u32>,
@@ -252,8 +258,8 @@ pub struct Program {
     pub names: HashMap<Id, String>,
     pub member_names: HashMap<(Id, u32), String>,
     /// `OpDecorate` on ids: decoration and its literal operands.
-    pub decorations: HashMap<Id, Vec<(spirv::Decoration, Vec<u32>)>>,
-    pub member_decorations: HashMap<(Id, u32), Vec<(spirv::Decoration, Vec<u32>)>>,
+    pub decorations: HashMap<Id, Decorations>,
+    pub member_decorations: HashMap<(Id, u32), Decorations>,
     pub constants: HashMap<Id, Constant>,
     /// Default values of specialization constants.
     pub spec_constants: HashMap<Id, Constant>,

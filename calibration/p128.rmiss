@@ -1,0 +1,7 @@
+#version 460
+#extension GL_EXT_ray_tracing : require
+struct Payload { uint data[32]; };
+layout(location = 0) rayPayloadInEXT Payload payload;
+void main() {
+    for (uint i = 0u; i < 32; i++) { payload.data[i] = 7u; }
+}

@@ -1,0 +1,15 @@
+#![no_main]
+//! Any text: compiled and analysed, or an input error.
+use libfuzzer_sys::fuzz_target;
+use std::path::Path;
+
+fuzz_target!(|data: &[u8]| {
+    if let Ok(src) = std::str::from_utf8(data) {
+        let path = Path::new("fuzz.wgsl");
+        if let Ok(words) = rtlint::front::wgsl::compile(src, path) {
+            if let Ok(p) = rtlint::spirv::parse(&words, path, rtlint::front::Language::Wgsl) {
+                let _ = rtlint::rules::check_program(&p, &rtlint::config::Config::default());
+            }
+        }
+    }
+});

@@ -1,0 +1,373 @@
+//! The trace graph of a pipeline: which shader each trace or callable site
+//! can invoke.
+//!
+//! A trace selects its hit group by `instanceOffset + sbtOffset +
+//! sbtStride × geometryIndex` and its miss shader by `missIndex`. When a
+//! description gives the instances and the operands are constants, the
+//! targets are resolved exactly; otherwise every group (or miss shader) is a
+//! target and the graph says so. Constant ray flags prune targets: skipping
+//! closest-hit shaders, opaque rays (no any-hit), culled triangles or AABBs.
+
+use crate::diag::Location;
+use crate::pipeline::{HitGroupKind, Pipeline, ShaderRef};
+use crate::spirv::{Operandish, SiteKind, Stage};
+
+/// `SkipClosestHitShaderKHR` and the flags that remove any-hit or geometry.
+const FLAG_OPAQUE: u64 = 0x1;
+const FLAG_NO_OPAQUE: u64 = 0x2;
+const FLAG_SKIP_CLOSEST_HIT: u64 = 0x8;
+const FLAG_SKIP_TRIANGLES: u64 = 0x100;
+const FLAG_SKIP_AABBS: u64 = 0x200;
+
+/// Where a shader sits in the pipeline.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Serialize)]
+#[serde(rename_all = "snake_case", tag = "slot", content = "index")]
+pub enum Slot {
+    Raygen(usize),
+    Miss(usize),
+    /// Hit group index; the node's stage says which shader of the group.
+    HitGroup(usize),
+    Callable(usize),
+}
+
+#[derive(Clone, Debug)]
+pub struct Node {
+    pub shader: ShaderRef,
+    pub slot: Slot,
+}
+
+impl Node {
+    /// `closesthit `main` (hit group 0)`-style name for messages.
+    pub fn describe(&self) -> String {
+        let slot = match self.slot {
+            Slot::Raygen(i) => format!("raygen {i}"),
+            Slot::Miss(i) => format!("miss {i}"),
+            Slot::HitGroup(i) => format!("hit group {i}"),
+            Slot::Callable(i) => format!("callable {i}"),
+        };
+        format!(
+            "{} `{}` ({slot})",
+            self.shader.stage.as_str(),
+            self.shader.entry
+        )
+    }
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum EdgeKind {
+    Trace,
+    Callable,
+}
+
+#[derive(Clone, Debug)]
+pub struct Edge {
+    pub from: usize,
+    pub to: usize,
+    pub kind: EdgeKind,
+    /// The site: index of the program and of the instruction.
+    pub program: usize,
+    pub inst: usize,
+    pub location: Option<Location>,
+}
+
+#[derive(Clone, Debug, Default)]
+pub struct TraceGraph {
+    pub nodes: Vec<Node>,
+    pub edges: Vec<Edge>,
+    /// What the graph had to assume (unresolved SBT operands, no description).
+    pub assumptions: Vec<String>,
+    /// Sites selecting a group or miss shader the pipeline does not have.
+    pub out_of_range: Vec<(Option<Location>, String)>,
+}
+
+impl TraceGraph {
+    pub fn edges_from(&self, n: usize) -> impl Iterator<Item = &Edge> {
+        self.edges.iter().filter(move |e| e.from == n)
+    }
+
+    pub fn traces(&self) -> impl Iterator<Item = &Edge> {
+        self.edges.iter().filter(|e| e.kind == EdgeKind::Trace)
+    }
+}
+
+/// Builds the trace graph of a pipeline.
+pub fn trace_graph(pipeline: &Pipeline) -> TraceGraph {
+    let mut g = TraceGraph::default();
+    for (i, s) in pipeline.raygen.iter().enumerate() {
+        g.nodes.push(Node {
+            shader: s.clone(),
+            slot: Slot::Raygen(i),
+        });
+    }
+    for (i, s) in pipeline.miss.iter().enumerate() {
+        g.nodes.push(Node {
+            shader: s.clone(),
+            slot: Slot::Miss(i),
+        });
+    }
+    for (i, group) in pipeline.hit_groups.iter().enumerate() {
+        for s in group.shaders() {
+            g.nodes.push(Node {
+                shader: s.clone(),
+                slot: Slot::HitGroup(i),
+            });
+        }
+    }
+    for (i, s) in pipeline.callable.iter().enumerate() {
+        g.nodes.push(Node {
+            shader: s.clone(),
+            slot: Slot::Callable(i),
+        });
+    }
+    if !pipeline.described() {
+        g.assumptions.push(
+            "no pipeline description: every trace may reach every hit group and miss shader".into(),
+        );
+    }
+    let described = pipeline.described();
+    for from in 0..g.nodes.len() {
+        let shader = g.nodes[from].shader.clone();
+        let Some(program) = pipeline.program(&shader) else {
+            continue;
+        };
+        let reach = program.reachable_functions(shader.function);
+        for site in &program.sites {
+            let Some(f) = program.functions.get(site.function) else {
+                continue;
+            };
+            if !reach.contains(&f.id) {
+                continue;
+            }
+            let location = program.site_location(site.inst);
+            let at = location
+                .as_ref()
+                .map(|l| format!(" at {l}"))
+                .unwrap_or_default();
+            let mut targets: Vec<usize> = Vec::new();
+            let kind = match site.kind {
+                SiteKind::TraceRay => EdgeKind::Trace,
+                SiteKind::ExecuteCallable => EdgeKind::Callable,
+                _ => continue,
+            };
+            if let (EdgeKind::Trace, Some(t)) = (kind, site.trace) {
+                let flags = t.ray_flags.constant().unwrap_or(0);
+                let dynamic_flags = t.ray_flags.constant().is_none();
+                let opaque = !dynamic_flags
+                    && (flags & FLAG_OPAQUE != 0
+                        || (pipeline.all_geometry_opaque && flags & FLAG_NO_OPAQUE == 0));
+                let skip_ch = !dynamic_flags && flags & FLAG_SKIP_CLOSEST_HIT != 0;
+                let skip_tri = !dynamic_flags && flags & FLAG_SKIP_TRIANGLES != 0;
+                let skip_aabb = !dynamic_flags && flags & FLAG_SKIP_AABBS != 0;
+                let groups: Vec<usize> = match (
+                    described,
+                    const_of(t.sbt_offset),
+                    const_of(t.sbt_stride),
+                ) {
+                    (true, Some(off), Some(stride)) => {
+                        let mut v = Vec::new();
+                        for &inst in &pipeline.instance_sbt_offsets {
+                            for geo in 0..u64::from(pipeline.geometries_per_instance) {
+                                let idx = u64::from(inst) + off + stride * geo;
+                                if (idx as usize) < pipeline.hit_groups.len() {
+                                    if !v.contains(&(idx as usize)) {
+                                        v.push(idx as usize);
+                                    }
+                                } else {
+                                    g.out_of_range.push((
+                                            location.clone(),
+                                            format!("trace{at} selects hit group {idx}, the pipeline has {}", pipeline.hit_groups.len()),
+                                        ));
+                                }
+                            }
+                        }
+                        v
+                    }
+                    (true, _, _) => {
+                        g.assumptions.push(format!(
+                                "trace{at} has a SBT offset or stride unknown at compile time: it may reach every hit group"
+                            ));
+                        (0..pipeline.hit_groups.len()).collect()
+                    }
+                    _ => (0..pipeline.hit_groups.len()).collect(),
+                };
+                for (n, node) in g.nodes.iter().enumerate() {
+                    let Slot::HitGroup(gi) = node.slot else {
+                        continue;
+                    };
+                    if !groups.contains(&gi) {
+                        continue;
+                    }
+                    let group_kind = pipeline.hit_groups.get(gi).map(|h| h.kind);
+                    let culled = match group_kind {
+                        Some(HitGroupKind::Triangles) => skip_tri,
+                        Some(HitGroupKind::Procedural) => skip_aabb,
+                        None => true,
+                    };
+                    let wanted = match node.shader.stage {
+                        Stage::ClosestHit => !skip_ch,
+                        Stage::AnyHit => !opaque,
+                        _ => true,
+                    };
+                    if wanted && !culled {
+                        targets.push(n);
+                    }
+                }
+                let misses: Vec<usize> = match (described, const_of(t.miss_index)) {
+                    (true, Some(m)) => {
+                        if (m as usize) >= pipeline.miss.len() {
+                            g.out_of_range.push((
+                                location.clone(),
+                                format!(
+                                    "trace{at} selects miss shader {m}, the pipeline has {}",
+                                    pipeline.miss.len()
+                                ),
+                            ));
+                        }
+                        vec![m as usize]
+                    }
+                    (true, None) => {
+                        g.assumptions.push(format!(
+                            "trace{at} has a miss index unknown at compile time: it may reach every miss shader"
+                        ));
+                        (0..pipeline.miss.len()).collect()
+                    }
+                    _ => (0..pipeline.miss.len()).collect(),
+                };
+                for (n, node) in g.nodes.iter().enumerate() {
+                    if matches!(node.slot, Slot::Miss(m) if misses.contains(&m)) {
+                        targets.push(n);
+                    }
+                }
+            } else {
+                let callables: Vec<usize> = match (
+                    described,
+                    site.sbt_index.as_ref().and_then(|o| const_of(*o)),
+                ) {
+                    (true, Some(c)) => vec![c as usize],
+                    _ => (0..pipeline.callable.len()).collect(),
+                };
+                for (n, node) in g.nodes.iter().enumerate() {
+                    if matches!(node.slot, Slot::Callable(c) if callables.contains(&c)) {
+                        targets.push(n);
+                    }
+                }
+            }
+            for to in targets {
+                g.edges.push(Edge {
+                    from,
+                    to,
+                    kind,
+                    program: shader.program,
+                    inst: site.inst,
+                    location: location.clone(),
+                });
+            }
+        }
+    }
+    g.assumptions.sort();
+    g.assumptions.dedup();
+    g
+}
+
+/// A constant operand; a specialization constant counts with its default.
+fn const_of(o: Operandish) -> Option<u64> {
+    match o {
+        Operandish::Const(v) => Some(v),
+        Operandish::Spec { default, .. } => Some(default),
+        Operandish::Dynamic(_) => None,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::pipeline::load;
+    use std::path::Path;
+
+    fn pipeline(rel: &str) -> Pipeline {
+        load(&Path::new(env!("CARGO_MANIFEST_DIR")).join(rel)).unwrap()
+    }
+
+    fn edges(g: &TraceGraph) -> Vec<(String, String)> {
+        let mut v: Vec<_> = g
+            .edges
+            .iter()
+            .map(|e| (g.nodes[e.from].describe(), g.nodes[e.to].describe()))
+            .collect();
+        v.sort();
+        v
+    }
+
+    #[test]
+    fn recursive_reflection_edges() {
+        let g = trace_graph(&pipeline(
+            "fixtures/pipelines/reflect_recursive.pipeline.toml",
+        ));
+        // The shadow ray skips closest-hit shaders and goes to miss 1; the
+        // reflection ray reaches the group and miss 0.
+        assert_eq!(
+            edges(&g),
+            [
+                (
+                    "closesthit `main` (hit group 0)",
+                    "closesthit `main` (hit group 0)"
+                ),
+                ("closesthit `main` (hit group 0)", "miss `main` (miss 0)"),
+                ("closesthit `main` (hit group 0)", "miss `main` (miss 1)"),
+                (
+                    "raygeneration `main` (raygen 0)",
+                    "closesthit `main` (hit group 0)"
+                ),
+                ("raygeneration `main` (raygen 0)", "miss `main` (miss 0)"),
+            ]
+            .map(|(a, b)| (a.to_string(), b.to_string()))
+        );
+        assert!(g.assumptions.is_empty());
+    }
+
+    #[test]
+    fn without_description_all_targets() {
+        let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/pipelines/iterative");
+        let programs = ["reflect.rgen.spv", "reflect.rchit.spv", "shadow.rmiss.spv"]
+            .iter()
+            .map(|f| crate::front::load(&dir.join(f), crate::front::Language::Spirv).unwrap())
+            .collect();
+        let g = trace_graph(&Pipeline::from_programs(programs));
+        // The shadow ray still skips the closest hit; the miss index is not
+        // resolved without a description.
+        assert_eq!(g.edges.len(), 3);
+        assert_eq!(g.assumptions.len(), 1);
+    }
+
+    #[test]
+    fn instances_any_hit_and_opaque_geometry() {
+        let mut p = pipeline("fixtures/pipelines/procedural.pipeline.toml");
+        // Instance offsets 0 and 1 with stride 1 reach both groups; the ray
+        // is not opaque, so the alpha test runs.
+        let stages = |g: &TraceGraph| {
+            let mut v: Vec<&str> = g
+                .edges
+                .iter()
+                .map(|e| g.nodes[e.to].shader.stage.as_str())
+                .collect();
+            v.sort();
+            v
+        };
+        let g = trace_graph(&p);
+        assert_eq!(
+            stages(&g),
+            ["anyhit", "closesthit", "closesthit", "intersection", "miss"]
+        );
+        p.all_geometry_opaque = true;
+        assert_eq!(
+            stages(&trace_graph(&p)),
+            ["closesthit", "closesthit", "intersection", "miss"]
+        );
+        p.instance_sbt_offsets = vec![0];
+        assert_eq!(stages(&trace_graph(&p)), ["closesthit", "miss"]);
+        p.instance_sbt_offsets = vec![5];
+        let g = trace_graph(&p);
+        assert_eq!(stages(&g), ["miss"]);
+        assert_eq!(g.out_of_range.len(), 1);
+    }
+}

@@ -1,0 +1,13 @@
+//! Analyses: pure functions over a [`Program`](crate::spirv::Program) (and a
+//! [`Pipeline`](crate::pipeline::Pipeline) where the scene matters).
+
+pub mod callgraph;
+pub mod layout;
+pub mod liveness;
+pub mod recursion;
+pub mod scalar;
+pub mod stack;
+
+pub use liveness::{live_report, LiveReport};
+pub use recursion::{recursion, RecursionReport};
+pub use stack::{stack_report, StackReport};

@@ -1,0 +1,1279 @@
+//! Recursion depth of a pipeline, cycle bounds from depth guards, and loops
+//! that trace rays.
+//!
+//! Ray generation runs at level 0; a trace from a shader at level L invokes
+//! its targets at L + 1, and `maxPipelineRayRecursionDepth` must cover the
+//! deepest level. A cycle in the trace graph (a closest-hit shader that can
+//! reach itself) is bounded only when each trace on it is dominated by a
+//! comparison of a depth counter carried in the payload against a constant
+//! (or a push / specialization constant the description gives), and the
+//! counter grows along the cycle.
+
+use super::callgraph::{trace_graph, EdgeKind, TraceGraph};
+use crate::diag::Location;
+use crate::pipeline::{DescribedConstant, Pipeline};
+use crate::spirv::{Constant, Function, Id, Program, Stage, Type};
+use rspirv::dr::{Instruction, Operand};
+use spirv::{Op, StorageClass};
+use std::collections::{BTreeMap, HashMap, HashSet};
+
+/// A recognised depth guard on a trace that closes a cycle.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct Guard {
+    /// `payload.depth`-style name of the counter.
+    pub counter: String,
+    /// `<` or `<=`: the trace happens while `counter op bound`.
+    pub op: &'static str,
+    pub bound: i64,
+    /// Where the bound comes from, in words.
+    pub bound_source: String,
+    /// How much the counter grows per trace.
+    pub step: i64,
+    /// The counter's value where the cycle is entered.
+    pub initial: i64,
+    /// True when no constant initial store was found and 0 was assumed.
+    pub initial_assumed: bool,
+    /// How many times the cycle can trace in one chain.
+    pub traces: u64,
+    #[serde(skip)]
+    pub location: Option<Location>,
+}
+
+/// One trace site that closes a cycle.
+#[derive(Clone, Debug)]
+pub struct CycleSite {
+    pub program: usize,
+    pub inst: usize,
+    pub location: Option<Location>,
+    /// The guard, or why none was recognised.
+    pub guard: Result<Guard, String>,
+}
+
+/// A strongly connected part of the trace graph with a cycle.
+#[derive(Clone, Debug)]
+pub struct Cycle {
+    pub nodes: Vec<usize>,
+    pub sites: Vec<CycleSite>,
+    /// Extra levels the cycle adds; `None` when unbounded at compile time.
+    pub extra_levels: Option<u64>,
+}
+
+#[derive(Clone, Debug)]
+pub struct ChainStep {
+    pub node: usize,
+    /// The level the node is entered at.
+    pub level: u32,
+    /// Further levels reached by a bounded cycle through this node.
+    pub repeat: u64,
+    /// The trace that invoked it.
+    pub via: Option<Location>,
+}
+
+/// A trace from a closest-hit or miss shader.
+#[derive(Clone, Debug)]
+pub struct RecursiveSite {
+    pub node: usize,
+    pub program: usize,
+    pub inst: usize,
+    pub location: Option<Location>,
+}
+
+#[derive(Clone, Debug)]
+pub struct RecursionReport {
+    pub graph: TraceGraph,
+    /// Required `maxPipelineRayRecursionDepth`; `None` when unbounded.
+    pub required_depth: Option<u32>,
+    pub declared_depth: Option<u32>,
+    pub device_limit: u32,
+    /// The chain that needs the required depth.
+    pub chain: Vec<ChainStep>,
+    pub cycles: Vec<Cycle>,
+    /// Deepest level each node runs at (`None`: unreached or unbounded).
+    pub node_level: Vec<Option<u32>>,
+    pub recursive_sites: Vec<RecursiveSite>,
+}
+
+impl RecursionReport {
+    /// `raygeneration `main` → closesthit `main` ×4 → miss `main``.
+    pub fn chain_text(&self) -> String {
+        let parts: Vec<String> = self
+            .chain
+            .iter()
+            .map(|s| {
+                let name = self.graph.nodes[s.node].describe();
+                if s.repeat > 0 {
+                    format!("{name} at levels {}–{}", s.level, s.level as u64 + s.repeat)
+                } else {
+                    format!("{name} at level {}", s.level)
+                }
+            })
+            .collect();
+        parts.join(" → ")
+    }
+
+    pub fn unbounded_cycle(&self) -> Option<&Cycle> {
+        self.cycles.iter().find(|c| c.extra_levels.is_none())
+    }
+}
+
+/// Depth analysis of a pipeline.
+pub fn recursion(pipeline: &Pipeline) -> RecursionReport {
+    let graph = trace_graph(pipeline);
+    let n = graph.nodes.len();
+    let mut adj: Vec<Vec<usize>> = vec![Vec::new(); n];
+    for e in graph.traces() {
+        if !adj[e.from].contains(&e.to) {
+            adj[e.from].push(e.to);
+        }
+    }
+    let sccs = tarjan(&adj);
+    let mut scc_of = vec![0usize; n];
+    for (c, nodes) in sccs.iter().enumerate() {
+        for &v in nodes {
+            scc_of[v] = c;
+        }
+    }
+    // Cycles and their bounds.
+    let mut extra: Vec<Option<u64>> = vec![Some(0); sccs.len()];
+    let mut cycles = Vec::new();
+    for (c, nodes) in sccs.iter().enumerate() {
+        let cyclic: Vec<_> = graph
+            .traces()
+            .filter(|e| scc_of[e.from] == c && scc_of[e.to] == c)
+            .collect();
+        if cyclic.is_empty() {
+            continue;
+        }
+        let mut sites: Vec<CycleSite> = Vec::new();
+        for e in &cyclic {
+            if sites
+                .iter()
+                .any(|s| s.program == e.program && s.inst == e.inst)
+            {
+                continue;
+            }
+            let guard = recognise_guard(pipeline, &graph, &scc_of, c, e.from, e.inst);
+            sites.push(CycleSite {
+                program: e.program,
+                inst: e.inst,
+                location: e.location.clone(),
+                guard,
+            });
+        }
+        let bound = if sites.iter().all(|s| s.guard.is_ok()) {
+            // Sites sharing a counter share its budget; distinct counters add.
+            let mut per_counter: BTreeMap<&str, u64> = BTreeMap::new();
+            for g in sites.iter().filter_map(|s| s.guard.as_ref().ok()) {
+                let e = per_counter.entry(&g.counter).or_default();
+                *e = (*e).max(g.traces);
+            }
+            Some(per_counter.values().sum())
+        } else {
+            None
+        };
+        extra[c] = bound;
+        cycles.push(Cycle {
+            nodes: nodes.clone(),
+            sites,
+            extra_levels: bound,
+        });
+    }
+    // Levels in topological order (Tarjan yields sinks first).
+    #[derive(Clone, Copy)]
+    enum Lv {
+        Unreached,
+        At(u64),
+        Unbounded,
+    }
+    let mut entry = vec![Lv::Unreached; sccs.len()];
+    let mut pred: Vec<Option<(usize, usize)>> = vec![None; sccs.len()];
+    for c in (0..sccs.len()).rev() {
+        if sccs[c]
+            .iter()
+            .any(|&v| graph.nodes[v].shader.stage == Stage::RayGeneration)
+        {
+            entry[c] = Lv::At(0);
+        }
+        for (k, e) in graph.traces().enumerate() {
+            if scc_of[e.to] != c || scc_of[e.from] == c {
+                continue;
+            }
+            let from = scc_of[e.from];
+            // A guarded trace that closes the cycle stops tracing at the
+            // cycle's last level; other traces (shadow rays) leave from it.
+            let closes_cycle = cycles.iter().any(|cy: &Cycle| {
+                cy.nodes.contains(&e.from)
+                    && cy
+                        .sites
+                        .iter()
+                        .any(|s| s.program == e.program && s.inst == e.inst)
+            });
+            let top = match (entry[from], extra[from]) {
+                (Lv::At(_), Some(0)) if closes_cycle => Lv::Unreached,
+                (Lv::At(l), Some(x)) if closes_cycle => Lv::At(l + x),
+                (Lv::At(l), Some(x)) => Lv::At(l + x + 1),
+                (Lv::Unreached, _) => Lv::Unreached,
+                _ => Lv::Unbounded,
+            };
+            match (entry[c], top) {
+                (_, Lv::Unreached) | (Lv::Unbounded, _) => {}
+                (_, Lv::Unbounded) => {
+                    entry[c] = Lv::Unbounded;
+                    pred[c] = Some((k, from));
+                }
+                (Lv::Unreached, Lv::At(t)) => {
+                    entry[c] = Lv::At(t);
+                    pred[c] = Some((k, from));
+                }
+                (Lv::At(l), Lv::At(t)) => {
+                    if t > l {
+                        entry[c] = Lv::At(t);
+                        pred[c] = Some((k, from));
+                    }
+                }
+            }
+        }
+    }
+    let top_of = |c: usize| match (entry[c], extra[c]) {
+        (Lv::At(l), Some(x)) => Lv::At(l + x),
+        (Lv::Unreached, _) => Lv::Unreached,
+        _ => Lv::Unbounded,
+    };
+    let node_level: Vec<Option<u32>> = (0..n)
+        .map(|v| match top_of(scc_of[v]) {
+            Lv::At(l) => u32::try_from(l).ok(),
+            _ => None,
+        })
+        .collect();
+    let mut required = Some(0u64);
+    let mut deepest: Option<usize> = None;
+    for c in 0..sccs.len() {
+        match top_of(c) {
+            Lv::Unbounded => {
+                required = None;
+                deepest = Some(c);
+                break;
+            }
+            Lv::At(l) => {
+                if required.is_some_and(|r| l > r) || deepest.is_none() {
+                    required = Some(l.max(required.unwrap_or(0)));
+                    deepest = Some(c);
+                }
+            }
+            Lv::Unreached => {}
+        }
+    }
+    // The chain, back from the deepest part.
+    let mut chain = Vec::new();
+    let mut cur = deepest;
+    let traces: Vec<_> = graph.traces().collect();
+    let mut guard_steps = 0;
+    while let Some(c) = cur {
+        guard_steps += 1;
+        if guard_steps > sccs.len() + 1 {
+            break;
+        }
+        let (node, via) = match pred[c] {
+            Some((k, _)) => (traces[k].to, traces[k].location.clone()),
+            None => (sccs[c][0], None),
+        };
+        let level = match entry[c] {
+            Lv::At(l) => l as u32,
+            _ => 0,
+        };
+        chain.push(ChainStep {
+            node,
+            level,
+            repeat: extra[c].unwrap_or(0),
+            via,
+        });
+        cur = pred[c].map(|(_, from)| from);
+    }
+    chain.reverse();
+    let mut recursive_sites: Vec<RecursiveSite> = Vec::new();
+    for e in graph.traces() {
+        let stage = graph.nodes[e.from].shader.stage;
+        if matches!(stage, Stage::ClosestHit | Stage::Miss)
+            && !recursive_sites
+                .iter()
+                .any(|s| s.program == e.program && s.inst == e.inst)
+        {
+            recursive_sites.push(RecursiveSite {
+                node: e.from,
+                program: e.program,
+                inst: e.inst,
+                location: e.location.clone(),
+            });
+        }
+    }
+    RecursionReport {
+        required_depth: required.and_then(|r| u32::try_from(r).ok()),
+        declared_depth: pipeline.max_recursion_depth,
+        device_limit: pipeline.device_max_recursion_depth,
+        graph,
+        chain,
+        cycles,
+        node_level,
+        recursive_sites,
+    }
+}
+
+/// Strongly connected components, sinks first.
+fn tarjan(adj: &[Vec<usize>]) -> Vec<Vec<usize>> {
+    struct T<'a> {
+        adj: &'a [Vec<usize>],
+        index: Vec<Option<usize>>,
+        low: Vec<usize>,
+        on: Vec<bool>,
+        stack: Vec<usize>,
+        next: usize,
+        out: Vec<Vec<usize>>,
+    }
+    impl T<'_> {
+        fn visit(&mut self, v: usize) {
+            self.index[v] = Some(self.next);
+            self.low[v] = self.next;
+            self.next += 1;
+            self.stack.push(v);
+            self.on[v] = true;
+            for &w in &self.adj[v] {
+                match self.index[w] {
+                    None => {
+                        self.visit(w);
+                        self.low[v] = self.low[v].min(self.low[w]);
+                    }
+                    Some(i) if self.on[w] => self.low[v] = self.low[v].min(i),
+                    _ => {}
+                }
+            }
+            if Some(self.low[v]) == self.index[v] {
+                let mut c = Vec::new();
+                while let Some(w) = self.stack.pop() {
+                    self.on[w] = false;
+                    c.push(w);
+                    if w == v {
+                        break;
+                    }
+                }
+                c.sort_unstable();
+                self.out.push(c);
+            }
+        }
+    }
+    let n = adj.len();
+    let mut t = T {
+        adj,
+        index: vec![None; n],
+        low: vec![0; n],
+        on: vec![false; n],
+        stack: Vec::new(),
+        next: 0,
+        out: Vec::new(),
+    };
+    for v in 0..n {
+        if t.index[v].is_none() {
+            t.visit(v);
+        }
+    }
+    t.out
+}
+
+// ---------------------------------------------------------------------------
+// Values: counters, bounds, conditions.
+
+fn ids(inst: &Instruction) -> impl Iterator<Item = Id> + '_ {
+    inst.operands.iter().filter_map(|o| match o {
+        Operand::IdRef(x) => Some(*x),
+        _ => None,
+    })
+}
+
+/// What a depth or loop counter is.
+#[derive(Clone, Debug, PartialEq, Eq)]
+enum Counter {
+    /// A member path of the incoming payload.
+    Payload { var: Id, path: Vec<u64> },
+    /// A function-local variable.
+    Local(Id),
+}
+
+fn global(program: &Program, id: Id) -> Option<&crate::spirv::Global> {
+    program.globals.iter().find(|g| g.id == id)
+}
+
+/// The base variable and constant member path of a pointer.
+fn pointer_path(program: &Program, ptr: Id) -> Option<(Id, Vec<u64>)> {
+    let inst = program.def(ptr)?;
+    match inst.class.opcode {
+        Op::Variable => Some((ptr, Vec::new())),
+        Op::AccessChain | Op::InBoundsAccessChain => {
+            let v: Vec<Id> = ids(inst).collect();
+            let (&base, idx) = v.split_first()?;
+            let (root, mut path) = pointer_path(program, base)?;
+            for &i in idx {
+                path.push(program.const_u64(i)?);
+            }
+            Some((root, path))
+        }
+        Op::CopyObject => pointer_path(program, ids(inst).next()?),
+        _ => None,
+    }
+}
+
+fn strip_conversions(program: &Program, mut id: Id) -> Id {
+    for _ in 0..16 {
+        match program.def(id) {
+            Some(i)
+                if matches!(
+                    i.class.opcode,
+                    Op::Bitcast | Op::UConvert | Op::SConvert | Op::CopyObject
+                ) =>
+            {
+                id = ids(i).next().unwrap_or(id);
+            }
+            _ => break,
+        }
+    }
+    id
+}
+
+/// Stores to a local variable (whole-variable stores only).
+fn stores_to(program: &Program, f: &Function, var: Id) -> Vec<Id> {
+    program.insts[f.start..=f.end]
+        .iter()
+        .filter(|i| i.class.opcode == Op::Store)
+        .filter_map(|i| {
+            let v: Vec<Id> = ids(i).collect();
+            (v.first() == Some(&var))
+                .then(|| v.get(1).copied())
+                .flatten()
+        })
+        .collect()
+}
+
+fn counter_of(program: &Program, id: Id, depth: u32) -> Option<Counter> {
+    if depth > 8 {
+        return None;
+    }
+    let id = strip_conversions(program, id);
+    let inst = program.def(id)?;
+    if inst.class.opcode != Op::Load {
+        return None;
+    }
+    let ptr = ids(inst).next()?;
+    let (var, path) = pointer_path(program, ptr)?;
+    if let Some(g) = global(program, var) {
+        return (g.storage == StorageClass::IncomingRayPayloadKHR)
+            .then_some(Counter::Payload { var, path });
+    }
+    if !path.is_empty() {
+        return None;
+    }
+    // A local copy of the payload counter (`uint depth = payload.depth;`).
+    let f = program
+        .function_of(*program.defs.get(&var)?)
+        .and_then(|i| program.functions.get(i))?;
+    let stores = stores_to(program, f, var);
+    if let [only] = stores.as_slice() {
+        if let Some(c @ Counter::Payload { .. }) = counter_of(program, *only, depth + 1) {
+            return Some(c);
+        }
+    }
+    Some(Counter::Local(var))
+}
+
+fn counter_name(program: &Program, c: &Counter) -> String {
+    match c {
+        Counter::Local(v) => program.display_name(*v),
+        Counter::Payload { var, path } => {
+            let mut s = program.display_name(*var);
+            let mut ty = global(program, *var).map(|g| g.ty);
+            for &k in path {
+                match ty.and_then(|t| program.ty(t)) {
+                    Some(Type::Struct { members }) => {
+                        s.push('.');
+                        s.push_str(&program.member_name(ty.unwrap_or(0), k as u32));
+                        ty = members.get(k as usize).copied();
+                    }
+                    _ => {
+                        s.push_str(&format!("[{k}]"));
+                        ty = None;
+                    }
+                }
+            }
+            s
+        }
+    }
+}
+
+/// Names a description may use for a uniform or push-constant member:
+/// `block.member`, `Type.member`, `member`.
+fn member_keys(program: &Program, ptr: Id) -> Vec<String> {
+    let Some((var, path)) = pointer_path(program, ptr) else {
+        return Vec::new();
+    };
+    let Some(g) = global(program, var) else {
+        return Vec::new();
+    };
+    let mut segs = Vec::new();
+    let mut ty = Some(g.ty);
+    for &k in &path {
+        let Some(t) = ty else { break };
+        match program.ty(t) {
+            Some(Type::Struct { members }) => {
+                // naga wraps uniform structs in an unnamed block member.
+                if let Some(n) = program.member_names.get(&(t, k as u32)) {
+                    if !n.is_empty() {
+                        segs.push(n.clone());
+                    }
+                }
+                ty = members.get(k as usize).copied();
+            }
+            _ => {
+                segs.push(k.to_string());
+                ty = None;
+            }
+        }
+    }
+    let mut keys = Vec::new();
+    if let Some(name) = g.name.as_ref().filter(|n| !n.is_empty()) {
+        keys.push(
+            std::iter::once(name.clone())
+                .chain(segs.clone())
+                .collect::<Vec<_>>()
+                .join("."),
+        );
+    }
+    if let Some(tn) = program.name(g.ty).filter(|n| !n.is_empty()) {
+        keys.push(
+            std::iter::once(tn.to_string())
+                .chain(segs.clone())
+                .collect::<Vec<_>>()
+                .join("."),
+        );
+    }
+    for k in 1..segs.len().max(1) {
+        keys.push(segs[k..].join("."));
+    }
+    if segs.len() == 1 {
+        keys.push(segs[0].clone());
+    }
+    keys
+}
+
+/// A loop or recursion bound: its value and where it comes from.
+fn bound_of(
+    program: &Program,
+    id: Id,
+    constants: &BTreeMap<String, DescribedConstant>,
+) -> Result<(i64, String), String> {
+    let id = strip_conversions(program, id);
+    if let Some(Constant::Int(v)) = program.constants.get(&id) {
+        return Ok((
+            signed(program, id, *v),
+            format!("the constant {}", *v as i64),
+        ));
+    }
+    if let Some(Constant::Int(v)) = program.spec_constants.get(&id) {
+        let name = program.display_name(id);
+        if let Some(c) = constants.get(&name) {
+            return Ok((
+                c.value,
+                format!(
+                    "specialization constant `{name}` = {} from the description",
+                    c.value
+                ),
+            ));
+        }
+        return Ok((
+            *v as i64,
+            format!("specialization constant `{name}` (default {})", *v as i64),
+        ));
+    }
+    let Some(inst) = program.def(id) else {
+        return Err("an unknown value".into());
+    };
+    if inst.class.opcode == Op::Load {
+        let ptr = ids(inst).next().unwrap_or(0);
+        let storage = pointer_path(program, ptr)
+            .and_then(|(v, _)| global(program, v))
+            .map(|g| g.storage);
+        let kind = match storage {
+            Some(StorageClass::PushConstant) => "push constant",
+            Some(StorageClass::Uniform) => "uniform value",
+            Some(StorageClass::StorageBuffer) => "storage buffer value",
+            Some(StorageClass::ShaderRecordBufferKHR) => "shader record value",
+            _ => return Err("a value computed at run time".into()),
+        };
+        let keys = member_keys(program, ptr);
+        for k in &keys {
+            if let Some(c) = constants.get(k) {
+                return Ok((
+                    c.value,
+                    format!("{kind} `{k}` = {} from the description", c.value),
+                ));
+            }
+        }
+        let name = keys.first().cloned().unwrap_or_else(|| "?".into());
+        return Err(format!(
+            "{kind} `{name}`, which the pipeline description does not give"
+        ));
+    }
+    Err("a value computed at run time".into())
+}
+
+fn signed(program: &Program, id: Id, v: u64) -> i64 {
+    let ty = program.def(id).and_then(|i| i.result_type);
+    match ty.and_then(|t| program.ty(t)) {
+        Some(Type::Int {
+            width: 32,
+            signed: true,
+        }) => v as u32 as i32 as i64,
+        _ => v as i64,
+    }
+}
+
+/// A relation `lhs < rhs` (strict) or `lhs <= rhs` that holds.
+#[derive(Clone, Copy, Debug)]
+struct Rel {
+    lhs: Id,
+    rhs: Id,
+    strict: bool,
+}
+
+/// The relations that hold when `cond` has value `want`.
+fn relations(program: &Program, cond: Id, want: bool, out: &mut Vec<Rel>, depth: u32) {
+    if depth > 8 {
+        return;
+    }
+    let Some(inst) = program.def(cond) else {
+        return;
+    };
+    let v: Vec<Id> = ids(inst).collect();
+    let (a, b) = match v.as_slice() {
+        [a, b] => (*a, *b),
+        [a] => (*a, 0),
+        _ => return,
+    };
+    use Op::*;
+    let op = inst.class.opcode;
+    let (lhs, rhs, strict) = match (op, want) {
+        (LogicalNot, _) => return relations(program, a, !want, out, depth + 1),
+        (LogicalAnd, true) | (LogicalOr, false) => {
+            relations(program, a, want, out, depth + 1);
+            relations(program, b, want, out, depth + 1);
+            return;
+        }
+        (ULessThan | SLessThan, true) | (UGreaterThanEqual | SGreaterThanEqual, false) => {
+            (a, b, true)
+        }
+        (ULessThanEqual | SLessThanEqual, true) | (UGreaterThan | SGreaterThan, false) => {
+            (a, b, false)
+        }
+        (UGreaterThan | SGreaterThan, true) | (ULessThanEqual | SLessThanEqual, false) => {
+            (b, a, true)
+        }
+        (UGreaterThanEqual | SGreaterThanEqual, true) | (ULessThan | SLessThan, false) => {
+            (b, a, false)
+        }
+        _ => return,
+    };
+    out.push(Rel { lhs, rhs, strict });
+}
+
+// ---------------------------------------------------------------------------
+// Dominators and loops.
+
+/// Immediate dominators by block index (Cooper, Harvey, Kennedy).
+pub fn dominators(f: &Function) -> Vec<Option<usize>> {
+    let n = f.blocks.len();
+    if n == 0 {
+        return Vec::new();
+    }
+    // Post-order by an explicit stack: shader CFGs can be large.
+    let mut order = Vec::new();
+    let mut seen = vec![false; n];
+    let mut stack = vec![(0usize, 0usize)];
+    seen[0] = true;
+    while let Some((b, k)) = stack.pop() {
+        match f.blocks[b].succs.get(k) {
+            Some(&s) => {
+                stack.push((b, k + 1));
+                if !seen[s] {
+                    seen[s] = true;
+                    stack.push((s, 0));
+                }
+            }
+            None => order.push(b),
+        }
+    }
+    order.reverse();
+    let mut rpo = vec![usize::MAX; n];
+    for (i, &b) in order.iter().enumerate() {
+        rpo[b] = i;
+    }
+    let mut preds = vec![Vec::new(); n];
+    for (b, block) in f.blocks.iter().enumerate() {
+        for &s in &block.succs {
+            preds[s].push(b);
+        }
+    }
+    let mut idom: Vec<Option<usize>> = vec![None; n];
+    idom[0] = Some(0);
+    let mut changed = true;
+    while changed {
+        changed = false;
+        for &b in order.iter().skip(1) {
+            let mut new: Option<usize> = None;
+            for &p in &preds[b] {
+                if idom[p].is_none() {
+                    continue;
+                }
+                new = Some(match new {
+                    None => p,
+                    Some(mut x) => {
+                        let mut y = p;
+                        while x != y {
+                            while rpo[x] > rpo[y] {
+                                x = idom[x].unwrap_or(0);
+                            }
+                            while rpo[y] > rpo[x] {
+                                y = idom[y].unwrap_or(0);
+                            }
+                        }
+                        x
+                    }
+                });
+            }
+            if new.is_some() && idom[b] != new {
+                idom[b] = new;
+                changed = true;
+            }
+        }
+    }
+    idom
+}
+
+fn dominates(idom: &[Option<usize>], a: usize, mut b: usize) -> bool {
+    for _ in 0..=idom.len() {
+        if a == b {
+            return true;
+        }
+        match idom.get(b).copied().flatten() {
+            Some(p) if p != b => b = p,
+            _ => return false,
+        }
+    }
+    false
+}
+
+/// Relations guaranteed to hold at instruction `inst` by the conditional
+/// branches that dominate it.
+fn dominating_relations(program: &Program, f: &Function, inst: usize) -> Vec<(Rel, usize)> {
+    let idom = dominators(f);
+    let Some(b) = f.block_of(inst) else {
+        return Vec::new();
+    };
+    let mut out = Vec::new();
+    let mut d = idom.get(b).copied().flatten();
+    let mut steps = 0;
+    while let Some(db) = d {
+        steps += 1;
+        if steps > f.blocks.len() + 1 {
+            break;
+        }
+        let term_i = f.blocks[db].end;
+        let term = &program.insts[term_i];
+        if term.class.opcode == Op::BranchConditional {
+            let v: Vec<Id> = ids(term).collect();
+            if let [cond, t, e, ..] = v.as_slice() {
+                let (tb, eb) = (f.block_by_label(*t), f.block_by_label(*e));
+                if let (Some(tb), Some(eb)) = (tb, eb) {
+                    let want = if tb != eb && dominates(&idom, tb, b) {
+                        Some(true)
+                    } else if tb != eb && dominates(&idom, eb, b) {
+                        Some(false)
+                    } else {
+                        None
+                    };
+                    if let Some(w) = want {
+                        let mut rels = Vec::new();
+                        relations(program, *cond, w, &mut rels, 0);
+                        out.extend(rels.into_iter().map(|r| (r, term_i)));
+                    }
+                }
+            }
+        }
+        if idom[db] == Some(db) {
+            break;
+        }
+        d = idom[db];
+    }
+    out
+}
+
+// ---------------------------------------------------------------------------
+// Depth guards.
+
+fn recognise_guard(
+    pipeline: &Pipeline,
+    graph: &TraceGraph,
+    scc_of: &[usize],
+    scc: usize,
+    node: usize,
+    site_inst: usize,
+) -> Result<Guard, String> {
+    let shader = &graph.nodes[node].shader;
+    let program = pipeline
+        .program(shader)
+        .ok_or_else(|| "the shader's module is missing".to_string())?;
+    let site = program
+        .sites
+        .iter()
+        .find(|s| s.inst == site_inst)
+        .ok_or_else(|| "the trace is missing".to_string())?;
+    let out_payload = site.payload.unwrap_or(0);
+    // Every point from the trace up the call chain to the entry point.
+    let g = program
+        .functions
+        .get(site.function)
+        .ok_or_else(|| "the trace is outside a function".to_string())?;
+    let chains = super::liveness::call_chains(program, shader.function, g.id);
+    let mut points = vec![site_inst];
+    if let Some(chain) = chains.first() {
+        points.extend(chain.iter().rev().copied());
+    }
+    let mut seen_counter: Option<String> = None;
+    let mut why_not: Option<String> = None;
+    for &p in &points {
+        let Some(f) = program
+            .function_of(p)
+            .and_then(|i| program.functions.get(i))
+        else {
+            continue;
+        };
+        for (rel, term) in dominating_relations(program, f, p) {
+            let Some(counter @ Counter::Payload { .. }) = counter_of(program, rel.lhs, 0) else {
+                continue;
+            };
+            let name = counter_name(program, &counter);
+            seen_counter.get_or_insert(name.clone());
+            let (bound, bound_source) = match bound_of(program, rel.rhs, &pipeline.constants) {
+                Ok(b) => b,
+                Err(e) => {
+                    why_not = Some(format!("`{name}` is compared with {e}"));
+                    continue;
+                }
+            };
+            let Counter::Payload { path, .. } = &counter else {
+                continue;
+            };
+            let Some(step) = growth(program, shader.function, out_payload, &counter) else {
+                why_not = Some(format!(
+                    "`{name}` guards the trace but the traced payload's counter does not grow by a constant"
+                ));
+                continue;
+            };
+            let (initial, initial_assumed) =
+                initial_value(pipeline, graph, scc_of, scc, path).map_or((0, true), |v| (v, false));
+            let limit = if rel.strict { bound } else { bound + 1 };
+            let traces = if limit <= initial {
+                0
+            } else {
+                ((limit - initial) as u64).div_ceil(step as u64)
+            };
+            return Ok(Guard {
+                counter: name,
+                op: if rel.strict { "<" } else { "<=" },
+                bound,
+                bound_source,
+                step,
+                initial,
+                initial_assumed,
+                traces,
+                location: program
+                    .inst_location(term)
+                    .or_else(|| program.site_location(term)),
+            });
+        }
+    }
+    Err(why_not.unwrap_or_else(|| match seen_counter {
+        Some(c) => format!("no comparison of `{c}` with a known bound dominates the trace"),
+        None => "no depth counter comparison dominates the trace".into(),
+    }))
+}
+
+/// By how much the traced payload's copy of the counter exceeds the
+/// incoming one: a store `out.path = counter + c` with `c > 0`.
+fn growth(program: &Program, entry: Id, out_payload: Id, counter: &Counter) -> Option<i64> {
+    let Counter::Payload { path, .. } = counter else {
+        return None;
+    };
+    for fid in program.reachable_functions(entry) {
+        let f = program.function(fid)?;
+        for inst in &program.insts[f.start..=f.end] {
+            if inst.class.opcode != Op::Store {
+                continue;
+            }
+            let v: Vec<Id> = ids(inst).collect();
+            let [ptr, value, ..] = v.as_slice() else {
+                continue;
+            };
+            if pointer_path(program, *ptr) != Some((out_payload, path.clone())) {
+                continue;
+            }
+            let value = strip_conversions(program, *value);
+            let Some(add) = program.def(value) else {
+                continue;
+            };
+            if add.class.opcode != Op::IAdd {
+                continue;
+            }
+            let ops: Vec<Id> = ids(add).collect();
+            for (x, c) in [(0, 1), (1, 0)] {
+                let (Some(&x), Some(&c)) = (ops.get(x), ops.get(c)) else {
+                    continue;
+                };
+                let Some(step) = program.const_u64(c).map(|s| signed(program, c, s)) else {
+                    continue;
+                };
+                if step > 0 && counter_of(program, x, 0).as_ref() == Some(counter) {
+                    return Some(step);
+                }
+            }
+        }
+    }
+    None
+}
+
+/// The constant the counter member gets in shaders that enter the cycle.
+fn initial_value(
+    pipeline: &Pipeline,
+    graph: &TraceGraph,
+    scc_of: &[usize],
+    scc: usize,
+    path: &[u64],
+) -> Option<i64> {
+    let mut value = None;
+    for e in graph.traces() {
+        if scc_of[e.to] != scc || scc_of[e.from] == scc || e.kind != EdgeKind::Trace {
+            continue;
+        }
+        let shader = &graph.nodes[e.from].shader;
+        let program = pipeline.program(shader)?;
+        let payload = program.sites.iter().find(|s| s.inst == e.inst)?.payload?;
+        for fid in program.reachable_functions(shader.function) {
+            let Some(f) = program.function(fid) else {
+                continue;
+            };
+            for inst in &program.insts[f.start..=f.end] {
+                if inst.class.opcode != Op::Store {
+                    continue;
+                }
+                let v: Vec<Id> = ids(inst).collect();
+                if let [ptr, val, ..] = v.as_slice() {
+                    if pointer_path(program, *ptr) == Some((payload, path.to_vec())) {
+                        if let Some(c) = program.const_u64(*val) {
+                            let c = signed(program, *val, c);
+                            value = Some(value.map_or(c, |v: i64| v.min(c)));
+                        }
+                    }
+                }
+            }
+        }
+    }
+    value
+}
+
+// ---------------------------------------------------------------------------
+// Loops that trace.
+
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct LoopBound {
+    pub counter: String,
+    pub op: &'static str,
+    pub bound: i64,
+    pub bound_source: String,
+}
+
+/// A loop whose body traces (or calls a function that does).
+#[derive(Clone, Debug)]
+pub struct TraceLoop {
+    pub entry: String,
+    pub stage: Stage,
+    /// Index of the loop header's `OpLabel`.
+    pub header: usize,
+    pub location: Option<Location>,
+    pub site_location: Option<Location>,
+    /// The recognised bound, or why none was.
+    pub bound: Result<LoopBound, String>,
+}
+
+/// Loops around trace sites in every entry point of a program; bounds come
+/// from constants, specialization constants, or `constants` (by name).
+pub fn trace_loops(
+    program: &Program,
+    constants: &BTreeMap<String, DescribedConstant>,
+) -> Vec<TraceLoop> {
+    let mut out: Vec<TraceLoop> = Vec::new();
+    for e in &program.entry_points {
+        for site in &program.sites {
+            if site.kind != crate::spirv::SiteKind::TraceRay {
+                continue;
+            }
+            let Some(g) = program.functions.get(site.function) else {
+                continue;
+            };
+            for chain in super::liveness::call_chains(program, e.function, g.id) {
+                let mut points = vec![site.inst];
+                points.extend(chain.iter().rev().copied());
+                for &p in &points {
+                    let Some(f) = program
+                        .function_of(p)
+                        .and_then(|i| program.functions.get(i))
+                    else {
+                        continue;
+                    };
+                    for (header, body) in natural_loops(f) {
+                        let Some(pb) = f.block_of(p) else { continue };
+                        if !body.contains(&pb) {
+                            continue;
+                        }
+                        let header_inst = f.blocks[header].start;
+                        if out
+                            .iter()
+                            .any(|l| l.header == header_inst && l.entry == e.name)
+                        {
+                            continue;
+                        }
+                        let location = (f.blocks[header].start..=f.blocks[header].end)
+                            .find_map(|i| super::liveness::useful_location(program, i))
+                            .or_else(|| program.site_location(header_inst));
+                        out.push(TraceLoop {
+                            entry: e.name.clone(),
+                            stage: e.stage,
+                            header: header_inst,
+                            location,
+                            site_location: program.site_location(site.inst),
+                            bound: loop_bound(program, f, &body, constants),
+                        });
+                    }
+                }
+            }
+        }
+    }
+    out
+}
+
+/// Natural loops: header block and body blocks, one per back edge target.
+fn natural_loops(f: &Function) -> Vec<(usize, HashSet<usize>)> {
+    let idom = dominators(f);
+    let mut preds = vec![Vec::new(); f.blocks.len()];
+    for (b, block) in f.blocks.iter().enumerate() {
+        for &s in &block.succs {
+            preds[s].push(b);
+        }
+    }
+    let mut loops: HashMap<usize, HashSet<usize>> = HashMap::new();
+    for (b, block) in f.blocks.iter().enumerate() {
+        for &h in &block.succs {
+            if !dominates(&idom, h, b) {
+                continue;
+            }
+            let body = loops.entry(h).or_insert_with(|| HashSet::from([h]));
+            let mut work = vec![b];
+            while let Some(x) = work.pop() {
+                if body.insert(x) {
+                    work.extend(preds[x].iter().copied());
+                }
+            }
+        }
+    }
+    let mut v: Vec<_> = loops.into_iter().collect();
+    v.sort_by_key(|(h, _)| *h);
+    v
+}
+
+fn loop_bound(
+    program: &Program,
+    f: &Function,
+    body: &HashSet<usize>,
+    constants: &BTreeMap<String, DescribedConstant>,
+) -> Result<LoopBound, String> {
+    let mut why: Option<String> = None;
+    let mut blocks: Vec<usize> = body.iter().copied().collect();
+    blocks.sort_unstable();
+    for b in blocks {
+        let term = &program.insts[f.blocks[b].end];
+        if term.class.opcode != Op::BranchConditional {
+            continue;
+        }
+        let v: Vec<Id> = ids(term).collect();
+        let [cond, t, e, ..] = v.as_slice() else {
+            continue;
+        };
+        let (Some(tb), Some(eb)) = (f.block_by_label(*t), f.block_by_label(*e)) else {
+            continue;
+        };
+        let stay = match (body.contains(&tb), body.contains(&eb)) {
+            (true, false) => true,
+            (false, true) => false,
+            _ => continue,
+        };
+        let mut rels = Vec::new();
+        relations(program, *cond, stay, &mut rels, 0);
+        for rel in rels {
+            let Some(Counter::Local(var)) = counter_of(program, rel.lhs, 0) else {
+                continue;
+            };
+            let name = program.display_name(var);
+            if !increments(program, f, body, var) {
+                why.get_or_insert(format!(
+                    "`{name}` is compared but not incremented by a constant in the loop"
+                ));
+                continue;
+            }
+            match bound_of(program, rel.rhs, constants) {
+                Ok((bound, bound_source)) => {
+                    return Ok(LoopBound {
+                        counter: name,
+                        op: if rel.strict { "<" } else { "<=" },
+                        bound,
+                        bound_source,
+                    })
+                }
+                Err(e) => why = Some(format!("the loop runs while `{name}` is below {e}")),
+            }
+        }
+    }
+    Err(why.unwrap_or_else(|| "no exit compares a counter with a bound".into()))
+}
+
+/// Whether the loop stores `var = var + c` (c > 0) somewhere in its body.
+fn increments(program: &Program, f: &Function, body: &HashSet<usize>, var: Id) -> bool {
+    body.iter().any(|&b| {
+        program.insts[f.blocks[b].start..=f.blocks[b].end]
+            .iter()
+            .any(|inst| {
+                let v: Vec<Id> = ids(inst).collect();
+                if inst.class.opcode != Op::Store || v.first() != Some(&var) {
+                    return false;
+                }
+                let Some(add) = v.get(1).and_then(|x| program.def(*x)) else {
+                    return false;
+                };
+                let ops: Vec<Id> = ids(add).collect();
+                add.class.opcode == Op::IAdd
+                    && ops.len() == 2
+                    && [(0, 1), (1, 0)].iter().any(|&(x, c)| {
+                        program.const_u64(ops[c]).is_some_and(|s| s > 0)
+                            && counter_of(program, ops[x], 0) == Some(Counter::Local(var))
+                    })
+            })
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::pipeline::load;
+    use std::path::Path;
+
+    fn pipeline(rel: &str) -> Pipeline {
+        load(&Path::new(env!("CARGO_MANIFEST_DIR")).join(rel)).unwrap()
+    }
+
+    #[test]
+    fn recursive_reflections_need_n_plus_two() {
+        let r = recursion(&pipeline(
+            "fixtures/pipelines/reflect_recursive.pipeline.toml",
+        ));
+        // 3 reflections (maxDepth = 3), a shadow ray from the deepest hit.
+        assert_eq!(r.required_depth, Some(5));
+        assert_eq!(r.cycles.len(), 1);
+        let g = r.cycles[0].sites[0].guard.as_ref().unwrap();
+        assert_eq!(g.counter, "payload.depth");
+        assert_eq!(
+            (g.op, g.bound, g.step, g.initial, g.traces),
+            ("<", 3, 1, 0, 3)
+        );
+        assert!(!g.initial_assumed);
+        assert!(
+            g.bound_source.contains("pushConst.maxDepth"),
+            "{}",
+            g.bound_source
+        );
+        assert_eq!(
+            r.chain_text(),
+            "raygeneration `main` (raygen 0) at level 0 → closesthit `main` (hit group 0) at levels 1–4 → miss `main` (miss 1) at level 5"
+        );
+        assert_eq!(r.recursive_sites.len(), 2);
+    }
+
+    #[test]
+    fn recursion_without_the_push_constant_is_unbounded() {
+        let mut p = pipeline("fixtures/pipelines/reflect_recursive.pipeline.toml");
+        p.constants.clear();
+        let r = recursion(&p);
+        assert_eq!(r.required_depth, None);
+        let c = r.unbounded_cycle().unwrap();
+        let why = c.sites[0].guard.as_ref().unwrap_err();
+        assert_eq!(
+            why,
+            "`payload.depth` is compared with push constant `pushConst.maxDepth`, which the pipeline description does not give"
+        );
+    }
+
+    #[test]
+    fn iterative_reflections_need_two() {
+        let r = recursion(&pipeline(
+            "fixtures/pipelines/reflect_iterative.pipeline.toml",
+        ));
+        assert_eq!(r.required_depth, Some(2));
+        assert!(r.cycles.is_empty());
+        assert_eq!(r.recursive_sites.len(), 1);
+        let p = pipeline("fixtures/pipelines/reflect_iterative.pipeline.toml");
+        let loops = trace_loops(&p.programs[0], &p.constants);
+        assert_eq!(loops.len(), 1);
+        let b = loops[0].bound.as_ref().unwrap();
+        assert_eq!((b.counter.as_str(), b.op, b.bound), ("bounce", "<=", 4));
+        assert_eq!(
+            b.bound_source,
+            "specialization constant `MAX_BOUNCES` (default 4)"
+        );
+    }
+
+    #[test]
+    fn reference_wgsl_pipeline_needs_one() {
+        let p = pipeline("shaders/reflect_iterative.pipeline.toml");
+        let r = recursion(&p);
+        assert_eq!(r.required_depth, Some(1));
+        let loops = trace_loops(&p.programs[0], &p.constants);
+        assert_eq!(loops.len(), 1);
+        let b = loops[0].bound.as_ref().unwrap();
+        assert_eq!((b.counter.as_str(), b.bound), ("bounce", 8));
+        let none = trace_loops(&p.programs[0], &BTreeMap::new());
+        assert_eq!(
+            none[0].bound.as_ref().unwrap_err(),
+            "the loop runs while `bounce` is below uniform value `params.max_bounces`, which the pipeline description does not give"
+        );
+    }
+
+    #[test]
+    fn wgsl_guard_at_the_helper_call() {
+        // naga puts the trace in a helper: the guard dominates the call.
+        let r = recursion(&pipeline(
+            "fixtures/pipelines/reflect_recursive_wgsl.pipeline.toml",
+        ));
+        assert_eq!(r.required_depth, Some(5));
+        let g = r.cycles[0].sites[0].guard.as_ref().unwrap();
+        assert_eq!(
+            (g.counter.as_str(), g.bound, g.traces),
+            ("incoming.depth", 4, 4)
+        );
+        assert_eq!(
+            g.bound_source,
+            "uniform value `params.max_depth` = 4 from the description"
+        );
+    }
+}

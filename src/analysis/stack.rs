@@ -1,0 +1,931 @@
+//! The stack-size calculator.
+//!
+//! Each shader gets two figures:
+//! - the **driver-comparable** size, from the payloads alone, in the shape
+//!   the NVIDIA driver reports (`vkGetRayTracingShaderGroupStackSizeKHR`):
+//!   ray generation 0 B for payloads up to 128 B, closest-hit 32 B minimum
+//!   growing with the payload it passes on in 32-B steps, miss, any-hit and
+//!   intersection 0 B. Drivers do not count live state there.
+//! - the **model** size: the driver-comparable part plus the live state that
+//!   cannot be recomputed after a trace (max over sites) and function-local
+//!   arrays, which a driver must keep in memory somewhere.
+//!
+//! From these the pipeline stack follows by the Vulkan and DXR default
+//! formulas (declared and required depth) and by the exact call-chain
+//! maximum the Vulkan spec recommends setting explicitly. The assumptions
+//! are in `docs/stack.md`.
+
+use super::callgraph::{EdgeKind, Slot};
+use super::liveness::{live_sites, LiveSite};
+use super::recursion::{recursion, RecursionReport};
+use super::scalar::scalar_size;
+use crate::pipeline::Pipeline;
+use crate::spirv::{Program, SiteKind, Stage, Type};
+use spirv::StorageClass;
+use std::collections::HashMap;
+
+/// The largest pipeline stack measured to run on an NVIDIA H200 (driver
+/// 580.159.04): 14,702 bytes per thread ran and 14,746 lost the device, at
+/// 64×64, 512×512 and 2048×2048 alike (calibration/device-run.sh bisect).
+pub const NVIDIA_KNOWN_SAFE_STACK_BYTES: u64 = 14_702;
+
+/// Where the bytes of one shader's model come from.
+#[derive(Clone, Debug, Default, serde::Serialize)]
+pub struct Breakdown {
+    /// Non-rematerializable live state, max over the shader's sites.
+    pub live_state: u64,
+    /// All live state, rematerializable values included, max over sites.
+    pub live_state_total: u64,
+    /// The largest payload the shader traces with.
+    pub outgoing_payload: u64,
+    pub incoming_payload: u64,
+    pub hit_attributes: u64,
+    /// The largest callable data the shader passes on.
+    pub callable_data: u64,
+    pub incoming_callable_data: u64,
+    /// Function-local arrays (kept in memory, not registers).
+    pub local_arrays: u64,
+}
+
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct ShaderStack {
+    pub entry: String,
+    pub stage: Stage,
+    pub file: String,
+    /// `raygen 0`, `miss 1`, `hit group 2`, `callable 0`.
+    pub group: String,
+    /// The full model: driver-comparable part + live state + local arrays.
+    pub model_bytes: u64,
+    /// The payload-driven part a driver reports.
+    pub driver_model_bytes: u64,
+    /// What the driver reported, when queried (`rtlint stack --driver`).
+    pub driver_bytes: Option<u64>,
+    pub breakdown: Breakdown,
+}
+
+/// The per-stage maxima the default formulas take.
+#[derive(Clone, Copy, Debug, Default, serde::Serialize)]
+pub struct StageMax {
+    pub raygen: u64,
+    pub closest_hit: u64,
+    pub miss: u64,
+    pub intersection: u64,
+    pub any_hit: u64,
+    pub callable: u64,
+}
+
+/// The pipeline stack figures from one set of per-shader sizes.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct Formulas {
+    pub stage_max: StageMax,
+    /// Vulkan default with the declared depth (what the driver uses).
+    pub vulkan_default: Option<u64>,
+    pub vulkan_default_required: Option<u64>,
+    pub dxr_default: Option<u64>,
+    pub dxr_default_required: Option<u64>,
+    /// Max over all call chains of the sum of the shaders on the chain.
+    pub exact_call_chain: Option<u64>,
+}
+
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct StackReport {
+    pub pipeline: Option<String>,
+    pub required_depth: Option<u32>,
+    pub declared_depth: Option<u32>,
+    pub device_max_depth: u32,
+    /// The chain that needs the required depth, in words.
+    pub depth_chain: String,
+    pub shaders: Vec<ShaderStack>,
+    pub vulkan_default: Option<u64>,
+    pub vulkan_default_required: Option<u64>,
+    pub dxr_default: Option<u64>,
+    pub dxr_default_required: Option<u64>,
+    pub exact_call_chain: Option<u64>,
+    /// What to pass to `vkCmdSetRayTracingPipelineStackSizeKHR` /
+    /// `SetPipelineStackSize`.
+    pub recommended: Option<u64>,
+    /// Full-model formulas (live state and arrays included).
+    pub model: Formulas,
+    /// The same formulas over the driver-comparable sizes.
+    pub driver_comparable: Formulas,
+    /// The same formulas over the driver's own numbers, when queried.
+    pub driver: Option<Formulas>,
+    pub assumptions: Vec<String>,
+}
+
+/// Vulkan's default: `RG + min(1, D) × max(CH, MS, IS + AH) + max(0, D − 1)
+/// × max(CH, MS) + 2 × CS`.
+pub fn vulkan_default(m: &StageMax, depth: u32) -> u64 {
+    let d = u64::from(depth);
+    m.raygen
+        + d.min(1) * m.closest_hit.max(m.miss).max(m.intersection + m.any_hit)
+        + d.saturating_sub(1) * m.closest_hit.max(m.miss)
+        + 2 * m.callable
+}
+
+/// DXR's default (the same shape as Vulkan's; the D3D12 spec states it with
+/// `RGSMax`, `CHSMax`, `MSMax`, `ISMax + AHSMax`, `CSMax`).
+pub fn dxr_default(m: &StageMax, depth: u32) -> u64 {
+    let d = u64::from(depth);
+    m.raygen
+        + m.closest_hit.max(m.miss).max(m.intersection + m.any_hit) * d.min(1)
+        + m.closest_hit.max(m.miss) * d.saturating_sub(1)
+        + 2 * m.callable
+}
+
+fn align(v: u64, a: u64) -> u64 {
+    v.div_ceil(a) * a
+}
+
+/// Stack bytes for passing a payload on, as NVIDIA reports them for a
+/// shader that traces: 32-byte steps with a 32-byte minimum, and 32 more
+/// once the payload is over 128 bytes (measured 4 to 256 bytes: 160 → 192,
+/// 256 → 288; calibration/, docs/stack.md).
+fn passed_on(payload: u64) -> u64 {
+    match payload {
+        0 => 0,
+        p if p <= 128 => align(p, 32).max(32),
+        p => align(p, 32) + 32,
+    }
+}
+
+/// The driver-comparable size of one shader, calibrated on an NVIDIA H200
+/// with driver 580.159.04 (169 shaders: 162 exact, 164 within 15 %).
+/// A shader that makes no trace or callable call reports 0. Ray generation
+/// keeps the part of a payload over 128 bytes less 96 (192 → 96, 256 → 160)
+/// plus one 32-byte block when any state is live across a call; the driver
+/// reports 64 rather than 32 for a bounce loop carrying 52–60 bytes, which
+/// this model does not predict.
+pub fn driver_model(stage: Stage, b: &Breakdown) -> u64 {
+    let calls = b.outgoing_payload > 0 || b.callable_data > 0;
+    if !calls {
+        return 0;
+    }
+    match stage {
+        Stage::RayGeneration => {
+            let spill = if b.outgoing_payload > 128 {
+                align(b.outgoing_payload, 32) - 96
+            } else {
+                0
+            };
+            spill + if b.live_state > 0 { 32 } else { 0 }
+        }
+        Stage::ClosestHit | Stage::Miss => passed_on(b.outgoing_payload),
+        Stage::Callable => passed_on(b.outgoing_payload.max(b.callable_data)),
+        _ => 0,
+    }
+}
+
+fn global_size(program: &Program, id: u32) -> u64 {
+    program
+        .globals
+        .iter()
+        .find(|g| g.id == id)
+        .and_then(|g| scalar_size(program, g.ty))
+        .unwrap_or(0)
+}
+
+/// Breakdown of one entry point of a program.
+pub fn breakdown(program: &Program, entry: &str) -> Breakdown {
+    breakdown_with(program, entry, &live_sites(program))
+}
+
+/// [`breakdown`] with the program's live sites already computed.
+pub fn breakdown_with(program: &Program, entry: &str, sites: &[LiveSite]) -> Breakdown {
+    let mut b = Breakdown::default();
+    let Some(e) = program.entry_points.iter().find(|e| e.name == entry) else {
+        return b;
+    };
+    let reach = program.reachable_functions(e.function);
+    for site in &program.sites {
+        let Some(f) = program.functions.get(site.function) else {
+            continue;
+        };
+        if !reach.contains(&f.id) {
+            continue;
+        }
+        let size = site.payload.map_or(0, |p| global_size(program, p));
+        match site.kind {
+            SiteKind::TraceRay => b.outgoing_payload = b.outgoing_payload.max(size),
+            SiteKind::ExecuteCallable => b.callable_data = b.callable_data.max(size),
+            _ => {}
+        }
+    }
+    // The stage's own inputs: the interface lists them from SPIR-V 1.4 on;
+    // older modules get every global of the class.
+    let in_interface = |id: u32| e.interface.is_empty() || e.interface.contains(&id);
+    for g in &program.globals {
+        if !in_interface(g.id) && program.version >= (1, 4) {
+            continue;
+        }
+        let size = scalar_size(program, g.ty).unwrap_or(0);
+        match g.storage {
+            StorageClass::IncomingRayPayloadKHR => {
+                b.incoming_payload = b.incoming_payload.max(size)
+            }
+            StorageClass::HitAttributeKHR => b.hit_attributes = b.hit_attributes.max(size),
+            StorageClass::IncomingCallableDataKHR => {
+                b.incoming_callable_data = b.incoming_callable_data.max(size)
+            }
+            _ => {}
+        }
+    }
+    // Only the stages that receive them.
+    if !matches!(
+        e.stage,
+        Stage::ClosestHit | Stage::Miss | Stage::AnyHit | Stage::Intersection
+    ) {
+        b.incoming_payload = 0;
+    }
+    if !matches!(
+        e.stage,
+        Stage::ClosestHit | Stage::AnyHit | Stage::Intersection
+    ) {
+        b.hit_attributes = 0;
+    }
+    for fid in &reach {
+        let Some(f) = program.function(*fid) else {
+            continue;
+        };
+        for inst in &program.insts[f.start..=f.end] {
+            if inst.class.opcode != spirv::Op::Variable {
+                continue;
+            }
+            let Some(Type::Pointer {
+                storage: StorageClass::Function,
+                pointee,
+            }) = inst.result_type.and_then(|t| program.ty(t))
+            else {
+                continue;
+            };
+            if matches!(program.ty(*pointee), Some(Type::Array { .. })) {
+                b.local_arrays += scalar_size(program, *pointee).unwrap_or(0);
+            }
+        }
+    }
+    for site in sites.iter().filter(|s| s.entry == entry) {
+        b.live_state_total = b.live_state_total.max(site.live_bytes);
+        b.live_state = b
+            .live_state
+            .max(site.live_bytes - site.rematerializable_bytes);
+    }
+    b
+}
+
+fn stage_max(shaders: &[(Stage, u64)]) -> StageMax {
+    let mut m = StageMax::default();
+    for &(stage, v) in shaders {
+        let slot = match stage {
+            Stage::RayGeneration => &mut m.raygen,
+            Stage::ClosestHit => &mut m.closest_hit,
+            Stage::Miss => &mut m.miss,
+            Stage::Intersection => &mut m.intersection,
+            Stage::AnyHit => &mut m.any_hit,
+            Stage::Callable => &mut m.callable,
+            _ => continue,
+        };
+        *slot = (*slot).max(v);
+    }
+    m
+}
+
+/// The formulas over per-node sizes (indexed like the trace graph's nodes).
+pub fn formulas(pipeline: &Pipeline, rec: &RecursionReport, sizes: &[u64]) -> Formulas {
+    let stages: Vec<(Stage, u64)> = rec
+        .graph
+        .nodes
+        .iter()
+        .zip(sizes)
+        .map(|(n, &s)| (n.shader.stage, s))
+        .collect();
+    let m = stage_max(&stages);
+    Formulas {
+        stage_max: m,
+        vulkan_default: pipeline.max_recursion_depth.map(|d| vulkan_default(&m, d)),
+        vulkan_default_required: rec.required_depth.map(|d| vulkan_default(&m, d)),
+        dxr_default: pipeline.max_recursion_depth.map(|d| dxr_default(&m, d)),
+        dxr_default_required: rec.required_depth.map(|d| dxr_default(&m, d)),
+        exact_call_chain: exact_call_chain(rec, sizes),
+    }
+}
+
+/// The maximum over call chains of the sum of the shaders on the chain.
+/// Any-hit and intersection shaders of one group run together on top of
+/// the tracing shader; callables stack on their caller; a bounded cycle
+/// repeats its largest shader once per level it adds.
+pub fn exact_call_chain(rec: &RecursionReport, sizes: &[u64]) -> Option<u64> {
+    let g = &rec.graph;
+    let n = g.nodes.len();
+    // Callable chains on top of each node.
+    fn with_callables(
+        g: &super::callgraph::TraceGraph,
+        sizes: &[u64],
+        v: usize,
+        memo: &mut HashMap<usize, u64>,
+        depth: usize,
+    ) -> u64 {
+        if let Some(&x) = memo.get(&v) {
+            return x;
+        }
+        let own = sizes.get(v).copied().unwrap_or(0);
+        if depth > g.nodes.len() {
+            return own;
+        }
+        let above = g
+            .edges_from(v)
+            .filter(|e| e.kind == EdgeKind::Callable)
+            .map(|e| with_callables(g, sizes, e.to, memo, depth + 1))
+            .max()
+            .unwrap_or(0);
+        memo.insert(v, own + above);
+        own + above
+    }
+    let mut memo = HashMap::new();
+    let mut w: Vec<u64> = (0..n)
+        .map(|v| with_callables(g, sizes, v, &mut memo, 0))
+        .collect();
+    // Intersection and any-hit of a procedural group are active together.
+    for v in 0..n {
+        if g.nodes[v].shader.stage != Stage::AnyHit {
+            continue;
+        }
+        let Slot::HitGroup(gi) = g.nodes[v].slot else {
+            continue;
+        };
+        let is: u64 = (0..n)
+            .filter(|&u| {
+                g.nodes[u].slot == Slot::HitGroup(gi)
+                    && g.nodes[u].shader.stage == Stage::Intersection
+            })
+            .map(|u| w[u])
+            .sum();
+        w[v] += is;
+    }
+    // Longest weighted path over trace edges, cycles by their bound.
+    let mut best: Vec<Option<u64>> = vec![None; n];
+    let level = |v: usize| rec.node_level[v];
+    let mut order: Vec<usize> = (0..n).collect();
+    // Levels order the acyclic part; nodes of one cycle share its weight.
+    order.sort_by_key(|&v| level(v).unwrap_or(u32::MAX));
+    let cycle_of = |v: usize| rec.cycles.iter().find(|c| c.nodes.contains(&v));
+    for _ in 0..2 {
+        for &v in &order {
+            let own = match cycle_of(v) {
+                Some(c) => {
+                    let x = c.extra_levels?;
+                    let max_w = c.nodes.iter().map(|&u| w[u]).max().unwrap_or(0);
+                    (x + 1) * max_w
+                }
+                None => w[v],
+            };
+            let entered = if g.nodes[v].shader.stage == Stage::RayGeneration {
+                Some(0)
+            } else {
+                g.traces()
+                    .filter(|e| e.to == v)
+                    .filter(|e| match (cycle_of(e.from), cycle_of(v)) {
+                        (Some(a), Some(b)) => !std::ptr::eq(a, b),
+                        _ => true,
+                    })
+                    .filter_map(|e| best[e.from])
+                    .max()
+            };
+            if let Some(base) = entered {
+                best[v] = Some(best[v].unwrap_or(0).max(base + own));
+            }
+        }
+    }
+    Some(best.iter().flatten().copied().max().unwrap_or(0))
+}
+
+/// `rtlint stack`: the stack figures of a described (or assumed) pipeline.
+pub fn stack_report(pipeline: &Pipeline) -> StackReport {
+    let rec = recursion(pipeline);
+    let mut cache: HashMap<(usize, String), Breakdown> = HashMap::new();
+    let sites: Vec<Vec<LiveSite>> = pipeline.programs.iter().map(live_sites).collect();
+    let mut shaders = Vec::new();
+    for node in &rec.graph.nodes {
+        let s = &node.shader;
+        let b = cache
+            .entry((s.program, s.entry.clone()))
+            .or_insert_with(|| match (pipeline.program(s), sites.get(s.program)) {
+                (Some(p), Some(sites)) => breakdown_with(p, &s.entry, sites),
+                _ => Breakdown::default(),
+            })
+            .clone();
+        let driver_model_bytes = driver_model(s.stage, &b);
+        let group = match node.slot {
+            Slot::Raygen(i) => format!("raygen {i}"),
+            Slot::Miss(i) => format!("miss {i}"),
+            Slot::HitGroup(i) => format!("hit group {i}"),
+            Slot::Callable(i) => format!("callable {i}"),
+        };
+        shaders.push(ShaderStack {
+            entry: s.entry.clone(),
+            stage: s.stage,
+            file: s.file.display().to_string(),
+            group,
+            model_bytes: driver_model_bytes + b.live_state + b.local_arrays,
+            driver_model_bytes,
+            driver_bytes: None,
+            breakdown: b,
+        });
+    }
+    let model_sizes: Vec<u64> = shaders.iter().map(|s| s.model_bytes).collect();
+    let driver_sizes: Vec<u64> = shaders.iter().map(|s| s.driver_model_bytes).collect();
+    let model = formulas(pipeline, &rec, &model_sizes);
+    let driver_comparable = formulas(pipeline, &rec, &driver_sizes);
+    let recommended = model
+        .exact_call_chain
+        .or(model.vulkan_default)
+        .map(|v| align(v, 16));
+    let mut assumptions = rec.graph.assumptions.clone();
+    if pipeline.max_recursion_depth.is_none() {
+        assumptions.push("no declared depth: default formulas use the required depth only".into());
+    }
+    if let Some(c) = rec.unbounded_cycle() {
+        let why = c
+            .sites
+            .iter()
+            .find_map(|s| s.guard.as_ref().err())
+            .cloned()
+            .unwrap_or_default();
+        assumptions.push(format!(
+            "recursion is unbounded at compile time ({why}): no exact call-chain value"
+        ));
+    }
+    for c in &rec.cycles {
+        for s in &c.sites {
+            if let Ok(g) = &s.guard {
+                if g.initial_assumed {
+                    assumptions.push(format!(
+                        "no constant initial value of `{}` found: 0 assumed",
+                        g.counter
+                    ));
+                }
+            }
+        }
+    }
+    StackReport {
+        pipeline: pipeline.path.as_ref().map(|p| p.display().to_string()),
+        required_depth: rec.required_depth,
+        declared_depth: pipeline.max_recursion_depth,
+        device_max_depth: pipeline.device_max_recursion_depth,
+        depth_chain: rec.chain_text(),
+        shaders,
+        vulkan_default: model.vulkan_default,
+        vulkan_default_required: model.vulkan_default_required,
+        dxr_default: model.dxr_default,
+        dxr_default_required: model.dxr_default_required,
+        exact_call_chain: model.exact_call_chain,
+        recommended,
+        model,
+        driver_comparable,
+        driver: None,
+        assumptions,
+    }
+}
+
+/// Adds a driver's own per-shader sizes (`vkGetRayTracingShaderGroupStackSizeKHR`,
+/// one per entry of `report.shaders`, in the same order) and the formulas
+/// computed from them. Sizes beyond `report.shaders` are ignored; missing
+/// ones leave the shader without a driver figure and count as 0.
+pub fn attach_driver(report: &mut StackReport, pipeline: &Pipeline, driver: &[Option<u64>]) {
+    for (s, d) in report.shaders.iter_mut().zip(driver) {
+        s.driver_bytes = *d;
+    }
+    let rec = recursion(pipeline);
+    let sizes: Vec<u64> = report
+        .shaders
+        .iter()
+        .map(|s| s.driver_bytes.unwrap_or(0))
+        .collect();
+    if sizes.len() == rec.graph.nodes.len() {
+        report.driver = Some(formulas(pipeline, &rec, &sizes));
+    }
+}
+
+fn formula_text(m: &StageMax, depth: u32) -> String {
+    format!(
+        "{} + min(1, {depth}) × max({}, {}, {} + {}) + max(0, {depth} − 1) × max({}, {}) + 2 × {} = {}",
+        m.raygen,
+        m.closest_hit,
+        m.miss,
+        m.intersection,
+        m.any_hit,
+        m.closest_hit,
+        m.miss,
+        m.callable,
+        vulkan_default(m, depth)
+    )
+}
+
+fn opt(v: Option<u64>) -> String {
+    v.map_or("—".into(), |v| format!("{v} B"))
+}
+
+/// The human form of `rtlint stack`.
+pub fn render_human(r: &StackReport) -> String {
+    use std::fmt::Write;
+    let mut s = String::new();
+    if let Some(p) = &r.pipeline {
+        let _ = writeln!(s, "pipeline {p}");
+    } else {
+        let _ = writeln!(
+            s,
+            "no pipeline description: every shader given is assumed reachable"
+        );
+    }
+    let depth = |d: Option<u32>| d.map_or("unbounded at compile time".into(), |d| d.to_string());
+    let _ = writeln!(
+        s,
+        "recursion depth: required {}, declared {}, device limit {}",
+        depth(r.required_depth),
+        r.declared_depth
+            .map_or("not given".into(), |d| d.to_string()),
+        r.device_max_depth
+    );
+    if !r.depth_chain.is_empty() {
+        let _ = writeln!(s, "  deepest chain: {}", r.depth_chain);
+    }
+    let _ = writeln!(s);
+    let names: Vec<String> = r
+        .shaders
+        .iter()
+        .map(|sh| {
+            let file = std::path::Path::new(&sh.file)
+                .file_name()
+                .map(|f| f.to_string_lossy().into_owned())
+                .unwrap_or_default();
+            format!("{} `{}` {}", sh.stage.as_str(), sh.entry, file)
+        })
+        .collect();
+    let w = names
+        .iter()
+        .map(|n| n.chars().count())
+        .max()
+        .unwrap_or(6)
+        .max(6);
+    let _ = writeln!(
+        s,
+        "{:<w$}  {:<12} {:>6} {:>7} {:>5} {:>6} {:>7} {:>4} {:>5} {:>8} {:>6}",
+        "shader",
+        "group",
+        "model",
+        "driver*",
+        "live",
+        "arrays",
+        "payload",
+        "in",
+        "attrs",
+        "callable",
+        "query"
+    );
+    for (sh, name) in r.shaders.iter().zip(&names) {
+        let b = &sh.breakdown;
+        let _ = writeln!(
+            s,
+            "{:<w$}  {:<12} {:>6} {:>7} {:>5} {:>6} {:>7} {:>4} {:>5} {:>8} {:>6}",
+            name,
+            sh.group,
+            sh.model_bytes,
+            sh.driver_model_bytes,
+            b.live_state,
+            b.local_arrays,
+            b.outgoing_payload,
+            b.incoming_payload,
+            b.hit_attributes,
+            b.callable_data,
+            sh.driver_bytes.map_or("—".into(), |d| d.to_string()),
+        );
+    }
+    let _ = writeln!(
+        s,
+        "  (bytes; model = driver* + live + arrays; driver* = the payload-driven part a driver reports; live = state across traces that cannot be recomputed; query = the driver's own figure with --driver)"
+    );
+    let _ = writeln!(s);
+    let mut block = |title: &str, f: &Formulas| {
+        let _ = writeln!(s, "{title}:");
+        if let Some(d) = r.declared_depth {
+            let _ = writeln!(
+                s,
+                "  Vulkan/DXR default, declared depth {d}: {}",
+                formula_text(&f.stage_max, d)
+            );
+        }
+        if let Some(d) = r.required_depth {
+            let _ = writeln!(
+                s,
+                "  Vulkan/DXR default, required depth {d}: {}",
+                formula_text(&f.stage_max, d)
+            );
+        }
+        let _ = writeln!(s, "  exact call-chain maximum: {}", opt(f.exact_call_chain));
+    };
+    block("full model", &r.model);
+    block("driver-comparable part", &r.driver_comparable);
+    if let Some(d) = &r.driver {
+        block("driver's own numbers", d);
+    }
+    let _ = writeln!(s);
+    match r.recommended {
+        Some(v) => {
+            let _ = writeln!(
+                s,
+                "recommended: vkCmdSetRayTracingPipelineStackSizeKHR(cmd, {v}) / SetPipelineStackSize({v})"
+            );
+            if let Some(d) = r.vulkan_default {
+                if d > v {
+                    let _ = writeln!(
+                        s,
+                        "  {} B ({:.0} %) below the default of {d} B",
+                        d - v,
+                        100.0 * (d - v) as f64 / d as f64
+                    );
+                }
+            }
+        }
+        None => {
+            let _ = writeln!(s, "recommended: none (recursion unbounded at compile time)");
+        }
+    }
+    for a in &r.assumptions {
+        let _ = writeln!(s, "note: {a}");
+    }
+    s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::pipeline::load;
+    use std::path::Path;
+
+    fn report(rel: &str) -> StackReport {
+        stack_report(&load(&Path::new(env!("CARGO_MANIFEST_DIR")).join(rel)).unwrap())
+    }
+
+    #[test]
+    fn formulas_and_the_calibrated_driver_model() {
+        // FIELD-NOTES' H100 figures for a 256-byte payload: raygen 160,
+        // closest-hit 544; the formulas on them.
+        let m = StageMax {
+            raygen: 160,
+            closest_hit: 544,
+            ..Default::default()
+        };
+        assert_eq!(vulkan_default(&m, 29), 15_936);
+        assert_eq!(vulkan_default(&m, 31), 17_024);
+        assert_eq!(vulkan_default(&m, 8), 4_512);
+        assert_eq!(dxr_default(&m, 31), 17_024);
+        let b = |p| Breakdown {
+            outgoing_payload: p,
+            ..Default::default()
+        };
+        // What an NVIDIA H200 (driver 580.159.04) reported for a closest-hit
+        // passing each payload size on (calibration/, docs/stack.md).
+        for (p, ch) in [
+            (4, 32),
+            (16, 32),
+            (32, 32),
+            (48, 64),
+            (64, 64),
+            (96, 96),
+            (128, 128),
+            (160, 192),
+            (192, 224),
+            (224, 256),
+            (256, 288),
+        ] {
+            assert_eq!(driver_model(Stage::ClosestHit, &b(p)), ch, "payload {p}");
+        }
+        for (p, rg) in [
+            (64, 0),
+            (128, 0),
+            (160, 64),
+            (192, 96),
+            (224, 128),
+            (256, 160),
+        ] {
+            assert_eq!(driver_model(Stage::RayGeneration, &b(p)), rg, "payload {p}");
+        }
+        // Live state across a call: one 32-byte block in ray generation.
+        let live = Breakdown {
+            outgoing_payload: 16,
+            live_state: 4,
+            ..Default::default()
+        };
+        assert_eq!(driver_model(Stage::RayGeneration, &live), 32);
+        // No call, no stack: a closest-hit or miss that does not trace.
+        assert_eq!(driver_model(Stage::Miss, &b(0)), 0);
+        assert_eq!(driver_model(Stage::ClosestHit, &b(0)), 0);
+    }
+
+    #[test]
+    fn recursive_pipeline() {
+        let r = report("fixtures/pipelines/reflect_recursive.pipeline.toml");
+        assert_eq!((r.required_depth, r.declared_depth), (Some(5), Some(5)));
+        let ch = r
+            .shaders
+            .iter()
+            .find(|s| s.stage == Stage::ClosestHit)
+            .unwrap();
+        // Payload {vec3, uint} = 16 B out, 16 B in; shadow payload 4 B.
+        assert_eq!(ch.breakdown.outgoing_payload, 16);
+        assert_eq!(ch.breakdown.incoming_payload, 16);
+        assert_eq!(ch.driver_model_bytes, 32);
+        // Across the shadow ray only recomputable values (hitPos from
+        // builtins, constant vectors); across the reflection `color` (12 B).
+        assert_eq!(
+            (ch.breakdown.live_state, ch.breakdown.live_state_total),
+            (12, 36)
+        );
+        assert_eq!(ch.model_bytes, 44);
+        let rg = r
+            .shaders
+            .iter()
+            .find(|s| s.stage == Stage::RayGeneration)
+            .unwrap();
+        assert_eq!(rg.driver_model_bytes, 0);
+        // Driver-comparable: 0 + 1 × 32 + 4 × 32 = 160; exact chain: raygen
+        // + 4 closest-hits + miss = 128.
+        assert_eq!(r.driver_comparable.vulkan_default, Some(160));
+        assert_eq!(r.driver_comparable.exact_call_chain, Some(128));
+        assert_eq!(rg.model_bytes, 0);
+        assert_eq!(r.vulkan_default, Some(5 * 44));
+        assert_eq!(r.exact_call_chain, Some(4 * 44));
+        assert_eq!(r.recommended, r.exact_call_chain.map(|v| align(v, 16)));
+        let json = serde_json::to_value(&r).unwrap();
+        for k in [
+            "required_depth",
+            "declared_depth",
+            "shaders",
+            "vulkan_default",
+            "dxr_default",
+            "exact_call_chain",
+            "recommended",
+        ] {
+            assert!(json.get(k).is_some(), "{k}");
+        }
+        assert_eq!(json["shaders"][0]["stage"], "ray_generation");
+        assert!(json["shaders"][0]["driver_bytes"].is_null());
+        let text = render_human(&r);
+        assert!(text.contains("required 5, declared 5"), "{text}");
+        assert!(
+            text.contains(
+                "0 + min(1, 5) × max(32, 0, 0 + 0) + max(0, 5 − 1) × max(32, 0) + 2 × 0 = 160"
+            ),
+            "{text}"
+        );
+    }
+
+    #[test]
+    fn iterative_pipeline_needs_less() {
+        let r = report("fixtures/pipelines/reflect_iterative.pipeline.toml");
+        assert_eq!(r.required_depth, Some(2));
+        // The driver reported raygen 64 (the model says 32: a bounce loop
+        // carrying 52 bytes), closest-hit 32, misses 0: 128 and 96.
+        assert_eq!(r.driver_comparable.vulkan_default, Some(96));
+        // raygen 32 + closest-hit 32 + shadow miss 0.
+        assert_eq!(r.driver_comparable.exact_call_chain, Some(64));
+        let rg = r
+            .shaders
+            .iter()
+            .find(|s| s.stage == Stage::RayGeneration)
+            .unwrap();
+        // origin, dir, color, throughput (4 × 12) + bounce (4).
+        assert_eq!(rg.breakdown.live_state, 52);
+        assert_eq!(rg.breakdown.outgoing_payload, 32);
+    }
+
+    #[test]
+    fn reference_wgsl_pipeline() {
+        let r = report("shaders/reflect_iterative.pipeline.toml");
+        assert_eq!(r.required_depth, Some(1));
+        let rg = &r.shaders[0];
+        assert_eq!(
+            (rg.breakdown.live_state, rg.breakdown.live_state_total),
+            (60, 80)
+        );
+        assert!(r.assumptions.is_empty(), "{:?}", r.assumptions);
+    }
+
+    #[test]
+    fn big_payload_pipeline() {
+        let r = report("fixtures/RT025/bad.pipeline.toml");
+        assert_eq!(r.required_depth, Some(31));
+        let sizes: Vec<(Stage, u64, u64)> = r
+            .shaders
+            .iter()
+            .map(|s| (s.stage, s.driver_model_bytes, s.model_bytes))
+            .collect();
+        assert_eq!(
+            sizes,
+            [
+                (Stage::RayGeneration, 416, 416),
+                (Stage::Miss, 0, 0),
+                (Stage::ClosestHit, 544, 544)
+            ]
+        );
+        // A 512-byte payload: 416 + 31 × 544.
+        assert_eq!(r.vulkan_default, Some(17_280));
+        assert_eq!(r.exact_call_chain, Some(17_280));
+        let good = report("fixtures/RT025/good.pipeline.toml");
+        assert_eq!(good.driver_comparable.vulkan_default, Some(4_768));
+    }
+
+    #[test]
+    fn no_description_and_no_panics() {
+        // Every shader module in the repository, as one conservative pipeline
+        // each, through every analysis.
+        let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+        let mut files = Vec::new();
+        let mut dirs = vec![root.join("fixtures"), root.join("shaders")];
+        while let Some(d) = dirs.pop() {
+            for e in std::fs::read_dir(&d).unwrap().flatten() {
+                let p = e.path();
+                if p.is_dir() {
+                    dirs.push(p);
+                } else if matches!(p.extension().and_then(|x| x.to_str()), Some("spv" | "wgsl")) {
+                    files.push(p);
+                }
+            }
+        }
+        assert!(files.len() >= 20, "{}", files.len());
+        for f in &files {
+            let lang = crate::front::Language::from_path(f).unwrap();
+            let program = crate::front::load(f, lang).unwrap();
+            let p = Pipeline::from_programs(vec![program]);
+            let r = stack_report(&p);
+            assert!(render_human(&r).contains("no pipeline description"));
+            let _ = super::super::liveness::live_report(&p.programs);
+        }
+    }
+
+    #[test]
+    fn callables_stack_on_their_caller() {
+        let r = report("fixtures/pipelines/callable.pipeline.toml");
+        let sizes: Vec<(&str, u64)> = r
+            .shaders
+            .iter()
+            .map(|s| (s.group.as_str(), s.model_bytes))
+            .collect();
+        // raygen: `weight` (4 B) across the callable, and the 32-byte block
+        // the driver keeps for it; flat.rcall: a local float[16] (64 B).
+        assert_eq!(
+            sizes,
+            [
+                ("raygen 0", 36),
+                ("miss 0", 0),
+                ("callable 0", 0),
+                ("callable 1", 64)
+            ]
+        );
+        // 36 + 1 × max(0, 0, 0) + 0 + 2 × 64.
+        assert_eq!(r.vulkan_default, Some(164));
+        // The raygen calls SBT index 1 only: 36 + 64.
+        assert_eq!(r.exact_call_chain, Some(100));
+        assert_eq!(r.recommended, Some(112));
+    }
+
+    #[test]
+    fn procedural_group_attributes() {
+        let r = report("fixtures/pipelines/procedural.pipeline.toml");
+        let attrs: Vec<(Stage, u64)> = r
+            .shaders
+            .iter()
+            .map(|s| (s.stage, s.breakdown.hit_attributes))
+            .collect();
+        assert_eq!(
+            attrs,
+            [
+                (Stage::RayGeneration, 0),
+                (Stage::Miss, 0),
+                (Stage::ClosestHit, 8),
+                (Stage::ClosestHit, 16),
+                (Stage::AnyHit, 16),
+                (Stage::Intersection, 16)
+            ]
+        );
+        // No shader traces from a hit group, and the driver reported 0 for each.
+        assert_eq!(r.exact_call_chain, Some(0));
+    }
+
+    #[test]
+    fn driver_numbers_beside_the_model() {
+        let p = load(
+            &Path::new(env!("CARGO_MANIFEST_DIR"))
+                .join("fixtures/pipelines/reflect_iterative.pipeline.toml"),
+        )
+        .unwrap();
+        let mut r = stack_report(&p);
+        // lavapipe answers 4 for every group and stage.
+        attach_driver(&mut r, &p, &[Some(4); 4]);
+        let d = r.driver.as_ref().unwrap();
+        assert_eq!(d.vulkan_default, Some(4 + 4 + 4));
+        assert_eq!(d.exact_call_chain, Some(12));
+        assert!(render_human(&r).contains("driver's own numbers"));
+        let json = serde_json::to_value(&r).unwrap();
+        assert_eq!(json["shaders"][0]["driver_bytes"], 4);
+    }
+}

@@ -1,0 +1,226 @@
+//! `rtlint.toml`: budgets, rule levels and language mappings.
+
+use crate::diag::{InputError, Location, Severity};
+use crate::front::Language;
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+/// A rule's configured level.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Level {
+    Allow,
+    Warn,
+    Error,
+}
+
+impl Level {
+    pub fn severity(self) -> Option<Severity> {
+        match self {
+            Level::Allow => None,
+            Level::Warn => Some(Severity::Warning),
+            Level::Error => Some(Severity::Error),
+        }
+    }
+}
+
+#[derive(Clone, Debug, serde::Deserialize)]
+#[serde(deny_unknown_fields, rename_all = "kebab-case")]
+pub struct Config {
+    /// RT001: ray payloads above this many bytes (scalar size) are reported.
+    #[serde(default = "default_payload_budget")]
+    pub payload_budget: u64,
+    /// RT010: bytes of state live across one trace call.
+    #[serde(default = "default_live_state_budget")]
+    pub live_state_budget: u64,
+    /// RT025: the largest default pipeline stack (bytes per thread) a device
+    /// is known to run.
+    #[serde(default = "default_stack_limit")]
+    pub stack_limit: u64,
+    /// Warnings fail the run too.
+    #[serde(default)]
+    pub deny_warnings: bool,
+    /// Rule levels by code (`RT001`) or name (`payload-over-budget`).
+    #[serde(default)]
+    pub rules: BTreeMap<String, Level>,
+    /// Languages for other file extensions: `rgen = "hlsl"`.
+    #[serde(default)]
+    pub languages: BTreeMap<String, String>,
+    /// Where the config came from, for messages.
+    #[serde(skip)]
+    pub path: Option<PathBuf>,
+}
+
+fn default_payload_budget() -> u64 {
+    32
+}
+
+fn default_live_state_budget() -> u64 {
+    crate::rules::rt010_live_state_over_budget::DEFAULT_BUDGET_BYTES
+}
+
+fn default_stack_limit() -> u64 {
+    crate::analysis::stack::NVIDIA_KNOWN_SAFE_STACK_BYTES
+}
+
+impl Default for Config {
+    fn default() -> Self {
+        Config {
+            payload_budget: default_payload_budget(),
+            live_state_budget: default_live_state_budget(),
+            stack_limit: default_stack_limit(),
+            deny_warnings: false,
+            rules: BTreeMap::new(),
+            languages: BTreeMap::new(),
+            path: None,
+        }
+    }
+}
+
+pub const FILE_NAME: &str = "rtlint.toml";
+
+impl Config {
+    pub fn parse(text: &str, path: &Path) -> Result<Config, InputError> {
+        let mut config: Config = toml::from_str(text).map_err(|e| {
+            let mut err = InputError::new("invalid-config", path, e.message().trim().to_string());
+            if let Some(span) = e.span() {
+                let (line, column) = crate::front::wgsl::line_col(text, span.start);
+                let (end_line, end_column) = crate::front::wgsl::line_col(text, span.end);
+                err = err.at(
+                    Location {
+                        path: path.to_path_buf(),
+                        line,
+                        column,
+                        end_line,
+                        end_column,
+                    },
+                    "here",
+                );
+            }
+            err
+        })?;
+        for key in config.rules.keys() {
+            if crate::rules::find(key).is_none() {
+                return Err(config_error(
+                    text,
+                    path,
+                    key,
+                    format!("unknown rule `{key}`"),
+                ));
+            }
+        }
+        for (ext, lang) in &config.languages {
+            if Language::parse(lang).is_none() {
+                return Err(config_error(
+                    text,
+                    path,
+                    lang,
+                    format!("unknown language `{lang}` for extension `{ext}` (expected hlsl, wgsl or spirv)"),
+                ));
+            }
+        }
+        config.path = Some(path.to_path_buf());
+        Ok(config)
+    }
+
+    pub fn load(path: &Path) -> Result<Config, InputError> {
+        let text = crate::front::read_text(path)?;
+        Config::parse(&text, path)
+    }
+
+    /// `rtlint.toml` in `start` or the nearest directory above it.
+    pub fn discover(start: &Path) -> Option<PathBuf> {
+        let start = std::fs::canonicalize(start).ok()?;
+        let mut dir = if start.is_dir() {
+            Some(start.as_path())
+        } else {
+            start.parent()
+        };
+        while let Some(d) = dir {
+            let candidate = d.join(FILE_NAME);
+            if candidate.is_file() {
+                return Some(candidate);
+            }
+            dir = d.parent();
+        }
+        None
+    }
+
+    /// The configured level of a rule, by code or by name.
+    pub fn level(&self, code: &str, name: &str) -> Option<Level> {
+        self.rules
+            .get(code)
+            .or_else(|| self.rules.get(name))
+            .copied()
+    }
+
+    /// The language configured for a path's extension.
+    pub fn language_for(&self, path: &Path) -> Option<Language> {
+        let ext = path.extension()?.to_str()?;
+        let ext = ext.trim_start_matches('.');
+        self.languages
+            .iter()
+            .find(|(k, _)| k.trim_start_matches('.').eq_ignore_ascii_case(ext))
+            .and_then(|(_, v)| Language::parse(v))
+    }
+}
+
+/// An error pointing at the first occurrence of `needle` in the config text.
+fn config_error(text: &str, path: &Path, needle: &str, message: String) -> InputError {
+    let err = InputError::new("invalid-config", path, message);
+    match text.find(needle) {
+        Some(at) => {
+            let (line, column) = crate::front::wgsl::line_col(text, at);
+            err.at(
+                Location::span(path, line, column, needle.chars().count() as u32),
+                "here",
+            )
+        }
+        None => err,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn parses_levels_budgets_and_languages() {
+        let c = Config::parse(
+            "payload-budget = 48\n[rules]\nRT003 = \"allow\"\npayload-packing-waste = \"error\"\n[languages]\nrgen = \"hlsl\"\n",
+            Path::new("rtlint.toml"),
+        )
+        .unwrap();
+        assert_eq!(c.payload_budget, 48);
+        assert_eq!(c.level("RT003", "member-straddles-row"), Some(Level::Allow));
+        assert_eq!(
+            c.level("RT002", "payload-packing-waste"),
+            Some(Level::Error)
+        );
+        assert_eq!(c.level("RT001", "payload-over-budget"), None);
+        assert_eq!(c.language_for(Path::new("a/b.rgen")), Some(Language::Hlsl));
+    }
+
+    #[test]
+    fn bad_config_names_the_position() {
+        let e = Config::parse(
+            "payload-budget = 32\nbogus = 1\n",
+            Path::new("x/rtlint.toml"),
+        )
+        .unwrap_err();
+        let l = &e.diagnostic().primary.as_ref().unwrap().location;
+        assert_eq!((l.line, l.column), (2, 1));
+        assert!(
+            e.diagnostic().message.contains("bogus"),
+            "{}",
+            e.diagnostic().message
+        );
+
+        let e = Config::parse("[rules]\nRT999 = \"warn\"\n", Path::new("rtlint.toml")).unwrap_err();
+        assert_eq!(e.diagnostic().message, "unknown rule `RT999`");
+        assert_eq!(e.diagnostic().primary.as_ref().unwrap().location.line, 2);
+
+        let e = Config::parse("payload-budget = \"big\"\n", Path::new("rtlint.toml")).unwrap_err();
+        assert_eq!(e.diagnostic().primary.as_ref().unwrap().location.line, 1);
+    }
+}

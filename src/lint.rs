@@ -1,0 +1,154 @@
+//! The linting driver shared by the CLI and the build-script API: find the
+//! inputs, load each into a Program, run the rules.
+
+use crate::config::Config;
+use crate::diag::{Diagnostic, InputError};
+use crate::front::{self, Language};
+use crate::spirv::Program;
+use std::path::{Path, PathBuf};
+
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Input {
+    pub path: PathBuf,
+    pub language: Language,
+}
+
+/// What walking the paths found.
+#[derive(Debug, Default)]
+pub struct Inputs {
+    pub files: Vec<Input>,
+    /// Pipeline descriptions (`*.pipeline.toml`).
+    pub pipelines: Vec<PathBuf>,
+    /// Paths that could not be used (missing, unknown language when named).
+    pub errors: Vec<InputError>,
+    /// Files skipped inside directories, for `--verbose`.
+    pub skipped: Vec<PathBuf>,
+}
+
+/// Walks `paths`: files are taken as named, directories recursively (sorted,
+/// so output is stable), picking files by extension.
+pub fn collect_inputs(paths: &[PathBuf], config: &Config, forced: Option<Language>) -> Inputs {
+    let mut inputs = Inputs::default();
+    for p in paths {
+        let meta = match std::fs::metadata(p) {
+            Ok(m) => m,
+            Err(e) => {
+                inputs.errors.push(front::io_error(p, &e));
+                continue;
+            }
+        };
+        if meta.is_dir() {
+            walk(p, config, forced, &mut inputs);
+        } else if is_pipeline(p) {
+            inputs.pipelines.push(p.clone());
+        } else {
+            match language_of(p, config, forced) {
+                Some(language) => inputs.files.push(Input {
+                    path: p.clone(),
+                    language,
+                }),
+                None => inputs.errors.push(InputError::new(
+                    "unknown-language",
+                    p,
+                    "cannot tell the shader language from the file extension; pass --lang or map the extension under [languages] in rtlint.toml",
+                )),
+            }
+        }
+    }
+    inputs
+}
+
+fn walk(dir: &Path, config: &Config, forced: Option<Language>, inputs: &mut Inputs) {
+    let mut entries: Vec<PathBuf> = match std::fs::read_dir(dir) {
+        Ok(rd) => rd.filter_map(|e| e.ok().map(|e| e.path())).collect(),
+        Err(e) => {
+            inputs.errors.push(front::io_error(dir, &e));
+            return;
+        }
+    };
+    entries.sort();
+    for p in entries {
+        let name = p.file_name().and_then(|n| n.to_str()).unwrap_or("");
+        if name.starts_with('.') || name == "target" {
+            continue;
+        }
+        if p.is_dir() {
+            walk(&p, config, forced, inputs);
+        } else if is_pipeline(&p) {
+            inputs.pipelines.push(p);
+        } else if let Some(language) =
+            language_of(&p, config, None).or(forced.filter(|_| is_shader_like(&p)))
+        {
+            inputs.files.push(Input { path: p, language });
+        } else {
+            inputs.skipped.push(p);
+        }
+    }
+}
+
+pub fn is_pipeline(p: &Path) -> bool {
+    p.file_name()
+        .and_then(|n| n.to_str())
+        .is_some_and(|n| n.ends_with(".pipeline.toml"))
+}
+
+/// `--lang` applies to named files; inside directories only to files that are
+/// not obviously something else.
+fn is_shader_like(p: &Path) -> bool {
+    !matches!(
+        p.extension().and_then(|e| e.to_str()),
+        Some("md" | "toml" | "txt" | "json" | "sh" | "py" | "rs" | "png" | "ppm")
+    ) && p.extension().is_some()
+}
+
+fn language_of(p: &Path, config: &Config, forced: Option<Language>) -> Option<Language> {
+    forced
+        .or_else(|| config.language_for(p))
+        .or_else(|| Language::from_path(p))
+}
+
+/// One input's outcome.
+#[derive(Debug)]
+pub struct Checked {
+    pub path: PathBuf,
+    pub program: Option<Program>,
+    pub diagnostics: Vec<Diagnostic>,
+}
+
+/// Loads and checks one input; a bad input becomes one error diagnostic.
+pub fn check_input(input: &Input, config: &Config) -> Checked {
+    match front::load(&input.path, input.language) {
+        Ok(program) => {
+            let diagnostics = crate::rules::check_program(&program, config);
+            Checked {
+                path: input.path.clone(),
+                program: Some(program),
+                diagnostics,
+            }
+        }
+        Err(e) => Checked {
+            path: input.path.clone(),
+            program: None,
+            diagnostics: vec![*e.0],
+        },
+    }
+}
+
+/// Loads a pipeline description and runs the pipeline rules on it.
+pub fn check_pipeline(path: &Path, config: &Config) -> Checked {
+    match crate::pipeline::load(path) {
+        Ok(pipeline) => {
+            let ctx = crate::rules::PipelineContext::new(&pipeline, config);
+            Checked {
+                path: path.to_path_buf(),
+                program: None,
+                diagnostics: crate::rules::check_pipeline(&ctx),
+            }
+        }
+        Err(e) => Checked {
+            path: path.to_path_buf(),
+            program: None,
+            diagnostics: vec![*e.0],
+        },
+    }
+}

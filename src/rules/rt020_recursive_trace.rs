@@ -1,0 +1,107 @@
+//! RT020 `recursive-trace`: a closest-hit or miss shader traces a ray that
+//! can invoke a closest-hit shader again, so the stack grows per bounce.
+
+use crate::analysis::callgraph::EdgeKind;
+use crate::analysis::recursion::RecursionReport;
+use crate::diag::{Diagnostic, Severity};
+use crate::pipeline::Pipeline;
+use crate::spirv::Stage;
+
+pub const CODE: &str = "RT020";
+pub const NAME: &str = "recursive-trace";
+pub const LEVEL: Severity = Severity::Warning;
+
+/// One finding per trace site in a closest-hit or miss shader whose ray can
+/// reach a closest-hit shader. Shadow rays that skip closest-hit shaders
+/// (or reach only miss shaders) add one fixed level and are not reported.
+pub fn check(pipeline: &Pipeline, rec: &RecursionReport) -> Vec<Diagnostic> {
+    let g = &rec.graph;
+    let mut out = Vec::new();
+    for site in &rec.recursive_sites {
+        let reaches_hit = g.edges.iter().any(|e| {
+            e.kind == EdgeKind::Trace
+                && e.program == site.program
+                && e.inst == site.inst
+                && g.nodes[e.to].shader.stage == Stage::ClosestHit
+        });
+        if !reaches_hit {
+            continue;
+        }
+        let node = &g.nodes[site.node];
+        let file = pipeline
+            .programs
+            .get(site.program)
+            .map(|p| p.path.clone())
+            .unwrap_or_else(|| node.shader.file.clone());
+        let stage = match node.shader.stage {
+            Stage::Miss => "miss",
+            _ => "closest-hit",
+        };
+        let mut d = Diagnostic::new(
+            LEVEL,
+            NAME,
+            &file,
+            format!(
+                "{stage} shader `{}` traces a ray that can invoke a closest-hit shader again",
+                node.shader.entry
+            ),
+        )
+        .with_code(CODE)
+        .with_subject(node.shader.entry.clone())
+        .with_primary(site.location.clone(), "recursive trace");
+        match rec.required_depth {
+            Some(depth) => {
+                d = d.with_note(format!(
+                    "the pipeline needs recursion depth {depth}: {}",
+                    rec.chain_text()
+                ))
+            }
+            None => d = d.with_note("the recursion depth is unbounded at compile time"),
+        }
+        out.push(d.with_help(
+            "loop over bounces in the ray generation shader and return the hit in the payload",
+        ));
+    }
+    out
+}
+
+pub static RULE: super::Rule = super::Rule {
+    code: CODE,
+    name: NAME,
+    group: super::Group::Perf,
+    level: LEVEL,
+    summary: "trace call from a closest-hit or miss shader",
+    doc: include_str!("../../rules/RT020.md"),
+    kind: super::Kind::Pipeline(run),
+};
+
+fn run(ctx: &super::PipelineContext) -> Vec<Diagnostic> {
+    check(ctx.pipeline, &ctx.recursion)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::analysis::recursion::recursion;
+    use crate::pipeline::load;
+    use std::path::Path;
+
+    fn run(rel: &str) -> Vec<Diagnostic> {
+        let p = load(&Path::new(env!("CARGO_MANIFEST_DIR")).join(rel)).unwrap();
+        check(&p, &recursion(&p))
+    }
+
+    #[test]
+    fn bad_and_good() {
+        let d = run("fixtures/RT020/bad.pipeline.toml");
+        assert_eq!(d.len(), 1, "{d:?}");
+        assert_eq!(
+            d[0].message,
+            "closest-hit shader `main` traces a ray that can invoke a closest-hit shader again"
+        );
+        assert_eq!(d[0].primary.as_ref().unwrap().location.line, 26);
+        assert!(d[0].notes[0].starts_with("the pipeline needs recursion depth 5"));
+        // The iterative pipeline's closest-hit shader traces only a shadow ray.
+        assert!(run("fixtures/RT020/good.pipeline.toml").is_empty());
+    }
+}

@@ -1,0 +1,89 @@
+//! RT021 `depth-exceeds-declared`: the pipeline recurses deeper than the
+//! `maxPipelineRayRecursionDepth` the application declares.
+
+use crate::analysis::recursion::RecursionReport;
+use crate::diag::{Diagnostic, Severity};
+use crate::pipeline::Pipeline;
+use std::path::PathBuf;
+
+pub const CODE: &str = "RT021";
+pub const NAME: &str = "depth-exceeds-declared";
+pub const LEVEL: Severity = Severity::Error;
+
+pub(crate) fn pipeline_file(pipeline: &Pipeline) -> PathBuf {
+    pipeline
+        .path
+        .clone()
+        .or_else(|| pipeline.raygen.first().map(|s| s.file.clone()))
+        .unwrap_or_default()
+}
+
+/// A finding when the required depth (bounded) exceeds the declared one.
+pub fn check(pipeline: &Pipeline, rec: &RecursionReport) -> Vec<Diagnostic> {
+    let (Some(required), Some(declared)) = (rec.required_depth, pipeline.max_recursion_depth)
+    else {
+        return Vec::new();
+    };
+    if required <= declared {
+        return Vec::new();
+    }
+    let deepest = rec.chain.iter().rev().find_map(|s| s.via.clone());
+    vec![Diagnostic::new(
+        LEVEL,
+        NAME,
+        &pipeline_file(pipeline),
+        format!("pipeline needs recursion depth {required}, above the declared {declared}"),
+    )
+    .with_code(CODE)
+    .with_primary(
+        pipeline.max_recursion_depth_location.clone(),
+        format!("declared {declared} here"),
+    )
+    .with_secondary(deepest, format!("this trace runs at depth {required}"))
+    .with_note(format!("deepest chain: {}", rec.chain_text()))
+    .with_note(
+        "recursing past the declared depth is undefined: lavapipe crashes at once; NVIDIA returns correct results for some extra levels, then hangs the GPU",
+    )
+    .with_help(format!("set `max_recursion_depth = {required}` (maxPipelineRayRecursionDepth)"))]
+}
+
+pub static RULE: super::Rule = super::Rule {
+    code: CODE,
+    name: NAME,
+    group: super::Group::Correctness,
+    level: LEVEL,
+    summary: "pipeline needs more recursion than it declares",
+    doc: include_str!("../../rules/RT021.md"),
+    kind: super::Kind::Pipeline(run),
+};
+
+fn run(ctx: &super::PipelineContext) -> Vec<Diagnostic> {
+    check(ctx.pipeline, &ctx.recursion)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::analysis::recursion::recursion;
+    use crate::pipeline::load;
+    use std::path::Path;
+
+    fn run(rel: &str) -> Vec<Diagnostic> {
+        let p = load(&Path::new(env!("CARGO_MANIFEST_DIR")).join(rel)).unwrap();
+        check(&p, &recursion(&p))
+    }
+
+    #[test]
+    fn bad_and_good() {
+        let d = run("fixtures/RT021/bad.pipeline.toml");
+        assert_eq!(d.len(), 1);
+        assert_eq!(
+            d[0].message,
+            "pipeline needs recursion depth 5, above the declared 3"
+        );
+        assert_eq!(d[0].severity, Severity::Error);
+        assert_eq!(d[0].primary.as_ref().unwrap().location.line, 2);
+        assert_eq!(d[0].secondary.len(), 1);
+        assert!(run("fixtures/RT021/good.pipeline.toml").is_empty());
+    }
+}

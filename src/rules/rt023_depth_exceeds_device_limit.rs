@@ -1,0 +1,106 @@
+//! RT023 `depth-exceeds-device-limit`: the declared or required recursion
+//! depth is above what devices support (31 on lavapipe, NVIDIA and DXR).
+
+use super::rt021_depth_exceeds_declared::pipeline_file;
+use crate::analysis::recursion::RecursionReport;
+use crate::diag::{Diagnostic, Severity};
+use crate::pipeline::Pipeline;
+
+pub const CODE: &str = "RT023";
+pub const NAME: &str = "depth-exceeds-device-limit";
+pub const LEVEL: Severity = Severity::Error;
+
+/// `device_limit` is `maxRayRecursionDepth` (31 on the devices measured;
+/// the description's `device_max_recursion_depth` overrides it).
+pub fn check(pipeline: &Pipeline, rec: &RecursionReport, device_limit: u32) -> Vec<Diagnostic> {
+    let mut out = Vec::new();
+    let file = pipeline_file(pipeline);
+    let note = "NVIDIA fails pipeline creation above 31; lavapipe accepts it and crashes when a ray recurses past 31";
+    if let Some(declared) = pipeline.max_recursion_depth.filter(|&d| d > device_limit) {
+        out.push(
+            Diagnostic::new(
+                LEVEL,
+                NAME,
+                &file,
+                format!(
+                    "declared recursion depth {declared} exceeds the device limit of {device_limit}"
+                ),
+            )
+            .with_code(CODE)
+            .with_primary(
+                pipeline.max_recursion_depth_location.clone(),
+                format!("declared {declared} here"),
+            )
+            .with_note(note)
+            .with_help(format!(
+                "declare at most {device_limit} and bound the recursion in the shaders"
+            )),
+        );
+    }
+    if let Some(required) = rec.required_depth.filter(|&d| d > device_limit) {
+        let deepest = rec.chain.iter().rev().find_map(|s| s.via.clone());
+        out.push(
+            Diagnostic::new(
+                LEVEL,
+                NAME,
+                &file,
+                format!(
+                    "pipeline needs recursion depth {required}, above the device limit of {device_limit}"
+                ),
+            )
+            .with_code(CODE)
+            .with_primary(deepest, format!("this trace runs at depth {required}"))
+            .with_note(format!("deepest chain: {}", rec.chain_text()))
+            .with_note(note)
+            .with_help("loop over bounces in the ray generation shader instead of recursing"),
+        );
+    }
+    out
+}
+
+pub static RULE: super::Rule = super::Rule {
+    code: CODE,
+    name: NAME,
+    group: super::Group::Correctness,
+    level: LEVEL,
+    summary: "recursion depth above the device limit",
+    doc: include_str!("../../rules/RT023.md"),
+    kind: super::Kind::Pipeline(run),
+};
+
+fn run(ctx: &super::PipelineContext) -> Vec<Diagnostic> {
+    check(
+        ctx.pipeline,
+        &ctx.recursion,
+        ctx.pipeline.device_max_recursion_depth,
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::analysis::recursion::recursion;
+    use crate::pipeline::{load, DEFAULT_DEVICE_MAX_RECURSION_DEPTH};
+    use std::path::Path;
+
+    fn run(rel: &str) -> Vec<Diagnostic> {
+        let p = load(&Path::new(env!("CARGO_MANIFEST_DIR")).join(rel)).unwrap();
+        check(&p, &recursion(&p), p.device_max_recursion_depth)
+    }
+
+    #[test]
+    fn bad_and_good() {
+        let d = run("fixtures/RT023/bad.pipeline.toml");
+        assert_eq!(d.len(), 2, "{d:?}");
+        assert_eq!(
+            d[0].message,
+            "declared recursion depth 40 exceeds the device limit of 31"
+        );
+        assert_eq!(
+            d[1].message,
+            "pipeline needs recursion depth 40, above the device limit of 31"
+        );
+        assert!(run("fixtures/RT023/good.pipeline.toml").is_empty());
+        assert_eq!(DEFAULT_DEVICE_MAX_RECURSION_DEPTH, 31);
+    }
+}

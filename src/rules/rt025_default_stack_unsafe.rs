@@ -1,0 +1,119 @@
+//! RT025 `default-stack-unsafe`: the stack size a driver picks by default
+//! for the declared depth is larger than a device is known to survive.
+
+use super::rt021_depth_exceeds_declared::pipeline_file;
+use crate::analysis::stack::StackReport;
+use crate::diag::{Diagnostic, Severity};
+use crate::pipeline::Pipeline;
+
+pub const CODE: &str = "RT025";
+pub const NAME: &str = "default-stack-unsafe";
+pub const LEVEL: Severity = Severity::Error;
+pub use crate::analysis::stack::NVIDIA_KNOWN_SAFE_STACK_BYTES as DEFAULT_LIMIT_BYTES;
+
+/// A finding when the Vulkan default stack, from the driver-comparable
+/// sizes and the declared depth, exceeds `limit_bytes`.
+pub fn check(pipeline: &Pipeline, stack: &StackReport, limit_bytes: u64) -> Vec<Diagnostic> {
+    let Some(default) = stack.driver_comparable.vulkan_default else {
+        return Vec::new();
+    };
+    if default <= limit_bytes {
+        return Vec::new();
+    }
+    let declared = pipeline.max_recursion_depth.unwrap_or(0);
+    let mut d = Diagnostic::new(
+        LEVEL,
+        NAME,
+        &pipeline_file(pipeline),
+        format!(
+            "default pipeline stack of {default} bytes per thread is above the {limit_bytes} bytes known to run"
+        ),
+    )
+    .with_code(CODE)
+    .with_primary(
+        pipeline.max_recursion_depth_location.clone(),
+        format!("depth {declared} multiplies the largest closest-hit or miss stack"),
+    )
+    .with_note(
+        "on an NVIDIA H200 (driver 580.159.04) a pipeline stack of 14,746 bytes per thread lost the device at the first trace and 14,702 ran; a stack set below what the call chain needs hung the GPU",
+    );
+    let help = match stack
+        .recommended
+        .or(stack.driver_comparable.exact_call_chain)
+    {
+        Some(v) => {
+            d = d.with_note(format!(
+                "the deepest call chain needs {v} bytes ({})",
+                if stack.depth_chain.is_empty() {
+                    "no chain".into()
+                } else {
+                    stack.depth_chain.clone()
+                }
+            ));
+            if v <= limit_bytes {
+                format!("set the stack explicitly: vkCmdSetRayTracingPipelineStackSizeKHR(cmd, {v}) or SetPipelineStackSize({v})")
+            } else {
+                // The scene itself needs more than is known to run.
+                "reduce the recursion depth or the payload until the call chain fits, then set the stack explicitly".into()
+            }
+        }
+        None => "declare the depth the pipeline needs and set the stack size explicitly".into(),
+    };
+    vec![d.with_help(help)]
+}
+
+pub static RULE: super::Rule = super::Rule {
+    code: CODE,
+    name: NAME,
+    group: super::Group::Correctness,
+    level: LEVEL,
+    summary: "default pipeline stack above what the device is known to survive",
+    doc: include_str!("../../rules/RT025.md"),
+    kind: super::Kind::Pipeline(run),
+};
+
+fn run(ctx: &super::PipelineContext) -> Vec<Diagnostic> {
+    check(ctx.pipeline, &ctx.stack, ctx.config.stack_limit)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::analysis::stack::stack_report;
+    use crate::pipeline::load;
+    use std::path::Path;
+
+    fn run(rel: &str) -> Vec<Diagnostic> {
+        let p = load(&Path::new(env!("CARGO_MANIFEST_DIR")).join(rel)).unwrap();
+        check(&p, &stack_report(&p), DEFAULT_LIMIT_BYTES)
+    }
+
+    #[test]
+    fn bad_and_good() {
+        let d = run("fixtures/RT025/bad.pipeline.toml");
+        assert_eq!(d.len(), 1);
+        // 416 + 31 × 544, the calibrated model for a 512-byte payload.
+        assert_eq!(
+            d[0].message,
+            "default pipeline stack of 17280 bytes per thread is above the 14702 bytes known to run"
+        );
+        // 30 reflections really need 17,280 bytes: setting it would not help.
+        assert_eq!(
+            d[0].help.as_deref(),
+            Some("reduce the recursion depth or the payload until the call chain fits, then set the stack explicitly")
+        );
+        // Depth 8: 416 + 8 × 544 = 4768.
+        assert!(run("fixtures/RT025/good.pipeline.toml").is_empty());
+        // Declared 31 but the guard allows 2 reflections: the exact chain
+        // (416 + 3 × 544 = 2,048) is safe to set.
+        let mut p =
+            load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/RT025/bad.pipeline.toml"))
+                .unwrap();
+        p.constants.get_mut("pushConst.maxDepth").unwrap().value = 2;
+        let d = check(&p, &stack_report(&p), DEFAULT_LIMIT_BYTES);
+        assert_eq!(
+            d[0].help.as_deref(),
+            Some("set the stack explicitly: vkCmdSetRayTracingPipelineStackSizeKHR(cmd, 2048) or SetPipelineStackSize(2048)")
+        );
+    }
+}
