@@ -3673,6 +3673,7 @@ impl<'a> Lowerer<'a> {
                     this.ty_name(to)
                 ),
             )
+            .label(format!("this is a `{}`", this.ty_name(&v.ty)))
         };
         match (&v.ty, to) {
             (Ty::Sc(a), Ty::Sc(b)) => self.convert_scalar(v.id, *a, *b, to),
