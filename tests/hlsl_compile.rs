@@ -346,3 +346,32 @@ fn compile_speed() {
     let per = start.elapsed().as_secs_f64() * 1000.0 / entries as f64;
     eprintln!("{entries} entry points, {per:.3} ms per entry point");
 }
+
+/// The project's HLSL fixture gives the same findings on the same lines when
+/// compiled by rtlint as when compiled by Slang (tests/slang.rs): for the
+/// entry point's own module and for the whole file.
+#[test]
+fn payload_fixture_findings_match_slang_lines() {
+    use rtlint::front::Language;
+    use std::collections::BTreeSet;
+    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/hlsl/payloads.hlsl");
+    let expected = BTreeSet::from([(2, "RT001"), (2, "RT002"), (4, "RT003")]);
+    let findings = |program: &rtlint::spirv::Program| -> BTreeSet<(u32, &'static str)> {
+        rtlint::rules::check_program(program, &rtlint::config::Config::default())
+            .iter()
+            .map(|d| {
+                let p = d.primary.as_ref().expect("positioned");
+                assert_eq!(p.location.path.file_name().unwrap(), "payloads.hlsl");
+                (p.location.line, d.code.unwrap())
+            })
+            .collect()
+    };
+    let entries = hlsl::compile(&src, &HlslOptions::default()).unwrap();
+    let gen = entries.iter().find(|e| e.name == "RayGen").unwrap();
+    validate(&gen.words, "payloads-RayGen");
+    let program =
+        rtlint::spirv::parse(&gen.words, Path::new("payloads.spv"), Language::Spirv).unwrap();
+    assert_eq!(findings(&program), expected);
+    let whole = rtlint::front::load(&src, Language::Hlsl).unwrap();
+    assert_eq!(findings(&whole), expected);
+}
