@@ -91,8 +91,14 @@ fn gpu(rt: bool) -> Option<Gpu> {
         if ray_query {
             exts.push(ash::khr::ray_query::NAME.as_ptr());
         }
+        // Storage images without a declared format (float3 texels, and Slang's
+        // output) need these.
+        let core = vk::PhysicalDeviceFeatures::default()
+            .shader_storage_image_read_without_format(true)
+            .shader_storage_image_write_without_format(true);
         let mut info = vk::DeviceCreateInfo::default()
             .queue_create_infos(&qinfo)
+            .enabled_features(&core)
             .push_next(&mut v12);
         if rt {
             info = info
@@ -1348,4 +1354,145 @@ fn textures_and_storage_images_on_the_driver() {
         gpu.free_image(tex);
         gpu.free_image(img);
     }
+}
+
+/// Runs `entry` of `file` once and returns every output buffer's bytes;
+/// `setup` makes the bindings, `run` dispatches.
+unsafe fn run_compute_case(gpu: &Gpu, words: &[u32], entry: &str, file: &str) -> Vec<Vec<u8>> {
+    let read = |b: &Buffer, n: usize| std::slice::from_raw_parts(b.ptr, n).to_vec();
+    match file {
+        "exec_memory.hlsl" => {
+            let raw = gpu.buffer(1024, vk::BufferUsageFlags::STORAGE_BUFFER);
+            let init: Vec<u32> = (0..64).map(|i| 1000 + i).collect();
+            std::ptr::copy_nonoverlapping(init.as_ptr() as *const u8, raw.ptr, 256);
+            let counts = gpu.buffer(16, vk::BufferUsageFlags::STORAGE_BUFFER);
+            gpu.dispatch(
+                words,
+                entry,
+                &[Bind::Storage(&raw), Bind::Storage(&counts)],
+                1,
+            );
+            // Word 195 onward and the compare-exchange winner depend on scheduling.
+            let mut r = read(&raw, 772);
+            r.truncate(768);
+            let mut c = read(&counts, 12);
+            c.truncate(12);
+            gpu.free(raw);
+            gpu.free(counts);
+            vec![r, c]
+        }
+        "exec_textures.hlsl" => {
+            let texels = [
+                [1.0f32, 0.0, 0.0, 1.0],
+                [0.0, 2.0, 0.0, 1.0],
+                [0.0, 0.0, 3.0, 1.0],
+                [4.0, 4.0, 4.0, 1.0],
+            ];
+            let tex = gpu.image(2, 2, vk::ImageUsageFlags::SAMPLED, &texels);
+            let img = gpu.image(4, 4, vk::ImageUsageFlags::STORAGE, &[]);
+            let sampler = gpu
+                .device
+                .create_sampler(
+                    &vk::SamplerCreateInfo::default()
+                        .mag_filter(vk::Filter::NEAREST)
+                        .min_filter(vk::Filter::NEAREST),
+                    None,
+                )
+                .unwrap();
+            let out = gpu.buffer(256, vk::BufferUsageFlags::STORAGE_BUFFER);
+            gpu.dispatch(
+                words,
+                entry,
+                &[
+                    Bind::SampledImage(tex.view),
+                    Bind::Sampler(sampler),
+                    Bind::StorageImage(img.view),
+                    Bind::Storage(&out),
+                ],
+                1,
+            );
+            let r = read(&out, 256);
+            gpu.device.destroy_sampler(sampler, None);
+            gpu.free(out);
+            gpu.free_image(tex);
+            gpu.free_image(img);
+            vec![r]
+        }
+        _ => unreachable!("no setup for {file}"),
+    }
+}
+
+/// Sets `OpSource`'s language to Unknown: Slang writes a code (11) that older
+/// SPIR-V consumers reject.
+fn unknown_source_language(words: &mut [u32]) {
+    let mut i = 5;
+    while i < words.len() {
+        let n = (words[i] >> 16) as usize;
+        if words[i] & 0xffff == 3 && n > 1 {
+            words[i + 1] = 0;
+        }
+        i += n.max(1);
+    }
+}
+
+/// The same HLSL compiled by Slang and by rtlint computes the same bytes on
+/// the driver. Skipped when Slang is missing, unless CI=true.
+#[test]
+fn differential_against_slang_on_the_driver() {
+    let slang = match rtlint::front::slang::Slang::find() {
+        Ok(s) => s,
+        Err(e) => {
+            assert!(
+                std::env::var("CI").as_deref() != Ok("true"),
+                "Slang is required in CI: {e}"
+            );
+            eprintln!("no Slang ({e}); skipping");
+            return;
+        }
+    };
+    let Some(gpu) = gpu(false) else { return };
+    let mut compared = 0;
+    for file in ["exec_memory.hlsl", "exec_textures.hlsl"] {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("tests/hlsl")
+            .join(file);
+        let ours = compile_whole(file);
+        let mut theirs = slang.compile_hlsl(&path, "Main", "compute", &[]).unwrap();
+        unknown_source_language(&mut theirs);
+        // Compare only where Slang's module is valid: for `img[p].z *= 2.0`
+        // Slang 2026.12 emits an OpImageTexelPointer to a vector, which
+        // spirv-val and lavapipe reject.
+        if let Some(why) = invalid_spirv(&theirs) {
+            eprintln!("{file}: Slang's module is invalid, not compared: {why}");
+            continue;
+        }
+        compared += 1;
+        unsafe {
+            let a = run_compute_case(&gpu, &ours, "Main", file);
+            // Slang names every entry point `main`.
+            let b = run_compute_case(&gpu, &theirs, "main", file);
+            assert_eq!(a, b, "{file}: rtlint and Slang disagree");
+        }
+    }
+    assert!(compared >= 1, "nothing was compared");
+}
+
+/// spirv-val's complaint about `words`, if any (None also when spirv-val is missing).
+fn invalid_spirv(words: &[u32]) -> Option<String> {
+    let file = std::env::temp_dir().join(format!("rtlint-diff-{}.spv", std::process::id()));
+    let bytes: Vec<u8> = words.iter().flat_map(|w| w.to_le_bytes()).collect();
+    std::fs::write(&file, bytes).ok()?;
+    let out = std::process::Command::new("spirv-val")
+        .args(["--target-env", "vulkan1.2"])
+        .arg(&file)
+        .output()
+        .ok()?;
+    let _ = std::fs::remove_file(&file);
+    (!out.status.success()).then(|| {
+        String::from_utf8_lossy(&out.stderr)
+            .lines()
+            .next()
+            .unwrap_or("")
+            .to_string()
+    })
 }
