@@ -779,7 +779,7 @@ impl Gpu {
     #[allow(clippy::too_many_arguments)]
     unsafe fn trace(
         &self,
-        words: &[u32],
+        modules: &[&[u32]],
         stages: &[(&str, vk::ShaderStageFlags)],
         groups: &[vk::RayTracingShaderGroupCreateInfoKHR],
         tables: [&[u32]; 4],
@@ -789,9 +789,14 @@ impl Gpu {
     ) {
         let d = &self.device;
         let rt_ext = ash::khr::ray_tracing_pipeline::Device::new(&self.instance, d);
-        let shader = d
-            .create_shader_module(&vk::ShaderModuleCreateInfo::default().code(words), None)
-            .unwrap();
+        // One module for every stage, or one per stage (Slang's output).
+        let shaders: Vec<vk::ShaderModule> = modules
+            .iter()
+            .map(|w| {
+                d.create_shader_module(&vk::ShaderModuleCreateInfo::default().code(w), None)
+                    .unwrap()
+            })
+            .collect();
         let names: Vec<std::ffi::CString> = stages
             .iter()
             .map(|(n, _)| std::ffi::CString::new(*n).unwrap())
@@ -799,10 +804,11 @@ impl Gpu {
         let infos: Vec<_> = names
             .iter()
             .zip(stages)
-            .map(|(n, (_, k))| {
+            .enumerate()
+            .map(|(i, (n, (_, k)))| {
                 vk::PipelineShaderStageCreateInfo::default()
                     .stage(*k)
-                    .module(shader)
+                    .module(shaders[i.min(shaders.len() - 1)])
                     .name(n)
             })
             .collect();
@@ -892,7 +898,9 @@ impl Gpu {
         d.destroy_pipeline(pipeline, None);
         d.destroy_pipeline_layout(pipeline_layout, None);
         d.destroy_descriptor_set_layout(set_layout, None);
-        d.destroy_shader_module(shader, None);
+        for m in shaders {
+            d.destroy_shader_module(m, None);
+        }
     }
 
     /// Runs compute entry `entry` with `binds`, `groups` workgroups along x.
@@ -1025,7 +1033,7 @@ fn ray_tracing_pipeline_on_the_driver() {
         let out = gpu.buffer(16 * 16, vk::BufferUsageFlags::STORAGE_BUFFER);
         use vk::ShaderStageFlags as S;
         gpu.trace(
-            &words,
+            &[&words],
             &[
                 ("RG", S::RAYGEN_KHR),
                 ("MissColor", S::MISS_KHR),
@@ -1070,7 +1078,7 @@ fn intersection_and_callable_on_the_driver() {
         let out = gpu.buffer(16 * 16, vk::BufferUsageFlags::STORAGE_BUFFER);
         use vk::ShaderStageFlags as S;
         gpu.trace(
-            &words,
+            &[&words],
             &[
                 ("Gen", S::RAYGEN_KHR),
                 ("Miss", S::MISS_KHR),
@@ -1495,4 +1503,121 @@ fn invalid_spirv(words: &[u32]) -> Option<String> {
             .unwrap_or("")
             .to_string()
     })
+}
+
+/// The ray-tracing pipeline and the procedural/callable pipeline compiled by
+/// Slang (one module per entry point) and by rtlint give the same bytes.
+#[test]
+fn ray_tracing_differential_against_slang_on_the_driver() {
+    let slang = match rtlint::front::slang::Slang::find() {
+        Ok(s) => s,
+        Err(e) => {
+            assert!(
+                std::env::var("CI").as_deref() != Ok("true"),
+                "Slang is required in CI: {e}"
+            );
+            eprintln!("no Slang ({e}); skipping");
+            return;
+        }
+    };
+    let Some(gpu) = gpu(true) else { return };
+    use vk::ShaderStageFlags as S;
+    let tri = vk::RayTracingShaderGroupTypeKHR::TRIANGLES_HIT_GROUP;
+    let proc_ = vk::RayTracingShaderGroupTypeKHR::PROCEDURAL_HIT_GROUP;
+    let none = vk::SHADER_UNUSED_KHR;
+    type Case<'c> = (
+        &'c str,
+        Geom,
+        Vec<(&'c str, S, &'c str)>,
+        Vec<vk::RayTracingShaderGroupCreateInfoKHR<'static>>,
+        [&'c [u32]; 4],
+    );
+    let cases: Vec<Case> = vec![
+        (
+            "exec_pipeline.hlsl",
+            Geom::Triangle,
+            vec![
+                ("RG", S::RAYGEN_KHR, "raygeneration"),
+                ("MissColor", S::MISS_KHR, "miss"),
+                ("MissProbe", S::MISS_KHR, "miss"),
+                ("Hit", S::CLOSEST_HIT_KHR, "closesthit"),
+                ("Filter", S::ANY_HIT_KHR, "anyhit"),
+            ],
+            vec![
+                general(0),
+                general(1),
+                general(2),
+                hit_group(tri, 3, 4, none),
+            ],
+            [&[0], &[1, 2], &[3], &[]],
+        ),
+        (
+            "exec_procedural.hlsl",
+            Geom::SphereBox,
+            vec![
+                ("Gen", S::RAYGEN_KHR, "raygeneration"),
+                ("Miss", S::MISS_KHR, "miss"),
+                ("SphereHit", S::CLOSEST_HIT_KHR, "closesthit"),
+                ("Sphere", S::INTERSECTION_KHR, "intersection"),
+                ("Twice", S::CALLABLE_KHR, "callable"),
+            ],
+            vec![
+                general(0),
+                general(1),
+                hit_group(proc_, 2, none, 3),
+                general(4),
+            ],
+            [&[0], &[1], &[2], &[3]],
+        ),
+    ];
+    let mut compared = 0;
+    for (file, geom, stages, groups, tables) in cases {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("tests/hlsl")
+            .join(file);
+        let ours = compile_whole(file);
+        let mut theirs = Vec::new();
+        for (entry, _, stage) in &stages {
+            let mut w = slang
+                .compile_hlsl(&path, entry, stage, &[])
+                .unwrap_or_else(|e| panic!("{e}"));
+            unknown_source_language(&mut w);
+            if let Some(why) = invalid_spirv(&w) {
+                panic!("{file}: Slang's {entry} is invalid: {why}");
+            }
+            theirs.push(w);
+        }
+        let run = |modules: &[&[u32]], names: &[&str]| unsafe {
+            let scene = gpu.scene(match geom {
+                Geom::Triangle => Geom::Triangle,
+                Geom::SphereBox => Geom::SphereBox,
+            });
+            let out = gpu.buffer(16 * 16, vk::BufferUsageFlags::STORAGE_BUFFER);
+            let st: Vec<(&str, S)> = names
+                .iter()
+                .zip(&stages)
+                .map(|(n, (_, k, _))| (*n, *k))
+                .collect();
+            gpu.trace(
+                modules,
+                &st,
+                &groups,
+                tables,
+                &[Bind::Accel(scene.tlas), Bind::Storage(&out)],
+                4,
+                4,
+            );
+            let bytes = std::slice::from_raw_parts(out.ptr, 256).to_vec();
+            gpu.free(out);
+            gpu.drop_scene(scene);
+            bytes
+        };
+        let our_names: Vec<&str> = stages.iter().map(|(n, _, _)| *n).collect();
+        let a = run(&[&ours], &our_names);
+        let slang_modules: Vec<&[u32]> = theirs.iter().map(|w| w.as_slice()).collect();
+        let b = run(&slang_modules, &vec!["main"; stages.len()]);
+        assert_eq!(a, b, "{file}: rtlint and Slang disagree");
+        compared += 1;
+    }
+    assert_eq!(compared, 2);
 }
