@@ -1483,6 +1483,36 @@ fn differential_against_slang_on_the_driver() {
         }
     }
     assert!(compared >= 1, "nothing was compared");
+    drop(gpu);
+    // Inline ray tracing, where the driver has ray queries.
+    let Some(rt) = self::gpu(true) else { return };
+    if !rt.ray_query {
+        return;
+    }
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/hlsl/exec_rayquery.hlsl");
+    let ours = compile_whole("exec_rayquery.hlsl");
+    let mut theirs = slang.compile_hlsl(&path, "Query", "compute", &[]).unwrap();
+    unknown_source_language(&mut theirs);
+    assert_eq!(invalid_spirv(&theirs), None);
+    let run = |words: &[u32], entry: &str| unsafe {
+        let scene = rt.scene(Geom::Triangle);
+        let out = rt.buffer(256, vk::BufferUsageFlags::STORAGE_BUFFER);
+        rt.dispatch(
+            words,
+            entry,
+            &[Bind::Accel(scene.tlas), Bind::Storage(&out)],
+            1,
+        );
+        let bytes = std::slice::from_raw_parts(out.ptr, 256).to_vec();
+        rt.free(out);
+        rt.drop_scene(scene);
+        bytes
+    };
+    assert_eq!(
+        run(&ours, "Query"),
+        run(&theirs, "main"),
+        "ray query: rtlint and Slang disagree"
+    );
 }
 
 /// spirv-val's complaint about `words`, if any (None also when spirv-val is missing).
