@@ -1651,3 +1651,64 @@ fn ray_tracing_differential_against_slang_on_the_driver() {
     }
     assert_eq!(compared, 2);
 }
+
+/// Compile time per entry point, rtlint against Slang, on the shaders both
+/// accept (`cargo test --release --test hlsl_exec bench -- --ignored --nocapture`).
+#[test]
+#[ignore]
+fn bench_against_slang() {
+    let slang = rtlint::front::slang::Slang::find().expect("Slang");
+    let cases: &[(&str, &[(&str, &str)])] = &[
+        (
+            "exec_pipeline.hlsl",
+            &[
+                ("RG", "raygeneration"),
+                ("MissColor", "miss"),
+                ("MissProbe", "miss"),
+                ("Hit", "closesthit"),
+                ("Filter", "anyhit"),
+            ],
+        ),
+        (
+            "exec_procedural.hlsl",
+            &[
+                ("Gen", "raygeneration"),
+                ("Miss", "miss"),
+                ("SphereHit", "closesthit"),
+                ("Sphere", "intersection"),
+                ("Twice", "callable"),
+            ],
+        ),
+        ("exec_rayquery.hlsl", &[("Query", "compute")]),
+        ("exec_memory.hlsl", &[("Main", "compute")]),
+    ];
+    let rounds = 20;
+    let (mut ours, mut theirs, mut entries) = (0.0f64, 0.0f64, 0usize);
+    for (file, list) in cases {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("tests/hlsl")
+            .join(file);
+        for (entry, stage) in list.iter() {
+            let opts = HlslOptions {
+                entry: Some(entry.to_string()),
+                ..Default::default()
+            };
+            let t = std::time::Instant::now();
+            for _ in 0..rounds {
+                hlsl::compile(&path, &opts).unwrap();
+            }
+            ours += t.elapsed().as_secs_f64() / rounds as f64;
+            let t = std::time::Instant::now();
+            for _ in 0..rounds {
+                slang.compile_hlsl(&path, entry, stage, &[]).unwrap();
+            }
+            theirs += t.elapsed().as_secs_f64() / rounds as f64;
+            entries += 1;
+        }
+    }
+    let (o, s) = (
+        ours * 1000.0 / entries as f64,
+        theirs * 1000.0 / entries as f64,
+    );
+    eprintln!("{entries} entry points: rtlint {o:.3} ms, Slang {s:.3} ms per entry point; Slang / rtlint = {:.1}x", s / o);
+}
