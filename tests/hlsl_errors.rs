@@ -226,6 +226,18 @@ fn missing_entry_point() {
 }
 
 #[test]
+fn subobjects_and_templated_methods_are_refused() {
+    assert_eq!(
+        err("TriangleHitGroup hg = { \"\", \"Hit\" };\n[numthreads(1,1,1)] void m() {}"),
+        "main.hlsl:1:1: not supported: `TriangleHitGroup`"
+    );
+    assert_eq!(
+        err("ByteAddressBuffer b;\n[numthreads(1,1,1)]\nvoid m()\n{\n    float4 v = b.Load<float4>(0);\n}"),
+        "main.hlsl:5:18: not supported: templated method `Load<...>`"
+    );
+}
+
+#[test]
 fn layout_changing_constructs_are_refused() {
     assert_eq!(
         err("#pragma pack_matrix(row_major)\n"),

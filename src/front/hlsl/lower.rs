@@ -811,7 +811,16 @@ impl<'a> Lowerer<'a> {
             | "ConsumeStructuredBuffer"
             | "Texture2DMS"
             | "HitObject"
-            | "string" => {
+            | "string"
+            | "TriangleHitGroup"
+            | "ProceduralPrimitiveHitGroup"
+            | "RaytracingShaderConfig"
+            | "RaytracingPipelineConfig"
+            | "RaytracingPipelineConfig1"
+            | "GlobalRootSignature"
+            | "LocalRootSignature"
+            | "StateObjectConfig"
+            | "SubobjectToExportsAssociation" => {
                 return Err(unsupported(t.pos, format!("`{name}`")).len(name.len() as u32));
             }
             _ => match self.lookup_type_name(name, ns) {
