@@ -197,6 +197,8 @@ pub struct Lowerer<'a> {
     global_decls: Vec<(Id, String, Ty, Pos)>,
     /// Locals and parameters for debug info: (function, variable, name, type, position).
     local_decls: Vec<(usize, Id, String, Ty, Pos)>,
+    /// Descriptor variables (what a resource parameter may be given).
+    resource_vars: HashSet<Id>,
 }
 
 /// Source positions of named declarations (the side table `Program` reads).
@@ -431,6 +433,7 @@ impl<'a> Lowerer<'a> {
             this_place: None,
             global_decls: Vec::new(),
             local_decls: Vec::new(),
+            resource_vars: HashSet::new(),
         }
     }
 
@@ -549,8 +552,12 @@ impl<'a> Lowerer<'a> {
             for p in &f.params {
                 let t = self.resolve_ty(&p.ty, &f.ns)?;
                 let t = self.apply_dims(t, &p.dims, p.pos, false)?;
-                if t.is_resource() {
-                    return Err(unsupported(p.pos, "resource function parameters"));
+                if t.is_resource() && (matches!(t, Ty::Array(..) | Ty::RtArray(_)) || p.mods.output)
+                {
+                    return Err(unsupported(
+                        p.pos,
+                        "arrays of resources, or `out` resources, as function parameters",
+                    ));
                 }
                 params.push(Param {
                     ty: t,
@@ -602,8 +609,12 @@ impl<'a> Lowerer<'a> {
             for p in &f.params {
                 let t = self.resolve_ty(&p.ty, &f.ns)?;
                 let t = self.apply_dims(t, &p.dims, p.pos, false)?;
-                if t.is_resource() {
-                    return Err(unsupported(p.pos, "resource function parameters"));
+                if t.is_resource() && (matches!(t, Ty::Array(..) | Ty::RtArray(_)) || p.mods.output)
+                {
+                    return Err(unsupported(
+                        p.pos,
+                        "arrays of resources, or `out` resources, as function parameters",
+                    ));
                 }
                 params.push(Param {
                     ty: t,
@@ -1086,6 +1097,7 @@ impl<'a> Lowerer<'a> {
         let pty = self.b.type_pointer(None, class, tid);
         let var = self.global_var(pty, class, None);
         self.b.name(var, name);
+        self.resource_vars.insert(var);
         if let Some((set, binding)) = binding {
             if matches!(
                 class,
@@ -2038,8 +2050,13 @@ impl<'a> Lowerer<'a> {
                 if matches!(p.ty, Ty::RayQuery(_)) {
                     return Err(unsupported(f.pos, "RayQuery function parameters"));
                 }
-                let t = self.ty_id(&p.ty)?;
-                ptys.push(self.b.type_pointer(None, StorageClass::Function, t));
+                let (class, _) = self.param_class(&p.ty);
+                let t = if p.ty.is_resource() {
+                    self.descriptor_type(&p.ty, &[])?.0
+                } else {
+                    self.ty_id(&p.ty)?
+                };
+                ptys.push(self.b.type_pointer(None, class, t));
             }
             let fty = self.b.type_function(ret_id, ptys.clone());
             self.b
@@ -2069,13 +2086,14 @@ impl<'a> Lowerer<'a> {
                 self.b.name(id, decl.name.clone());
                 self.local_decls
                     .push((self.cur_fn, id, decl.name.clone(), p.ty.clone(), decl.pos));
+                let (class, layout) = self.param_class(&p.ty);
                 self.scopes[0].insert(
                     decl.name.clone(),
                     Place::Ptr {
                         ptr: id,
                         ty: p.ty.clone(),
-                        layout: Layout::None,
-                        class: StorageClass::Function,
+                        layout,
+                        class,
                     },
                 );
             }
@@ -2092,6 +2110,21 @@ impl<'a> Lowerer<'a> {
         }
         self.b.end_function()?;
         Ok(())
+    }
+
+    /// How a parameter is passed: values by a Function-storage pointer (the
+    /// caller's copy); resources by a pointer to the resource variable itself.
+    fn param_class(&self, t: &Ty) -> (StorageClass, Layout) {
+        match t {
+            Ty::StructuredBuffer(..) | Ty::ByteAddress(_) => {
+                (StorageClass::StorageBuffer, Layout::Std430)
+            }
+            Ty::ConstantBuffer(_) => (StorageClass::Uniform, Layout::CBuffer),
+            Ty::Accel | Ty::Sampler | Ty::Texture { .. } => {
+                (StorageClass::UniformConstant, Layout::None)
+            }
+            _ => (StorageClass::Function, Layout::None),
+        }
     }
 
     fn bind_entry_params(&mut self, f: &'a Function, sig: &FnSig, stage: Stage) -> Result<()> {

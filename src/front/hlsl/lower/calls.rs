@@ -1057,6 +1057,18 @@ impl<'a> Lowerer<'a> {
         }
         let mut temps = Vec::new();
         for ((p, (place, v)), a) in sig.params.iter().zip(&argv).zip(&args) {
+            if p.ty.is_resource() {
+                // Passed as the resource variable itself, which SPIR-V's
+                // logical addressing allows only for whole variables.
+                if !self.resource_vars.contains(&v.id) {
+                    return Err(unsupported(
+                        a.pos(),
+                        "passing an element of a resource array to a function",
+                    ));
+                }
+                temps.push(v.id);
+                continue;
+            }
             let tmp = self.local_var(&p.ty, "")?;
             if p.input {
                 let val = match place {

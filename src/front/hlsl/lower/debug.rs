@@ -208,6 +208,9 @@ impl<'a> Lowerer<'a> {
             for p in &sig.params {
                 targs.push(self.dbg_type(&mut d, &p.ty));
             }
+            if targs[1..].contains(&d.none) {
+                continue; // resource parameters have no debug type to give
+            }
             let fty = self.dbg_inst(&d, op::TYPE_FUNCTION, &targs);
             let n = self.b.string(sig.name.clone());
             let pos = sig.func.pos;
