@@ -53,7 +53,8 @@ static float3 accumulated;
 static const float weights[COUNT] = { 0.1, 0.2, 0.3, 0.4 };
 static const int3 offsets[2] = { int3(1, 2, 3), int3(-1, -2, -3) };
 
-float sum3(float a, float b, float c) { return a + b + c; }
+export float sum3(float a, float b, float c) { return a + b + c; }
+inline float id(float x) { return x; }
 
 float scale(float x) { return x * 3.0; }
 float3 scale(float3 x) { return x * 4.0; }

@@ -331,7 +331,7 @@ impl<'t> Parser<'t> {
                 Some("precise") => m.precise = true,
                 Some("nointerpolation") => m.nointerp = true,
                 Some(
-                    "inline" | "extern" | "volatile" | "linear" | "snorm" | "unorm"
+                    "inline" | "export" | "extern" | "volatile" | "linear" | "snorm" | "unorm"
                     | "globallycoherent",
                 ) => {}
                 _ => return m,
