@@ -226,6 +226,16 @@ fn missing_entry_point() {
 }
 
 #[test]
+fn matrices_in_component_intrinsics_are_refused() {
+    assert_eq!(
+        err(&format!(
+            "{RG}    float3x3 m = 1;\n    float3x3 a = abs(m);\n}}"
+        )),
+        "main.hlsl:5:18: not supported: matrix arguments to this intrinsic"
+    );
+}
+
+#[test]
 fn subobjects_and_templated_methods_are_refused() {
     assert_eq!(
         err("TriangleHitGroup hg = { \"\", \"Hit\" };\n[numthreads(1,1,1)] void m() {}"),

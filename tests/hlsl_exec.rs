@@ -469,6 +469,8 @@ fn compute_semantics_on_the_driver() {
         I(-4),
         U(6),
         I(3),
+        I(1),
+        I(8),
     ];
     let got = unsafe { gpu.run(&entries[0].words, "Main", expected.len() + 4, &inputs()) };
     let mut wrong = Vec::new();

@@ -226,4 +226,8 @@ void Main()
         gg = z < 2;
     }
     put(zc);
+    // 77..78: HLSL 2021 and() / select()
+    bool2 both = and(bool2(true, b1 > 0), bool2(b1 > 0, false));
+    put(both.x ? 1 : 0);
+    put(select(b1 > 0, 5, 7) + select(bool2(false, true), int2(1, 2), int2(3, 4)).x);
 }

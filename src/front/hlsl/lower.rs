@@ -4168,6 +4168,9 @@ impl<'a> Lowerer<'a> {
             }
             UnOp::Not => {
                 let v = self.expr(a)?;
+                if let Ty::Mat(..) = v.ty {
+                    return Err(unsupported(pos, "`!` on a matrix"));
+                }
                 let t = v.ty.with_scalar(Sc::Bool);
                 let b = self.convert(v, &t, pos, false)?;
                 let tid = self.ty_id(&t)?;
