@@ -3023,6 +3023,10 @@ impl<'a> Lowerer<'a> {
                     class,
                 })
             }
+            Ty::Texture { dim: Dim::Cube, .. } => Err(Error::new(
+                pos,
+                "a TextureCube cannot be indexed; use SampleLevel",
+            )),
             Ty::Texture { rw, sc, n, dim } => {
                 let Place::Ptr { ptr, .. } = bp else {
                     unreachable!("textures are variables")
