@@ -65,7 +65,7 @@ fn main() {
             }
         };
         for entry in entries {
-            let stage = entry.stage.name();
+            let stage = rtlint::front::slang::stage_name(entry.stage);
             if let Err(e) = slang.compile_hlsl(file, &entry.name, stage, &[]) {
                 let first = e.lines().next().unwrap_or("").to_string();
                 left_out.push(format!("{name}:{}: Slang: {first}", entry.name));

@@ -322,4 +322,35 @@ fn entry_modules_carry_debug_info() {
     assert_eq!(at(Decl::Member(payload, 1)), Some((17, 10)));
     assert_eq!(at(Decl::Var(id("Camera"))), Some((7, 9)));
     assert_eq!(at(Decl::Func(id("RayGen"))), Some((26, 6)));
+    // Locals too (DebugLocalVariable + DebugDeclare).
+    assert_eq!(at(Decl::Var(id("ray"))), Some((32, 13)));
+}
+
+/// The project's HLSL fixture gives the same findings on the same lines when
+/// compiled by rtlint as when compiled by Slang (tests/slang.rs): for the
+/// entry point's own module and for the whole file.
+#[test]
+fn payload_fixture_findings_match_slang_lines() {
+    use rtlint::front::Language;
+    use std::collections::BTreeSet;
+    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/hlsl/payloads.hlsl");
+    let expected = BTreeSet::from([(2, "RT001"), (2, "RT002"), (4, "RT003")]);
+    let findings = |program: &rtlint::spirv::Program| -> BTreeSet<(u32, &'static str)> {
+        rtlint::rules::check_program(program, &rtlint::config::Config::default())
+            .iter()
+            .map(|d| {
+                let p = d.primary.as_ref().expect("positioned");
+                assert_eq!(p.location.path.file_name().unwrap(), "payloads.hlsl");
+                (p.location.line, d.code.unwrap())
+            })
+            .collect()
+    };
+    let entries = hlsl::compile(&src, &HlslOptions::default()).unwrap();
+    let gen = entries.iter().find(|e| e.name == "RayGen").unwrap();
+    validate(&gen.words, "payloads-RayGen");
+    let program =
+        rtlint::spirv::parse(&gen.words, Path::new("payloads.spv"), Language::Spirv).unwrap();
+    assert_eq!(findings(&program), expected);
+    let whole = rtlint::front::load(&src, Language::Hlsl).unwrap();
+    assert_eq!(findings(&whole), expected);
 }

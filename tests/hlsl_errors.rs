@@ -178,7 +178,7 @@ fn preprocessor_errors_show_the_include_chain() {
     );
     assert_eq!(
         err("#if 1\n#error stop: no\n#endif"),
-        "main.hlsl:2:2: #error stop : no"
+        "main.hlsl:2:2: #error stop: no"
     );
 }
 
@@ -223,6 +223,28 @@ fn missing_entry_point() {
     )
     .unwrap_err();
     assert!(e.to_string().contains("no entry point named `nope`"), "{e}");
+}
+
+#[test]
+fn matrices_in_component_intrinsics_are_refused() {
+    assert_eq!(
+        err(&format!(
+            "{RG}    float3x3 m = 1;\n    float3x3 a = abs(m);\n}}"
+        )),
+        "main.hlsl:5:18: not supported: matrix arguments to this intrinsic"
+    );
+}
+
+#[test]
+fn subobjects_and_templated_methods_are_refused() {
+    assert_eq!(
+        err("TriangleHitGroup hg = { \"\", \"Hit\" };\n[numthreads(1,1,1)] void m() {}"),
+        "main.hlsl:1:1: not supported: `TriangleHitGroup`"
+    );
+    assert_eq!(
+        err("ByteAddressBuffer b;\n[numthreads(1,1,1)]\nvoid m()\n{\n    float4 v = b.Load<float4>(0);\n}"),
+        "main.hlsl:5:18: not supported: templated method `Load<...>`"
+    );
 }
 
 #[test]

@@ -91,8 +91,14 @@ fn gpu(rt: bool) -> Option<Gpu> {
         if ray_query {
             exts.push(ash::khr::ray_query::NAME.as_ptr());
         }
+        // Storage images without a declared format (float3 texels, and Slang's
+        // output) need these.
+        let core = vk::PhysicalDeviceFeatures::default()
+            .shader_storage_image_read_without_format(true)
+            .shader_storage_image_write_without_format(true);
         let mut info = vk::DeviceCreateInfo::default()
             .queue_create_infos(&qinfo)
+            .enabled_features(&core)
             .push_next(&mut v12);
         if rt {
             info = info
@@ -460,6 +466,11 @@ fn compute_semantics_on_the_driver() {
         F(-2.0),
         F(12.0),
         I(45),
+        I(-4),
+        U(6),
+        I(3),
+        I(1),
+        I(8),
     ];
     let got = unsafe { gpu.run(&entries[0].words, "Main", expected.len() + 4, &inputs()) };
     let mut wrong = Vec::new();
@@ -770,7 +781,7 @@ impl Gpu {
     #[allow(clippy::too_many_arguments)]
     unsafe fn trace(
         &self,
-        words: &[u32],
+        modules: &[&[u32]],
         stages: &[(&str, vk::ShaderStageFlags)],
         groups: &[vk::RayTracingShaderGroupCreateInfoKHR],
         tables: [&[u32]; 4],
@@ -780,9 +791,14 @@ impl Gpu {
     ) {
         let d = &self.device;
         let rt_ext = ash::khr::ray_tracing_pipeline::Device::new(&self.instance, d);
-        let shader = d
-            .create_shader_module(&vk::ShaderModuleCreateInfo::default().code(words), None)
-            .unwrap();
+        // One module for every stage, or one per stage (Slang's output).
+        let shaders: Vec<vk::ShaderModule> = modules
+            .iter()
+            .map(|w| {
+                d.create_shader_module(&vk::ShaderModuleCreateInfo::default().code(w), None)
+                    .unwrap()
+            })
+            .collect();
         let names: Vec<std::ffi::CString> = stages
             .iter()
             .map(|(n, _)| std::ffi::CString::new(*n).unwrap())
@@ -790,10 +806,11 @@ impl Gpu {
         let infos: Vec<_> = names
             .iter()
             .zip(stages)
-            .map(|(n, (_, k))| {
+            .enumerate()
+            .map(|(i, (n, (_, k)))| {
                 vk::PipelineShaderStageCreateInfo::default()
                     .stage(*k)
-                    .module(shader)
+                    .module(shaders[i.min(shaders.len() - 1)])
                     .name(n)
             })
             .collect();
@@ -883,7 +900,9 @@ impl Gpu {
         d.destroy_pipeline(pipeline, None);
         d.destroy_pipeline_layout(pipeline_layout, None);
         d.destroy_descriptor_set_layout(set_layout, None);
-        d.destroy_shader_module(shader, None);
+        for m in shaders {
+            d.destroy_shader_module(m, None);
+        }
     }
 
     /// Runs compute entry `entry` with `binds`, `groups` workgroups along x.
@@ -1016,7 +1035,7 @@ fn ray_tracing_pipeline_on_the_driver() {
         let out = gpu.buffer(16 * 16, vk::BufferUsageFlags::STORAGE_BUFFER);
         use vk::ShaderStageFlags as S;
         gpu.trace(
-            &words,
+            &[&words],
             &[
                 ("RG", S::RAYGEN_KHR),
                 ("MissColor", S::MISS_KHR),
@@ -1061,7 +1080,7 @@ fn intersection_and_callable_on_the_driver() {
         let out = gpu.buffer(16 * 16, vk::BufferUsageFlags::STORAGE_BUFFER);
         use vk::ShaderStageFlags as S;
         gpu.trace(
-            &words,
+            &[&words],
             &[
                 ("Gen", S::RAYGEN_KHR),
                 ("Miss", S::MISS_KHR),
@@ -1345,4 +1364,292 @@ fn textures_and_storage_images_on_the_driver() {
         gpu.free_image(tex);
         gpu.free_image(img);
     }
+}
+
+/// Runs `entry` of `file` once and returns every output buffer's bytes;
+/// `setup` makes the bindings, `run` dispatches.
+unsafe fn run_compute_case(gpu: &Gpu, words: &[u32], entry: &str, file: &str) -> Vec<Vec<u8>> {
+    let read = |b: &Buffer, n: usize| std::slice::from_raw_parts(b.ptr, n).to_vec();
+    match file {
+        "exec_memory.hlsl" => {
+            let raw = gpu.buffer(1024, vk::BufferUsageFlags::STORAGE_BUFFER);
+            let init: Vec<u32> = (0..64).map(|i| 1000 + i).collect();
+            std::ptr::copy_nonoverlapping(init.as_ptr() as *const u8, raw.ptr, 256);
+            let counts = gpu.buffer(16, vk::BufferUsageFlags::STORAGE_BUFFER);
+            gpu.dispatch(
+                words,
+                entry,
+                &[Bind::Storage(&raw), Bind::Storage(&counts)],
+                1,
+            );
+            // Word 195 onward and the compare-exchange winner depend on scheduling.
+            let mut r = read(&raw, 772);
+            r.truncate(768);
+            let mut c = read(&counts, 12);
+            c.truncate(12);
+            gpu.free(raw);
+            gpu.free(counts);
+            vec![r, c]
+        }
+        "exec_textures.hlsl" => {
+            let texels = [
+                [1.0f32, 0.0, 0.0, 1.0],
+                [0.0, 2.0, 0.0, 1.0],
+                [0.0, 0.0, 3.0, 1.0],
+                [4.0, 4.0, 4.0, 1.0],
+            ];
+            let tex = gpu.image(2, 2, vk::ImageUsageFlags::SAMPLED, &texels);
+            let img = gpu.image(4, 4, vk::ImageUsageFlags::STORAGE, &[]);
+            let sampler = gpu
+                .device
+                .create_sampler(
+                    &vk::SamplerCreateInfo::default()
+                        .mag_filter(vk::Filter::NEAREST)
+                        .min_filter(vk::Filter::NEAREST),
+                    None,
+                )
+                .unwrap();
+            let out = gpu.buffer(256, vk::BufferUsageFlags::STORAGE_BUFFER);
+            gpu.dispatch(
+                words,
+                entry,
+                &[
+                    Bind::SampledImage(tex.view),
+                    Bind::Sampler(sampler),
+                    Bind::StorageImage(img.view),
+                    Bind::Storage(&out),
+                ],
+                1,
+            );
+            let r = read(&out, 256);
+            gpu.device.destroy_sampler(sampler, None);
+            gpu.free(out);
+            gpu.free_image(tex);
+            gpu.free_image(img);
+            vec![r]
+        }
+        _ => unreachable!("no setup for {file}"),
+    }
+}
+
+/// Sets `OpSource`'s language to Unknown: Slang writes a code (11) that older
+/// SPIR-V consumers reject.
+fn unknown_source_language(words: &mut [u32]) {
+    let mut i = 5;
+    while i < words.len() {
+        let n = (words[i] >> 16) as usize;
+        if words[i] & 0xffff == 3 && n > 1 {
+            words[i + 1] = 0;
+        }
+        i += n.max(1);
+    }
+}
+
+/// The same HLSL compiled by Slang and by rtlint computes the same bytes on
+/// the driver. Skipped when Slang is missing, unless CI=true.
+#[test]
+fn differential_against_slang_on_the_driver() {
+    let slang = match rtlint::front::slang::Slang::find() {
+        Ok(s) => s,
+        Err(e) => {
+            assert!(
+                std::env::var("CI").as_deref() != Ok("true"),
+                "Slang is required in CI: {e}"
+            );
+            eprintln!("no Slang ({e}); skipping");
+            return;
+        }
+    };
+    let Some(gpu) = gpu(false) else { return };
+    let mut compared = 0;
+    for file in ["exec_memory.hlsl", "exec_textures.hlsl"] {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("tests/hlsl")
+            .join(file);
+        let ours = compile_whole(file);
+        let mut theirs = slang.compile_hlsl(&path, "Main", "compute", &[]).unwrap();
+        unknown_source_language(&mut theirs);
+        // Compare only where Slang's module is valid: for `img[p].z *= 2.0`
+        // Slang 2026.12 emits an OpImageTexelPointer to a vector, which
+        // spirv-val and lavapipe reject.
+        if let Some(why) = invalid_spirv(&theirs) {
+            eprintln!("{file}: Slang's module is invalid, not compared: {why}");
+            continue;
+        }
+        compared += 1;
+        unsafe {
+            let a = run_compute_case(&gpu, &ours, "Main", file);
+            // Slang names every entry point `main`.
+            let b = run_compute_case(&gpu, &theirs, "main", file);
+            assert_eq!(a, b, "{file}: rtlint and Slang disagree");
+        }
+    }
+    assert!(compared >= 1, "nothing was compared");
+    drop(gpu);
+    // Inline ray tracing, where the driver has ray queries.
+    let Some(rt) = self::gpu(true) else { return };
+    if !rt.ray_query {
+        return;
+    }
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/hlsl/exec_rayquery.hlsl");
+    let ours = compile_whole("exec_rayquery.hlsl");
+    let mut theirs = slang.compile_hlsl(&path, "Query", "compute", &[]).unwrap();
+    unknown_source_language(&mut theirs);
+    assert_eq!(invalid_spirv(&theirs), None);
+    let run = |words: &[u32], entry: &str| unsafe {
+        let scene = rt.scene(Geom::Triangle);
+        let out = rt.buffer(256, vk::BufferUsageFlags::STORAGE_BUFFER);
+        rt.dispatch(
+            words,
+            entry,
+            &[Bind::Accel(scene.tlas), Bind::Storage(&out)],
+            1,
+        );
+        let bytes = std::slice::from_raw_parts(out.ptr, 256).to_vec();
+        rt.free(out);
+        rt.drop_scene(scene);
+        bytes
+    };
+    assert_eq!(
+        run(&ours, "Query"),
+        run(&theirs, "main"),
+        "ray query: rtlint and Slang disagree"
+    );
+}
+
+/// spirv-val's complaint about `words`, if any (None also when spirv-val is missing).
+fn invalid_spirv(words: &[u32]) -> Option<String> {
+    let file = std::env::temp_dir().join(format!("rtlint-diff-{}.spv", std::process::id()));
+    let bytes: Vec<u8> = words.iter().flat_map(|w| w.to_le_bytes()).collect();
+    std::fs::write(&file, bytes).ok()?;
+    let out = std::process::Command::new("spirv-val")
+        .args(["--target-env", "vulkan1.2"])
+        .arg(&file)
+        .output()
+        .ok()?;
+    let _ = std::fs::remove_file(&file);
+    (!out.status.success()).then(|| {
+        String::from_utf8_lossy(&out.stderr)
+            .lines()
+            .next()
+            .unwrap_or("")
+            .to_string()
+    })
+}
+
+/// The ray-tracing pipeline and the procedural/callable pipeline compiled by
+/// Slang (one module per entry point) and by rtlint give the same bytes.
+#[test]
+fn ray_tracing_differential_against_slang_on_the_driver() {
+    let slang = match rtlint::front::slang::Slang::find() {
+        Ok(s) => s,
+        Err(e) => {
+            assert!(
+                std::env::var("CI").as_deref() != Ok("true"),
+                "Slang is required in CI: {e}"
+            );
+            eprintln!("no Slang ({e}); skipping");
+            return;
+        }
+    };
+    let Some(gpu) = gpu(true) else { return };
+    use vk::ShaderStageFlags as S;
+    let tri = vk::RayTracingShaderGroupTypeKHR::TRIANGLES_HIT_GROUP;
+    let proc_ = vk::RayTracingShaderGroupTypeKHR::PROCEDURAL_HIT_GROUP;
+    let none = vk::SHADER_UNUSED_KHR;
+    type Case<'c> = (
+        &'c str,
+        Geom,
+        Vec<(&'c str, S, &'c str)>,
+        Vec<vk::RayTracingShaderGroupCreateInfoKHR<'static>>,
+        [&'c [u32]; 4],
+    );
+    let cases: Vec<Case> = vec![
+        (
+            "exec_pipeline.hlsl",
+            Geom::Triangle,
+            vec![
+                ("RG", S::RAYGEN_KHR, "raygeneration"),
+                ("MissColor", S::MISS_KHR, "miss"),
+                ("MissProbe", S::MISS_KHR, "miss"),
+                ("Hit", S::CLOSEST_HIT_KHR, "closesthit"),
+                ("Filter", S::ANY_HIT_KHR, "anyhit"),
+            ],
+            vec![
+                general(0),
+                general(1),
+                general(2),
+                hit_group(tri, 3, 4, none),
+            ],
+            [&[0], &[1, 2], &[3], &[]],
+        ),
+        (
+            "exec_procedural.hlsl",
+            Geom::SphereBox,
+            vec![
+                ("Gen", S::RAYGEN_KHR, "raygeneration"),
+                ("Miss", S::MISS_KHR, "miss"),
+                ("SphereHit", S::CLOSEST_HIT_KHR, "closesthit"),
+                ("Sphere", S::INTERSECTION_KHR, "intersection"),
+                ("Twice", S::CALLABLE_KHR, "callable"),
+            ],
+            vec![
+                general(0),
+                general(1),
+                hit_group(proc_, 2, none, 3),
+                general(4),
+            ],
+            [&[0], &[1], &[2], &[3]],
+        ),
+    ];
+    let mut compared = 0;
+    for (file, geom, stages, groups, tables) in cases {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("tests/hlsl")
+            .join(file);
+        let ours = compile_whole(file);
+        let mut theirs = Vec::new();
+        for (entry, _, stage) in &stages {
+            let mut w = slang
+                .compile_hlsl(&path, entry, stage, &[])
+                .unwrap_or_else(|e| panic!("{e}"));
+            unknown_source_language(&mut w);
+            if let Some(why) = invalid_spirv(&w) {
+                panic!("{file}: Slang's {entry} is invalid: {why}");
+            }
+            theirs.push(w);
+        }
+        let run = |modules: &[&[u32]], names: &[&str]| unsafe {
+            let scene = gpu.scene(match geom {
+                Geom::Triangle => Geom::Triangle,
+                Geom::SphereBox => Geom::SphereBox,
+            });
+            let out = gpu.buffer(16 * 16, vk::BufferUsageFlags::STORAGE_BUFFER);
+            let st: Vec<(&str, S)> = names
+                .iter()
+                .zip(&stages)
+                .map(|(n, (_, k, _))| (*n, *k))
+                .collect();
+            gpu.trace(
+                modules,
+                &st,
+                &groups,
+                tables,
+                &[Bind::Accel(scene.tlas), Bind::Storage(&out)],
+                4,
+                4,
+            );
+            let bytes = std::slice::from_raw_parts(out.ptr, 256).to_vec();
+            gpu.free(out);
+            gpu.drop_scene(scene);
+            bytes
+        };
+        let our_names: Vec<&str> = stages.iter().map(|(n, _, _)| *n).collect();
+        let a = run(&[&ours], &our_names);
+        let slang_modules: Vec<&[u32]> = theirs.iter().map(|w| w.as_slice()).collect();
+        let b = run(&slang_modules, &vec!["main"; stages.len()]);
+        assert_eq!(a, b, "{file}: rtlint and Slang disagree");
+        compared += 1;
+    }
+    assert_eq!(compared, 2);
 }

@@ -215,3 +215,67 @@ fn deep_nesting_and_macro_bombs_end_in_errors() {
         "{e}"
     );
 }
+
+/// Mutated shaders the compiler accepts must give valid SPIR-V: an accepted
+/// input never becomes an invalid module. Needs spirv-val (skipped without it
+/// unless CI=true).
+#[test]
+fn accepted_mutations_validate() {
+    if std::process::Command::new("spirv-val")
+        .arg("--version")
+        .output()
+        .is_err()
+    {
+        assert!(
+            std::env::var("CI").as_deref() != Ok("true"),
+            "spirv-val is required in CI"
+        );
+        return;
+    }
+    let files = shaders();
+    let iterations: usize = std::env::var("RTLINT_FUZZ_ITERS")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(100)
+        / 4;
+    let dir = std::env::temp_dir().join(format!("rtlint-mut-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let mut checked = 0;
+    for (i, (name, text)) in files.iter().enumerate() {
+        for k in 0..iterations {
+            let seed = 0xA076_1D64_78BD_642F ^ ((i as u64) << 32 | k as u64);
+            let mut rng = Rng(seed | 1);
+            let input = mutate(&mut rng, text);
+            let mut loader = MemLoader(
+                files
+                    .iter()
+                    .map(|(n, t)| (PathBuf::from(n), t.clone()))
+                    .collect(),
+            );
+            let Ok(m) = compile_source_whole(
+                Path::new(name),
+                &input,
+                &mut loader,
+                &HlslOptions::default(),
+            ) else {
+                continue;
+            };
+            let file = dir.join("m.spv");
+            let bytes: Vec<u8> = m.words.iter().flat_map(|w| w.to_le_bytes()).collect();
+            std::fs::write(&file, bytes).unwrap();
+            let out = std::process::Command::new("spirv-val")
+                .args(["--target-env", "vulkan1.2", "--scalar-block-layout"])
+                .arg(&file)
+                .output()
+                .unwrap();
+            assert!(
+                out.status.success(),
+                "seed {seed:#x} of {name} compiled to invalid SPIR-V: {}\n{input}",
+                String::from_utf8_lossy(&out.stderr)
+            );
+            checked += 1;
+        }
+    }
+    eprintln!("{checked} accepted mutations validated");
+    assert!(checked > 0);
+}

@@ -213,4 +213,21 @@ void Main()
             break;
     }
     put(acc2);
+    // 74..75: a shift keeps its left operand's type
+    int negative = -8 * (int)(b1 / 4.0);
+    put(negative >> 1u);
+    put(3u << 1);
+    // 76: && in a loop condition
+    int zc = 0;
+    bool gg = true;
+    for (int z = 0; z < 8 && gg; z++)
+    {
+        zc += 1;
+        gg = z < 2;
+    }
+    put(zc);
+    // 77..78: HLSL 2021 and() / select()
+    bool2 both = and(bool2(true, b1 > 0), bool2(b1 > 0, false));
+    put(both.x ? 1 : 0);
+    put(select(b1 > 0, 5, 7) + select(bool2(false, true), int2(1, 2), int2(3, 4)).x);
 }

@@ -15,6 +15,15 @@ struct Probe
     float seen;
 };
 
+// The acceleration structure passes to a helper as a parameter.
+float probe(RaytracingAccelerationStructure tlas, RayDesc ray)
+{
+    Probe p;
+    p.seen = 0;
+    TraceRay(tlas, RAY_FLAG_NONE, 0xFF, 0, 1, 1, ray, p);
+    return p.seen;
+}
+
 [shader("raygeneration")]
 void RG()
 {
@@ -29,11 +38,8 @@ void RG()
     Payload p;
     p.color = float4(0, 0, 0, 0);
     TraceRay(scene, RAY_FLAG_NONE, 0xFF, 0, 1, 0, ray, p);
-    Probe probe;
-    probe.seen = 0;
     ray.Direction = float3(0, 0, -1);
-    TraceRay(scene, RAY_FLAG_NONE, 0xFF, 0, 1, 1, ray, probe);
-    outBuf[id.y * dim.x + id.x] = float4(p.color.xyz, p.color.w + probe.seen);
+    outBuf[id.y * dim.x + id.x] = float4(p.color.xyz, p.color.w + probe(scene, ray));
 }
 
 [shader("miss")]

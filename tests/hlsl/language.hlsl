@@ -53,7 +53,8 @@ static float3 accumulated;
 static const float weights[COUNT] = { 0.1, 0.2, 0.3, 0.4 };
 static const int3 offsets[2] = { int3(1, 2, 3), int3(-1, -2, -3) };
 
-float sum3(float a, float b, float c) { return a + b + c; }
+export float sum3(float a, float b, float c) { return a + b + c; }
+inline float id(float x) { return x; }
 
 float scale(float x) { return x * 3.0; }
 float3 scale(float3 x) { return x * 4.0; }
@@ -147,6 +148,11 @@ void Main(uint3 dtid : SV_DispatchThreadID, uint3 gtid : SV_GroupThreadID, uint3
             break;
     }
     do { w--; } while (w > 0);
+    bool going = true;
+    for (int z = 0; z < 8 && going; z++)
+        going = acc < 50.0 || z == 0;
+    do { w++; } while (w < 4 && (going || acc > 1.0));
+    while (w > 0 && shared[w] >= 0.0 ? true : false) { w--; }
     switch (i % 4)
     {
     case 0:

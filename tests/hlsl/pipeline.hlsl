@@ -54,22 +54,28 @@ void ShadowMiss(inout ShadowPayload s)
     s.hit = false;
 }
 
+// Resources pass to helpers as the variables themselves.
+bool occluded(RaytracingAccelerationStructure tlas, float3 origin, float3 dir)
+{
+    RayDesc r;
+    r.Origin = origin;
+    r.Direction = dir;
+    r.TMin = 0.01;
+    r.TMax = 1000.0;
+    ShadowPayload s;
+    s.hit = true;
+    // Offset 1, stride 2, miss shader 1: the shadow miss.
+    TraceRay(tlas, RAY_FLAG_ACCEPT_FIRST_HIT_AND_END_SEARCH | RAY_FLAG_SKIP_CLOSEST_HIT_SHADER,
+             0xFF, 1, 2, 1, r, s);
+    return s.hit;
+}
+
 [shader("closesthit")]
 void ClosestHit(inout Payload p, in BuiltInTriangleIntersectionAttributes attr)
 {
     float3 bary = float3(1.0 - attr.barycentrics.x - attr.barycentrics.y, attr.barycentrics);
     float3 hitPos = WorldRayOrigin() + WorldRayDirection() * RayTCurrent();
 
-    RayDesc shadow;
-    shadow.Origin = hitPos;
-    shadow.Direction = -lightDir;
-    shadow.TMin = 0.01;
-    shadow.TMax = 1000.0;
-    ShadowPayload sp;
-    sp.hit = true;
-    // Offset 1, stride 2, miss shader 1: the shadow miss.
-    TraceRay(scene, RAY_FLAG_ACCEPT_FIRST_HIT_AND_END_SEARCH | RAY_FLAG_SKIP_CLOSEST_HIT_SHADER,
-             0xFF, 1, 2, 1, shadow, sp);
-    float lit = sp.hit ? 0.2 : 1.0;
+    float lit = occluded(scene, hitPos, -lightDir) ? 0.2 : 1.0;
     p.color = bary * lit * saturate(dot(normalize(hitPos), -lightDir));
 }

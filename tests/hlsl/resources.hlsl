@@ -37,6 +37,9 @@ RWTexture2D<float2> motion : register(u4);
 RWTexture2D<float3> noFormat : register(u5);
 RaytracingAccelerationStructure tlas : register(t6);
 [[vk::shader_record_ext]] ConstantBuffer<HitRecord> record;
+ConstantBuffer<HitRecord> perDraw[4] : register(b9);
+StructuredBuffer<float4> vertexStreams[] : register(t0, space3);
+RWByteAddressBuffer rawBuffers[2] : register(u10);
 [[vk::push_constant]] ConstantBuffer<PushData> push;
 
 [shader("closesthit")]
@@ -49,7 +52,10 @@ void BindlessHit(inout Payload p, in BuiltInTriangleIntersectionAttributes attr)
     float layer = layers.SampleLevel(samp, float3(attr.barycentrics, 2), 0);
     float4 texel = materials[0].Load(int3(1, 2, 0));
     float4 texel2 = textures8[1][uint2(3, 4)];
-    p.color = albedo * env * push.tint + other * layer + texel + texel2;
+    float4 streamed = vertexStreams[NonUniformResourceIndex(m)][PrimitiveIndex()];
+    float rough = perDraw[m & 3].roughness;
+    rawBuffers[m & 1].Store(0, asuint(rough));
+    p.color = albedo * env * push.tint + other * layer + texel + texel2 + streamed * rough;
 }
 
 [shader("miss")]

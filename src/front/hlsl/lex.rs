@@ -68,6 +68,10 @@ pub fn lex(src: &str, file: u32) -> Result<Vec<Token>, Error> {
     let b = src.as_bytes();
     let mut out = Vec::new();
     let (mut i, mut line, mut col) = (0usize, 1u32, 1u32);
+    // Editors on Windows often start files with a byte-order mark.
+    if src.starts_with('\u{feff}') {
+        i = 3;
+    }
     let mut bol = true;
     let mut space = false;
     let empty: Rc<Vec<Rc<str>>> = Rc::new(Vec::new());
@@ -323,6 +327,13 @@ mod tests {
         let bols: Vec<bool> = t.iter().map(|t| t.bol).collect();
         assert_eq!(bols, vec![true, false, false, false, true]);
         assert_eq!(t[3].pos.line, 2);
+    }
+
+    #[test]
+    fn byte_order_mark_and_crlf() {
+        let t = lex("\u{feff}a\r\n  b", 0).unwrap();
+        let p: Vec<(u32, u32)> = t.iter().map(|t| (t.pos.line, t.pos.col)).collect();
+        assert_eq!(p, vec![(1, 1), (2, 3)]);
     }
 
     #[test]

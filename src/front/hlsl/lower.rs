@@ -195,6 +195,10 @@ pub struct Lowerer<'a> {
     this_place: Option<Place>,
     /// Globals with source positions, for debug info: (variable, name, type, position).
     global_decls: Vec<(Id, String, Ty, Pos)>,
+    /// Locals and parameters for debug info: (function, variable, name, type, position).
+    local_decls: Vec<(usize, Id, String, Ty, Pos)>,
+    /// Descriptor variables (what a resource parameter may be given).
+    resource_vars: HashSet<Id>,
 }
 
 /// Source positions of named declarations (the side table `Program` reads).
@@ -428,6 +432,8 @@ impl<'a> Lowerer<'a> {
             nonuniform_ptrs: HashSet::new(),
             this_place: None,
             global_decls: Vec::new(),
+            local_decls: Vec::new(),
+            resource_vars: HashSet::new(),
         }
     }
 
@@ -546,8 +552,12 @@ impl<'a> Lowerer<'a> {
             for p in &f.params {
                 let t = self.resolve_ty(&p.ty, &f.ns)?;
                 let t = self.apply_dims(t, &p.dims, p.pos, false)?;
-                if t.is_resource() {
-                    return Err(unsupported(p.pos, "resource function parameters"));
+                if t.is_resource() && (matches!(t, Ty::Array(..) | Ty::RtArray(_)) || p.mods.output)
+                {
+                    return Err(unsupported(
+                        p.pos,
+                        "arrays of resources, or `out` resources, as function parameters",
+                    ));
                 }
                 params.push(Param {
                     ty: t,
@@ -599,8 +609,12 @@ impl<'a> Lowerer<'a> {
             for p in &f.params {
                 let t = self.resolve_ty(&p.ty, &f.ns)?;
                 let t = self.apply_dims(t, &p.dims, p.pos, false)?;
-                if t.is_resource() {
-                    return Err(unsupported(p.pos, "resource function parameters"));
+                if t.is_resource() && (matches!(t, Ty::Array(..) | Ty::RtArray(_)) || p.mods.output)
+                {
+                    return Err(unsupported(
+                        p.pos,
+                        "arrays of resources, or `out` resources, as function parameters",
+                    ));
                 }
                 params.push(Param {
                     ty: t,
@@ -808,7 +822,16 @@ impl<'a> Lowerer<'a> {
             | "ConsumeStructuredBuffer"
             | "Texture2DMS"
             | "HitObject"
-            | "string" => {
+            | "string"
+            | "TriangleHitGroup"
+            | "ProceduralPrimitiveHitGroup"
+            | "RaytracingShaderConfig"
+            | "RaytracingPipelineConfig"
+            | "RaytracingPipelineConfig1"
+            | "GlobalRootSignature"
+            | "LocalRootSignature"
+            | "StateObjectConfig"
+            | "SubobjectToExportsAssociation" => {
                 return Err(unsupported(t.pos, format!("`{name}`")).len(name.len() as u32));
             }
             _ => match self.lookup_type_name(name, ns) {
@@ -1057,64 +1080,7 @@ impl<'a> Lowerer<'a> {
             }
             (t.clone(), arrays)
         };
-        let (mut tid, class) = match &inner {
-            Ty::ConstantBuffer(k) => {
-                let (layout, class) = self.cbuffer_class(attrs);
-                (self.block_struct(*k, layout)?, class)
-            }
-            Ty::StructuredBuffer(e, rw) => {
-                let elem = self.spv(e, Layout::Std430)?;
-                let stride = array_stride(e, Layout::Std430, &self.structs);
-                let rt = self.b.id();
-                self.b.type_runtime_array_id(Some(rt), elem);
-                self.b
-                    .decorate(rt, Decoration::ArrayStride, [Operand::LiteralBit32(stride)]);
-                let st = self.b.id();
-                self.b.type_struct_id(Some(st), [rt]);
-                self.b.decorate(st, Decoration::Block, []);
-                self.b
-                    .member_decorate(st, 0, Decoration::Offset, [Operand::LiteralBit32(0)]);
-                if !rw {
-                    self.b.member_decorate(st, 0, Decoration::NonWritable, []);
-                }
-                let tn = if *rw {
-                    "type.RWStructuredBuffer"
-                } else {
-                    "type.StructuredBuffer"
-                };
-                self.b.name(st, tn);
-                (st, StorageClass::StorageBuffer)
-            }
-            Ty::ByteAddress(rw) => {
-                let u = self.spv(&Ty::Sc(Sc::Uint), Layout::None)?;
-                let rt = self.b.id();
-                self.b.type_runtime_array_id(Some(rt), u);
-                self.b
-                    .decorate(rt, Decoration::ArrayStride, [Operand::LiteralBit32(4)]);
-                let st = self.b.id();
-                self.b.type_struct_id(Some(st), [rt]);
-                self.b.decorate(st, Decoration::Block, []);
-                self.b
-                    .member_decorate(st, 0, Decoration::Offset, [Operand::LiteralBit32(0)]);
-                if !rw {
-                    self.b.member_decorate(st, 0, Decoration::NonWritable, []);
-                }
-                self.b.name(
-                    st,
-                    if *rw {
-                        "type.RWByteAddressBuffer"
-                    } else {
-                        "type.ByteAddressBuffer"
-                    },
-                );
-                (st, StorageClass::StorageBuffer)
-            }
-            Ty::Accel | Ty::Sampler | Ty::Texture { .. } => (
-                self.spv(&inner, Layout::None)?,
-                StorageClass::UniformConstant,
-            ),
-            _ => unreachable!("resource_var on a non-resource"),
-        };
+        let (mut tid, class) = self.descriptor_type(&inner, attrs)?;
         for n in arrays.iter().rev() {
             tid = match n {
                 Some(n) => {
@@ -1131,6 +1097,7 @@ impl<'a> Lowerer<'a> {
         let pty = self.b.type_pointer(None, class, tid);
         let var = self.global_var(pty, class, None);
         self.b.name(var, name);
+        self.resource_vars.insert(var);
         if let Some((set, binding)) = binding {
             if matches!(
                 class,
@@ -1143,6 +1110,72 @@ impl<'a> Lowerer<'a> {
             }
         }
         Ok(var)
+    }
+
+    /// The SPIR-V type of one descriptor (or push-constant / shader-record
+    /// block) of `inner`, and its storage class; one id per kind, so arrays of
+    /// resources and their elements agree.
+    fn descriptor_type(&mut self, inner: &Ty, attrs: &[Attr]) -> Result<(Id, StorageClass)> {
+        if let Ty::ConstantBuffer(k) = inner {
+            let (layout, class) = self.cbuffer_class(attrs);
+            return Ok((self.block_struct(*k, layout)?, class));
+        }
+        if let Ty::Accel | Ty::Sampler | Ty::Texture { .. } = inner {
+            return Ok((
+                self.spv(inner, Layout::None)?,
+                StorageClass::UniformConstant,
+            ));
+        }
+        let key = (inner.clone(), Layout::Std430, true);
+        if let Some(id) = self.ty_cache.get(&key) {
+            return Ok((*id, StorageClass::StorageBuffer));
+        }
+        let (elem, stride, rw, name) = match inner {
+            Ty::StructuredBuffer(e, rw) => (
+                self.spv(e, Layout::Std430)?,
+                array_stride(e, Layout::Std430, &self.structs),
+                *rw,
+                if *rw {
+                    "type.RWStructuredBuffer"
+                } else {
+                    "type.StructuredBuffer"
+                },
+            ),
+            Ty::ByteAddress(rw) => (
+                self.spv(&Ty::Sc(Sc::Uint), Layout::None)?,
+                4,
+                *rw,
+                if *rw {
+                    "type.RWByteAddressBuffer"
+                } else {
+                    "type.ByteAddressBuffer"
+                },
+            ),
+            other => {
+                return Err(Error::new(
+                    Pos::default(),
+                    format!(
+                        "internal compiler error: `{}` is not a descriptor",
+                        self.ty_name(other)
+                    ),
+                ))
+            }
+        };
+        let rt = self.b.id();
+        self.b.type_runtime_array_id(Some(rt), elem);
+        self.b
+            .decorate(rt, Decoration::ArrayStride, [Operand::LiteralBit32(stride)]);
+        let st = self.b.id();
+        self.b.type_struct_id(Some(st), [rt]);
+        self.b.decorate(st, Decoration::Block, []);
+        self.b
+            .member_decorate(st, 0, Decoration::Offset, [Operand::LiteralBit32(0)]);
+        if !rw {
+            self.b.member_decorate(st, 0, Decoration::NonWritable, []);
+        }
+        self.b.name(st, name);
+        self.ty_cache.insert(key, st);
+        Ok((st, StorageClass::StorageBuffer))
     }
 
     /// A Block-decorated copy of struct `k` laid out for a buffer.
@@ -1481,11 +1514,8 @@ impl<'a> Lowerer<'a> {
                 self.b
                     .type_image(st, d, 0, arrayed, 0, if *rw { 2 } else { 1 }, format, None)
             }
-            _ => {
-                return Err(Error::new(
-                    Pos::default(),
-                    "internal compiler error: buffer type used as a value",
-                ))
+            Ty::StructuredBuffer(..) | Ty::ByteAddress(_) | Ty::ConstantBuffer(_) => {
+                return Ok(self.descriptor_type(t, &[])?.0);
             }
         };
         self.ty_cache.insert(key, id);
@@ -2020,8 +2050,13 @@ impl<'a> Lowerer<'a> {
                 if matches!(p.ty, Ty::RayQuery(_)) {
                     return Err(unsupported(f.pos, "RayQuery function parameters"));
                 }
-                let t = self.ty_id(&p.ty)?;
-                ptys.push(self.b.type_pointer(None, StorageClass::Function, t));
+                let (class, _) = self.param_class(&p.ty);
+                let t = if p.ty.is_resource() {
+                    self.descriptor_type(&p.ty, &[])?.0
+                } else {
+                    self.ty_id(&p.ty)?
+                };
+                ptys.push(self.b.type_pointer(None, class, t));
             }
             let fty = self.b.type_function(ret_id, ptys.clone());
             self.b
@@ -2049,13 +2084,16 @@ impl<'a> Lowerer<'a> {
             for ((p, decl), pty) in params.zip(&f.params).zip(ptys) {
                 let id = self.b.function_parameter(pty)?;
                 self.b.name(id, decl.name.clone());
+                self.local_decls
+                    .push((self.cur_fn, id, decl.name.clone(), p.ty.clone(), decl.pos));
+                let (class, layout) = self.param_class(&p.ty);
                 self.scopes[0].insert(
                     decl.name.clone(),
                     Place::Ptr {
                         ptr: id,
                         ty: p.ty.clone(),
-                        layout: Layout::None,
-                        class: StorageClass::Function,
+                        layout,
+                        class,
                     },
                 );
             }
@@ -2072,6 +2110,21 @@ impl<'a> Lowerer<'a> {
         }
         self.b.end_function()?;
         Ok(())
+    }
+
+    /// How a parameter is passed: values by a Function-storage pointer (the
+    /// caller's copy); resources by a pointer to the resource variable itself.
+    fn param_class(&self, t: &Ty) -> (StorageClass, Layout) {
+        match t {
+            Ty::StructuredBuffer(..) | Ty::ByteAddress(_) => {
+                (StorageClass::StorageBuffer, Layout::Std430)
+            }
+            Ty::ConstantBuffer(_) => (StorageClass::Uniform, Layout::CBuffer),
+            Ty::Accel | Ty::Sampler | Ty::Texture { .. } => {
+                (StorageClass::UniformConstant, Layout::None)
+            }
+            _ => (StorageClass::Function, Layout::None),
+        }
     }
 
     fn bind_entry_params(&mut self, f: &'a Function, sig: &FnSig, stage: Stage) -> Result<()> {
@@ -2253,8 +2306,18 @@ impl<'a> Lowerer<'a> {
             self.start_block(None)?;
         }
         let id = self.b.id();
+        // Pointers reached through a NonUniformResourceIndex stay NonUniform.
+        let nonuniform = op == Op::AccessChain
+            && operands.iter().enumerate().any(|(i, o)| {
+                matches!(o, Operand::IdRef(x)
+                    if (i == 0 && self.nonuniform_ptrs.contains(x)) || (i > 0 && self.nonuniform.contains(x)))
+            });
         let inst = Instruction::new(op, ty, ty.map(|_| id), operands);
         self.b.insert_into_block(InsertPoint::End, inst)?;
+        if nonuniform {
+            self.b.decorate(id, Decoration::NonUniform, []);
+            self.nonuniform_ptrs.insert(id);
+        }
         Ok(id)
     }
 
@@ -2337,14 +2400,14 @@ impl<'a> Lowerer<'a> {
                 }
                 self.start_block(Some(lm))?;
             }
-            StmtKind::While(c, body) => self.lower_loop(None, Some(c), None, body, false)?,
-            StmtKind::DoWhile(body, c) => self.lower_loop(None, Some(c), None, body, true)?,
+            StmtKind::While(c, body) => self.lower_loop(Some(c), None, body, false)?,
+            StmtKind::DoWhile(body, c) => self.lower_loop(Some(c), None, body, true)?,
             StmtKind::For(init, c, step, body) => {
                 self.scopes.push(HashMap::new());
                 if let Some(i) = init {
                     self.stmt(i)?;
                 }
-                self.lower_loop(None, c.as_ref(), step.as_ref(), body, false)?;
+                self.lower_loop(c.as_ref(), step.as_ref(), body, false)?;
                 self.scopes.pop();
             }
             StmtKind::Break => {
@@ -2380,7 +2443,7 @@ impl<'a> Lowerer<'a> {
                 self.term = true;
             }
             StmtKind::Discard => return Err(unsupported(s.pos, "`discard` (pixel shaders)").len(7)),
-            StmtKind::Switch(sel, cases) => self.lower_switch(sel, cases, s.pos)?,
+            StmtKind::Switch(sel, cases) => self.lower_switch(sel, cases)?,
         }
         Ok(())
     }
@@ -2394,7 +2457,6 @@ impl<'a> Lowerer<'a> {
 
     fn lower_loop(
         &mut self,
-        _init: Option<&'a Stmt>,
         cond: Option<&'a Expr>,
         step: Option<&'a Expr>,
         body: &'a Stmt,
@@ -2446,7 +2508,7 @@ impl<'a> Lowerer<'a> {
         Ok(())
     }
 
-    fn lower_switch(&mut self, sel: &'a Expr, cases: &'a [Case], pos: Pos) -> Result<()> {
+    fn lower_switch(&mut self, sel: &'a Expr, cases: &'a [Case]) -> Result<()> {
         let v = self.expr(sel)?;
         let v = match v.ty {
             Ty::Sc(Sc::Int) | Ty::Sc(Sc::Uint) => v,
@@ -2472,7 +2534,6 @@ impl<'a> Lowerer<'a> {
                 }
             }
         }
-        let _ = pos;
         self.b
             .selection_merge(merge, spirv::SelectionControl::NONE)?;
         self.b.switch(v.id, default, targets)?;
@@ -2569,6 +2630,8 @@ impl<'a> Lowerer<'a> {
             return Ok(());
         }
         let var = self.local_var(&t, &v.name)?;
+        self.local_decls
+            .push((self.cur_fn, var, v.name.clone(), t.clone(), v.pos));
         if let Some(init) = &v.init {
             let val = self.expr_as(init, &t)?;
             if self.term {
@@ -2679,15 +2742,30 @@ impl<'a> Lowerer<'a> {
             } => {
                 let t = self.spv(&elem, layout)?;
                 let pty = self.b.type_pointer(None, class, t);
-                let nu = self.nonuniform.contains(&index);
                 let ptr = self.inst(
                     Op::AccessChain,
                     Some(pty),
                     vec![Operand::IdRef(ptr), Operand::IdRef(index)],
                 )?;
-                if nu {
-                    self.b.decorate(ptr, Decoration::NonUniform, []);
-                    self.nonuniform_ptrs.insert(ptr);
+                if self.nonuniform_ptrs.contains(&ptr) {
+                    let cap = match &elem {
+                        Ty::Texture { rw: false, .. } => {
+                            Some(Capability::SampledImageArrayNonUniformIndexing)
+                        }
+                        Ty::Texture { rw: true, .. } => {
+                            Some(Capability::StorageImageArrayNonUniformIndexing)
+                        }
+                        Ty::StructuredBuffer(..) | Ty::ByteAddress(_) => {
+                            Some(Capability::StorageBufferArrayNonUniformIndexing)
+                        }
+                        Ty::ConstantBuffer(_) => {
+                            Some(Capability::UniformBufferArrayNonUniformIndexing)
+                        }
+                        _ => None,
+                    };
+                    if let Some(c) = cap {
+                        self.cap(c);
+                    }
                 }
                 Ok(Place::Ptr {
                     ptr,
@@ -2945,6 +3023,10 @@ impl<'a> Lowerer<'a> {
                     class,
                 })
             }
+            Ty::Texture { dim: Dim::Cube, .. } => Err(Error::new(
+                pos,
+                "a TextureCube cannot be indexed; use SampleLevel",
+            )),
             Ty::Texture { rw, sc, n, dim } => {
                 let Place::Ptr { ptr, .. } = bp else {
                     unreachable!("textures are variables")
@@ -3017,6 +3099,9 @@ impl<'a> Lowerer<'a> {
                     self.start_block(None)?;
                 }
                 let mut id = self.b.load(tid, None, *ptr, None, [])?;
+                if self.nonuniform_ptrs.contains(ptr) {
+                    self.b.decorate(id, Decoration::NonUniform, []);
+                }
                 if *layout != Layout::None && ty.is_aggregate() {
                     let plain = self.ty_id(ty)?;
                     id = self.op(Op::CopyLogical, plain, &[id])?;
@@ -3634,6 +3719,7 @@ impl<'a> Lowerer<'a> {
                     this.ty_name(to)
                 ),
             )
+            .label(format!("this is a `{}`", this.ty_name(&v.ty)))
         };
         match (&v.ty, to) {
             (Ty::Sc(a), Ty::Sc(b)) => self.convert_scalar(v.id, *a, *b, to),
@@ -3772,6 +3858,14 @@ impl<'a> Lowerer<'a> {
         if ct.scalar() == Some(Sc::Bool) && !(cmp && matches!(op, Eq | Ne)) {
             ct = ct.with_scalar(Sc::Int);
         }
+        if matches!(op, Shl | Shr) {
+            // A shift has its left operand's type (HLSL, like C).
+            let ls = match a.ty.scalar() {
+                Some(Sc::Bool) | None => Sc::Int,
+                Some(s) => s,
+            };
+            ct = ct.with_scalar(ls);
+        }
         if bits && ct.scalar() == Some(Sc::Float) {
             return Err(Error::new(
                 pos,
@@ -3784,6 +3878,9 @@ impl<'a> Lowerer<'a> {
             if let Some(v) = self.fold(op, x, y) {
                 return Ok(v);
             }
+        }
+        if let (Ty::Mat(..), true) = (&ct, cmp) {
+            return Err(unsupported(pos, "comparing matrices"));
         }
         if let Ty::Mat(s, r, c) = ct {
             // Matrix operators are component-wise: one row at a time.
@@ -3814,14 +3911,9 @@ impl<'a> Lowerer<'a> {
                     pos,
                 )?);
             }
-            let rt = if cmp { Ty::Vec(Sc::Bool, c) } else { row };
-            if cmp {
-                return Err(unsupported(pos, "comparing matrices"));
-            }
             let mt = Ty::Mat(s, r, c);
             let tid = self.ty_id(&mt)?;
             let ids: Vec<Id> = rows.iter().map(|v| v.id).collect();
-            let _ = rt;
             let id = self.op(Op::CompositeConstruct, tid, &ids)?;
             return Ok(Val { id, ty: mt });
         }
@@ -4080,6 +4172,9 @@ impl<'a> Lowerer<'a> {
             }
             UnOp::Not => {
                 let v = self.expr(a)?;
+                if let Ty::Mat(..) = v.ty {
+                    return Err(unsupported(pos, "`!` on a matrix"));
+                }
                 let t = v.ty.with_scalar(Sc::Bool);
                 let b = self.convert(v, &t, pos, false)?;
                 let tid = self.ty_id(&t)?;

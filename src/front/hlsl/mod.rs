@@ -12,7 +12,7 @@ pub mod parse;
 pub mod pp;
 pub mod types;
 
-pub use lower::Stage;
+pub use crate::spirv::Stage;
 
 use crate::diag::{InputError, Location};
 use crate::front::wgsl::NamedDecl;
@@ -87,11 +87,11 @@ fn entry_indices(
     path: &Path,
     files: &[PathBuf],
     options: &HlslOptions,
-) -> Result<Vec<(usize, String, Stage)>, InputError> {
+) -> Result<Vec<(usize, String, lower::Stage)>, InputError> {
     let entries = lowerer
         .declare()
         .map_err(|e| e.into_input_error(files, path))?;
-    let all: Vec<(usize, String, Stage)> = entries
+    let all: Vec<(usize, String, lower::Stage)> = entries
         .into_iter()
         .enumerate()
         .map(|(i, e)| (i, e.name, e.stage))
@@ -154,15 +154,18 @@ fn compile_source_inner(
     for (_, name, stage) in picked {
         // A fresh module per entry point, holding only what it reaches.
         let mut l = lower::Lowerer::new(&items, &files);
-        let entries = l.declare().map_err(|e| e.into_input_error(&files, path))?;
+        l.declare().map_err(|e| e.into_input_error(&files, path))?;
         let k = l
             .entry_function(&name)
             .ok_or_else(|| InputError::new("hlsl-error", path, "entry point vanished"))?;
-        let _ = entries;
         let (words, _) = l
             .finish(&[k])
             .map_err(|e| e.into_input_error(&files, path))?;
-        out.push(CompiledEntry { name, stage, words });
+        out.push(CompiledEntry {
+            name,
+            stage: Stage::from_model(stage.model()),
+            words,
+        });
     }
     Ok(out)
 }
@@ -194,7 +197,10 @@ fn compile_source_whole_inner(
         .map_err(|e| e.into_input_error(&files, path))?;
     Ok(CompiledModule {
         words,
-        entries: picked.into_iter().map(|(_, n, s)| (n, s)).collect(),
+        entries: picked
+            .into_iter()
+            .map(|(_, n, s)| (n, Stage::from_model(s.model())))
+            .collect(),
         decls,
     })
 }

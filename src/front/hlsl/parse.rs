@@ -82,6 +82,16 @@ const PLAIN_TYPES: &[&str] = &[
     "RWByteAddressBuffer",
     "string",
     "HitObject",
+    // DXR state-object subobjects: recognised so they can be refused by name.
+    "TriangleHitGroup",
+    "ProceduralPrimitiveHitGroup",
+    "RaytracingShaderConfig",
+    "RaytracingPipelineConfig",
+    "RaytracingPipelineConfig1",
+    "GlobalRootSignature",
+    "LocalRootSignature",
+    "StateObjectConfig",
+    "SubobjectToExportsAssociation",
 ];
 
 /// Splits `float3x4` into (`float`, 3, 4); `float3` gives (`float`, 3, 0).
@@ -321,7 +331,7 @@ impl<'t> Parser<'t> {
                 Some("precise") => m.precise = true,
                 Some("nointerpolation") => m.nointerp = true,
                 Some(
-                    "inline" | "extern" | "volatile" | "linear" | "snorm" | "unorm"
+                    "inline" | "export" | "extern" | "volatile" | "linear" | "snorm" | "unorm"
                     | "globallycoherent",
                 ) => {}
                 _ => return m,
@@ -1133,6 +1143,13 @@ impl<'t> Parser<'t> {
             if self.eat(".") {
                 // Member and method expressions point at the name after the dot.
                 let (name, pos) = self.ident()?;
+                if self.is("<") && self.type_at(1) {
+                    return Err(Error::new(
+                        pos,
+                        format!("not supported: templated method `{name}<...>`"),
+                    )
+                    .len(name.len() as u32));
+                }
                 if self.is("(") {
                     let args = self.args()?;
                     e = Expr {

@@ -263,8 +263,15 @@ impl<'a> Preprocessor<'a> {
                 Ok(())
             }
             "error" => {
-                let msg: Vec<String> = rest.iter().map(Token::spelling).collect();
-                Err(Error::new(pos, format!("#error {}", msg.join(" "))).len(5))
+                // The message as written: spaces only where the source had them.
+                let mut msg = String::new();
+                for (n, t) in rest.iter().enumerate() {
+                    if n > 0 && t.space {
+                        msg.push(' ');
+                    }
+                    msg.push_str(&t.spelling());
+                }
+                Err(Error::new(pos, format!("#error {msg}")).len(5))
             }
             "warning" => Ok(()),
             "line" => {

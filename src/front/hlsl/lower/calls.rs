@@ -145,6 +145,10 @@ impl<'a> Lowerer<'a> {
                 format!("expected numbers, found `{}`", self.ty_name(&t)),
             ));
         }
+        if let Ty::Mat(..) = t {
+            // GLSL.std.450 works on scalars and vectors only.
+            return Err(unsupported(pos, "matrix arguments to this intrinsic"));
+        }
         let mut ids = Vec::new();
         for v in vals {
             ids.push(self.convert(v, &t, pos, false)?.id);
@@ -353,6 +357,46 @@ impl<'a> Lowerer<'a> {
             return self.interlocked(name, args, pos);
         }
         match name {
+            "and" | "or" => {
+                // HLSL 2021's component-wise logic (`&&` no longer is on vectors).
+                self.arity(name, args, 2, pos)?;
+                let a = self.expr(&args[0])?;
+                let b = self.expr(&args[1])?;
+                let t = self.common(&a.ty, &b.ty, pos)?.with_scalar(Sc::Bool);
+                if let Ty::Mat(..) = t {
+                    return Err(unsupported(pos, format!("matrix arguments to `{name}`")));
+                }
+                let x = self.convert(a, &t, pos, false)?;
+                let y = self.convert(b, &t, pos, false)?;
+                let tid = self.ty_id(&t)?;
+                let op = if name == "and" {
+                    Op::LogicalAnd
+                } else {
+                    Op::LogicalOr
+                };
+                let id = self.op(op, tid, &[x.id, y.id])?;
+                return Ok(Some(Val { id, ty: t }));
+            }
+            "select" => {
+                self.arity(name, args, 3, pos)?;
+                let c = self.expr(&args[0])?;
+                let a = self.expr(&args[1])?;
+                let b = self.expr(&args[2])?;
+                let mut t = self.common(&a.ty, &b.ty, pos)?;
+                if let (Ty::Vec(_, n), Ty::Sc(s)) = (&c.ty, &t) {
+                    t = Ty::Vec(*s, *n);
+                }
+                if let Ty::Mat(..) = t {
+                    return Err(unsupported(pos, "matrix arguments to `select`"));
+                }
+                let ct = t.with_scalar(Sc::Bool);
+                let cb = self.convert(c, &ct, args[0].pos, false)?;
+                let x = self.convert(a, &t, args[1].pos, false)?;
+                let y = self.convert(b, &t, args[2].pos, false)?;
+                let tid = self.ty_id(&t)?;
+                let id = self.op(Op::Select, tid, &[cb.id, x.id, y.id])?;
+                return Ok(Some(Val { id, ty: t }));
+            }
             "sincos" => {
                 self.arity(name, args, 3, pos)?;
                 let x = self.expr(&args[0])?;
@@ -1057,6 +1101,18 @@ impl<'a> Lowerer<'a> {
         }
         let mut temps = Vec::new();
         for ((p, (place, v)), a) in sig.params.iter().zip(&argv).zip(&args) {
+            if p.ty.is_resource() {
+                // Passed as the resource variable itself, which SPIR-V's
+                // logical addressing allows only for whole variables.
+                if !self.resource_vars.contains(&v.id) {
+                    return Err(unsupported(
+                        a.pos(),
+                        "passing an element of a resource array to a function",
+                    ));
+                }
+                temps.push(v.id);
+                continue;
+            }
             let tmp = self.local_var(&p.ty, "")?;
             if p.input {
                 let val = match place {

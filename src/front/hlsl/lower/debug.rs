@@ -15,6 +15,9 @@ mod op {
     pub const TYPE_MEMBER: u32 = 11;
     pub const GLOBAL_VARIABLE: u32 = 18;
     pub const FUNCTION: u32 = 20;
+    pub const LOCAL_VARIABLE: u32 = 26;
+    pub const DECLARE: u32 = 28;
+    pub const EXPRESSION: u32 = 31;
     pub const SOURCE: u32 = 35;
     pub const FUNCTION_DEFINITION: u32 = 101;
     pub const TYPE_MATRIX: u32 = 108;
@@ -29,6 +32,9 @@ pub(super) struct DebugInfo {
     types: HashMap<Ty, Id>,
     /// (debug function, function, result id) for `DebugFunctionDefinition`.
     pub(super) definitions: Vec<(Id, Id, Id)>,
+    /// (function, debug local, variable, result id) for `DebugDeclare`.
+    declares: Vec<(Id, Id, Id, Id)>,
+    expression: Id,
 }
 
 impl<'a> Lowerer<'a> {
@@ -145,6 +151,8 @@ impl<'a> Lowerer<'a> {
             sources: Vec::new(),
             types: HashMap::new(),
             definitions: Vec::new(),
+            declares: Vec::new(),
+            expression: 0,
         };
         d.none = self.dbg_inst(&d, op::INFO_NONE, &[]);
         for f in self.file_ids.clone() {
@@ -186,6 +194,7 @@ impl<'a> Lowerer<'a> {
             );
         }
         let flags = self.const_u32(3);
+        let mut dbg_fns = HashMap::new();
         for k in 0..self.funcs.len() {
             if !self.lowered.contains(&k) {
                 continue;
@@ -198,6 +207,9 @@ impl<'a> Lowerer<'a> {
             let mut targs = vec![flags, ret];
             for p in &sig.params {
                 targs.push(self.dbg_type(&mut d, &p.ty));
+            }
+            if targs[1..].contains(&d.none) {
+                continue; // resource parameters have no debug type to give
             }
             let fty = self.dbg_inst(&d, op::TYPE_FUNCTION, &targs);
             let n = self.b.string(sig.name.clone());
@@ -216,6 +228,33 @@ impl<'a> Lowerer<'a> {
             );
             let result = self.b.id();
             d.definitions.push((f, sig.id, result));
+            dbg_fns.insert(k, f);
+        }
+        d.expression = self.dbg_inst(&d, op::EXPRESSION, &[]);
+        let local_flags = self.const_u32(4); // FlagIsLocal
+        for (k, var, name, ty, pos) in self.local_decls.clone() {
+            let Some(&scope) = dbg_fns.get(&k) else {
+                continue;
+            };
+            let t = self.dbg_type(&mut d, &ty);
+            if t == d.none {
+                continue;
+            }
+            let n = self.b.string(name);
+            let source = d
+                .sources
+                .get(pos.file as usize)
+                .copied()
+                .unwrap_or(d.sources[0]);
+            let line = self.const_u32(pos.line.max(1));
+            let col = self.const_u32(pos.col.max(1));
+            let local = self.dbg_inst(
+                &d,
+                op::LOCAL_VARIABLE,
+                &[n, t, source, line, col, scope, local_flags],
+            );
+            let result = self.b.id();
+            d.declares.push((self.funcs[k].id, local, var, result));
         }
         Some(d)
     }
@@ -238,6 +277,23 @@ impl<'a> Lowerer<'a> {
                 .iter()
                 .position(|i| i.class.opcode != Op::Variable)
                 .unwrap_or(block.instructions.len());
+            for (_, local, var, result) in d.declares.iter().filter(|x| x.0 == *fn_id).rev() {
+                block.instructions.insert(
+                    at,
+                    Instruction::new(
+                        Op::ExtInst,
+                        Some(d.void),
+                        Some(*result),
+                        vec![
+                            Operand::IdRef(d.set),
+                            Operand::LiteralExtInstInteger(op::DECLARE),
+                            Operand::IdRef(*local),
+                            Operand::IdRef(*var),
+                            Operand::IdRef(d.expression),
+                        ],
+                    ),
+                );
+            }
             block.instructions.insert(
                 at,
                 Instruction::new(

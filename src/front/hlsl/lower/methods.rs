@@ -372,6 +372,10 @@ impl<'a> Lowerer<'a> {
                 let id = self.inst(Op::ImageSampleExplicitLod, Some(vt), ops)?;
                 Ok(Some(self.shrink(Val { id, ty: v4 }, &texel)?))
             }
+            "Load" if dim == Dim::Cube => Err(Error::new(
+                pos,
+                "a TextureCube has no `Load`; use SampleLevel",
+            )),
             "Load" => {
                 self.arity(name, args, 1, pos)?;
                 let c = self.expr(&args[0])?;
