@@ -76,6 +76,12 @@ fn walk(dir: &Path, config: &Config, forced: Option<Language>, inputs: &mut Inpu
             walk(&p, config, forced, inputs);
         } else if is_pipeline(&p) {
             inputs.pipelines.push(p);
+        } else if p
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("hlsli"))
+        {
+            // A header: analysed through the shaders that include it.
+            inputs.skipped.push(p);
         } else if let Some(language) =
             language_of(&p, config, None).or(forced.filter(|_| is_shader_like(&p)))
         {

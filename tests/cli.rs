@@ -113,6 +113,8 @@ fn directories_are_walked_and_bad_files_do_not_hide_good_ones() {
     .unwrap();
     std::fs::write(d.join("b.wgsl"), "fn main( {").unwrap();
     std::fs::write(d.join("notes.txt"), "not a shader").unwrap();
+    // A header has no entry points of its own: skipped when walking.
+    std::fs::write(d.join("common.hlsli"), "struct Shared { float3 c; };\n").unwrap();
     let o = run(&["check", "-v", d.to_str().unwrap()]);
     let text = stdout(&o);
     assert_eq!(o.status.code(), Some(2), "{text}");
