@@ -287,7 +287,7 @@ fn emit(
                 for p in skipped {
                     writeln!(
                         out,
-                        "note: skipped {} (not a shader extension)",
+                        "note: skipped {} (not a shader on its own)",
                         p.display()
                     )
                     .map_err(io)?;
