@@ -739,20 +739,6 @@ fn interface(words: &[u32], file: &str) -> Interface {
     i
 }
 
-/// Debian's validation layer (1.3.239) predates Slang's OpSource language
-/// (11) and rejects the whole module for it; the driver ignores OpSource, so
-/// under validation it is set to Unknown.
-fn unknown_source_language(words: &mut [u32]) {
-    let mut at = 5;
-    while at < words.len() {
-        let count = (words[at] >> 16) as usize;
-        if words[at] & 0xffff == spirv::Op::Source as u32 && count > 1 {
-            words[at + 1] = 0;
-        }
-        at += count.max(1);
-    }
-}
-
 /// Differences between two readbacks: (elements compared, elements that
 /// differ, largest channel difference; `f32::INFINITY` for an unequal word).
 fn diff(format: Format, a: &[u8], b: &[u8]) -> (usize, usize, f32) {
@@ -884,7 +870,7 @@ fn rtlint_and_slang_agree_on_the_driver() {
         }
         if ctx.validation_enabled() {
             for m in ours_modules.iter_mut().chain(&mut slang_modules) {
-                unknown_source_language(m);
+                common::unknown_source_language(m);
             }
         }
         // Under RTLINT_VK_VALIDATION=1 the Khronos layer checks each build's

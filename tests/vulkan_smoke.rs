@@ -6,6 +6,8 @@
 
 #![cfg(feature = "vulkan")]
 
+mod common;
+
 use rtlint::reference::{self, Params, Scene};
 use rtlint::vk::{
     raw, AccelerationStructure, Binding, BindingKind, Buffer, Context, Geometry, Group, Instance,
@@ -60,14 +62,7 @@ fn compile_shader(ctx: &Context) -> Vec<u32> {
 /// The driver ignores `OpSource`, so under validation it is set to Unknown.
 fn for_validation(ctx: &Context, mut words: Vec<u32>) -> Vec<u32> {
     if ctx.validation_enabled() {
-        let mut at = 5;
-        while at < words.len() {
-            let (count, opcode) = ((words[at] >> 16) as usize, words[at] & 0xFFFF);
-            if opcode == 3 && count > 1 {
-                words[at + 1] = 0;
-            }
-            at += count.max(1);
-        }
+        common::unknown_source_language(&mut words);
     }
     words
 }

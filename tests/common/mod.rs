@@ -17,6 +17,20 @@ pub fn in_ci() -> bool {
 /// 2023.1 does not know the WGSL source language (10), so OpSource's language
 /// is set to Unknown on a copy first. Panics when spirv-val is missing: the
 /// setup script installs it, and a validation test must not pass silently.
+/// Sets every `OpSource` language to Unknown (0). Debian's SPIRV-Tools and
+/// validation layer (2023.1 / 1.3.239) predate WGSL (10) and Slang (11) and
+/// reject the whole module for them; drivers ignore `OpSource`.
+pub fn unknown_source_language(words: &mut [u32]) {
+    let mut i = 5;
+    while i < words.len() {
+        let count = (words[i] >> 16) as usize;
+        if words[i] & 0xffff == 3 && count > 1 && i + 1 < words.len() {
+            words[i + 1] = 0;
+        }
+        i += count.max(1);
+    }
+}
+
 pub fn spirv_val(words: &[u32]) -> Result<(), String> {
     spirv_val_with(words, &[])
 }
@@ -24,14 +38,7 @@ pub fn spirv_val(words: &[u32]) -> Result<(), String> {
 /// [`spirv_val`] with further options (`--scalar-block-layout`).
 pub fn spirv_val_with(words: &[u32], options: &[&str]) -> Result<(), String> {
     let mut w = words.to_vec();
-    let mut i = 5;
-    while i < w.len() {
-        let count = (w[i] >> 16) as usize;
-        if w[i] & 0xffff == 3 && count > 1 {
-            w[i + 1] = 0;
-        }
-        i += count.max(1);
-    }
+    unknown_source_language(&mut w);
     let dir = std::env::temp_dir().join(format!("rtlint-val-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let file = dir.join(format!("{:x}.spv", hash(&w)));
