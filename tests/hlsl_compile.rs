@@ -354,3 +354,79 @@ fn payload_fixture_findings_match_slang_lines() {
     let whole = rtlint::front::load(&src, Language::Hlsl).unwrap();
     assert_eq!(findings(&whole), expected);
 }
+
+/// `#line 200 "virtual.hlsl"` renumbers what follows in the module's debug
+/// info: declarations (DebugInfo.100), instructions (OpLine) and so the
+/// findings of `rtlint check` land on the renumbered lines of the named file.
+#[test]
+fn line_directive_renumbers_debug_info_and_findings() {
+    use rtlint::front::Language;
+    use rtlint::spirv::Decl;
+    use std::collections::BTreeSet;
+    let fixture = Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/hlsl/payloads.hlsl");
+    let text = format!(
+        "#line 200 \"virtual.hlsl\"\n{}",
+        std::fs::read_to_string(&fixture).unwrap()
+    );
+    let mut loader = hlsl::pp::MemLoader::default();
+    let path = Path::new("real.hlsl");
+    let opts = HlslOptions::default();
+    let entries = hlsl::compile_source(path, &text, &mut loader, &opts).unwrap();
+    validate(&entries[0].words, "line-directive");
+    let program =
+        rtlint::spirv::parse(&entries[0].words, Path::new("out.spv"), Language::Spirv).unwrap();
+    let id = |name: &str| {
+        program
+            .names
+            .iter()
+            .filter(|(_, n)| n.as_str() == name)
+            .map(|(id, _)| *id)
+            .min()
+            .unwrap()
+    };
+    let at = |d: Decl| {
+        program
+            .decl_location(d)
+            .map(|l| (l.path.display().to_string(), l.line, l.column))
+    };
+    let fat = id("SuboptimalPayload");
+    // Fixture line 2 (struct) is line 201 after `#line 200` on line 1 of the text.
+    assert_eq!(at(Decl::Type(fat)), Some(("virtual.hlsl".into(), 201, 8)));
+    assert_eq!(
+        at(Decl::Member(fat, 1)),
+        Some(("virtual.hlsl".into(), 203, 12))
+    );
+    assert_eq!(
+        at(Decl::Func(id("RayGen"))),
+        Some(("virtual.hlsl".into(), 219, 6))
+    );
+    let findings = rtlint::rules::check_program(&program, &rtlint::config::Config::default());
+    let primary: BTreeSet<(String, u32, &str)> = findings
+        .iter()
+        .map(|d| {
+            let l = &d.primary.as_ref().expect("positioned").location;
+            (l.path.display().to_string(), l.line, d.code.unwrap())
+        })
+        .collect();
+    let v = |l, c| ("virtual.hlsl".to_string(), l, c);
+    assert_eq!(
+        primary,
+        BTreeSet::from([v(201, "RT001"), v(201, "RT002"), v(203, "RT003")])
+    );
+    // The TraceRay call (fixture line 31) is evidence placed through OpLine.
+    let secondary: BTreeSet<(String, u32)> = findings
+        .iter()
+        .flat_map(|d| d.secondary.iter())
+        .map(|l| (l.location.path.display().to_string(), l.location.line))
+        .collect();
+    assert!(
+        secondary.contains(&("virtual.hlsl".to_string(), 230)),
+        "{secondary:?}"
+    );
+    // Whole-file modules (what `rtlint check` reads) agree.
+    let whole = hlsl::compile_source_whole(path, &text, &mut loader, &opts).unwrap();
+    assert!(whole
+        .decls
+        .iter()
+        .any(|(_, l)| l.path == Path::new("virtual.hlsl") && l.line == 201));
+}

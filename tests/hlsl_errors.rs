@@ -272,3 +272,35 @@ fn entry_parameters_follow_dxr_positions() {
         "{e}"
     );
 }
+
+/// Errors after `#line N "file"` are reported in that file from line N on;
+/// a bad `#line` is an error at its argument.
+#[test]
+fn line_directive_moves_error_positions() {
+    assert_eq!(
+        err(&format!("#line 100 \"virtual.hlsl\"\n{RG}\n    x = 1;\n}}")),
+        "virtual.hlsl:104:5: unknown name `x`"
+    );
+    // Without a file name only the numbering changes.
+    assert_eq!(
+        err(&format!("{RG}#line 10\n    float3 v = float2(1, 2);\n}}")),
+        "main.hlsl:10:16: cannot convert `float2` to `float3`"
+    );
+    // In an include; the include chain keeps the real including line.
+    let e = error_of(&[
+        (
+            "main.hlsl",
+            "#include \"a.hlsli\"\n[shader(\"raygeneration\")]\nvoid rg() { f(); }\n",
+        ),
+        ("a.hlsli", "#line 7 \"gen.hlsl\"\nvoid f() { y = 2; }\n"),
+    ]);
+    assert_eq!(e, "gen.hlsl:7:12: unknown name `y`");
+    assert_eq!(
+        err("#line 1 2\n"),
+        "main.hlsl:1:9: #line takes a file name in double quotes"
+    );
+    assert_eq!(
+        err("#line -3\n"),
+        "main.hlsl:1:7: #line needs a line number from 1 to 2147483647"
+    );
+}
