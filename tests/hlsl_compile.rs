@@ -560,6 +560,11 @@ fn pixel_shader_semantics_and_derivatives() {
         assert!(ops.contains(&(op as u32)), "{op:?} missing");
     }
     assert!(opcodes(&ours[1].words).contains(&(Op::ImageSampleImplicitLod as u32)));
+    let kills = opcodes(&ours[0].words)
+        .iter()
+        .filter(|o| **o == Op::Kill as u32)
+        .count();
+    assert_eq!(kills, 2, "`discard` in the entry body and in the helper");
     // The fine and coarse forms need DerivativeControl; the plain ones do not.
     let caps = |w: &[u32]| {
         let mut caps = Vec::new();

@@ -335,6 +335,16 @@ fn derivatives_outside_pixel_shaders() {
         e,
         "main.hlsl:3:23: `Sample` is only available in pixel shaders"
     );
+    // `discard` likewise, in an entry body and through a helper.
+    assert_eq!(
+        err(&format!("{RG}    discard;\n}}")),
+        "main.hlsl:4:5: `discard` is only available in pixel shaders, not raygeneration shaders"
+    );
+    let e = err("void f() { discard; }\n[numthreads(1, 1, 1)]\nvoid cs() { f(); }");
+    assert_eq!(
+        e,
+        "main.hlsl:1:12: `discard` is only available in pixel shaders"
+    );
     // The same helper is fine from a pixel shader.
     let ok = "float f(float x) { return ddx_fine(x); }\n[shader(\"pixel\")]\nfloat4 ps(float2 uv : UV) : SV_Target { return f(uv.x); }";
     let mut loader = MemLoader::default();

@@ -1,5 +1,6 @@
 // Pixel shaders: semantics on parameters, struct members and the return
-// value; derivatives in the entry body and in a helper; implicit-LOD Sample.
+// value; derivatives in the entry body and in a helper; implicit-LOD Sample;
+// discard.
 Texture2D<float4> albedo : register(t0);
 SamplerState linearSampler : register(s0);
 
@@ -17,12 +18,18 @@ struct Targets {
 
 float edge(float v)
 {
+    if (v < 0) {
+        discard;
+    }
     return fwidth(v);
 }
 
 [shader("pixel")]
 Targets Shade(VertexOut input, float4 tint : COLOR, bool front : SV_IsFrontFace, out float4 extra : SV_Target1)
 {
+    if (tint.a == 0) {
+        discard;
+    }
     float2 dx = ddx(input.uv);
     float2 dy = ddy(input.uv);
     float3 n = ddx_fine(input.normal) + ddy_fine(input.normal)

@@ -2495,7 +2495,32 @@ impl<'a> Lowerer<'a> {
                 }
                 self.term = true;
             }
-            StmtKind::Discard => return Err(unsupported(s.pos, "`discard` (pixel shaders)").len(7)),
+            StmtKind::Discard => {
+                match self.cur_stage {
+                    Some(Stage::Pixel) => {}
+                    Some(st) => {
+                        return Err(Error::new(
+                            s.pos,
+                            format!(
+                                "`discard` is only available in pixel shaders, not {} shaders",
+                                st.name()
+                            ),
+                        )
+                        .len(7))
+                    }
+                    None => {
+                        self.fn_derivs
+                            .entry(self.cur_fn)
+                            .or_insert(("discard", s.pos));
+                    }
+                }
+                if self.term {
+                    self.start_block(None)?;
+                }
+                // OpKill: SPIR-V 1.4 without SPV_KHR_terminate_invocation, as Vulkan 1.2 accepts.
+                self.b.kill()?;
+                self.term = true;
+            }
             StmtKind::Switch(sel, cases) => self.lower_switch(sel, cases)?,
         }
         Ok(())

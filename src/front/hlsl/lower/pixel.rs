@@ -303,7 +303,7 @@ impl<'a> Lowerer<'a> {
         Ok(())
     }
 
-    /// Derivatives (and `discard`) exist only in pixel shaders: a function that
+    /// Derivatives, implicit-LOD `Sample` and `discard` exist only in pixel shaders: a function that
     /// uses them must not be reached from another stage's entry point.
     pub(super) fn check_derivatives(&self, reached: &HashSet<usize>, entry: &FnSig) -> Result<()> {
         let mut uses: Vec<(usize, &(&str, Pos))> = self
