@@ -354,3 +354,238 @@ fn payload_fixture_findings_match_slang_lines() {
     let whole = rtlint::front::load(&src, Language::Hlsl).unwrap();
     assert_eq!(findings(&whole), expected);
 }
+
+/// `#line 200 "virtual.hlsl"` renumbers what follows in the module's debug
+/// info: declarations (DebugInfo.100), instructions (OpLine) and so the
+/// findings of `rtlint check` land on the renumbered lines of the named file.
+#[test]
+fn line_directive_renumbers_debug_info_and_findings() {
+    use rtlint::front::Language;
+    use rtlint::spirv::Decl;
+    use std::collections::BTreeSet;
+    let fixture = Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/hlsl/payloads.hlsl");
+    let text = format!(
+        "#line 200 \"virtual.hlsl\"\n{}",
+        std::fs::read_to_string(&fixture).unwrap()
+    );
+    let mut loader = hlsl::pp::MemLoader::default();
+    let path = Path::new("real.hlsl");
+    let opts = HlslOptions::default();
+    let entries = hlsl::compile_source(path, &text, &mut loader, &opts).unwrap();
+    validate(&entries[0].words, "line-directive");
+    let program =
+        rtlint::spirv::parse(&entries[0].words, Path::new("out.spv"), Language::Spirv).unwrap();
+    let id = |name: &str| {
+        program
+            .names
+            .iter()
+            .filter(|(_, n)| n.as_str() == name)
+            .map(|(id, _)| *id)
+            .min()
+            .unwrap()
+    };
+    let at = |d: Decl| {
+        program
+            .decl_location(d)
+            .map(|l| (l.path.display().to_string(), l.line, l.column))
+    };
+    let fat = id("SuboptimalPayload");
+    // Fixture line 2 (struct) is line 201 after `#line 200` on line 1 of the text.
+    assert_eq!(at(Decl::Type(fat)), Some(("virtual.hlsl".into(), 201, 8)));
+    assert_eq!(
+        at(Decl::Member(fat, 1)),
+        Some(("virtual.hlsl".into(), 203, 12))
+    );
+    assert_eq!(
+        at(Decl::Func(id("RayGen"))),
+        Some(("virtual.hlsl".into(), 219, 6))
+    );
+    let findings = rtlint::rules::check_program(&program, &rtlint::config::Config::default());
+    let primary: BTreeSet<(String, u32, &str)> = findings
+        .iter()
+        .map(|d| {
+            let l = &d.primary.as_ref().expect("positioned").location;
+            (l.path.display().to_string(), l.line, d.code.unwrap())
+        })
+        .collect();
+    let v = |l, c| ("virtual.hlsl".to_string(), l, c);
+    assert_eq!(
+        primary,
+        BTreeSet::from([v(201, "RT001"), v(201, "RT002"), v(203, "RT003")])
+    );
+    // The TraceRay call (fixture line 31) is evidence placed through OpLine.
+    let secondary: BTreeSet<(String, u32)> = findings
+        .iter()
+        .flat_map(|d| d.secondary.iter())
+        .map(|l| (l.location.path.display().to_string(), l.location.line))
+        .collect();
+    assert!(
+        secondary.contains(&("virtual.hlsl".to_string(), 230)),
+        "{secondary:?}"
+    );
+    // Whole-file modules (what `rtlint check` reads) agree.
+    let whole = hlsl::compile_source_whole(path, &text, &mut loader, &opts).unwrap();
+    assert!(whole
+        .decls
+        .iter()
+        .any(|(_, l)| l.path == Path::new("virtual.hlsl") && l.line == 201));
+}
+
+/// Interface facts of one entry point: execution model and modes, and each
+/// Input/Output variable as "class decoration, ..." (`BuiltIn`, `Location`,
+/// `Flat`). Read from the words directly: rspirv's loader refuses the
+/// NonSemantic debug instructions among the globals.
+fn interface(words: &[u32], entry: &str) -> (String, Vec<String>, BTreeSet<String>) {
+    use spirv::{BuiltIn, Decoration, ExecutionMode, ExecutionModel, StorageClass};
+    let mut insts = Vec::new();
+    let mut i = 5;
+    while i < words.len() {
+        let n = (words[i] >> 16) as usize;
+        insts.push((words[i] & 0xffff, &words[i + 1..i + n]));
+        i += n;
+    }
+    let string = |w: &[u32]| {
+        let bytes: Vec<u8> = w.iter().flat_map(|x| x.to_le_bytes()).collect();
+        let end = bytes.iter().position(|b| *b == 0).unwrap();
+        String::from_utf8(bytes[..end].to_vec()).unwrap()
+    };
+    // By name, or the only one (Slang names a lone entry point `main`).
+    let eps: Vec<&[u32]> = insts
+        .iter()
+        .filter(|(op, _)| *op == 15)
+        .map(|(_, o)| *o)
+        .collect();
+    let ep = match eps.iter().find(|o| string(&o[2..]) == entry) {
+        Some(ep) => *ep,
+        None if eps.len() == 1 => eps[0],
+        None => panic!("no entry point {entry}"),
+    };
+    let model = format!("{:?}", ExecutionModel::from_u32(ep[0]).unwrap());
+    let id = ep[1];
+    let name_words = string(&ep[2..]).len() / 4 + 1;
+    let globals = &ep[2 + name_words..];
+    let mut modes: Vec<String> = insts
+        .iter()
+        .filter(|(op, o)| *op == 16 && o[0] == id)
+        .map(|(_, o)| format!("{:?}", ExecutionMode::from_u32(o[1]).unwrap()))
+        .collect();
+    modes.sort();
+    let mut io = BTreeSet::new();
+    for (_, v) in insts
+        .iter()
+        .filter(|(op, o)| *op == 59 && globals.contains(&o[1]))
+    {
+        let class = StorageClass::from_u32(v[2]).unwrap();
+        if !matches!(class, StorageClass::Input | StorageClass::Output) {
+            continue;
+        }
+        let mut facts: Vec<String> = insts
+            .iter()
+            .filter(|(op, o)| *op == 71 && o[0] == v[1])
+            .map(|(_, o)| match Decoration::from_u32(o[1]).unwrap() {
+                Decoration::BuiltIn => format!("BuiltIn {:?}", BuiltIn::from_u32(o[2]).unwrap()),
+                Decoration::Location => format!("Location {}", o[2]),
+                d => format!("{d:?}"),
+            })
+            .collect();
+        facts.sort();
+        io.insert(format!("{class:?} {}", facts.join(", ")));
+    }
+    (model, modes, io)
+}
+
+/// Opcodes in `words`.
+fn opcodes(words: &[u32]) -> Vec<u32> {
+    let mut ops = Vec::new();
+    let mut i = 5;
+    while i < words.len() {
+        ops.push(words[i] & 0xffff);
+        i += (words[i] >> 16) as usize;
+    }
+    ops
+}
+
+use std::collections::BTreeSet;
+
+/// A pixel shader with semantics (struct members flattened, SV_Position,
+/// SV_IsFrontFace, SV_Target[n] from the return struct and an `out`
+/// parameter) and every derivative intrinsic validates, and has the interface
+/// Slang gives the same shader.
+#[test]
+fn pixel_shader_semantics_and_derivatives() {
+    let entries = compile_all("pixel.hlsl");
+    assert_eq!(
+        entries,
+        vec![
+            ("Shade".to_string(), Stage::Fragment),
+            ("Explicit".to_string(), Stage::Fragment)
+        ]
+    );
+    let path = shader("pixel.hlsl");
+    let ours = hlsl::compile(&path, &HlslOptions::default()).unwrap();
+    let shade = interface(&ours[0].words, "Shade");
+    let s = |v: &[&str]| v.iter().map(|s| s.to_string()).collect::<BTreeSet<_>>();
+    assert_eq!(shade.0, "Fragment");
+    assert_eq!(shade.1, vec!["OriginUpperLeft"]);
+    assert_eq!(
+        shade.2,
+        s(&[
+            "Input BuiltIn FragCoord",
+            "Input BuiltIn FrontFacing",
+            "Input Location 0",
+            "Input Location 1",
+            "Input Flat, Location 2",
+            "Input Location 3",
+            "Output Location 0",
+            "Output Location 1",
+            "Output Location 2",
+        ])
+    );
+    let explicit = interface(&ours[1].words, "Explicit");
+    assert_eq!(
+        explicit.2,
+        s(&["Input Location 1", "Input Location 3", "Output Location 0",])
+    );
+    use spirv::Op;
+    let ops = opcodes(&ours[0].words);
+    for op in [
+        Op::DPdx,
+        Op::DPdy,
+        Op::DPdxFine,
+        Op::DPdyFine,
+        Op::DPdxCoarse,
+        Op::DPdyCoarse,
+        Op::Fwidth,
+    ] {
+        assert!(ops.contains(&(op as u32)), "{op:?} missing");
+    }
+    assert!(opcodes(&ours[1].words).contains(&(Op::ImageSampleImplicitLod as u32)));
+    let kills = opcodes(&ours[0].words)
+        .iter()
+        .filter(|o| **o == Op::Kill as u32)
+        .count();
+    assert_eq!(kills, 2, "`discard` in the entry body and in the helper");
+    // The fine and coarse forms need DerivativeControl; the plain ones do not.
+    let caps = |w: &[u32]| {
+        let mut caps = Vec::new();
+        let mut i = 5;
+        while i < w.len() {
+            if w[i] & 0xffff == Op::Capability as u32 {
+                caps.push(w[i + 1]);
+            }
+            i += (w[i] >> 16) as usize;
+        }
+        caps
+    };
+    let derivative_control = spirv::Capability::DerivativeControl as u32;
+    assert!(caps(&ours[0].words).contains(&derivative_control));
+    assert!(!caps(&ours[1].words).contains(&derivative_control));
+    // Slang compiles the same file to the same interface.
+    let slang = rtlint::front::slang::Slang::find().expect("Slang is required (scripts/setup)");
+    for (k, name) in ["Shade", "Explicit"].iter().enumerate() {
+        let theirs = slang.compile_hlsl(&path, name, "pixel", &[]).unwrap();
+        let (model, modes, io) = interface(&theirs, name);
+        let mine = interface(&ours[k].words, name);
+        assert_eq!((model, modes, io), mine, "{name}: Slang vs rtlint");
+    }
+}

@@ -420,6 +420,11 @@ fn cases() -> Vec<Case> {
 /// file in tests/hlsl must be in a case or here.
 const NOT_RUN: &[(&str, &str)] = &[
     (
+        "pixel.hlsl",
+        "a pixel shader: rtlint::vk has no graphics pipeline; tests/hlsl_compile.rs \
+         compares its interface (built-ins, locations, Flat, execution mode) with Slang's",
+    ),
+    (
         "exec_compute.hlsl",
         "Slang 2026.12 rejects valid HLSL in it: a method assigns `this.count` without \
          `[mutating]`, the `(float2)q` truncating cast, unscoped enum constants (`MODE_C`); \

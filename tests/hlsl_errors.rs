@@ -272,3 +272,144 @@ fn entry_parameters_follow_dxr_positions() {
         "{e}"
     );
 }
+
+/// Errors after `#line N "file"` are reported in that file from line N on;
+/// a bad `#line` is an error at its argument.
+#[test]
+fn line_directive_moves_error_positions() {
+    assert_eq!(
+        err(&format!("#line 100 \"virtual.hlsl\"\n{RG}\n    x = 1;\n}}")),
+        "virtual.hlsl:104:5: unknown name `x`"
+    );
+    // Without a file name only the numbering changes.
+    assert_eq!(
+        err(&format!("{RG}#line 10\n    float3 v = float2(1, 2);\n}}")),
+        "main.hlsl:10:16: cannot convert `float2` to `float3`"
+    );
+    // In an include; the include chain keeps the real including line.
+    let e = error_of(&[
+        (
+            "main.hlsl",
+            "#include \"a.hlsli\"\n[shader(\"raygeneration\")]\nvoid rg() { f(); }\n",
+        ),
+        ("a.hlsli", "#line 7 \"gen.hlsl\"\nvoid f() { y = 2; }\n"),
+    ]);
+    assert_eq!(e, "gen.hlsl:7:12: unknown name `y`");
+    assert_eq!(
+        err("#line 1 2\n"),
+        "main.hlsl:1:9: #line takes a file name in double quotes"
+    );
+    assert_eq!(
+        err("#line -3\n"),
+        "main.hlsl:1:7: #line needs a line number from 1 to 2147483647"
+    );
+}
+
+const PS: &str = "[shader(\"pixel\")]\n";
+
+/// Derivatives exist only in pixel shaders: in another stage's entry body,
+/// or in a helper that such an entry point reaches, they are errors at the call.
+#[test]
+fn derivatives_outside_pixel_shaders() {
+    assert_eq!(
+        err("[numthreads(1, 1, 1)]\nvoid cs()\n{\n    float a = ddx(1.0);\n}"),
+        "main.hlsl:4:15: `ddx` is only available in pixel shaders, not compute shaders"
+    );
+    assert_eq!(
+        err("struct P { float4 c; };\n[shader(\"closesthit\")]\nvoid ch(inout P p, BuiltInTriangleIntersectionAttributes a)\n{\n    p.c = fwidth(p.c);\n}"),
+        "main.hlsl:5:11: `fwidth` is only available in pixel shaders, not closesthit shaders"
+    );
+    assert_eq!(
+        err("[shader(\"raygeneration\")]\nvoid rg()\n{\n    float a = ddy_coarse(2.0);\n}"),
+        "main.hlsl:4:15: `ddy_coarse` is only available in pixel shaders, not raygeneration shaders"
+    );
+    // Through a helper: the error is at the call in the helper.
+    let e = err("float f(float x) { return ddx_fine(x); }\n[numthreads(1, 1, 1)]\nvoid cs()\n{\n    float a = f(1.0);\n}");
+    assert_eq!(
+        e,
+        "main.hlsl:1:27: `ddx_fine` is only available in pixel shaders"
+    );
+    // Implicit-LOD `Sample` takes derivatives too.
+    let e = err("Texture2D t;\nSamplerState s;\nfloat4 f() { return t.Sample(s, float2(0, 0)); }\n[numthreads(1, 1, 1)]\nvoid cs() { float4 c = f(); }");
+    assert_eq!(
+        e,
+        "main.hlsl:3:23: `Sample` is only available in pixel shaders"
+    );
+    // `discard` likewise, in an entry body and through a helper.
+    assert_eq!(
+        err(&format!("{RG}    discard;\n}}")),
+        "main.hlsl:4:5: `discard` is only available in pixel shaders, not raygeneration shaders"
+    );
+    let e = err("void f() { discard; }\n[numthreads(1, 1, 1)]\nvoid cs() { f(); }");
+    assert_eq!(
+        e,
+        "main.hlsl:1:12: `discard` is only available in pixel shaders"
+    );
+    // The same helper is fine from a pixel shader.
+    let ok = "float f(float x) { return ddx_fine(x); }\n[shader(\"pixel\")]\nfloat4 ps(float2 uv : UV) : SV_Target { return f(uv.x); }";
+    let mut loader = MemLoader::default();
+    hlsl::compile_source(
+        Path::new("main.hlsl"),
+        ok,
+        &mut loader,
+        &HlslOptions::default(),
+    )
+    .unwrap();
+    assert_eq!(
+        err(&format!(
+            "{PS}float4 ps(float2 uv : UV) : SV_Target {{ return ddx(uv, uv); }}"
+        )),
+        "main.hlsl:2:48: `ddx` takes 1 argument(s), 2 given"
+    );
+}
+
+/// Pixel shader inputs and outputs: semantics are required and checked.
+#[test]
+fn pixel_shader_interface_errors() {
+    assert_eq!(
+        err(&format!(
+            "{PS}float4 ps(float2 uv) : SV_Target {{ return 0; }}"
+        )),
+        "main.hlsl:2:18: pixel shader inputs need a semantic"
+    );
+    assert_eq!(
+        err(&format!("{PS}float4 ps(float2 uv : UV) {{ return 0; }}")),
+        "main.hlsl:2:1: a pixel shader's return value needs a semantic such as `SV_Target`"
+    );
+    assert_eq!(
+        err(&format!(
+            "{PS}float4 ps(float2 uv : UV) : COLOR {{ return 0; }}"
+        )),
+        "main.hlsl:2:29: pixel shader outputs are render targets (`SV_Target[n]`), not `COLOR`"
+    );
+    assert_eq!(
+        err(&format!(
+            "{PS}float4 ps(float2 uv : UV) : SV_Target9 {{ return 0; }}"
+        )),
+        "main.hlsl:2:29: `SV_Target9` names no render target (SV_Target0 to SV_Target7)"
+    );
+    assert_eq!(
+        err(&format!(
+            "{PS}float4 ps(uint s : SV_SampleIndex) : SV_Target {{ return 0; }}"
+        )),
+        "main.hlsl:2:20: not supported: semantic `SV_SampleIndex` on a pixel shader input"
+    );
+    assert_eq!(
+        err(&format!(
+            "{PS}float4 ps(float2 p : SV_Position) : SV_Target {{ return 0; }}"
+        )),
+        "main.hlsl:2:18: `SV_Position` must be a `float4`"
+    );
+    assert_eq!(
+        err(&format!("{PS}void ps(float a : A, out float4 c : SV_Target, out float4 d : SV_Target0) {{ c = a; d = a; }}")),
+        "main.hlsl:2:63: `SV_Target0` takes output location 0, already taken by `SV_Target`"
+    );
+    assert_eq!(
+        err(&format!("{PS}float4 ps([[vk::location(2)]] float a : A, float b : B) : SV_Target {{ return a + b; }}")),
+        "main.hlsl:2:54: pixel shader inputs either all have `[[vk::location]]` or none do"
+    );
+    assert_eq!(
+        err(&format!("{PS}float4 ps(float3x3 m : M) : SV_Target {{ return 0; }}")),
+        "main.hlsl:2:20: not supported: `float3x3` as a pixel shader input (scalars and vectors only)"
+    );
+}

@@ -8,6 +8,7 @@
 mod calls;
 mod debug;
 mod methods;
+mod pixel;
 
 use super::ast::*;
 use super::error::{Error, Pos, Result};
@@ -29,6 +30,7 @@ pub enum Stage {
     Intersection,
     Callable,
     Compute,
+    Pixel,
 }
 
 impl Stage {
@@ -41,6 +43,7 @@ impl Stage {
             "intersection" => Stage::Intersection,
             "callable" => Stage::Callable,
             "compute" => Stage::Compute,
+            "pixel" => Stage::Pixel,
             _ => return None,
         })
     }
@@ -53,6 +56,7 @@ impl Stage {
             Stage::Intersection => "intersection",
             Stage::Callable => "callable",
             Stage::Compute => "compute",
+            Stage::Pixel => "pixel",
         }
     }
     pub fn model(self) -> ExecutionModel {
@@ -64,6 +68,7 @@ impl Stage {
             Stage::Intersection => ExecutionModel::IntersectionKHR,
             Stage::Callable => ExecutionModel::CallableKHR,
             Stage::Compute => ExecutionModel::GLCompute,
+            Stage::Pixel => ExecutionModel::Fragment,
         }
     }
 }
@@ -199,7 +204,15 @@ pub struct Lowerer<'a> {
     local_decls: Vec<(usize, Id, String, Ty, Pos)>,
     /// Descriptor variables (what a resource parameter may be given).
     resource_vars: HashSet<Id>,
+    /// Per user struct, each member's semantic and attributes (pixel-shader I/O).
+    struct_io: HashMap<u32, Vec<MemberIo>>,
+    /// Functions outside an entry body that use derivatives: (name, position),
+    /// checked against the entry points that reach them.
+    fn_derivs: HashMap<usize, (&'static str, Pos)>,
 }
+
+/// A struct member's semantic and attributes.
+type MemberIo = (Option<(String, Pos)>, Vec<Attr>);
 
 /// Source positions of named declarations (the side table `Program` reads).
 pub type Decls = Vec<(NamedDecl, Location)>;
@@ -420,6 +433,8 @@ impl<'a> Lowerer<'a> {
             cur_ns: String::new(),
             cur_stage: None,
             cur_label: 0,
+            struct_io: HashMap::new(),
+            fn_derivs: HashMap::new(),
             ret_ty: Ty::Void,
             scopes: Vec::new(),
             flow: Vec::new(),
@@ -684,6 +699,13 @@ impl<'a> Lowerer<'a> {
             fields,
             pos: s.pos,
         });
+        self.struct_io.insert(
+            k,
+            s.fields
+                .iter()
+                .map(|f| (f.semantic.clone(), f.attrs.clone()))
+                .collect(),
+        );
         self.struct_names.insert(s.name.clone(), k);
         Ok(())
     }
@@ -1933,6 +1955,19 @@ impl<'a> Lowerer<'a> {
                 self.lower_function(k)?;
             }
         }
+        let mut wrappers = HashMap::new();
+        for &e in entries {
+            if self.funcs[e].stage == Some(Stage::Pixel) && !wrappers.contains_key(&e) {
+                let w = self.pixel_wrapper(e)?;
+                wrappers.insert(e, w);
+            }
+        }
+        // Static initializers in the wrappers may call functions not yet lowered.
+        while let Some(k) = self.pending.pop() {
+            if self.lowered.insert(k) {
+                self.lower_function(k)?;
+            }
+        }
         self.check_recursion()?;
         for &e in entries {
             let sig = self.funcs[e].clone();
@@ -1948,12 +1983,24 @@ impl<'a> Lowerer<'a> {
                 vars.extend(self.fn_used.get(&f).cloned().unwrap_or_default());
                 stack.extend(self.fn_calls.get(&f).cloned().unwrap_or_default());
             }
+            if stage != Stage::Pixel {
+                self.check_derivatives(&seen, &sig)?;
+            }
+            let mut entry_id = sig.id;
+            if let Some((w, io)) = wrappers.get(&e) {
+                entry_id = *w;
+                vars.extend(io.iter().copied());
+            }
             let vars: Vec<Id> = vars.into_iter().collect();
             self.b
-                .entry_point(stage.model(), sig.id, sig.name.clone(), vars);
+                .entry_point(stage.model(), entry_id, sig.name.clone(), vars);
             if stage == Stage::Compute {
                 self.b
                     .execution_mode(sig.id, spirv::ExecutionMode::LocalSize, sig.numthreads);
+            } else if stage == Stage::Pixel {
+                // Vulkan requires it; HLSL's SV_Position has its origin at the top left.
+                self.b
+                    .execution_mode(entry_id, spirv::ExecutionMode::OriginUpperLeft, []);
             } else {
                 self.ray_tracing_caps();
             }
@@ -2020,7 +2067,9 @@ impl<'a> Lowerer<'a> {
         self.flow.clear();
         self.term = false;
         let ret_id = self.ty_id(&sig.ret)?;
-        if let Some(stage) = sig.stage {
+        // A pixel entry point is lowered as an ordinary function (`src.NAME`,
+        // as DXC names it) that a wrapper calls; see `pixel_wrapper`.
+        if let Some(stage) = sig.stage.filter(|s| *s != Stage::Pixel) {
             if sig.ret != Ty::Void {
                 return Err(unsupported(
                     f.ret.pos,
@@ -2061,7 +2110,11 @@ impl<'a> Lowerer<'a> {
             let fty = self.b.type_function(ret_id, ptys.clone());
             self.b
                 .begin_function(ret_id, Some(sig.id), spirv::FunctionControl::NONE, fty)?;
-            self.b.name(sig.id, sig.name.clone());
+            if sig.stage == Some(Stage::Pixel) {
+                self.b.name(sig.id, format!("src.{}", sig.name));
+            } else {
+                self.b.name(sig.id, sig.name.clone());
+            }
             let mut ptys = ptys.into_iter();
             let mut params = sig.params.iter();
             if let Some(k) = sig.this {
@@ -2442,7 +2495,32 @@ impl<'a> Lowerer<'a> {
                 }
                 self.term = true;
             }
-            StmtKind::Discard => return Err(unsupported(s.pos, "`discard` (pixel shaders)").len(7)),
+            StmtKind::Discard => {
+                match self.cur_stage {
+                    Some(Stage::Pixel) => {}
+                    Some(st) => {
+                        return Err(Error::new(
+                            s.pos,
+                            format!(
+                                "`discard` is only available in pixel shaders, not {} shaders",
+                                st.name()
+                            ),
+                        )
+                        .len(7))
+                    }
+                    None => {
+                        self.fn_derivs
+                            .entry(self.cur_fn)
+                            .or_insert(("discard", s.pos));
+                    }
+                }
+                if self.term {
+                    self.start_block(None)?;
+                }
+                // OpKill: SPIR-V 1.4 without SPV_KHR_terminate_invocation, as Vulkan 1.2 accepts.
+                self.b.kill()?;
+                self.term = true;
+            }
             StmtKind::Switch(sel, cases) => self.lower_switch(sel, cases)?,
         }
         Ok(())

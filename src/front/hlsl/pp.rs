@@ -132,7 +132,7 @@ impl<'a> Preprocessor<'a> {
         Ok(())
     }
 
-    fn lines(&mut self, tokens: Vec<Token>) -> Result<()> {
+    fn lines(&mut self, mut tokens: Vec<Token>) -> Result<()> {
         let mut conds: Vec<Cond> = Vec::new();
         let mut pending: Vec<Token> = Vec::new();
         let mut i = 0;
@@ -204,6 +204,20 @@ impl<'a> Preprocessor<'a> {
                     }
                 }
                 _ if !active => {}
+                "line" => {
+                    self.flush(&mut pending)?;
+                    let (number, file) = self.line_directive(name_tok, &line[1..])?;
+                    // The line after the directive becomes `number`; later
+                    // lines follow on. Positions seen so far (possibly already
+                    // renumbered) are shifted, so several `#line`s compose.
+                    let next = hash.line.saturating_add(1);
+                    for t in &mut tokens[j..] {
+                        t.pos.line = number.saturating_add(t.pos.line.saturating_sub(next));
+                        if let Some(f) = file {
+                            t.pos.file = f;
+                        }
+                    }
+                }
                 _ => {
                     // Text before a directive is expanded first: a macro
                     // defined or undefined by the directive affects only what follows.
@@ -274,19 +288,67 @@ impl<'a> Preprocessor<'a> {
                 Err(Error::new(pos, format!("#error {msg}")).len(5))
             }
             "warning" => Ok(()),
-            "line" => {
-                // `#line N "file"` renumbers what follows; we keep real positions,
-                // which is what the source map promises, and only check the syntax.
-                match rest.first().map(|t| &t.tok) {
-                    Some(Tok::Int(..)) => Ok(()),
-                    _ => Err(Error::new(pos, "#line needs a line number")),
-                }
-            }
             other => {
                 Err(Error::new(pos, format!("unknown directive `#{other}`"))
                     .len(other.len() as u32))
             }
         }
+    }
+
+    /// Checks `#line N ["file"]` (macros in it expanded, as C allows) and
+    /// gives the new number and, when a file is named, its file-table index.
+    fn line_directive(&mut self, name_tok: &Token, rest: &[Token]) -> Result<(u32, Option<u32>)> {
+        let pos = name_tok.pos;
+        let expanded;
+        let rest = if rest.iter().any(|t| t.ident().is_some()) {
+            expanded = self.expand(rest.to_vec())?;
+            &expanded[..]
+        } else {
+            rest
+        };
+        let number = match rest.first() {
+            // C's limit is 2147483647; 0 cannot name a line.
+            Some(Token {
+                tok: Tok::Int(n, _),
+                ..
+            }) if (1..=2_147_483_647).contains(n) => *n as u32,
+            Some(t) => {
+                return Err(
+                    Error::new(t.pos, "#line needs a line number from 1 to 2147483647")
+                        .len(t.spelling().len() as u32),
+                )
+            }
+            None => return Err(Error::new(pos, "#line needs a line number").len(4)),
+        };
+        let file = match rest.get(1) {
+            None => None,
+            Some(Token {
+                tok: Tok::Str(s), ..
+            }) => {
+                let path = PathBuf::from(&**s);
+                // One file-table entry per name, so debug info has one source per name.
+                let k = match self.files.iter().position(|f| *f == path) {
+                    Some(k) => k,
+                    None => {
+                        self.files.push(path);
+                        self.files.len() - 1
+                    }
+                };
+                Some(k as u32)
+            }
+            Some(t) => {
+                return Err(
+                    Error::new(t.pos, "#line takes a file name in double quotes")
+                        .len(t.spelling().len() as u32),
+                )
+            }
+        };
+        if let Some(t) = rest.get(2) {
+            return Err(
+                Error::new(t.pos, "unexpected token after #line").len(t.spelling().len() as u32)
+            );
+        }
+        Ok((number, file))
     }
 
     fn define(&mut self, pos: Pos, rest: &[Token]) -> Result<()> {
@@ -1085,5 +1147,107 @@ mod tests {
         .unwrap();
         let p: Vec<(u32, u32)> = o.tokens.iter().map(|t| (t.pos.line, t.pos.col)).collect();
         assert_eq!(p, vec![(3, 5), (3, 3), (3, 3)]);
+    }
+
+    /// (file name, line, column) of every output token.
+    fn positions(files: &[(&str, &str)]) -> Vec<(String, u32, u32)> {
+        let mut loader = MemLoader(
+            files
+                .iter()
+                .map(|(p, t)| (PathBuf::from(p), t.to_string()))
+                .collect(),
+        );
+        let o = preprocess(Path::new(files[0].0), files[0].1, &mut loader, &[], &[])
+            .ok()
+            .unwrap();
+        o.tokens
+            .iter()
+            .map(|t| {
+                let f = o.files[t.pos.file as usize].display().to_string();
+                (f, t.pos.line, t.pos.col)
+            })
+            .collect()
+    }
+
+    #[test]
+    fn line_directive_renumbers_what_follows() {
+        let p = positions(&[(
+            "m.hlsl",
+            "a\n#line 100 \"virtual.hlsl\"\nb\n\n  c\n#line 7\nd",
+        )]);
+        let want = [
+            ("m.hlsl", 1, 1),
+            ("virtual.hlsl", 100, 1),
+            ("virtual.hlsl", 102, 3),
+            ("virtual.hlsl", 7, 1),
+        ];
+        let want: Vec<(String, u32, u32)> = want
+            .iter()
+            .map(|(f, l, c)| (f.to_string(), *l, *c))
+            .collect();
+        assert_eq!(p, want);
+        // `__LINE__` and errors see the new numbers.
+        assert_eq!(pp("#line 41\n__LINE__"), "41");
+        let e = pp_with(&[("m", "#line 9 \"v.h\"\n\n#error here")], &[]).unwrap_err();
+        assert!(e.starts_with("10:2: #error here"), "{e}");
+        // Macros in the arguments are expanded; a macro body lands where it is used.
+        let p = positions(&[(
+            "m",
+            "#define N 50\n#define F \"f.h\"\n#define M x y\n#line N F\n M",
+        )]);
+        assert_eq!(p, vec![("f.h".into(), 50, 2), ("f.h".into(), 50, 2)]);
+    }
+
+    #[test]
+    fn line_directive_in_includes_and_skipped_groups() {
+        // The renumbering stays in its file: the includer keeps counting after the include.
+        let p = positions(&[
+            ("main.hlsl", "#include \"a.h\"\nz"),
+            ("a.h", "#line 20 \"gen.h\"\ny"),
+        ]);
+        assert_eq!(p, vec![("gen.h".into(), 20, 1), ("main.hlsl".into(), 2, 1)]);
+        // Includes after `#line "x"` still resolve next to the real file.
+        let p = positions(&[
+            (
+                "dir/main.hlsl",
+                "#line 5 \"elsewhere/v.hlsl\"\n#include \"b.h\"\nw",
+            ),
+            ("dir/b.h", "q"),
+        ]);
+        assert_eq!(
+            p,
+            vec![("dir/b.h".into(), 1, 1), ("elsewhere/v.hlsl".into(), 6, 1)]
+        );
+        // Inside a group not taken it is not even checked, as in C.
+        assert_eq!(pp("#if 0\n#line x\n#endif\nv"), "v");
+    }
+
+    #[test]
+    fn line_directive_errors_at_their_arguments() {
+        let err = |s: &str| pp_with(&[("m", s)], &[]).unwrap_err();
+        let e = err("\n#line");
+        assert!(e.starts_with("2:2: #line needs a line number"), "{e}");
+        let e = err("#line x");
+        assert!(
+            e.starts_with("1:7: #line needs a line number from 1 to 2147483647"),
+            "{e}"
+        );
+        let e = err("#line 0");
+        assert!(
+            e.starts_with("1:7: #line needs a line number from 1"),
+            "{e}"
+        );
+        let e = err("#line 4294967296");
+        assert!(
+            e.starts_with("1:7: #line needs a line number from 1"),
+            "{e}"
+        );
+        let e = err("#line 3 file");
+        assert!(
+            e.starts_with("1:9: #line takes a file name in double quotes"),
+            "{e}"
+        );
+        let e = err("#line 3 \"f\" 4");
+        assert!(e.starts_with("1:13: unexpected token after #line"), "{e}");
     }
 }

@@ -101,6 +101,62 @@ impl<'a> Lowerer<'a> {
         Ok(())
     }
 
+    /// `ddx`, `ddy`, their `_fine`/`_coarse` forms and `fwidth` → `OpDPdx`... on
+    /// float scalars and vectors (integers convert, as in DXC).
+    fn derivative(&mut self, name: &str, args: &'a [Expr], pos: Pos) -> Result<Val> {
+        let (op, static_name): (Op, &'static str) = match name {
+            "ddx" => (Op::DPdx, "ddx"),
+            "ddy" => (Op::DPdy, "ddy"),
+            "ddx_fine" => (Op::DPdxFine, "ddx_fine"),
+            "ddy_fine" => (Op::DPdyFine, "ddy_fine"),
+            "ddx_coarse" => (Op::DPdxCoarse, "ddx_coarse"),
+            "ddy_coarse" => (Op::DPdyCoarse, "ddy_coarse"),
+            _ => (Op::Fwidth, "fwidth"),
+        };
+        let len = name.len() as u32;
+        match self.cur_stage {
+            Some(Stage::Pixel) => {}
+            Some(s) => {
+                return Err(Error::new(
+                    pos,
+                    format!(
+                        "`{name}` is only available in pixel shaders, not {} shaders",
+                        s.name()
+                    ),
+                )
+                .len(len))
+            }
+            // In a helper: checked against the entry points that reach it.
+            None => {
+                self.fn_derivs
+                    .entry(self.cur_fn)
+                    .or_insert((static_name, pos));
+            }
+        }
+        self.arity(name, args, 1, pos)?;
+        let v = self.expr(&args[0])?;
+        let ty = match v.ty {
+            Ty::Sc(_) => Ty::Sc(Sc::Float),
+            Ty::Vec(_, n) => Ty::Vec(Sc::Float, n),
+            _ => {
+                return Err(Error::new(
+                    args[0].pos,
+                    format!(
+                        "`{name}` takes a scalar or vector, not `{}`",
+                        self.ty_name(&v.ty)
+                    ),
+                ))
+            }
+        };
+        let v = self.convert(v, &ty, args[0].pos, false)?;
+        if !matches!(op, Op::DPdx | Op::DPdy | Op::Fwidth) {
+            self.cap(Capability::DerivativeControl);
+        }
+        let tid = self.ty_id(&ty)?;
+        let id = self.inst(op, Some(tid), vec![Operand::IdRef(v.id)])?;
+        Ok(Val { id, ty })
+    }
+
     fn glsl(&mut self, inst: u32, ty: &Ty, args: &[Id]) -> Result<Val> {
         let tid = self.ty_id(ty)?;
         let mut ops = vec![
@@ -443,8 +499,10 @@ impl<'a> Lowerer<'a> {
             | "all" | "asuint" | "asint" | "asfloat" | "f32tof16" | "f16tof32" | "countbits"
             | "firstbithigh" | "firstbitlow" | "reversebits" | "isnan" | "isinf" | "isfinite"
             | "mad" | "fma" | "rcp" | "log10" => self.args(args)?,
-            "ddx" | "ddy" | "ddx_fine" | "ddy_fine" | "ddx_coarse" | "ddy_coarse" | "fwidth"
-            | "clip" => {
+            "ddx" | "ddy" | "ddx_fine" | "ddy_fine" | "ddx_coarse" | "ddy_coarse" | "fwidth" => {
+                return self.derivative(name, args, pos).map(Some);
+            }
+            "clip" => {
                 return Err(unsupported(pos, format!("`{name}` (pixel shaders only)"))
                     .len(name.len() as u32));
             }

@@ -323,16 +323,25 @@ impl<'a> Lowerer<'a> {
             Ty::Vec(Sc::Float, cn)
         };
         match name {
-            "Sample" => Err(unsupported(
+            "Sample" if self.cur_stage.is_some_and(|s| s != Stage::Pixel) => Err(unsupported(
                 pos,
                 "`Sample` (implicit level of detail) outside pixel shaders; use `SampleLevel`",
             )
             .len(6)),
-            "SampleLevel" | "SampleGrad" => {
+            "Sample" | "SampleLevel" | "SampleGrad" => {
                 if rw {
                     return Err(Error::new(pos, format!("RWTexture has no method `{name}`")));
                 }
-                self.arity(name, args, if name == "SampleLevel" { 3 } else { 4 }, pos)?;
+                if name == "Sample" && self.cur_stage.is_none() {
+                    // Implicit LOD takes derivatives: checked against the reaching entry points.
+                    self.fn_derivs.entry(self.cur_fn).or_insert(("Sample", pos));
+                }
+                let want = match name {
+                    "Sample" => 2,
+                    "SampleLevel" => 3,
+                    _ => 4,
+                };
+                self.arity(name, args, want, pos)?;
                 let s = self.expr(&args[0])?;
                 if s.ty != Ty::Sampler {
                     return Err(Error::new(args[0].pos, "expected a SamplerState"));
@@ -348,7 +357,10 @@ impl<'a> Lowerer<'a> {
                 let v4 = Ty::Vec(sc, 4);
                 let vt = self.ty_id(&v4)?;
                 let mut ops = vec![Operand::IdRef(si), Operand::IdRef(uv.id)];
-                if name == "SampleLevel" {
+                if name == "Sample" {
+                    let id = self.inst(Op::ImageSampleImplicitLod, Some(vt), ops)?;
+                    return Ok(Some(self.shrink(Val { id, ty: v4 }, &texel)?));
+                } else if name == "SampleLevel" {
                     let lod = self.expr(&args[2])?;
                     let lod = self.convert(lod, &Ty::Sc(Sc::Float), args[2].pos, false)?;
                     ops.push(Operand::ImageOperands(spirv::ImageOperands::LOD));
