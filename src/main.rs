@@ -326,11 +326,8 @@ fn layout(common: Common) -> Result<u8, String> {
     let mut problems: Vec<Diagnostic> = errors;
     problems.extend(inputs.errors.iter().map(|e| (*e.0).clone()));
     let mut files = Vec::new();
-    for input in &inputs.files {
-        match rtlint::front::load(&input.path, input.language) {
-            Ok(p) => files.push(rtlint::analysis::layout::FileLayouts::new(&p)),
-            Err(InputError(d)) => problems.push(*d),
-        }
+    for p in load_programs(&inputs, &mut problems) {
+        files.push(rtlint::analysis::layout::FileLayouts::new(&p));
     }
     match format {
         Format::Json => {
@@ -359,13 +356,7 @@ fn live(common: Common) -> Result<u8, String> {
     } = setup(&common)?;
     let mut problems: Vec<Diagnostic> = errors;
     problems.extend(inputs.errors.iter().map(|e| (*e.0).clone()));
-    let mut programs = Vec::new();
-    for input in &inputs.files {
-        match rtlint::front::load(&input.path, input.language) {
-            Ok(p) => programs.push(p),
-            Err(InputError(d)) => problems.push(*d),
-        }
-    }
+    let programs = load_programs(&inputs, &mut problems);
     let report = rtlint::analysis::live_report(&programs);
     print_report(
         format,
@@ -393,13 +384,7 @@ fn stack(common: Common, driver: bool) -> Result<u8, String> {
     }
     // Loose shaders: one conservative pipeline over all of them.
     if !inputs.files.is_empty() {
-        let mut programs = Vec::new();
-        for input in &inputs.files {
-            match rtlint::front::load(&input.path, input.language) {
-                Ok(p) => programs.push(p),
-                Err(InputError(d)) => problems.push(*d),
-            }
-        }
+        let programs = load_programs(&inputs, &mut problems);
         if !programs.is_empty() {
             pipelines.push(rtlint::pipeline::Pipeline::from_programs(programs));
         }
@@ -447,6 +432,21 @@ fn stack(common: Common, driver: bool) -> Result<u8, String> {
     }
     .map_err(|e| e.to_string())?;
     print_report(format, &value, human, &problems)
+}
+
+/// Loads every input into a Program; the ones that fail become input errors.
+fn load_programs(
+    inputs: &lint::Inputs,
+    problems: &mut Vec<Diagnostic>,
+) -> Vec<rtlint::spirv::Program> {
+    let mut programs = Vec::new();
+    for input in &inputs.files {
+        match rtlint::front::load(&input.path, input.language) {
+            Ok(p) => programs.push(p),
+            Err(InputError(d)) => problems.push(*d),
+        }
+    }
+    programs
 }
 
 /// Prints a report as JSON or text, then any input errors; exit 2 on errors.

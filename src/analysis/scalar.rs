@@ -1,7 +1,9 @@
-//! Sizes of values as a driver keeps them: the scalar layout (every member at
-//! the alignment of its largest scalar), which is how Vulkan sizes payload and
-//! attribute blocks and how DXC sizes payloads. Used for live state and the
-//! stack model; `layout.rs` owns the buffer layouts.
+//! Sizes of values as a driver keeps them: scalar layout, each member at its
+//! own largest scalar's alignment, and descriptor handles as 8 bytes. Used
+//! for live values and the stack model. Payload sizes as rules report them
+//! come from `layout.rs`, whose rule aligns every scalar to the block's
+//! largest (Vulkan's payload rule); the two agree unless a struct mixes
+//! scalar widths.
 
 use crate::spirv::{Id, Program, Type};
 

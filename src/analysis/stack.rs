@@ -439,7 +439,11 @@ pub fn exact_call_chain(rec: &RecursionReport, sizes: &[u64]) -> Option<u64> {
 
 /// `rtlint stack`: the stack figures of a described (or assumed) pipeline.
 pub fn stack_report(pipeline: &Pipeline) -> StackReport {
-    let rec = recursion(pipeline);
+    stack_report_with(pipeline, &recursion(pipeline))
+}
+
+/// [`stack_report`] over a recursion analysis the caller already has.
+pub fn stack_report_with(pipeline: &Pipeline, rec: &RecursionReport) -> StackReport {
     let mut cache: HashMap<(usize, String), Breakdown> = HashMap::new();
     let sites: Vec<Vec<LiveSite>> = pipeline.programs.iter().map(live_sites).collect();
     let mut shaders = Vec::new();
@@ -476,8 +480,8 @@ pub fn stack_report(pipeline: &Pipeline) -> StackReport {
     }
     let model_sizes: Vec<u64> = shaders.iter().map(|s| s.model_bytes).collect();
     let driver_sizes: Vec<u64> = shaders.iter().map(|s| s.driver_model_bytes).collect();
-    let model = formulas(pipeline, &rec, &model_sizes);
-    let driver_comparable = formulas(pipeline, &rec, &driver_sizes);
+    let model = formulas(pipeline, rec, &model_sizes);
+    let driver_comparable = formulas(pipeline, rec, &driver_sizes);
     let recommended = model
         .exact_call_chain
         .or(model.vulkan_default)

@@ -145,11 +145,13 @@ pub struct PipelineContext<'a> {
 
 impl<'a> PipelineContext<'a> {
     pub fn new(pipeline: &'a crate::pipeline::Pipeline, config: &'a Config) -> Self {
+        let recursion = crate::analysis::recursion(pipeline);
+        let stack = crate::analysis::stack::stack_report_with(pipeline, &recursion);
         PipelineContext {
             pipeline,
             config,
-            recursion: crate::analysis::recursion(pipeline),
-            stack: crate::analysis::stack_report(pipeline),
+            recursion,
+            stack,
         }
     }
 }
