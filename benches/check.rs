@@ -4,8 +4,8 @@
 //! Prints a table; `cargo bench --bench check`.
 
 use rtlint::config::Config;
-use rtlint::front::Language;
 use rtlint::lint::{check_input, Input};
+use rtlint::shader::Language;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 

@@ -46,7 +46,7 @@ fn main() {
             .max()
             .unwrap_or(0)
     };
-    use rtlint::spirv::Stage as S;
+    use rtlint::shader::Stage as S;
     let m = rtlint::analysis::stack::StageMax {
         raygen: per(S::RayGeneration),
         closest_hit: per(S::ClosestHit),

@@ -1,7 +1,7 @@
 //! `rtlint.toml`: budgets, rule levels and language mappings.
 
 use crate::diag::{InputError, Location, Severity};
-use crate::front::Language;
+use crate::shader::Language;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
@@ -84,8 +84,8 @@ impl Config {
         let mut config: Config = toml::from_str(text).map_err(|e| {
             let mut err = InputError::new("invalid-config", path, e.message().trim().to_string());
             if let Some(span) = e.span() {
-                let (line, column) = crate::front::wgsl::line_col(text, span.start);
-                let (end_line, end_column) = crate::front::wgsl::line_col(text, span.end);
+                let (line, column) = crate::shader::line_col(text, span.start);
+                let (end_line, end_column) = crate::shader::line_col(text, span.end);
                 err = err.at(
                     Location {
                         path: path.to_path_buf(),
@@ -170,7 +170,7 @@ fn config_error(text: &str, path: &Path, needle: &str, message: String) -> Input
     let err = InputError::new("invalid-config", path, message);
     match text.find(needle) {
         Some(at) => {
-            let (line, column) = crate::front::wgsl::line_col(text, at);
+            let (line, column) = crate::shader::line_col(text, at);
             err.at(
                 Location::span(path, line, column, needle.chars().count() as u32),
                 "here",

@@ -31,49 +31,7 @@ impl fmt::Display for Severity {
     }
 }
 
-/// A place in a source file. Lines and columns are 1-based; a column of 0 means
-/// "the whole line" (debug info without columns).
-#[derive(Clone, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
-pub struct Location {
-    pub path: PathBuf,
-    pub line: u32,
-    pub column: u32,
-    pub end_line: u32,
-    pub end_column: u32,
-}
-
-impl Location {
-    pub fn point(path: impl Into<PathBuf>, line: u32, column: u32) -> Self {
-        Location {
-            path: path.into(),
-            line,
-            column,
-            end_line: line,
-            end_column: column,
-        }
-    }
-
-    /// A location spanning `len` columns from `column` on one line.
-    pub fn span(path: impl Into<PathBuf>, line: u32, column: u32, len: u32) -> Self {
-        Location {
-            path: path.into(),
-            line,
-            column,
-            end_line: line,
-            end_column: column + len,
-        }
-    }
-}
-
-impl fmt::Display for Location {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        if self.column > 0 {
-            write!(f, "{}:{}:{}", self.path.display(), self.line, self.column)
-        } else {
-            write!(f, "{}:{}", self.path.display(), self.line)
-        }
-    }
-}
+pub use crate::shader::Location;
 
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Label {

@@ -1,6 +1,6 @@
 //! rtlint: a toolkit and linter for ray-tracing shaders.
 //!
-//! Data flow: front-ends → SPIR-V → [`spirv::Program`] → analyses → rules →
+//! Data flow: front-ends → SPIR-V → [`program::Program`] → analyses → rules →
 //! [`diag::Diagnostic`]s → reports. See `docs/architecture.md`.
 
 pub mod analysis;
@@ -9,9 +9,10 @@ pub mod diag;
 pub mod front;
 pub mod lint;
 pub mod pipeline;
+pub mod program;
 pub mod reference;
 pub mod report;
 pub mod rules;
-pub mod spirv;
+pub mod shader;
 #[cfg(feature = "vulkan")]
 pub mod vk;

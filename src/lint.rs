@@ -3,8 +3,9 @@
 
 use crate::config::Config;
 use crate::diag::{Diagnostic, InputError};
-use crate::front::{self, Language};
-use crate::spirv::Program;
+use crate::front;
+use crate::program::Program;
+use crate::shader::Language;
 use std::path::{Path, PathBuf};
 
 #[derive(Clone, Debug, PartialEq, Eq)]

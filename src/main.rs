@@ -4,9 +4,9 @@ use clap::{Parser, Subcommand};
 use codespan_reporting::term::termcolor::{ColorChoice, StandardStream};
 use rtlint::config::Config;
 use rtlint::diag::{Diagnostic, InputError, Severity};
-use rtlint::front::Language;
 use rtlint::lint;
 use rtlint::report::{self, Format, Sources, Summary};
+use rtlint::shader::Language;
 use std::io::Write;
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -405,7 +405,8 @@ fn stack(common: Common, driver: bool) -> Result<u8, String> {
         let mut r = rtlint::analysis::stack_report(p);
         #[cfg(feature = "vulkan")]
         if let Some(ctx) = &device {
-            let sizes = rtlint::vk::driver_stack_sizes(ctx, p).map_err(|e| {
+            let depth = rtlint::analysis::recursion(p).required_depth;
+            let sizes = rtlint::vk::driver_stack_sizes(ctx, p, depth).map_err(|e| {
                 format!(
                     "--driver: creating the pipeline on {} failed: {e}",
                     ctx.info().name
@@ -438,7 +439,7 @@ fn stack(common: Common, driver: bool) -> Result<u8, String> {
 fn load_programs(
     inputs: &lint::Inputs,
     problems: &mut Vec<Diagnostic>,
-) -> Vec<rtlint::spirv::Program> {
+) -> Vec<rtlint::program::Program> {
     let mut programs = Vec::new();
     for input in &inputs.files {
         match rtlint::front::load(&input.path, input.language) {

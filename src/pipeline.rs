@@ -4,8 +4,10 @@
 //! `docs/pipeline.md` for the format.
 
 use crate::diag::{InputError, Location};
-use crate::front::{self, Language};
-use crate::spirv::{Id, Program, Stage};
+use crate::front;
+use crate::program::{Id, Program};
+use crate::shader::Language;
+use crate::shader::Stage;
 use serde::Deserialize;
 use std::collections::BTreeMap;
 use std::ops::Range;
@@ -14,6 +16,28 @@ use toml::Spanned;
 
 /// The recursion limit of lavapipe, NVIDIA and DXR.
 pub const DEFAULT_DEVICE_MAX_RECURSION_DEPTH: u32 = 31;
+
+/// Where a shader sits in the pipeline.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, serde::Serialize)]
+#[serde(rename_all = "snake_case", tag = "slot", content = "index")]
+pub enum Slot {
+    Raygen(usize),
+    Miss(usize),
+    /// Hit group index; the node's stage says which shader of the group.
+    HitGroup(usize),
+    Callable(usize),
+}
+
+impl std::fmt::Display for Slot {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Slot::Raygen(i) => write!(f, "raygen {i}"),
+            Slot::Miss(i) => write!(f, "miss {i}"),
+            Slot::HitGroup(i) => write!(f, "hit group {i}"),
+            Slot::Callable(i) => write!(f, "callable {i}"),
+        }
+    }
+}
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
 #[serde(rename_all = "snake_case")]
@@ -379,7 +403,7 @@ impl Loader<'_> {
         let cx = self.cx;
         let r = raw.get_ref();
         let dir = cx.path.parent().unwrap_or(Path::new(""));
-        let file = crate::spirv::debug::normalize(&dir.join(r.file.get_ref()));
+        let file = crate::program::debug::normalize(&dir.join(r.file.get_ref()));
         let here = cx.loc(r.file.span());
         let lang = Language::from_path(&file).ok_or_else(|| {
             cx.error(

@@ -28,8 +28,8 @@ fn one_module_per_entry_point_into_a_directory() {
     for entry in ["RayGen", "Miss", "ShadowMiss", "ClosestHit"] {
         let words = common::read_words(&d.join(format!("{entry}.spv")));
         common::spirv_val(&words).unwrap_or_else(|e| panic!("{entry}: {e}"));
-        let p =
-            rtlint::spirv::parse(&words, &d.join("m.spv"), rtlint::front::Language::Spirv).unwrap();
+        let p = rtlint::program::parse(&words, &d.join("m.spv"), rtlint::shader::Language::Spirv)
+            .unwrap();
         assert_eq!(p.entry_points.len(), 1);
         assert_eq!(p.entry_points[0].name, entry);
     }
@@ -83,11 +83,10 @@ fn entry_whole_module_defines_and_ambiguity() {
     let a = common::read_words(&d.join("a.spv"));
     common::spirv_val(&a).unwrap();
     // VALUE + INC folds or stays as 7 and 1: either way a constant 7 is there.
-    let p = rtlint::spirv::parse(&a, &d.join("a.spv"), rtlint::front::Language::Spirv).unwrap();
-    assert!(p
-        .constants
-        .values()
-        .any(|c| *c == rtlint::spirv::Constant::Int(7) || *c == rtlint::spirv::Constant::Int(8)));
+    let p = rtlint::program::parse(&a, &d.join("a.spv"), rtlint::shader::Language::Spirv).unwrap();
+    assert!(p.constants.values().any(
+        |c| *c == rtlint::program::Constant::Int(7) || *c == rtlint::program::Constant::Int(8)
+    ));
     // Without the include directory: an error naming the include.
     let o = run(&["compile", &s(&src), "-E", "A", "-o", &s(&d.join("a.spv"))]);
     assert_eq!(o.status.code(), Some(2));
@@ -106,7 +105,7 @@ fn entry_whole_module_defines_and_ambiguity() {
     ]);
     assert_eq!(o.status.code(), Some(0));
     let w = common::read_words(&d.join("w.spv"));
-    let p = rtlint::spirv::parse(&w, &d.join("w.spv"), rtlint::front::Language::Spirv).unwrap();
+    let p = rtlint::program::parse(&w, &d.join("w.spv"), rtlint::shader::Language::Spirv).unwrap();
     assert_eq!(p.entry_points.len(), 2);
 }
 

@@ -6,9 +6,9 @@ mod common;
 
 use common::root;
 use rtlint::config::Config;
-use rtlint::front::Language;
 use rtlint::lint::{check_input, Input};
 use rtlint::report::{human, Sources};
+use rtlint::shader::Language;
 use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
 
@@ -35,7 +35,7 @@ fn placed_markers(source: &Path) -> BTreeSet<(PathBuf, u32, String)> {
         match rest.split_once('@') {
             Some((codes, place)) => {
                 let (file, l) = place.trim().rsplit_once(':').unwrap();
-                let path = rtlint::spirv::debug::normalize(&source.parent().unwrap().join(file));
+                let path = rtlint::program::debug::normalize(&source.parent().unwrap().join(file));
                 for code in codes.split_whitespace() {
                     out.insert((path.clone(), l.parse().unwrap(), code.to_string()));
                 }

@@ -193,8 +193,9 @@ fn cbuffer_uses_hlsl_packing() {
 /// members included) must carry their own source lines.
 #[test]
 fn program_sees_hlsl_declaration_positions() {
-    use rtlint::front::{load, Language};
-    use rtlint::spirv::Decl;
+    use rtlint::front::load;
+    use rtlint::program::Decl;
+    use rtlint::shader::Language;
     let path = shader("pipeline.hlsl");
     let program = load(&path, Language::Hlsl).unwrap();
     let id_named = |name: &str| {
@@ -301,12 +302,12 @@ fn entry_modules_hold_only_their_globals() {
 /// positions in NonSemantic.Shader.DebugInfo.100.
 #[test]
 fn entry_modules_carry_debug_info() {
-    use rtlint::front::Language;
-    use rtlint::spirv::Decl;
+    use rtlint::program::Decl;
+    use rtlint::shader::Language;
     let path = shader("pipeline.hlsl");
     let entries = hlsl::compile(&path, &HlslOptions::default()).unwrap();
     let gen = entries.iter().find(|e| e.name == "RayGen").unwrap();
-    let program = rtlint::spirv::parse(&gen.words, &path, Language::Hlsl).unwrap();
+    let program = rtlint::program::parse(&gen.words, &path, Language::Hlsl).unwrap();
     let id = |name: &str| {
         program
             .names
@@ -331,11 +332,11 @@ fn entry_modules_carry_debug_info() {
 /// entry point's own module and for the whole file.
 #[test]
 fn payload_fixture_findings_match_slang_lines() {
-    use rtlint::front::Language;
+    use rtlint::shader::Language;
     use std::collections::BTreeSet;
     let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/hlsl/payloads.hlsl");
     let expected = BTreeSet::from([(2, "RT001"), (2, "RT002"), (4, "RT003")]);
-    let findings = |program: &rtlint::spirv::Program| -> BTreeSet<(u32, &'static str)> {
+    let findings = |program: &rtlint::program::Program| -> BTreeSet<(u32, &'static str)> {
         rtlint::rules::check_program(program, &rtlint::config::Config::default())
             .iter()
             .map(|d| {
@@ -349,7 +350,7 @@ fn payload_fixture_findings_match_slang_lines() {
     let gen = entries.iter().find(|e| e.name == "RayGen").unwrap();
     validate(&gen.words, "payloads-RayGen");
     let program =
-        rtlint::spirv::parse(&gen.words, Path::new("payloads.spv"), Language::Spirv).unwrap();
+        rtlint::program::parse(&gen.words, Path::new("payloads.spv"), Language::Spirv).unwrap();
     assert_eq!(findings(&program), expected);
     let whole = rtlint::front::load(&src, Language::Hlsl).unwrap();
     assert_eq!(findings(&whole), expected);
@@ -360,8 +361,8 @@ fn payload_fixture_findings_match_slang_lines() {
 /// findings of `rtlint check` land on the renumbered lines of the named file.
 #[test]
 fn line_directive_renumbers_debug_info_and_findings() {
-    use rtlint::front::Language;
-    use rtlint::spirv::Decl;
+    use rtlint::program::Decl;
+    use rtlint::shader::Language;
     use std::collections::BTreeSet;
     let fixture = Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/hlsl/payloads.hlsl");
     let text = format!(
@@ -374,7 +375,7 @@ fn line_directive_renumbers_debug_info_and_findings() {
     let entries = hlsl::compile_source(path, &text, &mut loader, &opts).unwrap();
     validate(&entries[0].words, "line-directive");
     let program =
-        rtlint::spirv::parse(&entries[0].words, Path::new("out.spv"), Language::Spirv).unwrap();
+        rtlint::program::parse(&entries[0].words, Path::new("out.spv"), Language::Spirv).unwrap();
     let id = |name: &str| {
         program
             .names

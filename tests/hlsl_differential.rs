@@ -10,11 +10,12 @@
 
 mod common;
 
-use rtlint::analysis::scalar::scalar_size;
 use rtlint::front::hlsl::{self, HlslOptions};
 use rtlint::front::slang::{stage_name, Slang};
-use rtlint::front::Language;
-use rtlint::spirv::{Program, Stage};
+use rtlint::program::scalar::scalar_size;
+use rtlint::program::Program;
+use rtlint::shader::Language;
+use rtlint::shader::Stage;
 use rtlint::vk::{
     raw, Aabb, AccelerationStructure, Binding, BindingKind, Buffer, ComputePipeline, Context,
     Geometry, Group, Instance, RayTracingPipeline, RayTracingPipelineDesc, Resource, ShaderStage,
@@ -689,7 +690,7 @@ struct Interface {
 
 fn interface(words: &[u32], file: &str) -> Interface {
     use spirv::StorageClass as S;
-    let p: Program = rtlint::spirv::parse(words, Path::new(file), Language::Spirv)
+    let p: Program = rtlint::program::parse(words, Path::new(file), Language::Spirv)
         .unwrap_or_else(|e| panic!("{file}: {e:?}"));
     assert_eq!(
         p.entry_points.len(),

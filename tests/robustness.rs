@@ -5,7 +5,7 @@
 mod common;
 
 use rtlint::config::Config;
-use rtlint::front::Language;
+use rtlint::shader::Language;
 use std::path::Path;
 
 struct Rng(u64);
@@ -68,7 +68,7 @@ fn mutated_spirv_never_panics() {
             let mut w = seed.clone();
             mutate_words(&mut rng, &mut w);
             let r = std::panic::catch_unwind(|| {
-                match rtlint::spirv::parse(&w, Path::new("m.spv"), Language::Spirv) {
+                match rtlint::program::parse(&w, Path::new("m.spv"), Language::Spirv) {
                     Ok(p) => {
                         let _ = rtlint::rules::check_program(&p, &config);
                         let _ = rtlint::analysis::layout::FileLayouts::new(&p).render_human();
@@ -122,7 +122,7 @@ fn mutated_wgsl_never_panics() {
         };
         let r = std::panic::catch_unwind(|| {
             if let Ok(words) = rtlint::front::wgsl::compile(&src, Path::new("m.wgsl")) {
-                let p = rtlint::spirv::parse(&words, Path::new("m.wgsl"), Language::Wgsl)
+                let p = rtlint::program::parse(&words, Path::new("m.wgsl"), Language::Wgsl)
                     .expect("naga output parses");
                 let _ = rtlint::rules::check_program(&p, &Config::default());
             }

@@ -14,7 +14,7 @@ fn bundled_wgsl_shaders_are_valid_and_clean() {
         let text = std::fs::read_to_string(&p).unwrap();
         let words = rtlint::front::wgsl::compile(&text, &p).unwrap();
         common::spirv_val(&words).unwrap_or_else(|e| panic!("{}: {e}", p.display()));
-        let program = rtlint::front::load(&p, rtlint::front::Language::Wgsl).unwrap();
+        let program = rtlint::front::load(&p, rtlint::shader::Language::Wgsl).unwrap();
         let findings = rtlint::rules::check_program(&program, &rtlint::config::Config::default());
         assert!(findings.is_empty(), "{}: {findings:?}", p.display());
     }

@@ -5,7 +5,7 @@
 mod common;
 
 use rtlint::front::slang::Slang;
-use rtlint::front::Language;
+use rtlint::shader::Language;
 use std::collections::BTreeSet;
 use std::path::Path;
 
@@ -17,7 +17,8 @@ fn slang_compiled_hlsl_lands_on_source_lines() {
         .compile_hlsl(&src, "RayGen", "raygeneration", &["-g".to_string()])
         .unwrap();
     common::spirv_val(&words).unwrap();
-    let program = rtlint::spirv::parse(&words, Path::new("payloads.spv"), Language::Spirv).unwrap();
+    let program =
+        rtlint::program::parse(&words, Path::new("payloads.spv"), Language::Spirv).unwrap();
     let found: BTreeSet<(u32, &str)> =
         rtlint::rules::check_program(&program, &rtlint::config::Config::default())
             .iter()

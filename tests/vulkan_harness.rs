@@ -429,7 +429,7 @@ fn load_spv(name: &str) -> Vec<u32> {
         .join("tests/shaders/procedural")
         .join(format!("{name}.spv"));
     let bytes = std::fs::read(&path).expect("committed SPIR-V (tests/shaders/procedural/build.sh)");
-    rtlint::front::spirv::words_from_bytes(&bytes, &path).unwrap()
+    rtlint::program::words_from_bytes(&bytes, &path).unwrap()
 }
 
 /// A pipeline with every group kind: raygen, miss, a triangle hit group with

@@ -5,8 +5,8 @@ use std::path::Path;
 
 fuzz_target!(|data: &[u8]| {
     let path = Path::new("fuzz.spv");
-    if let Ok(words) = rtlint::front::spirv::words_from_bytes(data, path) {
-        if let Ok(p) = rtlint::spirv::parse(&words, path, rtlint::front::Language::Spirv) {
+    if let Ok(words) = rtlint::program::words_from_bytes(data, path) {
+        if let Ok(p) = rtlint::program::parse(&words, path, rtlint::shader::Language::Spirv) {
             let _ = rtlint::rules::check_program(&p, &rtlint::config::Config::default());
         }
     }

@@ -7,7 +7,7 @@ fuzz_target!(|data: &[u8]| {
     if let Ok(src) = std::str::from_utf8(data) {
         let path = Path::new("fuzz.wgsl");
         if let Ok(words) = rtlint::front::wgsl::compile(src, path) {
-            if let Ok(p) = rtlint::spirv::parse(&words, path, rtlint::front::Language::Wgsl) {
+            if let Ok(p) = rtlint::program::parse(&words, path, rtlint::shader::Language::Wgsl) {
                 let _ = rtlint::rules::check_program(&p, &rtlint::config::Config::default());
             }
         }

@@ -9,8 +9,10 @@
 //! closest-hit shaders, opaque rays (no any-hit), culled triangles or AABBs.
 
 use crate::diag::Location;
+pub use crate::pipeline::Slot;
 use crate::pipeline::{HitGroupKind, Pipeline, ShaderRef};
-use crate::spirv::{Operandish, SiteKind, Stage};
+use crate::program::{Operandish, SiteKind};
+use crate::shader::Stage;
 
 /// `SkipClosestHitShaderKHR` and the flags that remove any-hit or geometry.
 const FLAG_OPAQUE: u64 = 0x1;
@@ -18,17 +20,6 @@ const FLAG_NO_OPAQUE: u64 = 0x2;
 const FLAG_SKIP_CLOSEST_HIT: u64 = 0x8;
 const FLAG_SKIP_TRIANGLES: u64 = 0x100;
 const FLAG_SKIP_AABBS: u64 = 0x200;
-
-/// Where a shader sits in the pipeline.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Serialize)]
-#[serde(rename_all = "snake_case", tag = "slot", content = "index")]
-pub enum Slot {
-    Raygen(usize),
-    Miss(usize),
-    /// Hit group index; the node's stage says which shader of the group.
-    HitGroup(usize),
-    Callable(usize),
-}
 
 #[derive(Clone, Debug)]
 pub struct Node {
@@ -39,16 +30,11 @@ pub struct Node {
 impl Node {
     /// `closesthit `main` (hit group 0)`-style name for messages.
     pub fn describe(&self) -> String {
-        let slot = match self.slot {
-            Slot::Raygen(i) => format!("raygen {i}"),
-            Slot::Miss(i) => format!("miss {i}"),
-            Slot::HitGroup(i) => format!("hit group {i}"),
-            Slot::Callable(i) => format!("callable {i}"),
-        };
         format!(
-            "{} `{}` ({slot})",
+            "{} `{}` ({})",
             self.shader.stage.as_str(),
-            self.shader.entry
+            self.shader.entry,
+            self.slot
         )
     }
 }
@@ -330,7 +316,7 @@ mod tests {
         let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/pipelines/iterative");
         let programs = ["reflect.rgen.spv", "reflect.rchit.spv", "shadow.rmiss.spv"]
             .iter()
-            .map(|f| crate::front::load(&dir.join(f), crate::front::Language::Spirv).unwrap())
+            .map(|f| crate::front::load(&dir.join(f), crate::shader::Language::Spirv).unwrap())
             .collect();
         let g = trace_graph(&Pipeline::from_programs(programs));
         // The shadow ray still skips the closest hit; the miss index is not

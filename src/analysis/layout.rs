@@ -11,7 +11,7 @@
 //!   row, and the trailing element is not padded (`uint A[256]` = 4084 bytes);
 //! - **WGSL**: WGSL's own alignment and size rules, for WGSL sources.
 
-use crate::spirv::{Id, Program, Type};
+use crate::program::{Id, Program, Type};
 
 /// A type flattened to what layout needs; built once from the Program.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -444,7 +444,7 @@ pub fn layout_type(program: &Program, ty: Id, var_name: &str) -> Option<TypeLayo
     }
     let (scalar_offsets, scalar_size) = scalar_layout(&members);
     let (packed_offsets, packed) = packed_members(&members);
-    let wgsl = (program.language == crate::front::Language::Wgsl).then(|| wgsl_members(&members));
+    let wgsl = (program.language == crate::shader::Language::Wgsl).then(|| wgsl_members(&members));
     let member_layouts: Vec<MemberLayout> = members
         .iter()
         .enumerate()
@@ -516,7 +516,7 @@ fn render_struct(
     let mut s = format!("struct {name} {{\n");
     for &k in order {
         let m = &members[k];
-        if program.language == crate::front::Language::Wgsl {
+        if program.language == crate::shader::Language::Wgsl {
             s.push_str(&format!("    {}: {},\n", m.name, m.ty));
         } else {
             // HLSL puts array extents after the name.
@@ -526,7 +526,7 @@ fn render_struct(
             }
         }
     }
-    s.push_str(if program.language == crate::front::Language::Wgsl {
+    s.push_str(if program.language == crate::shader::Language::Wgsl {
         "}"
     } else {
         "};"
@@ -573,7 +573,7 @@ pub fn interface_layouts(program: &Program) -> Vec<TypeLayout> {
 #[derive(Clone, Debug, serde::Serialize)]
 pub struct FileLayouts {
     pub path: String,
-    pub language: crate::front::Language,
+    pub language: crate::shader::Language,
     pub types: Vec<TypeLayout>,
 }
 

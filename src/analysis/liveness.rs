@@ -14,9 +14,10 @@
 //! caller's live values live across it too, so each site is expanded along
 //! each call chain from an entry point.
 
-use super::scalar::scalar_size;
 use crate::diag::Location;
-use crate::spirv::{Constant, Function, Id, Program, SiteKind, Stage, Type};
+use crate::program::scalar::scalar_size;
+use crate::program::{Constant, Function, Id, Program, SiteKind, Type};
+use crate::shader::Stage;
 use rspirv::dr::{Instruction, Operand};
 use spirv::{Op, StorageClass};
 use std::collections::{HashMap, HashSet, VecDeque};
@@ -259,7 +260,7 @@ pub fn call_chains(program: &Program, root: Id, target: Id) -> Vec<Vec<usize>> {
 /// puts `OpLine 1 1` on code that has no span.
 pub fn useful_location(program: &Program, inst: usize) -> Option<Location> {
     let l = program.inst_location(inst)?;
-    if program.language == crate::front::Language::Wgsl && l.line == 1 && l.column == 1 {
+    if program.language == crate::shader::Language::Wgsl && l.line == 1 && l.column == 1 {
         return None;
     }
     Some(l)
@@ -691,7 +692,7 @@ impl FnLiveness {
                     && id_operands(inst).next().and_then(|p| self.root(p)) == Some(var)
             })
             .find_map(|i| useful_location(program, i))
-            .or_else(|| program.decl_location(crate::spirv::Decl::Var(var)))
+            .or_else(|| program.decl_location(crate::program::Decl::Var(var)))
     }
 
     /// Whether an SSA value can be recomputed after the trace from builtins,
@@ -884,7 +885,8 @@ pub fn render_human(report: &LiveReport) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::front::{load, Language};
+    use crate::front::load;
+    use crate::shader::Language;
     use std::path::Path;
 
     fn program(rel: &str) -> Program {

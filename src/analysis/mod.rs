@@ -1,11 +1,10 @@
-//! Analyses: pure functions over a [`Program`](crate::spirv::Program) (and a
+//! Analyses: pure functions over a [`Program`](crate::program::Program) (and a
 //! [`Pipeline`](crate::pipeline::Pipeline) where the scene matters).
 
 pub mod callgraph;
 pub mod layout;
 pub mod liveness;
 pub mod recursion;
-pub mod scalar;
 pub mod stack;
 
 pub use liveness::{live_report, LiveReport};

@@ -12,7 +12,8 @@
 use super::callgraph::{trace_graph, EdgeKind, TraceGraph};
 use crate::diag::Location;
 use crate::pipeline::{DescribedConstant, Pipeline};
-use crate::spirv::{Constant, Function, Id, Program, Stage, Type};
+use crate::program::{Constant, Function, Id, Program, Type};
+use crate::shader::Stage;
 use rspirv::dr::{Instruction, Operand};
 use spirv::{Op, StorageClass};
 use std::collections::{BTreeMap, HashMap, HashSet};
@@ -397,7 +398,7 @@ enum Counter {
     Local(Id),
 }
 
-fn global(program: &Program, id: Id) -> Option<&crate::spirv::Global> {
+fn global(program: &Program, id: Id) -> Option<&crate::program::Global> {
     program.globals.iter().find(|g| g.id == id)
 }
 
@@ -677,8 +678,8 @@ fn relations(program: &Program, cond: Id, want: bool, out: &mut Vec<Rel>, depth:
             .filter(|v| {
                 // A null bool is false.
                 let c = program.constants.get(v);
-                c != Some(&crate::spirv::Constant::Bool(!want))
-                    && !(want && c == Some(&crate::spirv::Constant::Null))
+                c != Some(&crate::program::Constant::Bool(!want))
+                    && !(want && c == Some(&crate::program::Constant::Null))
             })
             .collect();
         if let [only] = possible.as_slice() {
@@ -1055,7 +1056,7 @@ pub fn trace_loops(
     let mut out: Vec<TraceLoop> = Vec::new();
     for e in &program.entry_points {
         for site in &program.sites {
-            if site.kind != crate::spirv::SiteKind::TraceRay {
+            if site.kind != crate::program::SiteKind::TraceRay {
                 continue;
             }
             let Some(g) = program.functions.get(site.function) else {

@@ -15,14 +15,16 @@
 //! maximum the Vulkan spec recommends setting explicitly. The assumptions
 //! are in `docs/stack.md`.
 
-use super::callgraph::{EdgeKind, Slot};
+use super::callgraph::EdgeKind;
 use super::liveness::{live_sites, LiveSite};
 use super::recursion::{recursion, RecursionReport};
-use super::scalar::scalar_size;
 use crate::pipeline::Pipeline;
-use crate::spirv::{Program, SiteKind, Stage, Type};
+use crate::pipeline::Slot;
+use crate::program::scalar::scalar_size;
+use crate::program::{Program, SiteKind, Type};
+use crate::shader::Stage;
 use spirv::StorageClass;
-use std::collections::HashMap;
+use std::collections::{BTreeMap, HashMap};
 
 /// The largest pipeline stack measured to run on an NVIDIA H200 (driver
 /// 580.159.04): 14,702 bytes per thread ran and 14,746 lost the device, at
@@ -457,12 +459,7 @@ pub fn stack_report_with(pipeline: &Pipeline, rec: &RecursionReport) -> StackRep
             })
             .clone();
         let driver_model_bytes = driver_model(s.stage, &b);
-        let group = match node.slot {
-            Slot::Raygen(i) => format!("raygen {i}"),
-            Slot::Miss(i) => format!("miss {i}"),
-            Slot::HitGroup(i) => format!("hit group {i}"),
-            Slot::Callable(i) => format!("callable {i}"),
-        };
+        let group = node.slot.to_string();
         shaders.push(ShaderStack {
             entry: s.entry.clone(),
             stage: s.stage,
@@ -537,11 +534,17 @@ pub fn stack_report_with(pipeline: &Pipeline, rec: &RecursionReport) -> StackRep
 /// one per entry of `report.shaders`, in the same order) and the formulas
 /// computed from them. Sizes beyond `report.shaders` are ignored; missing
 /// ones leave the shader without a driver figure and count as 0.
-pub fn attach_driver(report: &mut StackReport, pipeline: &Pipeline, driver: &[Option<u64>]) {
-    for (s, d) in report.shaders.iter_mut().zip(driver) {
-        s.driver_bytes = *d;
-    }
+/// Puts the driver's per-shader stack sizes (by pipeline slot and stage)
+/// beside the model's, and applies the formulas to the driver's numbers.
+pub fn attach_driver(
+    report: &mut StackReport,
+    pipeline: &Pipeline,
+    driver: &BTreeMap<(Slot, Stage), u64>,
+) {
     let rec = recursion(pipeline);
+    for (s, n) in report.shaders.iter_mut().zip(&rec.graph.nodes) {
+        s.driver_bytes = driver.get(&(n.slot, n.shader.stage)).copied();
+    }
     let sizes: Vec<u64> = report
         .shaders
         .iter()
@@ -914,7 +917,7 @@ mod tests {
         }
         assert!(files.len() >= 20, "{}", files.len());
         for f in &files {
-            let lang = crate::front::Language::from_path(f).unwrap();
+            let lang = crate::shader::Language::from_path(f).unwrap();
             let program = crate::front::load(f, lang).unwrap();
             let p = Pipeline::from_programs(vec![program]);
             let r = stack_report(&p);
@@ -981,7 +984,13 @@ mod tests {
         .unwrap();
         let mut r = stack_report(&p);
         // lavapipe answers 4 for every group and stage.
-        attach_driver(&mut r, &p, &[Some(4); 4]);
+        let driver: BTreeMap<_, _> = recursion(&p)
+            .graph
+            .nodes
+            .iter()
+            .map(|n| ((n.slot, n.shader.stage), 4))
+            .collect();
+        attach_driver(&mut r, &p, &driver);
         let d = r.driver.as_ref().unwrap();
         assert_eq!(d.vulkan_default, Some(4 + 4 + 4));
         assert_eq!(d.exact_call_chain, Some(12));

@@ -4,51 +4,12 @@
 
 pub mod hlsl;
 pub mod slang;
-pub mod spirv;
 pub mod wgsl;
 
-use crate::diag::{InputError, Location};
+use crate::diag::InputError;
+use crate::program::NamedDecl;
+use crate::shader::{Language, Location};
 use std::path::{Path, PathBuf};
-
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub enum Language {
-    Wgsl,
-    Spirv,
-    Hlsl,
-    Glsl,
-}
-
-impl Language {
-    pub fn as_str(self) -> &'static str {
-        match self {
-            Language::Wgsl => "wgsl",
-            Language::Spirv => "spirv",
-            Language::Hlsl => "hlsl",
-            Language::Glsl => "glsl",
-        }
-    }
-
-    /// The language a file holds, judged by its extension.
-    pub fn from_path(path: &Path) -> Option<Language> {
-        match path.extension()?.to_str()?.to_ascii_lowercase().as_str() {
-            "wgsl" => Some(Language::Wgsl),
-            "spv" | "spirv" => Some(Language::Spirv),
-            "hlsl" | "hlsli" => Some(Language::Hlsl),
-            _ => None,
-        }
-    }
-
-    pub fn parse(name: &str) -> Option<Language> {
-        match name.to_ascii_lowercase().as_str() {
-            "wgsl" => Some(Language::Wgsl),
-            "spirv" | "spv" => Some(Language::Spirv),
-            "hlsl" => Some(Language::Hlsl),
-            "glsl" => Some(Language::Glsl),
-            _ => None,
-        }
-    }
-}
 
 /// One SPIR-V module produced from one input file.
 #[derive(Clone, Debug)]
@@ -62,7 +23,7 @@ pub struct Compiled {
     pub input_language: Language,
     pub words: Vec<u32>,
     /// Declaration positions the SPIR-V's own debug info lacks.
-    pub decls: Vec<(wgsl::NamedDecl, Location)>,
+    pub decls: Vec<(NamedDecl, Location)>,
 }
 
 /// Reads and compiles one file to SPIR-V.
@@ -82,7 +43,7 @@ pub fn compile_path(path: &Path, language: Language) -> Result<Compiled, InputEr
         }
         Language::Spirv => {
             let bytes = std::fs::read(path).map_err(|e| io_error(path, &e))?;
-            let words = spirv::words_from_bytes(&bytes, path)?;
+            let words = crate::program::words_from_bytes(&bytes, path)?;
             Ok(Compiled {
                 path: path.to_path_buf(),
                 language: Language::Spirv,
@@ -112,10 +73,10 @@ pub fn compile_path(path: &Path, language: Language) -> Result<Compiled, InputEr
     }
 }
 
-/// Compiles one file and builds its [`Program`](crate::spirv::Program).
-pub fn load(path: &Path, language: Language) -> Result<crate::spirv::Program, InputError> {
+/// Compiles one file and builds its [`Program`](crate::program::Program).
+pub fn load(path: &Path, language: Language) -> Result<crate::program::Program, InputError> {
     let c = compile_path(path, language)?;
-    let mut program = crate::spirv::parse(&c.words, &c.path, c.language)?;
+    let mut program = crate::program::parse(&c.words, &c.path, c.language)?;
     program.attach_named_decls(&c.decls);
     Ok(program)
 }

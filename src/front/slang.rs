@@ -26,8 +26,8 @@ pub struct Slang {
 }
 
 /// The Slang stage name of a ray-tracing or compute entry point.
-pub fn stage_name(stage: crate::spirv::Stage) -> &'static str {
-    use crate::spirv::Stage as S;
+pub fn stage_name(stage: crate::shader::Stage) -> &'static str {
+    use crate::shader::Stage as S;
     match stage {
         S::RayGeneration => "raygeneration",
         S::Intersection => "intersection",

@@ -1,7 +1,9 @@
 //! WGSL through naga: parse, validate with every capability, write SPIR-V with
 //! debug info so each instruction carries its WGSL line and column.
 
-use crate::diag::{InputError, Location};
+use crate::diag::InputError;
+use crate::program::NamedDecl;
+use crate::shader::{line_col, Location};
 use naga::back::spv;
 use naga::valid::{Capabilities, ValidationFlags, Validator};
 use std::path::Path;
@@ -138,15 +140,6 @@ pub fn declarations(
     out
 }
 
-/// A declaration named in source, matched to SPIR-V ids through `OpName`.
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub enum NamedDecl {
-    Type(String),
-    Member(String, u32),
-    Global(String),
-    Function(String),
-}
-
 fn name_location(path: &Path, source: &str, at: usize, name: &str) -> Location {
     span_location(
         path,
@@ -278,17 +271,4 @@ pub fn span_location(path: &Path, source: &str, span: naga::Span) -> Location {
         end_line,
         end_column,
     }
-}
-
-/// 1-based line and column (in characters) of a byte offset.
-pub fn line_col(source: &str, offset: usize) -> (u32, u32) {
-    let mut offset = offset.min(source.len());
-    while !source.is_char_boundary(offset) {
-        offset -= 1;
-    }
-    let before = &source[..offset];
-    let line = before.matches('\n').count() as u32 + 1;
-    let line_start = before.rfind('\n').map(|i| i + 1).unwrap_or(0);
-    let column = source[line_start..offset].chars().count() as u32 + 1;
-    (line, column)
 }

@@ -74,7 +74,7 @@ impl Sources {
             .or_insert_with(|| text.to_string());
     }
 
-    pub fn add_program(&mut self, program: &crate::spirv::Program) {
+    pub fn add_program(&mut self, program: &crate::program::Program) {
         for f in &program.files {
             if let Some(t) = &f.text {
                 self.add_embedded(&f.path, t);

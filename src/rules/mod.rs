@@ -17,7 +17,7 @@ pub mod rt025_default_stack_unsafe;
 use crate::analysis::layout::{self, TypeLayout};
 use crate::config::Config;
 use crate::diag::{Diagnostic, Location, Severity};
-use crate::spirv::{Decl, Id, Program, SiteKind};
+use crate::program::{Decl, Id, Program, SiteKind};
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
 #[serde(rename_all = "lowercase")]

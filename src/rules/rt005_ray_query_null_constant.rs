@@ -1,6 +1,6 @@
 use super::{Context, Group, Kind, Rule};
 use crate::diag::{Diagnostic, Severity};
-use crate::spirv::{Constant, Type};
+use crate::program::{Constant, Type};
 use rspirv::dr::Operand;
 use spirv::Op;
 

@@ -3,7 +3,7 @@
 
 use crate::analysis::liveness::LiveSite;
 use crate::diag::{Diagnostic, Severity};
-use crate::spirv::Program;
+use crate::program::Program;
 
 pub const CODE: &str = "RT010";
 pub const NAME: &str = "live-state-over-budget";
@@ -101,7 +101,8 @@ fn run(ctx: &super::Context) -> Vec<Diagnostic> {
 mod tests {
     use super::*;
     use crate::analysis::liveness::live_sites;
-    use crate::front::{load, Language};
+    use crate::front::load;
+    use crate::shader::Language;
     use std::path::Path;
 
     fn run(rel: &str, budget: u64) -> Vec<Diagnostic> {

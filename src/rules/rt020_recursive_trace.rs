@@ -5,7 +5,7 @@ use crate::analysis::callgraph::EdgeKind;
 use crate::analysis::recursion::RecursionReport;
 use crate::diag::{Diagnostic, Severity};
 use crate::pipeline::Pipeline;
-use crate::spirv::Stage;
+use crate::shader::Stage;
 
 pub const CODE: &str = "RT020";
 pub const NAME: &str = "recursive-trace";

@@ -9,26 +9,21 @@ use std::ffi::CString;
 use std::sync::Arc;
 use std::time::Duration;
 
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub enum Stage {
-    RayGeneration,
-    Miss,
-    ClosestHit,
-    AnyHit,
-    Intersection,
-    Callable,
-}
+pub use crate::shader::Stage;
 
-impl Stage {
-    fn flags(self) -> vk::ShaderStageFlags {
-        match self {
-            Stage::RayGeneration => vk::ShaderStageFlags::RAYGEN_KHR,
-            Stage::Miss => vk::ShaderStageFlags::MISS_KHR,
-            Stage::ClosestHit => vk::ShaderStageFlags::CLOSEST_HIT_KHR,
-            Stage::AnyHit => vk::ShaderStageFlags::ANY_HIT_KHR,
-            Stage::Intersection => vk::ShaderStageFlags::INTERSECTION_KHR,
-            Stage::Callable => vk::ShaderStageFlags::CALLABLE_KHR,
-        }
+/// The Vulkan stage flag of a shader stage.
+fn stage_flags(stage: Stage) -> vk::ShaderStageFlags {
+    match stage {
+        Stage::RayGeneration => vk::ShaderStageFlags::RAYGEN_KHR,
+        Stage::Miss => vk::ShaderStageFlags::MISS_KHR,
+        Stage::ClosestHit => vk::ShaderStageFlags::CLOSEST_HIT_KHR,
+        Stage::AnyHit => vk::ShaderStageFlags::ANY_HIT_KHR,
+        Stage::Intersection => vk::ShaderStageFlags::INTERSECTION_KHR,
+        Stage::Callable => vk::ShaderStageFlags::CALLABLE_KHR,
+        Stage::Compute => vk::ShaderStageFlags::COMPUTE,
+        Stage::Vertex => vk::ShaderStageFlags::VERTEX,
+        Stage::Fragment => vk::ShaderStageFlags::FRAGMENT,
+        Stage::Other => vk::ShaderStageFlags::empty(),
     }
 }
 
@@ -237,7 +232,7 @@ impl RayTracingPipeline {
         for (s, name) in desc.stages.iter().zip(&names) {
             stages.push(
                 vk::PipelineShaderStageCreateInfo::default()
-                    .stage(s.stage.flags())
+                    .stage(stage_flags(s.stage))
                     .module(modules.get(s.spirv)?)
                     .name(name),
             );

@@ -5,29 +5,15 @@ use super::{
     Binding, BindingKind, Context, Group, RayTracingPipeline, RayTracingPipelineDesc, Result,
     ShaderStage, Stage,
 };
-use crate::analysis::callgraph::Slot;
-use crate::analysis::recursion;
-use crate::pipeline::{HitGroupKind, Pipeline};
-use crate::spirv::{self, Type};
-use spirv::Stage as S;
+use crate::pipeline::{HitGroupKind, Pipeline, Slot};
+use crate::program::scalar::scalar_size;
+use crate::program::Type;
 use std::collections::BTreeMap;
-
-fn vk_stage(s: S) -> Option<Stage> {
-    Some(match s {
-        S::RayGeneration => Stage::RayGeneration,
-        S::Miss => Stage::Miss,
-        S::ClosestHit => Stage::ClosestHit,
-        S::AnyHit => Stage::AnyHit,
-        S::Intersection => Stage::Intersection,
-        S::Callable => Stage::Callable,
-        _ => return None,
-    })
-}
 
 /// Descriptor bindings (set 0) and push-constant bytes the pipeline's
 /// shaders declare, so the layout matches them.
 fn interface(pipeline: &Pipeline) -> (Vec<Binding>, u32) {
-    use ::spirv::StorageClass as C;
+    use spirv::StorageClass as C;
     let mut bindings: BTreeMap<u32, BindingKind> = BTreeMap::new();
     let mut push = 0u32;
     for p in &pipeline.programs {
@@ -39,16 +25,14 @@ fn interface(pipeline: &Pipeline) -> (Vec<Binding>, u32) {
                 (C::UniformConstant, Some(Type::Image)) => BindingKind::StorageImage,
                 (C::StorageBuffer, _) => BindingKind::StorageBuffer,
                 (C::Uniform, _) => {
-                    if p.decoration(g.ty, ::spirv::Decoration::BufferBlock)
-                        .is_some()
-                    {
+                    if p.decoration(g.ty, spirv::Decoration::BufferBlock).is_some() {
                         BindingKind::StorageBuffer
                     } else {
                         BindingKind::UniformBuffer
                     }
                 }
                 (C::PushConstant, _) => {
-                    let size = crate::analysis::scalar::scalar_size(p, g.ty).unwrap_or(0);
+                    let size = scalar_size(p, g.ty).unwrap_or(0);
                     push = push.max(size.next_multiple_of(4) as u32);
                     continue;
                 }
@@ -70,17 +54,25 @@ fn interface(pipeline: &Pipeline) -> (Vec<Binding>, u32) {
     )
 }
 
-/// The driver's stack size for each shader of `recursion(pipeline).graph.nodes`
-/// (the order of `StackReport::shaders`).
-pub fn driver_stack_sizes<'p>(ctx: &Context, pipeline: &'p Pipeline) -> Result<Vec<Option<u64>>> {
-    let rec = recursion(pipeline);
+/// The driver's stack size for every shader of the pipeline, by its slot and
+/// stage. The pipeline is created with its declared recursion depth, else
+/// `depth` (the depth the caller found it needs). Comparing the numbers with
+/// the model is the caller's business.
+pub fn driver_stack_sizes<'p>(
+    ctx: &Context,
+    pipeline: &'p Pipeline,
+    depth: Option<u32>,
+) -> Result<BTreeMap<(Slot, Stage), u64>> {
     let mut stages: Vec<ShaderStage> = Vec::new();
     let mut stage_of = |sref: &'p crate::pipeline::ShaderRef| -> Option<u32> {
         let program = pipeline.program(sref)?;
+        if !sref.stage.is_ray_tracing() {
+            return None;
+        }
         stages.push(ShaderStage {
             spirv: &program.words,
             entry_point: &sref.entry,
-            stage: vk_stage(sref.stage)?,
+            stage: sref.stage,
         });
         Some(stages.len() as u32 - 1)
     };
@@ -124,7 +116,7 @@ pub fn driver_stack_sizes<'p>(ctx: &Context, pipeline: &'p Pipeline) -> Result<V
     let (bindings, push_constant_size) = interface(pipeline);
     let depth = pipeline
         .max_recursion_depth
-        .or(rec.required_depth)
+        .or(depth)
         .unwrap_or(1)
         .min(ctx.limits().max_ray_recursion_depth);
     let rt = RayTracingPipeline::new(
@@ -139,24 +131,32 @@ pub fn driver_stack_sizes<'p>(ctx: &Context, pipeline: &'p Pipeline) -> Result<V
         },
     )?;
     let sizes = rt.group_stack_sizes();
-    Ok(rec
-        .graph
-        .nodes
-        .iter()
-        .map(|n| {
-            let key = match n.slot {
-                Slot::Raygen(i) => (0, i),
-                Slot::Miss(i) => (1, i),
-                Slot::HitGroup(i) => (2, i),
-                Slot::Callable(i) => (3, i),
-            };
-            let g = sizes.get(*slot_group.get(&key)? as usize)?;
-            match n.shader.stage {
-                S::ClosestHit => g.closest_hit,
-                S::AnyHit => g.any_hit,
-                S::Intersection => g.intersection,
-                _ => g.general,
+    let mut out = BTreeMap::new();
+    for (&(kind, i), &g) in &slot_group {
+        let Some(g) = sizes.get(g as usize) else {
+            continue;
+        };
+        let slot = match kind {
+            0 => Slot::Raygen(i),
+            1 => Slot::Miss(i),
+            2 => Slot::HitGroup(i),
+            _ => Slot::Callable(i),
+        };
+        let shaders = match slot {
+            Slot::HitGroup(_) => vec![
+                (Stage::ClosestHit, g.closest_hit),
+                (Stage::AnyHit, g.any_hit),
+                (Stage::Intersection, g.intersection),
+            ],
+            Slot::Raygen(_) => vec![(Stage::RayGeneration, g.general)],
+            Slot::Miss(_) => vec![(Stage::Miss, g.general)],
+            Slot::Callable(_) => vec![(Stage::Callable, g.general)],
+        };
+        for (stage, size) in shaders {
+            if let Some(size) = size {
+                out.insert((slot, stage), size);
             }
-        })
-        .collect())
+        }
+    }
+    Ok(out)
 }

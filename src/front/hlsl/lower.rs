@@ -15,63 +15,12 @@ use super::error::{Error, Pos, Result};
 use super::parse::split_numeric;
 use super::types::*;
 use crate::diag::Location;
-use crate::front::wgsl::NamedDecl;
+use crate::program::NamedDecl;
+pub use crate::shader::Stage;
 use rspirv::dr::{self, Builder, InsertPoint, Instruction, Operand};
-use spirv::{BuiltIn, Capability, Decoration, ExecutionModel, Op, StorageClass, Word as Id};
+use spirv::{BuiltIn, Capability, Decoration, Op, StorageClass, Word as Id};
 use std::collections::{BTreeSet, HashMap, HashSet};
 use std::path::PathBuf;
-
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub enum Stage {
-    RayGeneration,
-    ClosestHit,
-    AnyHit,
-    Miss,
-    Intersection,
-    Callable,
-    Compute,
-    Pixel,
-}
-
-impl Stage {
-    pub fn from_name(s: &str) -> Option<Stage> {
-        Some(match s {
-            "raygeneration" => Stage::RayGeneration,
-            "closesthit" => Stage::ClosestHit,
-            "anyhit" => Stage::AnyHit,
-            "miss" => Stage::Miss,
-            "intersection" => Stage::Intersection,
-            "callable" => Stage::Callable,
-            "compute" => Stage::Compute,
-            "pixel" => Stage::Pixel,
-            _ => return None,
-        })
-    }
-    pub fn name(self) -> &'static str {
-        match self {
-            Stage::RayGeneration => "raygeneration",
-            Stage::ClosestHit => "closesthit",
-            Stage::AnyHit => "anyhit",
-            Stage::Miss => "miss",
-            Stage::Intersection => "intersection",
-            Stage::Callable => "callable",
-            Stage::Compute => "compute",
-            Stage::Pixel => "pixel",
-        }
-    }
-    pub fn model(self) -> ExecutionModel {
-        match self {
-            Stage::RayGeneration => ExecutionModel::RayGenerationKHR,
-            Stage::ClosestHit => ExecutionModel::ClosestHitKHR,
-            Stage::AnyHit => ExecutionModel::AnyHitKHR,
-            Stage::Miss => ExecutionModel::MissKHR,
-            Stage::Intersection => ExecutionModel::IntersectionKHR,
-            Stage::Callable => ExecutionModel::CallableKHR,
-            Stage::Compute => ExecutionModel::GLCompute,
-            Stage::Pixel => ExecutionModel::Fragment,
-        }
-    }
-}
 
 #[derive(Clone, Debug)]
 pub struct Val {
@@ -546,7 +495,7 @@ impl<'a> Lowerer<'a> {
                         let s = attr_str(a)
                             .ok_or_else(|| Error::new(a.pos, "expected [shader(\"stage\")]"))?;
                         stage =
-                            Some(Stage::from_name(s).ok_or_else(|| {
+                            Some(Stage::from_hlsl_name(s).ok_or_else(|| {
                                 unsupported(a.pos, format!("shader stage \"{s}\""))
                             })?);
                     }
@@ -1957,7 +1906,7 @@ impl<'a> Lowerer<'a> {
         }
         let mut wrappers = HashMap::new();
         for &e in entries {
-            if self.funcs[e].stage == Some(Stage::Pixel) && !wrappers.contains_key(&e) {
+            if self.funcs[e].stage == Some(Stage::Fragment) && !wrappers.contains_key(&e) {
                 let w = self.pixel_wrapper(e)?;
                 wrappers.insert(e, w);
             }
@@ -1983,7 +1932,7 @@ impl<'a> Lowerer<'a> {
                 vars.extend(self.fn_used.get(&f).cloned().unwrap_or_default());
                 stack.extend(self.fn_calls.get(&f).cloned().unwrap_or_default());
             }
-            if stage != Stage::Pixel {
+            if stage != Stage::Fragment {
                 self.check_derivatives(&seen, &sig)?;
             }
             let mut entry_id = sig.id;
@@ -1992,12 +1941,16 @@ impl<'a> Lowerer<'a> {
                 vars.extend(io.iter().copied());
             }
             let vars: Vec<Id> = vars.into_iter().collect();
-            self.b
-                .entry_point(stage.model(), entry_id, sig.name.clone(), vars);
+            self.b.entry_point(
+                stage.model().expect("HLSL stages have an execution model"),
+                entry_id,
+                sig.name.clone(),
+                vars,
+            );
             if stage == Stage::Compute {
                 self.b
                     .execution_mode(sig.id, spirv::ExecutionMode::LocalSize, sig.numthreads);
-            } else if stage == Stage::Pixel {
+            } else if stage == Stage::Fragment {
                 // Vulkan requires it; HLSL's SV_Position has its origin at the top left.
                 self.b
                     .execution_mode(entry_id, spirv::ExecutionMode::OriginUpperLeft, []);
@@ -2069,11 +2022,11 @@ impl<'a> Lowerer<'a> {
         let ret_id = self.ty_id(&sig.ret)?;
         // A pixel entry point is lowered as an ordinary function (`src.NAME`,
         // as DXC names it) that a wrapper calls; see `pixel_wrapper`.
-        if let Some(stage) = sig.stage.filter(|s| *s != Stage::Pixel) {
+        if let Some(stage) = sig.stage.filter(|s| *s != Stage::Fragment) {
             if sig.ret != Ty::Void {
                 return Err(unsupported(
                     f.ret.pos,
-                    format!("{} entry points returning a value", stage.name()),
+                    format!("{} entry points returning a value", stage.hlsl_name()),
                 ));
             }
             let fty = self.b.type_function(ret_id, []);
@@ -2110,7 +2063,7 @@ impl<'a> Lowerer<'a> {
             let fty = self.b.type_function(ret_id, ptys.clone());
             self.b
                 .begin_function(ret_id, Some(sig.id), spirv::FunctionControl::NONE, fty)?;
-            if sig.stage == Some(Stage::Pixel) {
+            if sig.stage == Some(Stage::Fragment) {
                 self.b.name(sig.id, format!("src.{}", sig.name));
             } else {
                 self.b.name(sig.id, sig.name.clone());
@@ -2248,7 +2201,7 @@ impl<'a> Lowerer<'a> {
             }
             return Err(unsupported(
                 decl.pos,
-                format!("this parameter in a {} entry point", stage.name()),
+                format!("this parameter in a {} entry point", stage.hlsl_name()),
             )
             .len(decl.name.len() as u32)
             .note("ray-tracing entry points take `inout` payload / callable data and `in` hit attributes (structs)"));
@@ -2497,13 +2450,13 @@ impl<'a> Lowerer<'a> {
             }
             StmtKind::Discard => {
                 match self.cur_stage {
-                    Some(Stage::Pixel) => {}
+                    Some(Stage::Fragment) => {}
                     Some(st) => {
                         return Err(Error::new(
                             s.pos,
                             format!(
                                 "`discard` is only available in pixel shaders, not {} shaders",
-                                st.name()
+                                st.hlsl_name()
                             ),
                         )
                         .len(7))
@@ -4386,6 +4339,7 @@ impl Lowerer<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use spirv::ExecutionModel;
 
     #[test]
     fn swizzles_and_matrix_elements() {
@@ -4420,8 +4374,14 @@ mod tests {
             builtin_constant("RAY_FLAG_SKIP_PROCEDURAL_PRIMITIVES"),
             Some(0x200)
         );
-        assert_eq!(Stage::from_name("intersection"), Some(Stage::Intersection));
-        assert_eq!(Stage::ClosestHit.model(), ExecutionModel::ClosestHitKHR);
+        assert_eq!(
+            Stage::from_hlsl_name("intersection"),
+            Some(Stage::Intersection)
+        );
+        assert_eq!(
+            Stage::ClosestHit.model(),
+            Some(ExecutionModel::ClosestHitKHR)
+        );
     }
 
     #[test]

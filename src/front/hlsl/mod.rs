@@ -12,10 +12,11 @@ pub mod parse;
 pub mod pp;
 pub mod types;
 
-pub use crate::spirv::Stage;
+pub use crate::shader::Stage;
 
-use crate::diag::{InputError, Location};
-use crate::front::wgsl::NamedDecl;
+use crate::diag::InputError;
+use crate::program::NamedDecl;
+use crate::shader::Location;
 use std::path::{Path, PathBuf};
 
 /// What `rtlint compile` and `rtlint check` pass to the compiler.
@@ -87,11 +88,11 @@ fn entry_indices(
     path: &Path,
     files: &[PathBuf],
     options: &HlslOptions,
-) -> Result<Vec<(usize, String, lower::Stage)>, InputError> {
+) -> Result<Vec<(usize, String, Stage)>, InputError> {
     let entries = lowerer
         .declare()
         .map_err(|e| e.into_input_error(files, path))?;
-    let all: Vec<(usize, String, lower::Stage)> = entries
+    let all: Vec<(usize, String, Stage)> = entries
         .into_iter()
         .enumerate()
         .map(|(i, e)| (i, e.name, e.stage))
@@ -163,7 +164,7 @@ fn compile_source_inner(
             .map_err(|e| e.into_input_error(&files, path))?;
         out.push(CompiledEntry {
             name,
-            stage: Stage::from_model(stage.model()),
+            stage: stage,
             words,
         });
     }
@@ -197,10 +198,7 @@ fn compile_source_whole_inner(
         .map_err(|e| e.into_input_error(&files, path))?;
     Ok(CompiledModule {
         words,
-        entries: picked
-            .into_iter()
-            .map(|(_, n, s)| (n, Stage::from_model(s.model())))
-            .collect(),
+        entries: picked.into_iter().map(|(_, n, s)| (n, s)).collect(),
         decls,
     })
 }

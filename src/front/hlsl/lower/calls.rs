@@ -93,7 +93,7 @@ impl<'a> Lowerer<'a> {
             if !allowed.contains(&s) {
                 return Err(Error::new(
                     pos,
-                    format!("`{name}` is not available in {} shaders", s.name()),
+                    format!("`{name}` is not available in {} shaders", s.hlsl_name()),
                 )
                 .len(name.len() as u32));
             }
@@ -115,13 +115,13 @@ impl<'a> Lowerer<'a> {
         };
         let len = name.len() as u32;
         match self.cur_stage {
-            Some(Stage::Pixel) => {}
+            Some(Stage::Fragment) => {}
             Some(s) => {
                 return Err(Error::new(
                     pos,
                     format!(
                         "`{name}` is only available in pixel shaders, not {} shaders",
-                        s.name()
+                        s.hlsl_name()
                     ),
                 )
                 .len(len))

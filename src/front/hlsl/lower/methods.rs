@@ -323,7 +323,7 @@ impl<'a> Lowerer<'a> {
             Ty::Vec(Sc::Float, cn)
         };
         match name {
-            "Sample" if self.cur_stage.is_some_and(|s| s != Stage::Pixel) => Err(unsupported(
+            "Sample" if self.cur_stage.is_some_and(|s| s != Stage::Fragment) => Err(unsupported(
                 pos,
                 "`Sample` (implicit level of detail) outside pixel shaders; use `SampleLevel`",
             )

@@ -28,7 +28,7 @@ impl<'a> Lowerer<'a> {
         let f = sig.func;
         self.cur_fn = k;
         self.cur_ns = f.ns.clone();
-        self.cur_stage = Some(Stage::Pixel);
+        self.cur_stage = Some(Stage::Fragment);
         self.scopes = vec![HashMap::new()];
         self.flow.clear();
         self.term = false;
@@ -314,7 +314,7 @@ impl<'a> Lowerer<'a> {
             .collect();
         uses.sort_by_key(|u| u.0);
         if let Some((_, (name, pos))) = uses.first() {
-            let stage = entry.stage.map(Stage::name).unwrap_or("");
+            let stage = entry.stage.map(Stage::hlsl_name).unwrap_or("");
             return Err(
                 Error::new(*pos, format!("`{name}` is only available in pixel shaders"))
                     .len(name.len() as u32)

@@ -6,16 +6,20 @@
 //! types, globals, entry points, functions with their CFG, ray-tracing sites,
 //! and the source position of declarations — is derived once in [`build`].
 
+mod binary;
 mod build;
 pub mod debug;
+pub mod scalar;
 mod textdecl;
 pub mod types;
 
+pub use binary::{words_from_bytes, MAGIC};
 pub use build::parse;
 pub use types::{ArrayLen, Type};
 
 use crate::diag::Location;
-use crate::front::Language;
+use crate::shader::Language;
+use crate::shader::Stage;
 use rspirv::dr::{Instruction, Operand};
 use spirv::{Op, StorageClass};
 use std::collections::HashMap;
@@ -56,64 +60,15 @@ pub enum Decl {
     Func(Id),
 }
 
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, serde::Serialize)]
-#[serde(rename_all = "snake_case")]
-pub enum Stage {
-    RayGeneration,
-    Intersection,
-    AnyHit,
-    ClosestHit,
-    Miss,
-    Callable,
-    Compute,
-    Vertex,
-    Fragment,
-    Other,
-}
-
-impl Stage {
-    pub fn from_model(model: spirv::ExecutionModel) -> Stage {
-        use spirv::ExecutionModel as M;
-        match model {
-            M::RayGenerationKHR => Stage::RayGeneration,
-            M::IntersectionKHR => Stage::Intersection,
-            M::AnyHitKHR => Stage::AnyHit,
-            M::ClosestHitKHR => Stage::ClosestHit,
-            M::MissKHR => Stage::Miss,
-            M::CallableKHR => Stage::Callable,
-            M::GLCompute => Stage::Compute,
-            M::Vertex => Stage::Vertex,
-            M::Fragment => Stage::Fragment,
-            _ => Stage::Other,
-        }
-    }
-
-    pub fn as_str(self) -> &'static str {
-        match self {
-            Stage::RayGeneration => "raygeneration",
-            Stage::Intersection => "intersection",
-            Stage::AnyHit => "anyhit",
-            Stage::ClosestHit => "closesthit",
-            Stage::Miss => "miss",
-            Stage::Callable => "callable",
-            Stage::Compute => "compute",
-            Stage::Vertex => "vertex",
-            Stage::Fragment => "fragment",
-            Stage::Other => "other",
-        }
-    }
-
-    pub fn is_ray_tracing(self) -> bool {
-        matches!(
-            self,
-            Stage::RayGeneration
-                | Stage::Intersection
-                | Stage::AnyHit
-                | Stage::ClosestHit
-                | Stage::Miss
-                | Stage::Callable
-        )
-    }
+/// A declaration named in source, matched to SPIR-V ids through `OpName`:
+/// how front-ends hand over declaration positions the module's own debug
+/// info lacks (see [`Program::attach_named_decls`]).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum NamedDecl {
+    Type(String),
+    Member(String, u32),
+    Global(String),
+    Function(String),
 }
 
 #[derive(Clone, Debug)]
@@ -468,8 +423,8 @@ impl Program {
 
     /// Adds declaration positions a front-end knows by name (WGSL: naga keeps
     /// spans that its SPIR-V writer does not emit), matched through `OpName`.
-    pub fn attach_named_decls(&mut self, decls: &[(crate::front::wgsl::NamedDecl, Location)]) {
-        use crate::front::wgsl::NamedDecl as N;
+    pub fn attach_named_decls(&mut self, decls: &[(NamedDecl, Location)]) {
+        use NamedDecl as N;
         for (decl, loc) in decls {
             let file = match self.files.iter().position(|f| f.path == loc.path) {
                 Some(i) => i as u32,

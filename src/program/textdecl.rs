@@ -114,7 +114,7 @@ fn find_struct(s: &[u8], name: &str) -> Option<(usize, usize, usize)> {
 }
 
 fn line_col(text: &str, offset: usize) -> (u32, u32) {
-    crate::front::wgsl::line_col(text, offset)
+    crate::shader::line_col(text, offset)
 }
 
 /// Fills struct and member positions from the source text where debug info
@@ -122,7 +122,7 @@ fn line_col(text: &str, offset: usize) -> (u32, u32) {
 pub fn fill(program: &mut Program) {
     if !matches!(
         program.language,
-        crate::front::Language::Glsl | crate::front::Language::Hlsl
+        crate::shader::Language::Glsl | crate::shader::Language::Hlsl
     ) {
         return;
     }

@@ -5,7 +5,7 @@
 //! largest (Vulkan's payload rule); the two agree unless a struct mixes
 //! scalar widths.
 
-use crate::spirv::{Id, Program, Type};
+use crate::program::{Id, Program, Type};
 
 /// Bytes a value of type `ty` occupies under the scalar layout. `None` for
 /// types without a size (runtime arrays, unknown array lengths, ray queries,

@@ -1,7 +1,7 @@
 //! Debug-info helpers: resolving source paths and naming types.
 
 use super::{Id, Program, Type};
-use crate::front::Language;
+use crate::shader::Language;
 use std::path::{Path, PathBuf};
 
 /// Where a path named by debug info lives on this machine: as written if it

@@ -57,7 +57,7 @@ pub fn parse(words: &[u32], path: &Path, language: Language) -> Result<Program, 
     if words.len() < 5 {
         return Err(err(path, "SPIR-V module is shorter than the 5-word header"));
     }
-    if words[0] != crate::front::spirv::MAGIC {
+    if words[0] != super::binary::MAGIC {
         return Err(err(
             path,
             format!("not a SPIR-V module: word 0 is {:#010x}", words[0]),
