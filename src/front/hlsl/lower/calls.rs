@@ -89,7 +89,7 @@ impl<'a> Lowerer<'a> {
     }
 
     fn stage_check(&self, name: &str, allowed: &[Stage], pos: Pos) -> Result<()> {
-        if let Some(s) = self.cur_stage {
+        if let Some(s) = self.f.cur_stage {
             if !allowed.contains(&s) {
                 return Err(Error::new(
                     pos,
@@ -114,7 +114,7 @@ impl<'a> Lowerer<'a> {
             _ => (Op::Fwidth, "fwidth"),
         };
         let len = name.len() as u32;
-        match self.cur_stage {
+        match self.f.cur_stage {
             Some(Stage::Fragment) => {}
             Some(s) => {
                 return Err(Error::new(
@@ -129,7 +129,7 @@ impl<'a> Lowerer<'a> {
             // In a helper: checked against the entry points that reach it.
             None => {
                 self.fn_derivs
-                    .entry(self.cur_fn)
+                    .entry(self.f.cur_fn)
                     .or_insert((static_name, pos));
             }
         }
@@ -221,8 +221,8 @@ impl<'a> Lowerer<'a> {
     }
 
     fn find_user(&self, name: &str) -> Option<Vec<usize>> {
-        if !self.cur_ns.is_empty() {
-            if let Some(v) = self.fn_by_name.get(&format!("{}{name}", self.cur_ns)) {
+        if !self.f.cur_ns.is_empty() {
+            if let Some(v) = self.fn_by_name.get(&format!("{}{name}", self.f.cur_ns)) {
                 return Some(v.clone());
             }
         }
@@ -230,7 +230,7 @@ impl<'a> Lowerer<'a> {
     }
 
     fn call(&mut self, name: &str, args: &'a [Expr], pos: Pos) -> Result<Option<Val>> {
-        if let Some(this) = self.this_place.clone() {
+        if let Some(this) = self.f.this_place.clone() {
             if let Ty::Struct(k) = this.ty() {
                 let qualified = format!("{}::{name}", self.structs[*k as usize].name);
                 if let Some(c) = self.fn_by_name.get(&qualified).cloned() {
@@ -245,7 +245,7 @@ impl<'a> Lowerer<'a> {
         }
         if let Some((bi, ty, stages)) = system_value(name) {
             self.arity(name, args, 0, pos)?;
-            if self.cur_stage == Some(Stage::Compute) {
+            if self.f.cur_stage == Some(Stage::Compute) {
                 return Err(Error::new(
                     pos,
                     format!("`{name}` is not available in compute shaders"),
@@ -357,7 +357,7 @@ impl<'a> Lowerer<'a> {
                 self.arity(name, args, 0, pos)?;
                 self.stage_check(name, &[Stage::AnyHit], pos)?;
                 self.ray_tracing_caps();
-                if self.term {
+                if self.f.term {
                     self.start_block(None)?;
                 }
                 if name == "IgnoreHit" {
@@ -365,7 +365,7 @@ impl<'a> Lowerer<'a> {
                 } else {
                     self.b.terminate_ray_khr()?;
                 }
-                self.term = true;
+                self.f.term = true;
                 return Ok(None);
             }
             "NonUniformResourceIndex" => {
@@ -1183,11 +1183,11 @@ impl<'a> Lowerer<'a> {
             temps.push(tmp);
         }
         let rt = self.ty_id(&sig.ret)?;
-        if self.term {
+        if self.f.term {
             self.start_block(None)?;
         }
         let id = self.b.function_call(rt, None, sig.id, temps.clone())?;
-        self.fn_calls.entry(self.cur_fn).or_default().insert(k);
+        self.fn_calls.entry(self.f.cur_fn).or_default().insert(k);
         if !self.lowered.contains(&k) && !self.pending.contains(&k) {
             self.pending.push(k);
         }

@@ -323,7 +323,7 @@ impl<'a> Lowerer<'a> {
             Ty::Vec(Sc::Float, cn)
         };
         match name {
-            "Sample" if self.cur_stage.is_some_and(|s| s != Stage::Fragment) => Err(unsupported(
+            "Sample" if self.f.cur_stage.is_some_and(|s| s != Stage::Fragment) => Err(unsupported(
                 pos,
                 "`Sample` (implicit level of detail) outside pixel shaders; use `SampleLevel`",
             )
@@ -332,9 +332,11 @@ impl<'a> Lowerer<'a> {
                 if rw {
                     return Err(Error::new(pos, format!("RWTexture has no method `{name}`")));
                 }
-                if name == "Sample" && self.cur_stage.is_none() {
+                if name == "Sample" && self.f.cur_stage.is_none() {
                     // Implicit LOD takes derivatives: checked against the reaching entry points.
-                    self.fn_derivs.entry(self.cur_fn).or_insert(("Sample", pos));
+                    self.fn_derivs
+                        .entry(self.f.cur_fn)
+                        .or_insert(("Sample", pos));
                 }
                 let want = match name {
                     "Sample" => 2,

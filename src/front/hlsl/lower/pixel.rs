@@ -26,13 +26,7 @@ impl<'a> Lowerer<'a> {
     pub(super) fn pixel_wrapper(&mut self, k: usize) -> Result<(Id, Vec<Id>)> {
         let sig = self.funcs[k].clone();
         let f = sig.func;
-        self.cur_fn = k;
-        self.cur_ns = f.ns.clone();
-        self.cur_stage = Some(Stage::Fragment);
-        self.scopes = vec![HashMap::new()];
-        self.flow.clear();
-        self.term = false;
-        self.this_place = None;
+        self.f = FnCtx::new(k, &f.ns, Some(Stage::Fragment), Ty::Void);
         let void = self.b.type_void();
         let fty = self.b.type_function(void, []);
         let id = self.b.id();
@@ -45,7 +39,7 @@ impl<'a> Lowerer<'a> {
             self.line(e.pos);
             let v = self.expr_as(e, &t)?;
             self.use_global(var);
-            if self.term {
+            if self.f.term {
                 self.start_block(None)?;
             }
             self.b.store(var, v.id, None, [])?;

@@ -1,0 +1,976 @@
+//! Declarations: structs, typedefs, enums, functions and methods, globals,
+//! constant buffers and resource bindings.
+
+use super::*;
+
+impl<'a> Lowerer<'a> {
+    /// Reads every declaration and function signature; returns the entry points.
+    pub fn declare(&mut self) -> Result<Vec<EntryInfo>> {
+        let items = self.items;
+        for item in items {
+            match item {
+                Item::Struct(s) => self.declare_struct(s)?,
+                Item::Typedef {
+                    ty,
+                    dims,
+                    name,
+                    pos,
+                } => {
+                    let t = self.resolve_ty(ty, "")?;
+                    let t = self.apply_dims(t, dims, *pos, false)?;
+                    self.typedefs.insert(name.clone(), t);
+                }
+                Item::Enum {
+                    name,
+                    scoped,
+                    underlying,
+                    variants,
+                    ..
+                } => {
+                    let sc = match underlying {
+                        Some(t) => match self.resolve_ty(t, "")? {
+                            Ty::Sc(s @ (Sc::Int | Sc::Uint)) => s,
+                            _ => return Err(Error::new(t.pos, "enum type must be int or uint")),
+                        },
+                        None => Sc::Int,
+                    };
+                    self.typedefs.insert(name.clone(), Ty::Sc(sc));
+                    let mut next = 0i64;
+                    let ns = name
+                        .rsplit_once("::")
+                        .map(|(n, _)| format!("{n}::"))
+                        .unwrap_or_default();
+                    for (v, _, value) in variants {
+                        if let Some(e) = value {
+                            next = self.const_int(e)?;
+                        }
+                        let id = self.const_scalar(sc, next as f64, next);
+                        let c = Global::Const(Val { id, ty: Ty::Sc(sc) });
+                        self.globals.insert(format!("{name}::{v}"), c.clone());
+                        self.const_items
+                            .insert(format!("{name}::{v}"), CVal::I(next));
+                        if !scoped {
+                            self.globals.insert(format!("{ns}{v}"), c);
+                            self.const_items.insert(format!("{ns}{v}"), CVal::I(next));
+                        }
+                        next += 1;
+                    }
+                }
+                _ => {}
+            }
+        }
+        self.declare_globals()?;
+        let mut entries = Vec::new();
+        for item in items {
+            if let Item::Struct(sd) = item {
+                self.declare_methods(sd)?;
+                continue;
+            }
+            let Item::Function(f) = item else { continue };
+            let mut stage = None;
+            let mut numthreads = [1, 1, 1];
+            for a in &f.attrs {
+                match a.name.as_str() {
+                    "shader" => {
+                        let s = attr_str(a)
+                            .ok_or_else(|| Error::new(a.pos, "expected [shader(\"stage\")]"))?;
+                        stage =
+                            Some(Stage::from_hlsl_name(s).ok_or_else(|| {
+                                unsupported(a.pos, format!("shader stage \"{s}\""))
+                            })?);
+                    }
+                    "numthreads" => {
+                        if a.args.len() != 3 {
+                            return Err(Error::new(a.pos, "[numthreads] needs three sizes"));
+                        }
+                        for (n, e) in a.args.iter().enumerate() {
+                            numthreads[n] = self.const_int(e)? as u32;
+                        }
+                        stage.get_or_insert(Stage::Compute);
+                    }
+                    _ => {}
+                }
+            }
+            let ret = self.resolve_ty(&f.ret, &f.ns)?;
+            let mut params = Vec::new();
+            for p in &f.params {
+                let t = self.resolve_ty(&p.ty, &f.ns)?;
+                let t = self.apply_dims(t, &p.dims, p.pos, false)?;
+                if t.is_resource() && (matches!(t, Ty::Array(..) | Ty::RtArray(_)) || p.mods.output)
+                {
+                    return Err(unsupported(
+                        p.pos,
+                        "arrays of resources, or `out` resources, as function parameters",
+                    ));
+                }
+                params.push(Param {
+                    ty: t,
+                    out: p.mods.output,
+                    input: p.mods.input || !p.mods.output,
+                });
+            }
+            let id = self.b.id();
+            if f.body.is_none() {
+                continue; // a prototype: the definition carries the signature
+            }
+            let idx = self.funcs.len();
+            self.funcs.push(FnSig {
+                name: f.name.clone(),
+                params,
+                ret,
+                id,
+                func: f,
+                this: None,
+                stage,
+                numthreads,
+            });
+            self.fn_by_name.entry(f.name.clone()).or_default().push(idx);
+            self.decls.push((
+                NamedDecl::Function(f.name.clone()),
+                self.loc(f.pos, f.name.len() as u32),
+            ));
+            if let Some(s) = stage {
+                entries.push(EntryInfo {
+                    name: f.name.clone(),
+                    stage: s,
+                });
+            }
+        }
+        Ok(entries)
+    }
+
+    pub(super) fn declare_methods(&mut self, sd: &'a StructDecl) -> Result<()> {
+        let Some(&k) = self.struct_names.get(&sd.name) else {
+            return Ok(());
+        };
+        for f in &sd.methods {
+            let ret = self.resolve_ty(&f.ret, &f.ns)?;
+            let mut params = vec![Param {
+                ty: Ty::Struct(k),
+                out: true,
+                input: true,
+            }];
+            for p in &f.params {
+                let t = self.resolve_ty(&p.ty, &f.ns)?;
+                let t = self.apply_dims(t, &p.dims, p.pos, false)?;
+                if t.is_resource() && (matches!(t, Ty::Array(..) | Ty::RtArray(_)) || p.mods.output)
+                {
+                    return Err(unsupported(
+                        p.pos,
+                        "arrays of resources, or `out` resources, as function parameters",
+                    ));
+                }
+                params.push(Param {
+                    ty: t,
+                    out: p.mods.output,
+                    input: p.mods.input || !p.mods.output,
+                });
+            }
+            let name = format!("{}::{}", sd.name, f.name);
+            let idx = self.funcs.len();
+            let id = self.b.id();
+            self.funcs.push(FnSig {
+                name: name.clone(),
+                params,
+                ret,
+                id,
+                func: f,
+                this: Some(k),
+                stage: None,
+                numthreads: [1, 1, 1],
+            });
+            self.fn_by_name.entry(name.clone()).or_default().push(idx);
+            self.decls.push((
+                NamedDecl::Function(name),
+                self.loc(f.pos, f.name.len() as u32),
+            ));
+        }
+        Ok(())
+    }
+
+    pub(super) fn declare_struct(&mut self, s: &StructDecl) -> Result<()> {
+        let mut fields = Vec::new();
+        for f in &s.fields {
+            let t = self.resolve_ty(&f.ty, "")?;
+            let t = self.apply_dims(t, &f.dims, f.pos, false)?;
+            if t.is_resource() || matches!(t, Ty::RayQuery(_)) {
+                return Err(unsupported(f.pos, "resources inside structs"));
+            }
+            if fields.iter().any(|x: &Field| x.name == f.name) {
+                return Err(Error::new(f.pos, format!("duplicate member `{}`", f.name)));
+            }
+            fields.push(Field {
+                name: f.name.clone(),
+                ty: t,
+                pos: f.pos,
+                row_major: f.mods.row_major,
+            });
+        }
+        if self.struct_names.contains_key(&s.name) {
+            return Err(Error::new(
+                s.pos,
+                format!("`{}` is already defined", s.name),
+            ));
+        }
+        let k = self.structs.len() as u32;
+        self.decls.push((
+            NamedDecl::Type(s.name.clone()),
+            self.loc(s.pos, s.name.len() as u32),
+        ));
+        for (i, f) in fields.iter().enumerate() {
+            self.decls.push((
+                NamedDecl::Member(s.name.clone(), i as u32),
+                self.loc(f.pos, f.name.len() as u32),
+            ));
+        }
+        self.structs.push(StructDef {
+            name: s.name.clone(),
+            fields,
+            pos: s.pos,
+        });
+        self.struct_io.insert(
+            k,
+            s.fields
+                .iter()
+                .map(|f| (f.semantic.clone(), f.attrs.clone()))
+                .collect(),
+        );
+        self.struct_names.insert(s.name.clone(), k);
+        Ok(())
+    }
+
+    pub(super) fn lookup_type_name(&self, name: &str, ns: &str) -> Option<Ty> {
+        let mut prefix = ns.to_string();
+        loop {
+            let q = format!("{prefix}{name}");
+            if let Some(k) = self.struct_names.get(&q) {
+                return Some(Ty::Struct(*k));
+            }
+            if let Some(t) = self.typedefs.get(&q) {
+                return Some(t.clone());
+            }
+            if prefix.is_empty() {
+                return None;
+            }
+            prefix.truncate(prefix.len() - 2);
+            prefix = match prefix.rfind("::") {
+                Some(k) => prefix[..k + 2].to_string(),
+                None => String::new(),
+            };
+        }
+    }
+
+    pub(super) fn resolve_ty(&mut self, t: &TypeRef, ns: &str) -> Result<Ty> {
+        let name = t.name.as_str();
+        let targ_ty = |this: &mut Self, k: usize, default: Ty| -> Result<Ty> {
+            match t.args.get(k) {
+                Some(TArg::Type(a)) => this.resolve_ty(a, ns),
+                Some(TArg::Expr(e)) => Err(Error::new(e.pos, "expected a type argument")),
+                None => Ok(default),
+            }
+        };
+        if let Some((base, a, b)) = split_numeric(name) {
+            let sc = match base {
+                "bool" => Sc::Bool,
+                "int" | "min16int" | "min12int" | "int32_t" => Sc::Int,
+                "uint" | "dword" | "min16uint" | "uint32_t" => Sc::Uint,
+                // Without 16-bit types enabled, DXC treats half as float.
+                "float" | "half" | "min16float" | "min10float" | "float32_t" => Sc::Float,
+                other => {
+                    return Err(
+                        unsupported(t.pos, format!("type `{other}` (only 32-bit types)"))
+                            .len(other.len() as u32),
+                    )
+                }
+            };
+            return self.numeric(sc, a, b, t.pos);
+        }
+        Ok(match name {
+            "void" => Ty::Void,
+            "vector" | "matrix" => {
+                let sc = match targ_ty(self, 0, Ty::Sc(Sc::Float))? {
+                    Ty::Sc(s) => s,
+                    _ => {
+                        return Err(Error::new(
+                            t.pos,
+                            "vector and matrix elements must be scalars",
+                        ))
+                    }
+                };
+                let dim = |this: &mut Self, k: usize| -> Result<u8> {
+                    match t.args.get(k) {
+                        Some(TArg::Expr(e)) => Ok(this.const_int(e)?.clamp(0, 255) as u8),
+                        Some(TArg::Type(a)) => Err(Error::new(a.pos, "expected a size")),
+                        None => Ok(4),
+                    }
+                };
+                let a = dim(self, 1)?;
+                let b = if name == "matrix" { dim(self, 2)? } else { 0 };
+                if a == 0 || a > 4 || (name == "matrix" && (b == 0 || b > 4)) {
+                    return Err(Error::new(t.pos, "vector and matrix sizes are 1 to 4"));
+                }
+                return self.numeric(sc, a, b, t.pos);
+            }
+            "RaytracingAccelerationStructure" => Ty::Accel,
+            "RayQuery" => {
+                let flags = match t.args.first() {
+                    Some(TArg::Expr(e)) => self.const_int(e)? as u32,
+                    _ => {
+                        return Err(Error::new(
+                            t.pos,
+                            "RayQuery needs its flags: RayQuery<RAY_FLAG_NONE>",
+                        ))
+                    }
+                };
+                Ty::RayQuery(flags)
+            }
+            "SamplerState" => Ty::Sampler,
+            "ByteAddressBuffer" => Ty::ByteAddress(false),
+            "RWByteAddressBuffer" => Ty::ByteAddress(true),
+            "StructuredBuffer" | "RWStructuredBuffer" => {
+                let e = targ_ty(self, 0, Ty::Void)?;
+                if e == Ty::Void || e.is_resource() {
+                    return Err(Error::new(t.pos, format!("{name} needs an element type")));
+                }
+                if let Ty::Mat(..) = e {
+                    return Err(unsupported(
+                        t.pos,
+                        format!("{name} of a matrix; wrap the matrix in a struct"),
+                    ));
+                }
+                Ty::StructuredBuffer(Box::new(e), name.starts_with("RW"))
+            }
+            "ConstantBuffer" => match targ_ty(self, 0, Ty::Void)? {
+                Ty::Struct(k) => Ty::ConstantBuffer(k),
+                _ => return Err(Error::new(t.pos, "ConstantBuffer needs a struct type")),
+            },
+            "Texture1D" | "Texture2D" | "Texture3D" | "TextureCube" | "Texture2DArray"
+            | "RWTexture1D" | "RWTexture2D" | "RWTexture3D" | "RWTexture2DArray" => {
+                let rw = name.starts_with("RW");
+                let dim = match name.trim_start_matches("RW") {
+                    "Texture1D" => Dim::D1,
+                    "Texture2D" => Dim::D2,
+                    "Texture3D" => Dim::D3,
+                    "TextureCube" => Dim::Cube,
+                    _ => Dim::D2Array,
+                };
+                let (sc, n) = match targ_ty(self, 0, Ty::Vec(Sc::Float, 4))? {
+                    Ty::Sc(s) if s != Sc::Bool => (s, 1),
+                    Ty::Vec(s, n) if s != Sc::Bool => (s, n),
+                    _ => {
+                        return Err(Error::new(
+                            t.pos,
+                            "texture elements must be scalars or vectors",
+                        ))
+                    }
+                };
+                Ty::Texture { dim, sc, n, rw }
+            }
+            "SamplerComparisonState"
+            | "Buffer"
+            | "RWBuffer"
+            | "AppendStructuredBuffer"
+            | "ConsumeStructuredBuffer"
+            | "Texture2DMS"
+            | "HitObject"
+            | "string"
+            | "TriangleHitGroup"
+            | "ProceduralPrimitiveHitGroup"
+            | "RaytracingShaderConfig"
+            | "RaytracingPipelineConfig"
+            | "RaytracingPipelineConfig1"
+            | "GlobalRootSignature"
+            | "LocalRootSignature"
+            | "StateObjectConfig"
+            | "SubobjectToExportsAssociation" => {
+                return Err(unsupported(t.pos, format!("`{name}`")).len(name.len() as u32));
+            }
+            _ => match self.lookup_type_name(name, ns) {
+                Some(t) => t,
+                None => {
+                    return Err(
+                        Error::new(t.pos, format!("unknown type `{name}`")).len(name.len() as u32)
+                    )
+                }
+            },
+        })
+    }
+
+    pub(super) fn numeric(&mut self, sc: Sc, a: u8, b: u8, pos: Pos) -> Result<Ty> {
+        Ok(match (a, b) {
+            (0, _) | (1, 0) => Ty::Sc(sc),
+            (n, 0) => Ty::Vec(sc, n),
+            (r, c) => {
+                if sc != Sc::Float {
+                    return Err(unsupported(pos, "non-float matrices"));
+                }
+                if r < 2 || c < 2 {
+                    return Err(unsupported(pos, "matrices with one row or column"));
+                }
+                Ty::Mat(sc, r, c)
+            }
+        })
+    }
+
+    pub(super) fn apply_dims(
+        &mut self,
+        mut t: Ty,
+        dims: &[Option<Expr>],
+        pos: Pos,
+        unbounded_ok: bool,
+    ) -> Result<Ty> {
+        for d in dims.iter().rev() {
+            t = match d {
+                Some(e) => {
+                    let n = self.const_int(e)?;
+                    if n <= 0 {
+                        return Err(Error::new(e.pos, "array size must be positive"));
+                    }
+                    Ty::Array(Box::new(t), n as u32)
+                }
+                None if unbounded_ok => Ty::RtArray(Box::new(t)),
+                None => return Err(Error::new(pos, "array size missing")),
+            };
+        }
+        Ok(t)
+    }
+
+    pub(super) fn declare_globals(&mut self) -> Result<()> {
+        let items = self.items;
+        // Explicit bindings first, so automatic ones avoid them.
+        let mut used: HashSet<(u32, u32)> = HashSet::new();
+        let explicit = |attrs: &[Attr],
+                        reg: &Option<Register>,
+                        this: &mut Self|
+         -> Result<Option<(u32, u32)>> {
+            for a in attrs {
+                if a.name == "vk::binding" {
+                    let b = a
+                        .args
+                        .first()
+                        .map(|e| this.const_int(e))
+                        .transpose()?
+                        .unwrap_or(0) as u32;
+                    let s = a
+                        .args
+                        .get(1)
+                        .map(|e| this.const_int(e))
+                        .transpose()?
+                        .unwrap_or(0) as u32;
+                    return Ok(Some((s, b)));
+                }
+            }
+            Ok(reg.as_ref().map(|r| (r.space, r.index)))
+        };
+        for item in items {
+            let (attrs, reg) = match item {
+                Item::Var(v) => (&v.attrs, &v.register),
+                Item::CBuffer {
+                    attrs, register, ..
+                } => (attrs, register),
+                _ => continue,
+            };
+            if let Some(sb) = explicit(attrs, reg, self)? {
+                used.insert(sb);
+            }
+        }
+        let mut next_auto = 0u32;
+        let mut globals_members: Vec<&VarDecl> = Vec::new();
+        for item in items {
+            match item {
+                Item::CBuffer {
+                    attrs,
+                    name,
+                    pos,
+                    register,
+                    members,
+                } => {
+                    let binding = match explicit(attrs, register, self)? {
+                        Some(sb) => Some(sb),
+                        None if attrs.iter().any(|a| a.name == "vk::push_constant") => None,
+                        None => Some(self.auto_binding(&mut used, &mut next_auto)),
+                    };
+                    let members: Vec<&VarDecl> = members.iter().collect();
+                    self.declare_cbuffer(attrs, name, *pos, binding, &members)?;
+                }
+                Item::Var(v) if self.in_implicit_globals(v)? => globals_members.push(v),
+                Item::Var(v) => self.declare_global_var(v, &mut used, &mut next_auto)?,
+                _ => {}
+            }
+        }
+        if let Some(first) = globals_members.first() {
+            // Plain globals live in the implicit `$Globals` constant buffer, as in DXC.
+            let pos = first.pos;
+            let binding = self.auto_binding(&mut used, &mut next_auto);
+            self.declare_cbuffer(&[], "$Globals", pos, Some(binding), &globals_members)?;
+        }
+        Ok(())
+    }
+
+    /// Whether a global belongs in `$Globals`: not static, groupshared, a
+    /// resource or a specialization constant.
+    pub(super) fn in_implicit_globals(&mut self, v: &VarDecl) -> Result<bool> {
+        if v.mods.is_static
+            || v.mods.groupshared
+            || v.attrs.iter().any(|a| a.name == "vk::constant_id")
+        {
+            return Ok(false);
+        }
+        let t = self.resolve_ty(&v.ty, "")?;
+        Ok(
+            !t.is_resource()
+                && !matches!(t, Ty::RayQuery(_))
+                && !v.dims.iter().any(Option::is_none),
+        )
+    }
+
+    pub(super) fn declare_cbuffer(
+        &mut self,
+        attrs: &[Attr],
+        name: &str,
+        pos: Pos,
+        binding: Option<(u32, u32)>,
+        members: &[&VarDecl],
+    ) -> Result<()> {
+        let mut fields = Vec::new();
+        for m in members {
+            if let Some(init) = &m.init {
+                return Err(unsupported(
+                    init.pos,
+                    "initializers of constant-buffer members (declare the global `static const`)",
+                ));
+            }
+            let t = self.resolve_ty(&m.ty, "")?;
+            let t = self.apply_dims(t, &m.dims, m.pos, false)?;
+            if t.is_resource() {
+                return Err(unsupported(m.pos, "resources inside cbuffer"));
+            }
+            fields.push(Field {
+                name: m.name.clone(),
+                ty: t,
+                pos: m.pos,
+                row_major: m.mods.row_major,
+            });
+        }
+        let k = self.structs.len() as u32;
+        self.structs.push(StructDef {
+            name: format!("type.{name}"),
+            fields: fields.clone(),
+            pos,
+        });
+        self.decls.push((
+            NamedDecl::Type(format!("type.{name}")),
+            self.loc(pos, name.len() as u32),
+        ));
+        for (i, f) in fields.iter().enumerate() {
+            self.decls.push((
+                NamedDecl::Member(format!("type.{name}"), i as u32),
+                self.loc(f.pos, f.name.len() as u32),
+            ));
+        }
+        let var = self.resource_var(&Ty::ConstantBuffer(k), attrs, binding, name)?;
+        self.global_decls
+            .push((var, name.to_string(), Ty::Struct(k), pos));
+        self.decls.push((
+            NamedDecl::Global(name.to_string()),
+            self.loc(pos, name.len() as u32),
+        ));
+        let (layout, class) = self.cbuffer_class(attrs);
+        for (i, f) in fields.iter().enumerate() {
+            self.cbuffer_members
+                .insert(f.name.clone(), (var, f.ty.clone(), i as u32, layout, class));
+        }
+        Ok(())
+    }
+
+    pub(super) fn auto_binding(
+        &mut self,
+        used: &mut HashSet<(u32, u32)>,
+        next: &mut u32,
+    ) -> (u32, u32) {
+        while used.contains(&(0, *next)) {
+            *next += 1;
+        }
+        used.insert((0, *next));
+        (0, *next)
+    }
+
+    /// Layout and storage class of a cbuffer / ConstantBuffer by its attributes.
+    pub(super) fn cbuffer_class(&self, attrs: &[Attr]) -> (Layout, StorageClass) {
+        if attrs.iter().any(|a| a.name == "vk::push_constant") {
+            (Layout::Std430, StorageClass::PushConstant)
+        } else if attrs
+            .iter()
+            .any(|a| a.name == "vk::shader_record_ext" || a.name == "vk::shader_record_nv")
+        {
+            (Layout::Std430, StorageClass::ShaderRecordBufferKHR)
+        } else {
+            (Layout::CBuffer, StorageClass::Uniform)
+        }
+    }
+
+    /// Declares a descriptor (or push-constant / shader-record) variable.
+    pub(super) fn resource_var(
+        &mut self,
+        ty: &Ty,
+        attrs: &[Attr],
+        binding: Option<(u32, u32)>,
+        name: &str,
+    ) -> Result<Id> {
+        let (inner, arrays) = {
+            let mut t = ty;
+            let mut arrays = Vec::new();
+            loop {
+                match t {
+                    Ty::Array(e, n) => {
+                        arrays.push(Some(*n));
+                        t = e;
+                    }
+                    Ty::RtArray(e) => {
+                        arrays.push(None);
+                        t = e;
+                    }
+                    _ => break,
+                }
+            }
+            (t.clone(), arrays)
+        };
+        let (mut tid, class) = self.descriptor_type(&inner, attrs)?;
+        for n in arrays.iter().rev() {
+            tid = match n {
+                Some(n) => {
+                    let len = self.const_u32(*n);
+                    self.b.type_array(tid, len)
+                }
+                None => {
+                    self.cap(Capability::RuntimeDescriptorArray);
+                    self.ext("SPV_EXT_descriptor_indexing");
+                    self.b.type_runtime_array(tid)
+                }
+            };
+        }
+        let pty = self.b.type_pointer(None, class, tid);
+        let var = self.global_var(pty, class, None);
+        self.b.name(var, name);
+        self.resource_vars.insert(var);
+        if let Some((set, binding)) = binding {
+            if matches!(
+                class,
+                StorageClass::Uniform | StorageClass::StorageBuffer | StorageClass::UniformConstant
+            ) {
+                self.b
+                    .decorate(var, Decoration::DescriptorSet, [Operand::LiteralBit32(set)]);
+                self.b
+                    .decorate(var, Decoration::Binding, [Operand::LiteralBit32(binding)]);
+            }
+        }
+        Ok(var)
+    }
+
+    /// The SPIR-V type of one descriptor (or push-constant / shader-record
+    /// block) of `inner`, and its storage class; one id per kind, so arrays of
+    /// resources and their elements agree.
+    pub(super) fn descriptor_type(
+        &mut self,
+        inner: &Ty,
+        attrs: &[Attr],
+    ) -> Result<(Id, StorageClass)> {
+        if let Ty::ConstantBuffer(k) = inner {
+            let (layout, class) = self.cbuffer_class(attrs);
+            return Ok((self.block_struct(*k, layout)?, class));
+        }
+        if let Ty::Accel | Ty::Sampler | Ty::Texture { .. } = inner {
+            return Ok((
+                self.spv(inner, Layout::None)?,
+                StorageClass::UniformConstant,
+            ));
+        }
+        let key = (inner.clone(), Layout::Std430, true);
+        if let Some(id) = self.ty_cache.get(&key) {
+            return Ok((*id, StorageClass::StorageBuffer));
+        }
+        let (elem, stride, rw, name) = match inner {
+            Ty::StructuredBuffer(e, rw) => (
+                self.spv(e, Layout::Std430)?,
+                array_stride(e, Layout::Std430, &self.structs),
+                *rw,
+                if *rw {
+                    "type.RWStructuredBuffer"
+                } else {
+                    "type.StructuredBuffer"
+                },
+            ),
+            Ty::ByteAddress(rw) => (
+                self.spv(&Ty::Sc(Sc::Uint), Layout::None)?,
+                4,
+                *rw,
+                if *rw {
+                    "type.RWByteAddressBuffer"
+                } else {
+                    "type.ByteAddressBuffer"
+                },
+            ),
+            other => {
+                return Err(Error::new(
+                    Pos::default(),
+                    format!(
+                        "internal compiler error: `{}` is not a descriptor",
+                        self.ty_name(other)
+                    ),
+                ))
+            }
+        };
+        let rt = self.b.id();
+        self.b.type_runtime_array_id(Some(rt), elem);
+        self.b
+            .decorate(rt, Decoration::ArrayStride, [Operand::LiteralBit32(stride)]);
+        let st = self.b.id();
+        self.b.type_struct_id(Some(st), [rt]);
+        self.b.decorate(st, Decoration::Block, []);
+        self.b
+            .member_decorate(st, 0, Decoration::Offset, [Operand::LiteralBit32(0)]);
+        if !rw {
+            self.b.member_decorate(st, 0, Decoration::NonWritable, []);
+        }
+        self.b.name(st, name);
+        self.ty_cache.insert(key, st);
+        Ok((st, StorageClass::StorageBuffer))
+    }
+
+    /// A Block-decorated copy of struct `k` laid out for a buffer.
+    pub(super) fn block_struct(&mut self, k: u32, layout: Layout) -> Result<Id> {
+        let key = (Ty::Struct(k), layout, true);
+        if let Some(id) = self.ty_cache.get(&key) {
+            return Ok(*id);
+        }
+        let id = self.struct_type(k, layout, true)?;
+        self.ty_cache.insert(key, id);
+        Ok(id)
+    }
+
+    pub(super) fn declare_global_var(
+        &mut self,
+        v: &'a VarDecl,
+        used: &mut HashSet<(u32, u32)>,
+        next: &mut u32,
+    ) -> Result<()> {
+        let t = self.resolve_ty(&v.ty, "")?;
+        let res = t.is_resource();
+        let t = self.apply_dims(t, &v.dims, v.pos, res)?;
+        self.decls.push((
+            NamedDecl::Global(v.name.clone()),
+            self.loc(v.pos, v.name.len() as u32),
+        ));
+        if t.is_resource() {
+            let binding = match v.attrs.iter().find(|a| a.name == "vk::binding") {
+                Some(a) => {
+                    let b = a
+                        .args
+                        .first()
+                        .map(|e| self.const_int(e))
+                        .transpose()?
+                        .unwrap_or(0) as u32;
+                    let s = a
+                        .args
+                        .get(1)
+                        .map(|e| self.const_int(e))
+                        .transpose()?
+                        .unwrap_or(0) as u32;
+                    Some((s, b))
+                }
+                None => match &v.register {
+                    Some(r) => Some((r.space, r.index)),
+                    None if v.attrs.iter().any(|a| a.name == "vk::push_constant") => None,
+                    None => Some(self.auto_binding(used, next)),
+                },
+            };
+            let var = self.resource_var(&t, &v.attrs, binding, &v.name)?;
+            let shown = match &t {
+                Ty::ConstantBuffer(k) => Ty::Struct(*k),
+                other => other.clone(),
+            };
+            self.global_decls.push((var, v.name.clone(), shown, v.pos));
+            let (layout, class) = match &t {
+                Ty::ConstantBuffer(_) => self.cbuffer_class(&v.attrs),
+                Ty::StructuredBuffer(..) | Ty::ByteAddress(_) => {
+                    (Layout::Std430, StorageClass::StorageBuffer)
+                }
+                _ => {
+                    let mut inner = &t;
+                    while let Ty::Array(e, _) | Ty::RtArray(e) = inner {
+                        inner = e;
+                    }
+                    match inner {
+                        Ty::ConstantBuffer(_) => self.cbuffer_class(&v.attrs),
+                        Ty::StructuredBuffer(..) | Ty::ByteAddress(_) => {
+                            (Layout::Std430, StorageClass::StorageBuffer)
+                        }
+                        _ => (Layout::None, StorageClass::UniformConstant),
+                    }
+                }
+            };
+            self.globals.insert(
+                v.name.clone(),
+                Global::Place(Place::Ptr {
+                    ptr: var,
+                    ty: t,
+                    layout,
+                    class,
+                }),
+            );
+            return Ok(());
+        }
+        if matches!(t, Ty::RayQuery(_)) {
+            return Err(unsupported(
+                v.pos,
+                "global RayQuery objects (declare them in the function)",
+            ));
+        }
+        if v.mods.groupshared {
+            let tid = self.spv(&t, Layout::None)?;
+            let pty = self.b.type_pointer(None, StorageClass::Workgroup, tid);
+            let var = self.global_var(pty, StorageClass::Workgroup, None);
+            self.b.name(var, &v.name);
+            self.global_decls
+                .push((var, v.name.clone(), t.clone(), v.pos));
+            if v.init.is_some() {
+                return Err(Error::new(
+                    v.pos,
+                    "groupshared variables cannot have initializers",
+                ));
+            }
+            self.globals.insert(
+                v.name.clone(),
+                Global::Place(Place::Ptr {
+                    ptr: var,
+                    ty: t,
+                    layout: Layout::None,
+                    class: StorageClass::Workgroup,
+                }),
+            );
+            return Ok(());
+        }
+        if let Some(a) = v.attrs.iter().find(|a| a.name == "vk::constant_id") {
+            return self.spec_constant(v, a, &t);
+        }
+        if !v.mods.is_static {
+            return Err(unsupported(
+                v.pos,
+                "global variables outside a cbuffer (the implicit $Globals buffer); declare it `static` or put it in a cbuffer",
+            )
+            .len(v.name.len() as u32));
+        }
+        let mut deferred = None;
+        let init = match &v.init {
+            Some(e) => {
+                let c = self.const_value(e, &t)?;
+                if c.is_none() {
+                    // Computed at the start of every entry point, as DXC does.
+                    deferred = Some(e);
+                }
+                c
+            }
+            None => None,
+        };
+        // Scalars and vectors that never change are used as constants directly.
+        if v.mods.is_const && matches!(t, Ty::Sc(_) | Ty::Vec(..)) {
+            if let (Ty::Sc(s), Some(e)) = (&t, &v.init) {
+                if let Some(c) = self.const_eval(e)? {
+                    let c = match (s, c) {
+                        (Sc::Float, c) => CVal::F(c.as_f64()),
+                        (_, CVal::F(f)) => CVal::I(f as i64),
+                        (_, c) => c,
+                    };
+                    self.const_items.insert(v.name.clone(), c);
+                }
+            }
+            if let Some(id) = init {
+                self.globals
+                    .insert(v.name.clone(), Global::Const(Val { id, ty: t }));
+                return Ok(());
+            }
+        }
+        let tid = self.spv(&t, Layout::None)?;
+        let pty = self.b.type_pointer(None, StorageClass::Private, tid);
+        let init = match init {
+            Some(i) => i,
+            None => self.b.constant_null(tid),
+        };
+        let var = self.global_var(pty, StorageClass::Private, Some(init));
+        self.b.name(var, &v.name);
+        self.global_decls
+            .push((var, v.name.clone(), t.clone(), v.pos));
+        if let Some(e) = deferred {
+            self.deferred_inits.push((var, t.clone(), e));
+        }
+        self.globals.insert(
+            v.name.clone(),
+            Global::Place(Place::Ptr {
+                ptr: var,
+                ty: t,
+                layout: Layout::None,
+                class: StorageClass::Private,
+            }),
+        );
+        Ok(())
+    }
+
+    /// `[[vk::constant_id(N)]] const T name = default;`: a specialization constant.
+    pub(super) fn spec_constant(&mut self, v: &VarDecl, a: &Attr, t: &Ty) -> Result<()> {
+        let id_expr = a
+            .args
+            .first()
+            .ok_or_else(|| Error::new(a.pos, "vk::constant_id needs an id"))?;
+        let spec_id = self.const_int(id_expr)? as u32;
+        let Ty::Sc(s) = t else {
+            return Err(unsupported(
+                v.pos,
+                "specialization constants that are not scalars",
+            ));
+        };
+        let default = match &v.init {
+            Some(e) => self.const_eval(e)?.ok_or_else(|| {
+                Error::new(e.pos, "a specialization constant needs a constant default")
+            })?,
+            None => {
+                return Err(Error::new(
+                    v.pos,
+                    "a specialization constant needs a default value",
+                ))
+            }
+        };
+        let tid = self.sc_id(*s);
+        let id = match s {
+            Sc::Bool => {
+                let on = default.as_f64() != 0.0;
+                let id = self.b.id();
+                let op = if on {
+                    Op::SpecConstantTrue
+                } else {
+                    Op::SpecConstantFalse
+                };
+                self.b.insert_types_global_values(
+                    InsertPoint::End,
+                    Instruction::new(op, Some(tid), Some(id), vec![]),
+                );
+                id
+            }
+            Sc::Float => self
+                .b
+                .spec_constant_bit32(tid, (default.as_f64() as f32).to_bits()),
+            _ => {
+                let i = match default {
+                    CVal::I(i) => i,
+                    CVal::F(f) => f as i64,
+                };
+                self.b.spec_constant_bit32(tid, i as u32)
+            }
+        };
+        self.b
+            .decorate(id, Decoration::SpecId, [Operand::LiteralBit32(spec_id)]);
+        self.b.name(id, v.name.clone());
+        self.globals
+            .insert(v.name.clone(), Global::Const(Val { id, ty: t.clone() }));
+        Ok(())
+    }
+}
