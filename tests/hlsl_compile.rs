@@ -590,3 +590,32 @@ fn pixel_shader_semantics_and_derivatives() {
         assert_eq!((model, modes, io), mine, "{name}: Slang vs rtlint");
     }
 }
+
+/// The operands of every `OpFunctionCall` (57) of the module: result type, id,
+/// function, arguments.
+fn calls(words: &[u32]) -> Vec<Vec<u32>> {
+    instructions(words)
+        .into_iter()
+        .filter(|(op, _)| *op == 57)
+        .map(|(_, ops)| ops)
+        .collect()
+}
+
+#[test]
+fn default_parameter_values_fill_left_out_arguments() {
+    let entries = compile_all("default_params.hlsl");
+    assert_eq!(entries, vec![("Main".to_string(), Stage::Compute)]);
+    let m = hlsl::compile_file(&shader("default_params.hlsl"), &HlslOptions::default()).unwrap();
+    let scaled = named(&m.words, "scaled")[0];
+    let bump = named(&m.words, "Counter::bump")[0];
+    let all = calls(&m.words);
+    // Every call passes every parameter, whether written or defaulted.
+    let to = |f: u32| -> Vec<usize> {
+        all.iter()
+            .filter(|c| c[2] == f)
+            .map(|c| c.len() - 3)
+            .collect()
+    };
+    assert_eq!(to(scaled), vec![3, 3, 3]);
+    assert_eq!(to(bump), vec![2, 2]);
+}

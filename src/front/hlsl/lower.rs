@@ -90,6 +90,8 @@ struct FnSig<'a> {
     ret: Ty,
     id: Id,
     func: &'a Function,
+    /// Default values of the trailing parameters that have one.
+    defaults: Vec<&'a Expr>,
     /// For methods: the struct whose `this` is the first parameter.
     this: Option<u32>,
     stage: Option<Stage>,

@@ -687,11 +687,9 @@ impl<'t> Parser<'t> {
                 let (pname, ppos) = self.ident()?;
                 let dims = self.dims()?;
                 let (semantic, register) = self.post_decl()?;
+                // A default value: used for trailing arguments a call leaves out.
                 let init = if self.eat("=") {
-                    return Err(Error::new(
-                        self.pos(),
-                        "not supported: default parameter values",
-                    ));
+                    Some(self.ternary()?)
                 } else {
                     None
                 };

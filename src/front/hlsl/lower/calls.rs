@@ -1079,9 +1079,13 @@ impl<'a> Lowerer<'a> {
         args: Vec<Arg<'a>>,
         pos: Pos,
     ) -> Result<Option<Val>> {
+        // Trailing parameters with default values may be left out.
         let cands: Vec<usize> = cands
             .into_iter()
-            .filter(|k| self.funcs[*k].params.len() == args.len())
+            .filter(|k| {
+                let f = &self.funcs[*k];
+                (f.params.len() - f.defaults.len()..=f.params.len()).contains(&args.len())
+            })
             .collect();
         if cands.is_empty() {
             return Err(Error::new(
@@ -1156,6 +1160,14 @@ impl<'a> Lowerer<'a> {
         let sig = self.funcs[k].clone();
         if sig.stage.is_some() {
             return Err(unsupported(pos, "calling an entry point function"));
+        }
+        let mut args = args;
+        let first_default = sig.params.len() - sig.defaults.len();
+        for i in args.len()..sig.params.len() {
+            // Evaluated at the call, as C++ and DXC do.
+            let e = sig.defaults[i - first_default];
+            argv.push((None, self.expr(e)?));
+            args.push(Arg::Expr(e));
         }
         let mut temps = Vec::new();
         for ((p, (place, v)), a) in sig.params.iter().zip(&argv).zip(&args) {

@@ -61,6 +61,7 @@ impl<'a> Lowerer<'a> {
         }
         self.declare_globals()?;
         let mut entries = Vec::new();
+        let mut protos: Vec<&'a Function> = Vec::new();
         for item in items {
             if let Item::Struct(sd) = item {
                 self.declare_methods(sd)?;
@@ -111,11 +112,26 @@ impl<'a> Lowerer<'a> {
             }
             let id = self.b.id();
             if f.body.is_none() {
-                continue; // a prototype: the definition carries the signature
+                // A prototype: the definition carries the signature, the
+                // prototype may carry the default values.
+                protos.push(f);
+                continue;
             }
+            let proto = protos
+                .iter()
+                .rev()
+                .find(|p| p.name == f.name && p.params.len() == f.params.len());
+            let defaults = match defaults_of(f)? {
+                d if d.is_empty() => match proto {
+                    Some(p) => defaults_of(p)?,
+                    None => d,
+                },
+                d => d,
+            };
             let idx = self.funcs.len();
             self.funcs.push(FnSig {
                 name: f.name.clone(),
+                defaults,
                 params,
                 ret,
                 id,
@@ -171,6 +187,7 @@ impl<'a> Lowerer<'a> {
             let id = self.b.id();
             self.funcs.push(FnSig {
                 name: name.clone(),
+                defaults: defaults_of(f)?,
                 params,
                 ret,
                 id,
@@ -973,4 +990,26 @@ impl<'a> Lowerer<'a> {
             .insert(v.name.clone(), Global::Const(Val { id, ty: t.clone() }));
         Ok(())
     }
+}
+
+/// The default values of `f`'s trailing parameters; every parameter after one
+/// with a default value needs one too.
+fn defaults_of(f: &Function) -> Result<Vec<&Expr>> {
+    let Some(first) = f.params.iter().position(|p| p.init.is_some()) else {
+        return Ok(Vec::new());
+    };
+    f.params[first..]
+        .iter()
+        .map(|p| {
+            p.init.as_ref().ok_or_else(|| {
+                Error::new(
+                    p.pos,
+                    format!(
+                        "parameter `{}` follows one with a default value and needs one too",
+                        p.name
+                    ),
+                )
+            })
+        })
+        .collect()
 }
