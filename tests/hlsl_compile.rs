@@ -619,3 +619,24 @@ fn default_parameter_values_fill_left_out_arguments() {
     assert_eq!(to(scaled), vec![3, 3, 3]);
     assert_eq!(to(bump), vec![2, 2]);
 }
+
+#[test]
+fn forward_declarations_classes_static_and_out_of_line_methods() {
+    let entries = compile_all("records.hlsl");
+    assert_eq!(entries, vec![("Main".to_string(), Stage::Compute)]);
+    let m = hlsl::compile_file(&shader("records.hlsl"), &HlslOptions::default()).unwrap();
+    let all = calls(&m.words);
+    let args_of = |name: &str| -> Vec<usize> {
+        let f = named(&m.words, name)[0];
+        all.iter()
+            .filter(|c| c[2] == f)
+            .map(|c| c.len() - 3)
+            .collect()
+    };
+    // Static methods take no `this`; the out-of-line `pack` does.
+    assert_eq!(args_of("GbufferData::make"), vec![2]);
+    assert_eq!(args_of("GbufferData::channel"), vec![1, 1, 1]);
+    assert_eq!(args_of("GbufferData::pack"), vec![1]);
+    // `luminance` is found through `using namespace shading` (twice).
+    assert_eq!(args_of("shading::luminance"), vec![1, 1]);
+}

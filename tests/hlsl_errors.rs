@@ -122,8 +122,8 @@ fn unsupported_constructs_are_named() {
         "main.hlsl:4:5: not supported: type `double` (only 32-bit types)"
     );
     assert_eq!(
-        err("struct S { float f; static float get() { return 1; } };"),
-        "main.hlsl:1:34: not supported: static struct methods"
+        err("struct S { float f; static const uint N = 4; };"),
+        "main.hlsl:1:34: not supported: static data members"
     );
 }
 

@@ -71,6 +71,8 @@ pub struct Function {
     pub params: Vec<VarDecl>,
     pub semantic: Option<(String, Pos)>,
     pub body: Option<Vec<Stmt>>,
+    /// A `static` struct method: no `this`.
+    pub is_static: bool,
 }
 
 #[derive(Clone, Debug)]
@@ -107,6 +109,8 @@ pub enum Item {
         members: Vec<VarDecl>,
     },
     Function(Function),
+    /// `using namespace a::b;`: unqualified names also look in `a::b::`.
+    Using(String),
 }
 
 #[derive(Clone, Debug)]

@@ -171,6 +171,8 @@ pub struct Lowerer<'a> {
     pub decls: Vec<(NamedDecl, Location)>,
     /// The function being lowered.
     f: FnCtx,
+    /// Namespaces named by `using namespace`, searched after the enclosing ones.
+    usings: Vec<String>,
     /// `NonUniformResourceIndex` results, decorated when they index resources.
     nonuniform: HashSet<Id>,
     /// cbuffer member name → (variable, type, index, layout, storage class).
@@ -415,6 +417,13 @@ impl<'a> Lowerer<'a> {
             lowered: HashSet::new(),
             decls: Vec::new(),
             f: FnCtx::new(usize::MAX, "", None, Ty::Void),
+            usings: items
+                .iter()
+                .filter_map(|i| match i {
+                    Item::Using(n) => Some(format!("{n}::")),
+                    _ => None,
+                })
+                .collect(),
             struct_io: HashMap::new(),
             fn_derivs: HashMap::new(),
             nonuniform: HashSet::new(),

@@ -14,6 +14,8 @@ pub struct Parser<'t> {
     i: usize,
     types: HashSet<String>,
     ns: Vec<String>,
+    /// Namespaces named by `using namespace`.
+    using: Vec<String>,
     depth: usize,
 }
 
@@ -121,6 +123,7 @@ pub fn parse(tokens: &[Token]) -> Result<Vec<Item>> {
         i: 0,
         types: HashSet::new(),
         ns: Vec::new(),
+        using: Vec::new(),
         depth: 0,
     };
     let mut items = Vec::new();
@@ -188,6 +191,11 @@ impl<'t> Parser<'t> {
                     name.push_str(self.peek_at(1).and_then(Token::ident).unwrap_or_default());
                     self.i += 2;
                 }
+                // DXC's `dx` namespace holds built-ins (`dx::HitObject`,
+                // `dx::MaybeReorderThread`): they are known by their bare names.
+                if let Some(bare) = name.strip_prefix("dx::") {
+                    name = bare.to_string();
+                }
                 Ok((name, t.pos))
             }
             _ => Err(self.unexpected("a name")),
@@ -206,7 +214,7 @@ impl<'t> Parser<'t> {
         let Some(name) = self.peek_at(k).and_then(Token::ident) else {
             return false;
         };
-        if is_builtin_type(name) || self.types.contains(name) {
+        if (is_builtin_type(name) || self.types.contains(name)) && !self.is_at(k + 1, "::") {
             return true;
         }
         // A qualified name whose last part is a known type.
@@ -220,14 +228,19 @@ impl<'t> Parser<'t> {
             full.push_str(n);
             j += 2;
         }
-        self.types.contains(&full) || self.ns_qualified(&full).is_some()
+        let full = full.strip_prefix("dx::").unwrap_or(&full);
+        is_builtin_type(full) || self.types.contains(full) || self.ns_qualified(full).is_some()
     }
 
     fn ns_qualified(&self, name: &str) -> Option<String> {
         let mut prefix = self.ns.join("::");
         loop {
             if prefix.is_empty() {
-                return None;
+                return self
+                    .using
+                    .iter()
+                    .map(|u| format!("{u}::{name}"))
+                    .find(|q| self.types.contains(q));
             }
             let q = format!("{prefix}::{name}");
             if self.types.contains(&q) {
@@ -360,12 +373,47 @@ impl<'t> Parser<'t> {
             self.ns.pop();
             return Ok(());
         }
-        if self.is_kw("struct")
-            && (self.peek_at(2).is_some_and(|t| t.is("{")) || self.is_at(1, "["))
+        let record = self.is_kw("struct") || self.is_kw("class");
+        if record && self.is_at(2, ";") {
+            // A forward declaration: `struct X;`, `class Foo;`.
+            self.i += 1;
+            let (name, _) = self.ident()?;
+            self.declare_type(&name);
+            self.expect(";")?;
+            return Ok(());
+        }
+        if record && (self.peek_at(2).is_some_and(|t| t.is("{") || t.is(":")) || self.is_at(1, "["))
         {
             let s = self.struct_decl()?;
             self.expect(";")?;
             items.push(Item::Struct(s));
+            return Ok(());
+        }
+        if self.is_kw("using") {
+            self.i += 1;
+            if self.eat("namespace") {
+                let (name, _) = self.ident()?;
+                self.expect(";")?;
+                if name != "dx" {
+                    self.using.push(name.clone());
+                    items.push(Item::Using(name));
+                }
+                return Ok(());
+            }
+            // `using Name = Type;`: a typedef.
+            let (name, pos) = self.ident()?;
+            self.expect("=")?;
+            let _ = self.mods();
+            let ty = self.type_ref()?;
+            let dims = self.dims()?;
+            self.expect(";")?;
+            self.declare_type(&name);
+            items.push(Item::Typedef {
+                ty,
+                dims,
+                name: self.qualify(&name),
+                pos,
+            });
             return Ok(());
         }
         if self.is_kw("typedef") {
@@ -474,11 +522,37 @@ impl<'t> Parser<'t> {
             self.is_at(k, "(")
         } {
             let (name, pos) = self.ident()?;
-            if name.contains("::") {
-                return Err(Error::new(
-                    pos,
-                    "not supported: out-of-line member definition",
-                ));
+            if let Some((owner, method)) = name.rsplit_once("::") {
+                // `T S::m(...) { ... }`: the definition of a method declared in `S`.
+                let owner = self
+                    .ns_qualified(owner)
+                    .unwrap_or_else(|| owner.to_string());
+                if let Some(sd) = items.iter_mut().rev().find_map(|it| match it {
+                    Item::Struct(sd) if sd.name == owner => Some(sd),
+                    _ => None,
+                }) {
+                    let mut f = self.function(attrs, ty, method.to_string(), pos)?;
+                    f.name = method.to_string();
+                    let Some(decl) = sd.methods.iter_mut().find(|m| {
+                        m.name == method && m.body.is_none() && m.params.len() == f.params.len()
+                    }) else {
+                        return Err(Error::new(
+                            pos,
+                            format!(
+                                "`{owner}` declares no method `{method}` with {} parameter(s)",
+                                f.params.len()
+                            ),
+                        ));
+                    };
+                    f.is_static = decl.is_static;
+                    for (d, p) in decl.params.iter().zip(f.params.iter_mut()) {
+                        if p.init.is_none() {
+                            p.init = d.init.clone();
+                        }
+                    }
+                    *decl = f;
+                    return Ok(());
+                }
             }
             let f = self.function(attrs, ty, name, pos)?;
             items.push(Item::Function(f));
@@ -494,11 +568,13 @@ impl<'t> Parser<'t> {
     }
 
     fn struct_decl(&mut self) -> Result<StructDecl> {
-        self.expect("struct")?;
+        if !self.eat("class") {
+            self.expect("struct")?;
+        }
         let _ = self.attrs()?; // `[raypayload]`
         let (name, pos) = self.ident()?;
         self.declare_type(&name);
-        if self.eat(":") {
+        if self.is(":") {
             return Err(Error::new(self.pos(), "not supported: struct inheritance"));
         }
         self.expect("{")?;
@@ -508,30 +584,36 @@ impl<'t> Parser<'t> {
             if self.peek().is_none() {
                 return Err(self.unexpected("`}`"));
             }
+            // `public:` / `private:` / `protected:` sections: access is not checked.
+            if ["public", "private", "protected"]
+                .iter()
+                .any(|k| self.is_kw(k))
+                && self.is_at(1, ":")
+            {
+                self.i += 2;
+                continue;
+            }
             let fattrs = self.attrs()?;
             let mods = self.mods();
-            if self.is_kw("struct") {
+            if self.is_kw("struct") || self.is_kw("class") {
                 return Err(Error::new(self.pos(), "not supported: nested struct").len(6));
             }
             let ty = self.type_ref()?;
             if self.peek().and_then(Token::ident).is_some() && self.is_at(1, "(") {
-                if mods.is_static {
-                    return Err(Error::new(
-                        self.pos(),
-                        "not supported: static struct methods",
-                    ));
-                }
                 let (mname, mpos) = self.ident()?;
+                // Without a body, the definition follows outside (`T S::m(...) {}`).
                 let mut f = self.function(fattrs, ty, mname.clone(), mpos)?;
-                if f.body.is_none() {
-                    return Err(Error::new(
-                        mpos,
-                        "not supported: struct method declared without a body",
-                    ));
-                }
                 f.name = mname;
+                f.is_static = mods.is_static;
+                if f.is_static {
+                    // Unqualified names in a static method look in the struct first.
+                    f.ns = format!("{}::", self.qualify(&name));
+                }
                 methods.push(f);
                 continue;
+            }
+            if mods.is_static {
+                return Err(Error::new(ty.pos, "not supported: static data members"));
             }
             self.declarators(fattrs, mods, ty, &mut fields)?;
         }
@@ -731,6 +813,7 @@ impl<'t> Parser<'t> {
             params,
             semantic,
             body,
+            is_static: false,
         })
     }
 

@@ -226,7 +226,13 @@ impl<'a> Lowerer<'a> {
                 return Some(v.clone());
             }
         }
-        self.fn_by_name.get(name).cloned()
+        if let Some(v) = self.fn_by_name.get(name) {
+            return Some(v.clone());
+        }
+        self.usings
+            .iter()
+            .find_map(|u| self.fn_by_name.get(&format!("{u}{name}")))
+            .cloned()
     }
 
     fn call(&mut self, name: &str, args: &'a [Expr], pos: Pos) -> Result<Option<Val>> {
@@ -234,6 +240,10 @@ impl<'a> Lowerer<'a> {
             if let Ty::Struct(k) = this.ty() {
                 let qualified = format!("{}::{name}", self.structs[*k as usize].name);
                 if let Some(c) = self.fn_by_name.get(&qualified).cloned() {
+                    if c.iter().all(|k| self.funcs[*k].this.is_none()) {
+                        let args = args.iter().map(Arg::Expr).collect();
+                        return self.call_user(name, c, args, pos);
+                    }
                     let mut all = vec![Arg::Place(this, pos)];
                     all.extend(args.iter().map(Arg::Expr));
                     return self.call_user(name, c, all, pos);

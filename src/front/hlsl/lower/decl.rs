@@ -160,12 +160,18 @@ impl<'a> Lowerer<'a> {
             return Ok(());
         };
         for f in &sd.methods {
+            if f.body.is_none() {
+                continue; // declared, never defined: a call finds no overload
+            }
             let ret = self.resolve_ty(&f.ret, &f.ns)?;
-            let mut params = vec![Param {
-                ty: Ty::Struct(k),
-                out: true,
-                input: true,
-            }];
+            let mut params = Vec::new();
+            if !f.is_static {
+                params.push(Param {
+                    ty: Ty::Struct(k),
+                    out: true,
+                    input: true,
+                });
+            }
             for p in &f.params {
                 let t = self.resolve_ty(&p.ty, &f.ns)?;
                 let t = self.apply_dims(t, &p.dims, p.pos, false)?;
@@ -192,7 +198,7 @@ impl<'a> Lowerer<'a> {
                 ret,
                 id,
                 func: f,
-                this: Some(k),
+                this: (!f.is_static).then_some(k),
                 stage: None,
                 numthreads: [1, 1, 1],
             });
@@ -267,7 +273,13 @@ impl<'a> Lowerer<'a> {
                 return Some(t.clone());
             }
             if prefix.is_empty() {
-                return None;
+                return self.usings.iter().find_map(|u| {
+                    let q = format!("{u}{name}");
+                    match self.struct_names.get(&q) {
+                        Some(k) => Some(Ty::Struct(*k)),
+                        None => self.typedefs.get(&q).cloned(),
+                    }
+                });
             }
             prefix.truncate(prefix.len() - 2);
             prefix = match prefix.rfind("::") {
