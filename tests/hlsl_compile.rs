@@ -640,3 +640,55 @@ fn forward_declarations_classes_static_and_out_of_line_methods() {
     // `luminance` is found through `using namespace shading` (twice).
     assert_eq!(args_of("shading::luminance"), vec![1, 1]);
 }
+
+#[test]
+fn subobjects_are_parsed_and_exposed() {
+    let entries = compile_all("subobjects.hlsl");
+    assert_eq!(entries.len(), 3);
+    let m = hlsl::compile_file(&shader("subobjects.hlsl"), &HlslOptions::default()).unwrap();
+    let s = &m.subobjects;
+    assert_eq!(s.shader_configs.len(), 1);
+    assert_eq!(s.shader_configs[0].name, "ShaderConfig");
+    assert_eq!(s.shader_configs[0].max_payload_bytes, 16);
+    assert_eq!(s.shader_configs[0].max_attribute_bytes, 8);
+    assert_eq!(s.shader_configs[0].location.line, 19);
+    assert_eq!(s.max_recursion_depth(), Some(3));
+    assert_eq!(s.pipeline_configs[0].flags, 0x200);
+    let groups: Vec<_> = s
+        .hit_groups
+        .iter()
+        .map(|g| {
+            (
+                g.name.as_str(),
+                g.procedural,
+                g.any_hit.as_deref(),
+                g.closest_hit.as_deref(),
+                g.intersection.as_deref(),
+            )
+        })
+        .collect();
+    assert_eq!(
+        groups,
+        vec![
+            ("Opaque", false, None, Some("ShadeHit"), None),
+            (
+                "Spheres",
+                true,
+                Some("SphereAny"),
+                Some("ShadeHit"),
+                Some("SphereHit")
+            ),
+        ]
+    );
+    assert_eq!(s.associations[0].subobject, "ShaderConfig");
+    assert_eq!(
+        s.associations[0].exports,
+        vec!["Gen", "Background", "ShadeHit"]
+    );
+    assert_eq!(s.root_signatures.len(), 2);
+    assert_eq!(
+        s.root_signatures[0].text,
+        "DescriptorTable(UAV(u0)), SRV(t0)"
+    );
+    assert!(s.root_signatures[1].local);
+}

@@ -236,11 +236,7 @@ fn matrices_in_component_intrinsics_are_refused() {
 }
 
 #[test]
-fn subobjects_and_templated_methods_are_refused() {
-    assert_eq!(
-        err("TriangleHitGroup hg = { \"\", \"Hit\" };\n[numthreads(1,1,1)] void m() {}"),
-        "main.hlsl:1:1: not supported: `TriangleHitGroup`"
-    );
+fn templated_methods_are_refused() {
     assert_eq!(
         err("ByteAddressBuffer b;\n[numthreads(1,1,1)]\nvoid m()\n{\n    float4 v = b.Load<float4>(0);\n}"),
         "main.hlsl:5:18: not supported: templated method `Load<...>`"
@@ -411,5 +407,17 @@ fn pixel_shader_interface_errors() {
     assert_eq!(
         err(&format!("{PS}float4 ps(float3x3 m : M) : SV_Target {{ return 0; }}")),
         "main.hlsl:2:20: not supported: `float3x3` as a pixel shader input (scalars and vectors only)"
+    );
+}
+
+#[test]
+fn malformed_subobjects() {
+    assert_eq!(
+        err("RaytracingShaderConfig c = { 16 };\n[numthreads(1,1,1)] void m() {}"),
+        "main.hlsl:1:24: a `RaytracingShaderConfig` has 2 field(s) (maximum payload size, maximum attribute size), 1 given"
+    );
+    assert_eq!(
+        err("TriangleHitGroup g = { 1, \"Hit\" };\n[numthreads(1,1,1)] void m() {}"),
+        "main.hlsl:1:24: the any-hit shader of a `TriangleHitGroup` must be a string"
     );
 }

@@ -19,6 +19,7 @@ mod stmt;
 use super::ast::*;
 use super::error::{Error, Pos, Result};
 use super::parse::split_numeric;
+use super::subobject;
 use super::types::*;
 use crate::diag::Location;
 use crate::program::NamedDecl;
@@ -171,6 +172,8 @@ pub struct Lowerer<'a> {
     pub decls: Vec<(NamedDecl, Location)>,
     /// The function being lowered.
     f: FnCtx,
+    /// DXR subobjects the file declares.
+    pub subobjects: super::subobject::Subobjects,
     /// Namespaces named by `using namespace`, searched after the enclosing ones.
     usings: Vec<String>,
     /// `NonUniformResourceIndex` results, decorated when they index resources.
@@ -417,6 +420,7 @@ impl<'a> Lowerer<'a> {
             lowered: HashSet::new(),
             decls: Vec::new(),
             f: FnCtx::new(usize::MAX, "", None, Ty::Void),
+            subobjects: Default::default(),
             usings: items
                 .iter()
                 .filter_map(|i| match i {

@@ -10,6 +10,7 @@ pub mod lex;
 mod lower;
 pub mod parse;
 pub mod pp;
+pub mod subobject;
 pub mod types;
 
 pub use crate::shader::Stage;
@@ -45,6 +46,8 @@ pub struct CompiledModule {
     pub entries: Vec<(String, Stage)>,
     /// Source positions of structs, members, globals and functions.
     pub decls: Vec<(NamedDecl, Location)>,
+    /// DXR subobjects (shader and pipeline configs, hit groups, associations).
+    pub subobjects: subobject::Subobjects,
 }
 
 /// Compiles each entry point of `path` into its own module.
@@ -193,6 +196,7 @@ fn compile_source_whole_inner(
         .iter()
         .filter_map(|(_, name, _)| l.entry_function(name))
         .collect();
+    let subobjects = std::mem::take(&mut l.subobjects);
     let (words, decls) = l
         .finish(&ks)
         .map_err(|e| e.into_input_error(&files, path))?;
@@ -200,5 +204,6 @@ fn compile_source_whole_inner(
         words,
         entries: picked.into_iter().map(|(_, n, s)| (n, s)).collect(),
         decls,
+        subobjects,
     })
 }

@@ -84,7 +84,7 @@ const PLAIN_TYPES: &[&str] = &[
     "RWByteAddressBuffer",
     "string",
     "HitObject",
-    // DXR state-object subobjects: recognised so they can be refused by name.
+    // DXR state-object subobjects (see `subobject`).
     "TriangleHitGroup",
     "ProceduralPrimitiveHitGroup",
     "RaytracingShaderConfig",
@@ -1283,7 +1283,13 @@ impl<'t> Parser<'t> {
             }
             Tok::Str(s) => {
                 self.i += 1;
-                ExprKind::Str(s.to_string())
+                // Adjacent literals join, as in C: `"SRV(t0), " "UAV(u0)"`.
+                let mut s = s.to_string();
+                while let Some(Tok::Str(more)) = self.peek().map(|t| &t.tok) {
+                    s.push_str(more);
+                    self.i += 1;
+                }
+                ExprKind::Str(s)
             }
             Tok::Punct("(") => {
                 self.i += 1;

@@ -522,6 +522,9 @@ impl<'a> Lowerer<'a> {
                     let members: Vec<&VarDecl> = members.iter().collect();
                     self.declare_cbuffer(attrs, name, *pos, binding, &members)?;
                 }
+                Item::Var(v) if subobject::Kind::from_type_name(&v.ty.name).is_some() => {
+                    self.declare_subobject(v)?
+                }
                 Item::Var(v) if self.in_implicit_globals(v)? => globals_members.push(v),
                 Item::Var(v) => self.declare_global_var(v, &mut used, &mut next_auto)?,
                 _ => {}
@@ -534,6 +537,49 @@ impl<'a> Lowerer<'a> {
             self.declare_cbuffer(&[], "$Globals", pos, Some(binding), &globals_members)?;
         }
         Ok(())
+    }
+
+    /// A DXR subobject: its content is recorded, nothing is emitted.
+    fn declare_subobject(&mut self, v: &VarDecl) -> Result<()> {
+        let Some(kind) = subobject::Kind::from_type_name(&v.ty.name) else {
+            return Ok(());
+        };
+        let Some(init) = &v.init else {
+            return Err(Error::new(
+                v.pos,
+                format!("`{}` needs an initializer `{{ ... }}`", v.name),
+            ));
+        };
+        let mut values = Vec::new();
+        for e in subobject::fields(kind, init, v.pos)? {
+            values.push(match &e.kind {
+                ExprKind::Str(s) => subobject::Value::Str(s.clone()),
+                _ => subobject::Value::Int(self.subobject_int(e)?),
+            });
+        }
+        let location = self.loc(v.pos, v.name.len() as u32);
+        subobject::record(&mut self.subobjects, kind, &v.name, values, location);
+        Ok(())
+    }
+
+    /// An integer field of a subobject: a constant expression over numbers,
+    /// `static const` values and the `RAYTRACING_PIPELINE_FLAG_*` /
+    /// `STATE_OBJECT_FLAG*` names.
+    fn subobject_int(&mut self, e: &Expr) -> Result<u32> {
+        match &e.kind {
+            ExprKind::Ident(n) if subobject::flag_constant(n).is_some() => {
+                Ok(subobject::flag_constant(n).unwrap_or_default())
+            }
+            ExprKind::Binary(BinOp::BitOr, a, b) => {
+                Ok(self.subobject_int(a)? | self.subobject_int(b)?)
+            }
+            _ => {
+                let v = self.const_int(e)?;
+                u32::try_from(v).map_err(|_| {
+                    Error::new(e.pos, format!("{v} is out of range for a subobject field"))
+                })
+            }
+        }
     }
 
     /// Whether a global belongs in `$Globals`: not static, groupshared, a
