@@ -692,3 +692,15 @@ fn subobjects_are_parsed_and_exposed() {
     );
     assert!(s.root_signatures[1].local);
 }
+
+#[test]
+fn helpers_returning_resources_are_inlined() {
+    let entries = compile_all("resource_helpers.hlsl");
+    assert_eq!(entries, vec![("Main".to_string(), Stage::Compute)]);
+    let m = hlsl::compile_file(&shader("resource_helpers.hlsl"), &HlslOptions::default()).unwrap();
+    // No function returns a resource: the helpers are not functions of the module.
+    for helper in ["material", "palette", "raw", "defaultSampler"] {
+        assert!(named(&m.words, helper).is_empty(), "{helper} was emitted");
+    }
+    assert!(calls(&m.words).is_empty());
+}

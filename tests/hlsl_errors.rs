@@ -421,3 +421,15 @@ fn malformed_subobjects() {
         "main.hlsl:1:24: the any-hit shader of a `TriangleHitGroup` must be a string"
     );
 }
+
+#[test]
+fn resource_helpers_that_cannot_be_inlined_are_refused() {
+    assert_eq!(
+        err("Texture2D a;\nTexture2D b;\nTexture2D pick(bool x) { if (x) return a; return b; }\n[numthreads(1,1,1)]\nvoid m()\n{\n    uint w, h;\n    pick(true).GetDimensions(w, h);\n}"),
+        "main.hlsl:3:11: not supported: a function returning a resource whose body is more than `return <resource>;`"
+    );
+    assert_eq!(
+        err("SamplerState a;\nSamplerState b;\nTexture2D t;\nSamplerState pick(bool x) { return x ? a : b; }\n[numthreads(1,1,1)]\nvoid m()\n{\n    float4 c = t.SampleLevel(pick(true), float2(0, 0), 0);\n}"),
+        "main.hlsl:4:38: not supported: choosing a resource with `?:`"
+    );
+}

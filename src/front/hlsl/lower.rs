@@ -127,6 +127,8 @@ struct FnCtx {
     term: bool,
     /// `this` of the method being lowered; its members resolve by bare name.
     this_place: Option<Place>,
+    /// Resource-returning helpers being inlined (see `resource_call`).
+    inline_depth: u32,
 }
 
 impl FnCtx {
@@ -141,6 +143,7 @@ impl FnCtx {
             flow: Vec::new(),
             term: false,
             this_place: None,
+            inline_depth: 0,
         }
     }
 }
@@ -212,6 +215,15 @@ const TRI_ATTRS: u32 = 1;
 
 fn unsupported(pos: Pos, what: impl std::fmt::Display) -> Error {
     Error::new(pos, format!("not supported: {what}"))
+}
+
+/// A resource reached through something other than a variable (which
+/// SPIR-V's logical addressing needs).
+fn not_a_variable(pos: Pos) -> Error {
+    unsupported(
+        pos,
+        "a resource that is not a variable, an element of a resource array or the result of a `return <resource>;` helper",
+    )
 }
 
 impl From<dr::Error> for Error {

@@ -250,6 +250,10 @@ impl<'a> Lowerer<'a> {
                 }
             }
         }
+        if self.returns_resource(name) {
+            let p = self.resource_call(name, args, pos)?;
+            return self.read(&p).map(Some);
+        }
         if let Some(c) = self.find_user(name) {
             return self.call_user(name, c, args.iter().map(Arg::Expr).collect(), pos);
         }
@@ -1237,5 +1241,90 @@ impl<'a> Lowerer<'a> {
         } else {
             Some(Val { id, ty: sig.ret })
         })
+    }
+
+    /// Whether `name` is a user function returning a resource.
+    pub(super) fn returns_resource(&self, name: &str) -> bool {
+        self.find_user(name)
+            .is_some_and(|c| c.iter().any(|k| self.funcs[*k].ret.is_resource()))
+    }
+
+    /// A call of a helper that returns a resource: SPIR-V's logical
+    /// addressing cannot return one, so (as DXC's legalization does) the
+    /// helper is inlined. Its body must be `return <resource expression>;`,
+    /// evaluated with the parameters bound to the arguments.
+    pub(super) fn resource_call(
+        &mut self,
+        name: &str,
+        args: &'a [Expr],
+        pos: Pos,
+    ) -> Result<Place> {
+        let cands = self.find_user(name).unwrap_or_default();
+        let Some(k) = cands.into_iter().find(|k| {
+            let f = &self.funcs[*k];
+            f.this.is_none()
+                && (f.params.len() - f.defaults.len()..=f.params.len()).contains(&args.len())
+        }) else {
+            return Err(Error::new(
+                pos,
+                format!("no overload of `{name}` takes {} argument(s)", args.len()),
+            )
+            .len(name.len() as u32));
+        };
+        let sig = self.funcs[k].clone();
+        let body = sig.func.body.as_deref().unwrap_or_default();
+        let [Stmt {
+            kind: StmtKind::Return(Some(ret)),
+            ..
+        }] = body
+        else {
+            return Err(unsupported(
+                sig.func.pos,
+                "a function returning a resource whose body is more than `return <resource>;`",
+            )
+            .len(sig.name.len() as u32));
+        };
+        if self.f.inline_depth >= 16 {
+            return Err(Error::new(
+                pos,
+                format!("`{name}` is recursive; HLSL does not allow recursion"),
+            ));
+        }
+        let first_default = sig.params.len() - sig.defaults.len();
+        let mut scope = HashMap::new();
+        for (i, (p, decl)) in sig.params.iter().zip(&sig.func.params).enumerate() {
+            let a = match args.get(i) {
+                Some(a) => a,
+                None => sig.defaults[i - first_default],
+            };
+            if p.out {
+                return Err(unsupported(
+                    decl.pos,
+                    "`out` parameters of a function returning a resource",
+                ));
+            }
+            let place = if p.ty.is_resource() {
+                self.place(a)?
+            } else {
+                let v = self.expr(a)?;
+                Place::Value(self.convert(v, &p.ty, a.pos, false)?)
+            };
+            scope.insert(decl.name.clone(), place);
+        }
+        // The helper's body sees its parameters and the globals, not the caller's locals.
+        let scopes = std::mem::replace(&mut self.f.scopes, vec![scope]);
+        let this = self.f.this_place.take();
+        let ns = std::mem::replace(&mut self.f.cur_ns, sig.func.ns.clone());
+        self.f.inline_depth += 1;
+        let r = self.place(ret);
+        self.f.inline_depth -= 1;
+        self.f.scopes = scopes;
+        self.f.this_place = this;
+        self.f.cur_ns = ns;
+        let r = r?;
+        if !r.ty().is_resource() {
+            return Err(Error::new(ret.pos, "expected a resource"));
+        }
+        Ok(r)
     }
 }

@@ -738,6 +738,10 @@ impl<'a> Lowerer<'a> {
         let side = |this: &mut Self, label: Id, e: &'a Expr| -> Result<(Id, Ty)> {
             this.start_block(Some(label))?;
             let v = this.expr(e)?;
+            if v.ty.is_resource() || matches!(v.ty, Ty::RayQuery(_)) {
+                // Vulkan has no function variables of resource types.
+                return Err(unsupported(pos, "choosing a resource with `?:`"));
+            }
             let tmp = this.local_var(&v.ty, "")?;
             if this.f.term {
                 this.start_block(None)?;

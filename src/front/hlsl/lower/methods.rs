@@ -48,13 +48,13 @@ impl<'a> Lowerer<'a> {
             }
             Ty::Texture { .. } => {
                 let Place::Ptr { ptr, .. } = p else {
-                    unreachable!("textures are variables")
+                    return Err(not_a_variable(pos));
                 };
                 self.texture(ptr, &t, name, args, pos)
             }
             Ty::StructuredBuffer(e, _) => {
                 let Place::Ptr { ptr, .. } = p.clone() else {
-                    unreachable!("buffers are variables")
+                    return Err(not_a_variable(pos));
                 };
                 match name {
                     "Load" => {
@@ -97,7 +97,7 @@ impl<'a> Lowerer<'a> {
             }
             Ty::ByteAddress(rw) => {
                 let Place::Ptr { ptr, .. } = p else {
-                    unreachable!("buffers are variables")
+                    return Err(not_a_variable(pos));
                 };
                 self.byte_address(ptr, *rw, name, args, pos)
             }

@@ -208,6 +208,9 @@ impl<'a> Lowerer<'a> {
                 }
                 self.index(bp, iv, idx, e.pos)
             }
+            ExprKind::Call(name, args) if self.returns_resource(name) => {
+                self.resource_call(name, args, e.pos)
+            }
             _ => Ok(Place::Value(self.expr(e)?)),
         }
     }
@@ -359,7 +362,7 @@ impl<'a> Lowerer<'a> {
             Ty::StructuredBuffer(e, _) => {
                 let i = scalar_index(self, iv)?;
                 let Place::Ptr { ptr, class, .. } = bp else {
-                    unreachable!("buffers are variables")
+                    return Err(not_a_variable(pos));
                 };
                 let et = self.spv(e, Layout::Std430)?;
                 let pty = self.b.type_pointer(None, class, et);
@@ -382,7 +385,7 @@ impl<'a> Lowerer<'a> {
             )),
             Ty::Texture { rw, sc, n, dim } => {
                 let Place::Ptr { ptr, .. } = bp else {
-                    unreachable!("textures are variables")
+                    return Err(not_a_variable(pos));
                 };
                 let cn = self.coord_size(*dim, false);
                 let ct = if cn == 1 {
