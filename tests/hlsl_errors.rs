@@ -433,3 +433,56 @@ fn resource_helpers_that_cannot_be_inlined_are_refused() {
         "main.hlsl:4:38: not supported: choosing a resource with `?:`"
     );
 }
+
+/// Every attribute in the table is implemented (and a test shader uses it),
+/// a hint (and a test shader uses it), or refused at its position; names not
+/// in the table are refused too. No attribute is silently ignored.
+#[test]
+fn every_attribute_is_implemented_or_refused() {
+    use rtlint::front::hlsl::attrs::{Support, ATTRIBUTES};
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/hlsl");
+    let shaders: String = std::fs::read_dir(&dir)
+        .unwrap()
+        .filter_map(|e| std::fs::read_to_string(e.ok()?.path()).ok())
+        .collect::<Vec<_>>()
+        .join("\n")
+        .to_ascii_lowercase();
+    for a in ATTRIBUTES {
+        match a.support {
+            Support::Implemented | Support::Hint => {
+                let written = [format!("[{}", a.name), format!("[[{}", a.name)];
+                assert!(
+                    written.iter().any(|w| shaders.contains(w.as_str())),
+                    "no test shader under tests/hlsl uses `{}`",
+                    a.name
+                );
+            }
+            Support::Refused(what) => {
+                let src = format!("[[{}(1)]]\n[numthreads(1,1,1)]\nvoid m() {{}}", a.name);
+                assert_eq!(
+                    err(&src),
+                    format!("main.hlsl:1:3: not supported: {what}"),
+                    "{}",
+                    a.name
+                );
+            }
+        }
+    }
+    assert_eq!(
+        err("[[vk::made_up]]\n[numthreads(1,1,1)]\nvoid m() {}"),
+        "main.hlsl:1:3: not supported: attribute `vk::made_up`"
+    );
+    // Implemented, but not where it is written.
+    assert_eq!(
+        err("[[vk::binding(0)]]\n[numthreads(1,1,1)]\nvoid m() {}"),
+        "main.hlsl:1:3: not supported: `vk::binding` on a function"
+    );
+    assert_eq!(
+        err("[numthreads(1,1,1)]\nvoid m()\n{\n    [[vk::image_format(\"rgba8\")]] uint x = 0;\n}"),
+        "main.hlsl:4:7: not supported: `vk::image_format` on a statement"
+    );
+    assert_eq!(
+        err("[[vk::image_format(\"rgba8\")]] Texture2D t;\n[numthreads(1,1,1)]\nvoid m() {}"),
+        "main.hlsl:1:3: not supported: `vk::image_format` on anything but an RWTexture"
+    );
+}

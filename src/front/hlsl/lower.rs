@@ -164,7 +164,7 @@ pub struct Lowerer<'a> {
     consts: HashMap<(Id, u32), Id>,
     glsl: Id,
     caps: HashSet<Capability>,
-    exts: HashSet<&'static str>,
+    exts: HashSet<String>,
     builtins: HashMap<BuiltIn, Id>,
     rt_vars: HashMap<(StorageClass, Ty), Id>,
     next_location: HashMap<StorageClass, u32>,
@@ -177,6 +177,8 @@ pub struct Lowerer<'a> {
     f: FnCtx,
     /// DXR subobjects the file declares.
     pub subobjects: super::subobject::Subobjects,
+    /// Globals whose attributes add extensions or capabilities when used.
+    global_reqs: HashMap<Id, Requirements>,
     /// Namespaces named by `using namespace`, searched after the enclosing ones.
     usings: Vec<String>,
     /// `NonUniformResourceIndex` results, decorated when they index resources.
@@ -203,6 +205,10 @@ pub struct Lowerer<'a> {
     /// checked against the entry points that reach them.
     fn_derivs: HashMap<usize, (&'static str, Pos)>,
 }
+
+/// Extensions and capabilities a declaration's `vk::ext_*` attributes name.
+#[derive(Clone, Debug, Default)]
+struct Requirements(Vec<String>, Vec<Capability>);
 
 /// A struct member's semantic and attributes.
 type MemberIo = (Option<(String, Pos)>, Vec<Attr>);
@@ -433,6 +439,7 @@ impl<'a> Lowerer<'a> {
             decls: Vec::new(),
             f: FnCtx::new(usize::MAX, "", None, Ty::Void),
             subobjects: Default::default(),
+            global_reqs: HashMap::new(),
             usings: items
                 .iter()
                 .filter_map(|i| match i {
@@ -469,9 +476,51 @@ impl<'a> Lowerer<'a> {
         }
     }
 
-    fn ext(&mut self, e: &'static str) {
-        if self.exts.insert(e) {
+    fn ext(&mut self, e: &str) {
+        if self.exts.insert(e.to_string()) {
             self.b.extension(e);
+        }
+    }
+
+    /// `[[vk::ext_extension("SPV_...")]]` and `[[vk::ext_capability(N)]]`:
+    /// what a declaration needs from the module.
+    fn ext_requirements(&mut self, attrs: &[Attr]) -> Result<Requirements> {
+        let mut req = Requirements::default();
+        for a in attrs {
+            match a.name.as_str() {
+                "vk::ext_extension" => {
+                    let name = attr_str(a).ok_or_else(|| {
+                        Error::new(a.pos, "expected [[vk::ext_extension(\"SPV_...\")]]")
+                    })?;
+                    req.0.push(name.to_string());
+                }
+                "vk::ext_capability" => {
+                    let e = a
+                        .args
+                        .first()
+                        .ok_or_else(|| Error::new(a.pos, "expected [[vk::ext_capability(N)]]"))?;
+                    let n = self.const_int(e)?;
+                    let c = u32::try_from(n)
+                        .ok()
+                        .and_then(Capability::from_u32)
+                        .ok_or_else(|| {
+                            Error::new(e.pos, format!("unknown SPIR-V capability {n}"))
+                        })?;
+                    req.1.push(c);
+                }
+                _ => {}
+            }
+        }
+        Ok(req)
+    }
+
+    /// Adds the extensions and capabilities of `req` to the module.
+    fn require(&mut self, req: &Requirements) {
+        for e in &req.0 {
+            self.ext(e);
+        }
+        for c in &req.1 {
+            self.cap(*c);
         }
     }
 

@@ -5,6 +5,7 @@
 //! place at this module's boundary. See `docs/hlsl.md` for what is supported.
 
 pub mod ast;
+pub mod attrs;
 pub mod error;
 pub mod lex;
 mod lower;

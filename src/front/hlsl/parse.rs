@@ -5,6 +5,7 @@
 //! meets them.
 
 use super::ast::*;
+use super::attrs::{check, check_site, Site};
 use super::error::{Error, Pos, Result};
 use super::lex::{Tok, Token};
 use std::collections::HashSet;
@@ -22,6 +23,29 @@ pub struct Parser<'t> {
 /// Nesting limit: deep enough for any real shader, shallow enough that a
 /// fuzzer's `((((...` cannot overflow the stack.
 const MAX_DEPTH: usize = 96;
+
+/// Keywords `mods` reads.
+const MODIFIERS: &[&str] = &[
+    "static",
+    "const",
+    "groupshared",
+    "uniform",
+    "in",
+    "out",
+    "inout",
+    "row_major",
+    "column_major",
+    "precise",
+    "nointerpolation",
+    "inline",
+    "export",
+    "extern",
+    "volatile",
+    "linear",
+    "snorm",
+    "unorm",
+    "globallycoherent",
+];
 
 /// What may follow a declarator: a semantic and a register binding.
 type PostDecl = (Option<(String, Pos)>, Option<Register>);
@@ -312,7 +336,13 @@ impl<'t> Parser<'t> {
                     }
                     self.expect(")")?;
                 }
-                out.push(Attr { name, args, pos });
+                let name = match super::attrs::lookup(&name) {
+                    Some(info) => info.name.to_string(),
+                    None => name,
+                };
+                let attr = Attr { name, args, pos };
+                check(&attr)?;
+                out.push(attr);
                 if !self.eat(",") {
                     break;
                 }
@@ -353,11 +383,30 @@ impl<'t> Parser<'t> {
         }
     }
 
+    /// How many modifier keywords start at the current token.
+    fn mods_len(&self) -> usize {
+        let mut k = 0;
+        while let Some(w) = self.peek_at(k).and_then(Token::ident) {
+            if !MODIFIERS.contains(&w) {
+                break;
+            }
+            k += 1;
+        }
+        k
+    }
+
     fn item(&mut self, items: &mut Vec<Item>) -> Result<()> {
         if self.eat(";") {
             return Ok(());
         }
         let attrs = self.attrs()?;
+        let declares_code = self.is_kw("cbuffer") || self.is_kw("tbuffer") || {
+            let k = self.mods_len();
+            self.type_at(k)
+        };
+        if !declares_code {
+            check_site(&attrs, Site::Struct)?;
+        }
         if self.is_kw("namespace") {
             self.i += 1;
             let (name, _) = self.ident()?;
@@ -472,6 +521,7 @@ impl<'t> Parser<'t> {
             if self.is_kw("tbuffer") {
                 return Err(Error::new(kw_pos, "not supported: tbuffer").len(7));
             }
+            check_site(&attrs, Site::Global)?;
             self.i += 1;
             let (name, pos) = self.ident()?;
             let (_, register) = self.post_decl()?;
@@ -482,6 +532,7 @@ impl<'t> Parser<'t> {
                     return Err(self.unexpected("`}`"));
                 }
                 let mattrs = self.attrs()?;
+                check_site(&mattrs, Site::Member)?;
                 let mods = self.mods();
                 let ty = self.type_ref()?;
                 self.declarators(mattrs, mods, ty, &mut members)?;
@@ -531,6 +582,7 @@ impl<'t> Parser<'t> {
                     Item::Struct(sd) if sd.name == owner => Some(sd),
                     _ => None,
                 }) {
+                    check_site(&attrs, Site::Function)?;
                     let mut f = self.function(attrs, ty, method.to_string(), pos)?;
                     f.name = method.to_string();
                     let Some(decl) = sd.methods.iter_mut().find(|m| {
@@ -554,10 +606,12 @@ impl<'t> Parser<'t> {
                     return Ok(());
                 }
             }
+            check_site(&attrs, Site::Function)?;
             let f = self.function(attrs, ty, name, pos)?;
             items.push(Item::Function(f));
             return Ok(());
         }
+        check_site(&attrs, Site::Global)?;
         let mut vars = Vec::new();
         self.declarators(attrs, mods, ty, &mut vars)?;
         items.extend(vars.into_iter().map(|mut v| {
@@ -571,7 +625,7 @@ impl<'t> Parser<'t> {
         if !self.eat("class") {
             self.expect("struct")?;
         }
-        let _ = self.attrs()?; // `[raypayload]`
+        check_site(&self.attrs()?, Site::Struct)?; // `[raypayload]`
         let (name, pos) = self.ident()?;
         self.declare_type(&name);
         if self.is(":") {
@@ -601,6 +655,7 @@ impl<'t> Parser<'t> {
             let ty = self.type_ref()?;
             if self.peek().and_then(Token::ident).is_some() && self.is_at(1, "(") {
                 let (mname, mpos) = self.ident()?;
+                check_site(&fattrs, Site::Function)?;
                 // Without a body, the definition follows outside (`T S::m(...) {}`).
                 let mut f = self.function(fattrs, ty, mname.clone(), mpos)?;
                 f.name = mname;
@@ -615,6 +670,7 @@ impl<'t> Parser<'t> {
             if mods.is_static {
                 return Err(Error::new(ty.pos, "not supported: static data members"));
             }
+            check_site(&fattrs, Site::Member)?;
             self.declarators(fattrs, mods, ty, &mut fields)?;
         }
         self.i += 1;
@@ -761,6 +817,7 @@ impl<'t> Parser<'t> {
         if !(self.is(")") || self.is_kw("void") && self.is_at(1, ")")) {
             loop {
                 let pattrs = self.attrs()?;
+                check_site(&pattrs, Site::Param)?;
                 let mods = self.mods();
                 if !self.type_at(0) {
                     return Err(self.unexpected("a parameter type"));
@@ -838,7 +895,8 @@ impl<'t> Parser<'t> {
     }
 
     fn stmt_inner(&mut self) -> Result<Stmt> {
-        let _ = self.attrs()?; // [unroll], [loop], [branch], [flatten]: hints only
+        // [unroll], [loop], [branch], [flatten]: hints only.
+        check_site(&self.attrs()?, Site::Statement)?;
         let pos = self.pos();
         let kind = match self.peek().map(|t| &t.tok) {
             None => return Err(self.unexpected("a statement")),

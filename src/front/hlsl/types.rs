@@ -53,6 +53,8 @@ pub enum Ty {
         sc: Sc,
         n: u8,
         rw: bool,
+        /// `[[vk::image_format("...")]]`; else derived from the element type.
+        fmt: Option<spirv::ImageFormat>,
     },
     StructuredBuffer(Box<Ty>, bool),
     ByteAddress(bool),

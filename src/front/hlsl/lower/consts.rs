@@ -70,7 +70,13 @@ impl<'a> Lowerer<'a> {
                 self.b.type_ray_query_khr()
             }
             Ty::Sampler => self.b.type_sampler(),
-            Ty::Texture { dim, sc, n, rw } => {
+            Ty::Texture {
+                dim,
+                sc,
+                n,
+                rw,
+                fmt,
+            } => {
                 let st = self.sc_id(if *sc == Sc::Bool { Sc::Uint } else { *sc });
                 let (d, arrayed) = match dim {
                     Dim::D1 => (spirv::Dim::Dim1D, 0),
@@ -87,11 +93,11 @@ impl<'a> Lowerer<'a> {
                     });
                 }
                 let format = if *rw {
-                    self.image_format(*sc, *n)
+                    fmt.unwrap_or_else(|| self.image_format(*sc, *n))
                 } else {
                     spirv::ImageFormat::Unknown
                 };
-                if *rw && *n == 2 {
+                if *rw && (*n == 2 || fmt.is_some_and(extended_format)) {
                     self.cap(Capability::StorageImageExtendedFormats);
                 }
                 if *rw && format == spirv::ImageFormat::Unknown {
@@ -510,4 +516,26 @@ impl<'a> Lowerer<'a> {
             _ => Err(Error::new(pos, "this type has no constant initializer")),
         }
     }
+}
+
+/// Storage-image formats that need `StorageImageExtendedFormats`.
+fn extended_format(f: spirv::ImageFormat) -> bool {
+    use spirv::ImageFormat as F;
+    !matches!(
+        f,
+        F::Unknown
+            | F::Rgba32f
+            | F::Rgba16f
+            | F::R32f
+            | F::Rgba8
+            | F::Rgba8Snorm
+            | F::Rgba32i
+            | F::Rgba16i
+            | F::Rgba8i
+            | F::R32i
+            | F::Rgba32ui
+            | F::Rgba16ui
+            | F::Rgba8ui
+            | F::R32ui
+    )
 }

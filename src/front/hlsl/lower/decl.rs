@@ -393,7 +393,13 @@ impl<'a> Lowerer<'a> {
                         ))
                     }
                 };
-                Ty::Texture { dim, sc, n, rw }
+                Ty::Texture {
+                    dim,
+                    sc,
+                    n,
+                    rw,
+                    fmt: None,
+                }
             }
             "SamplerComparisonState"
             | "Buffer"
@@ -506,6 +512,17 @@ impl<'a> Lowerer<'a> {
         let mut next_auto = 0u32;
         let mut globals_members: Vec<&VarDecl> = Vec::new();
         for item in items {
+            // Extensions and capabilities a declaration names: an
+            // `ext_builtin_input` adds them where it is used, others here.
+            let attrs = match item {
+                Item::Var(v) => &v.attrs,
+                Item::CBuffer { attrs, .. } => attrs,
+                _ => &Vec::new(),
+            };
+            if !attrs.iter().any(|a| a.name == "vk::ext_builtin_input") {
+                let req = self.ext_requirements(attrs)?;
+                self.require(&req);
+            }
             match item {
                 Item::CBuffer {
                     attrs,
@@ -522,6 +539,9 @@ impl<'a> Lowerer<'a> {
                     let members: Vec<&VarDecl> = members.iter().collect();
                     self.declare_cbuffer(attrs, name, *pos, binding, &members)?;
                 }
+                Item::Var(v) if v.attrs.iter().any(|a| a.name == "vk::ext_builtin_input") => {
+                    self.declare_ext_builtin(v)?
+                }
                 Item::Var(v) if subobject::Kind::from_type_name(&v.ty.name).is_some() => {
                     self.declare_subobject(v)?
                 }
@@ -536,6 +556,55 @@ impl<'a> Lowerer<'a> {
             let binding = self.auto_binding(&mut used, &mut next_auto);
             self.declare_cbuffer(&[], "$Globals", pos, Some(binding), &globals_members)?;
         }
+        Ok(())
+    }
+
+    /// `[[vk::ext_builtin_input(N)]] static const T name;`: an `Input`
+    /// variable decorated `BuiltIn N` (with the extensions and capabilities
+    /// its other `vk::ext_*` attributes name, added where it is used).
+    fn declare_ext_builtin(&mut self, v: &'a VarDecl) -> Result<()> {
+        let Some(a) = v.attrs.iter().find(|a| a.name == "vk::ext_builtin_input") else {
+            return Ok(());
+        };
+        if !(v.mods.is_static && v.mods.is_const) || v.init.is_some() {
+            return Err(Error::new(
+                v.pos,
+                "a `vk::ext_builtin_input` variable must be `static const` without an initializer",
+            ));
+        }
+        let e = a
+            .args
+            .first()
+            .ok_or_else(|| Error::new(a.pos, "expected [[vk::ext_builtin_input(N)]]"))?;
+        let n = self.const_int(e)?;
+        let bi = u32::try_from(n)
+            .ok()
+            .and_then(BuiltIn::from_u32)
+            .ok_or_else(|| Error::new(e.pos, format!("unknown SPIR-V built-in {n}")))?;
+        let req = self.ext_requirements(&v.attrs)?;
+        let t = self.resolve_ty(&v.ty, "")?;
+        let t = self.apply_dims(t, &v.dims, v.pos, false)?;
+        if t.is_resource() || matches!(t, Ty::RtArray(_) | Ty::RayQuery(_)) {
+            return Err(Error::new(v.pos, "a built-in input must be a value type"));
+        }
+        let tid = self.ty_id(&t)?;
+        let pty = self.b.type_pointer(None, StorageClass::Input, tid);
+        let var = self.global_var(pty, StorageClass::Input, None);
+        self.b.name(var, v.name.clone());
+        self.b
+            .decorate(var, Decoration::BuiltIn, [Operand::BuiltIn(bi)]);
+        self.global_reqs.insert(var, req);
+        self.global_decls
+            .push((var, v.name.clone(), t.clone(), v.pos));
+        self.globals.insert(
+            v.name.clone(),
+            Global::Place(Place::Ptr {
+                ptr: var,
+                ty: t,
+                layout: Layout::None,
+                class: StorageClass::Input,
+            }),
+        );
         Ok(())
     }
 
@@ -830,6 +899,10 @@ impl<'a> Lowerer<'a> {
         next: &mut u32,
     ) -> Result<()> {
         let t = self.resolve_ty(&v.ty, "")?;
+        let t = match v.attrs.iter().find(|a| a.name == "vk::image_format") {
+            Some(a) => with_image_format(t, a)?,
+            None => t,
+        };
         let res = t.is_resource();
         let t = self.apply_dims(t, &v.dims, v.pos, res)?;
         self.decls.push((
@@ -1070,4 +1143,79 @@ fn defaults_of(f: &Function) -> Result<Vec<&Expr>> {
             })
         })
         .collect()
+}
+
+/// Applies `[[vk::image_format("name")]]` to a storage texture type.
+fn with_image_format(t: Ty, a: &Attr) -> Result<Ty> {
+    let name = attr_str(a)
+        .ok_or_else(|| Error::new(a.pos, "expected [[vk::image_format(\"format\")]]"))?;
+    let format = image_format_named(name)
+        .ok_or_else(|| Error::new(a.pos, format!("unknown image format \"{name}\"")))?;
+    match t {
+        Ty::Texture {
+            dim,
+            sc,
+            n,
+            rw: true,
+            ..
+        } => Ok(Ty::Texture {
+            dim,
+            sc,
+            n,
+            rw: true,
+            fmt: Some(format),
+        }),
+        _ => Err(unsupported(
+            a.pos,
+            "`vk::image_format` on anything but an RWTexture",
+        )),
+    }
+}
+
+/// DXC's names for `vk::image_format`.
+fn image_format_named(name: &str) -> Option<spirv::ImageFormat> {
+    use spirv::ImageFormat as F;
+    Some(match name {
+        "unknown" => F::Unknown,
+        "rgba32f" => F::Rgba32f,
+        "rgba16f" => F::Rgba16f,
+        "r32f" => F::R32f,
+        "rgba8" => F::Rgba8,
+        "rgba8snorm" => F::Rgba8Snorm,
+        "rg32f" => F::Rg32f,
+        "rg16f" => F::Rg16f,
+        "r11g11b10f" => F::R11fG11fB10f,
+        "r16f" => F::R16f,
+        "rgba16" => F::Rgba16,
+        "rgb10a2" => F::Rgb10A2,
+        "rg16" => F::Rg16,
+        "rg8" => F::Rg8,
+        "r16" => F::R16,
+        "r8" => F::R8,
+        "rgba16snorm" => F::Rgba16Snorm,
+        "rg16snorm" => F::Rg16Snorm,
+        "rg8snorm" => F::Rg8Snorm,
+        "r16snorm" => F::R16Snorm,
+        "r8snorm" => F::R8Snorm,
+        "rgba32i" => F::Rgba32i,
+        "rgba16i" => F::Rgba16i,
+        "rgba8i" => F::Rgba8i,
+        "r32i" => F::R32i,
+        "rg32i" => F::Rg32i,
+        "rg16i" => F::Rg16i,
+        "rg8i" => F::Rg8i,
+        "r16i" => F::R16i,
+        "r8i" => F::R8i,
+        "rgba32ui" => F::Rgba32ui,
+        "rgba16ui" => F::Rgba16ui,
+        "rgba8ui" => F::Rgba8ui,
+        "r32ui" => F::R32ui,
+        "rgb10a2ui" => F::Rgb10a2ui,
+        "rg32ui" => F::Rg32ui,
+        "rg16ui" => F::Rg16ui,
+        "rg8ui" => F::Rg8ui,
+        "r16ui" => F::R16ui,
+        "r8ui" => F::R8ui,
+        _ => return None,
+    })
 }

@@ -139,6 +139,8 @@ impl<'a> Lowerer<'a> {
             }
             self.start_block(None)?;
         }
+        let req = self.ext_requirements(&f.attrs)?;
+        self.require(&req);
         let body = f.body.as_deref().unwrap_or(&[]);
         self.block(body)?;
         if !self.f.term {
@@ -298,6 +300,9 @@ impl<'a> Lowerer<'a> {
 
     pub(super) fn use_global(&mut self, id: Id) {
         self.fn_used.entry(self.f.cur_fn).or_default().insert(id);
+        if let Some(req) = self.global_reqs.get(&id).cloned() {
+            self.require(&req);
+        }
     }
 
     pub(super) fn read_builtin(&mut self, bi: BuiltIn, t: &Ty) -> Result<Val> {

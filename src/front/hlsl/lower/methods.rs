@@ -312,7 +312,7 @@ impl<'a> Lowerer<'a> {
         args: &'a [Expr],
         pos: Pos,
     ) -> Result<Option<Val>> {
-        let Ty::Texture { dim, sc, n, rw } = t.clone() else {
+        let Ty::Texture { dim, sc, n, rw, .. } = t.clone() else {
             unreachable!("texture method")
         };
         let texel = if n == 1 { Ty::Sc(sc) } else { Ty::Vec(sc, n) };

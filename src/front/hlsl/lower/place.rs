@@ -383,7 +383,7 @@ impl<'a> Lowerer<'a> {
                 pos,
                 "a TextureCube cannot be indexed; use SampleLevel",
             )),
-            Ty::Texture { rw, sc, n, dim } => {
+            Ty::Texture { rw, sc, n, dim, .. } => {
                 let Place::Ptr { ptr, .. } = bp else {
                     return Err(not_a_variable(pos));
                 };
