@@ -660,6 +660,47 @@ fn drop_unused_globals(module: &mut dr::Module) {
     let targets_dead = |i: &Instruction| matches!(i.operands.first(), Some(Operand::IdRef(id)) if dead.contains(id));
     module.debug_names.retain(|i| !targets_dead(i));
     module.annotations.retain(|i| !targets_dead(i));
+    drop_unused_stage_pointers(module);
+}
+
+/// Pointer types of ray-tracing-only storage classes that nothing refers to
+/// any more (their variable was dropped): they would need the ray-tracing
+/// capability in, say, a compute module.
+fn drop_unused_stage_pointers(module: &mut dr::Module) {
+    let rt_class = |i: &Instruction| {
+        i.class.opcode == Op::TypePointer
+            && matches!(
+                i.operands.first(),
+                Some(Operand::StorageClass(
+                    StorageClass::ShaderRecordBufferKHR
+                        | StorageClass::RayPayloadKHR
+                        | StorageClass::IncomingRayPayloadKHR
+                        | StorageClass::HitAttributeKHR
+                        | StorageClass::CallableDataKHR
+                        | StorageClass::IncomingCallableDataKHR
+                ))
+            )
+    };
+    let mut used = HashSet::new();
+    let mut note = |i: &Instruction| {
+        used.extend(i.result_type);
+        for op in &i.operands {
+            if let Operand::IdRef(id) = op {
+                used.insert(*id);
+            }
+        }
+    };
+    module.types_global_values.iter().for_each(&mut note);
+    for f in &module.functions {
+        f.def.iter().for_each(&mut note);
+        f.parameters.iter().for_each(&mut note);
+        for b in &f.blocks {
+            b.instructions.iter().for_each(&mut note);
+        }
+    }
+    module
+        .types_global_values
+        .retain(|i| !(rt_class(i) && i.result_id.is_some_and(|id| !used.contains(&id))));
 }
 
 /// Moves every function's `OpVariable`s to the top of its entry block, where
