@@ -777,3 +777,28 @@ fn position_fetch_is_a_built_in_input_with_its_extension_and_capability() {
         .iter()
         .any(|(op, ops)| *op == 17 && ops[0] == 5336));
 }
+
+/// (set, binding) of the variable named `name`.
+fn binding_of(words: &[u32], name: &str) -> (u32, u32) {
+    let id = named(words, name)[0];
+    let deco = |d: u32| {
+        instructions(words)
+            .into_iter()
+            .find(|(op, ops)| *op == 71 && ops[0] == id && ops[1] == d)
+            .map(|(_, ops)| ops[2])
+            .unwrap()
+    };
+    (deco(34), deco(33))
+}
+
+#[test]
+fn space_only_registers_and_static_const_array_sizes() {
+    compile_all("bindings_and_sizes.hlsl");
+    let m =
+        hlsl::compile_file(&shader("bindings_and_sizes.hlsl"), &HlslOptions::default()).unwrap();
+    assert_eq!(binding_of(&m.words, "bindlessTextures"), (99, 0));
+    assert_eq!(binding_of(&m.words, "bindlessBuffers"), (98, 0));
+    assert_eq!(binding_of(&m.words, "Extra"), (7, 0));
+    assert_eq!(binding_of(&m.words, "output"), (0, 0));
+    assert_eq!(binding_of(&m.words, "Params"), (0, 0));
+}

@@ -40,8 +40,10 @@ pub struct Mods {
 
 #[derive(Clone, Debug)]
 pub struct Register {
+    /// `t`, `u`, `b`, `s`; `?` for a space alone (`register(space1)`).
     pub class: char,
-    pub index: u32,
+    /// `None` for a space alone: the binding is the next free one in it.
+    pub index: Option<u32>,
     pub space: u32,
     pub pos: Pos,
 }

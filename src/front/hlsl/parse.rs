@@ -705,14 +705,24 @@ impl<'t> Parser<'t> {
                 "register" => {
                     self.expect("(")?;
                     let (r, rpos) = self.ident()?;
-                    let mut chars = r.chars();
-                    let class = chars.next().unwrap_or('?').to_ascii_lowercase();
-                    let index = chars
-                        .as_str()
-                        .parse::<u32>()
-                        .map_err(|_| Error::new(rpos, format!("malformed register `{r}`")))?;
+                    let space_of = |s: &str| s.strip_prefix("space").and_then(|n| n.parse().ok());
                     let mut space = 0;
-                    if self.eat(",") {
+                    let (class, index) = match space_of(&r) {
+                        // `register(space99)`: a space, the binding left to the compiler.
+                        Some(sp) => {
+                            space = sp;
+                            ('?', None)
+                        }
+                        None => {
+                            let mut chars = r.chars();
+                            let class = chars.next().unwrap_or('?').to_ascii_lowercase();
+                            let index = chars.as_str().parse::<u32>().map_err(|_| {
+                                Error::new(rpos, format!("malformed register `{r}`"))
+                            })?;
+                            (class, Some(index))
+                        }
+                    };
+                    if index.is_some() && self.eat(",") {
                         let (s, spos) = self.ident()?;
                         space = s
                             .strip_prefix("space")

@@ -9,6 +9,21 @@ impl<'a> Lowerer<'a> {
         let items = self.items;
         for item in items {
             match item {
+                // Scalar `static const`s are known in source order, so array
+                // sizes in later structs and typedefs can use them.
+                Item::Var(v) if v.mods.is_static && v.mods.is_const && v.dims.is_empty() => {
+                    if let (Some(e), Ok(Ty::Sc(s))) = (&v.init, self.resolve_ty(&v.ty, "")) {
+                        // Not constant (or not yet resolvable): declared later as usual.
+                        if let Ok(Some(c)) = self.const_eval(e) {
+                            let c = match (s, c) {
+                                (Sc::Float, c) => CVal::F(c.as_f64()),
+                                (_, CVal::F(f)) => CVal::I(f as i64),
+                                (_, c) => c,
+                            };
+                            self.const_items.insert(v.name.clone(), c);
+                        }
+                    }
+                }
                 Item::Struct(s) => self.declare_struct(s)?,
                 Item::Typedef {
                     ty,
@@ -495,7 +510,7 @@ impl<'a> Lowerer<'a> {
                     return Ok(Some((s, b)));
                 }
             }
-            Ok(reg.as_ref().map(|r| (r.space, r.index)))
+            Ok(reg.as_ref().and_then(|r| Some((r.space, r.index?))))
         };
         for item in items {
             let (attrs, reg) = match item {
@@ -534,7 +549,12 @@ impl<'a> Lowerer<'a> {
                     let binding = match explicit(attrs, register, self)? {
                         Some(sb) => Some(sb),
                         None if attrs.iter().any(|a| a.name == "vk::push_constant") => None,
-                        None => Some(self.auto_binding(&mut used, &mut next_auto)),
+                        None => Some(match register {
+                            Some(Register {
+                                index: None, space, ..
+                            }) => self.auto_binding_in(&mut used, *space),
+                            _ => self.auto_binding(&mut used, &mut next_auto),
+                        }),
                     };
                     let members: Vec<&VarDecl> = members.iter().collect();
                     self.declare_cbuffer(attrs, name, *pos, binding, &members)?;
@@ -725,6 +745,20 @@ impl<'a> Lowerer<'a> {
                 .insert(f.name.clone(), (var, f.ty.clone(), i as u32, layout, class));
         }
         Ok(())
+    }
+
+    /// The next free binding in set `space`.
+    pub(super) fn auto_binding_in(
+        &mut self,
+        used: &mut HashSet<(u32, u32)>,
+        space: u32,
+    ) -> (u32, u32) {
+        let mut b = 0;
+        while used.contains(&(space, b)) {
+            b += 1;
+        }
+        used.insert((space, b));
+        (space, b)
     }
 
     pub(super) fn auto_binding(
@@ -927,7 +961,14 @@ impl<'a> Lowerer<'a> {
                     Some((s, b))
                 }
                 None => match &v.register {
-                    Some(r) => Some((r.space, r.index)),
+                    Some(Register {
+                        index: Some(i),
+                        space,
+                        ..
+                    }) => Some((*space, *i)),
+                    Some(Register {
+                        index: None, space, ..
+                    }) => Some(self.auto_binding_in(used, *space)),
                     None if v.attrs.iter().any(|a| a.name == "vk::push_constant") => None,
                     None => Some(self.auto_binding(used, next)),
                 },
