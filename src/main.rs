@@ -518,6 +518,9 @@ fn compile(
     if whole {
         return match hlsl::compile_file(&file, &options) {
             Ok(m) => {
+                for w in &m.warnings {
+                    eprintln!("{w}");
+                }
                 write(&output, &m.words)?;
                 eprintln!("{}: {} entry points", output.display(), m.entries.len());
                 Ok(0)
@@ -531,6 +534,9 @@ fn compile(
     };
     if entries.is_empty() {
         return Err(format!("{}: no entry point to compile", file.display()));
+    }
+    for w in &entries[0].warnings {
+        eprintln!("{w}");
     }
     if output.is_dir() {
         for e in &entries {

@@ -802,3 +802,16 @@ fn space_only_registers_and_static_const_array_sizes() {
     assert_eq!(binding_of(&m.words, "output"), (0, 0));
     assert_eq!(binding_of(&m.words, "Params"), (0, 0));
 }
+
+#[test]
+fn windows_include_paths_and_case_mismatches() {
+    compile_all("windows_includes.hlsl");
+    let m = hlsl::compile_file(&shader("windows_includes.hlsl"), &HlslOptions::default()).unwrap();
+    // One warning: the include whose case differs (the second matches exactly).
+    assert_eq!(m.warnings.len(), 1, "{:?}", m.warnings);
+    assert!(m.warnings[0].contains(
+        "windows_includes.hlsl:4:2: warning: include `include/util/hlslcompat.hlsli` matched"
+    ));
+    assert!(m.warnings[0].ends_with("include/Util/HlslCompat.hlsli` only when ignoring case"));
+    assert_eq!(named(&m.words, "srgbToLinear").len(), 1);
+}

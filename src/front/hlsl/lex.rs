@@ -164,12 +164,10 @@ pub fn lex(src: &str, file: u32) -> Result<Vec<Token>, Error> {
                         i += 1;
                         break;
                     }
-                    Some(b'\\') if i + 1 < b.len() => {
-                        s.push(match b[i + 1] {
-                            b'n' => '\n',
-                            b't' => '\t',
-                            other => other as char,
-                        });
+                    // `\"` and `\\` are escapes; any other backslash is kept, as
+                    // in Windows include paths (`"util\Compat.h"`).
+                    Some(b'\\') if matches!(b.get(i + 1), Some(b'"' | b'\\')) => {
+                        s.push(b[i + 1] as char);
                         i += 2;
                     }
                     Some(_) => {

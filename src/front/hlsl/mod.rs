@@ -38,6 +38,8 @@ pub struct CompiledEntry {
     pub name: String,
     pub stage: Stage,
     pub words: Vec<u32>,
+    /// `file:line:col: warning: message` (e.g. an include matched ignoring case).
+    pub warnings: Vec<String>,
 }
 
 /// A whole file compiled to one module holding every entry point.
@@ -49,6 +51,8 @@ pub struct CompiledModule {
     pub decls: Vec<(NamedDecl, Location)>,
     /// DXR subobjects (shader and pipeline configs, hit groups, associations).
     pub subobjects: subobject::Subobjects,
+    /// `file:line:col: warning: message` (e.g. an include matched ignoring case).
+    pub warnings: Vec<String>,
 }
 
 /// Compiles each entry point of `path` into its own module.
@@ -81,10 +85,36 @@ fn parse_source_inner(
     loader: &mut dyn pp::FileLoader,
     options: &HlslOptions,
 ) -> Result<(Vec<ast::Item>, Vec<PathBuf>), InputError> {
+    parse_with_warnings(path, text, loader, options).map(|(items, files, _)| (items, files))
+}
+
+/// Preprocesses and parses; also gives the warnings, rendered
+/// `file:line:col: warning: message`.
+fn parse_with_warnings(
+    path: &Path,
+    text: &str,
+    loader: &mut dyn pp::FileLoader,
+    options: &HlslOptions,
+) -> Result<(Vec<ast::Item>, Vec<PathBuf>, Vec<String>), InputError> {
     let out = pp::preprocess(path, text, loader, &options.include_dirs, &options.defines)
         .map_err(|f| f.error.into_input_error(&f.files, path))?;
     let items = parse::parse(&out.tokens).map_err(|e| e.into_input_error(&out.files, path))?;
-    Ok((items, out.files))
+    let warnings = out
+        .warnings
+        .iter()
+        .map(|w| {
+            let file = out
+                .files
+                .get(w.pos.file as usize)
+                .map(|f| f.display().to_string())
+                .unwrap_or_default();
+            format!(
+                "{file}:{}:{}: warning: {}",
+                w.pos.line, w.pos.col, w.message
+            )
+        })
+        .collect();
+    Ok((items, out.files, warnings))
 }
 
 fn entry_indices(
@@ -152,7 +182,7 @@ fn compile_source_inner(
     loader: &mut dyn pp::FileLoader,
     options: &HlslOptions,
 ) -> Result<Vec<CompiledEntry>, InputError> {
-    let (items, files) = parse_source_inner(path, text, loader, options)?;
+    let (items, files, warnings) = parse_with_warnings(path, text, loader, options)?;
     let mut probe = lower::Lowerer::new(&items, &files);
     let picked = entry_indices(&mut probe, path, &files, options)?;
     let mut out = Vec::new();
@@ -168,8 +198,9 @@ fn compile_source_inner(
             .map_err(|e| e.into_input_error(&files, path))?;
         out.push(CompiledEntry {
             name,
-            stage: stage,
+            stage,
             words,
+            warnings: warnings.clone(),
         });
     }
     Ok(out)
@@ -190,7 +221,7 @@ fn compile_source_whole_inner(
     loader: &mut dyn pp::FileLoader,
     options: &HlslOptions,
 ) -> Result<CompiledModule, InputError> {
-    let (items, files) = parse_source_inner(path, text, loader, options)?;
+    let (items, files, warnings) = parse_with_warnings(path, text, loader, options)?;
     let mut l = lower::Lowerer::new(&items, &files);
     let picked = entry_indices(&mut l, path, &files, options)?;
     let ks: Vec<usize> = picked
@@ -206,5 +237,6 @@ fn compile_source_whole_inner(
         entries: picked.into_iter().map(|(_, n, s)| (n, s)).collect(),
         decls,
         subobjects,
+        warnings,
     })
 }

@@ -1436,7 +1436,7 @@ mod tests {
                 members,
                 ..
             } => {
-                assert_eq!((r.class, r.index, r.space), ('b', 1, 2));
+                assert_eq!((r.class, r.index, r.space), ('b', Some(1), 2));
                 assert_eq!(members.len(), 2);
             }
             other => panic!("{other:?}"),

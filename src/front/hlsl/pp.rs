@@ -13,6 +13,11 @@ use std::rc::Rc;
 /// Where `#include` looks for files; tests and fuzzers read from memory.
 pub trait FileLoader: Send {
     fn read(&mut self, path: &Path) -> Option<String>;
+    /// The names in a folder (files and folders), for matching an include
+    /// whose case differs from the file's.
+    fn list(&mut self, _dir: &Path) -> Vec<String> {
+        Vec::new()
+    }
 }
 
 pub struct FsLoader;
@@ -20,6 +25,20 @@ pub struct FsLoader;
 impl FileLoader for FsLoader {
     fn read(&mut self, path: &Path) -> Option<String> {
         std::fs::read_to_string(path).ok()
+    }
+
+    fn list(&mut self, dir: &Path) -> Vec<String> {
+        let dir = if dir.as_os_str().is_empty() {
+            Path::new(".")
+        } else {
+            dir
+        };
+        std::fs::read_dir(dir)
+            .map(|r| {
+                r.filter_map(|e| e.ok()?.file_name().into_string().ok())
+                    .collect()
+            })
+            .unwrap_or_default()
     }
 }
 
@@ -31,6 +50,43 @@ impl FileLoader for MemLoader {
     fn read(&mut self, path: &Path) -> Option<String> {
         self.0.get(path).cloned()
     }
+
+    fn list(&mut self, dir: &Path) -> Vec<String> {
+        let mut names: Vec<String> = self
+            .0
+            .keys()
+            .filter_map(|p| p.strip_prefix(dir).ok()?.components().next())
+            .filter_map(|c| c.as_os_str().to_str().map(String::from))
+            .collect();
+        names.sort();
+        names.dedup();
+        names
+    }
+}
+
+/// `path` with each component matched without regard to case where the exact
+/// name is missing (Windows file systems ignore case; DXR code relies on it).
+fn case_insensitive_match(loader: &mut dyn FileLoader, path: &Path) -> Option<PathBuf> {
+    use std::path::Component;
+    let mut out = PathBuf::new();
+    let mut changed = false;
+    for c in path.components() {
+        match c {
+            Component::Normal(name) => {
+                let name = name.to_str()?;
+                let names = loader.list(&out);
+                if names.iter().any(|n| n == name) {
+                    out.push(name);
+                } else {
+                    let m = names.iter().find(|n| n.eq_ignore_ascii_case(name))?;
+                    out.push(m);
+                    changed = true;
+                }
+            }
+            other => out.push(other.as_os_str()),
+        }
+    }
+    changed.then_some(out)
 }
 
 #[derive(Clone, Debug)]
@@ -44,6 +100,7 @@ struct Macro {
 pub struct Output {
     pub tokens: Vec<Token>,
     pub files: Vec<PathBuf>,
+    pub warnings: Vec<Error>,
 }
 
 struct Cond {
@@ -68,6 +125,8 @@ pub struct Preprocessor<'a> {
     out: Vec<Token>,
     /// Expansion work done so far; bounds runaway macros.
     budget: usize,
+    /// Warnings (positions and messages), rendered by the caller.
+    pub warnings: Vec<Error>,
 }
 
 const MAX_INCLUDE_DEPTH: usize = 64;
@@ -88,6 +147,7 @@ impl<'a> Preprocessor<'a> {
             stack: Vec::new(),
             out: Vec::new(),
             budget: 0,
+            warnings: Vec::new(),
         };
         // `-D` values are lexed as a file of their own, so errors point somewhere.
         for (name, value) in defines {
@@ -119,6 +179,7 @@ impl<'a> Preprocessor<'a> {
         Ok(Output {
             tokens: self.out,
             files: self.files,
+            warnings: self.warnings,
         })
     }
 
@@ -452,6 +513,8 @@ impl<'a> Preprocessor<'a> {
             }
             _ => return Err(Error::new(pos, "#include needs \"file\" or <file>")),
         };
+        // Windows separators: `#include "util\Compat.h"`.
+        let name = name.replace('\\', "/");
         let current = self.stack.last().map(|s| s.0).unwrap_or(0);
         let mut candidates = Vec::new();
         if quoted {
@@ -465,10 +528,29 @@ impl<'a> Preprocessor<'a> {
             candidates.push(d.join(&name));
         }
         let mut found = None;
-        for c in candidates {
-            if let Some(text) = self.loader.read(&c) {
-                found = Some((c, text));
+        for c in &candidates {
+            if let Some(text) = self.loader.read(c) {
+                found = Some((c.clone(), text));
                 break;
+            }
+        }
+        if found.is_none() {
+            // Windows ignores case: take a file whose name differs only in case, and say so.
+            for c in &candidates {
+                let Some(m) = case_insensitive_match(self.loader, c) else {
+                    continue;
+                };
+                if let Some(text) = self.loader.read(&m) {
+                    self.warnings.push(Error::new(
+                        pos,
+                        format!(
+                            "include `{name}` matched `{}` only when ignoring case",
+                            m.display()
+                        ),
+                    ));
+                    found = Some((m, text));
+                    break;
+                }
             }
         }
         let Some((path, text)) = found else {
@@ -996,6 +1078,7 @@ pub fn preprocess(
         Ok(()) => Ok(Output {
             tokens: pp.out,
             files: pp.files,
+            warnings: pp.warnings,
         }),
         Err(error) => Err(Box::new(Failure {
             error,
