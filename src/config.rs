@@ -1,6 +1,6 @@
 //! `rtlint.toml`: budgets, rule levels and language mappings.
 
-use crate::diag::{InputError, Location, Severity};
+use crate::diag::{InputError, InputErrorKind, Location, Severity};
 use crate::shader::Language;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -80,7 +80,11 @@ pub const FILE_NAME: &str = "rtlint.toml";
 impl Config {
     pub fn parse(text: &str, path: &Path) -> Result<Config, InputError> {
         let mut config: Config = toml::from_str(text).map_err(|e| {
-            let mut err = InputError::new("invalid-config", path, e.message().trim().to_string());
+            let mut err = InputError::new(
+                InputErrorKind::InvalidConfig,
+                path,
+                e.message().trim().to_string(),
+            );
             if let Some(span) = e.span() {
                 let (line, column) = crate::shader::line_col(text, span.start);
                 let (end_line, end_column) = crate::shader::line_col(text, span.end);
@@ -146,7 +150,11 @@ impl Config {
         match self.rule_keys.iter().find(|(k, _)| !known(k)) {
             None => Ok(()),
             Some((key, at)) => {
-                let err = InputError::new("invalid-config", path, format!("unknown rule `{key}`"));
+                let err = InputError::new(
+                    InputErrorKind::InvalidConfig,
+                    path,
+                    format!("unknown rule `{key}`"),
+                );
                 Err(match at {
                     Some(l) => err.at(l.clone(), "here"),
                     None => err,
@@ -188,7 +196,7 @@ fn find_location(text: &str, path: &Path, needle: &str) -> Option<Location> {
 
 /// An error pointing at the first occurrence of `needle` in the config text.
 fn config_error(text: &str, path: &Path, needle: &str, message: String) -> InputError {
-    let err = InputError::new("invalid-config", path, message);
+    let err = InputError::new(InputErrorKind::InvalidConfig, path, message);
     match find_location(text, path, needle) {
         Some(l) => err.at(l, "here"),
         None => err,

@@ -2,7 +2,7 @@
 //! inputs, load each into a Program, run the rules.
 
 use crate::config::Config;
-use crate::diag::{Diagnostic, InputError};
+use crate::diag::{Diagnostic, InputError, InputErrorKind};
 use crate::front;
 use crate::program::Program;
 use crate::shader::Language;
@@ -56,7 +56,7 @@ pub fn collect_inputs(paths: &[PathBuf], config: &Config, forced: Option<Languag
                     language,
                 }),
                 None => inputs.errors.push(InputError::new(
-                    "unknown-language",
+                    InputErrorKind::UnknownLanguage,
                     p,
                     "cannot tell the shader language from the file extension; pass --lang or map the extension under [languages] in rtlint.toml",
                 )),

@@ -7,7 +7,7 @@ pub mod slang;
 pub mod wgsl;
 
 use crate::diag::InputError;
-pub use crate::diag::{io_error, read_text};
+pub use crate::diag::{io_error, read_text, InputErrorKind};
 use crate::program::NamedDecl;
 use crate::shader::{Language, Location};
 use std::path::{Path, PathBuf};
@@ -64,7 +64,7 @@ pub fn compile_path(path: &Path, language: Language) -> Result<Compiled, InputEr
             })
         }
         Language::Glsl => Err(InputError::new(
-            "unsupported-language",
+            InputErrorKind::UnsupportedLanguage,
             path,
             format!(
                 "{} input is not supported by this build of rtlint",
