@@ -6,6 +6,7 @@
 pub mod analysis;
 pub mod config;
 pub mod diag;
+pub mod explain;
 pub mod front;
 pub mod lint;
 pub mod pipeline;

@@ -2,7 +2,7 @@
 //! inputs, load each into a Program, run the rules.
 
 use crate::config::Config;
-use crate::diag::{Diagnostic, InputError};
+use crate::diag::{Diagnostic, InputError, InputErrorKind};
 use crate::front;
 use crate::program::Program;
 use crate::shader::Language;
@@ -12,6 +12,13 @@ use std::path::{Path, PathBuf};
 pub struct Input {
     pub path: PathBuf,
     pub language: Language,
+}
+
+/// Loads `rtlint.toml` and checks its rule names against the registry.
+pub fn load_config(path: &Path) -> Result<Config, InputError> {
+    let config = Config::load(path)?;
+    config.check_rule_names(|k| crate::rules::find(k).is_some())?;
+    Ok(config)
 }
 
 /// What walking the paths found.
@@ -49,7 +56,7 @@ pub fn collect_inputs(paths: &[PathBuf], config: &Config, forced: Option<Languag
                     language,
                 }),
                 None => inputs.errors.push(InputError::new(
-                    "unknown-language",
+                    InputErrorKind::UnknownLanguage,
                     p,
                     "cannot tell the shader language from the file extension; pass --lang or map the extension under [languages] in rtlint.toml",
                 )),

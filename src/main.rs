@@ -201,7 +201,7 @@ fn setup(common: &Common) -> Result<Setup, String> {
         .clone()
         .or_else(|| common.paths.first().and_then(|p| Config::discover(p)));
     let config = match config_path {
-        Some(p) => match Config::load(&p) {
+        Some(p) => match lint::load_config(&p) {
             Ok(c) => c,
             Err(e) => {
                 errors.push(*e.0);
@@ -332,13 +332,14 @@ fn layout(common: Common) -> Result<u8, String> {
     match format {
         Format::Json => {
             let errors: Vec<_> = problems.iter().map(report::json::diagnostic).collect();
+            let files: Vec<_> = files.iter().map(report::layout::json).collect();
             let v = serde_json::json!({ "files": files, "errors": errors });
             println!("{}", serde_json::to_string_pretty(&v).unwrap_or_default());
         }
         _ => {
             let mut out = StandardStream::stdout(color_choice());
             for f in &files {
-                write!(out, "{}", f.render_human()).map_err(|e| e.to_string())?;
+                write!(out, "{}", report::layout::human(f)).map_err(|e| e.to_string())?;
             }
             let mut sources = Sources::default();
             report::human::render(&problems, &mut sources, &mut out).map_err(|e| e.to_string())?;
@@ -358,12 +359,7 @@ fn live(common: Common) -> Result<u8, String> {
     problems.extend(inputs.errors.iter().map(|e| (*e.0).clone()));
     let programs = load_programs(&inputs, &mut problems);
     let report = rtlint::analysis::live_report(&programs);
-    print_report(
-        format,
-        &report,
-        rtlint::analysis::liveness::render_human(&report),
-        &problems,
-    )
+    print_report(format, &report, report::live::human(&report), &problems)
 }
 
 fn stack(common: Common, driver: bool) -> Result<u8, String> {
@@ -405,7 +401,7 @@ fn stack(common: Common, driver: bool) -> Result<u8, String> {
         let mut r = rtlint::analysis::stack_report(p);
         #[cfg(feature = "vulkan")]
         if let Some(ctx) = &device {
-            let depth = rtlint::analysis::recursion(p).required_depth;
+            let depth = rtlint::analysis::recursion_report(p).required_depth;
             let sizes = rtlint::vk::driver_stack_sizes(ctx, p, depth).map_err(|e| {
                 format!(
                     "--driver: creating the pipeline on {} failed: {e}",
@@ -413,25 +409,24 @@ fn stack(common: Common, driver: bool) -> Result<u8, String> {
                 )
             })?;
             rtlint::analysis::stack::attach_driver(&mut r, p, &sizes);
-            r.assumptions.push(format!(
-                "driver: {} ({})",
-                ctx.info().name,
-                ctx.info().driver
-            ));
+            r.assumptions
+                .push(rtlint::analysis::callgraph::Assumption::Driver {
+                    device: ctx.info().name.clone(),
+                    driver: ctx.info().driver.clone(),
+                });
         }
         reports.push(r);
     }
     let human: String = reports
         .iter()
-        .map(rtlint::analysis::stack::render_human)
+        .map(report::stack::human)
         .collect::<Vec<_>>()
         .join("\n");
     let value = if reports.len() == 1 {
-        serde_json::to_value(&reports[0])
+        report::stack::json(&reports[0])
     } else {
-        serde_json::to_value(&reports)
-    }
-    .map_err(|e| e.to_string())?;
+        reports.iter().map(report::stack::json).collect()
+    };
     print_report(format, &value, human, &problems)
 }
 

@@ -3,7 +3,7 @@
 //! that pipeline rather than for every shader in a folder. See
 //! `docs/pipeline.md` for the format.
 
-use crate::diag::{InputError, Location};
+use crate::diag::{InputError, InputErrorKind, Location};
 use crate::front;
 use crate::program::{Id, Program};
 use crate::shader::Language;
@@ -107,6 +107,15 @@ pub struct Pipeline {
 }
 
 impl Pipeline {
+    /// The file findings about the whole pipeline point at: the description,
+    /// else the first ray-generation shader's file.
+    pub fn file(&self) -> PathBuf {
+        self.path
+            .clone()
+            .or_else(|| self.raygen.first().map(|s| s.file.clone()))
+            .unwrap_or_default()
+    }
+
     /// Whether a description says which shaders the scene uses.
     pub fn described(&self) -> bool {
         self.path.is_some()
@@ -238,7 +247,7 @@ pub fn parse(text: &str, path: &Path) -> Result<Pipeline, InputError> {
     let cx = Cx { text, path };
     let raw: RawPipeline = toml::from_str(text).map_err(|e| {
         let err = InputError::new(
-            "invalid-pipeline",
+            InputErrorKind::InvalidPipeline,
             path,
             format!("invalid pipeline description: {}", e.message().trim_end()),
         );
@@ -290,7 +299,7 @@ pub fn parse(text: &str, path: &Path) -> Result<Pipeline, InputError> {
     }
     if raw.raygen.is_empty() {
         return Err(InputError::new(
-            "invalid-pipeline",
+            InputErrorKind::InvalidPipeline,
             path,
             "pipeline description has no `[[raygen]]` shader",
         ));
@@ -380,7 +389,7 @@ impl Cx<'_> {
     }
 
     fn error(&self, span: Range<usize>, msg: impl Into<String>) -> InputError {
-        InputError::new("invalid-pipeline", self.path, msg).at(self.loc(span), "here")
+        InputError::new(InputErrorKind::InvalidPipeline, self.path, msg).at(self.loc(span), "here")
     }
 
     fn u32(&self, v: &Spanned<i64>, key: &str) -> Result<u32, InputError> {

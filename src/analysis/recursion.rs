@@ -12,22 +12,100 @@
 use super::callgraph::{trace_graph, EdgeKind, TraceGraph};
 use crate::diag::Location;
 use crate::pipeline::{DescribedConstant, Pipeline};
+use crate::program::cfg::{call_chains, dominates, dominators, natural_loops, strongly_connected};
 use crate::program::{Constant, Function, Id, Program, Type};
 use crate::shader::Stage;
 use rspirv::dr::{Instruction, Operand};
 use spirv::{Op, StorageClass};
-use std::collections::{BTreeMap, HashMap, HashSet};
+use std::collections::{BTreeMap, HashSet};
+
+/// Where a loop or recursion bound comes from.
+#[derive(Clone, Debug, PartialEq, Eq, PartialOrd, Ord)]
+pub enum BoundSource {
+    Constant(i64),
+    /// A specialization constant: its value in the pipeline description, else
+    /// its default.
+    SpecConstant {
+        name: String,
+        value: i64,
+        described: bool,
+    },
+    /// A push-constant, uniform, storage-buffer or shader-record value that
+    /// the pipeline description gives.
+    Described {
+        kind: ValueKind,
+        key: String,
+        value: i64,
+    },
+}
+
+/// Where a value that is not a constant is read from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
+pub enum ValueKind {
+    PushConstant,
+    Uniform,
+    StorageBuffer,
+    ShaderRecord,
+}
+
+/// Why a bound is not known at compile time.
+#[derive(Clone, Debug, PartialEq, Eq, PartialOrd, Ord)]
+pub enum UnknownBound {
+    /// An id the module does not define.
+    UnknownValue,
+    RuntimeValue,
+    /// A value the pipeline description could give but does not.
+    NotDescribed {
+        kind: ValueKind,
+        name: String,
+    },
+}
+
+/// Why no depth guard was recognised on a trace that closes a cycle.
+#[derive(Clone, Debug, PartialEq, Eq, PartialOrd, Ord)]
+pub enum NoGuard {
+    ModuleMissing,
+    TraceMissing,
+    OutsideFunction,
+    /// The counter is compared with a bound that is not known.
+    BoundUnknown {
+        counter: String,
+        bound: UnknownBound,
+    },
+    /// The counter guards the trace but the traced copy does not grow.
+    CounterDoesNotGrow {
+        counter: String,
+    },
+    /// No dominating comparison of a counter (named when one was seen) with a
+    /// known bound.
+    NoComparison {
+        counter: Option<String>,
+    },
+}
+
+/// Why no bound was recognised on a loop that traces.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum NoLoopBound {
+    NotIncremented {
+        counter: String,
+    },
+    BoundUnknown {
+        counter: String,
+        bound: UnknownBound,
+    },
+    NoCounter,
+}
 
 /// A recognised depth guard on a trace that closes a cycle.
-#[derive(Clone, Debug, serde::Serialize)]
+#[derive(Clone, Debug)]
 pub struct Guard {
     /// `payload.depth`-style name of the counter.
     pub counter: String,
     /// `<` or `<=`: the trace happens while `counter op bound`.
     pub op: &'static str,
     pub bound: i64,
-    /// Where the bound comes from, in words.
-    pub bound_source: String,
+    /// Where the bound comes from.
+    pub bound_source: BoundSource,
     /// How much the counter grows per trace.
     pub step: i64,
     /// The counter's value where the cycle is entered.
@@ -36,7 +114,6 @@ pub struct Guard {
     pub initial_assumed: bool,
     /// How many times the cycle can trace in one chain.
     pub traces: u64,
-    #[serde(skip)]
     pub location: Option<Location>,
 }
 
@@ -47,7 +124,7 @@ pub struct CycleSite {
     pub inst: usize,
     pub location: Option<Location>,
     /// The guard, or why none was recognised.
-    pub guard: Result<Guard, String>,
+    pub guard: Result<Guard, NoGuard>,
 }
 
 /// A strongly connected part of the trace graph with a cycle.
@@ -95,30 +172,13 @@ pub struct RecursionReport {
 }
 
 impl RecursionReport {
-    /// `raygeneration `main` → closesthit `main` ×4 → miss `main``.
-    pub fn chain_text(&self) -> String {
-        let parts: Vec<String> = self
-            .chain
-            .iter()
-            .map(|s| {
-                let name = self.graph.nodes[s.node].describe();
-                if s.repeat > 0 {
-                    format!("{name} at levels {}–{}", s.level, s.level as u64 + s.repeat)
-                } else {
-                    format!("{name} at level {}", s.level)
-                }
-            })
-            .collect();
-        parts.join(" → ")
-    }
-
     pub fn unbounded_cycle(&self) -> Option<&Cycle> {
         self.cycles.iter().find(|c| c.extra_levels.is_none())
     }
 }
 
 /// Depth analysis of a pipeline.
-pub fn recursion(pipeline: &Pipeline) -> RecursionReport {
+pub fn recursion_report(pipeline: &Pipeline) -> RecursionReport {
     let graph = trace_graph(pipeline);
     let n = graph.nodes.len();
     let mut adj: Vec<Vec<usize>> = vec![Vec::new(); n];
@@ -127,7 +187,7 @@ pub fn recursion(pipeline: &Pipeline) -> RecursionReport {
             adj[e.from].push(e.to);
         }
     }
-    let sccs = tarjan(&adj);
+    let sccs = strongly_connected(&adj);
     let mut scc_of = vec![0usize; n];
     for (c, nodes) in sccs.iter().enumerate() {
         for &v in nodes {
@@ -319,66 +379,6 @@ pub fn recursion(pipeline: &Pipeline) -> RecursionReport {
     }
 }
 
-/// Strongly connected components, sinks first.
-fn tarjan(adj: &[Vec<usize>]) -> Vec<Vec<usize>> {
-    struct T<'a> {
-        adj: &'a [Vec<usize>],
-        index: Vec<Option<usize>>,
-        low: Vec<usize>,
-        on: Vec<bool>,
-        stack: Vec<usize>,
-        next: usize,
-        out: Vec<Vec<usize>>,
-    }
-    impl T<'_> {
-        fn visit(&mut self, v: usize) {
-            self.index[v] = Some(self.next);
-            self.low[v] = self.next;
-            self.next += 1;
-            self.stack.push(v);
-            self.on[v] = true;
-            for &w in &self.adj[v] {
-                match self.index[w] {
-                    None => {
-                        self.visit(w);
-                        self.low[v] = self.low[v].min(self.low[w]);
-                    }
-                    Some(i) if self.on[w] => self.low[v] = self.low[v].min(i),
-                    _ => {}
-                }
-            }
-            if Some(self.low[v]) == self.index[v] {
-                let mut c = Vec::new();
-                while let Some(w) = self.stack.pop() {
-                    self.on[w] = false;
-                    c.push(w);
-                    if w == v {
-                        break;
-                    }
-                }
-                c.sort_unstable();
-                self.out.push(c);
-            }
-        }
-    }
-    let n = adj.len();
-    let mut t = T {
-        adj,
-        index: vec![None; n],
-        low: vec![0; n],
-        on: vec![false; n],
-        stack: Vec::new(),
-        next: 0,
-        out: Vec::new(),
-    };
-    for v in 0..n {
-        if t.index[v].is_none() {
-            t.visit(v);
-        }
-    }
-    t.out
-}
-
 // ---------------------------------------------------------------------------
 // Values: counters, bounds, conditions.
 
@@ -567,32 +567,34 @@ fn bound_of(
     program: &Program,
     id: Id,
     constants: &BTreeMap<String, DescribedConstant>,
-) -> Result<(i64, String), String> {
+) -> Result<(i64, BoundSource), UnknownBound> {
     let id = strip_conversions(program, id);
     if let Some(Constant::Int(v)) = program.constants.get(&id) {
-        return Ok((
-            signed(program, id, *v),
-            format!("the constant {}", *v as i64),
-        ));
+        return Ok((signed(program, id, *v), BoundSource::Constant(*v as i64)));
     }
     if let Some(Constant::Int(v)) = program.spec_constants.get(&id) {
         let name = program.display_name(id);
         if let Some(c) = constants.get(&name) {
             return Ok((
                 c.value,
-                format!(
-                    "specialization constant `{name}` = {} from the description",
-                    c.value
-                ),
+                BoundSource::SpecConstant {
+                    name,
+                    value: c.value,
+                    described: true,
+                },
             ));
         }
         return Ok((
             *v as i64,
-            format!("specialization constant `{name}` (default {})", *v as i64),
+            BoundSource::SpecConstant {
+                name,
+                value: *v as i64,
+                described: false,
+            },
         ));
     }
     let Some(inst) = program.def(id) else {
-        return Err("an unknown value".into());
+        return Err(UnknownBound::UnknownValue);
     };
     if inst.class.opcode == Op::Load {
         let ptr = ids(inst).next().unwrap_or(0);
@@ -600,27 +602,29 @@ fn bound_of(
             .and_then(|(v, _)| global(program, v))
             .map(|g| g.storage);
         let kind = match storage {
-            Some(StorageClass::PushConstant) => "push constant",
-            Some(StorageClass::Uniform) => "uniform value",
-            Some(StorageClass::StorageBuffer) => "storage buffer value",
-            Some(StorageClass::ShaderRecordBufferKHR) => "shader record value",
-            _ => return Err("a value computed at run time".into()),
+            Some(StorageClass::PushConstant) => ValueKind::PushConstant,
+            Some(StorageClass::Uniform) => ValueKind::Uniform,
+            Some(StorageClass::StorageBuffer) => ValueKind::StorageBuffer,
+            Some(StorageClass::ShaderRecordBufferKHR) => ValueKind::ShaderRecord,
+            _ => return Err(UnknownBound::RuntimeValue),
         };
         let keys = member_keys(program, ptr);
         for k in &keys {
             if let Some(c) = constants.get(k) {
                 return Ok((
                     c.value,
-                    format!("{kind} `{k}` = {} from the description", c.value),
+                    BoundSource::Described {
+                        kind,
+                        key: k.clone(),
+                        value: c.value,
+                    },
                 ));
             }
         }
         let name = keys.first().cloned().unwrap_or_else(|| "?".into());
-        return Err(format!(
-            "{kind} `{name}`, which the pipeline description does not give"
-        ));
+        return Err(UnknownBound::NotDescribed { kind, name });
     }
-    Err("a value computed at run time".into())
+    Err(UnknownBound::RuntimeValue)
 }
 
 fn signed(program: &Program, id: Id, v: u64) -> i64 {
@@ -719,92 +723,6 @@ fn relations(program: &Program, cond: Id, want: bool, out: &mut Vec<Rel>, depth:
     out.push(Rel { lhs, rhs, strict });
 }
 
-// ---------------------------------------------------------------------------
-// Dominators and loops.
-
-/// Immediate dominators by block index (Cooper, Harvey, Kennedy).
-pub fn dominators(f: &Function) -> Vec<Option<usize>> {
-    let n = f.blocks.len();
-    if n == 0 {
-        return Vec::new();
-    }
-    // Post-order by an explicit stack: shader CFGs can be large.
-    let mut order = Vec::new();
-    let mut seen = vec![false; n];
-    let mut stack = vec![(0usize, 0usize)];
-    seen[0] = true;
-    while let Some((b, k)) = stack.pop() {
-        match f.blocks[b].succs.get(k) {
-            Some(&s) => {
-                stack.push((b, k + 1));
-                if !seen[s] {
-                    seen[s] = true;
-                    stack.push((s, 0));
-                }
-            }
-            None => order.push(b),
-        }
-    }
-    order.reverse();
-    let mut rpo = vec![usize::MAX; n];
-    for (i, &b) in order.iter().enumerate() {
-        rpo[b] = i;
-    }
-    let mut preds = vec![Vec::new(); n];
-    for (b, block) in f.blocks.iter().enumerate() {
-        for &s in &block.succs {
-            preds[s].push(b);
-        }
-    }
-    let mut idom: Vec<Option<usize>> = vec![None; n];
-    idom[0] = Some(0);
-    let mut changed = true;
-    while changed {
-        changed = false;
-        for &b in order.iter().skip(1) {
-            let mut new: Option<usize> = None;
-            for &p in &preds[b] {
-                if idom[p].is_none() {
-                    continue;
-                }
-                new = Some(match new {
-                    None => p,
-                    Some(mut x) => {
-                        let mut y = p;
-                        while x != y {
-                            while rpo[x] > rpo[y] {
-                                x = idom[x].unwrap_or(0);
-                            }
-                            while rpo[y] > rpo[x] {
-                                y = idom[y].unwrap_or(0);
-                            }
-                        }
-                        x
-                    }
-                });
-            }
-            if new.is_some() && idom[b] != new {
-                idom[b] = new;
-                changed = true;
-            }
-        }
-    }
-    idom
-}
-
-fn dominates(idom: &[Option<usize>], a: usize, mut b: usize) -> bool {
-    for _ in 0..=idom.len() {
-        if a == b {
-            return true;
-        }
-        match idom.get(b).copied().flatten() {
-            Some(p) if p != b => b = p,
-            _ => return false,
-        }
-    }
-    false
-}
-
 /// Relations guaranteed to hold at instruction `inst` by the conditional
 /// branches that dominate it.
 fn dominating_relations(program: &Program, f: &Function, inst: usize) -> Vec<(Rel, usize)> {
@@ -860,29 +778,27 @@ fn recognise_guard(
     scc: usize,
     node: usize,
     site_inst: usize,
-) -> Result<Guard, String> {
+) -> Result<Guard, NoGuard> {
     let shader = &graph.nodes[node].shader;
-    let program = pipeline
-        .program(shader)
-        .ok_or_else(|| "the shader's module is missing".to_string())?;
+    let program = pipeline.program(shader).ok_or(NoGuard::ModuleMissing)?;
     let site = program
         .sites
         .iter()
         .find(|s| s.inst == site_inst)
-        .ok_or_else(|| "the trace is missing".to_string())?;
+        .ok_or(NoGuard::TraceMissing)?;
     let out_payload = site.payload.unwrap_or(0);
     // Every point from the trace up the call chain to the entry point.
     let g = program
         .functions
         .get(site.function)
-        .ok_or_else(|| "the trace is outside a function".to_string())?;
-    let chains = super::liveness::call_chains(program, shader.function, g.id);
+        .ok_or(NoGuard::OutsideFunction)?;
+    let chains = call_chains(program, shader.function, g.id, super::liveness::MAX_CHAINS);
     let mut points = vec![site_inst];
     if let Some(chain) = chains.first() {
         points.extend(chain.iter().rev().copied());
     }
     let mut seen_counter: Option<String> = None;
-    let mut why_not: Option<String> = None;
+    let mut why_not: Option<NoGuard> = None;
     for &p in &points {
         let Some(f) = program
             .function_of(p)
@@ -898,8 +814,11 @@ fn recognise_guard(
             seen_counter.get_or_insert(name.clone());
             let (bound, bound_source) = match bound_of(program, rel.rhs, &pipeline.constants) {
                 Ok(b) => b,
-                Err(e) => {
-                    why_not = Some(format!("`{name}` is compared with {e}"));
+                Err(bound) => {
+                    why_not = Some(NoGuard::BoundUnknown {
+                        counter: name,
+                        bound,
+                    });
                     continue;
                 }
             };
@@ -907,9 +826,7 @@ fn recognise_guard(
                 continue;
             };
             let Some(step) = growth(program, shader.function, out_payload, &counter) else {
-                why_not = Some(format!(
-                    "`{name}` guards the trace but the traced payload's counter does not grow by a constant"
-                ));
+                why_not = Some(NoGuard::CounterDoesNotGrow { counter: name });
                 continue;
             };
             let (initial, initial_assumed) =
@@ -935,9 +852,8 @@ fn recognise_guard(
             });
         }
     }
-    Err(why_not.unwrap_or_else(|| match seen_counter {
-        Some(c) => format!("no comparison of `{c}` with a known bound dominates the trace"),
-        None => "no depth counter comparison dominates the trace".into(),
+    Err(why_not.unwrap_or(NoGuard::NoComparison {
+        counter: seen_counter,
     }))
 }
 
@@ -1026,12 +942,12 @@ fn initial_value(
 // ---------------------------------------------------------------------------
 // Loops that trace.
 
-#[derive(Clone, Debug, serde::Serialize)]
+#[derive(Clone, Debug)]
 pub struct LoopBound {
     pub counter: String,
     pub op: &'static str,
     pub bound: i64,
-    pub bound_source: String,
+    pub bound_source: BoundSource,
 }
 
 /// A loop whose body traces (or calls a function that does).
@@ -1044,7 +960,7 @@ pub struct TraceLoop {
     pub location: Option<Location>,
     pub site_location: Option<Location>,
     /// The recognised bound, or why none was.
-    pub bound: Result<LoopBound, String>,
+    pub bound: Result<LoopBound, NoLoopBound>,
 }
 
 /// Loops around trace sites in every entry point of a program; bounds come
@@ -1062,7 +978,7 @@ pub fn trace_loops(
             let Some(g) = program.functions.get(site.function) else {
                 continue;
             };
-            for chain in super::liveness::call_chains(program, e.function, g.id) {
+            for chain in call_chains(program, e.function, g.id, super::liveness::MAX_CHAINS) {
                 let mut points = vec![site.inst];
                 points.extend(chain.iter().rev().copied());
                 for &p in &points {
@@ -1085,7 +1001,7 @@ pub fn trace_loops(
                             continue;
                         }
                         let location = (f.blocks[header].start..=f.blocks[header].end)
-                            .find_map(|i| super::liveness::useful_location(program, i))
+                            .find_map(|i| program.inst_location(i))
                             .or_else(|| program.site_location(header_inst));
                         out.push(TraceLoop {
                             entry: e.name.clone(),
@@ -1103,43 +1019,13 @@ pub fn trace_loops(
     out
 }
 
-/// Natural loops: header block and body blocks, one per back edge target.
-/// Natural loops of a function: header block and body blocks.
-pub(crate) fn natural_loops(f: &Function) -> Vec<(usize, HashSet<usize>)> {
-    let idom = dominators(f);
-    let mut preds = vec![Vec::new(); f.blocks.len()];
-    for (b, block) in f.blocks.iter().enumerate() {
-        for &s in &block.succs {
-            preds[s].push(b);
-        }
-    }
-    let mut loops: HashMap<usize, HashSet<usize>> = HashMap::new();
-    for (b, block) in f.blocks.iter().enumerate() {
-        for &h in &block.succs {
-            if !dominates(&idom, h, b) {
-                continue;
-            }
-            let body = loops.entry(h).or_insert_with(|| HashSet::from([h]));
-            let mut work = vec![b];
-            while let Some(x) = work.pop() {
-                if body.insert(x) {
-                    work.extend(preds[x].iter().copied());
-                }
-            }
-        }
-    }
-    let mut v: Vec<_> = loops.into_iter().collect();
-    v.sort_by_key(|(h, _)| *h);
-    v
-}
-
 fn loop_bound(
     program: &Program,
     f: &Function,
     body: &HashSet<usize>,
     constants: &BTreeMap<String, DescribedConstant>,
-) -> Result<LoopBound, String> {
-    let mut why: Option<String> = None;
+) -> Result<LoopBound, NoLoopBound> {
+    let mut why: Option<NoLoopBound> = None;
     let mut blocks: Vec<usize> = body.iter().copied().collect();
     blocks.sort_unstable();
     for b in blocks {
@@ -1167,9 +1053,7 @@ fn loop_bound(
             };
             let name = program.display_name(var);
             if !increments(program, f, body, var) {
-                why.get_or_insert(format!(
-                    "`{name}` is compared but not incremented by a constant in the loop"
-                ));
+                why.get_or_insert(NoLoopBound::NotIncremented { counter: name });
                 continue;
             }
             match bound_of(program, rel.rhs, constants) {
@@ -1181,11 +1065,16 @@ fn loop_bound(
                         bound_source,
                     })
                 }
-                Err(e) => why = Some(format!("the loop runs while `{name}` is below {e}")),
+                Err(bound) => {
+                    why = Some(NoLoopBound::BoundUnknown {
+                        counter: name,
+                        bound,
+                    })
+                }
             }
         }
     }
-    Err(why.unwrap_or_else(|| "no exit compares a counter with a bound".into()))
+    Err(why.unwrap_or(NoLoopBound::NoCounter))
 }
 
 /// Whether the loop stores `var = var + c` (c > 0) somewhere in its body.
@@ -1224,7 +1113,7 @@ mod tests {
 
     #[test]
     fn recursive_reflections_need_n_plus_two() {
-        let r = recursion(&pipeline(
+        let r = recursion_report(&pipeline(
             "fixtures/pipelines/reflect_recursive.pipeline.toml",
         ));
         // 3 reflections (maxDepth = 3), a shadow ray from the deepest hit.
@@ -1238,12 +1127,12 @@ mod tests {
         );
         assert!(!g.initial_assumed);
         assert!(
-            g.bound_source.contains("pushConst.maxDepth"),
-            "{}",
+            matches!(&g.bound_source, BoundSource::Described { kind: ValueKind::PushConstant, key, .. } if key == "pushConst.maxDepth"),
+            "{:?}",
             g.bound_source
         );
         assert_eq!(
-            r.chain_text(),
+            crate::explain::recursion_chain(&r),
             "raygeneration `main` (raygen 0) at level 0 → closesthit `main` (hit group 0) at levels 1–4 → miss `main` (miss 1) at level 5"
         );
         assert_eq!(r.recursive_sites.len(), 2);
@@ -1253,19 +1142,29 @@ mod tests {
     fn recursion_without_the_push_constant_is_unbounded() {
         let mut p = pipeline("fixtures/pipelines/reflect_recursive.pipeline.toml");
         p.constants.clear();
-        let r = recursion(&p);
+        let r = recursion_report(&p);
         assert_eq!(r.required_depth, None);
         let c = r.unbounded_cycle().unwrap();
         let why = c.sites[0].guard.as_ref().unwrap_err();
         assert_eq!(
             why,
+            &NoGuard::BoundUnknown {
+                counter: "payload.depth".into(),
+                bound: UnknownBound::NotDescribed {
+                    kind: ValueKind::PushConstant,
+                    name: "pushConst.maxDepth".into()
+                }
+            }
+        );
+        assert_eq!(
+            why.to_string(),
             "`payload.depth` is compared with push constant `pushConst.maxDepth`, which the pipeline description does not give"
         );
     }
 
     #[test]
     fn iterative_reflections_need_two() {
-        let r = recursion(&pipeline(
+        let r = recursion_report(&pipeline(
             "fixtures/pipelines/reflect_iterative.pipeline.toml",
         ));
         assert_eq!(r.required_depth, Some(2));
@@ -1278,14 +1177,18 @@ mod tests {
         assert_eq!((b.counter.as_str(), b.op, b.bound), ("bounce", "<=", 4));
         assert_eq!(
             b.bound_source,
-            "specialization constant `MAX_BOUNCES` (default 4)"
+            BoundSource::SpecConstant {
+                name: "MAX_BOUNCES".into(),
+                value: 4,
+                described: false
+            }
         );
     }
 
     #[test]
     fn reference_wgsl_pipeline_needs_one() {
         let p = pipeline("shaders/reflect_iterative.pipeline.toml");
-        let r = recursion(&p);
+        let r = recursion_report(&p);
         assert_eq!(r.required_depth, Some(1));
         let loops = trace_loops(&p.programs[0], &p.constants);
         assert_eq!(loops.len(), 1);
@@ -1293,7 +1196,7 @@ mod tests {
         assert_eq!((b.counter.as_str(), b.bound), ("bounce", 8));
         let none = trace_loops(&p.programs[0], &BTreeMap::new());
         assert_eq!(
-            none[0].bound.as_ref().unwrap_err(),
+            none[0].bound.as_ref().unwrap_err().to_string(),
             "the loop runs while `bounce` is below uniform value `params.max_bounces`, which the pipeline description does not give"
         );
     }
@@ -1303,7 +1206,7 @@ mod tests {
         // `if reflectivity > 0.0 && incoming.depth < params.max_bounces`:
         // naga stores the second comparison (or `false`) in a local bool and
         // branches on it; the branch still implies the comparison.
-        let r = recursion(&pipeline("shaders/reflect_recursive.pipeline.toml"));
+        let r = recursion_report(&pipeline("shaders/reflect_recursive.pipeline.toml"));
         assert_eq!(r.required_depth, Some(4));
         let g = r.cycles[0].sites[0].guard.as_ref().unwrap();
         assert_eq!(
@@ -1315,7 +1218,7 @@ mod tests {
     #[test]
     fn wgsl_guard_at_the_helper_call() {
         // naga puts the trace in a helper: the guard dominates the call.
-        let r = recursion(&pipeline(
+        let r = recursion_report(&pipeline(
             "fixtures/pipelines/reflect_recursive_wgsl.pipeline.toml",
         ));
         assert_eq!(r.required_depth, Some(5));
@@ -1326,7 +1229,11 @@ mod tests {
         );
         assert_eq!(
             g.bound_source,
-            "uniform value `params.max_depth` = 4 from the description"
+            BoundSource::Described {
+                kind: ValueKind::Uniform,
+                key: "params.max_depth".into(),
+                value: 4
+            }
         );
     }
 }

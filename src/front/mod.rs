@@ -7,6 +7,7 @@ pub mod slang;
 pub mod wgsl;
 
 use crate::diag::InputError;
+pub use crate::diag::{io_error, read_text, InputErrorKind};
 use crate::program::NamedDecl;
 use crate::shader::{Language, Location};
 use std::path::{Path, PathBuf};
@@ -63,7 +64,7 @@ pub fn compile_path(path: &Path, language: Language) -> Result<Compiled, InputEr
             })
         }
         Language::Glsl => Err(InputError::new(
-            "unsupported-language",
+            InputErrorKind::UnsupportedLanguage,
             path,
             format!(
                 "{} input is not supported by this build of rtlint",
@@ -79,20 +80,4 @@ pub fn load(path: &Path, language: Language) -> Result<crate::program::Program, 
     let mut program = crate::program::parse(&c.words, &c.path, c.language)?;
     program.attach_named_decls(&c.decls);
     Ok(program)
-}
-
-pub fn read_text(path: &Path) -> Result<String, InputError> {
-    let bytes = std::fs::read(path).map_err(|e| io_error(path, &e))?;
-    String::from_utf8(bytes).map_err(|e| {
-        let offset = e.utf8_error().valid_up_to();
-        InputError::new(
-            "invalid-utf8",
-            path,
-            format!("file is not valid UTF-8 (byte offset {offset})"),
-        )
-    })
-}
-
-pub fn io_error(path: &Path, e: &std::io::Error) -> InputError {
-    InputError::new("unreadable-file", path, format!("cannot read file: {e}"))
 }

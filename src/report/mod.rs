@@ -1,8 +1,12 @@
-//! Reports: the only place that turns diagnostics into text.
+//! Reports: the only place that turns diagnostics and analysis reports into
+//! text, for every command and format.
 
 pub mod human;
 pub mod json;
+pub mod layout;
+pub mod live;
 pub mod sarif;
+pub mod stack;
 
 use crate::diag::{Diagnostic, Location, Severity};
 use std::collections::HashMap;

@@ -53,7 +53,7 @@ pub fn check(pipeline: &Pipeline, rec: &RecursionReport) -> Vec<Diagnostic> {
             Some(depth) => {
                 d = d.with_note(format!(
                     "the pipeline needs recursion depth {depth}: {}",
-                    rec.chain_text()
+                    crate::explain::recursion_chain(rec)
                 ))
             }
             None => d = d.with_note("the recursion depth is unbounded at compile time"),
@@ -82,13 +82,13 @@ fn run(ctx: &super::PipelineContext) -> Vec<Diagnostic> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::analysis::recursion::recursion;
+    use crate::analysis::recursion::recursion_report;
     use crate::pipeline::load;
     use std::path::Path;
 
     fn run(rel: &str) -> Vec<Diagnostic> {
         let p = load(&Path::new(env!("CARGO_MANIFEST_DIR")).join(rel)).unwrap();
-        check(&p, &recursion(&p))
+        check(&p, &recursion_report(&p))
     }
 
     #[test]

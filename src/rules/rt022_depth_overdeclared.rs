@@ -1,7 +1,6 @@
 //! RT022 `depth-overdeclared`: the declared recursion depth is above what
 //! the pipeline needs, and the default stack pays for every extra level.
 
-use super::rt021_depth_exceeds_declared::pipeline_file;
 use crate::analysis::recursion::RecursionReport;
 use crate::analysis::stack::{vulkan_default, StackReport};
 use crate::diag::{Diagnostic, Severity};
@@ -25,7 +24,7 @@ pub fn check(pipeline: &Pipeline, rec: &RecursionReport, stack: &StackReport) ->
     let mut d = Diagnostic::new(
         LEVEL,
         NAME,
-        &pipeline_file(pipeline),
+        &pipeline.file(),
         format!("declared recursion depth {declared} is above the {required} the pipeline needs"),
     )
     .with_code(CODE)
@@ -33,7 +32,10 @@ pub fn check(pipeline: &Pipeline, rec: &RecursionReport, stack: &StackReport) ->
         pipeline.max_recursion_depth_location.clone(),
         format!("declared {declared} here"),
     )
-    .with_note(format!("deepest chain: {}", rec.chain_text()));
+    .with_note(format!(
+        "deepest chain: {}",
+        crate::explain::recursion_chain(rec)
+    ));
     if at_declared > at_required {
         d = d.with_note(format!(
             "the default stack is {at_declared} bytes per thread at depth {declared} and {at_required} at depth {required} (driver-comparable model)"
@@ -61,14 +63,14 @@ fn run(ctx: &super::PipelineContext) -> Vec<Diagnostic> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::analysis::recursion::recursion;
+    use crate::analysis::recursion::recursion_report;
     use crate::analysis::stack::stack_report;
     use crate::pipeline::load;
     use std::path::Path;
 
     fn run(rel: &str) -> Vec<Diagnostic> {
         let p = load(&Path::new(env!("CARGO_MANIFEST_DIR")).join(rel)).unwrap();
-        check(&p, &recursion(&p), &stack_report(&p))
+        check(&p, &recursion_report(&p), &stack_report(&p))
     }
 
     #[test]

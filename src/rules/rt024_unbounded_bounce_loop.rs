@@ -30,7 +30,7 @@ pub fn check(pipeline: &Pipeline, rec: &RecursionReport) -> Vec<Diagnostic> {
                 .with_subject(l.entry.clone())
                 .with_primary(l.location.clone(), "loop starts here")
                 .with_secondary(l.site_location.clone(), "traces here")
-                .with_note(why.clone())
+                .with_note(why.to_string())
                 .with_help(
                     "compare the bounce counter with a constant, or give the bound under `[constants]` in the pipeline description",
                 ),
@@ -48,7 +48,7 @@ pub fn check(pipeline: &Pipeline, rec: &RecursionReport) -> Vec<Diagnostic> {
             let names: Vec<String> = c
                 .nodes
                 .iter()
-                .map(|&n| rec.graph.nodes[n].describe())
+                .map(|&n| crate::explain::node(&rec.graph.nodes[n]))
                 .collect();
             out.push(
                 Diagnostic::new(
@@ -62,7 +62,7 @@ pub fn check(pipeline: &Pipeline, rec: &RecursionReport) -> Vec<Diagnostic> {
                 )
                 .with_code(CODE)
                 .with_primary(site.location.clone(), "this trace closes the cycle")
-                .with_note(why.clone())
+                .with_note(why.to_string())
                 .with_help(
                     "guard the trace with a depth counter carried in the payload and compared with a constant",
                 ),
@@ -89,13 +89,13 @@ fn run(ctx: &super::PipelineContext) -> Vec<Diagnostic> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::analysis::recursion::recursion;
+    use crate::analysis::recursion::recursion_report;
     use crate::pipeline::load;
     use std::path::Path;
 
     fn run(rel: &str) -> Vec<Diagnostic> {
         let p = load(&Path::new(env!("CARGO_MANIFEST_DIR")).join(rel)).unwrap();
-        check(&p, &recursion(&p))
+        check(&p, &recursion_report(&p))
     }
 
     #[test]
