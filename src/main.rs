@@ -85,6 +85,15 @@ enum Command {
         /// Compile only this entry point.
         #[arg(short = 'E', long = "entry")]
         entry: Option<String>,
+        /// The entry point's stage when it has no `[shader(...)]`: a DXC
+        /// profile (`ps_6_5`, `cs_6_5`, `lib_6_3`) or a stage name (`pixel`).
+        #[arg(
+            short = 'T',
+            long = "stage",
+            value_name = "PROFILE",
+            requires = "entry"
+        )]
+        stage: Option<String>,
         /// Include directory (searched after the including file's folder).
         #[arg(short = 'I', value_name = "DIR")]
         include: Vec<PathBuf>,
@@ -143,11 +152,12 @@ fn run(cli: Cli) -> Result<u8, String> {
         Command::Compile {
             file,
             entry,
+            stage,
             include,
             define,
             output,
             whole,
-        } => compile(file, entry, include, define, output, whole),
+        } => compile(file, entry, stage, include, define, output, whole),
         Command::Rules => {
             let mut out = std::io::stdout().lock();
             for r in rtlint::rules::RULES {
@@ -483,13 +493,22 @@ fn print_report<T: serde::Serialize>(
 fn compile(
     file: PathBuf,
     entry: Option<String>,
+    stage: Option<String>,
     include: Vec<PathBuf>,
     define: Vec<String>,
     output: PathBuf,
     whole: bool,
 ) -> Result<u8, String> {
     use rtlint::front::hlsl;
+    let stage = match stage.as_deref().map(hlsl::parse_stage).transpose() {
+        Ok(s) => s.flatten(),
+        Err(e) => {
+            eprintln!("error: -T: {e}");
+            return Ok(2);
+        }
+    };
     let options = hlsl::HlslOptions {
+        stage,
         include_dirs: include,
         defines: define
             .iter()

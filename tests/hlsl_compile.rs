@@ -815,3 +815,33 @@ fn windows_include_paths_and_case_mismatches() {
     assert!(m.warnings[0].ends_with("include/Util/HlslCompat.hlsli` only when ignoring case"));
     assert_eq!(named(&m.words, "srgbToLinear").len(), 1);
 }
+
+#[test]
+fn classic_entry_points_take_their_stage_from_the_command_line() {
+    let path = shader("classic/pixel_rayquery.hlsl");
+    let opts = HlslOptions {
+        entry: Some("main".into()),
+        stage: hlsl::parse_stage("ps_6_5").unwrap(),
+        ..Default::default()
+    };
+    let entries = hlsl::compile(&path, &opts).unwrap();
+    assert_eq!(entries.len(), 1);
+    assert_eq!(
+        (entries[0].name.as_str(), entries[0].stage),
+        ("main", Stage::Fragment)
+    );
+    validate(&entries[0].words, "classic-pixel");
+    let whole = hlsl::compile_file(&path, &opts).unwrap();
+    validate(&whole.words, "classic-pixel-all");
+    // Without the stage there is no entry point.
+    let e = hlsl::compile(&path, &HlslOptions::default()).unwrap_err();
+    assert!(e.to_string().contains("-E main -T ps_6_5"), "{e}");
+    // Profiles and names.
+    assert_eq!(hlsl::parse_stage("cs_6_0"), Ok(Some(Stage::Compute)));
+    assert_eq!(hlsl::parse_stage("lib_6_3"), Ok(None));
+    assert_eq!(hlsl::parse_stage("closesthit"), Ok(Some(Stage::ClosestHit)));
+    assert!(hlsl::parse_stage("vs_6_0")
+        .unwrap_err()
+        .starts_with("not supported: vertex"));
+    assert!(hlsl::parse_stage("ps_x").is_err());
+}

@@ -175,6 +175,9 @@ pub struct Lowerer<'a> {
     pub decls: Vec<(NamedDecl, Location)>,
     /// The function being lowered.
     f: FnCtx,
+    /// An entry point named on the command line with its stage, for
+    /// functions without `[shader(...)]`.
+    pub forced_entry: Option<(String, Stage)>,
     /// DXR subobjects the file declares.
     pub subobjects: super::subobject::Subobjects,
     /// Globals whose attributes add extensions or capabilities when used.
@@ -439,6 +442,7 @@ impl<'a> Lowerer<'a> {
             decls: Vec::new(),
             f: FnCtx::new(usize::MAX, "", None, Ty::Void),
             subobjects: Default::default(),
+            forced_entry: None,
             global_reqs: HashMap::new(),
             usings: items
                 .iter()

@@ -30,6 +30,56 @@ pub struct HlslOptions {
     pub defines: Vec<(String, String)>,
     /// Compile only this entry point.
     pub entry: Option<String>,
+    /// The stage of `entry` when it has no `[shader(...)]` (DXC's `-T`).
+    pub stage: Option<Stage>,
+}
+
+/// Reads a DXC target profile (`ps_6_5`, `cs_6_0`, `lib_6_3`) or a stage name
+/// (`pixel`, `closesthit`, ...). `lib_*` gives `None`: stages come from the
+/// `[shader(...)]` attributes.
+pub fn parse_stage(s: &str) -> Result<Option<Stage>, String> {
+    if let Some(stage) = Stage::from_hlsl_name(s) {
+        return Ok(Some(stage));
+    }
+    let (kind, version) = s
+        .split_once('_')
+        .ok_or_else(|| format!("unknown profile or stage `{s}`"))?;
+    let valid_version = version
+        .split('_')
+        .all(|p| !p.is_empty() && p.chars().all(|c| c.is_ascii_digit()));
+    if !valid_version {
+        return Err(format!("unknown profile `{s}`"));
+    }
+    match kind {
+        "ps" => Ok(Some(Stage::Fragment)),
+        "cs" => Ok(Some(Stage::Compute)),
+        "lib" => Ok(None),
+        "vs" | "gs" | "hs" | "ds" | "ms" | "as" => Err(format!(
+            "not supported: {} shaders (`{s}`)",
+            match kind {
+                "vs" => "vertex",
+                "gs" => "geometry",
+                "hs" => "hull",
+                "ds" => "domain",
+                "ms" => "mesh",
+                _ => "amplification",
+            }
+        )),
+        _ => Err(format!("unknown profile `{s}`")),
+    }
+}
+
+/// The lowerer for `items`, told about a command-line entry point's stage.
+fn lowerer<'a>(
+    items: &'a [ast::Item],
+    files: &'a [PathBuf],
+    options: &HlslOptions,
+) -> lower::Lowerer<'a> {
+    let mut l = lower::Lowerer::new(items, files);
+    if let (Some(e), Some(s)) = (&options.entry, options.stage) {
+        l.forced_entry = Some((e.clone(), s));
+    }
+    l
 }
 
 /// One entry point compiled to its own SPIR-V module.
@@ -139,7 +189,7 @@ fn entry_indices(
         let msg = match &options.entry {
             Some(name) => format!("no entry point named `{name}`"),
             None => {
-                "no entry points: mark one with [shader(\"...\")] or [numthreads(...)]".to_string()
+                "no entry points: mark one with [shader(\"...\")] or [numthreads(...)], or name it with its stage (-E main -T ps_6_5)".to_string()
             }
         };
         return Err(InputError::new(InputErrorKind::HlslError, path, msg));
@@ -183,12 +233,12 @@ fn compile_source_inner(
     options: &HlslOptions,
 ) -> Result<Vec<CompiledEntry>, InputError> {
     let (items, files, warnings) = parse_with_warnings(path, text, loader, options)?;
-    let mut probe = lower::Lowerer::new(&items, &files);
+    let mut probe = lowerer(&items, &files, options);
     let picked = entry_indices(&mut probe, path, &files, options)?;
     let mut out = Vec::new();
     for (_, name, stage) in picked {
         // A fresh module per entry point, holding only what it reaches.
-        let mut l = lower::Lowerer::new(&items, &files);
+        let mut l = lowerer(&items, &files, options);
         l.declare().map_err(|e| e.into_input_error(&files, path))?;
         let k = l.entry_function(&name).ok_or_else(|| {
             InputError::new(InputErrorKind::HlslError, path, "entry point vanished")
@@ -222,7 +272,7 @@ fn compile_source_whole_inner(
     options: &HlslOptions,
 ) -> Result<CompiledModule, InputError> {
     let (items, files, warnings) = parse_with_warnings(path, text, loader, options)?;
-    let mut l = lower::Lowerer::new(&items, &files);
+    let mut l = lowerer(&items, &files, options);
     let picked = entry_indices(&mut l, path, &files, options)?;
     let ks: Vec<usize> = picked
         .iter()

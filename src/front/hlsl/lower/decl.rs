@@ -107,6 +107,28 @@ impl<'a> Lowerer<'a> {
                     _ => {}
                 }
             }
+            // A classic entry point (`float4 main(...) : SV_Target`): the stage
+            // comes from the command line (`-E main -T ps_6_5`).
+            if let Some((name, forced)) = &self.forced_entry {
+                if *name == f.name {
+                    match stage {
+                        None => stage = Some(*forced),
+                        Some(s) if s != *forced => {
+                            return Err(Error::new(
+                                f.pos,
+                                format!(
+                                    "`{}` is marked a {} shader; the command line asks for {}",
+                                    f.name,
+                                    s.hlsl_name(),
+                                    forced.hlsl_name()
+                                ),
+                            )
+                            .len(f.name.len() as u32))
+                        }
+                        Some(_) => {}
+                    }
+                }
+            }
             let ret = self.resolve_ty(&f.ret, &f.ns)?;
             let mut params = Vec::new();
             for p in &f.params {
