@@ -845,3 +845,29 @@ fn classic_entry_points_take_their_stage_from_the_command_line() {
         .starts_with("not supported: vertex"));
     assert!(hlsl::parse_stage("ps_x").is_err());
 }
+
+/// `OpMemberDecorate` (72) of `struct_name`: (member, decoration) pairs.
+fn member_decorations(words: &[u32], struct_name: &str) -> Vec<(u32, u32)> {
+    let id = named(words, struct_name)[0];
+    instructions(words)
+        .into_iter()
+        .filter(|(op, ops)| *op == 72 && ops[0] == id)
+        .map(|(_, ops)| (ops[1], ops[2]))
+        .collect()
+}
+
+#[test]
+fn pack_matrix_pragma_sets_the_default_matrix_layout() {
+    compile_all("pack_matrix.hlsl");
+    let m = hlsl::compile_file(&shader("pack_matrix.hlsl"), &HlslOptions::default()).unwrap();
+    // HLSL row major is SPIR-V ColMajor (5), HLSL column major RowMajor (4).
+    let majors = |s: &str| -> Vec<(u32, u32)> {
+        member_decorations(&m.words, s)
+            .into_iter()
+            .filter(|(_, d)| *d == 4 || *d == 5)
+            .collect()
+    };
+    assert_eq!(majors("type.Camera"), vec![(0, 5), (1, 4)]);
+    assert_eq!(majors("Instance"), vec![(0, 5)]);
+    assert_eq!(majors("type.Later"), vec![(0, 4)]);
+}

@@ -246,8 +246,8 @@ fn templated_methods_are_refused() {
 #[test]
 fn layout_changing_constructs_are_refused() {
     assert_eq!(
-        err("#pragma pack_matrix(row_major)\n"),
-        "main.hlsl:1:2: not supported: #pragma pack_matrix(row_major)\n  note: declare matrices `row_major` one by one instead"
+        err("#pragma pack_matrix(diagonal)\n"),
+        "main.hlsl:1:2: #pragma pack_matrix needs row_major or column_major, not `diagonal`"
     );
     assert_eq!(
         err("StructuredBuffer<float4x4> m;\n[numthreads(1,1,1)] void f() {}"),

@@ -239,6 +239,20 @@ fn lex_number(b: &[u8]) -> Option<(Tok, usize)> {
         while i < b.len() && b[i].is_ascii_digit() {
             i += 1;
         }
+        // MSVC's spelling of special values, which DXC accepts: `1.#INF`.
+        for (spelling, v) in [
+            (&b"#INF"[..], f64::INFINITY),
+            (b"#IND", f64::NAN),
+            (b"#QNAN", f64::NAN),
+        ] {
+            if b[i..].starts_with(spelling) {
+                let mut j = i + spelling.len();
+                if j < b.len() && matches!(b[j], b'f' | b'F') {
+                    j += 1;
+                }
+                return Some((Tok::Float(v), j));
+            }
+        }
     }
     if i < b.len() && (b[i] == b'e' || b[i] == b'E') {
         let mut j = i + 1;

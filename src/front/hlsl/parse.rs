@@ -8,6 +8,7 @@ use super::ast::*;
 use super::attrs::{check, check_site, Site};
 use super::error::{Error, Pos, Result};
 use super::lex::{Tok, Token};
+use super::pp::{PACK_COLUMN_MAJOR, PACK_ROW_MAJOR};
 use std::collections::HashSet;
 
 pub struct Parser<'t> {
@@ -17,6 +18,8 @@ pub struct Parser<'t> {
     ns: Vec<String>,
     /// Namespaces named by `using namespace`.
     using: Vec<String>,
+    /// `#pragma pack_matrix` changes: (token index from which it holds, row major).
+    pack: Vec<(usize, bool)>,
     depth: usize,
 }
 
@@ -142,8 +145,19 @@ pub fn is_builtin_type(name: &str) -> bool {
 }
 
 pub fn parse(tokens: &[Token]) -> Result<Vec<Item>> {
+    // `#pragma pack_matrix` markers: (index of the next token, row major).
+    let mut pack = Vec::new();
+    let mut kept = Vec::with_capacity(tokens.len());
+    for t in tokens {
+        match t.tok {
+            Tok::Punct(PACK_ROW_MAJOR) => pack.push((kept.len(), true)),
+            Tok::Punct(PACK_COLUMN_MAJOR) => pack.push((kept.len(), false)),
+            _ => kept.push(t.clone()),
+        }
+    }
     let mut p = Parser {
-        t: tokens,
+        t: &kept,
+        pack,
         i: 0,
         types: HashSet::new(),
         ns: Vec::new(),
@@ -238,6 +252,9 @@ impl<'t> Parser<'t> {
         let Some(name) = self.peek_at(k).and_then(Token::ident) else {
             return false;
         };
+        if name == "unsigned" {
+            return true;
+        }
         if (is_builtin_type(name) || self.types.contains(name)) && !self.is_at(k + 1, "::") {
             return true;
         }
@@ -292,6 +309,16 @@ impl<'t> Parser<'t> {
 
     fn type_ref(&mut self) -> Result<TypeRef> {
         let (mut name, pos) = self.ident()?;
+        if name == "unsigned" {
+            // `unsigned int2`, `unsigned int`, `unsigned`: the `uint` types.
+            name = match self.peek().and_then(Token::ident) {
+                Some(n) if n.starts_with("int") && split_numeric(n).is_some() => {
+                    self.i += 1;
+                    format!("u{n}")
+                }
+                _ => "uint".to_string(),
+            };
+        }
         if !is_builtin_type(&name) && !self.types.contains(&name) {
             if let Some(q) = self.ns_qualified(&name) {
                 name = q;
@@ -355,8 +382,21 @@ impl<'t> Parser<'t> {
         Ok(out)
     }
 
+    /// Whether `#pragma pack_matrix(row_major)` holds at the current token.
+    fn row_major_default(&self) -> bool {
+        self.pack
+            .iter()
+            .rev()
+            .find(|(at, _)| *at <= self.i)
+            .is_some_and(|(_, row)| *row)
+    }
+
     fn mods(&mut self) -> Mods {
         let mut m = Mods::default();
+        if self.row_major_default() {
+            // Explicit `column_major` below turns it off again.
+            m.row_major = true;
+        }
         loop {
             match self.peek().and_then(Token::ident) {
                 Some("static") => m.is_static = true,
@@ -370,7 +410,10 @@ impl<'t> Parser<'t> {
                     m.output = true
                 }
                 Some("row_major") => m.row_major = true,
-                Some("column_major") => m.column_major = true,
+                Some("column_major") => {
+                    m.column_major = true;
+                    m.row_major = false;
+                }
                 Some("precise") => m.precise = true,
                 Some("nointerpolation") => m.nointerp = true,
                 Some(

@@ -130,6 +130,10 @@ pub struct Preprocessor<'a> {
 }
 
 const MAX_INCLUDE_DEPTH: usize = 64;
+
+/// Marker tokens for `#pragma pack_matrix(...)`, read by the parser.
+pub const PACK_ROW_MAJOR: &str = "#pragma pack_matrix(row_major)";
+pub const PACK_COLUMN_MAJOR: &str = "#pragma pack_matrix(column_major)";
 const EXPANSION_BUDGET: usize = 2_000_000;
 
 impl<'a> Preprocessor<'a> {
@@ -319,15 +323,23 @@ impl<'a> Preprocessor<'a> {
             "include" => self.include(pos, rest),
             "pragma" => {
                 if rest.first().and_then(Token::ident) == Some("pack_matrix") {
-                    // Changing the default matrix packing would change every layout.
+                    // The default packing of the matrices declared after it: a
+                    // marker token the parser reads (and removes).
                     let arg = rest.get(2).and_then(Token::ident).unwrap_or("");
-                    if arg != "column_major" {
-                        return Err(Error::new(
+                    let marker = match arg {
+                        "row_major" => PACK_ROW_MAJOR,
+                        "column_major" => PACK_COLUMN_MAJOR,
+                        _ => return Err(Error::new(
                             pos,
-                            format!("not supported: #pragma pack_matrix({arg})"),
-                        )
-                        .note("declare matrices `row_major` one by one instead"));
-                    }
+                            format!(
+                                "#pragma pack_matrix needs row_major or column_major, not `{arg}`"
+                            ),
+                        )),
+                    };
+                    let mut t = rest[0].clone();
+                    t.tok = Tok::Punct(marker);
+                    t.bol = false;
+                    self.out.push(t);
                 }
                 if rest.first().and_then(Token::ident) == Some("once") {
                     let file = self.stack.last().map(|s| s.0).unwrap_or(0);
