@@ -871,3 +871,27 @@ fn pack_matrix_pragma_sets_the_default_matrix_layout() {
     assert_eq!(majors("Instance"), vec![(0, 5)]);
     assert_eq!(majors("type.Later"), vec![(0, 4)]);
 }
+
+/// Member names of the struct named `name`, by `OpMemberName` (6).
+fn member_names(words: &[u32], name: &str) -> Vec<String> {
+    let id = named(words, name)[0];
+    instructions(words)
+        .into_iter()
+        .filter(|(op, ops)| *op == 6 && ops[0] == id)
+        .map(|(_, ops)| string_at(&ops[2..]))
+        .collect()
+}
+
+#[test]
+fn static_members_nested_structs_and_inheritance() {
+    compile_all("nested_records.hlsl");
+    let m = hlsl::compile_file(&shader("nested_records.hlsl"), &HlslOptions::default()).unwrap();
+    assert_eq!(
+        member_names(&m.words, "BrdfSample"),
+        vec!["value", "pdf", "direction"]
+    );
+    assert_eq!(member_names(&m.words, "L1::Packed"), vec!["c"]);
+    // The inherited method runs on the derived struct.
+    assert_eq!(named(&m.words, "BrdfSample::valueOverPdf").len(), 1);
+    assert_eq!(named(&m.words, "L1::Packed::Unpack").len(), 1);
+}

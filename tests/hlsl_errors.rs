@@ -121,10 +121,6 @@ fn unsupported_constructs_are_named() {
         err(&format!("{RG}    double d = 1;\n}}")),
         "main.hlsl:4:5: not supported: type `double` (only 32-bit types)"
     );
-    assert_eq!(
-        err("struct S { float f; static const uint N = 4; };"),
-        "main.hlsl:1:34: not supported: static data members"
-    );
 }
 
 #[test]

@@ -81,6 +81,8 @@ pub struct Function {
 pub struct StructDecl {
     pub name: String,
     pub pos: Pos,
+    /// `struct B : A`: A's members come first.
+    pub bases: Vec<TypeRef>,
     pub fields: Vec<VarDecl>,
     /// Methods: functions with an implicit `inout` `this`.
     pub methods: Vec<Function>,

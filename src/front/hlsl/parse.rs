@@ -476,7 +476,7 @@ impl<'t> Parser<'t> {
         }
         if record && (self.peek_at(2).is_some_and(|t| t.is("{") || t.is(":")) || self.is_at(1, "["))
         {
-            let s = self.struct_decl()?;
+            let s = self.struct_decl(items)?;
             self.expect(";")?;
             items.push(Item::Struct(s));
             return Ok(());
@@ -664,17 +664,45 @@ impl<'t> Parser<'t> {
         Ok(())
     }
 
-    fn struct_decl(&mut self) -> Result<StructDecl> {
+    /// A struct or class. Nested declarations (structs, enums, typedefs,
+    /// `static` members) go to `items`, qualified by the struct's name, before it.
+    fn struct_decl(&mut self, items: &mut Vec<Item>) -> Result<StructDecl> {
         if !self.eat("class") {
             self.expect("struct")?;
         }
         check_site(&self.attrs()?, Site::Struct)?; // `[raypayload]`
         let (name, pos) = self.ident()?;
         self.declare_type(&name);
-        if self.is(":") {
-            return Err(Error::new(self.pos(), "not supported: struct inheritance"));
+        let qualified = self.qualify(&name);
+        let mut bases = Vec::new();
+        if self.eat(":") {
+            loop {
+                let _ = self.eat("public") || self.eat("private") || self.eat("protected");
+                bases.push(self.type_ref()?);
+                if !self.eat(",") {
+                    break;
+                }
+            }
         }
         self.expect("{")?;
+        self.ns.push(name);
+        let body = self.struct_body(items, &qualified);
+        self.ns.pop();
+        let (fields, methods) = body?;
+        Ok(StructDecl {
+            name: qualified,
+            pos,
+            bases,
+            fields,
+            methods,
+        })
+    }
+
+    fn struct_body(
+        &mut self,
+        items: &mut Vec<Item>,
+        qualified: &str,
+    ) -> Result<(Vec<VarDecl>, Vec<Function>)> {
         let mut fields = Vec::new();
         let mut methods = Vec::new();
         while !self.is("}") {
@@ -690,11 +718,16 @@ impl<'t> Parser<'t> {
                 self.i += 2;
                 continue;
             }
+            if ["struct", "class", "enum", "typedef", "using"]
+                .iter()
+                .any(|k| self.is_kw(k))
+            {
+                // A nested declaration: a declaration of its own, named `Outer::Inner`.
+                self.item(items)?;
+                continue;
+            }
             let fattrs = self.attrs()?;
             let mods = self.mods();
-            if self.is_kw("struct") || self.is_kw("class") {
-                return Err(Error::new(self.pos(), "not supported: nested struct").len(6));
-            }
             let ty = self.type_ref()?;
             if self.peek().and_then(Token::ident).is_some() && self.is_at(1, "(") {
                 let (mname, mpos) = self.ident()?;
@@ -703,26 +736,25 @@ impl<'t> Parser<'t> {
                 let mut f = self.function(fattrs, ty, mname.clone(), mpos)?;
                 f.name = mname;
                 f.is_static = mods.is_static;
-                if f.is_static {
-                    // Unqualified names in a static method look in the struct first.
-                    f.ns = format!("{}::", self.qualify(&name));
-                }
                 methods.push(f);
                 continue;
             }
             if mods.is_static {
-                return Err(Error::new(ty.pos, "not supported: static data members"));
+                // A static member is a global named `S::name`.
+                check_site(&fattrs, Site::Global)?;
+                let mut vars = Vec::new();
+                self.declarators(fattrs, mods, ty, &mut vars)?;
+                items.extend(vars.into_iter().map(|mut v| {
+                    v.name = format!("{qualified}::{}", v.name);
+                    Item::Var(v)
+                }));
+                continue;
             }
             check_site(&fattrs, Site::Member)?;
             self.declarators(fattrs, mods, ty, &mut fields)?;
         }
         self.i += 1;
-        Ok(StructDecl {
-            name: self.qualify(&name),
-            pos,
-            fields,
-            methods,
-        })
+        Ok((fields, methods))
     }
 
     fn dims(&mut self) -> Result<Vec<Option<Expr>>> {

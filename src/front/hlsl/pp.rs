@@ -329,12 +329,14 @@ impl<'a> Preprocessor<'a> {
                     let marker = match arg {
                         "row_major" => PACK_ROW_MAJOR,
                         "column_major" => PACK_COLUMN_MAJOR,
-                        _ => return Err(Error::new(
-                            pos,
-                            format!(
+                        _ => {
+                            return Err(Error::new(
+                                pos,
+                                format!(
                                 "#pragma pack_matrix needs row_major or column_major, not `{arg}`"
                             ),
-                        )),
+                            ))
+                        }
                     };
                     let mut t = rest[0].clone();
                     t.tok = Tok::Punct(marker);

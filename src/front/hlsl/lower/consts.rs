@@ -409,13 +409,27 @@ impl<'a> Lowerer<'a> {
         })
     }
 
+    /// A named constant: looked up in the current namespace (or struct),
+    /// then each enclosing one, then the `using` namespaces.
     pub(super) fn enum_value(&self, n: &str) -> Option<CVal> {
-        if !self.f.cur_ns.is_empty() {
-            if let Some(c) = self.const_items.get(&format!("{}{n}", self.f.cur_ns)) {
+        let mut prefix = self.f.cur_ns.as_str();
+        loop {
+            if let Some(c) = self.const_items.get(&format!("{prefix}{n}")) {
                 return Some(c.clone());
             }
+            if prefix.is_empty() {
+                break;
+            }
+            let inner = &prefix[..prefix.len() - 2];
+            prefix = match inner.rfind("::") {
+                Some(k) => &inner[..k + 2],
+                None => "",
+            };
         }
-        self.const_items.get(n).cloned()
+        self.usings
+            .iter()
+            .find_map(|u| self.const_items.get(&format!("{u}{n}")))
+            .cloned()
     }
 
     /// A constant of type `t` from an initializer, or `None` when it is not constant.

@@ -14,7 +14,12 @@ impl<'a> Lowerer<'a> {
                 Item::Var(v) if v.mods.is_static && v.mods.is_const && v.dims.is_empty() => {
                     if let (Some(e), Ok(Ty::Sc(s))) = (&v.init, self.resolve_ty(&v.ty, "")) {
                         // Not constant (or not yet resolvable): declared later as usual.
-                        if let Ok(Some(c)) = self.const_eval(e) {
+                        let scope = v.name.rsplit_once("::").map(|(n, _)| format!("{n}::"));
+                        let saved =
+                            std::mem::replace(&mut self.f.cur_ns, scope.unwrap_or_default());
+                        let c = self.const_eval(e);
+                        self.f.cur_ns = saved;
+                        if let Ok(Some(c)) = c {
                             let c = match (s, c) {
                                 (Sc::Float, c) => CVal::F(c.as_f64()),
                                 (_, CVal::F(f)) => CVal::I(f as i64),
@@ -57,7 +62,11 @@ impl<'a> Lowerer<'a> {
                         .unwrap_or_default();
                     for (v, _, value) in variants {
                         if let Some(e) = value {
-                            next = self.const_int(e)?;
+                            // Earlier variants are in scope by bare name.
+                            let saved = std::mem::replace(&mut self.f.cur_ns, format!("{name}::"));
+                            let r = self.const_int(e);
+                            self.f.cur_ns = saved;
+                            next = r?;
                         }
                         let id = self.const_scalar(sc, next as f64, next);
                         let c = Global::Const(Val { id, ty: Ty::Sc(sc) });
@@ -196,7 +205,38 @@ impl<'a> Lowerer<'a> {
         let Some(&k) = self.struct_names.get(&sd.name) else {
             return Ok(());
         };
-        for f in &sd.methods {
+        // Methods of the bases (transitively) that the struct does not redefine,
+        // with the derived struct as `this` (its members start with the base's).
+        let mut methods: Vec<&'a Function> = sd.methods.iter().collect();
+        let mut bases: Vec<&TypeRef> = sd.bases.iter().collect();
+        let mut seen = 0;
+        while let Some(b) = bases.pop() {
+            seen += 1;
+            if seen > 64 {
+                break;
+            }
+            let Ok(Ty::Struct(kb)) = self.resolve_ty(b, &format!("{}::", sd.name)) else {
+                continue;
+            };
+            let base_name = self.structs[kb as usize].name.clone();
+            let items = self.items;
+            let Some(base) = items.iter().find_map(|i| match i {
+                Item::Struct(s) if s.name == base_name => Some(s),
+                _ => None,
+            }) else {
+                continue;
+            };
+            for m in &base.methods {
+                let redefined = methods
+                    .iter()
+                    .any(|x| x.name == m.name && x.params.len() == m.params.len());
+                if !redefined {
+                    methods.push(m);
+                }
+            }
+            bases.extend(base.bases.iter());
+        }
+        for f in methods {
             if f.body.is_none() {
                 continue; // declared, never defined: a call finds no overload
             }
@@ -249,9 +289,25 @@ impl<'a> Lowerer<'a> {
     }
 
     pub(super) fn declare_struct(&mut self, s: &StructDecl) -> Result<()> {
+        // Names in the struct (array sizes, nested types) look in it first.
+        let scope = format!("{}::", s.name);
+        let saved = std::mem::replace(&mut self.f.cur_ns, scope.clone());
+        let r = self.declare_struct_in(s, &scope);
+        self.f.cur_ns = saved;
+        r
+    }
+
+    fn declare_struct_in(&mut self, s: &StructDecl, scope: &str) -> Result<()> {
         let mut fields = Vec::new();
+        for b in &s.bases {
+            // A base's members come first, as C++ lays them out.
+            match self.resolve_ty(b, scope)? {
+                Ty::Struct(k) => fields.extend(self.structs[k as usize].fields.iter().cloned()),
+                _ => return Err(Error::new(b.pos, "a base must be a struct")),
+            }
+        }
         for f in &s.fields {
-            let t = self.resolve_ty(&f.ty, "")?;
+            let t = self.resolve_ty(&f.ty, scope)?;
             let t = self.apply_dims(t, &f.dims, f.pos, false)?;
             if t.is_resource() || matches!(t, Ty::RayQuery(_)) {
                 return Err(unsupported(f.pos, "resources inside structs"));
@@ -588,7 +644,14 @@ impl<'a> Lowerer<'a> {
                     self.declare_subobject(v)?
                 }
                 Item::Var(v) if self.in_implicit_globals(v)? => globals_members.push(v),
-                Item::Var(v) => self.declare_global_var(v, &mut used, &mut next_auto)?,
+                Item::Var(v) => {
+                    // A namespace's or struct's names are in scope in its initializers.
+                    let scope = v.name.rsplit_once("::").map(|(n, _)| format!("{n}::"));
+                    let saved = std::mem::replace(&mut self.f.cur_ns, scope.unwrap_or_default());
+                    let r = self.declare_global_var(v, &mut used, &mut next_auto);
+                    self.f.cur_ns = saved;
+                    r?
+                }
                 _ => {}
             }
         }
