@@ -895,3 +895,25 @@ fn static_members_nested_structs_and_inheritance() {
     assert_eq!(named(&m.words, "BrdfSample::valueOverPdf").len(), 1);
     assert_eq!(named(&m.words, "L1::Packed::Unpack").len(), 1);
 }
+
+/// Values of the 32-bit `OpConstant`s (43) of the module.
+fn constants(words: &[u32]) -> Vec<u32> {
+    instructions(words)
+        .into_iter()
+        .filter(|(op, ops)| *op == 43 && ops.len() == 3)
+        .map(|(_, ops)| ops[2])
+        .collect()
+}
+
+#[test]
+fn sizeof_msvc_spellings_and_functional_struct_casts() {
+    compile_all("sizeof_and_casts.hlsl");
+    let m = hlsl::compile_file(&shader("sizeof_and_casts.hlsl"), &HlslOptions::default()).unwrap();
+    let c = constants(&m.words);
+    // sizeof(float3) + sizeof(Mixed) * 100 + sizeof(float4x4) * 10000, folded.
+    assert!(c.contains(&(12 + 32 * 100 + 64 * 10000)), "{c:?}");
+    // META_COUNT: 3 * sizeof(uint).
+    assert!(c.contains(&12));
+    // 1.#INF.
+    assert!(c.contains(&f32::INFINITY.to_bits()));
+}

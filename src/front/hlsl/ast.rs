@@ -204,6 +204,8 @@ pub enum ExprKind {
     Index(Box<Expr>, Box<Expr>),
     Cast(TypeRef, Box<Expr>),
     InitList(Vec<Expr>),
+    /// `sizeof(T)` or `sizeof(T[N])`: bytes, scalars packed (as DXC's HLSL 2021).
+    SizeOf(TypeRef, Vec<Option<Expr>>),
     Comma(Box<Expr>, Box<Expr>),
 }
 

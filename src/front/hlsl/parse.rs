@@ -1287,6 +1287,14 @@ impl<'t> Parser<'t> {
         }
         // Skip the type (with a template list) and look for `)`.
         let mut k = 2;
+        if self.peek_at(1).and_then(Token::ident) == Some("unsigned")
+            && self
+                .peek_at(2)
+                .and_then(Token::ident)
+                .is_some_and(|n| n.starts_with("int"))
+        {
+            k = 3;
+        }
         while self.is_at(k, "::") {
             k += 2;
         }
@@ -1443,6 +1451,19 @@ impl<'t> Parser<'t> {
             Tok::Ident(k) if &**k == "true" || &**k == "false" => {
                 self.i += 1;
                 ExprKind::Bool(&**k == "true")
+            }
+            Tok::Ident(k) if &**k == "sizeof" && self.is_at(1, "(") => {
+                self.i += 2;
+                if !self.type_at(0) {
+                    return Err(Error::new(
+                        self.pos(),
+                        "not supported: `sizeof` of an expression; name a type",
+                    ));
+                }
+                let ty = self.type_ref()?;
+                let dims = self.dims()?;
+                self.expect(")")?;
+                ExprKind::SizeOf(ty, dims)
             }
             // `Enum::Value` names a value even though `Enum` is a type.
             Tok::Ident(_) if self.type_at(0) && !self.enum_value_ahead() => {

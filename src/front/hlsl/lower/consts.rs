@@ -323,6 +323,7 @@ impl<'a> Lowerer<'a> {
             ExprKind::Int(v, _) => Some(CVal::I(*v as i64)),
             ExprKind::Float(f) => Some(CVal::F(*f)),
             ExprKind::Bool(b) => Some(CVal::I(*b as i64)),
+            ExprKind::SizeOf(t, dims) => Some(CVal::I(self.size_of(t, dims, e.pos)? as i64)),
             ExprKind::Ident(n) => {
                 if let Some(v) = builtin_constant(n) {
                     return Ok(Some(CVal::I(v as i64)));
@@ -552,4 +553,19 @@ fn extended_format(f: spirv::ImageFormat) -> bool {
             | F::Rgba8ui
             | F::R32ui
     )
+}
+
+impl Lowerer<'_> {
+    /// `sizeof(T)` in bytes.
+    pub(super) fn size_of(&mut self, t: &TypeRef, dims: &[Option<Expr>], pos: Pos) -> Result<u32> {
+        let ns = self.f.cur_ns.clone();
+        let ty = self.resolve_ty(t, &ns)?;
+        let ty = self.apply_dims(ty, dims, pos, false)?;
+        packed_size(&ty, &self.structs).ok_or_else(|| {
+            Error::new(
+                pos,
+                format!("`{}` has no size in memory", self.ty_name(&ty)),
+            )
+        })
+    }
 }

@@ -57,6 +57,14 @@ impl<'a> Lowerer<'a> {
 
     pub(super) fn expr(&mut self, e: &'a Expr) -> Result<Val> {
         let v = match &e.kind {
+            // `sizeof` is a `uint` constant, as in DXC.
+            ExprKind::SizeOf(t, dims) => {
+                let n = self.size_of(t, dims, e.pos)?;
+                Val {
+                    id: self.const_u32(n),
+                    ty: Ty::Sc(Sc::Uint),
+                }
+            }
             ExprKind::Int(v, u) => {
                 if *u || *v > i32::MAX as u64 {
                     if *v > u32::MAX as u64 {
@@ -269,6 +277,30 @@ impl<'a> Lowerer<'a> {
     }
 
     pub(super) fn construct(&mut self, ty: &Ty, args: &'a [Expr], pos: Pos) -> Result<Val> {
+        if let Ty::Struct(_) = ty {
+            // `S(a, b)`: a functional cast, component by component (as `(S)v` or `{a, b}`).
+            if let [one] = args {
+                if let ExprKind::Int(0, _) = one.kind {
+                    let v = self.expr(one)?;
+                    return self.convert(v, ty, pos, true);
+                }
+            }
+            let mut flat = Vec::new();
+            for a in args {
+                let v = self.expr(a)?;
+                self.flatten(v, &mut flat)?;
+            }
+            let n = flat.len();
+            let mut it = flat.into_iter();
+            let v = self.build(ty, &mut it, pos)?;
+            if it.next().is_some() {
+                return Err(Error::new(
+                    pos,
+                    format!("too many components ({n}) for a `{}`", self.ty_name(ty)),
+                ));
+            }
+            return Ok(v);
+        }
         if !ty.is_numeric() {
             return Err(unsupported(
                 pos,
