@@ -917,3 +917,24 @@ fn sizeof_msvc_spellings_and_functional_struct_casts() {
     // 1.#INF.
     assert!(c.contains(&f32::INFINITY.to_bits()));
 }
+
+#[test]
+fn functions_are_specialized_on_their_buffer_arguments() {
+    compile_all("buffer_params.hlsl");
+    let m = hlsl::compile_file(&shader("buffer_params.hlsl"), &HlslOptions::default()).unwrap();
+    // One copy per distinct buffer: indicesA and indicesB.
+    assert_eq!(named(&m.words, "centroid").len(), 2);
+    assert_eq!(named(&m.words, "loadTriangle").len(), 2);
+    // Textures and samplers stay parameters: one `shade`, with 3 parameters.
+    assert_eq!(named(&m.words, "shade").len(), 1);
+    let insts = instructions(&m.words);
+    // No OpFunctionParameter (55) is a StorageBuffer (12) pointer (32).
+    let sb_ptrs: Vec<u32> = insts
+        .iter()
+        .filter(|(op, ops)| *op == 32 && ops[1] == 12)
+        .map(|(_, ops)| ops[0])
+        .collect();
+    assert!(!insts
+        .iter()
+        .any(|(op, ops)| *op == 55 && sb_ptrs.contains(&ops[0])));
+}

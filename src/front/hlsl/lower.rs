@@ -91,6 +91,9 @@ struct FnSig<'a> {
     ret: Ty,
     id: Id,
     func: &'a Function,
+    /// Parameters bound to a resource variable (a specialized copy, see
+    /// `specialize`): (parameter index, the variable's place).
+    bound: Vec<(usize, Place)>,
     /// Default values of the trailing parameters that have one.
     defaults: Vec<&'a Expr>,
     /// For methods: the struct whose `this` is the first parameter.
@@ -180,6 +183,8 @@ pub struct Lowerer<'a> {
     pub forced_entry: Option<(String, Stage)>,
     /// DXR subobjects the file declares.
     pub subobjects: super::subobject::Subobjects,
+    /// Functions specialized on their buffer arguments: (function, bound) → copy.
+    specialized: HashMap<(usize, Vec<(usize, Id)>), usize>,
     /// Globals whose attributes add extensions or capabilities when used.
     global_reqs: HashMap<Id, Requirements>,
     /// Namespaces named by `using namespace`, searched after the enclosing ones.
@@ -444,6 +449,7 @@ impl<'a> Lowerer<'a> {
             subobjects: Default::default(),
             forced_entry: None,
             global_reqs: HashMap::new(),
+            specialized: HashMap::new(),
             usings: items
                 .iter()
                 .filter_map(|i| match i {

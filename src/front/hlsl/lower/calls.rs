@@ -1184,7 +1184,10 @@ impl<'a> Lowerer<'a> {
             args.push(Arg::Expr(e));
         }
         let mut temps = Vec::new();
-        for ((p, (place, v)), a) in sig.params.iter().zip(&argv).zip(&args) {
+        // Buffers (storage-buffer pointers) cannot be function arguments
+        // without variable pointers: the function is specialized on them.
+        let mut bound = Vec::new();
+        for (i, ((p, (place, v)), a)) in sig.params.iter().zip(&argv).zip(&args).enumerate() {
             if p.ty.is_resource() {
                 // Passed as the resource variable itself, which SPIR-V's
                 // logical addressing allows only for whole variables.
@@ -1193,6 +1196,9 @@ impl<'a> Lowerer<'a> {
                         a.pos(),
                         "passing an element of a resource array to a function",
                     ));
+                }
+                if self.param_class(&p.ty).0 != StorageClass::UniformConstant {
+                    bound.push((i, v.id));
                 }
                 temps.push(v.id);
                 continue;
@@ -1208,11 +1214,23 @@ impl<'a> Lowerer<'a> {
             }
             temps.push(tmp);
         }
+        let (k, sig) = if bound.is_empty() {
+            (k, sig)
+        } else {
+            let k = self.specialize(k, &bound);
+            (k, self.funcs[k].clone())
+        };
+        let passed: Vec<Id> = temps
+            .iter()
+            .enumerate()
+            .filter(|(i, _)| !sig.bound.iter().any(|(b, _)| b == i))
+            .map(|(_, t)| *t)
+            .collect();
         let rt = self.ty_id(&sig.ret)?;
         if self.f.term {
             self.start_block(None)?;
         }
-        let id = self.b.function_call(rt, None, sig.id, temps.clone())?;
+        let id = self.b.function_call(rt, None, sig.id, passed)?;
         self.fn_calls.entry(self.f.cur_fn).or_default().insert(k);
         if !self.lowered.contains(&k) && !self.pending.contains(&k) {
             self.pending.push(k);
@@ -1241,6 +1259,37 @@ impl<'a> Lowerer<'a> {
         } else {
             Some(Val { id, ty: sig.ret })
         })
+    }
+
+    /// Function `k` with the buffer parameters `bound` (parameter index,
+    /// variable) replaced by those variables: one copy per combination.
+    fn specialize(&mut self, k: usize, bound: &[(usize, Id)]) -> usize {
+        let key = (k, bound.to_vec());
+        if let Some(&s) = self.specialized.get(&key) {
+            return s;
+        }
+        let mut sig = self.funcs[k].clone();
+        sig.id = self.b.id();
+        sig.bound = bound
+            .iter()
+            .map(|&(i, var)| {
+                let ty = sig.params[i].ty.clone();
+                let (class, layout) = self.param_class(&ty);
+                (
+                    i,
+                    Place::Ptr {
+                        ptr: var,
+                        ty,
+                        layout,
+                        class,
+                    },
+                )
+            })
+            .collect();
+        let s = self.funcs.len();
+        self.funcs.push(sig);
+        self.specialized.insert(key, s);
+        s
     }
 
     /// Whether `name` is a user function returning a resource.

@@ -178,6 +178,7 @@ impl<'a> Lowerer<'a> {
             self.funcs.push(FnSig {
                 name: f.name.clone(),
                 defaults,
+                bound: Vec::new(),
                 params,
                 ret,
                 id,
@@ -271,6 +272,7 @@ impl<'a> Lowerer<'a> {
             self.funcs.push(FnSig {
                 name: name.clone(),
                 defaults: defaults_of(f)?,
+                bound: Vec::new(),
                 params,
                 ret,
                 id,

@@ -77,7 +77,11 @@ impl<'a> Lowerer<'a> {
             }
         } else {
             let mut ptys = Vec::new();
-            for p in &sig.params {
+            let is_bound = |i: usize| sig.bound.iter().any(|(b, _)| *b == i);
+            for (i, p) in sig.params.iter().enumerate() {
+                if is_bound(i) {
+                    continue;
+                }
                 if matches!(p.ty, Ty::RayQuery(_)) {
                     return Err(unsupported(f.pos, "RayQuery function parameters"));
                 }
@@ -116,7 +120,17 @@ impl<'a> Lowerer<'a> {
             } else {
                 self.f.this_place = None;
             }
-            for ((p, decl), pty) in params.zip(&f.params).zip(ptys) {
+            let first = sig.this.is_some() as usize;
+            for (j, (p, decl)) in params.zip(&f.params).enumerate() {
+                if let Some((_, place)) = sig.bound.iter().find(|(b, _)| *b == j + first) {
+                    // A buffer this copy is specialized on.
+                    if let Place::Ptr { ptr, .. } = place {
+                        self.use_global(*ptr);
+                    }
+                    self.f.scopes[0].insert(decl.name.clone(), place.clone());
+                    continue;
+                }
+                let pty = ptys.next().unwrap_or_default();
                 let id = self.b.function_parameter(pty)?;
                 self.b.name(id, decl.name.clone());
                 self.local_decls.push((
