@@ -938,3 +938,31 @@ fn functions_are_specialized_on_their_buffer_arguments() {
         .iter()
         .any(|(op, ops)| *op == 55 && sb_ptrs.contains(&ops[0])));
 }
+
+#[test]
+fn templates_are_instantiated_per_argument_list() {
+    compile_all("templates.hlsl");
+    let m = hlsl::compile_file(&shader("templates.hlsl"), &HlslOptions::default()).unwrap();
+    for name in [
+        "interpolate<float3>",
+        "interpolate<float2>",
+        "sumFirst<float,3>",
+        "sumFirst<uint,2>",
+        "average<4>",
+        "average<8>",
+        "Pair<float3>",
+        "Pair<uint>",
+        "Pair<float3>::sum",
+        "Sampler::next<2>",
+        "Sampler::next<3>",
+    ] {
+        assert_eq!(named(&m.words, name).len(), 1, "{name}");
+    }
+    // The templates themselves are not functions of the module.
+    assert!(named(&m.words, "interpolate").is_empty());
+    assert!(named(&m.words, "anyHit").is_empty());
+    assert_eq!(
+        member_names(&m.words, "Pair<uint>"),
+        vec!["first", "second"]
+    );
+}

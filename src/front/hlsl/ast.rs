@@ -16,6 +16,16 @@ pub enum TArg {
     Expr(Expr),
 }
 
+/// A template parameter: `typename T` / `class T`, or a value `uint N`.
+#[derive(Clone, Debug)]
+pub struct TParam {
+    pub name: String,
+    /// `None` for a type parameter; the value's type otherwise.
+    pub value_ty: Option<TypeRef>,
+    pub default: Option<TArg>,
+    pub pos: Pos,
+}
+
 #[derive(Clone, Debug)]
 pub struct Attr {
     /// `shader`, `numthreads`, `vk::binding`, ...
@@ -75,6 +85,8 @@ pub struct Function {
     pub body: Option<Vec<Stmt>>,
     /// A `static` struct method: no `this`.
     pub is_static: bool,
+    /// Template parameters: a template, instantiated where it is used.
+    pub tparams: Vec<TParam>,
 }
 
 #[derive(Clone, Debug)]
@@ -83,6 +95,8 @@ pub struct StructDecl {
     pub pos: Pos,
     /// `struct B : A`: A's members come first.
     pub bases: Vec<TypeRef>,
+    /// Template parameters: a template, instantiated where it is used.
+    pub tparams: Vec<TParam>,
     pub fields: Vec<VarDecl>,
     /// Methods: functions with an implicit `inout` `this`.
     pub methods: Vec<Function>,
@@ -197,6 +211,10 @@ pub enum ExprKind {
     Ternary(Box<Expr>, Box<Expr>, Box<Expr>),
     /// A call of a function or intrinsic by name.
     Call(String, Vec<Expr>),
+    /// `f<T, 3>(args)`: a call with explicit template arguments.
+    CallT(String, Vec<TArg>, Vec<Expr>),
+    /// `obj.f<T>(args)`.
+    MethodT(Box<Expr>, String, Vec<TArg>, Vec<Expr>),
     /// `float3(...)`, `RayDesc(...)`: a constructor.
     Construct(TypeRef, Vec<Expr>),
     Method(Box<Expr>, String, Vec<Expr>),

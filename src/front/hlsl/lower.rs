@@ -15,6 +15,7 @@ mod methods;
 mod pixel;
 mod place;
 mod stmt;
+mod templates;
 
 use super::ast::*;
 use super::error::{Error, Pos, Result};
@@ -183,6 +184,16 @@ pub struct Lowerer<'a> {
     pub forced_entry: Option<(String, Stage)>,
     /// DXR subobjects the file declares.
     pub subobjects: super::subobject::Subobjects,
+    /// Function templates by qualified name (never lowered themselves).
+    fn_templates: HashMap<String, Vec<&'a Function>>,
+    /// Struct templates by qualified name.
+    struct_templates: HashMap<String, &'a StructDecl>,
+    /// Method templates by `Struct::method`.
+    method_templates: HashMap<String, Vec<&'a Function>>,
+    /// Instances of struct templates (`S<float>`), declared where first used.
+    instance_structs: HashMap<String, &'a StructDecl>,
+    /// Template instances this round of lowering found missing.
+    pub needed: Vec<super::template::Instance>,
     /// Functions specialized on their buffer arguments: (function, bound) → copy.
     specialized: HashMap<(usize, Vec<(usize, Id)>), usize>,
     /// Globals whose attributes add extensions or capabilities when used.
@@ -449,6 +460,19 @@ impl<'a> Lowerer<'a> {
             subobjects: Default::default(),
             forced_entry: None,
             global_reqs: HashMap::new(),
+            fn_templates: HashMap::new(),
+            struct_templates: HashMap::new(),
+            method_templates: HashMap::new(),
+            instance_structs: items
+                .iter()
+                .filter_map(|i| match i {
+                    Item::Struct(s) if s.tparams.is_empty() && s.name.contains('<') => {
+                        Some((s.name.clone(), s))
+                    }
+                    _ => None,
+                })
+                .collect(),
+            needed: Vec::new(),
             specialized: HashMap::new(),
             usings: items
                 .iter()
@@ -535,6 +559,22 @@ impl<'a> Lowerer<'a> {
     }
 
     /// Lowers the given entry points and everything they call; returns the module.
+    /// Lowers the given entry points and every function they reach (what
+    /// `finish` starts with); used to find the template instances a module needs.
+    pub fn lower_reached(&mut self, entries: &[usize]) -> Result<()> {
+        for &e in entries {
+            if !self.lowered.contains(&e) {
+                self.pending.push(e);
+            }
+        }
+        while let Some(k) = self.pending.pop() {
+            if self.lowered.insert(k) {
+                self.lower_function(k)?;
+            }
+        }
+        Ok(())
+    }
+
     pub fn finish(mut self, entries: &[usize]) -> Result<(Vec<u32>, Decls)> {
         for &e in entries {
             if !self.lowered.contains(&e) {

@@ -12,6 +12,7 @@ mod lower;
 pub mod parse;
 pub mod pp;
 pub mod subobject;
+pub mod template;
 pub mod types;
 
 pub use crate::shader::Stage;
@@ -226,13 +227,60 @@ pub fn compile_source(
     with_stack(|| compile_source_inner(path, text, loader, options))
 }
 
+/// Template instances: lowering finds the ones missing, they are added to
+/// the syntax tree, and lowering runs again until none is missing.
+fn instantiate_templates(items: &mut Vec<ast::Item>, files: &[PathBuf], options: &HlslOptions) {
+    const MAX_ROUNDS: usize = 64;
+    const MAX_INSTANCES: usize = 512;
+    let has_templates = items.iter().any(|i| match i {
+        ast::Item::Function(f) => !f.tparams.is_empty(),
+        ast::Item::Struct(s) => {
+            !s.tparams.is_empty() || s.methods.iter().any(|m| !m.tparams.is_empty())
+        }
+        _ => false,
+    });
+    if !has_templates {
+        return;
+    }
+    let mut made = std::collections::HashSet::new();
+    for _ in 0..MAX_ROUNDS {
+        let needed = {
+            let mut l = lowerer(items, files, options);
+            let entries = l.declare().map(|e| {
+                e.iter()
+                    .filter(|e| options.entry.as_ref().is_none_or(|n| *n == e.name))
+                    .filter_map(|e| l.entry_function(&e.name))
+                    .collect::<Vec<_>>()
+            });
+            if let Ok(ks) = entries {
+                let _ = l.lower_reached(&ks);
+            }
+            std::mem::take(&mut l.needed)
+        };
+        if needed.is_empty() {
+            return;
+        }
+        for inst in &needed {
+            // A failure here (or an instance asked for twice) leaves the
+            // instance missing: the compile then reports the use that needed it.
+            if !made.insert(inst.name.clone())
+                || made.len() > MAX_INSTANCES
+                || template::instantiate(items, inst).is_err()
+            {
+                return;
+            }
+        }
+    }
+}
+
 fn compile_source_inner(
     path: &Path,
     text: &str,
     loader: &mut dyn pp::FileLoader,
     options: &HlslOptions,
 ) -> Result<Vec<CompiledEntry>, InputError> {
-    let (items, files, warnings) = parse_with_warnings(path, text, loader, options)?;
+    let (mut items, files, warnings) = parse_with_warnings(path, text, loader, options)?;
+    instantiate_templates(&mut items, &files, options);
     let mut probe = lowerer(&items, &files, options);
     let picked = entry_indices(&mut probe, path, &files, options)?;
     let mut out = Vec::new();
@@ -271,7 +319,8 @@ fn compile_source_whole_inner(
     loader: &mut dyn pp::FileLoader,
     options: &HlslOptions,
 ) -> Result<CompiledModule, InputError> {
-    let (items, files, warnings) = parse_with_warnings(path, text, loader, options)?;
+    let (mut items, files, warnings) = parse_with_warnings(path, text, loader, options)?;
+    instantiate_templates(&mut items, &files, options);
     let mut l = lowerer(&items, &files, options);
     let picked = entry_indices(&mut l, path, &files, options)?;
     let ks: Vec<usize> = picked

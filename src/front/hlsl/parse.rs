@@ -20,6 +20,9 @@ pub struct Parser<'t> {
     using: Vec<String>,
     /// `#pragma pack_matrix` changes: (token index from which it holds, row major).
     pack: Vec<(usize, bool)>,
+    /// Names of function and struct templates (bare and qualified).
+    template_fns: HashSet<String>,
+    template_structs: HashSet<String>,
     depth: usize,
 }
 
@@ -158,6 +161,8 @@ pub fn parse(tokens: &[Token]) -> Result<Vec<Item>> {
     let mut p = Parser {
         t: &kept,
         pack,
+        template_fns: HashSet::new(),
+        template_structs: HashSet::new(),
         i: 0,
         types: HashSet::new(),
         ns: Vec::new(),
@@ -325,7 +330,9 @@ impl<'t> Parser<'t> {
             }
         }
         let mut args = Vec::new();
-        if TEMPLATE_TYPES.contains(&name.as_str()) && self.is("<") {
+        if self.is("<") && self.is_template_struct(&name) {
+            args = self.template_args()?;
+        } else if TEMPLATE_TYPES.contains(&name.as_str()) && self.is("<") {
             self.i += 1;
             loop {
                 if self.type_at(0) {
@@ -424,6 +431,148 @@ impl<'t> Parser<'t> {
             }
             self.i += 1;
         }
+    }
+
+    /// `template<...>` and the function, struct or alias it introduces.
+    fn template_item(&mut self, items: &mut Vec<Item>) -> Result<()> {
+        let tpos = self.pos();
+        let tparams = self.template_params()?;
+        let added: Vec<String> = tparams
+            .iter()
+            .filter(|p| p.value_ty.is_none() && self.types.insert(p.name.clone()))
+            .map(|p| p.name.clone())
+            .collect();
+        let mut one = Vec::new();
+        let r = self.item(&mut one);
+        for a in &added {
+            self.types.remove(a);
+        }
+        r?;
+        // Nested declarations (static members of a templated struct) are not templates.
+        let Some(last) = one.pop() else {
+            return Err(Error::new(
+                tpos,
+                "expected a declaration after `template<...>`",
+            ));
+        };
+        match last {
+            Item::Function(mut f) => {
+                self.template_fns.insert(f.name.clone());
+                if let Some((_, bare)) = f.name.rsplit_once("::") {
+                    self.template_fns.insert(bare.to_string());
+                }
+                f.tparams = tparams;
+                items.extend(one);
+                items.push(Item::Function(f));
+            }
+            Item::Struct(mut sd) => {
+                self.template_structs.insert(sd.name.clone());
+                if let Some((_, bare)) = sd.name.rsplit_once("::") {
+                    self.template_structs.insert(bare.to_string());
+                }
+                sd.tparams = tparams;
+                if !one.is_empty() {
+                    return Err(Error::new(
+                        sd.pos,
+                        "not supported: static members or nested types in a struct template",
+                    ));
+                }
+                items.push(Item::Struct(sd));
+            }
+            _ => {
+                return Err(Error::new(
+                    tpos,
+                    "not supported: templates other than functions and structs",
+                )
+                .len(8))
+            }
+        }
+        Ok(())
+    }
+
+    /// `template<typename T, uint N = 4>`.
+    fn template_params(&mut self) -> Result<Vec<TParam>> {
+        self.expect("template")?;
+        self.expect("<")?;
+        let mut out = Vec::new();
+        while !self.is(">") {
+            let pos = self.pos();
+            let value_ty = if self.eat("typename") || self.eat("class") {
+                None
+            } else {
+                Some(self.type_ref()?)
+            };
+            let (name, _) = self.ident()?;
+            let default = if self.eat("=") {
+                Some(if value_ty.is_none() {
+                    TArg::Type(self.type_ref()?)
+                } else {
+                    TArg::Expr(self.binary(0, true)?)
+                })
+            } else {
+                None
+            };
+            out.push(TParam {
+                name,
+                value_ty,
+                default,
+                pos,
+            });
+            if !self.eat(",") {
+                break;
+            }
+        }
+        self.expect(">")?;
+        Ok(out)
+    }
+
+    /// `<float3, 4>` after a template's name.
+    fn template_args(&mut self) -> Result<Vec<TArg>> {
+        self.expect("<")?;
+        let mut args = Vec::new();
+        while !self.is(">") {
+            if self.type_at(0) {
+                args.push(TArg::Type(self.type_ref()?));
+            } else {
+                args.push(TArg::Expr(self.binary(0, true)?));
+            }
+            if !self.eat(",") {
+                break;
+            }
+        }
+        self.expect(">")?;
+        Ok(args)
+    }
+
+    /// Whether `<` at `k` opens template arguments: `<` then a type or a
+    /// number and a closing `>` before anything that cannot be in a list.
+    fn template_args_at(&self, k: usize) -> bool {
+        if !self.is_at(k, "<") {
+            return false;
+        }
+        let mut j = k + 1;
+        let mut depth = 1;
+        while let Some(t) = self.peek_at(j) {
+            if t.is("<") {
+                depth += 1;
+            } else if t.is(">") {
+                depth -= 1;
+                if depth == 0 {
+                    return self.is_at(j + 1, "(");
+                }
+            } else if t.is(";") || t.is("{") || t.is("}") || t.is("&&") || t.is("||") {
+                return false;
+            }
+            j += 1;
+        }
+        false
+    }
+
+    fn is_template_struct(&self, name: &str) -> bool {
+        self.template_structs.contains(name)
+            || name
+                .rsplit_once("::")
+                .is_some_and(|(_, bare)| self.template_structs.contains(bare))
     }
 
     /// How many modifier keywords start at the current token.
@@ -601,7 +750,7 @@ impl<'t> Parser<'t> {
             .len(6));
         }
         if self.is_kw("template") {
-            return Err(Error::new(self.pos(), "not supported: templates").len(8));
+            return self.template_item(items);
         }
         if !self.type_at(0) {
             return Err(self.unexpected("a declaration"));
@@ -693,6 +842,7 @@ impl<'t> Parser<'t> {
             name: qualified,
             pos,
             bases,
+            tparams: Vec::new(),
             fields,
             methods,
         })
@@ -726,6 +876,37 @@ impl<'t> Parser<'t> {
                 self.item(items)?;
                 continue;
             }
+            let tparams = if self.is_kw("template") {
+                self.template_params()?
+            } else {
+                Vec::new()
+            };
+            let added: Vec<String> = tparams
+                .iter()
+                .filter(|p| p.value_ty.is_none() && self.types.insert(p.name.clone()))
+                .map(|p| p.name.clone())
+                .collect();
+            let member = self.struct_member(items, qualified, &mut fields, tparams);
+            for a in &added {
+                self.types.remove(a);
+            }
+            if let Some(f) = member? {
+                methods.push(f);
+            }
+        }
+        self.i += 1;
+        Ok((fields, methods))
+    }
+
+    /// One member of a struct body: a method (returned), a field or a static.
+    fn struct_member(
+        &mut self,
+        items: &mut Vec<Item>,
+        qualified: &str,
+        fields: &mut Vec<VarDecl>,
+        tparams: Vec<TParam>,
+    ) -> Result<Option<Function>> {
+        {
             let fattrs = self.attrs()?;
             let mods = self.mods();
             let ty = self.type_ref()?;
@@ -736,8 +917,17 @@ impl<'t> Parser<'t> {
                 let mut f = self.function(fattrs, ty, mname.clone(), mpos)?;
                 f.name = mname;
                 f.is_static = mods.is_static;
-                methods.push(f);
-                continue;
+                if !tparams.is_empty() {
+                    self.template_fns.insert(f.name.clone());
+                }
+                f.tparams = tparams;
+                return Ok(Some(f));
+            }
+            if !tparams.is_empty() {
+                return Err(Error::new(
+                    ty.pos,
+                    "not supported: member templates other than methods",
+                ));
             }
             if mods.is_static {
                 // A static member is a global named `S::name`.
@@ -748,13 +938,12 @@ impl<'t> Parser<'t> {
                     v.name = format!("{qualified}::{}", v.name);
                     Item::Var(v)
                 }));
-                continue;
+                return Ok(None);
             }
             check_site(&fattrs, Site::Member)?;
-            self.declarators(fattrs, mods, ty, &mut fields)?;
+            self.declarators(fattrs, mods, ty, fields)?;
+            Ok(None)
         }
-        self.i += 1;
-        Ok((fields, methods))
     }
 
     fn dims(&mut self) -> Result<Vec<Option<Expr>>> {
@@ -956,6 +1145,7 @@ impl<'t> Parser<'t> {
             semantic,
             body,
             is_static: false,
+            tparams: Vec::new(),
         })
     }
 
@@ -1375,12 +1565,14 @@ impl<'t> Parser<'t> {
             if self.eat(".") {
                 // Member and method expressions point at the name after the dot.
                 let (name, pos) = self.ident()?;
-                if self.is("<") && self.type_at(1) {
-                    return Err(Error::new(
+                if self.template_args_at(0) {
+                    let targs = self.template_args()?;
+                    let args = self.args()?;
+                    e = Expr {
+                        kind: ExprKind::MethodT(Box::new(e), name, targs, args),
                         pos,
-                        format!("not supported: templated method `{name}<...>`"),
-                    )
-                    .len(name.len() as u32));
+                    };
+                    continue;
                 }
                 if self.is("(") {
                     let args = self.args()?;
@@ -1476,6 +1668,15 @@ impl<'t> Parser<'t> {
             }
             Tok::Ident(_) => {
                 let (name, _) = self.ident()?;
+                let bare = name.rsplit("::").next().unwrap_or(&name);
+                if self.template_fns.contains(bare) && self.template_args_at(0) {
+                    let targs = self.template_args()?;
+                    let args = self.args()?;
+                    return Ok(Expr {
+                        kind: ExprKind::CallT(name, targs, args),
+                        pos,
+                    });
+                }
                 if self.is("(") {
                     let args = self.args()?;
                     ExprKind::Call(name, args)

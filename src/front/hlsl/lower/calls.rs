@@ -65,13 +65,15 @@ mod g {
 pub(super) enum Arg<'a> {
     Expr(&'a Expr),
     Place(Place, Pos),
+    /// An argument already evaluated (for an `in` parameter).
+    Value(Val, Pos),
 }
 
 impl Arg<'_> {
     fn pos(&self) -> Pos {
         match self {
             Arg::Expr(e) => e.pos,
-            Arg::Place(_, p) => *p,
+            Arg::Place(_, p) | Arg::Value(_, p) => *p,
         }
     }
 }
@@ -83,6 +85,10 @@ impl<'a> Lowerer<'a> {
         self.line(e.pos);
         match &e.kind {
             ExprKind::Call(name, args) => self.call(name, args, e.pos),
+            ExprKind::CallT(name, targs, args) => self.call_with_targs(name, targs, args, e.pos),
+            ExprKind::MethodT(obj, name, targs, args) => {
+                self.method_with_targs(obj, name, targs, args, e.pos)
+            }
             ExprKind::Method(obj, name, args) => self.method(obj, name, args, e.pos),
             _ => Ok(Some(self.expr(e)?)),
         }
@@ -248,6 +254,19 @@ impl<'a> Lowerer<'a> {
                     all.extend(args.iter().map(Arg::Expr));
                     return self.call_user(name, c, all, pos);
                 }
+            }
+        }
+        if let Some(this) = self.f.this_place.clone() {
+            if let Ty::Struct(k) = this.ty() {
+                let key = format!("{}::{name}", self.structs[*k as usize].name);
+                if let Some(ts) = self.method_templates.get(&key).cloned() {
+                    return self.template_call(name, ts, &[], args, Some(this), pos);
+                }
+            }
+        }
+        if self.find_user(name).is_none() {
+            if let Some(ts) = self.find_fn_template(name) {
+                return self.template_call(name, ts, &[], args, None, pos);
             }
         }
         if self.returns_resource(name) {
@@ -1118,6 +1137,10 @@ impl<'a> Lowerer<'a> {
                     ty: p.ty().clone(),
                 };
                 argv.push((Some(p.clone()), v));
+                continue;
+            }
+            if let Arg::Value(v, _) = a {
+                argv.push((None, v.clone()));
                 continue;
             }
             let Arg::Expr(a) = *a else { unreachable!() };

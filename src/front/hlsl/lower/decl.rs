@@ -29,6 +29,12 @@ impl<'a> Lowerer<'a> {
                         }
                     }
                 }
+                Item::Struct(s) if !s.tparams.is_empty() => {
+                    self.struct_templates.insert(s.name.clone(), s);
+                }
+                // An instance declared already where it was first used.
+                Item::Struct(s)
+                    if self.struct_names.contains_key(&s.name) && s.name.contains('<') => {}
                 Item::Struct(s) => self.declare_struct(s)?,
                 Item::Typedef {
                     ty,
@@ -88,10 +94,16 @@ impl<'a> Lowerer<'a> {
         let mut protos: Vec<&'a Function> = Vec::new();
         for item in items {
             if let Item::Struct(sd) = item {
-                self.declare_methods(sd)?;
+                if sd.tparams.is_empty() {
+                    self.declare_methods(sd)?;
+                }
                 continue;
             }
             let Item::Function(f) = item else { continue };
+            if !f.tparams.is_empty() {
+                self.fn_templates.entry(f.name.clone()).or_default().push(f);
+                continue;
+            }
             let mut stage = None;
             let mut numthreads = [1, 1, 1];
             for a in &f.attrs {
@@ -240,6 +252,13 @@ impl<'a> Lowerer<'a> {
         for f in methods {
             if f.body.is_none() {
                 continue; // declared, never defined: a call finds no overload
+            }
+            if !f.tparams.is_empty() {
+                self.method_templates
+                    .entry(format!("{}::{}", sd.name, f.name))
+                    .or_default()
+                    .push(f);
+                continue;
             }
             let ret = self.resolve_ty(&f.ret, &f.ns)?;
             let mut params = Vec::new();
@@ -514,6 +533,23 @@ impl<'a> Lowerer<'a> {
             | "StateObjectConfig"
             | "SubobjectToExportsAssociation" => {
                 return Err(unsupported(t.pos, format!("`{name}`")).len(name.len() as u32));
+            }
+            _ if !t.args.is_empty() && self.find_struct_template(name, ns).is_some() => {
+                match self.find_struct_template(name, ns) {
+                    Some(sd) => self.template_struct_ty(sd, t, ns)?,
+                    None => return Err(Error::new(t.pos, format!("unknown type `{name}`"))),
+                }
+            }
+            _ if !self.struct_names.contains_key(name)
+                && self.instance_structs.contains_key(name) =>
+            {
+                if let Some(sd) = self.instance_structs.get(name).copied() {
+                    self.declare_struct(sd)?;
+                }
+                match self.struct_names.get(name) {
+                    Some(k) => Ty::Struct(*k),
+                    None => return Err(Error::new(t.pos, format!("unknown type `{name}`"))),
+                }
             }
             _ => match self.lookup_type_name(name, ns) {
                 Some(t) => t,

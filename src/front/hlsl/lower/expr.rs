@@ -45,7 +45,10 @@ impl<'a> Lowerer<'a> {
     pub(super) fn expr_void(&mut self, e: &'a Expr) -> Result<()> {
         match &e.kind {
             // Calls of void functions have no value to produce.
-            ExprKind::Call(..) | ExprKind::Method(..) => {
+            ExprKind::Call(..)
+            | ExprKind::Method(..)
+            | ExprKind::CallT(..)
+            | ExprKind::MethodT(..) => {
                 self.call_expr(e)?;
             }
             _ => {
@@ -121,7 +124,10 @@ impl<'a> Lowerer<'a> {
                 v
             }
             ExprKind::Ternary(c, a, b) => self.ternary(c, a, b, e.pos)?,
-            ExprKind::Call(..) | ExprKind::Method(..) => match self.call_expr(e)? {
+            ExprKind::Call(..)
+            | ExprKind::Method(..)
+            | ExprKind::CallT(..)
+            | ExprKind::MethodT(..) => match self.call_expr(e)? {
                 Some(v) => v,
                 None => {
                     return Err(Error::new(

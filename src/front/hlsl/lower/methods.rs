@@ -116,7 +116,7 @@ impl<'a> Lowerer<'a> {
         self.write(&p, v, a.pos)
     }
 
-    fn byte_address(
+    pub(super) fn byte_address(
         &mut self,
         var: Id,
         rw: bool,
@@ -681,6 +681,57 @@ impl<'a> Lowerer<'a> {
             let id = self.op(Op::Transpose, tid, &[id])?;
             return Ok(Some(Val { id, ty: t34 }));
         }
+        Ok(Some(Val { id, ty: t }))
+    }
+
+    /// `buffer.Load<T>(address)` for 32-bit scalars and vectors: the words
+    /// `LoadN` reads, reinterpreted as `T`.
+    pub(super) fn typed_load(
+        &mut self,
+        p: Place,
+        name: &str,
+        targs: &'a [TArg],
+        args: &'a [Expr],
+        pos: Pos,
+    ) -> Result<Option<Val>> {
+        let (Place::Ptr { ptr, .. }, Ty::ByteAddress(rw)) = (&p, p.ty()) else {
+            return Err(not_a_variable(pos));
+        };
+        let ns = self.f.cur_ns.clone();
+        let t = match (name, targs) {
+            ("Load", [TArg::Type(t)]) => self.resolve_ty(t, &ns)?,
+            _ => {
+                return Err(unsupported(pos, format!("templated method `{name}<...>`"))
+                    .len(name.len() as u32))
+            }
+        };
+        let (sc, n) = match t {
+            Ty::Sc(s) if s != Sc::Bool => (s, 1),
+            Ty::Vec(s, n) if s != Sc::Bool => (s, n),
+            _ => {
+                return Err(unsupported(
+                    pos,
+                    format!(
+                        "`Load<{}>` (only 32-bit scalars and vectors)",
+                        self.ty_name(&t)
+                    ),
+                ))
+            }
+        };
+        let method = match n {
+            1 => "Load",
+            2 => "Load2",
+            3 => "Load3",
+            _ => "Load4",
+        };
+        let Some(words) = self.byte_address(*ptr, *rw, method, args, pos)? else {
+            return Err(Error::new(pos, "`Load` gave no value"));
+        };
+        if sc == Sc::Uint {
+            return Ok(Some(words));
+        }
+        let tid = self.ty_id(&t)?;
+        let id = self.op(Op::Bitcast, tid, &[words.id])?;
         Ok(Some(Val { id, ty: t }))
     }
 }
