@@ -555,6 +555,12 @@ impl<'a> Lowerer<'a> {
         }
         for c in &req.1 {
             self.cap(*c);
+            // A capability an extension brings needs that extension (any one
+            // of those that bring it); add the first when none is declared.
+            let exts = Operand::Capability(*c).required_extensions();
+            if !exts.is_empty() && !exts.iter().any(|e| self.exts.contains(*e)) {
+                self.ext(exts[0]);
+            }
         }
     }
 
