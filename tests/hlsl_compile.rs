@@ -966,3 +966,35 @@ fn templates_are_instantiated_per_argument_list() {
         vec!["first", "second"]
     );
 }
+
+#[test]
+fn local_resource_names_cube_arrays_and_function_like_defines() {
+    compile_all("resource_locals.hlsl");
+    let m = hlsl::compile_file(&shader("resource_locals.hlsl"), &HlslOptions::default()).unwrap();
+    let insts = instructions(&m.words);
+    // OpCapability (17) SampledCubeArray (45).
+    assert!(insts.iter().any(|(op, ops)| *op == 17 && ops[0] == 45));
+    // No function variable holds a resource: `albedo` and `s` are names only.
+    assert!(named(&m.words, "albedo").is_empty());
+    // 0x1.0p-10 and 0x1.8p4 are exact.
+    let c = constants(&m.words);
+    assert!(c.contains(&(2f32.powi(-10)).to_bits()));
+    assert!(c.contains(&24f32.to_bits()));
+
+    // `-D NAME(x)=...` defines a function-like macro.
+    let mut loader = rtlint::front::hlsl::pp::MemLoader::default();
+    let src = "VK_IMAGE_FORMAT(\"rgba8\") RWTexture2D<float4> img;\n[numthreads(1,1,1)] void m() { img[uint2(0, 0)] = 1; }";
+    let opts = HlslOptions {
+        defines: vec![(
+            "VK_IMAGE_FORMAT(x)".into(),
+            "[[vk::image_format(x)]]".into(),
+        )],
+        ..Default::default()
+    };
+    let m = hlsl::compile_source_whole(Path::new("d.hlsl"), src, &mut loader, &opts).unwrap();
+    validate(&m.words, "function-like-define");
+    // OpTypeImage (25) ... format Rgba8 (4).
+    assert!(instructions(&m.words)
+        .iter()
+        .any(|(op, ops)| *op == 25 && ops[7] == 4));
+}

@@ -225,6 +225,47 @@ fn lex_number(b: &[u8]) -> Option<(Tok, usize)> {
         while i < b.len() && b[i].is_ascii_hexdigit() {
             i += 1;
         }
+        let int_end = i;
+        // A hexadecimal float (C99): `0x1.8p-3`, mantissa in hex, exponent of 2.
+        let mut frac_digits = 0;
+        if i < b.len() && b[i] == b'.' {
+            let mut j = i + 1;
+            while j < b.len() && b[j].is_ascii_hexdigit() {
+                j += 1;
+            }
+            if j < b.len() && matches!(b[j], b'p' | b'P') {
+                frac_digits = j - i - 1;
+                i = j;
+            }
+        }
+        if i < b.len() && matches!(b[i], b'p' | b'P') {
+            let mut j = i + 1;
+            let neg = j < b.len() && b[j] == b'-';
+            if j < b.len() && matches!(b[j], b'+' | b'-') {
+                j += 1;
+            }
+            let es = j;
+            while j < b.len() && b[j].is_ascii_digit() {
+                j += 1;
+            }
+            if j > es {
+                let mut mantissa = 0f64;
+                for &d in b[s..int_end]
+                    .iter()
+                    .chain(&b[int_end + 1..int_end + 1 + frac_digits])
+                {
+                    mantissa = mantissa * 16.0 + (d as char).to_digit(16)? as f64;
+                }
+                let exp: i32 = std::str::from_utf8(&b[es..j]).ok()?.parse().ok()?;
+                let exp = if neg { -exp } else { exp } - 4 * frac_digits as i32;
+                let v = mantissa * 2f64.powi(exp);
+                if j < b.len() && matches!(b[j], b'f' | b'F' | b'h' | b'H' | b'l' | b'L') {
+                    j += 1;
+                }
+                return Some((Tok::Float(v), j));
+            }
+        }
+        let i = int_end;
         let v = u64::from_str_radix(std::str::from_utf8(&b[s..i]).ok()?, 16).ok()?;
         let (u, n) = int_suffix(&b[i..]);
         return Some((Tok::Int(v, u), i + n));
@@ -304,6 +345,17 @@ mod tests {
 
     fn kinds(s: &str) -> Vec<Tok> {
         lex(s, 0).unwrap().into_iter().map(|t| t.tok).collect()
+    }
+
+    #[test]
+    fn hexadecimal_floats_and_msvc_infinity() {
+        let toks =
+            |s: &str| -> Vec<Tok> { lex(s, 0).unwrap().into_iter().map(|t| t.tok).collect() };
+        assert!(matches!(toks("0x1.0p-24f")[..], [Tok::Float(v)] if v == 2f64.powi(-24)));
+        assert!(matches!(toks("0x1.8p1")[..], [Tok::Float(v)] if v == 3.0));
+        assert!(matches!(toks("0xAp0")[..], [Tok::Float(v)] if v == 10.0));
+        assert!(matches!(toks("0x10")[..], [Tok::Int(16, false)]));
+        assert!(matches!(toks("1.#INF")[..], [Tok::Float(v)] if v.is_infinite()));
     }
 
     #[test]

@@ -158,6 +158,13 @@ impl<'a> Preprocessor<'a> {
             let file = pp.files.len() as u32;
             pp.files
                 .push(PathBuf::from(format!("<command line -D{name}>")));
+            if name.contains('(') {
+                // `-D NAME(x)=body`: a function-like macro, read as `#define` reads it.
+                let line = lex(&format!("{name} {value}"), file)?;
+                let pos = line.first().map(|t| t.pos).unwrap_or_default();
+                pp.define(pos, &line)?;
+                continue;
+            }
             let body = lex(value, file)?
                 .into_iter()
                 .map(|mut t| {

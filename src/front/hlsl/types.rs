@@ -32,6 +32,8 @@ pub enum Dim {
     D3,
     Cube,
     D2Array,
+    D1Array,
+    CubeArray,
 }
 
 #[derive(Clone, Debug, PartialEq, Eq, Hash)]

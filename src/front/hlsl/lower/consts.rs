@@ -84,8 +84,17 @@ impl<'a> Lowerer<'a> {
                     Dim::D3 => (spirv::Dim::Dim3D, 0),
                     Dim::Cube => (spirv::Dim::DimCube, 0),
                     Dim::D2Array => (spirv::Dim::Dim2D, 1),
+                    Dim::D1Array => (spirv::Dim::Dim1D, 1),
+                    Dim::CubeArray => (spirv::Dim::DimCube, 1),
                 };
-                if *dim == Dim::D1 {
+                if *dim == Dim::CubeArray {
+                    self.cap(if *rw {
+                        Capability::ImageCubeArray
+                    } else {
+                        Capability::SampledCubeArray
+                    });
+                }
+                if matches!(dim, Dim::D1 | Dim::D1Array) {
                     self.cap(if *rw {
                         Capability::Image1D
                     } else {

@@ -488,13 +488,16 @@ impl<'a> Lowerer<'a> {
                 _ => return Err(Error::new(t.pos, "ConstantBuffer needs a struct type")),
             },
             "Texture1D" | "Texture2D" | "Texture3D" | "TextureCube" | "Texture2DArray"
-            | "RWTexture1D" | "RWTexture2D" | "RWTexture3D" | "RWTexture2DArray" => {
+            | "Texture1DArray" | "TextureCubeArray" | "RWTexture1D" | "RWTexture2D"
+            | "RWTexture3D" | "RWTexture2DArray" | "RWTexture1DArray" => {
                 let rw = name.starts_with("RW");
                 let dim = match name.trim_start_matches("RW") {
                     "Texture1D" => Dim::D1,
                     "Texture2D" => Dim::D2,
                     "Texture3D" => Dim::D3,
                     "TextureCube" => Dim::Cube,
+                    "Texture1DArray" => Dim::D1Array,
+                    "TextureCubeArray" => Dim::CubeArray,
                     _ => Dim::D2Array,
                 };
                 let (sc, n) = match targ_ty(self, 0, Ty::Vec(Sc::Float, 4))? {

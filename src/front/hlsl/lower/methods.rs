@@ -368,9 +368,9 @@ impl<'a> Lowerer<'a> {
                     ops.push(Operand::ImageOperands(spirv::ImageOperands::LOD));
                     ops.push(Operand::IdRef(lod.id));
                 } else {
-                    let gt = if dim == Dim::Cube || dim == Dim::D3 {
+                    let gt = if matches!(dim, Dim::Cube | Dim::CubeArray | Dim::D3) {
                         Ty::Vec(Sc::Float, 3)
-                    } else if dim == Dim::D1 {
+                    } else if matches!(dim, Dim::D1 | Dim::D1Array) {
                         Ty::Sc(Sc::Float)
                     } else {
                         Ty::Vec(Sc::Float, 2)
@@ -386,7 +386,7 @@ impl<'a> Lowerer<'a> {
                 let id = self.inst(Op::ImageSampleExplicitLod, Some(vt), ops)?;
                 Ok(Some(self.shrink(Val { id, ty: v4 }, &texel)?))
             }
-            "Load" if dim == Dim::Cube => Err(Error::new(
+            "Load" if matches!(dim, Dim::Cube | Dim::CubeArray) => Err(Error::new(
                 pos,
                 "a TextureCube has no `Load`; use SampleLevel",
             )),

@@ -379,7 +379,10 @@ impl<'a> Lowerer<'a> {
                     class,
                 })
             }
-            Ty::Texture { dim: Dim::Cube, .. } => Err(Error::new(
+            Ty::Texture {
+                dim: Dim::Cube | Dim::CubeArray,
+                ..
+            } => Err(Error::new(
                 pos,
                 "a TextureCube cannot be indexed; use SampleLevel",
             )),
@@ -421,13 +424,20 @@ impl<'a> Lowerer<'a> {
     pub(super) fn coord_size(&self, dim: Dim, sampling: bool) -> u8 {
         match dim {
             Dim::D1 => 1,
-            Dim::D2 => 2,
+            Dim::D2 | Dim::D1Array => 2,
             Dim::D3 | Dim::D2Array => 3,
             Dim::Cube => {
                 if sampling {
                     3
                 } else {
                     2
+                }
+            }
+            Dim::CubeArray => {
+                if sampling {
+                    4
+                } else {
+                    3
                 }
             }
         }

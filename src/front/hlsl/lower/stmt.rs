@@ -277,7 +277,30 @@ impl<'a> Lowerer<'a> {
             self.apply_dims(base, &v.dims, v.pos, false)?
         };
         if t.is_resource() {
-            return Err(unsupported(v.pos, "local resource variables").len(v.name.len() as u32));
+            // `Texture2D t = textures[i];`: a name for the resource it is
+            // initialized with (as DXC's legalization makes of it).
+            let place = match &v.init {
+                Some(init) if !v.mods.is_static => self.place(init)?,
+                _ => {
+                    return Err(unsupported(
+                        v.pos,
+                        "local resource variables without an initializer, or static",
+                    )
+                    .len(v.name.len() as u32))
+                }
+            };
+            if !matches!(place, Place::Ptr { .. }) || place.ty() != &t {
+                return Err(Error::new(
+                    v.pos,
+                    format!(
+                        "`{}` must be initialized with a `{}` variable or array element",
+                        v.name,
+                        self.ty_name(&t)
+                    ),
+                ));
+            }
+            self.bind(&v.name, place);
+            return Ok(());
         }
         if v.mods.is_static {
             let init = match &v.init {
@@ -323,6 +346,16 @@ impl<'a> Lowerer<'a> {
         let var = self.local_var(&t, &v.name)?;
         self.local_decls
             .push((self.f.cur_fn, var, v.name.clone(), t.clone(), v.pos));
+        // In scope in its own initializer, as in C (`RayDesc r = r = make();`).
+        self.bind(
+            &v.name,
+            Place::Ptr {
+                ptr: var,
+                ty: t.clone(),
+                layout: Layout::None,
+                class: StorageClass::Function,
+            },
+        );
         if let Some(init) = &v.init {
             let val = self.expr_as(init, &t)?;
             if self.f.term {
@@ -330,15 +363,6 @@ impl<'a> Lowerer<'a> {
             }
             self.b.store(var, val.id, None, [])?;
         }
-        self.bind(
-            &v.name,
-            Place::Ptr {
-                ptr: var,
-                ty: t,
-                layout: Layout::None,
-                class: StorageClass::Function,
-            },
-        );
         Ok(())
     }
 }
