@@ -482,3 +482,22 @@ fn every_attribute_is_implemented_or_refused() {
         "main.hlsl:1:3: not supported: `vk::image_format` on anything but an RWTexture"
     );
 }
+
+#[test]
+fn unsupported_helpers_are_refused_where_called() {
+    // Never called: not compiled, not refused.
+    let mut loader = MemLoader::default();
+    let src = "uint hash64(uint64_t v) { return uint(v); }\n[numthreads(1,1,1)]\nvoid m() {}";
+    assert!(hlsl::compile_source(
+        Path::new("a.hlsl"),
+        src,
+        &mut loader,
+        &HlslOptions::default()
+    )
+    .is_ok());
+    // Called: refused at the unsupported construct.
+    assert_eq!(
+        err("uint hash64(double v) { return uint(v); }\n[numthreads(1,1,1)]\nvoid m() { uint h = hash64(1); }"),
+        "main.hlsl:1:13: not supported: type `double` (only 32-bit types)"
+    );
+}

@@ -192,6 +192,9 @@ pub struct Lowerer<'a> {
     method_templates: HashMap<String, Vec<&'a Function>>,
     /// Instances of struct templates (`S<float>`), declared where first used.
     instance_structs: HashMap<String, &'a StructDecl>,
+    /// Helpers whose signatures use something unsupported: the error, given
+    /// when one is called.
+    unusable: HashMap<String, Error>,
     /// Template instances this round of lowering found missing.
     pub needed: Vec<super::template::Instance>,
     /// Functions specialized on their buffer arguments: (function, bound) → copy.
@@ -473,6 +476,7 @@ impl<'a> Lowerer<'a> {
                 })
                 .collect(),
             needed: Vec::new(),
+            unusable: HashMap::new(),
             specialized: HashMap::new(),
             usings: items
                 .iter()

@@ -268,6 +268,16 @@ impl<'a> Lowerer<'a> {
             if let Some(ts) = self.find_fn_template(name) {
                 return self.template_call(name, ts, &[], args, None, pos);
             }
+            let ns = self.f.cur_ns.clone();
+            let refused = self
+                .unusable
+                .get(&format!("{ns}{name}"))
+                .or_else(|| self.unusable.get(name));
+            if let Some(e) = refused {
+                let mut e = e.clone();
+                e.secondary.push((pos, format!("`{name}` is called here")));
+                return Err(e);
+            }
         }
         if self.returns_resource(name) {
             let p = self.resource_call(name, args, pos)?;

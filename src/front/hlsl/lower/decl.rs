@@ -150,24 +150,16 @@ impl<'a> Lowerer<'a> {
                     }
                 }
             }
-            let ret = self.resolve_ty(&f.ret, &f.ns)?;
-            let mut params = Vec::new();
-            for p in &f.params {
-                let t = self.resolve_ty(&p.ty, &f.ns)?;
-                let t = self.apply_dims(t, &p.dims, p.pos, false)?;
-                if t.is_resource() && (matches!(t, Ty::Array(..) | Ty::RtArray(_)) || p.mods.output)
-                {
-                    return Err(unsupported(
-                        p.pos,
-                        "arrays of resources, or `out` resources, as function parameters",
-                    ));
+            let (ret, params) = match self.signature(f) {
+                Ok(sig) => sig,
+                // A helper using something unsupported in its signature is
+                // refused where it is called; never called, it is not compiled.
+                Err(e) if stage.is_none() && e.message.starts_with("not supported") => {
+                    self.unusable.entry(f.name.clone()).or_insert(e);
+                    continue;
                 }
-                params.push(Param {
-                    ty: t,
-                    out: p.mods.output,
-                    input: p.mods.input || !p.mods.output,
-                });
-            }
+                Err(e) => return Err(e),
+            };
             let id = self.b.id();
             if f.body.is_none() {
                 // A prototype: the definition carries the signature, the
@@ -212,6 +204,28 @@ impl<'a> Lowerer<'a> {
             }
         }
         Ok(entries)
+    }
+
+    /// A function's return type and parameters.
+    fn signature(&mut self, f: &Function) -> Result<(Ty, Vec<Param>)> {
+        let ret = self.resolve_ty(&f.ret, &f.ns)?;
+        let mut params = Vec::new();
+        for p in &f.params {
+            let t = self.resolve_ty(&p.ty, &f.ns)?;
+            let t = self.apply_dims(t, &p.dims, p.pos, false)?;
+            if t.is_resource() && (matches!(t, Ty::Array(..) | Ty::RtArray(_)) || p.mods.output) {
+                return Err(unsupported(
+                    p.pos,
+                    "arrays of resources, or `out` resources, as function parameters",
+                ));
+            }
+            params.push(Param {
+                ty: t,
+                out: p.mods.output,
+                input: p.mods.input || !p.mods.output,
+            });
+        }
+        Ok((ret, params))
     }
 
     pub(super) fn declare_methods(&mut self, sd: &'a StructDecl) -> Result<()> {
