@@ -998,3 +998,17 @@ fn local_resource_names_cube_arrays_and_function_like_defines() {
         .iter()
         .any(|(op, ops)| *op == 25 && ops[7] == 4));
 }
+
+#[test]
+fn hlsl_2021_operators_local_structs_and_sizeof_of_names() {
+    compile_all("hlsl2021.hlsl");
+    let m = hlsl::compile_file(&shader("hlsl2021.hlsl"), &HlslOptions::default()).unwrap();
+    assert_eq!(named(&m.words, "LinearDepth::operator[]").len(), 1);
+    assert_eq!(
+        member_names(&m.words, "Sample"),
+        vec!["direction", "weight"]
+    );
+    let c = constants(&m.words);
+    // arraysize(directions) = 72 / 12 = 6, folded; sizeof(best) = 16.
+    assert!(c.contains(&6) && c.contains(&16), "{c:?}");
+}

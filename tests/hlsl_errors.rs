@@ -501,3 +501,20 @@ fn unsupported_helpers_are_refused_where_called() {
         "main.hlsl:1:13: not supported: type `double` (only 32-bit types)"
     );
 }
+
+#[test]
+fn bit_fields_are_refused_where_their_struct_is_used() {
+    let mut loader = MemLoader::default();
+    let src = "struct Packed { uint material : 24; uint sampler : 8; };\n[numthreads(1,1,1)]\nvoid m() {}";
+    assert!(hlsl::compile_source(
+        Path::new("a.hlsl"),
+        src,
+        &mut loader,
+        &HlslOptions::default()
+    )
+    .is_ok());
+    assert_eq!(
+        err("struct Packed { uint material : 24; uint sampler : 8; };\n[numthreads(1,1,1)]\nvoid m() { Packed p; p.material = 1; }"),
+        "main.hlsl:1:33: not supported: bit fields"
+    );
+}

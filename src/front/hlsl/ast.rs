@@ -70,6 +70,8 @@ pub struct VarDecl {
     pub semantic: Option<(String, Pos)>,
     pub register: Option<Register>,
     pub init: Option<Expr>,
+    /// `uint x : 24;`: a bit field of that many bits.
+    pub bits: Option<(u32, Pos)>,
 }
 
 #[derive(Clone, Debug)]
@@ -224,6 +226,9 @@ pub enum ExprKind {
     InitList(Vec<Expr>),
     /// `sizeof(T)` or `sizeof(T[N])`: bytes, scalars packed (as DXC's HLSL 2021).
     SizeOf(TypeRef, Vec<Option<Expr>>),
+    /// `sizeof(expression)`: the size of the expression's type (names,
+    /// members and elements only; it is not evaluated).
+    SizeOfExpr(Box<Expr>),
     Comma(Box<Expr>, Box<Expr>),
 }
 

@@ -20,6 +20,8 @@ pub struct Parser<'t> {
     using: Vec<String>,
     /// `#pragma pack_matrix` changes: (token index from which it holds, row major).
     pack: Vec<(usize, bool)>,
+    /// Structs declared inside function bodies, added before the function.
+    hoisted: Vec<Item>,
     /// Names of function and struct templates (bare and qualified).
     template_fns: HashSet<String>,
     template_structs: HashSet<String>,
@@ -164,6 +166,7 @@ pub fn parse(tokens: &[Token]) -> Result<Vec<Item>> {
     let mut p = Parser {
         t: &kept,
         pack,
+        hoisted: Vec::new(),
         template_fns: HashSet::new(),
         template_structs: HashSet::new(),
         i: 0,
@@ -630,6 +633,7 @@ impl<'t> Parser<'t> {
         {
             let s = self.struct_decl(items)?;
             self.expect(";")?;
+            items.append(&mut self.hoisted);
             items.push(Item::Struct(s));
             return Ok(());
         }
@@ -798,11 +802,13 @@ impl<'t> Parser<'t> {
                         }
                     }
                     *decl = f;
+                    items.append(&mut self.hoisted);
                     return Ok(());
                 }
             }
             check_site(&attrs, Site::Function)?;
             let f = self.function(attrs, ty, name, pos)?;
+            items.append(&mut self.hoisted);
             items.push(Item::Function(f));
             return Ok(());
         }
@@ -913,6 +919,28 @@ impl<'t> Parser<'t> {
             let fattrs = self.attrs()?;
             let mods = self.mods();
             let ty = self.type_ref()?;
+            if self.is_kw("operator") {
+                // `T operator[](...)`, `T operator+(...)`: a method named `operator[]`.
+                let mpos = self.pos();
+                self.i += 1;
+                let mut mname = String::from("operator");
+                while !self.is("(")
+                    || mname == "operator" && self.is_at(1, ")") && self.is_at(2, "(")
+                {
+                    let t = self.peek().ok_or_else(|| self.unexpected("an operator"))?;
+                    mname.push_str(&t.spelling());
+                    self.i += 1;
+                    if mname.len() > 12 {
+                        return Err(Error::new(mpos, "expected an operator after `operator`"));
+                    }
+                }
+                check_site(&fattrs, Site::Function)?;
+                let mut f = self.function(fattrs, ty, mname.clone(), mpos)?;
+                f.name = mname;
+                f.is_static = mods.is_static;
+                f.tparams = tparams;
+                return Ok(Some(f));
+            }
             if self.peek().and_then(Token::ident).is_some() && self.is_at(1, "(") {
                 let (mname, mpos) = self.ident()?;
                 check_site(&fattrs, Site::Function)?;
@@ -1035,6 +1063,17 @@ impl<'t> Parser<'t> {
         loop {
             let (name, pos) = self.ident()?;
             let dims = self.dims()?;
+            let bits = match self.peek_at(1) {
+                Some(Token {
+                    tok: Tok::Int(n, _),
+                    pos,
+                    ..
+                }) if self.is(":") => {
+                    self.i += 2;
+                    Some((*n as u32, *pos))
+                }
+                _ => None,
+            };
             let (semantic, register) = self.post_decl()?;
             let init = if self.eat("=") {
                 Some(self.initializer()?)
@@ -1051,6 +1090,7 @@ impl<'t> Parser<'t> {
                 semantic,
                 register,
                 init,
+                bits,
             });
             if !self.eat(",") {
                 break;
@@ -1119,6 +1159,7 @@ impl<'t> Parser<'t> {
                     semantic,
                     register,
                     init,
+                    bits: None,
                 });
                 if !self.eat(",") {
                     break;
@@ -1182,6 +1223,26 @@ impl<'t> Parser<'t> {
             Some(Tok::Punct(";")) => {
                 self.i += 1;
                 StmtKind::Empty
+            }
+            Some(Tok::Ident(k)) if (&**k == "struct" || &**k == "class") && self.is_at(2, "{") => {
+                // A struct declared in a function: declared before the function
+                // (named as written), then the declarators if any.
+                let mut nested = Vec::new();
+                let sd = self.struct_decl(&mut nested)?;
+                let ty = TypeRef {
+                    name: sd.name.clone(),
+                    args: Vec::new(),
+                    pos: sd.pos,
+                };
+                self.hoisted.extend(nested);
+                self.hoisted.push(Item::Struct(sd));
+                if self.eat(";") {
+                    StmtKind::Empty
+                } else {
+                    let mut vars = Vec::new();
+                    self.declarators(Vec::new(), Mods::default(), ty, &mut vars)?;
+                    StmtKind::Decl(vars)
+                }
             }
             Some(Tok::Ident(k)) => match &**k {
                 "if" => {
@@ -1650,10 +1711,12 @@ impl<'t> Parser<'t> {
             Tok::Ident(k) if &**k == "sizeof" && self.is_at(1, "(") => {
                 self.i += 2;
                 if !self.type_at(0) {
-                    return Err(Error::new(
-                        self.pos(),
-                        "not supported: `sizeof` of an expression; name a type",
-                    ));
+                    let e = self.expr()?;
+                    self.expect(")")?;
+                    return Ok(Expr {
+                        kind: ExprKind::SizeOfExpr(Box::new(e)),
+                        pos,
+                    });
                 }
                 let ty = self.type_ref()?;
                 let dims = self.dims()?;

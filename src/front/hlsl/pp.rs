@@ -153,6 +153,34 @@ impl<'a> Preprocessor<'a> {
             budget: 0,
             warnings: Vec::new(),
         };
+        // What DXC defines when it compiles for Vulkan (`-spirv`), before the
+        // user's `-D`s (which may replace them). Shader model 6.5: what this
+        // compiler implements.
+        let predefined = [
+            ("__spirv__", "1"),
+            ("__hlsl_dx_compiler", "1"),
+            ("__HLSL_VERSION", "2021"),
+            ("__SHADER_TARGET_MAJOR", "6"),
+            ("__SHADER_TARGET_MINOR", "5"),
+        ];
+        for (name, value) in predefined {
+            // Plain numbers: no file of their own (nothing in them can fail).
+            let body = lex(value, 0)?
+                .into_iter()
+                .map(|mut t| {
+                    t.bol = false;
+                    t
+                })
+                .collect();
+            pp.macros.insert(
+                Rc::from(name),
+                Macro {
+                    params: None,
+                    variadic: false,
+                    body,
+                },
+            );
+        }
         // `-D` values are lexed as a file of their own, so errors point somewhere.
         for (name, value) in defines {
             let file = pp.files.len() as u32;

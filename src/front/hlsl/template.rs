@@ -260,7 +260,7 @@ impl Subst<'_> {
                 targs.iter_mut().for_each(|a| self.targ(a));
                 args.iter_mut().for_each(|a| self.expr(a));
             }
-            ExprKind::Member(o, _) => self.expr(o),
+            ExprKind::Member(o, _) | ExprKind::SizeOfExpr(o) => self.expr(o),
             ExprKind::Index(a, b) => {
                 self.expr(a);
                 self.expr(b);

@@ -333,6 +333,16 @@ impl<'a> Lowerer<'a> {
             ExprKind::Float(f) => Some(CVal::F(*f)),
             ExprKind::Bool(b) => Some(CVal::I(*b as i64)),
             ExprKind::SizeOf(t, dims) => Some(CVal::I(self.size_of(t, dims, e.pos)? as i64)),
+            ExprKind::SizeOfExpr(x) => {
+                let t = self.type_of_name(x)?;
+                let n = packed_size(&t, &self.structs).ok_or_else(|| {
+                    Error::new(
+                        e.pos,
+                        format!("`{}` has no size in memory", self.ty_name(&t)),
+                    )
+                })?;
+                Some(CVal::I(n as i64))
+            }
             ExprKind::Ident(n) => {
                 if let Some(v) = builtin_constant(n) {
                     return Ok(Some(CVal::I(v as i64)));
@@ -576,5 +586,54 @@ impl Lowerer<'_> {
                 format!("`{}` has no size in memory", self.ty_name(&ty)),
             )
         })
+    }
+
+    /// The type of a name, member or element, without evaluating anything
+    /// (for `sizeof(expression)`).
+    pub(super) fn type_of_name(&mut self, e: &Expr) -> Result<Ty> {
+        let refuse = || {
+            unsupported(
+                e.pos,
+                "`sizeof` of an expression other than a name, member or element",
+            )
+        };
+        match &e.kind {
+            ExprKind::Ident(n) => {
+                for s in self.f.scopes.iter().rev() {
+                    if let Some(p) = s.get(n.as_str()) {
+                        return Ok(p.ty().clone());
+                    }
+                }
+                let ns = self.f.cur_ns.clone();
+                let names = [format!("{ns}{n}"), n.clone()];
+                for c in &names {
+                    match self.globals.get(c) {
+                        Some(Global::Const(v)) => return Ok(v.ty.clone()),
+                        Some(Global::Place(p)) => return Ok(p.ty().clone()),
+                        None => {}
+                    }
+                    if let Some((_, t, ..)) = self.cbuffer_members.get(c) {
+                        return Ok(t.clone());
+                    }
+                }
+                Err(Error::new(e.pos, format!("unknown name `{n}`")))
+            }
+            ExprKind::Index(b, _) => match self.type_of_name(b)? {
+                Ty::Array(t, _) | Ty::RtArray(t) => Ok(*t),
+                Ty::Vec(s, _) => Ok(Ty::Sc(s)),
+                Ty::Mat(s, _, c) => Ok(Ty::Vec(s, c)),
+                _ => Err(refuse()),
+            },
+            ExprKind::Member(b, m) => match self.type_of_name(b)? {
+                Ty::Struct(k) => self.structs[k as usize]
+                    .fields
+                    .iter()
+                    .find(|f| f.name == *m)
+                    .map(|f| f.ty.clone())
+                    .ok_or_else(refuse),
+                _ => Err(refuse()),
+            },
+            _ => Err(refuse()),
+        }
     }
 }

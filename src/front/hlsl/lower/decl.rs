@@ -35,7 +35,14 @@ impl<'a> Lowerer<'a> {
                 // An instance declared already where it was first used.
                 Item::Struct(s)
                     if self.struct_names.contains_key(&s.name) && s.name.contains('<') => {}
-                Item::Struct(s) => self.declare_struct(s)?,
+                Item::Struct(s) => match self.declare_struct(s) {
+                    Ok(()) => {}
+                    // A struct using something unsupported is refused where it is used.
+                    Err(e) if e.message.starts_with("not supported") => {
+                        self.unusable.entry(s.name.clone()).or_insert(e);
+                    }
+                    Err(e) => return Err(e),
+                },
                 Item::Typedef {
                     ty,
                     dims,
@@ -342,6 +349,9 @@ impl<'a> Lowerer<'a> {
             }
         }
         for f in &s.fields {
+            if let Some((_, pos)) = f.bits {
+                return Err(unsupported(pos, "bit fields"));
+            }
             let t = self.resolve_ty(&f.ty, scope)?;
             let t = self.apply_dims(t, &f.dims, f.pos, false)?;
             if t.is_resource() || matches!(t, Ty::RayQuery(_)) {
@@ -570,6 +580,11 @@ impl<'a> Lowerer<'a> {
             }
             _ => match self.lookup_type_name(name, ns) {
                 Some(t) => t,
+                None if self.unusable.contains_key(name) => {
+                    let mut e = self.unusable[name].clone();
+                    e.secondary.push((t.pos, format!("`{name}` is used here")));
+                    return Err(e);
+                }
                 None => {
                     return Err(
                         Error::new(t.pos, format!("unknown type `{name}`")).len(name.len() as u32)

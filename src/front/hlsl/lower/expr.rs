@@ -61,6 +61,16 @@ impl<'a> Lowerer<'a> {
     pub(super) fn expr(&mut self, e: &'a Expr) -> Result<Val> {
         let v = match &e.kind {
             // `sizeof` is a `uint` constant, as in DXC.
+            ExprKind::SizeOfExpr(_) => {
+                let n = match self.const_eval(e)? {
+                    Some(CVal::I(n)) => n as u32,
+                    _ => return Err(Error::new(e.pos, "`sizeof` needs a name")),
+                };
+                Val {
+                    id: self.const_u32(n),
+                    ty: Ty::Sc(Sc::Uint),
+                }
+            }
             ExprKind::SizeOf(t, dims) => {
                 let n = self.size_of(t, dims, e.pos)?;
                 Val {

@@ -319,6 +319,20 @@ impl<'a> Lowerer<'a> {
 
     pub(super) fn index(&mut self, bp: Place, iv: Val, idx: &'a Expr, pos: Pos) -> Result<Place> {
         let t = bp.ty().clone();
+        if let Ty::Struct(k) = &t {
+            // `s[i]` of a struct with `operator[]`: a call (its result is read-only).
+            let key = format!("{}::operator[]", self.structs[*k as usize].name);
+            if let Some(c) = self.fn_by_name.get(&key).cloned() {
+                let args = vec![
+                    super::calls::Arg::Place(bp, pos),
+                    super::calls::Arg::Value(iv, idx.pos),
+                ];
+                return match self.call_user("operator[]", c, args, pos)? {
+                    Some(v) => Ok(Place::Value(v)),
+                    None => Err(Error::new(pos, "`operator[]` returns nothing")),
+                };
+            }
+        }
         let const_index = match self.const_eval(idx)? {
             Some(CVal::I(v)) if v >= 0 => Some(v as u32),
             _ => None,
