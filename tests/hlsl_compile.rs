@@ -870,6 +870,15 @@ fn pack_matrix_pragma_sets_the_default_matrix_layout() {
     assert_eq!(majors("type.Camera"), vec![(0, 5), (1, 4)]);
     assert_eq!(majors("Instance"), vec![(0, 5)]);
     assert_eq!(majors("type.Later"), vec![(0, 4)]);
+    // A buffer of matrices: the layout is on the block's member.
+    let ids = named(&m.words, "type.StructuredBuffer");
+    let decorated = |d: u32| {
+        instructions(&m.words)
+            .iter()
+            .any(|(op, ops)| *op == 72 && ids.contains(&ops[0]) && ops[1] == 0 && ops[2] == d)
+    };
+    // RowMajor (4) and MatrixStride (7).
+    assert!(decorated(4) && decorated(7));
 }
 
 /// Member names of the struct named `name`, by `OpMemberName` (6).

@@ -246,8 +246,8 @@ fn layout_changing_constructs_are_refused() {
         "main.hlsl:1:2: #pragma pack_matrix needs row_major or column_major, not `diagonal`"
     );
     assert_eq!(
-        err("StructuredBuffer<float4x4> m;\n[numthreads(1,1,1)] void f() {}"),
-        "main.hlsl:1:1: not supported: StructuredBuffer of a matrix; wrap the matrix in a struct"
+        err("row_major StructuredBuffer<float4x4> m;\n[numthreads(1,1,1)] void f() {}"),
+        "main.hlsl:1:37: not supported: a StructuredBuffer of row_major matrices (wrap the matrix in a struct)"
     );
 }
 

@@ -20,12 +20,13 @@ cbuffer Later : register(b1)
 };
 
 StructuredBuffer<Instance> instances : register(t0);
+StructuredBuffer<float4x4> transforms : register(t1);
 RWStructuredBuffer<float4> output : register(u0);
 
 [numthreads(1, 1, 1)]
 void Main()
 {
     float4 p = mul(viewProj, float4(1, 2, 3, 1));
-    p += mul(explicitColumns, p) + mul(columns, p);
+    p += mul(explicitColumns, p) + mul(columns, p) + mul(transforms[1], p);
     output[0] = p + float4(mul(instances[0].objectToWorld, p), 0);
 }

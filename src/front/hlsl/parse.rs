@@ -1735,7 +1735,13 @@ impl<'t> Parser<'t> {
             Tok::Ident(_) => {
                 let (name, _) = self.ident()?;
                 let bare = name.rsplit("::").next().unwrap_or(&name);
-                if self.template_fns.contains(bare) && self.template_args_at(0) {
+                let builtin_template = matches!(
+                    name.as_str(),
+                    "vk::RawBufferLoad" | "vk::RawBufferStore" | "vk::ReadClock"
+                );
+                if (self.template_fns.contains(bare) || builtin_template)
+                    && self.template_args_at(0)
+                {
                     let targs = self.template_args()?;
                     let args = self.args()?;
                     return Ok(Expr {

@@ -499,12 +499,7 @@ impl<'a> Lowerer<'a> {
                 if e == Ty::Void || e.is_resource() {
                     return Err(Error::new(t.pos, format!("{name} needs an element type")));
                 }
-                if let Ty::Mat(..) = e {
-                    return Err(unsupported(
-                        t.pos,
-                        format!("{name} of a matrix; wrap the matrix in a struct"),
-                    ));
-                }
+
                 Ty::StructuredBuffer(Box::new(e), name.starts_with("RW"))
             }
             "ConstantBuffer" => match targ_ty(self, 0, Ty::Void)? {
@@ -1065,6 +1060,20 @@ impl<'a> Lowerer<'a> {
         if !rw {
             self.b.member_decorate(st, 0, Decoration::NonWritable, []);
         }
+        if let Ty::StructuredBuffer(e, _) = inner {
+            if let Ty::Mat(..) = **e {
+                // A buffer of matrices: the layout goes on the member holding them,
+                // HLSL's default column-major packing (SPIR-V RowMajor).
+                let (_, mstride, _) = matrix_layout(e, false, Layout::Std430);
+                self.b.member_decorate(
+                    st,
+                    0,
+                    Decoration::MatrixStride,
+                    [Operand::LiteralBit32(mstride)],
+                );
+                self.b.member_decorate(st, 0, Decoration::RowMajor, []);
+            }
+        }
         self.b.name(st, name);
         self.ty_cache.insert(key, st);
         Ok((st, StorageClass::StorageBuffer))
@@ -1088,6 +1097,14 @@ impl<'a> Lowerer<'a> {
         next: &mut u32,
     ) -> Result<()> {
         let t = self.resolve_ty(&v.ty, "")?;
+        if let Ty::StructuredBuffer(e, _) = &t {
+            if matches!(**e, Ty::Mat(..)) && v.mods.row_major {
+                return Err(unsupported(
+                    v.pos,
+                    "a StructuredBuffer of row_major matrices (wrap the matrix in a struct)",
+                ));
+            }
+        }
         let t = match v.attrs.iter().find(|a| a.name == "vk::image_format") {
             Some(a) => with_image_format(t, a)?,
             None => t,

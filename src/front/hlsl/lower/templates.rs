@@ -356,6 +356,9 @@ impl<'a> Lowerer<'a> {
         }
         match self.find_fn_template(name) {
             Some(ts) => self.template_call(name, ts, targs, args, None, pos),
+            None if name.starts_with("vk::") => {
+                Err(unsupported(pos, format!("`{name}`")).len(name.len() as u32))
+            }
             None => Err(
                 Error::new(pos, format!("`{name}` is not a function template"))
                     .len(name.len() as u32),
