@@ -247,7 +247,7 @@ fn layout_changing_constructs_are_refused() {
     );
     assert_eq!(
         err("row_major StructuredBuffer<float4x4> m;\n[numthreads(1,1,1)] void f() {}"),
-        "main.hlsl:1:37: not supported: a StructuredBuffer of row_major matrices (wrap the matrix in a struct)"
+        "main.hlsl:1:38: not supported: a StructuredBuffer of row_major matrices (wrap the matrix in a struct)"
     );
 }
 
