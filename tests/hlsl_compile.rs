@@ -1021,3 +1021,28 @@ fn hlsl_2021_operators_local_structs_and_sizeof_of_names() {
     // arraysize(directions) = 72 / 12 = 6, folded; sizeof(best) = 16.
     assert!(c.contains(&6) && c.contains(&16), "{c:?}");
 }
+
+#[test]
+fn wave_intrinsics_are_group_non_uniform_instructions() {
+    let entries = compile_all("wave.hlsl");
+    assert_eq!(entries.len(), 2);
+    let m = hlsl::compile_file(&shader("wave.hlsl"), &HlslOptions::default()).unwrap();
+    let ops: std::collections::BTreeSet<u32> = instructions(&m.words)
+        .into_iter()
+        .map(|(op, _)| op)
+        .filter(|op| (333..=366).contains(op))
+        .collect();
+    // Elect 333, All 334, Any 335, AllEqual 336, BroadcastFirst 338, Ballot 339,
+    // BallotBitCount 342, Shuffle 345, FAdd 350, IMul 351, UMin 354, FMax 358,
+    // BitwiseAnd/Or/Xor 359-361.
+    for op in [
+        333, 334, 335, 336, 338, 339, 342, 345, 350, 351, 354, 358, 359, 360, 361,
+    ] {
+        assert!(ops.contains(&op), "missing opcode {op}: {ops:?}");
+    }
+    // Subgroup scope (3) on every instruction: checked by spirv-val; the lane
+    // index is the SubgroupLocalInvocationId (41) built-in.
+    assert!(instructions(&m.words)
+        .iter()
+        .any(|(op, ops)| *op == 71 && ops[1] == 11 && ops[2] == 41));
+}

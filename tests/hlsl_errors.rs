@@ -114,8 +114,10 @@ fn unsupported_constructs_are_named() {
         "main.hlsl:6:18: not supported: `Sample` (implicit level of detail) outside pixel shaders; use `SampleLevel`"
     );
     assert_eq!(
-        err(&format!("{RG}    float w = WaveActiveSum(1.0);\n}}")),
-        "main.hlsl:4:15: not supported: wave intrinsic `WaveActiveSum`"
+        err(&format!(
+            "{RG}    float w = WaveMultiPrefixSum(1.0, 1);\n}}"
+        )),
+        "main.hlsl:4:15: not supported: wave intrinsic `WaveMultiPrefixSum`"
     );
     assert_eq!(
         err(&format!("{RG}    double d = 1;\n}}")),

@@ -16,6 +16,7 @@ mod pixel;
 mod place;
 mod stmt;
 mod templates;
+mod wave;
 
 use super::ast::*;
 use super::error::{Error, Pos, Result};

@@ -549,7 +549,15 @@ impl<'a> Lowerer<'a> {
                 return Err(unsupported(pos, format!("`{name}` (pixel shaders only)"))
                     .len(name.len() as u32));
             }
-            _ if name.starts_with("Wave") || name.starts_with("Quad") => {
+            _ if name.starts_with("Wave") => {
+                if let Some(v) = self.wave(name, args, pos)? {
+                    return Ok(Some(v));
+                }
+                return Err(
+                    unsupported(pos, format!("wave intrinsic `{name}`")).len(name.len() as u32)
+                );
+            }
+            _ if name.starts_with("Quad") => {
                 return Err(
                     unsupported(pos, format!("wave intrinsic `{name}`")).len(name.len() as u32)
                 );
