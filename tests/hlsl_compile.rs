@@ -1046,3 +1046,16 @@ fn wave_intrinsics_are_group_non_uniform_instructions() {
         .iter()
         .any(|(op, ops)| *op == 71 && ops[1] == 11 && ops[2] == 41));
 }
+
+#[test]
+fn comparison_samplers_sample_with_a_depth_reference() {
+    compile_all("shadow_compare.hlsl");
+    let m = hlsl::compile_file(&shader("shadow_compare.hlsl"), &HlslOptions::default()).unwrap();
+    let ops: Vec<u32> = instructions(&m.words)
+        .into_iter()
+        .map(|(op, _)| op)
+        .collect();
+    // OpImageSampleDrefImplicitLod (89) once, OpImageSampleDrefExplicitLod (90) twice.
+    assert_eq!(ops.iter().filter(|o| **o == 89).count(), 1);
+    assert_eq!(ops.iter().filter(|o| **o == 90).count(), 2);
+}

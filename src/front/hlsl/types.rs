@@ -50,6 +50,8 @@ pub enum Ty {
     Accel,
     RayQuery(u32),
     Sampler,
+    /// `SamplerComparisonState` (the same SPIR-V sampler; used with `SampleCmp*`).
+    SamplerCmp,
     Texture {
         dim: Dim,
         sc: Sc,
@@ -92,6 +94,7 @@ impl Ty {
         match self {
             Ty::Accel
             | Ty::Sampler
+            | Ty::SamplerCmp
             | Ty::Texture { .. }
             | Ty::StructuredBuffer(..)
             | Ty::ByteAddress(_)

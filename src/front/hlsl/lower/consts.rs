@@ -69,7 +69,7 @@ impl<'a> Lowerer<'a> {
                 self.ext("SPV_KHR_ray_query");
                 self.b.type_ray_query_khr()
             }
-            Ty::Sampler => self.b.type_sampler(),
+            Ty::Sampler | Ty::SamplerCmp => self.b.type_sampler(),
             Ty::Texture {
                 dim,
                 sc,

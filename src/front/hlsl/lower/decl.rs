@@ -492,6 +492,7 @@ impl<'a> Lowerer<'a> {
                 Ty::RayQuery(flags)
             }
             "SamplerState" => Ty::Sampler,
+            "SamplerComparisonState" => Ty::SamplerCmp,
             "ByteAddressBuffer" => Ty::ByteAddress(false),
             "RWByteAddressBuffer" => Ty::ByteAddress(true),
             "StructuredBuffer" | "RWStructuredBuffer" => {
@@ -537,8 +538,7 @@ impl<'a> Lowerer<'a> {
                     fmt: None,
                 }
             }
-            "SamplerComparisonState"
-            | "Buffer"
+            "Buffer"
             | "RWBuffer"
             | "AppendStructuredBuffer"
             | "ConsumeStructuredBuffer"
@@ -1007,7 +1007,7 @@ impl<'a> Lowerer<'a> {
             let (layout, class) = self.cbuffer_class(attrs);
             return Ok((self.block_struct(*k, layout)?, class));
         }
-        if let Ty::Accel | Ty::Sampler | Ty::Texture { .. } = inner {
+        if let Ty::Accel | Ty::Sampler | Ty::SamplerCmp | Ty::Texture { .. } = inner {
             return Ok((
                 self.spv(inner, Layout::None)?,
                 StorageClass::UniformConstant,

@@ -15,6 +15,7 @@ impl<'a> Lowerer<'a> {
             Ty::Accel => "RaytracingAccelerationStructure".into(),
             Ty::RayQuery(_) => "RayQuery".into(),
             Ty::Sampler => "SamplerState".into(),
+            Ty::SamplerCmp => "SamplerComparisonState".into(),
             Ty::Texture { rw, .. } => {
                 if *rw {
                     "RWTexture".into()

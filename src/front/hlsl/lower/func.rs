@@ -176,7 +176,7 @@ impl<'a> Lowerer<'a> {
                 (StorageClass::StorageBuffer, Layout::Std430)
             }
             Ty::ConstantBuffer(_) => (StorageClass::Uniform, Layout::CBuffer),
-            Ty::Accel | Ty::Sampler | Ty::Texture { .. } => {
+            Ty::Accel | Ty::Sampler | Ty::SamplerCmp | Ty::Texture { .. } => {
                 (StorageClass::UniformConstant, Layout::None)
             }
             _ => (StorageClass::Function, Layout::None),

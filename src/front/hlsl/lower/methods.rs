@@ -328,6 +328,9 @@ impl<'a> Lowerer<'a> {
                 "`Sample` (implicit level of detail) outside pixel shaders; use `SampleLevel`",
             )
             .len(6)),
+            "SampleCmp" | "SampleCmpLevelZero" | "SampleCmpLevel" => self
+                .sample_cmp(ptr, t, float_coord, name, args, pos)
+                .map(Some),
             "Sample" | "SampleLevel" | "SampleGrad" => {
                 if rw {
                     return Err(Error::new(pos, format!("RWTexture has no method `{name}`")));
@@ -733,5 +736,73 @@ impl<'a> Lowerer<'a> {
         let tid = self.ty_id(&t)?;
         let id = self.op(Op::Bitcast, tid, &[words.id])?;
         Ok(Some(Val { id, ty: t }))
+    }
+
+    /// `SampleCmp`, `SampleCmpLevelZero`, `SampleCmpLevel`: depth-comparison
+    /// sampling with a `SamplerComparisonState` (`OpImageSampleDref*`).
+    fn sample_cmp(
+        &mut self,
+        ptr: Id,
+        t: &Ty,
+        coord: Ty,
+        name: &str,
+        args: &'a [Expr],
+        pos: Pos,
+    ) -> Result<Val> {
+        let Ty::Texture { rw: false, sc, .. } = t else {
+            return Err(Error::new(pos, format!("RWTexture has no method `{name}`")));
+        };
+        let implicit = name == "SampleCmp";
+        if implicit {
+            if self.f.cur_stage.is_some_and(|s| s != Stage::Fragment) {
+                return Err(unsupported(
+                    pos,
+                    "`SampleCmp` (implicit level of detail) outside pixel shaders; use `SampleCmpLevelZero`",
+                ));
+            }
+            if self.f.cur_stage.is_none() {
+                self.fn_derivs
+                    .entry(self.f.cur_fn)
+                    .or_insert(("SampleCmp", pos));
+            }
+        }
+        let want = if name == "SampleCmpLevel" { 4 } else { 3 };
+        self.arity(name, args, want, pos)?;
+        let s = self.expr(&args[0])?;
+        if s.ty != Ty::SamplerCmp {
+            return Err(Error::new(args[0].pos, "expected a SamplerComparisonState"));
+        }
+        let uv = self.expr(&args[1])?;
+        let uv = self.convert(uv, &coord, args[1].pos, false)?;
+        let reference = self.expr(&args[2])?;
+        let reference = self.convert(reference, &Ty::Sc(Sc::Float), args[2].pos, false)?;
+        let im = self.image(ptr, t)?;
+        let st = self.ty_id(&Ty::SamplerCmp)?;
+        let sm = self.b.load(st, None, s.id, None, [])?;
+        let it = self.ty_id(t)?;
+        let sit = self.b.type_sampled_image(it);
+        let si = self.op(Op::SampledImage, sit, &[im, sm])?;
+        let rt = Ty::Sc(*sc);
+        let rid = self.ty_id(&rt)?;
+        let mut ops = vec![
+            Operand::IdRef(si),
+            Operand::IdRef(uv.id),
+            Operand::IdRef(reference.id),
+        ];
+        let op = if implicit {
+            Op::ImageSampleDrefImplicitLod
+        } else {
+            let lod = if name == "SampleCmpLevel" {
+                let l = self.expr(&args[3])?;
+                self.convert(l, &Ty::Sc(Sc::Float), args[3].pos, false)?.id
+            } else {
+                self.const_f32(0.0)
+            };
+            ops.push(Operand::ImageOperands(spirv::ImageOperands::LOD));
+            ops.push(Operand::IdRef(lod));
+            Op::ImageSampleDrefExplicitLod
+        };
+        let id = self.inst(op, Some(rid), ops)?;
+        Ok(Val { id, ty: rt })
     }
 }
