@@ -1059,3 +1059,33 @@ fn comparison_samplers_sample_with_a_depth_reference() {
     assert_eq!(ops.iter().filter(|o| **o == 89).count(), 1);
     assert_eq!(ops.iter().filter(|o| **o == 90).count(), 2);
 }
+
+#[test]
+fn shader_execution_reordering_uses_nv_invocation_reorder() {
+    let path = shader("ser.hlsl");
+    let opts = HlslOptions::default();
+    let entries = hlsl::compile(&path, &opts).unwrap();
+    for e in &entries {
+        validate_new(&e.words, &format!("ser-{}", e.name));
+    }
+    let gen = &entries[0];
+    assert_eq!(gen.stage, Stage::RayGeneration);
+    let insts = instructions(&gen.words);
+    let count = |op: u32| insts.iter().filter(|(o, _)| *o == op).count();
+    // OpCapability ShaderInvocationReorderNV (5383), OpTypeHitObjectNV (5281),
+    // OpHitObjectTraceRayNV (5260), OpHitObjectRecordMissNV (5263),
+    // OpHitObjectRecordEmptyNV (5259), OpHitObjectExecuteShaderNV (5264),
+    // OpReorderThreadWithHitObjectNV (5279), OpReorderThreadWithHintNV (5280).
+    assert!(insts.iter().any(|(op, ops)| *op == 17 && ops[0] == 5383));
+    assert_eq!(count(5281), 1);
+    assert_eq!(count(5260), 1);
+    assert_eq!(count(5263), 1);
+    assert_eq!(count(5264), 2);
+    assert_eq!(count(5279), 2);
+    assert_eq!(count(5280), 1);
+    assert!(count(5259) >= 1);
+    // The hit shaders do not reorder.
+    assert!(!instructions(&entries[1].words)
+        .iter()
+        .any(|(op, ops)| *op == 17 && ops[0] == 5383));
+}

@@ -520,3 +520,20 @@ fn bit_fields_are_refused_where_their_struct_is_used() {
         "main.hlsl:1:33: not supported: bit fields"
     );
 }
+
+#[test]
+fn hit_objects_are_made_in_place() {
+    let rg = "RaytracingAccelerationStructure s;\nstruct P { float x; };\n[shader(\"raygeneration\")]\nvoid rg()\n{\n";
+    assert_eq!(
+        err(&format!("{rg}    dx::HitObject a = dx::HitObject::MakeNop();\n    dx::HitObject b = a;\n}}")),
+        "main.hlsl:7:23: not supported: copying a HitObject; make it with HitObject::TraceRay, MakeMiss or MakeNop"
+    );
+    assert_eq!(
+        err(&format!("{rg}    RayDesc r = (RayDesc)0;\n    dx::HitObject m = dx::HitObject::MakeMiss(RAY_FLAG_FORCE_OPAQUE, 0, r);\n}}")),
+        "main.hlsl:7:47: not supported: ray flags other than 0 in HitObject::MakeMiss (SPV_NV_shader_invocation_reorder has none)"
+    );
+    assert_eq!(
+        err("struct P { float x; };\n[shader(\"closesthit\")]\nvoid ch(inout P p, in BuiltInTriangleIntersectionAttributes a)\n{\n    dx::MaybeReorderThread(1, 1);\n}"),
+        "main.hlsl:5:5: `MaybeReorderThread` is not available in closesthit shaders"
+    );
+}

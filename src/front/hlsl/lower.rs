@@ -14,6 +14,7 @@ mod func;
 mod methods;
 mod pixel;
 mod place;
+mod ser;
 mod stmt;
 mod templates;
 mod wave;

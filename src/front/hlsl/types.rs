@@ -50,6 +50,8 @@ pub enum Ty {
     Accel,
     RayQuery(u32),
     Sampler,
+    /// `dx::HitObject` (shader execution reordering): opaque, like a ray query.
+    HitObject,
     /// `SamplerComparisonState` (the same SPIR-V sampler; used with `SampleCmp*`).
     SamplerCmp,
     Texture {
@@ -66,6 +68,10 @@ pub enum Ty {
 }
 
 impl Ty {
+    /// Ray queries and hit objects: variables only, never copied or stored.
+    pub fn is_opaque(&self) -> bool {
+        matches!(self, Ty::RayQuery(_) | Ty::HitObject)
+    }
     pub fn scalar(&self) -> Option<Sc> {
         match self {
             Ty::Sc(s) | Ty::Vec(s, _) | Ty::Mat(s, _, _) => Some(*s),

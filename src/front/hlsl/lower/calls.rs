@@ -94,7 +94,7 @@ impl<'a> Lowerer<'a> {
         }
     }
 
-    fn stage_check(&self, name: &str, allowed: &[Stage], pos: Pos) -> Result<()> {
+    pub(super) fn stage_check(&self, name: &str, allowed: &[Stage], pos: Pos) -> Result<()> {
         if let Some(s) = self.f.cur_stage {
             if !allowed.contains(&s) {
                 return Err(Error::new(
@@ -263,6 +263,9 @@ impl<'a> Lowerer<'a> {
                     return self.template_call(name, ts, &[], args, Some(this), pos);
                 }
             }
+        }
+        if let Some(r) = self.ser_call(name, args, pos)? {
+            return Ok(r);
         }
         if self.find_user(name).is_none() {
             if let Some(ts) = self.find_fn_template(name) {

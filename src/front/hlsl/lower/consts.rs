@@ -70,6 +70,10 @@ impl<'a> Lowerer<'a> {
                 self.b.type_ray_query_khr()
             }
             Ty::Sampler | Ty::SamplerCmp => self.b.type_sampler(),
+            Ty::HitObject => {
+                self.ser_caps();
+                self.b.type_hit_object_nv()
+            }
             Ty::Texture {
                 dim,
                 sc,

@@ -354,7 +354,7 @@ impl<'a> Lowerer<'a> {
             }
             let t = self.resolve_ty(&f.ty, scope)?;
             let t = self.apply_dims(t, &f.dims, f.pos, false)?;
-            if t.is_resource() || matches!(t, Ty::RayQuery(_)) {
+            if t.is_resource() || t.is_opaque() {
                 return Err(unsupported(f.pos, "resources inside structs"));
             }
             if fields.iter().any(|x: &Field| x.name == f.name) {
@@ -493,6 +493,7 @@ impl<'a> Lowerer<'a> {
             }
             "SamplerState" => Ty::Sampler,
             "SamplerComparisonState" => Ty::SamplerCmp,
+            "HitObject" => Ty::HitObject,
             "ByteAddressBuffer" => Ty::ByteAddress(false),
             "RWByteAddressBuffer" => Ty::ByteAddress(true),
             "StructuredBuffer" | "RWStructuredBuffer" => {
@@ -543,7 +544,6 @@ impl<'a> Lowerer<'a> {
             | "AppendStructuredBuffer"
             | "ConsumeStructuredBuffer"
             | "Texture2DMS"
-            | "HitObject"
             | "string"
             | "TriangleHitGroup"
             | "ProceduralPrimitiveHitGroup"
@@ -754,7 +754,7 @@ impl<'a> Lowerer<'a> {
         let req = self.ext_requirements(&v.attrs)?;
         let t = self.resolve_ty(&v.ty, "")?;
         let t = self.apply_dims(t, &v.dims, v.pos, false)?;
-        if t.is_resource() || matches!(t, Ty::RtArray(_) | Ty::RayQuery(_)) {
+        if t.is_resource() || (matches!(t, Ty::RtArray(_)) || t.is_opaque()) {
             return Err(Error::new(v.pos, "a built-in input must be a value type"));
         }
         let tid = self.ty_id(&t)?;
@@ -831,11 +831,7 @@ impl<'a> Lowerer<'a> {
             return Ok(false);
         }
         let t = self.resolve_ty(&v.ty, "")?;
-        Ok(
-            !t.is_resource()
-                && !matches!(t, Ty::RayQuery(_))
-                && !v.dims.iter().any(Option::is_none),
-        )
+        Ok(!t.is_resource() && !t.is_opaque() && !v.dims.iter().any(Option::is_none))
     }
 
     pub(super) fn declare_cbuffer(
@@ -1181,10 +1177,10 @@ impl<'a> Lowerer<'a> {
             );
             return Ok(());
         }
-        if matches!(t, Ty::RayQuery(_)) {
+        if t.is_opaque() {
             return Err(unsupported(
                 v.pos,
-                "global RayQuery objects (declare them in the function)",
+                "global RayQuery or HitObject objects (declare them in the function)",
             ));
         }
         if v.mods.groupshared {

@@ -16,6 +16,7 @@ impl<'a> Lowerer<'a> {
             Ty::RayQuery(_) => "RayQuery".into(),
             Ty::Sampler => "SamplerState".into(),
             Ty::SamplerCmp => "SamplerComparisonState".into(),
+            Ty::HitObject => "HitObject".into(),
             Ty::Texture { rw, .. } => {
                 if *rw {
                     "RWTexture".into()
@@ -45,6 +46,17 @@ impl<'a> Lowerer<'a> {
 
     pub(super) fn expr_void(&mut self, e: &'a Expr) -> Result<()> {
         match &e.kind {
+            // `h = HitObject::TraceRay(...)`: the hit object is made in `h`.
+            ExprKind::Assign(None, lhs, rhs) if Self::is_hit_object_maker(rhs) => {
+                match self.place(lhs)? {
+                    Place::Ptr {
+                        ptr,
+                        ty: Ty::HitObject,
+                        ..
+                    } => self.make_hit_object(ptr, rhs)?,
+                    _ => return Err(Error::new(lhs.pos, "expected a HitObject variable")),
+                }
+            }
             // Calls of void functions have no value to produce.
             ExprKind::Call(..)
             | ExprKind::Method(..)
@@ -122,6 +134,9 @@ impl<'a> Lowerer<'a> {
             ExprKind::Assign(op, lhs, rhs) => {
                 let p = self.place(lhs)?;
                 let t = p.ty().clone();
+                if t == Ty::HitObject {
+                    return Err(unsupported(e.pos, "a HitObject assignment used as a value"));
+                }
                 let v = match op {
                     None => self.expr_as(rhs, &t)?,
                     Some(op) => {
@@ -787,7 +802,7 @@ impl<'a> Lowerer<'a> {
         let side = |this: &mut Self, label: Id, e: &'a Expr| -> Result<(Id, Ty)> {
             this.start_block(Some(label))?;
             let v = this.expr(e)?;
-            if v.ty.is_resource() || matches!(v.ty, Ty::RayQuery(_)) {
+            if v.ty.is_resource() || v.ty.is_opaque() {
                 // Vulkan has no function variables of resource types.
                 return Err(unsupported(pos, "choosing a resource with `?:`"));
             }

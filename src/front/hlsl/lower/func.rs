@@ -82,8 +82,11 @@ impl<'a> Lowerer<'a> {
                 if is_bound(i) {
                     continue;
                 }
-                if matches!(p.ty, Ty::RayQuery(_)) {
-                    return Err(unsupported(f.pos, "RayQuery function parameters"));
+                if p.ty.is_opaque() {
+                    return Err(unsupported(
+                        f.pos,
+                        "RayQuery or HitObject function parameters",
+                    ));
                 }
                 let (class, _) = self.param_class(&p.ty);
                 let t = if p.ty.is_resource() {

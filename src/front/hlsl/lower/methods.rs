@@ -40,6 +40,12 @@ impl<'a> Lowerer<'a> {
                 all.extend(args.iter().map(super::calls::Arg::Expr));
                 self.call_user(name, c, all, pos)
             }
+            Ty::HitObject => {
+                let Place::Ptr { ptr, .. } = p else {
+                    return Err(Error::new(obj.pos, "a HitObject must be a local variable"));
+                };
+                self.hit_object_method(ptr, name, args, pos)
+            }
             Ty::RayQuery(flags) => {
                 let Place::Ptr { ptr, .. } = p else {
                     return Err(Error::new(obj.pos, "a RayQuery must be a local variable"));

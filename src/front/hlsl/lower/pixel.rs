@@ -48,7 +48,7 @@ impl<'a> Lowerer<'a> {
         let mut args = Vec::new();
         let mut outs = Vec::new();
         for (p, decl) in sig.params.iter().zip(&f.params) {
-            if p.ty.is_resource() || matches!(p.ty, Ty::RayQuery(_)) {
+            if p.ty.is_resource() || p.ty.is_opaque() {
                 return Err(
                     unsupported(decl.pos, "resource parameters on a pixel entry point")
                         .len(decl.name.len() as u32),

@@ -465,7 +465,7 @@ impl<'a> Lowerer<'a> {
                 layout,
                 class,
             } => {
-                if ty.is_resource() || matches!(ty, Ty::RayQuery(_)) {
+                if ty.is_resource() || ty.is_opaque() {
                     return Ok(Val {
                         id: *ptr,
                         ty: ty.clone(),
@@ -668,7 +668,7 @@ impl<'a> Lowerer<'a> {
                 layout,
                 class,
             } => {
-                if ty.is_resource() || matches!(ty, Ty::RayQuery(_)) {
+                if ty.is_resource() || ty.is_opaque() {
                     return Err(unsupported(pos, "assigning resources or ray queries"));
                 }
                 if matches!(

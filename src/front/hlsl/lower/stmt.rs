@@ -343,6 +343,27 @@ impl<'a> Lowerer<'a> {
             );
             return Ok(());
         }
+        if t == Ty::HitObject {
+            // Made in place: `HitObject h = HitObject::TraceRay(...)`; a Nop without initializer.
+            let var = self.local_var(&t, &v.name)?;
+            self.bind(
+                &v.name,
+                Place::Ptr {
+                    ptr: var,
+                    ty: t,
+                    layout: Layout::None,
+                    class: StorageClass::Function,
+                },
+            );
+            return match &v.init {
+                Some(init) => self.make_hit_object(var, init),
+                None => {
+                    self.ser_caps();
+                    self.inst(Op::HitObjectRecordEmptyNV, None, vec![Operand::IdRef(var)])?;
+                    Ok(())
+                }
+            };
+        }
         let var = self.local_var(&t, &v.name)?;
         self.local_decls
             .push((self.f.cur_fn, var, v.name.clone(), t.clone(), v.pos));
