@@ -488,6 +488,22 @@ fn compute_semantics_on_the_driver() {
     assert_eq!(got[expected.len()], 0, "more results than expected");
 }
 
+/// Front-end constructs of the DXR corpus (default arguments, templates,
+/// classes, inheritance, static members, operator[], sizeof, functional casts,
+/// buffers passed to functions) compute what HLSL says on the driver.
+#[test]
+fn front_end_constructs_on_the_driver() {
+    let Some(gpu) = gpu(false) else { return };
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/hlsl/exec_frontend.hlsl");
+    let entries = hlsl::compile(&path, &HlslOptions::default()).unwrap_or_else(|e| panic!("{e}"));
+    let expected = [
+        6.5f32, 2.5, 2.5, 8.0, 10.0, 3.5, 16.0, 7.0, 12.0, 56.0, 3.0, 4.0, 7.5,
+    ];
+    let got = unsafe { gpu.run(&entries[0].words, "Main", expected.len() + 4, &[]) };
+    let got: Vec<f32> = got.iter().map(|w| f32::from_bits(*w)).collect();
+    assert_eq!(&got[..expected.len()], &expected[..]);
+}
+
 fn align_up(x: u64, a: u64) -> u64 {
     x.div_ceil(a) * a
 }
