@@ -2,64 +2,7 @@
 //! ray-tracing operations and methods of resources and ray queries.
 
 use super::*;
-
-/// GLSL.std.450 instruction numbers used here.
-mod g {
-    pub const ROUND_EVEN: u32 = 2;
-    pub const TRUNC: u32 = 3;
-    pub const FABS: u32 = 4;
-    pub const SABS: u32 = 5;
-    pub const FSIGN: u32 = 6;
-    pub const SSIGN: u32 = 7;
-    pub const FLOOR: u32 = 8;
-    pub const CEIL: u32 = 9;
-    pub const FRACT: u32 = 10;
-    pub const RADIANS: u32 = 11;
-    pub const DEGREES: u32 = 12;
-    pub const SIN: u32 = 13;
-    pub const COS: u32 = 14;
-    pub const TAN: u32 = 15;
-    pub const ASIN: u32 = 16;
-    pub const ACOS: u32 = 17;
-    pub const ATAN: u32 = 18;
-    pub const SINH: u32 = 19;
-    pub const COSH: u32 = 20;
-    pub const TANH: u32 = 21;
-    pub const ATAN2: u32 = 25;
-    pub const POW: u32 = 26;
-    pub const EXP: u32 = 27;
-    pub const LOG: u32 = 28;
-    pub const EXP2: u32 = 29;
-    pub const LOG2: u32 = 30;
-    pub const SQRT: u32 = 31;
-    pub const INVERSE_SQRT: u32 = 32;
-    pub const DETERMINANT: u32 = 33;
-    pub const FMIN: u32 = 37;
-    pub const UMIN: u32 = 38;
-    pub const SMIN: u32 = 39;
-    pub const FMAX: u32 = 40;
-    pub const UMAX: u32 = 41;
-    pub const SMAX: u32 = 42;
-    pub const FCLAMP: u32 = 43;
-    pub const UCLAMP: u32 = 44;
-    pub const SCLAMP: u32 = 45;
-    pub const FMIX: u32 = 46;
-    pub const STEP: u32 = 48;
-    pub const SMOOTH_STEP: u32 = 49;
-    pub const FMA: u32 = 50;
-    pub const PACK_HALF_2X16: u32 = 58;
-    pub const UNPACK_HALF_2X16: u32 = 62;
-    pub const LENGTH: u32 = 66;
-    pub const DISTANCE: u32 = 67;
-    pub const CROSS: u32 = 68;
-    pub const NORMALIZE: u32 = 69;
-    pub const FACE_FORWARD: u32 = 70;
-    pub const REFLECT: u32 = 71;
-    pub const REFRACT: u32 = 72;
-    pub const FIND_ILSB: u32 = 73;
-    pub const FIND_SMSB: u32 = 74;
-    pub const FIND_UMSB: u32 = 75;
-}
+use spirv::GlslStd450Op as G;
 
 /// A call argument: an expression, or a place already evaluated (`this`).
 pub(super) enum Arg<'a> {
@@ -163,11 +106,11 @@ impl<'a> Lowerer<'a> {
         Ok(Val { id, ty })
     }
 
-    fn glsl(&mut self, inst: u32, ty: &Ty, args: &[Id]) -> Result<Val> {
+    fn glsl(&mut self, inst: G, ty: &Ty, args: &[Id]) -> Result<Val> {
         let tid = self.ty_id(ty)?;
         let mut ops = vec![
             Operand::IdRef(self.glsl),
-            Operand::LiteralExtInstInteger(inst),
+            Operand::LiteralExtInstInteger(inst as u32),
         ];
         ops.extend(args.iter().map(|a| Operand::IdRef(*a)));
         let id = self.inst(Op::ExtInst, Some(tid), ops)?;
@@ -310,36 +253,36 @@ impl<'a> Lowerer<'a> {
             return Ok(Some(v));
         }
         let f = Ty::Sc(Sc::Float);
-        let one_float = |this: &mut Self, inst: u32| -> Result<Option<Val>> {
+        let one_float = |this: &mut Self, inst: G| -> Result<Option<Val>> {
             this.arity(name, args, 1, pos)?;
             let vals = this.args(args)?;
             let (t, ids) = this.unify(vals, true, pos)?;
             Ok(Some(this.glsl(inst, &t, &ids)?))
         };
         let unary_glsl = match name {
-            "sin" => Some(g::SIN),
-            "cos" => Some(g::COS),
-            "tan" => Some(g::TAN),
-            "asin" => Some(g::ASIN),
-            "acos" => Some(g::ACOS),
-            "atan" => Some(g::ATAN),
-            "sinh" => Some(g::SINH),
-            "cosh" => Some(g::COSH),
-            "tanh" => Some(g::TANH),
-            "exp" => Some(g::EXP),
-            "log" => Some(g::LOG),
-            "exp2" => Some(g::EXP2),
-            "log2" => Some(g::LOG2),
-            "sqrt" => Some(g::SQRT),
-            "rsqrt" => Some(g::INVERSE_SQRT),
-            "floor" => Some(g::FLOOR),
-            "ceil" => Some(g::CEIL),
-            "frac" => Some(g::FRACT),
-            "trunc" => Some(g::TRUNC),
-            "round" => Some(g::ROUND_EVEN),
-            "radians" => Some(g::RADIANS),
-            "degrees" => Some(g::DEGREES),
-            "normalize" => Some(g::NORMALIZE),
+            "sin" => Some(G::Sin),
+            "cos" => Some(G::Cos),
+            "tan" => Some(G::Tan),
+            "asin" => Some(G::Asin),
+            "acos" => Some(G::Acos),
+            "atan" => Some(G::Atan),
+            "sinh" => Some(G::Sinh),
+            "cosh" => Some(G::Cosh),
+            "tanh" => Some(G::Tanh),
+            "exp" => Some(G::Exp),
+            "log" => Some(G::Log),
+            "exp2" => Some(G::Exp2),
+            "log2" => Some(G::Log2),
+            "sqrt" => Some(G::Sqrt),
+            "rsqrt" => Some(G::InverseSqrt),
+            "floor" => Some(G::Floor),
+            "ceil" => Some(G::Ceil),
+            "frac" => Some(G::Fract),
+            "trunc" => Some(G::Trunc),
+            "round" => Some(G::RoundEven),
+            "radians" => Some(G::Radians),
+            "degrees" => Some(G::Degrees),
+            "normalize" => Some(G::Normalize),
             _ => None,
         };
         if let Some(inst) = unary_glsl {
@@ -503,8 +446,8 @@ impl<'a> Lowerer<'a> {
                 self.arity(name, args, 3, pos)?;
                 let x = self.expr(&args[0])?;
                 let (t, ids) = self.unify(vec![x], true, pos)?;
-                let sn = self.glsl(g::SIN, &t, &ids)?;
-                let cs = self.glsl(g::COS, &t, &ids)?;
+                let sn = self.glsl(G::Sin, &t, &ids)?;
+                let cs = self.glsl(G::Cos, &t, &ids)?;
                 self.store_out(&args[1], sn)?;
                 self.store_out(&args[2], cs)?;
                 return Ok(None);
@@ -514,7 +457,7 @@ impl<'a> Lowerer<'a> {
                 self.arity(name, args, 2, pos)?;
                 let x = self.expr(&args[0])?;
                 let (t, ids) = self.unify(vec![x], true, pos)?;
-                let ip = self.glsl(g::TRUNC, &t, &ids)?;
+                let ip = self.glsl(G::Trunc, &t, &ids)?;
                 let frac = self.binary(
                     BinOp::Sub,
                     Val {
@@ -531,7 +474,7 @@ impl<'a> Lowerer<'a> {
                 self.arity(name, args, 2, pos)?;
                 let vals = self.args(args)?;
                 let (t, ids) = self.unify(vals, true, pos)?;
-                let p = self.glsl(g::EXP2, &t, &ids[1..])?;
+                let p = self.glsl(G::Exp2, &t, &ids[1..])?;
                 return self
                     .binary(BinOp::Mul, Val { id: ids[0], ty: t }, p, pos)
                     .map(Some);
@@ -632,23 +575,23 @@ impl<'a> Lowerer<'a> {
                 if t != Ty::Vec(Sc::Float, 3) {
                     return Err(Error::new(pos, "`cross` needs float3 arguments"));
                 }
-                self.glsl(g::CROSS, &t, &ids)
+                self.glsl(G::Cross, &t, &ids)
             }
             "length" => {
                 let (_, ids) = self.unify(vals, true, pos)?;
-                self.glsl(g::LENGTH, &f, &ids)
+                self.glsl(G::Length, &f, &ids)
             }
             "distance" => {
                 let (_, ids) = self.unify(vals, true, pos)?;
-                self.glsl(g::DISTANCE, &f, &ids)
+                self.glsl(G::Distance, &f, &ids)
             }
             "reflect" => {
                 let (t, ids) = self.unify(vals, true, pos)?;
-                self.glsl(g::REFLECT, &t, &ids)
+                self.glsl(G::Reflect, &t, &ids)
             }
             "faceforward" => {
                 let (t, ids) = self.unify(vals, true, pos)?;
-                self.glsl(g::FACE_FORWARD, &t, &ids)
+                self.glsl(G::FaceForward, &t, &ids)
             }
             "refract" => {
                 let mut vals = vals;
@@ -656,14 +599,14 @@ impl<'a> Lowerer<'a> {
                 let eta = self.convert(eta, &f, pos, false)?;
                 let (t, mut ids) = self.unify(vals, true, pos)?;
                 ids.push(eta.id);
-                self.glsl(g::REFRACT, &t, &ids)
+                self.glsl(G::Refract, &t, &ids)
             }
             "lerp" | "smoothstep" | "fma" => {
                 let (t, ids) = self.unify(vals, true, pos)?;
                 let inst = match name {
-                    "lerp" => g::FMIX,
-                    "fma" => g::FMA,
-                    _ => g::SMOOTH_STEP,
+                    "lerp" => G::FMix,
+                    "fma" => G::Fma,
+                    _ => G::SmoothStep,
                 };
                 self.glsl(inst, &t, &ids)
             }
@@ -681,29 +624,29 @@ impl<'a> Lowerer<'a> {
                 let (t, ids) = self.unify(vals, true, pos)?;
                 let zero = self.const_splat(&t, 0.0)?;
                 let one = self.const_splat(&t, 1.0)?;
-                self.glsl(g::FCLAMP, &t, &[ids[0], zero, one])
+                self.glsl(G::FClamp, &t, &[ids[0], zero, one])
             }
             "clamp" | "min" | "max" => {
                 let (t, ids) = self.unify(vals, false, pos)?;
                 let s = t.scalar().unwrap_or(Sc::Float);
                 let inst = match (name, s) {
-                    ("clamp", Sc::Float) => g::FCLAMP,
-                    ("clamp", Sc::Int) => g::SCLAMP,
-                    ("clamp", _) => g::UCLAMP,
-                    ("min", Sc::Float) => g::FMIN,
-                    ("min", Sc::Int) => g::SMIN,
-                    ("min", _) => g::UMIN,
-                    (_, Sc::Float) => g::FMAX,
-                    (_, Sc::Int) => g::SMAX,
-                    _ => g::UMAX,
+                    ("clamp", Sc::Float) => G::FClamp,
+                    ("clamp", Sc::Int) => G::SClamp,
+                    ("clamp", _) => G::UClamp,
+                    ("min", Sc::Float) => G::FMin,
+                    ("min", Sc::Int) => G::SMin,
+                    ("min", _) => G::UMin,
+                    (_, Sc::Float) => G::FMax,
+                    (_, Sc::Int) => G::SMax,
+                    _ => G::UMax,
                 };
                 self.glsl(inst, &t, &ids)
             }
             "abs" => {
                 let (t, ids) = self.unify(vals, false, pos)?;
                 match t.scalar() {
-                    Some(Sc::Float) => self.glsl(g::FABS, &t, &ids),
-                    Some(Sc::Int) => self.glsl(g::SABS, &t, &ids),
+                    Some(Sc::Float) => self.glsl(G::FAbs, &t, &ids),
+                    Some(Sc::Int) => self.glsl(G::SAbs, &t, &ids),
                     _ => Ok(Val { id: ids[0], ty: t }),
                 }
             }
@@ -713,10 +656,10 @@ impl<'a> Lowerer<'a> {
                 let it = t.with_scalar(Sc::Int);
                 match t.scalar() {
                     Some(Sc::Float) => {
-                        let v = self.glsl(g::FSIGN, &t, &ids)?;
+                        let v = self.glsl(G::FSign, &t, &ids)?;
                         self.convert(v, &it, pos, true)
                     }
-                    Some(Sc::Int) => self.glsl(g::SSIGN, &t, &ids),
+                    Some(Sc::Int) => self.glsl(G::SSign, &t, &ids),
                     _ => {
                         let v = Val {
                             id: ids[0],
@@ -730,9 +673,9 @@ impl<'a> Lowerer<'a> {
             "pow" | "atan2" | "step" => {
                 let (t, ids) = self.unify(vals, true, pos)?;
                 let inst = match name {
-                    "pow" => g::POW,
-                    "atan2" => g::ATAN2,
-                    _ => g::STEP,
+                    "pow" => G::Pow,
+                    "atan2" => G::Atan2,
+                    _ => G::Step,
                 };
                 self.glsl(inst, &t, &ids)
             }
@@ -758,7 +701,7 @@ impl<'a> Lowerer<'a> {
             }
             "log10" => {
                 let (t, ids) = self.unify(vals, true, pos)?;
-                let l = self.glsl(g::LOG2, &t, &ids)?;
+                let l = self.glsl(G::Log2, &t, &ids)?;
                 let k = Val {
                     id: self.const_splat(&t, std::f64::consts::LOG10_2)?,
                     ty: t,
@@ -779,7 +722,7 @@ impl<'a> Lowerer<'a> {
             "determinant" => {
                 let v = vals.into_iter().next().unwrap_or_else(|| unreachable!());
                 match v.ty {
-                    Ty::Mat(_, r, c) if r == c => self.glsl(g::DETERMINANT, &f, &[v.id]),
+                    Ty::Mat(_, r, c) if r == c => self.glsl(G::Determinant, &f, &[v.id]),
                     _ => Err(Error::new(pos, "`determinant` needs a square matrix")),
                 }
             }
@@ -838,10 +781,9 @@ impl<'a> Lowerer<'a> {
                         let zero = self.const_f32(0.0);
                         let v2 = self.ty_id(&Ty::Vec(Sc::Float, 2))?;
                         let pair = self.op(Op::CompositeConstruct, v2, &[c.id, zero])?;
-                        out.push(self.glsl(g::PACK_HALF_2X16, &Ty::Sc(Sc::Uint), &[pair])?);
+                        out.push(self.glsl(G::PackHalf2x16, &Ty::Sc(Sc::Uint), &[pair])?);
                     } else {
-                        let pair =
-                            self.glsl(g::UNPACK_HALF_2X16, &Ty::Vec(Sc::Float, 2), &[c.id])?;
+                        let pair = self.glsl(G::UnpackHalf2x16, &Ty::Vec(Sc::Float, 2), &[c.id])?;
                         let ft = self.ty_id(&f)?;
                         let id = self.inst(
                             Op::CompositeExtract,
@@ -885,14 +827,14 @@ impl<'a> Lowerer<'a> {
                     }
                     "firstbithigh" => self.glsl(
                         if s == Some(Sc::Int) {
-                            g::FIND_SMSB
+                            G::FindSMsb
                         } else {
-                            g::FIND_UMSB
+                            G::FindUMsb
                         },
                         &t,
                         &[v.id],
                     )?,
-                    _ => self.glsl(g::FIND_ILSB, &t, &[v.id])?,
+                    _ => self.glsl(G::FindILsb, &t, &[v.id])?,
                 };
                 // HLSL returns uint components for all four.
                 self.convert(r, &t.with_scalar(Sc::Uint), pos, true)

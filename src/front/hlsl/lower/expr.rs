@@ -2,6 +2,58 @@
 
 use super::*;
 
+/// Opcodes of the binary operators by operand class: float, signed,
+/// unsigned, bool (`&&`/`||` are lowered by `logical`).
+const BINARY_OPS: &[(BinOp, [Op; 4])] = {
+    use BinOp::*;
+    use Op::*;
+    &[
+        (Add, [FAdd, IAdd, IAdd, IAdd]),
+        (Sub, [FSub, ISub, ISub, ISub]),
+        (Mul, [FMul, IMul, IMul, IMul]),
+        (Div, [FDiv, SDiv, UDiv, UDiv]),
+        (Rem, [FRem, SRem, UMod, UMod]),
+        (Shl, [ShiftLeftLogical; 4]),
+        (
+            Shr,
+            [
+                ShiftRightLogical,
+                ShiftRightArithmetic,
+                ShiftRightLogical,
+                ShiftRightLogical,
+            ],
+        ),
+        (BitAnd, [BitwiseAnd; 4]),
+        (BitOr, [BitwiseOr; 4]),
+        (BitXor, [BitwiseXor; 4]),
+        (Eq, [FOrdEqual, IEqual, IEqual, LogicalEqual]),
+        (Ne, [FUnordNotEqual, INotEqual, INotEqual, LogicalNotEqual]),
+        (Lt, [FOrdLessThan, SLessThan, ULessThan, ULessThan]),
+        (
+            Le,
+            [
+                FOrdLessThanEqual,
+                SLessThanEqual,
+                ULessThanEqual,
+                ULessThanEqual,
+            ],
+        ),
+        (
+            Gt,
+            [FOrdGreaterThan, SGreaterThan, UGreaterThan, UGreaterThan],
+        ),
+        (
+            Ge,
+            [
+                FOrdGreaterThanEqual,
+                SGreaterThanEqual,
+                UGreaterThanEqual,
+                UGreaterThanEqual,
+            ],
+        ),
+    ]
+};
+
 impl<'a> Lowerer<'a> {
     pub fn ty_name(&self, t: &Ty) -> String {
         match t {
@@ -596,112 +648,24 @@ impl<'a> Lowerer<'a> {
         let s = ct.scalar().unwrap_or(Sc::Float);
         let f = s == Sc::Float;
         let signed = s == Sc::Int;
-        let opcode = match op {
-            Add => {
-                if f {
-                    Op::FAdd
-                } else {
-                    Op::IAdd
-                }
-            }
-            Sub => {
-                if f {
-                    Op::FSub
-                } else {
-                    Op::ISub
-                }
-            }
-            Mul => {
-                if f {
-                    Op::FMul
-                } else {
-                    Op::IMul
-                }
-            }
-            Div => {
-                if f {
-                    Op::FDiv
-                } else if signed {
-                    Op::SDiv
-                } else {
-                    Op::UDiv
-                }
-            }
-            Rem => {
-                if f {
-                    Op::FRem
-                } else if signed {
-                    Op::SRem
-                } else {
-                    Op::UMod
-                }
-            }
-            Shl => Op::ShiftLeftLogical,
-            Shr => {
-                if signed {
-                    Op::ShiftRightArithmetic
-                } else {
-                    Op::ShiftRightLogical
-                }
-            }
-            BitAnd => Op::BitwiseAnd,
-            BitOr => Op::BitwiseOr,
-            BitXor => Op::BitwiseXor,
-            Eq => {
-                if f {
-                    Op::FOrdEqual
-                } else if s == Sc::Bool {
-                    Op::LogicalEqual
-                } else {
-                    Op::IEqual
-                }
-            }
-            Ne => {
-                if f {
-                    Op::FUnordNotEqual
-                } else if s == Sc::Bool {
-                    Op::LogicalNotEqual
-                } else {
-                    Op::INotEqual
-                }
-            }
-            Lt => {
-                if f {
-                    Op::FOrdLessThan
-                } else if signed {
-                    Op::SLessThan
-                } else {
-                    Op::ULessThan
-                }
-            }
-            Le => {
-                if f {
-                    Op::FOrdLessThanEqual
-                } else if signed {
-                    Op::SLessThanEqual
-                } else {
-                    Op::ULessThanEqual
-                }
-            }
-            Gt => {
-                if f {
-                    Op::FOrdGreaterThan
-                } else if signed {
-                    Op::SGreaterThan
-                } else {
-                    Op::UGreaterThan
-                }
-            }
-            Ge => {
-                if f {
-                    Op::FOrdGreaterThanEqual
-                } else if signed {
-                    Op::SGreaterThanEqual
-                } else {
-                    Op::UGreaterThanEqual
-                }
-            }
-            And | Or => unreachable!("handled by logical"),
+        let class = if f {
+            0
+        } else if signed {
+            1
+        } else if s == Sc::Bool {
+            3
+        } else {
+            2
+        };
+        let Some(opcode) = BINARY_OPS
+            .iter()
+            .find(|(o, _)| *o == op)
+            .map(|(_, ops)| ops[class])
+        else {
+            return Err(Error::new(
+                pos,
+                format!("`{}` is not an arithmetic operator", op.as_str()),
+            ));
         };
         let rt = if cmp { ct.with_scalar(Sc::Bool) } else { ct };
         let tid = self.ty_id(&rt)?;
