@@ -198,14 +198,11 @@ pub fn check(attr: &Attr) -> Result<()> {
         Some(AttrInfo {
             support: Refused(what),
             ..
-        }) => {
-            Err(Error::new(attr.pos, format!("not supported: {what}")).len(attr.name.len() as u32))
-        }
-        None => Err(Error::new(
-            attr.pos,
-            format!("not supported: attribute `{}`", attr.name),
-        )
-        .len(attr.name.len() as u32)),
+        }) => Err(Error::unsupported(attr.pos, what).len(attr.name.len() as u32)),
+        None => Err(
+            Error::unsupported(attr.pos, format!("attribute `{}`", attr.name))
+                .len(attr.name.len() as u32),
+        ),
     }
 }
 
@@ -215,9 +212,9 @@ pub fn check_site(attrs: &[Attr], site: Site) -> Result<()> {
         check(attr)?;
         if let Some(info) = lookup(&attr.name) {
             if info.sites & site.bit() == 0 {
-                return Err(Error::new(
+                return Err(Error::unsupported(
                     attr.pos,
-                    format!("not supported: `{}` on {}", attr.name, site.name()),
+                    format!("`{}` on {}", attr.name, site.name()),
                 )
                 .len(attr.name.len() as u32));
             }

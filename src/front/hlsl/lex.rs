@@ -184,7 +184,7 @@ pub fn lex(src: &str, file: u32) -> Result<Vec<Token>, Error> {
                 i += 3;
                 Tok::Int(b[start + 1] as u64, false)
             } else {
-                return Err(Error::new(pos, "not supported: character literal"));
+                return Err(Error::unsupported(pos, "character literal"));
             }
         } else {
             let rest = &src[i..];

@@ -244,7 +244,7 @@ const RAY_DESC: u32 = 0;
 const TRI_ATTRS: u32 = 1;
 
 fn unsupported(pos: Pos, what: impl std::fmt::Display) -> Error {
-    Error::new(pos, format!("not supported: {what}"))
+    Error::unsupported(pos, what)
 }
 
 /// A resource reached through something other than a variable (which
@@ -258,7 +258,7 @@ fn not_a_variable(pos: Pos) -> Error {
 
 impl From<dr::Error> for Error {
     fn from(e: dr::Error) -> Self {
-        Error::new(Pos::default(), format!("internal compiler error: {e}"))
+        Error::internal(e)
     }
 }
 

@@ -139,6 +139,9 @@ fn parse_source_inner(
     parse_with_warnings(path, text, loader, options).map(|(items, files, _)| (items, files))
 }
 
+/// Items, the file table, and warnings.
+type Parsed = (Vec<ast::Item>, Vec<PathBuf>, Vec<String>);
+
 /// Preprocesses and parses; also gives the warnings, rendered
 /// `file:line:col: warning: message`.
 fn parse_with_warnings(
@@ -146,7 +149,7 @@ fn parse_with_warnings(
     text: &str,
     loader: &mut dyn pp::FileLoader,
     options: &HlslOptions,
-) -> Result<(Vec<ast::Item>, Vec<PathBuf>, Vec<String>), InputError> {
+) -> Result<Parsed, InputError> {
     let out = pp::preprocess(path, text, loader, &options.include_dirs, &options.defines)
         .map_err(|f| f.error.into_input_error(&f.files, path))?;
     let items = parse::parse(&out.tokens).map_err(|e| e.into_input_error(&out.files, path))?;

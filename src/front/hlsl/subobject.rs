@@ -159,7 +159,7 @@ pub enum Value {
 
 /// Checks the initializer's shape against `kind`: the number of fields and
 /// which are strings. Gives the fields, each with its position.
-pub fn fields<'e>(kind: Kind, init: &'e Expr, pos: Pos) -> Result<Vec<&'e Expr>> {
+pub fn fields(kind: Kind, init: &Expr, pos: Pos) -> Result<Vec<&Expr>> {
     let want = kind.fields();
     let ExprKind::InitList(elems) = &init.kind else {
         return Err(Error::new(

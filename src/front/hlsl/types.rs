@@ -257,6 +257,26 @@ pub fn struct_offsets(k: u32, layout: Layout, structs: &[StructDef]) -> Vec<u32>
     out
 }
 
+/// `sizeof(T)` as DXC computes it: 32-bit scalars packed without padding
+/// (`float3` is 12 bytes, `struct { float a; float3 b; }` 16); `None` for
+/// types with no size in memory (resources, ray queries).
+pub fn packed_size(ty: &Ty, structs: &[StructDef]) -> Option<u32> {
+    Some(match ty {
+        Ty::Sc(_) => 4,
+        Ty::Vec(_, n) => 4 * *n as u32,
+        Ty::Mat(_, r, c) => 4 * *r as u32 * *c as u32,
+        Ty::Array(e, n) => packed_size(e, structs)? * n,
+        Ty::Struct(k) => {
+            let mut total = 0;
+            for f in &structs.get(*k as usize)?.fields {
+                total += packed_size(&f.ty, structs)?;
+            }
+            total
+        }
+        _ => return None,
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -318,24 +338,4 @@ mod tests {
         assert_eq!(size_align(&Ty::Struct(0), Layout::Std430, &s), (16, 16));
         assert_eq!(array_stride(&f, Layout::Std430, &s), 4);
     }
-}
-
-/// `sizeof(T)` as DXC computes it: 32-bit scalars packed without padding
-/// (`float3` is 12 bytes, `struct { float a; float3 b; }` 16); `None` for
-/// types with no size in memory (resources, ray queries).
-pub fn packed_size(ty: &Ty, structs: &[StructDef]) -> Option<u32> {
-    Some(match ty {
-        Ty::Sc(_) => 4,
-        Ty::Vec(_, n) => 4 * *n as u32,
-        Ty::Mat(_, r, c) => 4 * *r as u32 * *c as u32,
-        Ty::Array(e, n) => packed_size(e, structs)? * n,
-        Ty::Struct(k) => {
-            let mut total = 0;
-            for f in &structs.get(*k as usize)?.fields {
-                total += packed_size(&f.ty, structs)?;
-            }
-            total
-        }
-        _ => return None,
-    })
 }

@@ -38,7 +38,7 @@ impl<'a> Lowerer<'a> {
                 Item::Struct(s) => match self.declare_struct(s) {
                     Ok(()) => {}
                     // A struct using something unsupported is refused where it is used.
-                    Err(e) if e.message.starts_with("not supported") => {
+                    Err(e) if e.is_unsupported() => {
                         self.unusable.entry(s.name.clone()).or_insert(e);
                     }
                     Err(e) => return Err(e),
@@ -161,7 +161,7 @@ impl<'a> Lowerer<'a> {
                 Ok(sig) => sig,
                 // A helper using something unsupported in its signature is
                 // refused where it is called; never called, it is not compiled.
-                Err(e) if stage.is_none() && e.message.starts_with("not supported") => {
+                Err(e) if stage.is_none() && e.is_unsupported() => {
                     self.unusable.entry(f.name.clone()).or_insert(e);
                     continue;
                 }
