@@ -497,9 +497,14 @@ fn front_end_constructs_on_the_driver() {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/hlsl/exec_frontend.hlsl");
     let entries = hlsl::compile(&path, &HlslOptions::default()).unwrap_or_else(|e| panic!("{e}"));
     let expected = [
-        6.5f32, 2.5, 2.5, 8.0, 10.0, 3.5, 16.0, 7.0, 12.0, 56.0, 3.0, 4.0, 7.5,
+        6.5f32, 2.5, 2.5, 8.0, 10.0, 3.5, 16.0, 7.0, 12.0, 56.0, 3.0, 4.0, 7.5, 7.0, 3.0, 4.5, 3.0,
     ];
-    let got = unsafe { gpu.run(&entries[0].words, "Main", expected.len() + 4, &[]) };
+    // `sky`: color (1, 2, 3), intensity 0.5.
+    let sky: Vec<u8> = [1.0f32, 2.0, 3.0, 0.5]
+        .iter()
+        .flat_map(|f| f.to_le_bytes())
+        .collect();
+    let got = unsafe { gpu.run(&entries[0].words, "Main", expected.len() + 4, &sky) };
     let got: Vec<f32> = got.iter().map(|w| f32::from_bits(*w)).collect();
     assert_eq!(&got[..expected.len()], &expected[..]);
 }

@@ -3,6 +3,29 @@
 // operator[], sizeof, functional casts, buffers passed to functions.
 RWStructuredBuffer<float> results : register(u0);
 
+struct Sky
+{
+    float3 color;
+    float intensity;
+};
+ConstantBuffer<Sky> sky : register(b1);
+
+float brightness(Sky s) { return (s.color.x + s.color.y + s.color.z) * s.intensity; }
+
+namespace shading
+{
+    float fresnel(float f0) { return f0 + 0.5; }
+    namespace specular
+    {
+        // `fresnel` is found in the enclosing namespace.
+        float reflect(float f0) { return fresnel(f0) * 2; }
+    }
+}
+
+// A user template named like an intrinsic does not hide it.
+template<typename T>
+T TraceRay(T x) { return x * 3; }
+
 float scaled(float x, uint scale = 3, float bias = 0.5) { return x * scale + bias; }
 
 template<typename T>
@@ -82,4 +105,10 @@ void Main()
     results[10] = k.data.z;                      // 3
     results[11] = Table::Size;                   // 4
     results[12] = first(results) + 1;            // 7.5
+    const uint N = 3;
+    float local[N] = { 1, 2, 4 };
+    results[13] = local[N - 1] + N;              // 7
+    results[14] = shading::specular::reflect(1); // 3
+    results[15] = TraceRay(1.5);                 // 4.5
+    results[16] = brightness(sky);               // (1 + 2 + 3) * 0.5 = 3
 }

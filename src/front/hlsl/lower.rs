@@ -516,6 +516,27 @@ impl<'a> Lowerer<'a> {
         }
     }
 
+    /// Where an unqualified `name` may be declared, nearest first: the current
+    /// namespace (or struct) and each enclosing one, the global scope, then the
+    /// `using namespace`s.
+    fn scoped_names(&self, name: &str) -> Vec<String> {
+        let mut out = Vec::new();
+        let mut prefix = self.f.cur_ns.as_str();
+        loop {
+            out.push(format!("{prefix}{name}"));
+            if prefix.is_empty() {
+                break;
+            }
+            let inner = &prefix[..prefix.len() - 2];
+            prefix = match inner.rfind("::") {
+                Some(k) => &inner[..k + 2],
+                None => "",
+            };
+        }
+        out.extend(self.usings.iter().map(|u| format!("{u}{name}")));
+        out
+    }
+
     fn ext(&mut self, e: &str) {
         if self.exts.insert(e.to_string()) {
             self.b.extension(e);

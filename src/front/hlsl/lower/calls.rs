@@ -170,17 +170,9 @@ impl<'a> Lowerer<'a> {
     }
 
     fn find_user(&self, name: &str) -> Option<Vec<usize>> {
-        if !self.f.cur_ns.is_empty() {
-            if let Some(v) = self.fn_by_name.get(&format!("{}{name}", self.f.cur_ns)) {
-                return Some(v.clone());
-            }
-        }
-        if let Some(v) = self.fn_by_name.get(name) {
-            return Some(v.clone());
-        }
-        self.usings
+        self.scoped_names(name)
             .iter()
-            .find_map(|u| self.fn_by_name.get(&format!("{u}{name}")))
+            .find_map(|n| self.fn_by_name.get(n))
             .cloned()
     }
 
@@ -211,8 +203,16 @@ impl<'a> Lowerer<'a> {
             return Ok(r);
         }
         if self.find_user(name).is_none() {
+            // A template takes the call when one fits the arguments (a user
+            // template may share an intrinsic's name, `TraceRay`).
             if let Some(ts) = self.find_fn_template(name) {
-                return self.template_call(name, ts, &[], args, None, pos);
+                let fits = ts.iter().any(|f| {
+                    let required = f.params.iter().take_while(|p| p.init.is_none()).count();
+                    (required..=f.params.len()).contains(&args.len())
+                });
+                if fits {
+                    return self.template_call(name, ts, &[], args, None, pos);
+                }
             }
             let ns = self.f.cur_ns.clone();
             let refused = self
@@ -1118,7 +1118,17 @@ impl<'a> Lowerer<'a> {
                 };
                 argv.push((Some(p), v));
             } else {
-                let v = self.expr(a)?;
+                let mut v = self.expr(a)?;
+                if let Ty::ConstantBuffer(k) = v.ty {
+                    // A `ConstantBuffer<S>` passed for an `S`: its contents.
+                    let wants_buffer = cands
+                        .iter()
+                        .any(|c| matches!(self.funcs[*c].params[i].ty, Ty::ConstantBuffer(_)));
+                    if !wants_buffer {
+                        let p = self.place(a)?;
+                        v = self.struct_of(p, k, a.pos)?;
+                    }
+                }
                 argv.push((None, v));
             }
         }
@@ -1361,5 +1371,24 @@ impl<'a> Lowerer<'a> {
             return Err(Error::new(ret.pos, "expected a resource"));
         }
         Ok(r)
+    }
+
+    /// The value of a struct place read member by member (a constant buffer's
+    /// contents as an `S`).
+    pub(super) fn struct_of(&mut self, p: Place, k: u32, pos: Pos) -> Result<Val> {
+        let names: Vec<String> = self.structs[k as usize]
+            .fields
+            .iter()
+            .map(|f| f.name.clone())
+            .collect();
+        let mut ids = Vec::new();
+        for n in &names {
+            let m = self.member(p.clone(), n, pos)?;
+            ids.push(self.read(&m)?.id);
+        }
+        let t = Ty::Struct(k);
+        let tid = self.ty_id(&t)?;
+        let id = self.op(Op::CompositeConstruct, tid, &ids)?;
+        Ok(Val { id, ty: t })
     }
 }

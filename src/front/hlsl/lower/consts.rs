@@ -348,6 +348,18 @@ impl<'a> Lowerer<'a> {
                 Some(CVal::I(n as i64))
             }
             ExprKind::Ident(n) => {
+                // A local shadows every global: constant only when it is one.
+                if let Some(p) = self.f.scopes.iter().rev().find_map(|s| s.get(n.as_str())) {
+                    return Ok(match p {
+                        Place::Value(v) => match self.known(v) {
+                            Some((Sc::Float, b)) => Some(CVal::F(f32::from_bits(b) as f64)),
+                            Some((Sc::Int, b)) => Some(CVal::I(b as i32 as i64)),
+                            Some((_, b)) => Some(CVal::I(b as i64)),
+                            None => None,
+                        },
+                        _ => None,
+                    });
+                }
                 if let Some(v) = builtin_constant(n) {
                     return Ok(Some(CVal::I(v as i64)));
                 }

@@ -28,12 +28,7 @@ impl<'a> Lowerer<'a> {
                 }
             }
         }
-        let mut candidates = if self.f.cur_ns.is_empty() {
-            vec![name.to_string()]
-        } else {
-            vec![format!("{}{name}", self.f.cur_ns), name.to_string()]
-        };
-        candidates.extend(self.usings.iter().map(|u| format!("{u}{name}")));
+        let candidates = self.scoped_names(name);
         for c in &candidates {
             if let Some(g) = self.globals.get(c).cloned() {
                 return Ok(match g {

@@ -343,6 +343,33 @@ impl<'a> Lowerer<'a> {
             );
             return Ok(());
         }
+        if v.mods.is_const && !v.mods.is_static {
+            // `const int N = 3;`: a name for the constant (usable as an array size).
+            if let (Ty::Sc(_), Some(init)) = (&t, &v.init) {
+                let val = self.expr_as(init, &t)?;
+                if self.known(&val).is_some() {
+                    self.bind(&v.name, Place::Value(val));
+                    return Ok(());
+                }
+                let var = self.local_var(&t, &v.name)?;
+                self.local_decls
+                    .push((self.f.cur_fn, var, v.name.clone(), t.clone(), v.pos));
+                if self.f.term {
+                    self.start_block(None)?;
+                }
+                self.b.store(var, val.id, None, [])?;
+                self.bind(
+                    &v.name,
+                    Place::Ptr {
+                        ptr: var,
+                        ty: t,
+                        layout: Layout::None,
+                        class: StorageClass::Function,
+                    },
+                );
+                return Ok(());
+            }
+        }
         if t == Ty::HitObject {
             // Made in place: `HitObject h = HitObject::TraceRay(...)`; a Nop without initializer.
             let var = self.local_var(&t, &v.name)?;
