@@ -1089,3 +1089,25 @@ fn shader_execution_reordering_uses_nv_invocation_reorder() {
         .iter()
         .any(|(op, ops)| *op == 17 && ops[0] == 5383));
 }
+
+#[test]
+fn int64_types_layouts_literals_and_conversions() {
+    compile_all("int64.hlsl");
+    let m = hlsl::compile_file(&shader("int64.hlsl"), &HlslOptions::default()).unwrap();
+    let insts = instructions(&m.words);
+    // OpCapability Int64 (11).
+    assert!(insts.iter().any(|(op, ops)| *op == 17 && ops[0] == 11));
+    // 8-byte members: offsets 0, 8, 16.
+    assert_eq!(member_offsets(&m.words, "Range"), vec![0, 8, 16]);
+    // 64-bit constants (OpConstant with two value words): 5000000000 and -7 sign-extended.
+    let wide: Vec<u64> = insts
+        .iter()
+        .filter(|(op, ops)| *op == 43 && ops.len() == 4)
+        .map(|(_, ops)| ops[2] as u64 | (ops[3] as u64) << 32)
+        .collect();
+    assert!(wide.contains(&5_000_000_000), "{wide:?}");
+    assert!(wide.contains(&(-7i64 as u64)), "{wide:?}");
+    // Width changes: OpUConvert (113) and OpSConvert (114).
+    assert!(insts.iter().any(|(op, _)| *op == 113));
+    assert!(insts.iter().any(|(op, _)| *op == 114));
+}

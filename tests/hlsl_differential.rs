@@ -537,6 +537,10 @@ const NOT_RUN: &[(&str, &str)] = &[
          tests/hlsl_compile.rs compiles them",
     ),
     ("include", "a folder of include files"),
+    (
+        "int64.hlsl",
+        "64-bit integers: tests/hlsl_compile.rs checks layouts, constants and conversions",
+    ),
     ("common.hlsli", "an include file"),
 ];
 

@@ -121,7 +121,7 @@ fn unsupported_constructs_are_named() {
     );
     assert_eq!(
         err(&format!("{RG}    double d = 1;\n}}")),
-        "main.hlsl:4:5: not supported: type `double` (only 32-bit types)"
+        "main.hlsl:4:5: not supported: type `double` (only 32-bit floats, 32- and 64-bit integers)"
     );
 }
 
@@ -500,7 +500,7 @@ fn unsupported_helpers_are_refused_where_called() {
     // Called: refused at the unsupported construct.
     assert_eq!(
         err("uint hash64(double v) { return uint(v); }\n[numthreads(1,1,1)]\nvoid m() { uint h = hash64(1); }"),
-        "main.hlsl:1:13: not supported: type `double` (only 32-bit types)"
+        "main.hlsl:1:13: not supported: type `double` (only 32-bit floats, 32- and 64-bit integers)"
     );
 }
 

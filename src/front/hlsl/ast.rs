@@ -202,6 +202,8 @@ impl BinOp {
 #[derive(Clone, Debug)]
 pub enum ExprKind {
     Int(u64, bool),
+    /// A 64-bit literal (`1ull`, `0x1ffffffffl`, or too large for 32 bits).
+    Int64(u64, bool),
     Float(f64),
     Bool(bool),
     /// Only in attributes (`[shader("miss")]`).

@@ -12,6 +12,8 @@ pub enum Tok {
     Ident(Rc<str>),
     /// Integer literal: value and whether it had a `u`/`U` suffix.
     Int(u64, bool),
+    /// An integer literal with an `l`/`ll` suffix: 64-bit (`1ull`).
+    Long(u64, bool),
     /// Float literal: value (suffixes `f`, `h`, `l` are accepted and dropped).
     Float(f64),
     Str(Rc<str>),
@@ -46,6 +48,7 @@ impl Token {
         match &self.tok {
             Tok::Ident(s) => s.to_string(),
             Tok::Int(v, u) => format!("{v}{}", if *u { "u" } else { "" }),
+            Tok::Long(v, u) => format!("{v}{}ll", if *u { "u" } else { "" }),
             Tok::Float(f) => {
                 let s = format!("{f:?}");
                 s
@@ -267,8 +270,8 @@ fn lex_number(b: &[u8]) -> Option<(Tok, usize)> {
         }
         let i = int_end;
         let v = u64::from_str_radix(std::str::from_utf8(&b[s..i]).ok()?, 16).ok()?;
-        let (u, n) = int_suffix(&b[i..]);
-        return Some((Tok::Int(v, u), i + n));
+        let (u, long, n) = int_suffix(&b[i..]);
+        return Some((int_token(v, u, long), i + n));
     }
     while i < b.len() && b[i].is_ascii_digit() {
         i += 1;
@@ -322,21 +325,32 @@ fn lex_number(b: &[u8]) -> Option<(Tok, usize)> {
     } else {
         text.parse().ok()?
     };
-    let (u, n) = int_suffix(&b[i..]);
+    let (u, long, n) = int_suffix(&b[i..]);
     if i + n < b.len() && (b[i + n].is_ascii_alphanumeric() || b[i + n] == b'_') {
         return None;
     }
-    Some((Tok::Int(v, u), i + n))
+    Some((int_token(v, u, long), i + n))
 }
 
-fn int_suffix(b: &[u8]) -> (bool, usize) {
+/// `u`, `l`, `ul`, `ull`, ...: (unsigned, 64-bit, length).
+fn int_suffix(b: &[u8]) -> (bool, bool, usize) {
     let mut u = false;
+    let mut long = false;
     let mut n = 0;
     while n < b.len() && n < 3 && matches!(b[n], b'u' | b'U' | b'l' | b'L') {
         u |= matches!(b[n], b'u' | b'U');
+        long |= matches!(b[n], b'l' | b'L');
         n += 1;
     }
-    (u, n)
+    (u, long, n)
+}
+
+fn int_token(v: u64, u: bool, long: bool) -> Tok {
+    if long {
+        Tok::Long(v, u)
+    } else {
+        Tok::Int(v, u)
+    }
 }
 
 #[cfg(test)]

@@ -1676,9 +1676,17 @@ impl<'t> Parser<'t> {
             return Err(self.unexpected("an expression"));
         };
         let kind = match &t.tok {
+            Tok::Int(v, u) if *v > u32::MAX as u64 => {
+                self.i += 1;
+                ExprKind::Int64(*v, *u)
+            }
             Tok::Int(v, u) => {
                 self.i += 1;
                 ExprKind::Int(*v, *u)
+            }
+            Tok::Long(v, u) => {
+                self.i += 1;
+                ExprKind::Int64(*v, *u)
             }
             Tok::Float(f) => {
                 self.i += 1;

@@ -1075,7 +1075,7 @@ impl CondExpr<'_> {
         };
         self.i += 1;
         match &t.tok {
-            Tok::Int(v, _) => Ok(*v as i64),
+            Tok::Int(v, _) | Tok::Long(v, _) => Ok(*v as i64),
             // Identifiers left after expansion are 0, as in C.
             Tok::Ident(_) => Ok(0),
             Tok::Punct("!") => Ok((self.unary()? == 0) as i64),

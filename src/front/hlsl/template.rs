@@ -229,7 +229,11 @@ impl Subst<'_> {
                     e.kind = v.kind.clone();
                 }
             }
-            ExprKind::Int(..) | ExprKind::Float(_) | ExprKind::Bool(_) | ExprKind::Str(_) => {}
+            ExprKind::Int(..)
+            | ExprKind::Int64(..)
+            | ExprKind::Float(_)
+            | ExprKind::Bool(_)
+            | ExprKind::Str(_) => {}
             ExprKind::Unary(_, a) => self.expr(a),
             ExprKind::Binary(_, a, b) | ExprKind::Assign(_, a, b) | ExprKind::Comma(a, b) => {
                 self.expr(a);

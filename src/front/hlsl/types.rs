@@ -11,6 +11,9 @@ pub enum Sc {
     Bool,
     Int,
     Uint,
+    /// `int64_t` and `uint64_t` (ordered so that mixed arithmetic widens).
+    Int64,
+    Uint64,
     Float,
 }
 
@@ -20,8 +23,26 @@ impl Sc {
             Sc::Bool => "bool",
             Sc::Int => "int",
             Sc::Uint => "uint",
+            Sc::Int64 => "int64_t",
+            Sc::Uint64 => "uint64_t",
             Sc::Float => "float",
         }
+    }
+
+    /// Bytes of one value in memory.
+    pub fn size(self) -> u32 {
+        match self {
+            Sc::Int64 | Sc::Uint64 => 8,
+            _ => 4,
+        }
+    }
+
+    pub fn is_signed(self) -> bool {
+        matches!(self, Sc::Int | Sc::Int64)
+    }
+
+    pub fn is_64(self) -> bool {
+        matches!(self, Sc::Int64 | Sc::Uint64)
     }
 }
 
@@ -146,9 +167,9 @@ fn round_up(x: u32, a: u32) -> u32 {
 /// Size and alignment of `ty` under `layout` (scalars are 32-bit).
 pub fn size_align(ty: &Ty, layout: Layout, structs: &[StructDef]) -> (u32, u32) {
     match (ty, layout) {
-        (Ty::Sc(_), _) => (4, 4),
-        (Ty::Vec(_, n), Layout::CBuffer) => (4 * *n as u32, 4),
-        (Ty::Vec(_, n), _) => (4 * *n as u32, if *n == 2 { 8 } else { 16 }),
+        (Ty::Sc(s), _) => (s.size(), s.size()),
+        (Ty::Vec(s, n), Layout::CBuffer) => (s.size() * *n as u32, s.size()),
+        (Ty::Vec(s, n), _) => (s.size() * *n as u32, s.size() * if *n == 2 { 2 } else { 4 }),
         (Ty::Mat(..), _) => {
             let (count, stride, n) = matrix_layout(ty, false, layout);
             matrix_size_align(count, stride, n, layout)
@@ -262,8 +283,8 @@ pub fn struct_offsets(k: u32, layout: Layout, structs: &[StructDef]) -> Vec<u32>
 /// types with no size in memory (resources, ray queries).
 pub fn packed_size(ty: &Ty, structs: &[StructDef]) -> Option<u32> {
     Some(match ty {
-        Ty::Sc(_) => 4,
-        Ty::Vec(_, n) => 4 * *n as u32,
+        Ty::Sc(s) => s.size(),
+        Ty::Vec(s, n) => s.size() * *n as u32,
         Ty::Mat(_, r, c) => 4 * *r as u32 * *c as u32,
         Ty::Array(e, n) => packed_size(e, structs)? * n,
         Ty::Struct(k) => {

@@ -528,6 +528,14 @@ impl<'a> Lowerer<'a> {
 
     fn intrinsic(&mut self, name: &str, vals: Vec<Val>, pos: Pos) -> Result<Val> {
         let f = Ty::Sc(Sc::Float);
+        // 64-bit integers: the min/max/clamp/abs family only.
+        if vals.iter().any(|v| v.ty.scalar().is_some_and(Sc::is_64))
+            && !matches!(name, "min" | "max" | "clamp" | "abs")
+        {
+            return Err(
+                unsupported(pos, format!("`{name}` of 64-bit integers")).len(name.len() as u32)
+            );
+        }
         match name {
             "dot" => {
                 let (t, ids) = self.unify(vals, false, pos)?;
@@ -631,13 +639,13 @@ impl<'a> Lowerer<'a> {
                 let s = t.scalar().unwrap_or(Sc::Float);
                 let inst = match (name, s) {
                     ("clamp", Sc::Float) => G::FClamp,
-                    ("clamp", Sc::Int) => G::SClamp,
+                    ("clamp", s) if s.is_signed() => G::SClamp,
                     ("clamp", _) => G::UClamp,
                     ("min", Sc::Float) => G::FMin,
-                    ("min", Sc::Int) => G::SMin,
+                    ("min", s) if s.is_signed() => G::SMin,
                     ("min", _) => G::UMin,
                     (_, Sc::Float) => G::FMax,
-                    (_, Sc::Int) => G::SMax,
+                    (_, s) if s.is_signed() => G::SMax,
                     _ => G::UMax,
                 };
                 self.glsl(inst, &t, &ids)
@@ -646,7 +654,7 @@ impl<'a> Lowerer<'a> {
                 let (t, ids) = self.unify(vals, false, pos)?;
                 match t.scalar() {
                     Some(Sc::Float) => self.glsl(G::FAbs, &t, &ids),
-                    Some(Sc::Int) => self.glsl(G::SAbs, &t, &ids),
+                    Some(s) if s.is_signed() => self.glsl(G::SAbs, &t, &ids),
                     _ => Ok(Val { id: ids[0], ty: t }),
                 }
             }

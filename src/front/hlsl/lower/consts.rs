@@ -9,6 +9,14 @@ impl<'a> Lowerer<'a> {
             Sc::Bool => self.b.type_bool(),
             Sc::Int => self.b.type_int(32, 1),
             Sc::Uint => self.b.type_int(32, 0),
+            Sc::Int64 => {
+                self.cap(Capability::Int64);
+                self.b.type_int(64, 1)
+            }
+            Sc::Uint64 => {
+                self.cap(Capability::Int64);
+                self.b.type_int(64, 0)
+            }
             Sc::Float => self.b.type_float(32, None),
         }
     }
@@ -298,6 +306,10 @@ impl<'a> Lowerer<'a> {
             Sc::Bool => self.const_bool(i != 0 || f != 0.0),
             Sc::Int => self.const_i32(i as i32),
             Sc::Uint => self.const_u32(i as u32),
+            Sc::Int64 | Sc::Uint64 => {
+                let t = self.sc_id(s);
+                self.b.constant_bit64(t, i as u64)
+            }
             Sc::Float => self.const_f32(f as f32),
         }
     }
@@ -333,7 +345,7 @@ impl<'a> Lowerer<'a> {
 
     pub(super) fn const_eval(&mut self, e: &Expr) -> Result<Option<CVal>> {
         Ok(match &e.kind {
-            ExprKind::Int(v, _) => Some(CVal::I(*v as i64)),
+            ExprKind::Int(v, _) | ExprKind::Int64(v, _) => Some(CVal::I(*v as i64)),
             ExprKind::Float(f) => Some(CVal::F(*f)),
             ExprKind::Bool(b) => Some(CVal::I(*b as i64)),
             ExprKind::SizeOf(t, dims) => Some(CVal::I(self.size_of(t, dims, e.pos)? as i64)),

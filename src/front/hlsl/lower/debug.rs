@@ -41,13 +41,13 @@ impl<'a> Lowerer<'a> {
         let id = match t {
             Ty::Sc(s) => {
                 let name = self.b.string(s.name());
-                let size = self.const_u32(32);
+                let size = self.const_u32(8 * s.size());
                 // DWARF-style encodings: Boolean 2, Float 3, Signed 4, Unsigned 6.
                 let enc = self.const_u32(match s {
                     Sc::Bool => 2,
                     Sc::Float => 3,
-                    Sc::Int => 4,
-                    Sc::Uint => 6,
+                    Sc::Int | Sc::Int64 => 4,
+                    Sc::Uint | Sc::Uint64 => 6,
                 });
                 let flags = self.const_u32(0);
                 self.dbg_inst(d, D::DebugTypeBasic, &[name, size, enc, flags])

@@ -441,13 +441,16 @@ impl<'a> Lowerer<'a> {
                 "bool" => Sc::Bool,
                 "int" | "min16int" | "min12int" | "int32_t" => Sc::Int,
                 "uint" | "dword" | "min16uint" | "uint32_t" => Sc::Uint,
+                "int64_t" => Sc::Int64,
+                "uint64_t" => Sc::Uint64,
                 // Without 16-bit types enabled, DXC treats half as float.
                 "float" | "half" | "min16float" | "min10float" | "float32_t" => Sc::Float,
                 other => {
-                    return Err(
-                        unsupported(t.pos, format!("type `{other}` (only 32-bit types)"))
-                            .len(other.len() as u32),
+                    return Err(unsupported(
+                        t.pos,
+                        format!("type `{other}` (only 32-bit floats, 32- and 64-bit integers)"),
                     )
+                    .len(other.len() as u32))
                 }
             };
             return self.numeric(sc, a, b, t.pos);
@@ -522,8 +525,8 @@ impl<'a> Lowerer<'a> {
                     _ => Dim::D2Array,
                 };
                 let (sc, n) = match targ_ty(self, 0, Ty::Vec(Sc::Float, 4))? {
-                    Ty::Sc(s) if s != Sc::Bool => (s, 1),
-                    Ty::Vec(s, n) if s != Sc::Bool => (s, n),
+                    Ty::Sc(s) if s != Sc::Bool && !s.is_64() => (s, 1),
+                    Ty::Vec(s, n) if s != Sc::Bool && !s.is_64() => (s, n),
                     _ => {
                         return Err(Error::new(
                             t.pos,
@@ -1320,7 +1323,11 @@ impl<'a> Lowerer<'a> {
                     CVal::I(i) => i,
                     CVal::F(f) => f as i64,
                 };
-                self.b.spec_constant_bit32(tid, i as u32)
+                if s.is_64() {
+                    self.b.spec_constant_bit64(tid, i as u64)
+                } else {
+                    self.b.spec_constant_bit32(tid, i as u32)
+                }
             }
         };
         self.b

@@ -143,11 +143,20 @@ impl<'a> Lowerer<'a> {
                     ty: Ty::Sc(Sc::Uint),
                 }
             }
+            ExprKind::Int64(v, u) => {
+                // `uint64_t` with a `u` suffix or above `int64_t`'s range, as in C.
+                let s = if *u || *v > i64::MAX as u64 {
+                    Sc::Uint64
+                } else {
+                    Sc::Int64
+                };
+                Val {
+                    id: self.const_scalar(s, *v as f64, *v as i64),
+                    ty: Ty::Sc(s),
+                }
+            }
             ExprKind::Int(v, u) => {
                 if *u || *v > i32::MAX as u64 {
-                    if *v > u32::MAX as u64 {
-                        return Err(unsupported(e.pos, "64-bit integer literals"));
-                    }
                     Val {
                         id: self.const_u32(*v as u32),
                         ty: Ty::Sc(Sc::Uint),
@@ -506,9 +515,14 @@ impl<'a> Lowerer<'a> {
                     Sc::Int => (bits as i32 as f64, bits as i32 as i64),
                     _ => (bits as f64, bits as i64),
                 };
-                // Int <-> uint keeps the bits; float conversions convert the value.
+                // Between integers the value is sign- or zero-extended from its
+                // own type (then wraps to the target); float conversions convert.
                 let i = if from != Sc::Float && to != Sc::Float {
-                    bits as i64
+                    if from.is_signed() {
+                        bits as i32 as i64
+                    } else {
+                        bits as i64
+                    }
                 } else {
                     i
                 };
@@ -536,10 +550,20 @@ impl<'a> Lowerer<'a> {
                 };
                 self.op(op, tid, &[id, zero])?
             }
-            (Sc::Int, Sc::Float) => self.op(Op::ConvertSToF, tid, &[id])?,
-            (Sc::Uint, Sc::Float) => self.op(Op::ConvertUToF, tid, &[id])?,
-            (Sc::Float, Sc::Int) => self.op(Op::ConvertFToS, tid, &[id])?,
-            (Sc::Float, Sc::Uint) => self.op(Op::ConvertFToU, tid, &[id])?,
+            (s, Sc::Float) if s.is_signed() => self.op(Op::ConvertSToF, tid, &[id])?,
+            (_, Sc::Float) => self.op(Op::ConvertUToF, tid, &[id])?,
+            (Sc::Float, s) if s.is_signed() => self.op(Op::ConvertFToS, tid, &[id])?,
+            (Sc::Float, _) => self.op(Op::ConvertFToU, tid, &[id])?,
+            // Integers of another width: extended by the source's signedness,
+            // or truncated (the result type's signedness is its own).
+            (s, t) if s.size() != t.size() => {
+                let op = if s.is_signed() {
+                    Op::SConvert
+                } else {
+                    Op::UConvert
+                };
+                self.op(op, tid, &[id])?
+            }
             _ => self.op(Op::Bitcast, tid, &[id])?,
         };
         Ok(Val {
@@ -647,7 +671,7 @@ impl<'a> Lowerer<'a> {
         }
         let s = ct.scalar().unwrap_or(Sc::Float);
         let f = s == Sc::Float;
-        let signed = s == Sc::Int;
+        let signed = s.is_signed();
         let class = if f {
             0
         } else if signed {

@@ -715,8 +715,8 @@ impl<'a> Lowerer<'a> {
             }
         };
         let (sc, n) = match t {
-            Ty::Sc(s) if s != Sc::Bool => (s, 1),
-            Ty::Vec(s, n) if s != Sc::Bool => (s, n),
+            Ty::Sc(s) if s != Sc::Bool && !s.is_64() => (s, 1),
+            Ty::Vec(s, n) if s != Sc::Bool && !s.is_64() => (s, n),
             _ => {
                 return Err(unsupported(
                     pos,
