@@ -218,6 +218,10 @@ fn cbuffer_uses_hlsl_packing() {
         member_offsets(&m.words, "type.Packed"),
         vec![0, 12, 16, 52, 56, 64, 108]
     );
+    assert_eq!(
+        member_offsets(&m.words, "type.AfterStruct"),
+        vec![0, 72, 76]
+    );
     validate_with(&m.words, "cbuffer_packing", &["--scalar-block-layout"]);
 }
 

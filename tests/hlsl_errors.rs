@@ -537,3 +537,13 @@ fn hit_objects_are_made_in_place() {
         "main.hlsl:5:5: `MaybeReorderThread` is not available in closesthit shaders"
     );
 }
+
+#[test]
+fn stage_rules_hold_in_helpers_reached_from_an_entry_point() {
+    let src = "RaytracingAccelerationStructure s;\nstruct P { float x; };\nvoid trace()\n{\n    RayDesc r = (RayDesc)0;\n    P p;\n    TraceRay(s, 0, 0xff, 0, 1, 0, r, p);\n}\n[numthreads(1,1,1)]\nvoid main()\n{\n    trace();\n}";
+    let e = error_of(&[("main.hlsl", src)]);
+    assert_eq!(
+        e,
+        "main.hlsl:7:5: `TraceRay` is not available in compute shaders"
+    );
+}

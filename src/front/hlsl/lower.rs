@@ -194,6 +194,8 @@ pub struct Lowerer<'a> {
     method_templates: HashMap<String, Vec<&'a Function>>,
     /// Instances of struct templates (`S<float>`), declared where first used.
     instance_structs: HashMap<String, &'a StructDecl>,
+    /// Stage-restricted operations used in helpers: (name, stages, position).
+    fn_stage_uses: HashMap<usize, Vec<(String, Vec<Stage>, Pos)>>,
     /// Helpers whose signatures use something unsupported: the error, given
     /// when one is called.
     unusable: HashMap<String, Error>,
@@ -479,6 +481,7 @@ impl<'a> Lowerer<'a> {
                 .collect(),
             needed: Vec::new(),
             unusable: HashMap::new(),
+            fn_stage_uses: HashMap::new(),
             specialized: HashMap::new(),
             usings: items
                 .iter()
@@ -650,6 +653,7 @@ impl<'a> Lowerer<'a> {
             if stage != Stage::Fragment {
                 self.check_derivatives(&seen, &sig)?;
             }
+            self.check_stage_uses(&seen, &sig)?;
             let mut entry_id = sig.id;
             if let Some((w, io)) = wrappers.get(&e) {
                 entry_id = *w;

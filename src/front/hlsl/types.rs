@@ -262,8 +262,8 @@ pub fn struct_offsets(k: u32, layout: Layout, structs: &[StructDef]) -> Vec<u32>
         off = match (layout, &f.ty) {
             // Vectors may sit at scalar alignment unless they would cross a
             // 16-byte row (HLSL packing, and DXC's relaxed std430).
-            (_, Ty::Vec(..)) | (Layout::CBuffer, Ty::Sc(_)) => {
-                let o = round_up(off, 4);
+            (_, Ty::Vec(s, _)) | (Layout::CBuffer, Ty::Sc(s)) => {
+                let o = round_up(off, s.size());
                 if o % 16 + size > 16 {
                     round_up(o, 16)
                 } else {

@@ -37,15 +37,22 @@ impl<'a> Lowerer<'a> {
         }
     }
 
-    pub(super) fn stage_check(&self, name: &str, allowed: &[Stage], pos: Pos) -> Result<()> {
-        if let Some(s) = self.f.cur_stage {
-            if !allowed.contains(&s) {
+    pub(super) fn stage_check(&mut self, name: &str, allowed: &[Stage], pos: Pos) -> Result<()> {
+        match self.f.cur_stage {
+            Some(s) if !allowed.contains(&s) => {
                 return Err(Error::new(
                     pos,
                     format!("`{name}` is not available in {} shaders", s.hlsl_name()),
                 )
                 .len(name.len() as u32));
             }
+            Some(_) => {}
+            // In a helper: checked against every entry point that reaches it.
+            None => self.fn_stage_uses.entry(self.f.cur_fn).or_default().push((
+                name.to_string(),
+                allowed.to_vec(),
+                pos,
+            )),
         }
         Ok(())
     }

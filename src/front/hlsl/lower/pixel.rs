@@ -299,6 +299,36 @@ impl<'a> Lowerer<'a> {
 
     /// Derivatives, implicit-LOD `Sample` and `discard` exist only in pixel shaders: a function that
     /// uses them must not be reached from another stage's entry point.
+    /// Stage-restricted operations in helpers (`TraceRay`, system values, ...)
+    /// against an entry point that reaches them.
+    pub(super) fn check_stage_uses(&self, reached: &HashSet<usize>, entry: &FnSig) -> Result<()> {
+        let Some(stage) = entry.stage else {
+            return Ok(());
+        };
+        let mut fs: Vec<&usize> = reached.iter().collect();
+        fs.sort();
+        for f in fs {
+            for (name, allowed, pos) in self.fn_stage_uses.get(f).into_iter().flatten() {
+                if !allowed.contains(&stage) {
+                    return Err(Error::new(
+                        *pos,
+                        format!("`{name}` is not available in {} shaders", stage.hlsl_name()),
+                    )
+                    .len(name.len() as u32)
+                    .secondary(
+                        entry.func.pos,
+                        format!(
+                            "reached from {} entry point `{}`",
+                            stage.hlsl_name(),
+                            entry.name
+                        ),
+                    ));
+                }
+            }
+        }
+        Ok(())
+    }
+
     pub(super) fn check_derivatives(&self, reached: &HashSet<usize>, entry: &FnSig) -> Result<()> {
         let mut uses: Vec<(usize, &(&str, Pos))> = self
             .fn_derivs
