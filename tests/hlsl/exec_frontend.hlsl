@@ -77,6 +77,10 @@ struct Packed
 
 float first(RWStructuredBuffer<float> buf) { return buf[0]; }
 
+void store(uint i, float v) { results[i] = v; }
+// `return` of a void call in a void function.
+void forward(uint i, float v) { return store(i, v); }
+
 [numthreads(1, 1, 1)]
 void Main()
 {
@@ -111,4 +115,5 @@ void Main()
     results[14] = shading::specular::reflect(1); // 3
     results[15] = TraceRay(1.5);                 // 4.5
     results[16] = brightness(sky);               // (1 + 2 + 3) * 0.5 = 3
+    forward(17, 9.0);                            // 9
 }

@@ -103,6 +103,28 @@ impl<'a> Lowerer<'a> {
                         }
                         self.b.ret_value(v.id)?;
                     }
+                    // `return f();` of a void `f` in a void function, as C++ allows.
+                    (
+                        Some(
+                            e @ Expr {
+                                kind:
+                                    ExprKind::Call(..)
+                                    | ExprKind::Method(..)
+                                    | ExprKind::CallT(..)
+                                    | ExprKind::MethodT(..),
+                                ..
+                            },
+                        ),
+                        true,
+                    ) => {
+                        if self.call_expr(e)?.is_some() {
+                            return Err(Error::new(e.pos, "this function returns void"));
+                        }
+                        if self.f.term {
+                            self.start_block(None)?;
+                        }
+                        self.b.ret()?;
+                    }
                     (Some(e), true) => return Err(Error::new(e.pos, "this function returns void")),
                     (None, false) => return Err(Error::new(s.pos, "missing return value").len(6)),
                 }
