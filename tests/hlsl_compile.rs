@@ -1115,3 +1115,30 @@ fn int64_types_layouts_literals_and_conversions() {
     assert!(insts.iter().any(|(op, _)| *op == 113));
     assert!(insts.iter().any(|(op, _)| *op == 114));
 }
+
+#[test]
+fn ray_queries_are_passed_to_helpers_as_their_variable() {
+    compile_all("rayquery_params.hlsl");
+    let m = hlsl::compile_file(&shader("rayquery_params.hlsl"), &HlslOptions::default()).unwrap();
+    let insts = instructions(&m.words);
+    // OpTypeRayQueryKHR (4472), a Function (7) pointer (32) to it, and a
+    // parameter (55) of that pointer type in both helpers.
+    let rq = insts
+        .iter()
+        .find(|(op, _)| *op == 4472)
+        .map(|(_, o)| o[0])
+        .unwrap();
+    let ptr = insts
+        .iter()
+        .find(|(op, o)| *op == 32 && o[1] == 7 && o[2] == rq)
+        .map(|(_, o)| o[0])
+        .unwrap();
+    assert_eq!(
+        insts
+            .iter()
+            .filter(|(op, o)| *op == 55 && o[0] == ptr)
+            .count(),
+        2
+    );
+    assert_eq!(named(&m.words, "committed<1>").len(), 1);
+}

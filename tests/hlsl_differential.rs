@@ -538,6 +538,10 @@ const NOT_RUN: &[(&str, &str)] = &[
     ),
     ("include", "a folder of include files"),
     (
+        "rayquery_params.hlsl",
+        "ray queries passed to functions: tests/hlsl_compile.rs checks the parameters",
+    ),
+    (
         "int64.hlsl",
         "64-bit integers: tests/hlsl_compile.rs checks layouts, constants and conversions",
     ),

@@ -1199,6 +1199,20 @@ impl<'a> Lowerer<'a> {
         // without variable pointers: the function is specialized on them.
         let mut bound = Vec::new();
         for (i, ((p, (place, v)), a)) in sig.params.iter().zip(&argv).zip(&args).enumerate() {
+            if let Ty::RayQuery(_) = p.ty {
+                // A ray query is passed as its variable (it cannot be copied).
+                if p.out || v.ty != p.ty {
+                    return Err(Error::new(
+                        a.pos(),
+                        format!(
+                            "expected a `{}` variable (passed `in`)",
+                            self.ty_name(&p.ty)
+                        ),
+                    ));
+                }
+                temps.push(v.id);
+                continue;
+            }
             if p.ty.is_resource() {
                 // Passed as the resource variable itself, which SPIR-V's
                 // logical addressing allows only for whole variables.

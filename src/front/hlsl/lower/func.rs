@@ -82,11 +82,8 @@ impl<'a> Lowerer<'a> {
                 if is_bound(i) {
                     continue;
                 }
-                if p.ty.is_opaque() {
-                    return Err(unsupported(
-                        f.pos,
-                        "RayQuery or HitObject function parameters",
-                    ));
+                if p.ty == Ty::HitObject {
+                    return Err(unsupported(f.pos, "HitObject function parameters"));
                 }
                 let (class, _) = self.param_class(&p.ty);
                 let t = if p.ty.is_resource() {
