@@ -389,6 +389,7 @@ fn collect(paths: &[PathBuf], options: &Options, configs: &mut Configs) -> Input
             add_pipeline(p.clone(), &mut inputs, configs);
             continue;
         }
+        let p = &tidy(p);
         let key = std::fs::canonicalize(p).unwrap_or_else(|_| p.clone());
         if !seen.insert(key) {
             continue;
@@ -439,6 +440,7 @@ fn walk(
         .sort_by_file_path(|a, b| a.cmp(b))
         .filter_entry(|e| e.file_name() != "target")
         .build();
+    let mut found: Vec<(PathBuf, PathBuf)> = Vec::new();
     for entry in walker {
         let entry = match entry {
             Ok(e) => e,
@@ -456,9 +458,26 @@ fn walk(
         if !entry.file_type().is_some_and(|t| t.is_file()) {
             continue;
         }
-        let p = entry.path().to_path_buf();
+        let p = tidy(entry.path());
         let key = std::fs::canonicalize(&p).unwrap_or_else(|_| p.clone());
-        if !seen.insert(key) {
+        found.push((p, key));
+    }
+    // A file reached through a link and by its own path is read once, under
+    // the path without links when there is one.
+    let direct = |p: &Path, key: &Path| {
+        std::path::absolute(p).is_ok_and(|a| crate::program::debug::normalize(&a) == key)
+    };
+    let mut chosen: HashMap<PathBuf, PathBuf> = HashMap::new();
+    for (p, key) in &found {
+        match chosen.get(key) {
+            Some(q) if direct(q, key) || !direct(p, key) => {}
+            _ => {
+                chosen.insert(key.clone(), p.clone());
+            }
+        }
+    }
+    for (p, key) in found {
+        if chosen.get(&key) != Some(&p) || !seen.insert(key) {
             continue;
         }
         let config = configs.for_path(&p);
@@ -490,6 +509,19 @@ fn walk(
         } else {
             inputs.skipped.push(p);
         }
+    }
+}
+
+/// A path without `.` components: `./a/b` is `a/b`, as debug info names it.
+fn tidy(p: &Path) -> PathBuf {
+    let t: PathBuf = p
+        .components()
+        .filter(|c| !matches!(c, std::path::Component::CurDir))
+        .collect();
+    if t.as_os_str().is_empty() {
+        PathBuf::from(".")
+    } else {
+        t
     }
 }
 

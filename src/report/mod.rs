@@ -218,14 +218,18 @@ pub fn github(diagnostics: &[Diagnostic]) -> String {
             props.push_str(&format!(",line={line},endLine={}", end_line.max(line)));
             if col > 0 {
                 props.push_str(&format!(",col={col}"));
-                if end_line <= line && end_col > col {
-                    props.push_str(&format!(",endColumn={end_col}"));
+                // GitHub highlights `col..endColumn` on a single line.
+                if end_line <= line {
+                    props.push_str(&format!(",endColumn={}", end_col.max(col)));
                 }
             }
         }
         let mut message = d.message.clone();
         if let Some(s) = d.subject.as_ref().filter(|_| d.primary.is_none()) {
             message.push_str(&format!(" ({s})"));
+        }
+        if let Some(h) = &d.help {
+            message.push_str(&format!("\nhelp: {h}"));
         }
         out.push_str(&format!("::{level} {props}::{}\n", escape_data(&message)));
     }
