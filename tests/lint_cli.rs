@@ -595,3 +595,25 @@ fn the_ci_recipe_is_valid_yaml() {
     }
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
 }
+
+#[test]
+fn a_struct_in_a_shared_header_is_reported_once() {
+    let d = scratch("header");
+    std::fs::write(
+        d.join("payload.hlsli"),
+        "struct Fat {\n    float4 a;\n    float4 b;\n    float4 c;\n};\n",
+    )
+    .unwrap();
+    let shader = |entry: &str| {
+        format!(
+            "#include \"payload.hlsli\"\nRaytracingAccelerationStructure tlas : register(t0);\nRWTexture2D<float4> image : register(u1);\n[shader(\"raygeneration\")]\nvoid {entry}()\n{{\n    RayDesc ray;\n    ray.Origin = float3(0.0, 0.0, 0.0);\n    ray.Direction = float3(0.0, 0.0, 1.0);\n    ray.TMin = 0.001;\n    ray.TMax = 10.0;\n    Fat p = (Fat)0;\n    TraceRay(tlas, RAY_FLAG_FORCE_OPAQUE, 0xFF, 0, 1, 0, ray, p);\n    image[DispatchRaysIndex().xy] = p.a;\n}}\n"
+        )
+    };
+    std::fs::write(d.join("a.hlsl"), shader("A")).unwrap();
+    std::fs::write(d.join("b.hlsl"), shader("B")).unwrap();
+    let o = check_in(&d, &["."]);
+    assert_eq!(findings(&o), ["payload.hlsli:1:8: warning[RT001]"], "{}", text(&o));
+    let o = check_in(&d, &["--select", "RT001", "a.hlsl", "b.hlsl", "a.hlsl"]);
+    assert_eq!(findings(&o).len(), 1, "{}", text(&o));
+    assert!(text(&o).contains("in 2 files"), "{}", text(&o));
+}
