@@ -281,6 +281,28 @@ pub fn enabled(rule: &Rule, config: &Config) -> bool {
     on && !any(&config.ignore)
 }
 
+/// A rule's integer option: `[rules.CODE] key = N` in `rtlint.toml` (or the
+/// command line), else `fallback` (a legacy top-level key), else the default.
+pub fn option_u64(config: &Config, rule: &Rule, key: &str, fallback: Option<u64>) -> u64 {
+    config
+        .option(rule.code, rule.name, key)
+        .and_then(|v| v.as_integer())
+        .and_then(|v| u64::try_from(v).ok())
+        .or(fallback)
+        .or_else(|| {
+            rule.options
+                .iter()
+                .find(|o| o.name == key)
+                .and_then(|o| o.default.parse().ok())
+        })
+        .unwrap_or(0)
+}
+
+/// Whether `rule` (a code or name) declares the option `key`.
+pub fn has_option(rule: &str, key: &str) -> bool {
+    find(rule).is_some_and(|r| r.options.iter().any(|o| o.name == key))
+}
+
 /// The severity a rule reports at under `config`, or `None` when it does not
 /// run.
 pub fn configured(rule: &Rule, config: &Config) -> Option<Severity> {
@@ -336,6 +358,50 @@ pub(crate) fn indent(text: &str) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn declared_option_defaults_are_the_rules_constants() {
+        let c = Config::default();
+        assert_eq!(
+            option_u64(&c, &rt010_live_state_over_budget::RULE, "budget", None),
+            rt010_live_state_over_budget::DEFAULT_BUDGET_BYTES
+        );
+        assert_eq!(
+            option_u64(&c, &rt025_default_stack_unsafe::RULE, "limit", None),
+            rt025_default_stack_unsafe::DEFAULT_LIMIT_BYTES
+        );
+        assert_eq!(
+            option_u64(&c, &rt001_payload_over_budget::RULE, "budget", None),
+            32
+        );
+        // The table wins over the legacy key, the legacy key over the default.
+        let c = Config::parse(
+            "payload-budget = 40\n[rules.RT001]\nbudget = 48\nlevel = \"error\"\n",
+            std::path::Path::new("rtlint.toml"),
+        )
+        .unwrap();
+        assert_eq!(
+            option_u64(
+                &c,
+                &rt001_payload_over_budget::RULE,
+                "budget",
+                c.payload_budget
+            ),
+            48
+        );
+        assert_eq!(
+            c.level("RT001", "payload-over-budget"),
+            Some(crate::config::Level::Error)
+        );
+        let c = Config::parse(
+            "[rules.RT001]\nbudgt = 48\n",
+            std::path::Path::new("rtlint.toml"),
+        )
+        .unwrap();
+        let e = c.check_rule_options(has_option).unwrap_err();
+        assert_eq!(e.diagnostic().message, "rule `RT001` has no option `budgt`");
+        assert_eq!(e.diagnostic().primary.as_ref().unwrap().location.line, 2);
+    }
 
     /// Codes never change silently: this list is the contract.
     #[test]

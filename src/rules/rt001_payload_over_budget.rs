@@ -58,11 +58,16 @@ super::declare_rule! {
         group: Perf,
         summary: "ray payload larger than the payload budget",
         kind: super::Kind::Module(check),
+        options: [super::RuleOption {
+            name: "budget",
+            default: "32",
+            doc: "payloads above this many bytes are reported (top-level `payload-budget` and `--payload-budget` too)",
+        }],
     }
 }
 
 fn check(ctx: &Context) -> Vec<Diagnostic> {
-    let budget = ctx.config.payload_budget;
+    let budget = super::option_u64(ctx.config, &RULE, "budget", ctx.config.payload_budget);
     let mut out = Vec::new();
     for t in ctx
         .layouts

@@ -104,7 +104,7 @@ fn check(ctx: &Context) -> Vec<Diagnostic> {
                 t.hlsl_padding
             ))
             .with_help(format!("reorder the members:\n{}", indent(&decl)))
-            .with_fix(decl);
+            .with_fix(ctx.type_location(t), decl);
         out.push(d);
     }
     out

@@ -137,6 +137,11 @@ super::declare_rule! {
         group: Perf,
         summary: "state kept alive across a trace call above the budget",
         kind: super::Kind::Module(run),
+        options: [super::RuleOption {
+            name: "budget",
+            default: "64",
+            doc: "bytes live across one call that cannot be recomputed (top-level `live-state-budget` too)",
+        }],
     }
 }
 
@@ -144,7 +149,7 @@ fn run(ctx: &super::Context) -> Vec<Diagnostic> {
     check(
         ctx.program,
         &crate::analysis::liveness::live_sites(ctx.program),
-        ctx.config.live_state_budget.unwrap_or(DEFAULT_BUDGET_BYTES),
+        super::option_u64(ctx.config, &RULE, "budget", ctx.config.live_state_budget),
     )
 }
 

@@ -119,6 +119,11 @@ super::declare_rule! {
         group: Correctness,
         summary: "default pipeline stack above what the device is known to survive",
         kind: super::Kind::Pipeline(run),
+        options: [super::RuleOption {
+            name: "limit",
+            default: "14702",
+            doc: "the largest default pipeline stack, in bytes per thread, the device is known to run (top-level `stack-limit` too)",
+        }],
     }
 }
 
@@ -126,7 +131,7 @@ fn run(ctx: &super::PipelineContext) -> Vec<Diagnostic> {
     check(
         ctx.pipeline,
         &ctx.stack,
-        ctx.config.stack_limit.unwrap_or(DEFAULT_LIMIT_BYTES),
+        super::option_u64(ctx.config, &RULE, "limit", ctx.config.stack_limit),
     )
 }
 
