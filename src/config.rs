@@ -66,7 +66,7 @@ impl Level {
     }
 }
 
-#[derive(Clone, Debug, serde::Deserialize)]
+#[derive(Clone, Debug, Default, serde::Deserialize)]
 #[serde(deny_unknown_fields, rename_all = "kebab-case")]
 pub struct Config {
     /// RT001: ray payloads above this many bytes (scalar size) are reported
@@ -120,28 +120,6 @@ pub struct Config {
     /// The file's text, for pointing at what the rules reject.
     #[serde(skip)]
     text: Option<String>,
-}
-
-impl Default for Config {
-    fn default() -> Self {
-        Config {
-            payload_budget: None,
-            live_state_budget: None,
-            stack_limit: None,
-            deny_warnings: false,
-            rules: BTreeMap::new(),
-            languages: BTreeMap::new(),
-            select: None,
-            extend_select: Vec::new(),
-            ignore: Vec::new(),
-            exclude: Vec::new(),
-            per_file_ignores: BTreeMap::new(),
-            hlsl: SourceOptions::default(),
-            path: None,
-            rule_keys: Vec::new(),
-            text: None,
-        }
-    }
 }
 
 pub const FILE_NAME: &str = "rtlint.toml";
