@@ -3,7 +3,6 @@
 //! original source.
 
 pub mod hlsl;
-pub mod slang;
 pub mod wgsl;
 
 use crate::diag::InputError;
