@@ -360,9 +360,7 @@ fn read4(bytes: &[u8], n: usize) -> Vec<[f32; 4]> {
 }
 
 fn hlsl_path(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("tests/hlsl")
-        .join(name)
+    common::root().join("tests/hlsl").join(name)
 }
 
 fn compile_whole(name: &str) -> Vec<u32> {

@@ -51,7 +51,7 @@ fn bindings() -> [Binding; 4] {
 }
 
 fn compile_shader(ctx: &Context) -> Vec<u32> {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join(SHADER);
+    let path = common::root().join(SHADER);
     let source = std::fs::read_to_string(&path).expect("the reference shader is readable");
     let words =
         rtlint::front::wgsl::compile(&source, &path).expect("the reference shader compiles");

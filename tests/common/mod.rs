@@ -4,8 +4,13 @@
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
+/// The crate root: `CARGO_MANIFEST_DIR` as cargo sets it when it runs the
+/// test, else where the crate was built. A test binary run by hand on another
+/// machine (scripts/device-tests) is given the checkout's root that way.
 pub fn root() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+    std::env::var_os("CARGO_MANIFEST_DIR")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")))
 }
 
 /// Runs `spirv-val --target-env vulkan1.2` on a module (see
