@@ -13,7 +13,7 @@ use rtlint::vk::{
     Geometry, Group, Instance, RayTracingPipeline, RayTracingPipelineDesc, Resource, Sampler,
     ShaderStage, Stage, StorageImage,
 };
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 const STORAGE: raw::BufferUsageFlags = raw::BufferUsageFlags::STORAGE_BUFFER;
 

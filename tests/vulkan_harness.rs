@@ -16,7 +16,6 @@ use rtlint::vk::{
     BindingKind, Buffer, ComputePipeline, Context, ContextOptions, Error, Geometry, Group,
     Instance, RayTracingPipeline, RayTracingPipelineDesc, Resource, ShaderStage, Stage,
 };
-use std::path::Path;
 use std::time::{Duration, Instant};
 
 /// `RayQueryIntersection` values as naga's WGSL names them.
