@@ -68,7 +68,7 @@ fn main() {
         let model = time(20, || {
             std::hint::black_box(rtlint::analysis::stack_report(&pipeline));
         });
-        let depth = rtlint::analysis::recursion(&pipeline).required_depth;
+        let depth = rtlint::analysis::recursion_report(&pipeline).required_depth;
         let driver = ctx.as_ref().map(|c| {
             time(5, || {
                 rtlint::vk::driver_stack_sizes(c, &pipeline, depth).expect("driver query");

@@ -30,13 +30,14 @@ pub struct Config {
     /// RT001: ray payloads above this many bytes (scalar size) are reported.
     #[serde(default = "default_payload_budget")]
     pub payload_budget: u64,
-    /// RT010: bytes of state live across one trace call.
-    #[serde(default = "default_live_state_budget")]
-    pub live_state_budget: u64,
+    /// RT010: bytes of state live across one trace call (the rule's default
+    /// when unset).
+    #[serde(default)]
+    pub live_state_budget: Option<u64>,
     /// RT025: the largest default pipeline stack (bytes per thread) a device
-    /// is known to run.
-    #[serde(default = "default_stack_limit")]
-    pub stack_limit: u64,
+    /// is known to run (the rule's default when unset).
+    #[serde(default)]
+    pub stack_limit: Option<u64>,
     /// Warnings fail the run too.
     #[serde(default)]
     pub deny_warnings: bool,
@@ -49,30 +50,27 @@ pub struct Config {
     /// Where the config came from, for messages.
     #[serde(skip)]
     pub path: Option<PathBuf>,
+    /// Where each key of `[rules]` stands, so whoever knows the rules can
+    /// point at an unknown one.
+    #[serde(skip)]
+    rule_keys: Vec<(String, Option<Location>)>,
 }
 
 fn default_payload_budget() -> u64 {
     32
 }
 
-fn default_live_state_budget() -> u64 {
-    crate::rules::rt010_live_state_over_budget::DEFAULT_BUDGET_BYTES
-}
-
-fn default_stack_limit() -> u64 {
-    crate::analysis::stack::NVIDIA_KNOWN_SAFE_STACK_BYTES
-}
-
 impl Default for Config {
     fn default() -> Self {
         Config {
             payload_budget: default_payload_budget(),
-            live_state_budget: default_live_state_budget(),
-            stack_limit: default_stack_limit(),
+            live_state_budget: None,
+            stack_limit: None,
             deny_warnings: false,
             rules: BTreeMap::new(),
             languages: BTreeMap::new(),
             path: None,
+            rule_keys: Vec::new(),
         }
     }
 }
@@ -99,16 +97,11 @@ impl Config {
             }
             err
         })?;
-        for key in config.rules.keys() {
-            if crate::rules::find(key).is_none() {
-                return Err(config_error(
-                    text,
-                    path,
-                    key,
-                    format!("unknown rule `{key}`"),
-                ));
-            }
-        }
+        config.rule_keys = config
+            .rules
+            .keys()
+            .map(|k| (k.clone(), find_location(text, path, k)))
+            .collect();
         for (ext, lang) in &config.languages {
             if Language::parse(lang).is_none() {
                 return Err(config_error(
@@ -124,7 +117,7 @@ impl Config {
     }
 
     pub fn load(path: &Path) -> Result<Config, InputError> {
-        let text = crate::front::read_text(path)?;
+        let text = crate::diag::read_text(path)?;
         Config::parse(&text, path)
     }
 
@@ -146,6 +139,22 @@ impl Config {
         None
     }
 
+    /// An error at the first key of `[rules]` that `known` does not accept.
+    /// The config is data: the rule registry is consulted by its caller.
+    pub fn check_rule_names(&self, known: impl Fn(&str) -> bool) -> Result<(), InputError> {
+        let path = self.path.as_deref().unwrap_or(Path::new(FILE_NAME));
+        match self.rule_keys.iter().find(|(k, _)| !known(k)) {
+            None => Ok(()),
+            Some((key, at)) => {
+                let err = InputError::new("invalid-config", path, format!("unknown rule `{key}`"));
+                Err(match at {
+                    Some(l) => err.at(l.clone(), "here"),
+                    None => err,
+                })
+            }
+        }
+    }
+
     /// The configured level of a rule, by code or by name.
     pub fn level(&self, code: &str, name: &str) -> Option<Level> {
         self.rules
@@ -165,17 +174,23 @@ impl Config {
     }
 }
 
+/// The first occurrence of `needle` in the config text.
+fn find_location(text: &str, path: &Path, needle: &str) -> Option<Location> {
+    let at = text.find(needle)?;
+    let (line, column) = crate::shader::line_col(text, at);
+    Some(Location::span(
+        path,
+        line,
+        column,
+        needle.chars().count() as u32,
+    ))
+}
+
 /// An error pointing at the first occurrence of `needle` in the config text.
 fn config_error(text: &str, path: &Path, needle: &str, message: String) -> InputError {
     let err = InputError::new("invalid-config", path, message);
-    match text.find(needle) {
-        Some(at) => {
-            let (line, column) = crate::shader::line_col(text, at);
-            err.at(
-                Location::span(path, line, column, needle.chars().count() as u32),
-                "here",
-            )
-        }
+    match find_location(text, path, needle) {
+        Some(l) => err.at(l, "here"),
         None => err,
     }
 }
@@ -216,7 +231,10 @@ mod tests {
             e.diagnostic().message
         );
 
-        let e = Config::parse("[rules]\nRT999 = \"warn\"\n", Path::new("rtlint.toml")).unwrap_err();
+        let e = Config::parse("[rules]\nRT999 = \"warn\"\n", Path::new("rtlint.toml"))
+            .unwrap()
+            .check_rule_names(|k| k == "RT001")
+            .unwrap_err();
         assert_eq!(e.diagnostic().message, "unknown rule `RT999`");
         assert_eq!(e.diagnostic().primary.as_ref().unwrap().location.line, 2);
 

@@ -191,3 +191,20 @@ impl fmt::Display for InputError {
 }
 
 impl std::error::Error for InputError {}
+
+/// Reads a UTF-8 text input; an unreadable or non-UTF-8 file is an input error.
+pub fn read_text(path: &Path) -> Result<String, InputError> {
+    let bytes = std::fs::read(path).map_err(|e| io_error(path, &e))?;
+    String::from_utf8(bytes).map_err(|e| {
+        let offset = e.utf8_error().valid_up_to();
+        InputError::new(
+            "invalid-utf8",
+            path,
+            format!("file is not valid UTF-8 (byte offset {offset})"),
+        )
+    })
+}
+
+pub fn io_error(path: &Path, e: &std::io::Error) -> InputError {
+    InputError::new("unreadable-file", path, format!("cannot read file: {e}"))
+}

@@ -14,6 +14,13 @@ pub struct Input {
     pub language: Language,
 }
 
+/// Loads `rtlint.toml` and checks its rule names against the registry.
+pub fn load_config(path: &Path) -> Result<Config, InputError> {
+    let config = Config::load(path)?;
+    config.check_rule_names(|k| crate::rules::find(k).is_some())?;
+    Ok(config)
+}
+
 /// What walking the paths found.
 #[derive(Debug, Default)]
 pub struct Inputs {

@@ -201,7 +201,7 @@ fn setup(common: &Common) -> Result<Setup, String> {
         .clone()
         .or_else(|| common.paths.first().and_then(|p| Config::discover(p)));
     let config = match config_path {
-        Some(p) => match Config::load(&p) {
+        Some(p) => match lint::load_config(&p) {
             Ok(c) => c,
             Err(e) => {
                 errors.push(*e.0);
@@ -405,7 +405,7 @@ fn stack(common: Common, driver: bool) -> Result<u8, String> {
         let mut r = rtlint::analysis::stack_report(p);
         #[cfg(feature = "vulkan")]
         if let Some(ctx) = &device {
-            let depth = rtlint::analysis::recursion(p).required_depth;
+            let depth = rtlint::analysis::recursion_report(p).required_depth;
             let sizes = rtlint::vk::driver_stack_sizes(ctx, p, depth).map_err(|e| {
                 format!(
                     "--driver: creating the pipeline on {} failed: {e}",

@@ -107,6 +107,15 @@ pub struct Pipeline {
 }
 
 impl Pipeline {
+    /// The file findings about the whole pipeline point at: the description,
+    /// else the first ray-generation shader's file.
+    pub fn file(&self) -> PathBuf {
+        self.path
+            .clone()
+            .or_else(|| self.raygen.first().map(|s| s.file.clone()))
+            .unwrap_or_default()
+    }
+
     /// Whether a description says which shaders the scene uses.
     pub fn described(&self) -> bool {
         self.path.is_some()

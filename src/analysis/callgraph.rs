@@ -11,7 +11,7 @@
 use crate::diag::Location;
 pub use crate::pipeline::Slot;
 use crate::pipeline::{HitGroupKind, Pipeline, ShaderRef};
-use crate::program::{Operandish, SiteKind};
+use crate::program::{OperandValue, SiteKind};
 use crate::shader::Stage;
 
 /// `SkipClosestHitShaderKHR` and the flags that remove any-hit or geometry.
@@ -256,11 +256,11 @@ pub fn trace_graph(pipeline: &Pipeline) -> TraceGraph {
 }
 
 /// A constant operand; a specialization constant counts with its default.
-fn const_of(o: Operandish) -> Option<u64> {
+fn const_of(o: OperandValue) -> Option<u64> {
     match o {
-        Operandish::Const(v) => Some(v),
-        Operandish::Spec { default, .. } => Some(default),
-        Operandish::Dynamic(_) => None,
+        OperandValue::Const(v) => Some(v),
+        OperandValue::Spec { default, .. } => Some(default),
+        OperandValue::Dynamic(_) => None,
     }
 }
 

@@ -15,6 +15,7 @@
 //! each call chain from an entry point.
 
 use crate::diag::Location;
+use crate::program::cfg::call_chains;
 use crate::program::scalar::scalar_size;
 use crate::program::{Constant, Function, Id, Program, SiteKind, Type};
 use crate::shader::Stage;
@@ -117,7 +118,7 @@ pub fn live_report(programs: &[Program]) -> LiveReport {
 
 /// Call chains are enumerated up to this many per site; SPIR-V has no
 /// recursion, but a helper called from many places multiplies them.
-const MAX_CHAINS: usize = 64;
+pub(crate) const MAX_CHAINS: usize = 64;
 
 /// The sites of one program with the values live across each.
 pub fn live_sites(program: &Program) -> Vec<LiveSite> {
@@ -134,7 +135,7 @@ pub fn live_sites(program: &Program) -> Vec<LiveSite> {
             let Some(g) = program.functions.get(site.function) else {
                 continue;
             };
-            for chain in call_chains(program, entry.function, g.id) {
+            for chain in call_chains(program, entry.function, g.id, MAX_CHAINS) {
                 // Levels: the site in its own function, then each call upwards.
                 let mut points = vec![site.inst];
                 points.extend(chain.iter().rev().copied());
@@ -158,7 +159,7 @@ pub fn live_sites(program: &Program) -> Vec<LiveSite> {
                 values.sort_by(|a, b| b.size.cmp(&a.size).then(a.name.cmp(&b.name)));
                 let location = std::iter::once(site.inst)
                     .chain(chain.iter().rev().copied())
-                    .find_map(|i| useful_location(program, i));
+                    .find_map(|i| program.inst_location(i));
                 let payload = site.payload.map(|id| payload_info(program, id));
                 out.push(LiveSite {
                     path: program.path.clone(),
@@ -207,63 +208,6 @@ fn pointee(program: &Program, ptr_ty: Id) -> Option<Id> {
         Type::Pointer { pointee, .. } => Some(*pointee),
         _ => None,
     }
-}
-
-/// Every chain of `OpFunctionCall` instructions (outermost first) from
-/// function `root` to function `target`; `[[]]` when they are the same.
-pub fn call_chains(program: &Program, root: Id, target: Id) -> Vec<Vec<usize>> {
-    fn up(
-        program: &Program,
-        root: Id,
-        f: Id,
-        suffix: &mut Vec<usize>,
-        out: &mut Vec<Vec<usize>>,
-        visiting: &mut Vec<Id>,
-    ) {
-        if out.len() >= MAX_CHAINS {
-            return;
-        }
-        if f == root {
-            out.push(suffix.iter().rev().copied().collect());
-            return;
-        }
-        if visiting.contains(&f) {
-            return;
-        }
-        visiting.push(f);
-        for call in program.callers(f) {
-            let Some(caller) = program
-                .function_of(call)
-                .and_then(|i| program.functions.get(i))
-            else {
-                continue;
-            };
-            suffix.push(call);
-            up(program, root, caller.id, suffix, out, visiting);
-            suffix.pop();
-        }
-        visiting.pop();
-    }
-    let mut out = Vec::new();
-    up(
-        program,
-        root,
-        target,
-        &mut Vec::new(),
-        &mut out,
-        &mut Vec::new(),
-    );
-    out
-}
-
-/// An instruction's position, without naga's placeholder: its SPIR-V writer
-/// puts `OpLine 1 1` on code that has no span.
-pub fn useful_location(program: &Program, inst: usize) -> Option<Location> {
-    let l = program.inst_location(inst)?;
-    if program.language == crate::shader::Language::Wgsl && l.line == 1 && l.column == 1 {
-        return None;
-    }
-    Some(l)
 }
 
 /// A name for a value: its `OpName`, the variable it was loaded from, or the
@@ -608,7 +552,7 @@ impl FnLiveness {
                 program
                     .defs
                     .get(&id)
-                    .and_then(|&i| useful_location(program, i))
+                    .and_then(|&i| program.inst_location(i))
             };
             let use_at = self.first_use_after(program, inst, id);
             out.push(LiveValue {
@@ -678,7 +622,7 @@ impl FnLiveness {
         let k = found?;
         // Compiler-generated loads often lack a line; the next one with a
         // position is where the source uses the value.
-        (k..=f.end).find_map(|i| useful_location(program, i))
+        (k..=f.end).find_map(|i| program.inst_location(i))
     }
 
     /// Where a variable gets its value: the first write with a position,
@@ -691,7 +635,7 @@ impl FnLiveness {
                 inst.class.opcode == Op::Store
                     && id_operands(inst).next().and_then(|p| self.root(p)) == Some(var)
             })
-            .find_map(|i| useful_location(program, i))
+            .find_map(|i| program.inst_location(i))
             .or_else(|| program.decl_location(crate::program::Decl::Var(var)))
     }
 

@@ -8,5 +8,5 @@ pub mod recursion;
 pub mod stack;
 
 pub use liveness::{live_report, LiveReport};
-pub use recursion::{recursion, RecursionReport};
+pub use recursion::{recursion_report, RecursionReport};
 pub use stack::{stack_report, StackReport};

@@ -12,11 +12,12 @@
 use super::callgraph::{trace_graph, EdgeKind, TraceGraph};
 use crate::diag::Location;
 use crate::pipeline::{DescribedConstant, Pipeline};
+use crate::program::cfg::{call_chains, dominates, dominators, natural_loops, strongly_connected};
 use crate::program::{Constant, Function, Id, Program, Type};
 use crate::shader::Stage;
 use rspirv::dr::{Instruction, Operand};
 use spirv::{Op, StorageClass};
-use std::collections::{BTreeMap, HashMap, HashSet};
+use std::collections::{BTreeMap, HashSet};
 
 /// A recognised depth guard on a trace that closes a cycle.
 #[derive(Clone, Debug, serde::Serialize)]
@@ -118,7 +119,7 @@ impl RecursionReport {
 }
 
 /// Depth analysis of a pipeline.
-pub fn recursion(pipeline: &Pipeline) -> RecursionReport {
+pub fn recursion_report(pipeline: &Pipeline) -> RecursionReport {
     let graph = trace_graph(pipeline);
     let n = graph.nodes.len();
     let mut adj: Vec<Vec<usize>> = vec![Vec::new(); n];
@@ -127,7 +128,7 @@ pub fn recursion(pipeline: &Pipeline) -> RecursionReport {
             adj[e.from].push(e.to);
         }
     }
-    let sccs = tarjan(&adj);
+    let sccs = strongly_connected(&adj);
     let mut scc_of = vec![0usize; n];
     for (c, nodes) in sccs.iter().enumerate() {
         for &v in nodes {
@@ -317,66 +318,6 @@ pub fn recursion(pipeline: &Pipeline) -> RecursionReport {
         node_level,
         recursive_sites,
     }
-}
-
-/// Strongly connected components, sinks first.
-fn tarjan(adj: &[Vec<usize>]) -> Vec<Vec<usize>> {
-    struct T<'a> {
-        adj: &'a [Vec<usize>],
-        index: Vec<Option<usize>>,
-        low: Vec<usize>,
-        on: Vec<bool>,
-        stack: Vec<usize>,
-        next: usize,
-        out: Vec<Vec<usize>>,
-    }
-    impl T<'_> {
-        fn visit(&mut self, v: usize) {
-            self.index[v] = Some(self.next);
-            self.low[v] = self.next;
-            self.next += 1;
-            self.stack.push(v);
-            self.on[v] = true;
-            for &w in &self.adj[v] {
-                match self.index[w] {
-                    None => {
-                        self.visit(w);
-                        self.low[v] = self.low[v].min(self.low[w]);
-                    }
-                    Some(i) if self.on[w] => self.low[v] = self.low[v].min(i),
-                    _ => {}
-                }
-            }
-            if Some(self.low[v]) == self.index[v] {
-                let mut c = Vec::new();
-                while let Some(w) = self.stack.pop() {
-                    self.on[w] = false;
-                    c.push(w);
-                    if w == v {
-                        break;
-                    }
-                }
-                c.sort_unstable();
-                self.out.push(c);
-            }
-        }
-    }
-    let n = adj.len();
-    let mut t = T {
-        adj,
-        index: vec![None; n],
-        low: vec![0; n],
-        on: vec![false; n],
-        stack: Vec::new(),
-        next: 0,
-        out: Vec::new(),
-    };
-    for v in 0..n {
-        if t.index[v].is_none() {
-            t.visit(v);
-        }
-    }
-    t.out
 }
 
 // ---------------------------------------------------------------------------
@@ -719,92 +660,6 @@ fn relations(program: &Program, cond: Id, want: bool, out: &mut Vec<Rel>, depth:
     out.push(Rel { lhs, rhs, strict });
 }
 
-// ---------------------------------------------------------------------------
-// Dominators and loops.
-
-/// Immediate dominators by block index (Cooper, Harvey, Kennedy).
-pub fn dominators(f: &Function) -> Vec<Option<usize>> {
-    let n = f.blocks.len();
-    if n == 0 {
-        return Vec::new();
-    }
-    // Post-order by an explicit stack: shader CFGs can be large.
-    let mut order = Vec::new();
-    let mut seen = vec![false; n];
-    let mut stack = vec![(0usize, 0usize)];
-    seen[0] = true;
-    while let Some((b, k)) = stack.pop() {
-        match f.blocks[b].succs.get(k) {
-            Some(&s) => {
-                stack.push((b, k + 1));
-                if !seen[s] {
-                    seen[s] = true;
-                    stack.push((s, 0));
-                }
-            }
-            None => order.push(b),
-        }
-    }
-    order.reverse();
-    let mut rpo = vec![usize::MAX; n];
-    for (i, &b) in order.iter().enumerate() {
-        rpo[b] = i;
-    }
-    let mut preds = vec![Vec::new(); n];
-    for (b, block) in f.blocks.iter().enumerate() {
-        for &s in &block.succs {
-            preds[s].push(b);
-        }
-    }
-    let mut idom: Vec<Option<usize>> = vec![None; n];
-    idom[0] = Some(0);
-    let mut changed = true;
-    while changed {
-        changed = false;
-        for &b in order.iter().skip(1) {
-            let mut new: Option<usize> = None;
-            for &p in &preds[b] {
-                if idom[p].is_none() {
-                    continue;
-                }
-                new = Some(match new {
-                    None => p,
-                    Some(mut x) => {
-                        let mut y = p;
-                        while x != y {
-                            while rpo[x] > rpo[y] {
-                                x = idom[x].unwrap_or(0);
-                            }
-                            while rpo[y] > rpo[x] {
-                                y = idom[y].unwrap_or(0);
-                            }
-                        }
-                        x
-                    }
-                });
-            }
-            if new.is_some() && idom[b] != new {
-                idom[b] = new;
-                changed = true;
-            }
-        }
-    }
-    idom
-}
-
-fn dominates(idom: &[Option<usize>], a: usize, mut b: usize) -> bool {
-    for _ in 0..=idom.len() {
-        if a == b {
-            return true;
-        }
-        match idom.get(b).copied().flatten() {
-            Some(p) if p != b => b = p,
-            _ => return false,
-        }
-    }
-    false
-}
-
 /// Relations guaranteed to hold at instruction `inst` by the conditional
 /// branches that dominate it.
 fn dominating_relations(program: &Program, f: &Function, inst: usize) -> Vec<(Rel, usize)> {
@@ -876,7 +731,7 @@ fn recognise_guard(
         .functions
         .get(site.function)
         .ok_or_else(|| "the trace is outside a function".to_string())?;
-    let chains = super::liveness::call_chains(program, shader.function, g.id);
+    let chains = call_chains(program, shader.function, g.id, super::liveness::MAX_CHAINS);
     let mut points = vec![site_inst];
     if let Some(chain) = chains.first() {
         points.extend(chain.iter().rev().copied());
@@ -1062,7 +917,7 @@ pub fn trace_loops(
             let Some(g) = program.functions.get(site.function) else {
                 continue;
             };
-            for chain in super::liveness::call_chains(program, e.function, g.id) {
+            for chain in call_chains(program, e.function, g.id, super::liveness::MAX_CHAINS) {
                 let mut points = vec![site.inst];
                 points.extend(chain.iter().rev().copied());
                 for &p in &points {
@@ -1085,7 +940,7 @@ pub fn trace_loops(
                             continue;
                         }
                         let location = (f.blocks[header].start..=f.blocks[header].end)
-                            .find_map(|i| super::liveness::useful_location(program, i))
+                            .find_map(|i| program.inst_location(i))
                             .or_else(|| program.site_location(header_inst));
                         out.push(TraceLoop {
                             entry: e.name.clone(),
@@ -1101,36 +956,6 @@ pub fn trace_loops(
         }
     }
     out
-}
-
-/// Natural loops: header block and body blocks, one per back edge target.
-/// Natural loops of a function: header block and body blocks.
-pub(crate) fn natural_loops(f: &Function) -> Vec<(usize, HashSet<usize>)> {
-    let idom = dominators(f);
-    let mut preds = vec![Vec::new(); f.blocks.len()];
-    for (b, block) in f.blocks.iter().enumerate() {
-        for &s in &block.succs {
-            preds[s].push(b);
-        }
-    }
-    let mut loops: HashMap<usize, HashSet<usize>> = HashMap::new();
-    for (b, block) in f.blocks.iter().enumerate() {
-        for &h in &block.succs {
-            if !dominates(&idom, h, b) {
-                continue;
-            }
-            let body = loops.entry(h).or_insert_with(|| HashSet::from([h]));
-            let mut work = vec![b];
-            while let Some(x) = work.pop() {
-                if body.insert(x) {
-                    work.extend(preds[x].iter().copied());
-                }
-            }
-        }
-    }
-    let mut v: Vec<_> = loops.into_iter().collect();
-    v.sort_by_key(|(h, _)| *h);
-    v
 }
 
 fn loop_bound(
@@ -1224,7 +1049,7 @@ mod tests {
 
     #[test]
     fn recursive_reflections_need_n_plus_two() {
-        let r = recursion(&pipeline(
+        let r = recursion_report(&pipeline(
             "fixtures/pipelines/reflect_recursive.pipeline.toml",
         ));
         // 3 reflections (maxDepth = 3), a shadow ray from the deepest hit.
@@ -1253,7 +1078,7 @@ mod tests {
     fn recursion_without_the_push_constant_is_unbounded() {
         let mut p = pipeline("fixtures/pipelines/reflect_recursive.pipeline.toml");
         p.constants.clear();
-        let r = recursion(&p);
+        let r = recursion_report(&p);
         assert_eq!(r.required_depth, None);
         let c = r.unbounded_cycle().unwrap();
         let why = c.sites[0].guard.as_ref().unwrap_err();
@@ -1265,7 +1090,7 @@ mod tests {
 
     #[test]
     fn iterative_reflections_need_two() {
-        let r = recursion(&pipeline(
+        let r = recursion_report(&pipeline(
             "fixtures/pipelines/reflect_iterative.pipeline.toml",
         ));
         assert_eq!(r.required_depth, Some(2));
@@ -1285,7 +1110,7 @@ mod tests {
     #[test]
     fn reference_wgsl_pipeline_needs_one() {
         let p = pipeline("shaders/reflect_iterative.pipeline.toml");
-        let r = recursion(&p);
+        let r = recursion_report(&p);
         assert_eq!(r.required_depth, Some(1));
         let loops = trace_loops(&p.programs[0], &p.constants);
         assert_eq!(loops.len(), 1);
@@ -1303,7 +1128,7 @@ mod tests {
         // `if reflectivity > 0.0 && incoming.depth < params.max_bounces`:
         // naga stores the second comparison (or `false`) in a local bool and
         // branches on it; the branch still implies the comparison.
-        let r = recursion(&pipeline("shaders/reflect_recursive.pipeline.toml"));
+        let r = recursion_report(&pipeline("shaders/reflect_recursive.pipeline.toml"));
         assert_eq!(r.required_depth, Some(4));
         let g = r.cycles[0].sites[0].guard.as_ref().unwrap();
         assert_eq!(
@@ -1315,7 +1140,7 @@ mod tests {
     #[test]
     fn wgsl_guard_at_the_helper_call() {
         // naga puts the trace in a helper: the guard dominates the call.
-        let r = recursion(&pipeline(
+        let r = recursion_report(&pipeline(
             "fixtures/pipelines/reflect_recursive_wgsl.pipeline.toml",
         ));
         assert_eq!(r.required_depth, Some(5));

@@ -17,7 +17,7 @@
 
 use super::callgraph::EdgeKind;
 use super::liveness::{live_sites, LiveSite};
-use super::recursion::{recursion, RecursionReport};
+use super::recursion::{recursion_report, RecursionReport};
 use crate::pipeline::Pipeline;
 use crate::pipeline::Slot;
 use crate::program::scalar::scalar_size;
@@ -308,7 +308,7 @@ fn in_loop(program: &Program, inst: usize) -> bool {
     let Some(block) = f.block_of(inst) else {
         return false;
     };
-    crate::analysis::recursion::natural_loops(f)
+    crate::program::cfg::natural_loops(f)
         .iter()
         .any(|(_, body)| body.contains(&block))
 }
@@ -441,7 +441,7 @@ pub fn exact_call_chain(rec: &RecursionReport, sizes: &[u64]) -> Option<u64> {
 
 /// `rtlint stack`: the stack figures of a described (or assumed) pipeline.
 pub fn stack_report(pipeline: &Pipeline) -> StackReport {
-    stack_report_with(pipeline, &recursion(pipeline))
+    stack_report_with(pipeline, &recursion_report(pipeline))
 }
 
 /// [`stack_report`] over a recursion analysis the caller already has.
@@ -541,7 +541,7 @@ pub fn attach_driver(
     pipeline: &Pipeline,
     driver: &BTreeMap<(Slot, Stage), u64>,
 ) {
-    let rec = recursion(pipeline);
+    let rec = recursion_report(pipeline);
     for (s, n) in report.shaders.iter_mut().zip(&rec.graph.nodes) {
         s.driver_bytes = driver.get(&(n.slot, n.shader.stage)).copied();
     }
@@ -984,7 +984,7 @@ mod tests {
         .unwrap();
         let mut r = stack_report(&p);
         // lavapipe answers 4 for every group and stage.
-        let driver: BTreeMap<_, _> = recursion(&p)
+        let driver: BTreeMap<_, _> = recursion_report(&p)
             .graph
             .nodes
             .iter()

@@ -6,6 +6,7 @@ pub mod hlsl;
 pub mod wgsl;
 
 use crate::diag::InputError;
+pub use crate::diag::{io_error, read_text};
 use crate::program::NamedDecl;
 use crate::shader::{Language, Location};
 use std::path::{Path, PathBuf};
@@ -78,20 +79,4 @@ pub fn load(path: &Path, language: Language) -> Result<crate::program::Program, 
     let mut program = crate::program::parse(&c.words, &c.path, c.language)?;
     program.attach_named_decls(&c.decls);
     Ok(program)
-}
-
-pub fn read_text(path: &Path) -> Result<String, InputError> {
-    let bytes = std::fs::read(path).map_err(|e| io_error(path, &e))?;
-    String::from_utf8(bytes).map_err(|e| {
-        let offset = e.utf8_error().valid_up_to();
-        InputError::new(
-            "invalid-utf8",
-            path,
-            format!("file is not valid UTF-8 (byte offset {offset})"),
-        )
-    })
-}
-
-pub fn io_error(path: &Path, e: &std::io::Error) -> InputError {
-    InputError::new("unreadable-file", path, format!("cannot read file: {e}"))
 }

@@ -10,7 +10,7 @@ use rspirv::dr::{self, ModuleHeader};
 use std::path::Path;
 
 /// `NonSemantic.Shader.DebugInfo.100` instruction numbers we read.
-mod dbg {
+mod debug_info_op {
     pub const COMPILATION_UNIT: u32 = 1;
     pub const TYPE_COMPOSITE: u32 = 10;
     pub const TYPE_MEMBER: u32 = 11;
@@ -416,7 +416,11 @@ impl Builder<'_> {
                     if let (Some(file), Some(line), Some(column)) =
                         (file, lit_at(&inst, 1), lit_at(&inst, 2))
                     {
-                        cur = Some(SrcPos {
+                        // naga's writer puts `OpLine 1 1` on code that has no
+                        // span (its generated helpers): that is no position.
+                        let placeholder =
+                            self.p.language == Language::Wgsl && line == 1 && column == 1;
+                        cur = (!placeholder).then_some(SrcPos {
                             file,
                             line,
                             column,
@@ -452,7 +456,7 @@ impl Builder<'_> {
         // Operands after (set, instruction) are ids; shift by 2.
         let r = inst.result_id.unwrap_or(0);
         match which {
-            dbg::COMPILATION_UNIT => {
+            debug_info_op::COMPILATION_UNIT => {
                 // Version, DWARF version, source, language (a constant id).
                 let lang = self.const_u32(id_at(inst, 5));
                 if self.p.language == Language::Spirv {
@@ -464,7 +468,7 @@ impl Builder<'_> {
                     };
                 }
             }
-            dbg::SOURCE => {
+            debug_info_op::SOURCE => {
                 if let Some(f) = id_at(inst, 2).and_then(|s| self.file_for_string(s)) {
                     if let Some(text) = id_at(inst, 3).and_then(|t| self.strings.get(&t)).cloned() {
                         self.p.files[f as usize].text = Some(text);
@@ -472,7 +476,7 @@ impl Builder<'_> {
                     self.dbg_sources.insert(r, f);
                 }
             }
-            dbg::SOURCE_CONTINUED => {
+            debug_info_op::SOURCE_CONTINUED => {
                 // Appends to the most recent DebugSource's text.
                 if let Some(text) = id_at(inst, 2).and_then(|t| self.strings.get(&t)).cloned() {
                     if let Some(f) = self.dbg_sources.values().max().copied() {
@@ -482,7 +486,7 @@ impl Builder<'_> {
                     }
                 }
             }
-            dbg::LINE => {
+            debug_info_op::LINE => {
                 if let Some(file) = id_at(inst, 2)
                     .and_then(|s| self.dbg_sources.get(&s))
                     .copied()
@@ -500,13 +504,13 @@ impl Builder<'_> {
                     });
                 }
             }
-            dbg::NO_LINE => *cur = None,
-            dbg::TYPE_MEMBER => {
+            debug_info_op::NO_LINE => *cur = None,
+            debug_info_op::TYPE_MEMBER => {
                 if let Some(pos) = self.dbg_pos(inst, 4, 5, 6) {
                     self.dbg_members.insert(r, pos);
                 }
             }
-            dbg::TYPE_COMPOSITE => {
+            debug_info_op::TYPE_COMPOSITE => {
                 let name = id_at(inst, 2).and_then(|s| self.strings.get(&s)).cloned();
                 if let (Some(name), Some(pos)) = (name, self.dbg_pos(inst, 4, 5, 6)) {
                     let members = inst.operands.iter().skip(11).filter_map(|o| match o {
@@ -516,29 +520,29 @@ impl Builder<'_> {
                     self.dbg_composites.push((name, pos, members.collect()));
                 }
             }
-            dbg::GLOBAL_VARIABLE => {
+            debug_info_op::GLOBAL_VARIABLE => {
                 if let (Some(pos), Some(var)) = (self.dbg_pos(inst, 4, 5, 6), id_at(inst, 9)) {
                     self.p.decl_pos.insert(Decl::Var(var), pos);
                 }
             }
-            dbg::FUNCTION => {
+            debug_info_op::FUNCTION => {
                 if let Some(pos) = self.dbg_pos(inst, 4, 5, 6) {
                     self.dbg_functions.insert(r, pos);
                 }
             }
-            dbg::FUNCTION_DEFINITION => {
+            debug_info_op::FUNCTION_DEFINITION => {
                 if let (Some(df), Some(f)) = (id_at(inst, 2), id_at(inst, 3)) {
                     if let Some(pos) = self.dbg_functions.get(&df) {
                         self.p.decl_pos.insert(Decl::Func(f), *pos);
                     }
                 }
             }
-            dbg::LOCAL_VARIABLE => {
+            debug_info_op::LOCAL_VARIABLE => {
                 if let Some(pos) = self.dbg_pos(inst, 4, 5, 6) {
                     self.dbg_locals.insert(r, pos);
                 }
             }
-            dbg::DECLARE => {
+            debug_info_op::DECLARE => {
                 if let (Some(local), Some(var)) = (id_at(inst, 2), id_at(inst, 3)) {
                     if let Some(pos) = self.dbg_locals.get(&local) {
                         self.p.decl_pos.insert(Decl::Var(var), *pos);
@@ -878,8 +882,8 @@ impl Builder<'_> {
                 };
                 let o = |n| {
                     id_at(inst, n)
-                        .map(|id| self.p.operandish(id))
-                        .unwrap_or(Operandish::Dynamic(0))
+                        .map(|id| self.p.operand_value(id))
+                        .unwrap_or(OperandValue::Dynamic(0))
                 };
                 let (trace, payload, sbt_index) = match kind {
                     SiteKind::TraceRay => (

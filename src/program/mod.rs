@@ -8,6 +8,7 @@
 
 mod binary;
 mod build;
+pub mod cfg;
 pub mod debug;
 pub mod scalar;
 mod textdecl;
@@ -126,10 +127,11 @@ impl Function {
     }
 }
 
-/// A value that is a constant when the module makes it one.
+/// A trace or query operand's value: a constant when the module makes it
+/// one, a specialization constant with its default, else a runtime value.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
 #[serde(rename_all = "snake_case")]
-pub enum Operandish {
+pub enum OperandValue {
     Const(u64),
     /// A specialization constant with its default value.
     Spec {
@@ -139,10 +141,10 @@ pub enum Operandish {
     Dynamic(Id),
 }
 
-impl Operandish {
+impl OperandValue {
     pub fn constant(&self) -> Option<u64> {
         match self {
-            Operandish::Const(v) => Some(*v),
+            OperandValue::Const(v) => Some(*v),
             _ => None,
         }
     }
@@ -172,16 +174,16 @@ pub struct RtSite {
     /// The payload / callable-data variable, or the ray-query object.
     pub payload: Option<Id>,
     /// `OpExecuteCallableKHR`: the SBT index.
-    pub sbt_index: Option<Operandish>,
+    pub sbt_index: Option<OperandValue>,
 }
 
 #[derive(Clone, Copy, Debug, serde::Serialize)]
 pub struct TraceOperands {
-    pub ray_flags: Operandish,
-    pub cull_mask: Operandish,
-    pub sbt_offset: Operandish,
-    pub sbt_stride: Operandish,
-    pub miss_index: Operandish,
+    pub ray_flags: OperandValue,
+    pub cull_mask: OperandValue,
+    pub sbt_offset: OperandValue,
+    pub sbt_stride: OperandValue,
+    pub miss_index: OperandValue,
 }
 
 #[derive(Clone, Debug, PartialEq)]
@@ -283,14 +285,14 @@ impl Program {
         }
     }
 
-    pub fn operandish(&self, id: Id) -> Operandish {
+    pub fn operand_value(&self, id: Id) -> OperandValue {
         if let Some(v) = self.const_u64(id) {
-            return Operandish::Const(v);
+            return OperandValue::Const(v);
         }
         if let Some(Constant::Int(v)) = self.spec_constants.get(&id) {
-            return Operandish::Spec { id, default: *v };
+            return OperandValue::Spec { id, default: *v };
         }
-        Operandish::Dynamic(id)
+        OperandValue::Dynamic(id)
     }
 
     /// Converts a debug-info position to a diagnostic location.

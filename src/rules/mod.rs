@@ -145,7 +145,7 @@ pub struct PipelineContext<'a> {
 
 impl<'a> PipelineContext<'a> {
     pub fn new(pipeline: &'a crate::pipeline::Pipeline, config: &'a Config) -> Self {
-        let recursion = crate::analysis::recursion(pipeline);
+        let recursion = crate::analysis::recursion_report(pipeline);
         let stack = crate::analysis::stack::stack_report_with(pipeline, &recursion);
         PipelineContext {
             pipeline,

@@ -93,7 +93,7 @@ fn run(ctx: &super::Context) -> Vec<Diagnostic> {
     check(
         ctx.program,
         &crate::analysis::liveness::live_sites(ctx.program),
-        ctx.config.live_state_budget,
+        ctx.config.live_state_budget.unwrap_or(DEFAULT_BUDGET_BYTES),
     )
 }
 

@@ -4,19 +4,10 @@
 use crate::analysis::recursion::RecursionReport;
 use crate::diag::{Diagnostic, Severity};
 use crate::pipeline::Pipeline;
-use std::path::PathBuf;
 
 pub const CODE: &str = "RT021";
 pub const NAME: &str = "depth-exceeds-declared";
 pub const LEVEL: Severity = Severity::Error;
-
-pub(crate) fn pipeline_file(pipeline: &Pipeline) -> PathBuf {
-    pipeline
-        .path
-        .clone()
-        .or_else(|| pipeline.raygen.first().map(|s| s.file.clone()))
-        .unwrap_or_default()
-}
 
 /// A finding when the required depth (bounded) exceeds the declared one.
 pub fn check(pipeline: &Pipeline, rec: &RecursionReport) -> Vec<Diagnostic> {
@@ -31,7 +22,7 @@ pub fn check(pipeline: &Pipeline, rec: &RecursionReport) -> Vec<Diagnostic> {
     vec![Diagnostic::new(
         LEVEL,
         NAME,
-        &pipeline_file(pipeline),
+        &pipeline.file(),
         format!("pipeline needs recursion depth {required}, above the declared {declared}"),
     )
     .with_code(CODE)
@@ -64,13 +55,13 @@ fn run(ctx: &super::PipelineContext) -> Vec<Diagnostic> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::analysis::recursion::recursion;
+    use crate::analysis::recursion::recursion_report;
     use crate::pipeline::load;
     use std::path::Path;
 
     fn run(rel: &str) -> Vec<Diagnostic> {
         let p = load(&Path::new(env!("CARGO_MANIFEST_DIR")).join(rel)).unwrap();
-        check(&p, &recursion(&p))
+        check(&p, &recursion_report(&p))
     }
 
     #[test]

@@ -1,7 +1,6 @@
 //! RT022 `depth-overdeclared`: the declared recursion depth is above what
 //! the pipeline needs, and the default stack pays for every extra level.
 
-use super::rt021_depth_exceeds_declared::pipeline_file;
 use crate::analysis::recursion::RecursionReport;
 use crate::analysis::stack::{vulkan_default, StackReport};
 use crate::diag::{Diagnostic, Severity};
@@ -25,7 +24,7 @@ pub fn check(pipeline: &Pipeline, rec: &RecursionReport, stack: &StackReport) ->
     let mut d = Diagnostic::new(
         LEVEL,
         NAME,
-        &pipeline_file(pipeline),
+        &pipeline.file(),
         format!("declared recursion depth {declared} is above the {required} the pipeline needs"),
     )
     .with_code(CODE)
@@ -61,14 +60,14 @@ fn run(ctx: &super::PipelineContext) -> Vec<Diagnostic> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::analysis::recursion::recursion;
+    use crate::analysis::recursion::recursion_report;
     use crate::analysis::stack::stack_report;
     use crate::pipeline::load;
     use std::path::Path;
 
     fn run(rel: &str) -> Vec<Diagnostic> {
         let p = load(&Path::new(env!("CARGO_MANIFEST_DIR")).join(rel)).unwrap();
-        check(&p, &recursion(&p), &stack_report(&p))
+        check(&p, &recursion_report(&p), &stack_report(&p))
     }
 
     #[test]

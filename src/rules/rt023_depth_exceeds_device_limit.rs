@@ -1,7 +1,6 @@
 //! RT023 `depth-exceeds-device-limit`: the declared or required recursion
 //! depth is above what devices support (31 on lavapipe, NVIDIA and DXR).
 
-use super::rt021_depth_exceeds_declared::pipeline_file;
 use crate::analysis::recursion::RecursionReport;
 use crate::diag::{Diagnostic, Severity};
 use crate::pipeline::Pipeline;
@@ -14,7 +13,7 @@ pub const LEVEL: Severity = Severity::Error;
 /// the description's `device_max_recursion_depth` overrides it).
 pub fn check(pipeline: &Pipeline, rec: &RecursionReport, device_limit: u32) -> Vec<Diagnostic> {
     let mut out = Vec::new();
-    let file = pipeline_file(pipeline);
+    let file = pipeline.file();
     let note = "NVIDIA fails pipeline creation above 31; lavapipe accepts it (measured running to about 1,000 levels, crashing at 5,000), so a test on lavapipe does not catch it";
     if let Some(declared) = pipeline.max_recursion_depth.filter(|&d| d > device_limit) {
         out.push(
@@ -79,13 +78,13 @@ fn run(ctx: &super::PipelineContext) -> Vec<Diagnostic> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::analysis::recursion::recursion;
+    use crate::analysis::recursion::recursion_report;
     use crate::pipeline::{load, DEFAULT_DEVICE_MAX_RECURSION_DEPTH};
     use std::path::Path;
 
     fn run(rel: &str) -> Vec<Diagnostic> {
         let p = load(&Path::new(env!("CARGO_MANIFEST_DIR")).join(rel)).unwrap();
-        check(&p, &recursion(&p), p.device_max_recursion_depth)
+        check(&p, &recursion_report(&p), p.device_max_recursion_depth)
     }
 
     #[test]

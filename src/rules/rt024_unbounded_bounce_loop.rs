@@ -89,13 +89,13 @@ fn run(ctx: &super::PipelineContext) -> Vec<Diagnostic> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::analysis::recursion::recursion;
+    use crate::analysis::recursion::recursion_report;
     use crate::pipeline::load;
     use std::path::Path;
 
     fn run(rel: &str) -> Vec<Diagnostic> {
         let p = load(&Path::new(env!("CARGO_MANIFEST_DIR")).join(rel)).unwrap();
-        check(&p, &recursion(&p))
+        check(&p, &recursion_report(&p))
     }
 
     #[test]

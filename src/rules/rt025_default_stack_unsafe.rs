@@ -1,7 +1,6 @@
 //! RT025 `default-stack-unsafe`: the stack size a driver picks by default
 //! for the declared depth is larger than a device is known to survive.
 
-use super::rt021_depth_exceeds_declared::pipeline_file;
 use crate::analysis::stack::StackReport;
 use crate::diag::{Diagnostic, Severity};
 use crate::pipeline::Pipeline;
@@ -24,7 +23,7 @@ pub fn check(pipeline: &Pipeline, stack: &StackReport, limit_bytes: u64) -> Vec<
     let mut d = Diagnostic::new(
         LEVEL,
         NAME,
-        &pipeline_file(pipeline),
+        &pipeline.file(),
         format!(
             "default pipeline stack of {default} bytes per thread is above the {limit_bytes} bytes known to run"
         ),
@@ -73,7 +72,11 @@ pub static RULE: super::Rule = super::Rule {
 };
 
 fn run(ctx: &super::PipelineContext) -> Vec<Diagnostic> {
-    check(ctx.pipeline, &ctx.stack, ctx.config.stack_limit)
+    check(
+        ctx.pipeline,
+        &ctx.stack,
+        ctx.config.stack_limit.unwrap_or(DEFAULT_LIMIT_BYTES),
+    )
 }
 
 #[cfg(test)]
