@@ -6,6 +6,7 @@
 pub mod analysis;
 pub mod config;
 pub mod diag;
+pub mod explain;
 pub mod front;
 pub mod lint;
 pub mod pipeline;
@@ -15,5 +16,6 @@ pub mod reference;
 pub mod report;
 pub mod rules;
 pub mod shader;
+pub mod suppress;
 #[cfg(feature = "vulkan")]
 pub mod vk;

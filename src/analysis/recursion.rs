@@ -19,16 +19,93 @@ use rspirv::dr::{Instruction, Operand};
 use spirv::{Op, StorageClass};
 use std::collections::{BTreeMap, HashSet};
 
+/// Where a loop or recursion bound comes from.
+#[derive(Clone, Debug, PartialEq, Eq, PartialOrd, Ord)]
+pub enum BoundSource {
+    Constant(i64),
+    /// A specialization constant: its value in the pipeline description, else
+    /// its default.
+    SpecConstant {
+        name: String,
+        value: i64,
+        described: bool,
+    },
+    /// A push-constant, uniform, storage-buffer or shader-record value that
+    /// the pipeline description gives.
+    Described {
+        kind: ValueKind,
+        key: String,
+        value: i64,
+    },
+}
+
+/// Where a value that is not a constant is read from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
+pub enum ValueKind {
+    PushConstant,
+    Uniform,
+    StorageBuffer,
+    ShaderRecord,
+}
+
+/// Why a bound is not known at compile time.
+#[derive(Clone, Debug, PartialEq, Eq, PartialOrd, Ord)]
+pub enum UnknownBound {
+    /// An id the module does not define.
+    UnknownValue,
+    RuntimeValue,
+    /// A value the pipeline description could give but does not.
+    NotDescribed {
+        kind: ValueKind,
+        name: String,
+    },
+}
+
+/// Why no depth guard was recognised on a trace that closes a cycle.
+#[derive(Clone, Debug, PartialEq, Eq, PartialOrd, Ord)]
+pub enum NoGuard {
+    ModuleMissing,
+    TraceMissing,
+    OutsideFunction,
+    /// The counter is compared with a bound that is not known.
+    BoundUnknown {
+        counter: String,
+        bound: UnknownBound,
+    },
+    /// The counter guards the trace but the traced copy does not grow.
+    CounterDoesNotGrow {
+        counter: String,
+    },
+    /// No dominating comparison of a counter (named when one was seen) with a
+    /// known bound.
+    NoComparison {
+        counter: Option<String>,
+    },
+}
+
+/// Why no bound was recognised on a loop that traces.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum NoLoopBound {
+    NotIncremented {
+        counter: String,
+    },
+    BoundUnknown {
+        counter: String,
+        bound: UnknownBound,
+    },
+    NoCounter,
+}
+
 /// A recognised depth guard on a trace that closes a cycle.
-#[derive(Clone, Debug, serde::Serialize)]
+#[derive(Clone, Debug)]
 pub struct Guard {
     /// `payload.depth`-style name of the counter.
     pub counter: String,
     /// `<` or `<=`: the trace happens while `counter op bound`.
     pub op: &'static str,
     pub bound: i64,
-    /// Where the bound comes from, in words.
-    pub bound_source: String,
+    /// Where the bound comes from.
+    pub bound_source: BoundSource,
     /// How much the counter grows per trace.
     pub step: i64,
     /// The counter's value where the cycle is entered.
@@ -37,7 +114,6 @@ pub struct Guard {
     pub initial_assumed: bool,
     /// How many times the cycle can trace in one chain.
     pub traces: u64,
-    #[serde(skip)]
     pub location: Option<Location>,
 }
 
@@ -48,7 +124,7 @@ pub struct CycleSite {
     pub inst: usize,
     pub location: Option<Location>,
     /// The guard, or why none was recognised.
-    pub guard: Result<Guard, String>,
+    pub guard: Result<Guard, NoGuard>,
 }
 
 /// A strongly connected part of the trace graph with a cycle.
@@ -96,23 +172,6 @@ pub struct RecursionReport {
 }
 
 impl RecursionReport {
-    /// `raygeneration `main` → closesthit `main` ×4 → miss `main``.
-    pub fn chain_text(&self) -> String {
-        let parts: Vec<String> = self
-            .chain
-            .iter()
-            .map(|s| {
-                let name = self.graph.nodes[s.node].describe();
-                if s.repeat > 0 {
-                    format!("{name} at levels {}–{}", s.level, s.level as u64 + s.repeat)
-                } else {
-                    format!("{name} at level {}", s.level)
-                }
-            })
-            .collect();
-        parts.join(" → ")
-    }
-
     pub fn unbounded_cycle(&self) -> Option<&Cycle> {
         self.cycles.iter().find(|c| c.extra_levels.is_none())
     }
@@ -508,32 +567,34 @@ fn bound_of(
     program: &Program,
     id: Id,
     constants: &BTreeMap<String, DescribedConstant>,
-) -> Result<(i64, String), String> {
+) -> Result<(i64, BoundSource), UnknownBound> {
     let id = strip_conversions(program, id);
     if let Some(Constant::Int(v)) = program.constants.get(&id) {
-        return Ok((
-            signed(program, id, *v),
-            format!("the constant {}", *v as i64),
-        ));
+        return Ok((signed(program, id, *v), BoundSource::Constant(*v as i64)));
     }
     if let Some(Constant::Int(v)) = program.spec_constants.get(&id) {
         let name = program.display_name(id);
         if let Some(c) = constants.get(&name) {
             return Ok((
                 c.value,
-                format!(
-                    "specialization constant `{name}` = {} from the description",
-                    c.value
-                ),
+                BoundSource::SpecConstant {
+                    name,
+                    value: c.value,
+                    described: true,
+                },
             ));
         }
         return Ok((
             *v as i64,
-            format!("specialization constant `{name}` (default {})", *v as i64),
+            BoundSource::SpecConstant {
+                name,
+                value: *v as i64,
+                described: false,
+            },
         ));
     }
     let Some(inst) = program.def(id) else {
-        return Err("an unknown value".into());
+        return Err(UnknownBound::UnknownValue);
     };
     if inst.class.opcode == Op::Load {
         let ptr = ids(inst).next().unwrap_or(0);
@@ -541,27 +602,29 @@ fn bound_of(
             .and_then(|(v, _)| global(program, v))
             .map(|g| g.storage);
         let kind = match storage {
-            Some(StorageClass::PushConstant) => "push constant",
-            Some(StorageClass::Uniform) => "uniform value",
-            Some(StorageClass::StorageBuffer) => "storage buffer value",
-            Some(StorageClass::ShaderRecordBufferKHR) => "shader record value",
-            _ => return Err("a value computed at run time".into()),
+            Some(StorageClass::PushConstant) => ValueKind::PushConstant,
+            Some(StorageClass::Uniform) => ValueKind::Uniform,
+            Some(StorageClass::StorageBuffer) => ValueKind::StorageBuffer,
+            Some(StorageClass::ShaderRecordBufferKHR) => ValueKind::ShaderRecord,
+            _ => return Err(UnknownBound::RuntimeValue),
         };
         let keys = member_keys(program, ptr);
         for k in &keys {
             if let Some(c) = constants.get(k) {
                 return Ok((
                     c.value,
-                    format!("{kind} `{k}` = {} from the description", c.value),
+                    BoundSource::Described {
+                        kind,
+                        key: k.clone(),
+                        value: c.value,
+                    },
                 ));
             }
         }
         let name = keys.first().cloned().unwrap_or_else(|| "?".into());
-        return Err(format!(
-            "{kind} `{name}`, which the pipeline description does not give"
-        ));
+        return Err(UnknownBound::NotDescribed { kind, name });
     }
-    Err("a value computed at run time".into())
+    Err(UnknownBound::RuntimeValue)
 }
 
 fn signed(program: &Program, id: Id, v: u64) -> i64 {
@@ -715,29 +778,27 @@ fn recognise_guard(
     scc: usize,
     node: usize,
     site_inst: usize,
-) -> Result<Guard, String> {
+) -> Result<Guard, NoGuard> {
     let shader = &graph.nodes[node].shader;
-    let program = pipeline
-        .program(shader)
-        .ok_or_else(|| "the shader's module is missing".to_string())?;
+    let program = pipeline.program(shader).ok_or(NoGuard::ModuleMissing)?;
     let site = program
         .sites
         .iter()
         .find(|s| s.inst == site_inst)
-        .ok_or_else(|| "the trace is missing".to_string())?;
+        .ok_or(NoGuard::TraceMissing)?;
     let out_payload = site.payload.unwrap_or(0);
     // Every point from the trace up the call chain to the entry point.
     let g = program
         .functions
         .get(site.function)
-        .ok_or_else(|| "the trace is outside a function".to_string())?;
+        .ok_or(NoGuard::OutsideFunction)?;
     let chains = call_chains(program, shader.function, g.id, super::liveness::MAX_CHAINS);
     let mut points = vec![site_inst];
     if let Some(chain) = chains.first() {
         points.extend(chain.iter().rev().copied());
     }
     let mut seen_counter: Option<String> = None;
-    let mut why_not: Option<String> = None;
+    let mut why_not: Option<NoGuard> = None;
     for &p in &points {
         let Some(f) = program
             .function_of(p)
@@ -753,8 +814,11 @@ fn recognise_guard(
             seen_counter.get_or_insert(name.clone());
             let (bound, bound_source) = match bound_of(program, rel.rhs, &pipeline.constants) {
                 Ok(b) => b,
-                Err(e) => {
-                    why_not = Some(format!("`{name}` is compared with {e}"));
+                Err(bound) => {
+                    why_not = Some(NoGuard::BoundUnknown {
+                        counter: name,
+                        bound,
+                    });
                     continue;
                 }
             };
@@ -762,9 +826,7 @@ fn recognise_guard(
                 continue;
             };
             let Some(step) = growth(program, shader.function, out_payload, &counter) else {
-                why_not = Some(format!(
-                    "`{name}` guards the trace but the traced payload's counter does not grow by a constant"
-                ));
+                why_not = Some(NoGuard::CounterDoesNotGrow { counter: name });
                 continue;
             };
             let (initial, initial_assumed) =
@@ -790,9 +852,8 @@ fn recognise_guard(
             });
         }
     }
-    Err(why_not.unwrap_or_else(|| match seen_counter {
-        Some(c) => format!("no comparison of `{c}` with a known bound dominates the trace"),
-        None => "no depth counter comparison dominates the trace".into(),
+    Err(why_not.unwrap_or(NoGuard::NoComparison {
+        counter: seen_counter,
     }))
 }
 
@@ -881,12 +942,12 @@ fn initial_value(
 // ---------------------------------------------------------------------------
 // Loops that trace.
 
-#[derive(Clone, Debug, serde::Serialize)]
+#[derive(Clone, Debug)]
 pub struct LoopBound {
     pub counter: String,
     pub op: &'static str,
     pub bound: i64,
-    pub bound_source: String,
+    pub bound_source: BoundSource,
 }
 
 /// A loop whose body traces (or calls a function that does).
@@ -899,7 +960,7 @@ pub struct TraceLoop {
     pub location: Option<Location>,
     pub site_location: Option<Location>,
     /// The recognised bound, or why none was.
-    pub bound: Result<LoopBound, String>,
+    pub bound: Result<LoopBound, NoLoopBound>,
 }
 
 /// Loops around trace sites in every entry point of a program; bounds come
@@ -963,8 +1024,8 @@ fn loop_bound(
     f: &Function,
     body: &HashSet<usize>,
     constants: &BTreeMap<String, DescribedConstant>,
-) -> Result<LoopBound, String> {
-    let mut why: Option<String> = None;
+) -> Result<LoopBound, NoLoopBound> {
+    let mut why: Option<NoLoopBound> = None;
     let mut blocks: Vec<usize> = body.iter().copied().collect();
     blocks.sort_unstable();
     for b in blocks {
@@ -992,9 +1053,7 @@ fn loop_bound(
             };
             let name = program.display_name(var);
             if !increments(program, f, body, var) {
-                why.get_or_insert(format!(
-                    "`{name}` is compared but not incremented by a constant in the loop"
-                ));
+                why.get_or_insert(NoLoopBound::NotIncremented { counter: name });
                 continue;
             }
             match bound_of(program, rel.rhs, constants) {
@@ -1006,11 +1065,16 @@ fn loop_bound(
                         bound_source,
                     })
                 }
-                Err(e) => why = Some(format!("the loop runs while `{name}` is below {e}")),
+                Err(bound) => {
+                    why = Some(NoLoopBound::BoundUnknown {
+                        counter: name,
+                        bound,
+                    })
+                }
             }
         }
     }
-    Err(why.unwrap_or_else(|| "no exit compares a counter with a bound".into()))
+    Err(why.unwrap_or(NoLoopBound::NoCounter))
 }
 
 /// Whether the loop stores `var = var + c` (c > 0) somewhere in its body.
@@ -1063,12 +1127,12 @@ mod tests {
         );
         assert!(!g.initial_assumed);
         assert!(
-            g.bound_source.contains("pushConst.maxDepth"),
-            "{}",
+            matches!(&g.bound_source, BoundSource::Described { kind: ValueKind::PushConstant, key, .. } if key == "pushConst.maxDepth"),
+            "{:?}",
             g.bound_source
         );
         assert_eq!(
-            r.chain_text(),
+            crate::explain::recursion_chain(&r),
             "raygeneration `main` (raygen 0) at level 0 → closesthit `main` (hit group 0) at levels 1–4 → miss `main` (miss 1) at level 5"
         );
         assert_eq!(r.recursive_sites.len(), 2);
@@ -1084,6 +1148,16 @@ mod tests {
         let why = c.sites[0].guard.as_ref().unwrap_err();
         assert_eq!(
             why,
+            &NoGuard::BoundUnknown {
+                counter: "payload.depth".into(),
+                bound: UnknownBound::NotDescribed {
+                    kind: ValueKind::PushConstant,
+                    name: "pushConst.maxDepth".into()
+                }
+            }
+        );
+        assert_eq!(
+            why.to_string(),
             "`payload.depth` is compared with push constant `pushConst.maxDepth`, which the pipeline description does not give"
         );
     }
@@ -1103,7 +1177,11 @@ mod tests {
         assert_eq!((b.counter.as_str(), b.op, b.bound), ("bounce", "<=", 4));
         assert_eq!(
             b.bound_source,
-            "specialization constant `MAX_BOUNCES` (default 4)"
+            BoundSource::SpecConstant {
+                name: "MAX_BOUNCES".into(),
+                value: 4,
+                described: false
+            }
         );
     }
 
@@ -1118,7 +1196,7 @@ mod tests {
         assert_eq!((b.counter.as_str(), b.bound), ("bounce", 8));
         let none = trace_loops(&p.programs[0], &BTreeMap::new());
         assert_eq!(
-            none[0].bound.as_ref().unwrap_err(),
+            none[0].bound.as_ref().unwrap_err().to_string(),
             "the loop runs while `bounce` is below uniform value `params.max_bounces`, which the pipeline description does not give"
         );
     }
@@ -1151,7 +1229,11 @@ mod tests {
         );
         assert_eq!(
             g.bound_source,
-            "uniform value `params.max_depth` = 4 from the description"
+            BoundSource::Described {
+                kind: ValueKind::Uniform,
+                key: "params.max_depth".into(),
+                value: 4
+            }
         );
     }
 }

@@ -4,7 +4,7 @@
 
 use super::debug::resolve_path;
 use super::*;
-use crate::diag::InputError;
+use crate::diag::{InputError, InputErrorKind};
 use rspirv::binary::{Consumer, ParseAction};
 use rspirv::dr::{self, ModuleHeader};
 use std::path::Path;
@@ -48,7 +48,7 @@ impl Consumer for Collect {
 }
 
 fn err(path: &Path, msg: impl Into<String>) -> InputError {
-    InputError::new("invalid-spirv", path, msg)
+    InputError::new(InputErrorKind::InvalidSpirv, path, msg)
 }
 
 /// Parses and checks a module. `language` is the front-end's language; a

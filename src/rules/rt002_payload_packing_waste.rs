@@ -28,16 +28,18 @@ fn check(ctx: &Context) -> Vec<Diagnostic> {
         .iter()
         .filter(|t| t.is_struct && t.roles.iter().any(packed_roles))
     {
-        let (Some(best), Some(best_rows), Some(decl)) = (
+        let (Some(best), Some(best_rows), Some(order)) = (
             t.optimal_hlsl_packed_size,
             t.optimal_hlsl_rows,
-            &t.optimal_declaration,
+            &t.optimal_indices,
         ) else {
             continue;
         };
         if best >= t.hlsl_packed_size {
             continue;
         }
+        let decl =
+            crate::explain::struct_declaration(ctx.program.language, &t.name, order, &t.members);
         let d = ctx
             .diagnostic(
                 &RULE,
@@ -52,8 +54,8 @@ fn check(ctx: &Context) -> Vec<Diagnostic> {
                 "{} bytes of the declared layout are padding",
                 t.hlsl_padding
             ))
-            .with_help(format!("reorder the members:\n{}", indent(decl)))
-            .with_fix(decl.clone());
+            .with_help(format!("reorder the members:\n{}", indent(&decl)))
+            .with_fix(decl);
         out.push(d);
     }
     out

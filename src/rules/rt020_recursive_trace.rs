@@ -53,7 +53,7 @@ pub fn check(pipeline: &Pipeline, rec: &RecursionReport) -> Vec<Diagnostic> {
             Some(depth) => {
                 d = d.with_note(format!(
                     "the pipeline needs recursion depth {depth}: {}",
-                    rec.chain_text()
+                    crate::explain::recursion_chain(rec)
                 ))
             }
             None => d = d.with_note("the recursion depth is unbounded at compile time"),

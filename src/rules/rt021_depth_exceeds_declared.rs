@@ -31,7 +31,7 @@ pub fn check(pipeline: &Pipeline, rec: &RecursionReport) -> Vec<Diagnostic> {
         format!("declared {declared} here"),
     )
     .with_secondary(deepest, format!("this trace runs at depth {required}"))
-    .with_note(format!("deepest chain: {}", rec.chain_text()))
+    .with_note(format!("deepest chain: {}", crate::explain::recursion_chain(rec)))
     .with_note(
         "recursing past the declared depth is undefined: lavapipe crashes at once; NVIDIA returns correct results for some extra levels, then hangs the GPU",
     )

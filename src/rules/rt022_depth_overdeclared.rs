@@ -32,7 +32,10 @@ pub fn check(pipeline: &Pipeline, rec: &RecursionReport, stack: &StackReport) ->
         pipeline.max_recursion_depth_location.clone(),
         format!("declared {declared} here"),
     )
-    .with_note(format!("deepest chain: {}", rec.chain_text()));
+    .with_note(format!(
+        "deepest chain: {}",
+        crate::explain::recursion_chain(rec)
+    ));
     if at_declared > at_required {
         d = d.with_note(format!(
             "the default stack is {at_declared} bytes per thread at depth {declared} and {at_required} at depth {required} (driver-comparable model)"

@@ -49,7 +49,7 @@ pub fn check(pipeline: &Pipeline, rec: &RecursionReport, device_limit: u32) -> V
             )
             .with_code(CODE)
             .with_primary(deepest, format!("this trace runs at depth {required}"))
-            .with_note(format!("deepest chain: {}", rec.chain_text()))
+            .with_note(format!("deepest chain: {}", crate::explain::recursion_chain(rec)))
             .with_note(note)
             .with_help("loop over bounces in the ray generation shader instead of recursing"),
         );

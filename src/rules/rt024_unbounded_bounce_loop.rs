@@ -30,7 +30,7 @@ pub fn check(pipeline: &Pipeline, rec: &RecursionReport) -> Vec<Diagnostic> {
                 .with_subject(l.entry.clone())
                 .with_primary(l.location.clone(), "loop starts here")
                 .with_secondary(l.site_location.clone(), "traces here")
-                .with_note(why.clone())
+                .with_note(why.to_string())
                 .with_help(
                     "compare the bounce counter with a constant, or give the bound under `[constants]` in the pipeline description",
                 ),
@@ -48,7 +48,7 @@ pub fn check(pipeline: &Pipeline, rec: &RecursionReport) -> Vec<Diagnostic> {
             let names: Vec<String> = c
                 .nodes
                 .iter()
-                .map(|&n| rec.graph.nodes[n].describe())
+                .map(|&n| crate::explain::node(&rec.graph.nodes[n]))
                 .collect();
             out.push(
                 Diagnostic::new(
@@ -62,7 +62,7 @@ pub fn check(pipeline: &Pipeline, rec: &RecursionReport) -> Vec<Diagnostic> {
                 )
                 .with_code(CODE)
                 .with_primary(site.location.clone(), "this trace closes the cycle")
-                .with_note(why.clone())
+                .with_note(why.to_string())
                 .with_help(
                     "guard the trace with a depth counter carried in the payload and compared with a constant",
                 ),

@@ -46,7 +46,7 @@ pub fn check(pipeline: &Pipeline, stack: &StackReport, limit_bytes: u64) -> Vec<
                 if stack.depth_chain.is_empty() {
                     "no chain".into()
                 } else {
-                    stack.depth_chain.clone()
+                    crate::explain::stack_chain(stack)
                 }
             ));
             if v <= limit_bytes {
