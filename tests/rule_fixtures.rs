@@ -64,12 +64,12 @@ fn fixture_files(dir: &Path) -> Vec<PathBuf> {
         .map(|e| e.unwrap().path())
         .filter(|p| {
             let n = p.file_name().unwrap().to_str().unwrap();
-            (n.starts_with("bad") || n.starts_with("good"))
-                && !n.ends_with(".sh")
-                && !n.ends_with(".md")
-                && !n.ends_with(".hlsli")
-                && !(n.ends_with(".glsl") && n.matches('.').count() == 1)
-                && !(n.ends_with(".toml") && !n.ends_with(".pipeline.toml"))
+            let fixture = n.starts_with("bad") || n.starts_with("good");
+            let skipped = [".sh", ".md", ".hlsli"].iter().any(|e| n.ends_with(e))
+                // A plain `.glsl` is a header; `bad.rgen.glsl` is a shader.
+                || (n.ends_with(".glsl") && n.matches('.').count() == 1)
+                || (n.ends_with(".toml") && !n.ends_with(".pipeline.toml"));
+            fixture && !skipped
         })
         .collect();
     v.sort();
