@@ -203,6 +203,27 @@ fn payload_info(program: &Program, id: Id) -> PayloadInfo {
     }
 }
 
+/// The type of element `i` of a composite type.
+fn element_type(program: &Program, ty: Id, i: u32) -> Option<Id> {
+    match program.ty(ty)? {
+        Type::Struct { members } => members.get(i as usize).copied(),
+        Type::Vector { elem, .. } | Type::Array { elem, .. } => Some(*elem),
+        Type::Matrix { column, .. } => Some(*column),
+        _ => None,
+    }
+}
+
+/// How many elements a composite type has, when fixed.
+fn element_count(program: &Program, ty: Id) -> Option<u32> {
+    match program.ty(ty)? {
+        Type::Struct { members } => Some(members.len() as u32),
+        Type::Vector { count, .. } => Some(*count),
+        Type::Matrix { columns, .. } => Some(*columns),
+        Type::Array { len, .. } => len.value().map(|n| n.min(u32::MAX as u64) as u32),
+        _ => None,
+    }
+}
+
 fn pointee(program: &Program, ptr_ty: Id) -> Option<Id> {
     match program.ty(ptr_ty)? {
         Type::Pointer { pointee, .. } => Some(*pointee),
@@ -258,16 +279,34 @@ fn id_operands(inst: &Instruction) -> impl Iterator<Item = Id> + '_ {
     })
 }
 
+/// What backward liveness tracks: an SSA value (empty path), or part of a
+/// function-local variable, named by the constant access-chain indices that
+/// reach it from the variable (empty: all of it).
+type Place = (Id, Vec<u32>);
+
+/// A pointer into a function-local variable.
+#[derive(Clone, Debug)]
+struct LocalPtr {
+    var: Id,
+    /// Constant indices from the variable, up to the first dynamic one.
+    path: Vec<u32>,
+    /// Whether every index was constant (the pointer names exactly `path`).
+    exact: bool,
+}
+
+/// Parts are tracked separately up to this many elements per composite.
+const MAX_SPLIT: u32 = 64;
+
 /// Liveness facts of one function.
 pub struct FnLiveness {
     func: usize,
     /// Function-local `OpVariable`s.
     vars: HashSet<Id>,
-    /// Pointer ids derived from a local variable, to the variable.
-    roots: HashMap<Id, Id>,
+    /// Pointer ids derived from a local variable.
+    roots: HashMap<Id, LocalPtr>,
     /// SSA values that count as state: defined here, not pointers to locals.
     ssa: HashSet<Id>,
-    live_out: Vec<HashSet<Id>>,
+    live_out: Vec<HashSet<Place>>,
     /// Variables possibly written at each block's end.
     defined_out: Vec<HashSet<Id>>,
     preds: Vec<Vec<usize>>,
@@ -278,25 +317,55 @@ impl FnLiveness {
     pub fn new(program: &Program, func: usize) -> FnLiveness {
         let f = &program.functions[func];
         let mut vars = HashSet::new();
-        let mut roots = HashMap::new();
+        let mut roots: HashMap<Id, LocalPtr> = HashMap::new();
         let mut ssa = HashSet::new();
         for inst in &program.insts[f.start..=f.end] {
             let Some(r) = inst.result_id else { continue };
+            if program.is_debug_inst(inst) {
+                continue;
+            }
             match inst.class.opcode {
                 Op::Variable => {
                     vars.insert(r);
-                    roots.insert(r, r);
+                    roots.insert(
+                        r,
+                        LocalPtr {
+                            var: r,
+                            path: Vec::new(),
+                            exact: true,
+                        },
+                    );
                 }
                 Op::AccessChain
                 | Op::InBoundsAccessChain
                 | Op::PtrAccessChain
                 | Op::CopyObject
                 | Op::Bitcast => {
-                    let base = id_operands(inst).next();
-                    if let Some(root) = base.and_then(|b| roots.get(&b).copied()) {
-                        roots.insert(r, root);
-                    } else {
-                        ssa.insert(r);
+                    let ids: Vec<Id> = id_operands(inst).collect();
+                    match ids.first().and_then(|b| roots.get(b)).cloned() {
+                        Some(mut ptr) => {
+                            let chain = matches!(
+                                inst.class.opcode,
+                                Op::AccessChain | Op::InBoundsAccessChain
+                            );
+                            if inst.class.opcode == Op::PtrAccessChain
+                                || inst.class.opcode == Op::Bitcast
+                            {
+                                ptr.exact = false;
+                            }
+                            if chain {
+                                for &ix in &ids[1..] {
+                                    match program.const_u64(ix) {
+                                        Some(c) if ptr.exact => ptr.path.push(c as u32),
+                                        _ => ptr.exact = false,
+                                    }
+                                }
+                            }
+                            roots.insert(r, ptr);
+                        }
+                        None => {
+                            ssa.insert(r);
+                        }
                     }
                 }
                 Op::Label | Op::Function => {}
@@ -333,39 +402,33 @@ impl FnLiveness {
     }
 
     fn root(&self, id: Id) -> Option<Id> {
-        self.roots.get(&id).copied()
+        self.roots.get(&id).map(|p| p.var)
     }
 
-    /// Backward transfer of one instruction over the live set.
-    fn step_back(&self, inst: &Instruction, live: &mut HashSet<Id>) {
+    /// Backward transfer of one instruction over the live set. Debug-info
+    /// instructions (`DebugDeclare`, `DebugValue`) neither read nor write.
+    fn step_back(&self, program: &Program, inst: &Instruction, live: &mut HashSet<Place>) {
+        if program.is_debug_inst(inst) {
+            return;
+        }
         let op = inst.class.opcode;
         if let Some(r) = inst.result_id {
-            live.remove(&r);
+            live.remove(&(r, Vec::new()));
+            // An initializer writes the whole variable.
+            if op == Op::Variable {
+                live.retain(|(v, _)| *v != r);
+            }
         }
         match op {
             // Phi operands are used on the incoming edge, handled by `solve`.
             Op::Phi => return,
-            Op::Store => {
+            Op::Store | Op::CopyMemory | Op::CopyMemorySized => {
                 if let Some(Operand::IdRef(ptr)) = inst.operands.first() {
-                    if self.vars.contains(ptr) {
-                        live.remove(ptr);
+                    if let Some(p) = self.roots.get(ptr).filter(|p| p.exact) {
+                        self.kill(program, live, p);
                     }
                 }
             }
-            Op::CopyMemory | Op::CopyMemorySized => {
-                if let Some(Operand::IdRef(ptr)) = inst.operands.first() {
-                    if self.vars.contains(ptr) {
-                        live.remove(ptr);
-                    }
-                }
-                if let Some(Operand::IdRef(src)) = inst.operands.get(1) {
-                    if let Some(v) = self.root(*src) {
-                        live.insert(v);
-                    }
-                }
-            }
-            // An initializer writes the whole variable; the result id was
-            // removed above.
             _ => {}
         }
         let derives = matches!(
@@ -378,9 +441,9 @@ impl FnLiveness {
         );
         for (k, id) in id_operands(inst).enumerate() {
             if self.ssa.contains(&id) {
-                live.insert(id);
+                live.insert((id, Vec::new()));
             }
-            if let Some(v) = self.root(id) {
+            if let Some(p) = self.roots.get(&id) {
                 // Deriving a pointer reads nothing; a store's target is
                 // written, not read; anything else may read the variable.
                 let reads = match op {
@@ -390,14 +453,71 @@ impl FnLiveness {
                     _ => true,
                 };
                 if reads {
-                    live.insert(v);
+                    live.insert((p.var, p.path.clone()));
                 }
             }
         }
     }
 
+    /// A write of exactly `ptr`'s part: that part and everything inside it
+    /// is dead before the write; a live enclosing part stays live only in
+    /// the pieces the write does not cover.
+    fn kill(&self, program: &Program, live: &mut HashSet<Place>, ptr: &LocalPtr) {
+        let parts: Vec<Vec<u32>> = live
+            .iter()
+            .filter(|(v, _)| *v == ptr.var)
+            .map(|(_, q)| q.clone())
+            .collect();
+        for q in parts {
+            if q.starts_with(&ptr.path) {
+                live.remove(&(ptr.var, q));
+            } else if ptr.path.starts_with(&q) {
+                if let Some(pieces) = self.split(program, ptr.var, &q, &ptr.path) {
+                    live.remove(&(ptr.var, q));
+                    live.extend(pieces.into_iter().map(|p| (ptr.var, p)));
+                }
+            }
+        }
+    }
+
+    /// The parts of `outer` not inside `inner` (a longer path below it), as
+    /// the siblings met on the way down; `None` when a composite on the way
+    /// has no known, small element count.
+    fn split(
+        &self,
+        program: &Program,
+        var: Id,
+        outer: &[u32],
+        inner: &[u32],
+    ) -> Option<Vec<Vec<u32>>> {
+        let mut ty = program
+            .def(var)
+            .and_then(|d| d.result_type)
+            .and_then(|t| pointee(program, t))?;
+        for &i in outer {
+            ty = element_type(program, ty, i)?;
+        }
+        let mut out = Vec::new();
+        for depth in outer.len()..inner.len() {
+            let n = element_count(program, ty)?;
+            if n > MAX_SPLIT {
+                return None;
+            }
+            for j in (0..n).filter(|&j| j != inner[depth]) {
+                let mut piece = inner[..depth].to_vec();
+                piece.push(j);
+                out.push(piece);
+            }
+            ty = element_type(program, ty, inner[depth])?;
+        }
+        Some(out)
+    }
+
     /// Variables an instruction may write.
-    fn writes(&self, inst: &Instruction) -> Vec<Id> {
+    fn writes(&self, program: &Program, inst: &Instruction) -> Vec<Id> {
+        if program.is_debug_inst(inst) {
+            return Vec::new();
+        }
         match inst.class.opcode {
             Op::Variable if inst.operands.len() > 1 => inst.result_id.into_iter().collect(),
             Op::Load | Op::AccessChain | Op::InBoundsAccessChain | Op::PtrAccessChain => Vec::new(),
@@ -429,17 +549,18 @@ impl FnLiveness {
                 }
             }
         }
-        let mut live_in: Vec<HashSet<Id>> = vec![HashSet::new(); n];
+        let mut live_in: Vec<HashSet<Place>> = vec![HashSet::new(); n];
         let mut changed = true;
         let mut rounds = 0;
         while changed && rounds < 10_000 {
             changed = false;
             rounds += 1;
             for b in (0..n).rev() {
-                let mut out: HashSet<Id> = phi_uses[b].iter().copied().collect();
+                let mut out: HashSet<Place> =
+                    phi_uses[b].iter().map(|&v| (v, Vec::new())).collect();
                 for &s in &f.blocks[b].succs {
                     if let Some(li) = live_in.get(s) {
-                        out.extend(li.iter().copied());
+                        out.extend(li.iter().cloned());
                     }
                 }
                 let mut live = out.clone();
@@ -447,7 +568,7 @@ impl FnLiveness {
                     .iter()
                     .rev()
                 {
-                    self.step_back(inst, &mut live);
+                    self.step_back(program, inst, &mut live);
                 }
                 if out != self.live_out[b] || live != live_in[b] {
                     self.live_out[b] = out;
@@ -468,7 +589,7 @@ impl FnLiveness {
                     d.extend(self.defined_out[p].iter().copied());
                 }
                 for inst in &program.insts[f.blocks[b].start..=f.blocks[b].end] {
-                    d.extend(self.writes(inst));
+                    d.extend(self.writes(program, inst));
                 }
                 if d != self.defined_out[b] {
                     self.defined_out[b] = d;
@@ -486,9 +607,9 @@ impl FnLiveness {
         };
         let mut live = self.live_out[b].clone();
         for k in (inst + 1..=f.blocks[b].end).rev() {
-            self.step_back(&program.insts[k], &mut live);
+            self.step_back(program, &program.insts[k], &mut live);
         }
-        live
+        live.into_iter().map(|(id, _)| id).collect()
     }
 
     /// Variables possibly written before instruction `inst`.
@@ -502,7 +623,7 @@ impl FnLiveness {
             d.extend(self.defined_out[p].iter().copied());
         }
         for k in f.blocks[b].start..inst {
-            d.extend(self.writes(&program.insts[k]));
+            d.extend(self.writes(program, &program.insts[k]));
         }
         d
     }
@@ -575,7 +696,10 @@ impl FnLiveness {
         out
     }
 
-    fn reads(&self, inst: &Instruction, id: Id) -> bool {
+    fn reads(&self, program: &Program, inst: &Instruction, id: Id) -> bool {
+        if program.is_debug_inst(inst) {
+            return false;
+        }
         if inst.class.opcode == Op::Phi {
             return id_operands(inst).step_by(2).any(|x| x == id);
         }
@@ -598,7 +722,7 @@ impl FnLiveness {
         let b0 = f.block_of(inst)?;
         let mut found = None;
         for k in inst + 1..=f.blocks[b0].end {
-            if self.reads(&program.insts[k], id) {
+            if self.reads(program, &program.insts[k], id) {
                 found = Some(k);
                 break;
             }
@@ -611,7 +735,7 @@ impl FnLiveness {
                     continue;
                 }
                 for k in f.blocks[b].start..=f.blocks[b].end {
-                    if self.reads(&program.insts[k], id) {
+                    if self.reads(program, &program.insts[k], id) {
                         found = Some(k);
                         break 'bfs;
                     }
@@ -664,11 +788,26 @@ impl FnLiveness {
         let name = format!("{op:?}");
         let r = match op {
             Op::Phi | Op::FunctionCall | Op::FunctionParameter | Op::Variable => false,
-            _ if name.starts_with("Atomic") || name.starts_with("RayQuery") => false,
+            // A clock reads time, and subgroup operations depend on which
+            // invocations are active: neither gives the same value again.
+            Op::ReadClockKHR => false,
+            _ if name.starts_with("Atomic")
+                || name.starts_with("RayQuery")
+                || name.starts_with("GroupNonUniform")
+                || name.starts_with("Subgroup")
+                || name.starts_with("Group") =>
+            {
+                false
+            }
             Op::Load => {
                 let ptr = id_operands(inst).next().unwrap_or(0);
                 match self.root(ptr) {
                     Some(v) => self.remat_var(program, v, depth + 1),
+                    // A buffer_reference pointer is an address computed like
+                    // any value: the load is recomputable when it is.
+                    None if self.physical_pointer(program, ptr) => {
+                        self.remat_ssa(program, ptr, depth + 1)
+                    }
                     None => self.remat_global_ptr(program, ptr, depth + 1),
                 }
             }
@@ -685,6 +824,19 @@ impl FnLiveness {
         };
         self.remat.insert(id, r);
         r
+    }
+
+    /// Whether `ptr` is a `PhysicalStorageBuffer` pointer (GLSL
+    /// `buffer_reference`, HLSL `vk::RawBufferLoad`).
+    fn physical_pointer(&self, program: &Program, ptr: Id) -> bool {
+        let ty = program.def(ptr).and_then(|d| d.result_type);
+        matches!(
+            ty.and_then(|t| program.ty(t)),
+            Some(Type::Pointer {
+                storage: StorageClass::PhysicalStorageBuffer,
+                ..
+            })
+        )
     }
 
     fn remat_global_ptr(&mut self, program: &Program, ptr: Id, depth: u32) -> bool {
@@ -728,6 +880,9 @@ impl FnLiveness {
         let mut ok = true;
         for i in start..=end {
             let inst = &program.insts[i];
+            if program.is_debug_inst(inst) {
+                continue;
+            }
             let ids: Vec<Id> = id_operands(inst).collect();
             if !ids.iter().any(|x| self.root(*x) == Some(var)) && inst.result_id != Some(var) {
                 continue;

@@ -96,7 +96,11 @@ pub fn parse(words: &[u32], path: &Path, language: Language) -> Result<Program, 
         header: None,
         insts: Vec::new(),
     };
-    if let Err(e) = rspirv::binary::parse_words(words, &mut c) {
+    // Compilers copy source bytes into strings unchecked (glslang `-g` keeps
+    // a Latin-1 comment), and spirv-val accepts that: parse a copy whose
+    // strings have each invalid byte replaced by `?`.
+    let cleaned = valid_utf8_strings(words, &offsets);
+    if let Err(e) = rspirv::binary::parse_words(cleaned.as_deref().unwrap_or(words), &mut c) {
         use rspirv::binary::ParseState as S;
         let at = |n: usize| offsets.get(n).copied().unwrap_or(words.len() as u32);
         let msg = match e {
@@ -153,6 +157,7 @@ pub fn parse(words: &[u32], path: &Path, language: Language) -> Result<Program, 
             decl_pos: HashMap::new(),
             defs: HashMap::new(),
             debug_info_set: None,
+            debug_sets: Vec::new(),
         },
         strings: HashMap::new(),
         file_of_string: HashMap::new(),
@@ -169,6 +174,61 @@ pub fn parse(words: &[u32], path: &Path, language: Language) -> Result<Program, 
     b.sites();
     super::textdecl::fill(&mut b.p);
     Ok(b.p)
+}
+
+/// The word within an instruction where its literal string starts, for the
+/// instructions that carry one.
+fn string_word(op: Op, count: usize) -> Option<usize> {
+    let at = match op {
+        Op::String | Op::Name | Op::ExtInstImport => 2,
+        Op::MemberName | Op::EntryPoint => 3,
+        Op::SourceContinued | Op::SourceExtension | Op::Extension | Op::ModuleProcessed => 1,
+        Op::Source => 4,
+        _ => return None,
+    };
+    (at < count).then_some(at)
+}
+
+/// A copy of the module with every string's invalid UTF-8 bytes replaced by
+/// `?` (same length, so no word moves); `None` when every string is valid.
+fn valid_utf8_strings(words: &[u32], offsets: &[u32]) -> Option<Vec<u32>> {
+    let mut out: Option<Vec<u32>> = None;
+    for &at in offsets {
+        let at = at as usize;
+        let count = (words[at] >> 16) as usize;
+        let Some(op) = Op::from_u32(words[at] & 0xffff) else {
+            continue;
+        };
+        let Some(k) = string_word(op, count) else {
+            continue;
+        };
+        let mut bytes: Vec<u8> = words[at + k..at + count]
+            .iter()
+            .flat_map(|w| w.to_le_bytes())
+            .collect();
+        let len = bytes.iter().position(|&b| b == 0).unwrap_or(bytes.len());
+        let mut changed = false;
+        let mut start = 0;
+        while start < len {
+            match std::str::from_utf8(&bytes[start..len]) {
+                Ok(_) => break,
+                Err(e) => {
+                    let bad = start + e.valid_up_to();
+                    let n = e.error_len().unwrap_or(len - bad);
+                    bytes[bad..bad + n].fill(b'?');
+                    start = bad + n;
+                    changed = true;
+                }
+            }
+        }
+        if changed {
+            let out = out.get_or_insert_with(|| words.to_vec());
+            for (j, c) in bytes.chunks_exact(4).enumerate() {
+                out[at + k + j] = u32::from_le_bytes([c[0], c[1], c[2], c[3]]);
+            }
+        }
+    }
+    out
 }
 
 fn opname(words: &[u32], offset: u32) -> String {
@@ -385,8 +445,15 @@ impl Builder<'_> {
                     }
                 }
                 Op::ExtInstImport => {
-                    if str_at(&inst, 0) == Some("NonSemantic.Shader.DebugInfo.100") {
+                    let set = str_at(&inst, 0).unwrap_or("");
+                    if set == "NonSemantic.Shader.DebugInfo.100" {
                         self.p.debug_info_set = inst.result_id;
+                    }
+                    if set.starts_with("NonSemantic.")
+                        || set == "OpenCL.DebugInfo.100"
+                        || set == "DebugInfo"
+                    {
+                        self.p.debug_sets.extend(inst.result_id);
                     }
                 }
                 Op::EntryPoint => {
@@ -581,6 +648,19 @@ impl Builder<'_> {
     fn type_or_constant(&mut self, i: usize, inst: &dr::Instruction) -> Result<(), InputError> {
         let op = inst.class.opcode;
         let r = inst.result_id.unwrap_or(0);
+        if op == Op::TypeForwardPointer {
+            // `buffer_reference` structs point to themselves: the pointer type
+            // is named before its `OpTypePointer`, which later replaces this.
+            if let (Some(ptr), Some(Operand::StorageClass(storage))) =
+                (id_at(inst, 0), inst.operands.get(1))
+            {
+                self.p.types.entry(ptr).or_insert(Type::Pointer {
+                    storage: *storage,
+                    pointee: 0,
+                });
+            }
+            return Ok(());
+        }
         let ty = match op {
             Op::TypeVoid => Some(Type::Void),
             Op::TypeBool => Some(Type::Bool),

@@ -229,9 +229,20 @@ pub struct Program {
     pub defs: HashMap<Id, usize>,
     /// The id of the `NonSemantic.Shader.DebugInfo.100` import, if any.
     pub debug_info_set: Option<Id>,
+    /// Imports of instruction sets without semantics (`NonSemantic.*`,
+    /// `OpenCL.DebugInfo.100`, `DebugInfo`): their instructions only describe
+    /// the code, so no analysis may count them as reads or writes.
+    pub debug_sets: Vec<Id>,
 }
 
 impl Program {
+    /// Whether `inst` is an extended instruction of a set without semantics
+    /// (`DebugDeclare`, `DebugValue`, `DebugScope`, …): debug info, not code.
+    pub fn is_debug_inst(&self, inst: &Instruction) -> bool {
+        inst.class.opcode == Op::ExtInst
+            && matches!(inst.operands.first(), Some(Operand::IdRef(set)) if self.debug_sets.contains(set))
+    }
+
     pub fn name(&self, id: Id) -> Option<&str> {
         self.names.get(&id).map(String::as_str)
     }
