@@ -171,6 +171,7 @@ pub fn parse(words: &[u32], path: &Path, language: Language) -> Result<Program, 
     b.collect()?;
     b.functions()?;
     b.link_debug_composites();
+    b.drop_impossible_positions();
     b.sites();
     super::textdecl::fill(&mut b.p);
     Ok(b.p)
@@ -290,6 +291,31 @@ impl Builder<'_> {
                 self.word(inst)
             ),
         )
+    }
+
+    /// Positions on line 0 or past the end of their file's embedded text
+    /// (glslang 12 `-gV` writes both) are no positions.
+    fn drop_impossible_positions(&mut self) {
+        let lines: Vec<Option<usize>> = self
+            .p
+            .files
+            .iter()
+            .map(|f| f.text.as_ref().map(|t| t.lines().count()))
+            .collect();
+        let possible = |p: &SrcPos| {
+            p.line > 0
+                && lines
+                    .get(p.file as usize)
+                    .copied()
+                    .flatten()
+                    .is_none_or(|n| p.line as usize <= n)
+        };
+        for loc in &mut self.p.locs {
+            if loc.as_ref().is_some_and(|p| !possible(p)) {
+                *loc = None;
+            }
+        }
+        self.p.decl_pos.retain(|_, p| possible(p));
     }
 
     /// Every id used must be defined somewhere in the module and below the bound.

@@ -10,6 +10,7 @@ mod binary;
 mod build;
 pub mod cfg;
 pub mod debug;
+mod fold;
 pub mod scalar;
 mod textdecl;
 pub mod types;
@@ -302,6 +303,9 @@ impl Program {
         }
         if let Some(Constant::Int(v)) = self.spec_constants.get(&id) {
             return OperandValue::Spec { id, default: *v };
+        }
+        if let Some(v) = self.fold(id) {
+            return OperandValue::Const(v);
         }
         OperandValue::Dynamic(id)
     }
