@@ -166,3 +166,63 @@ pub fn check_pipeline(path: &Path, config: &Config) -> Checked {
         },
     }
 }
+
+/// The shader files a pipeline description uses (nothing when it cannot be
+/// read: `check_pipeline` reports that).
+pub fn described_shaders(path: &Path) -> Vec<PathBuf> {
+    crate::pipeline::load(path)
+        .map(|p| p.programs.iter().map(|p| canonical(&p.path)).collect())
+        .unwrap_or_default()
+}
+
+fn canonical(p: &Path) -> PathBuf {
+    std::fs::canonicalize(p).unwrap_or_else(|_| p.to_path_buf())
+}
+
+/// Runs the pipeline rules (RT020–RT025) on shaders no description uses:
+/// the shaders of each folder form one pipeline in which every trace may
+/// reach every hit group and miss shader, and each finding says so.
+pub fn check_loose(
+    programs: Vec<Program>,
+    described: &[PathBuf],
+    config: &Config,
+) -> Vec<Diagnostic> {
+    let mut groups: Vec<(PathBuf, Vec<Program>)> = Vec::new();
+    for p in programs {
+        if described.contains(&canonical(&p.path)) {
+            continue;
+        }
+        let has_rt = p.entry_points.iter().any(|e| e.stage.is_ray_tracing());
+        if !has_rt {
+            continue;
+        }
+        // A file holding a ray generation shader and others (WGSL, HLSL) is
+        // a pipeline of its own; one-stage modules pipeline with their folder.
+        let whole = p
+            .entry_points
+            .iter()
+            .any(|e| e.stage == crate::shader::Stage::RayGeneration)
+            && p.entry_points.len() > 1;
+        let dir = if whole {
+            p.path.clone()
+        } else {
+            p.path.parent().map(Path::to_path_buf).unwrap_or_default()
+        };
+        match groups.iter_mut().find(|(d, _)| *d == dir) {
+            Some((_, g)) => g.push(p),
+            None => groups.push((dir, vec![p])),
+        }
+    }
+    let mut out = Vec::new();
+    for (_, programs) in groups {
+        let pipeline = crate::pipeline::Pipeline::from_programs(programs);
+        let ctx = crate::rules::PipelineContext::new(&pipeline, config);
+        let note = crate::analysis::callgraph::Assumption::Undescribed.to_string();
+        out.extend(
+            crate::rules::check_pipeline(&ctx)
+                .into_iter()
+                .map(|d| d.with_note(note.clone())),
+        );
+    }
+    out
+}

@@ -239,16 +239,21 @@ fn check(
     let mut diagnostics = errors;
     diagnostics.extend(inputs.errors.iter().map(|e| (*e.0).clone()));
     let mut sources = Sources::default();
+    let mut programs = Vec::new();
     for input in &inputs.files {
         let checked = lint::check_input(input, &config);
-        if let Some(p) = &checked.program {
-            sources.add_program(p);
+        if let Some(p) = checked.program {
+            sources.add_program(&p);
+            programs.push(p);
         }
         diagnostics.extend(checked.diagnostics);
     }
+    let mut described = Vec::new();
     for p in &inputs.pipelines {
         diagnostics.extend(lint::check_pipeline(p, &config).diagnostics);
+        described.extend(lint::described_shaders(p));
     }
+    diagnostics.extend(lint::check_loose(programs, &described, &config));
     let summary = Summary::count(inputs.files.len() + inputs.pipelines.len(), &diagnostics);
     emit(
         format,
