@@ -226,3 +226,30 @@ pub fn check_loose(
     }
     out
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Without a description every trace may reach every shader: RT020–RT025
+    /// still run, and each finding says what was assumed.
+    #[test]
+    fn loose_shaders_get_pipeline_rules_with_the_assumption() {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/guards/constructed.wgsl");
+        let p = front::load(&path, Language::Wgsl).unwrap();
+        let d = check_loose(vec![p], &[], &Config::default());
+        let rt020: Vec<_> = d
+            .iter()
+            .filter(|d| d.code.as_deref() == Some("RT020"))
+            .collect();
+        assert_eq!(rt020.len(), 1, "{d:?}");
+        assert_eq!(rt020[0].primary.as_ref().unwrap().location.line, 38);
+        assert!(rt020[0]
+            .notes
+            .iter()
+            .any(|n| n.contains("every trace may reach every hit group and miss shader")));
+        // A shader a description uses is checked with that description only.
+        let p = front::load(&path, Language::Wgsl).unwrap();
+        assert!(check_loose(vec![p], &[canonical(&path)], &Config::default()).is_empty());
+    }
+}

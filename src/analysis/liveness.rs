@@ -670,10 +670,19 @@ impl FnLiveness {
             let def = if is_var {
                 self.var_def_location(program, id)
             } else {
-                program
-                    .defs
-                    .get(&id)
-                    .and_then(|&i| program.inst_location(i))
+                program.defs.get(&id).and_then(|&i| {
+                    program.inst_location(i).or_else(|| {
+                        // A builtin or resource loaded where the compiler
+                        // gave no line (naga's entry-point prologue): where
+                        // the global is declared.
+                        let inst = &program.insts[i];
+                        let ptr = id_operands(inst).next()?;
+                        (inst.class.opcode == Op::Load
+                            && program.globals.iter().any(|g| g.id == ptr))
+                        .then(|| program.var_location(ptr))
+                        .flatten()
+                    })
+                })
             };
             let use_at = self.first_use_after(program, inst, id);
             out.push(LiveValue {
@@ -1046,5 +1055,91 @@ mod tests {
             .find(|s| s.kind == LiveSiteKind::TraceRay)
             .unwrap();
         assert_eq!(names(trace), [("uv", 8, true)]);
+    }
+
+    /// Debug info never changes the answer: `-g`, `-gV` (DebugDeclare and
+    /// DebugValue name every local), WGSL and rtlint's HLSL alike. Loop-local
+    /// state written at the top of each iteration is not live, a struct
+    /// written field by field no more than one built whole.
+    #[test]
+    fn loop_locals_are_dead_whatever_the_debug_info() {
+        for rel in [
+            "fixtures/live/loop_local.rgen.spv",
+            "fixtures/live/loop_local.rgen.gV.spv",
+        ] {
+            let sites = live_sites(&program(rel));
+            assert_eq!(sites.len(), 2, "{rel}");
+            assert_eq!(
+                names(&sites[0]),
+                [("acc", 12, false), ("dir", 12, false), ("i", 4, false)],
+                "{rel}"
+            );
+            assert_eq!(
+                names(&sites[1]),
+                [("acc", 12, false), ("i", 4, false)],
+                "{rel}"
+            );
+        }
+        let s = one_site("fixtures/live/loop_local.hlsl");
+        assert_eq!(names(&s), [("acc", 12, false), ("i", 4, false)]);
+        let s = one_site("fixtures/live/loop_local.wgsl");
+        let n = names(&s);
+        assert!(!n.iter().any(|v| v.0 == "ray" || v.0 == "dir"), "{n:?}");
+        assert!(n.contains(&("acc", 12, false)) && n.contains(&("i", 4, false)));
+    }
+
+    /// One value per rematerialisation class (docs/stack.md), with and
+    /// without NonSemantic debug info.
+    #[test]
+    fn rematerialisation_classes() {
+        for rel in [
+            "fixtures/live/classes.rgen.spv",
+            "fixtures/live/classes.rgen.gV.spv",
+        ] {
+            let sites = live_sites(&program(rel));
+            assert_eq!(
+                names(&sites[0]),
+                [
+                    ("fromBuiltin", 16, true),
+                    ("fromImage", 16, true),
+                    ("fromStorage", 16, true),
+                    ("fromTexture", 16, true),
+                    ("fromUniform", 16, true),
+                    ("fromClock", 8, false),
+                    ("fromRealtime", 8, false),
+                ]
+                .iter()
+                .copied()
+                .collect::<std::collections::BTreeSet<_>>()
+                .into_iter()
+                .collect::<Vec<_>>(),
+                "{rel}"
+            );
+            let second = names(&sites[1]);
+            assert!(
+                second.contains(&("fromPayload", 16, false)),
+                "{rel}: {second:?}"
+            );
+        }
+        // buffer_reference loads are as recomputable as storage-buffer loads.
+        let s = one_site("fixtures/live/reference.rgen.spv");
+        assert_eq!(names(&s), [("albedo", 16, true), ("scale", 16, true)]);
+    }
+
+    /// glslang -g copies a Latin-1 comment byte into OpSource; spirv-val
+    /// accepts the module, and so does rtlint (each bad byte read as `?`).
+    #[test]
+    fn non_utf8_source_is_read() {
+        let p = program("fixtures/live/latin1.rgen.spv");
+        let text = p.files.iter().find_map(|f| f.text.clone()).unwrap();
+        assert!(text.contains("// Gr??e: a Latin-1 comment"), "{text}");
+        for rel in [
+            "fixtures/live/latin1.rgen.spv",
+            "fixtures/live/latin1.rgen.gV.spv",
+        ] {
+            let s = one_site(rel);
+            assert_eq!(names(&s), [("k", 4, true)], "{rel}");
+            assert_eq!(s.line, Some(10), "{rel}");
+        }
     }
 }

@@ -143,6 +143,9 @@ pub struct ChainStep {
     pub level: u32,
     /// Further levels reached by a bounded cycle through this node.
     pub repeat: u64,
+    /// No level bounds this step: it is on an unbounded cycle, or reached
+    /// from one (then `level` means nothing).
+    pub unbounded: bool,
     /// The trace that invoked it.
     pub via: Option<Location>,
 }
@@ -338,14 +341,17 @@ pub fn recursion_report(pipeline: &Pipeline) -> RecursionReport {
             Some((k, _)) => (traces[k].to, traces[k].location.clone()),
             None => (sccs[c][0], None),
         };
-        let level = match entry[c] {
-            Lv::At(l) => l as u32,
-            _ => 0,
+        let (level, unbounded) = match (entry[c], extra[c]) {
+            (Lv::At(l), Some(_)) => (l as u32, false),
+            // Entered at a known level, but the cycle through it has no bound.
+            (Lv::At(l), None) => (l as u32, true),
+            _ => (0, true),
         };
         chain.push(ChainStep {
             node,
             level,
             repeat: extra[c].unwrap_or(0),
+            unbounded,
             via,
         });
         cur = pred[c].map(|(_, from)| from);
@@ -1401,5 +1407,97 @@ mod tests {
                 value: 4
             }
         );
+    }
+
+    fn loose(rels: &[&str]) -> Pipeline {
+        let programs = rels
+            .iter()
+            .map(|rel| {
+                let path = Path::new(env!("CARGO_MANIFEST_DIR")).join(rel);
+                let lang = crate::shader::Language::from_path(&path).unwrap();
+                crate::front::load(&path, lang).unwrap()
+            })
+            .collect();
+        Pipeline::from_programs(programs)
+    }
+
+    /// GLSL through glslang with `-g` and `-gV`: a guard in a helper that
+    /// takes the payload `inout` (glslang's copy-in temporaries), a shadow
+    /// ray whose flags sit in a local (skip closest hit: no recursion), a
+    /// raygen loop counting bounces in the payload (`prd.depth++`).
+    #[test]
+    fn glsl_guards_through_inout_locals_and_payload_counters() {
+        for v in ["g", "gV"] {
+            let p = loose(&[
+                &format!("fixtures/guards/loop.rgen.{v}.spv"),
+                &format!("fixtures/guards/hit.rchit.{v}.spv"),
+                &format!("fixtures/guards/miss.rmiss.{v}.spv"),
+            ]);
+            let r = recursion_report(&p);
+            // depth < 3 from 0: hit at levels 1–4, the shadow ray's miss at 5.
+            assert_eq!(r.required_depth, Some(5), "{v}");
+            assert_eq!(r.cycles.len(), 1, "{v}");
+            assert_eq!(
+                r.cycles[0].sites.len(),
+                1,
+                "{v}: the shadow ray closes no cycle"
+            );
+            let g = r.cycles[0].sites[0].guard.as_ref().unwrap();
+            assert_eq!((g.bound, g.step, g.traces), (3, 1, 3), "{v}");
+            assert!(!g.initial_assumed, "{v}");
+            let loops = trace_loops(&p.programs[0], &p.constants);
+            assert_eq!(loops.len(), 1, "{v}");
+            let b = loops[0].bound.as_ref().unwrap();
+            assert_eq!(
+                (b.counter.as_str(), b.op, b.bound),
+                ("prd.depth", "<", 10),
+                "{v}"
+            );
+        }
+    }
+
+    /// HLSL through rtlint: the traced payload is a fresh local written field
+    /// by field from the incoming one (`next.depth = payload.depth + 1`).
+    #[test]
+    fn hlsl_guard_through_a_fresh_payload() {
+        let r = recursion_report(&loose(&["fixtures/guards/fresh.hlsl"]));
+        assert_eq!(r.required_depth, Some(4));
+        let g = r.cycles[0].sites[0].guard.as_ref().unwrap();
+        assert_eq!((g.bound, g.step, g.initial, g.traces), (3, 1, 0, 3));
+        assert!(!g.initial_assumed);
+    }
+
+    /// WGSL: the traced payload is constructed (`Payload(…, incoming.depth +
+    /// 1u)`), and the shadow ray's flags come through a `var` and naga's
+    /// helper's `RayDesc` parameter.
+    #[test]
+    fn wgsl_guard_through_a_constructed_payload() {
+        let r = recursion_report(&loose(&["fixtures/guards/constructed.wgsl"]));
+        assert_eq!(r.required_depth, Some(6));
+        assert_eq!(r.cycles[0].sites.len(), 1);
+        let g = r.cycles[0].sites[0].guard.as_ref().unwrap();
+        assert_eq!(
+            (g.counter.as_str(), g.bound, g.traces),
+            ("incoming.depth", 4, 4)
+        );
+        // The recursive trace is the closest hit's, not the raygen's.
+        assert_eq!(
+            r.cycles[0].sites[0].location.as_ref().map(|l| l.line),
+            Some(38)
+        );
+    }
+
+    /// An unbounded chain says so at every step past the cycle; no shader is
+    /// placed "at level 0" after it.
+    #[test]
+    fn unbounded_chain_has_no_level_past_the_cycle() {
+        let r = recursion_report(&pipeline("fixtures/RT024/bad.pipeline.toml"));
+        assert_eq!(r.required_depth, None);
+        let text = crate::explain::recursion_chain(&r);
+        assert!(
+            text.contains("at levels 1 and deeper, without bound"),
+            "{text}"
+        );
+        assert!(!text.contains("(miss 0) at level 0"), "{text}");
     }
 }
