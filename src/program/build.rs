@@ -1046,3 +1046,40 @@ pub fn is_terminator(op: Op) -> bool {
             | Op::TerminateRayKHR
     )
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// glslang 12 `-gV` gives `main` line 0; such positions, and lines past
+    /// the end of the file, are dropped rather than relayed.
+    #[test]
+    fn no_position_on_line_zero_or_past_the_end() {
+        let path =
+            Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/live/loop_local.rgen.gV.spv");
+        let bytes = std::fs::read(&path).unwrap();
+        let words = super::super::words_from_bytes(&bytes, &path).unwrap();
+        let p = parse(&words, &path, Language::Spirv).unwrap();
+        // The module does say line 0 for `main` (DebugFunction's line).
+        let zero_line_function = p.insts.iter().any(|i| {
+            i.class.opcode == Op::ExtInst
+                && lit_at(i, 1) == Some(debug_info_op::FUNCTION)
+                && id_at(i, 5).and_then(|c| p.const_u64(c)) == Some(0)
+        });
+        assert!(zero_line_function);
+        let lines = std::fs::read_to_string(path.with_file_name("loop_local.rgen"))
+            .unwrap()
+            .lines()
+            .count() as u32;
+        let all = p.locs.iter().flatten().chain(p.decl_pos.values());
+        for pos in all {
+            assert!(pos.line >= 1 && pos.line <= lines, "{pos:?}");
+        }
+        let main = p
+            .functions
+            .iter()
+            .find(|f| f.name.as_deref() == Some("main"))
+            .unwrap();
+        assert!(p.decl_location(Decl::Func(main.id)).is_none());
+    }
+}
