@@ -238,10 +238,7 @@ mod tests {
         let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/guards/constructed.wgsl");
         let p = front::load(&path, Language::Wgsl).unwrap();
         let d = check_loose(vec![p], &[], &Config::default());
-        let rt020: Vec<_> = d
-            .iter()
-            .filter(|d| d.code.as_deref() == Some("RT020"))
-            .collect();
+        let rt020: Vec<_> = d.iter().filter(|d| d.code == Some("RT020")).collect();
         assert_eq!(rt020.len(), 1, "{d:?}");
         assert_eq!(rt020[0].primary.as_ref().unwrap().location.line, 38);
         assert!(rt020[0]

@@ -154,7 +154,10 @@ fn findings(d: &[Diagnostic], roots: &[String]) -> Vec<String> {
                 d.severity,
                 scrub_text(&d.message, roots),
                 notes.join(" / "),
-                d.help.as_deref().map(|h| scrub_text(h, roots)).unwrap_or_default()
+                d.help
+                    .as_deref()
+                    .map(|h| scrub_text(h, roots))
+                    .unwrap_or_default()
             )
         })
         .collect();
@@ -296,11 +299,7 @@ fn load_spv(path: &Path) -> Program {
 }
 
 /// One comparison: the reference mode's facts against another mode's.
-fn compare(
-    what: &str,
-    facts: &BTreeMap<Mode, Value>,
-    differences: &mut Vec<(String, String)>,
-) {
+fn compare(what: &str, facts: &BTreeMap<Mode, Value>, differences: &mut Vec<(String, String)>) {
     let Some((first_mode, first)) = facts.iter().next() else {
         return;
     };
@@ -373,7 +372,11 @@ fn analyses_do_not_depend_on_debug_info() {
             let programs: Vec<Program> = glsl
                 .iter()
                 .filter(|r| r.parent() == Some(folder.as_path()))
-                .filter(|r| !invalid.iter().any(|i| i.starts_with(&format!("{} (", r.display()))))
+                .filter(|r| {
+                    !invalid
+                        .iter()
+                        .any(|i| i.starts_with(&format!("{} (", r.display())))
+                })
                 .map(|r| PathBuf::from(format!("{}.spv", out.join(m).join(r).display())))
                 .map(|p| load_spv(&p))
                 .collect();
@@ -383,7 +386,11 @@ fn analyses_do_not_depend_on_debug_info() {
             );
         }
         compared += 1;
-        compare(&format!("{}/ (loose)", folder.display()), &facts, &mut differences);
+        compare(
+            &format!("{}/ (loose)", folder.display()),
+            &facts,
+            &mut differences,
+        );
     }
 
     // Pipeline descriptions whose shaders are all GLSL.
