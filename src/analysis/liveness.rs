@@ -311,6 +311,8 @@ pub struct FnLiveness {
     defined_out: Vec<HashSet<Id>>,
     preds: Vec<Vec<usize>>,
     remat: HashMap<Id, bool>,
+    /// Variables' rematerialisation as read at an instruction.
+    remat_at: HashMap<(Id, usize), bool>,
 }
 
 impl FnLiveness {
@@ -392,6 +394,7 @@ impl FnLiveness {
             defined_out: vec![HashSet::new(); n],
             preds,
             remat: HashMap::new(),
+            remat_at: HashMap::new(),
         };
         fl.solve(program);
         fl
@@ -601,6 +604,14 @@ impl FnLiveness {
 
     /// Ids live just after instruction `inst` (SSA values and variables).
     pub fn live_after(&self, program: &Program, inst: usize) -> HashSet<Id> {
+        self.places_after(program, inst)
+            .into_iter()
+            .map(|(id, _)| id)
+            .collect()
+    }
+
+    /// SSA values and parts of variables live just after instruction `inst`.
+    fn places_after(&self, program: &Program, inst: usize) -> HashSet<Place> {
         let f = self.function(program);
         let Some(b) = f.block_of(inst) else {
             return HashSet::new();
@@ -609,7 +620,31 @@ impl FnLiveness {
         for k in (inst + 1..=f.blocks[b].end).rev() {
             self.step_back(program, &program.insts[k], &mut live);
         }
-        live.into_iter().map(|(id, _)| id).collect()
+        live
+    }
+
+    /// Bytes of the live parts of variable `var` (of type `ty`): all of it
+    /// when the whole is live, else the sum of the outermost live parts.
+    fn live_part_size(program: &Program, ty: Id, paths: &[&Vec<u32>]) -> u64 {
+        let whole = scalar_size(program, ty).unwrap_or(0);
+        if paths.iter().any(|p| p.is_empty()) {
+            return whole;
+        }
+        let outer = paths
+            .iter()
+            .filter(|p| !paths.iter().any(|q| q.len() < p.len() && p.starts_with(q)));
+        let mut sum = 0;
+        for p in outer {
+            let mut t = ty;
+            for &i in p.iter() {
+                match element_type(program, t, i) {
+                    Some(e) => t = e,
+                    None => return whole,
+                }
+            }
+            sum += scalar_size(program, t).unwrap_or(0);
+        }
+        sum.min(whole)
     }
 
     /// Variables possibly written before instruction `inst`.
@@ -630,7 +665,8 @@ impl FnLiveness {
 
     /// The values live across instruction `inst`, described.
     pub fn live_across(&mut self, program: &Program, inst: usize) -> Vec<LiveValue> {
-        let live = self.live_after(program, inst);
+        let places = self.places_after(program, inst);
+        let live: HashSet<Id> = places.iter().map(|(id, _)| *id).collect();
         let defined = self.defined_before(program, inst);
         let result = program.insts.get(inst).and_then(|i| i.result_id);
         let mut ids: Vec<Id> = live
@@ -663,7 +699,7 @@ impl FnLiveness {
                 _ => {}
             }
             let rematerializable = if is_var {
-                self.remat_var(program, id, 0)
+                self.remat_var(program, id, inst, 0)
             } else {
                 self.remat_ssa(program, id, 0)
             };
@@ -688,7 +724,16 @@ impl FnLiveness {
             out.push(LiveValue {
                 name: value_name(program, id, def.as_ref()),
                 ty: program.type_name(ty),
-                size: scalar_size(program, ty).unwrap_or(0),
+                size: if is_var {
+                    let paths: Vec<&Vec<u32>> = places
+                        .iter()
+                        .filter(|(v, _)| *v == id)
+                        .map(|(_, p)| p)
+                        .collect();
+                    FnLiveness::live_part_size(program, ty, &paths)
+                } else {
+                    scalar_size(program, ty).unwrap_or(0)
+                },
                 rematerializable,
                 storage: if is_var {
                     Storage::Variable
@@ -811,7 +856,7 @@ impl FnLiveness {
             Op::Load => {
                 let ptr = id_operands(inst).next().unwrap_or(0);
                 match self.root(ptr) {
-                    Some(v) => self.remat_var(program, v, depth + 1),
+                    Some(v) => self.remat_var(program, v, i, depth + 1),
                     // A buffer_reference pointer is an address computed like
                     // any value: the load is recomputable when it is.
                     None if self.physical_pointer(program, ptr) => {
@@ -876,17 +921,22 @@ impl FnLiveness {
         }
     }
 
-    /// A variable is recomputable when every write stores a recomputable
-    /// value and nothing else (a call, an atomic) gets its address.
-    fn remat_var(&mut self, program: &Program, var: Id, depth: u32) -> bool {
-        let key = var;
-        if let Some(&r) = self.remat.get(&key) {
+    /// A variable read at instruction `at` is recomputable when the writes
+    /// that reach `at` store recomputable values, no two of them store
+    /// different values into the same part (a merge of paths, like a phi, or
+    /// a value that changed), and nothing else (a call, an atomic) gets its
+    /// address.
+    fn remat_var(&mut self, program: &Program, var: Id, at: usize, depth: u32) -> bool {
+        let key = (var, at);
+        if let Some(&r) = self.remat_at.get(&key) {
             return r;
         }
-        self.remat.insert(key, false);
+        self.remat_at.insert(key, false);
         let f = self.function(program);
         let (start, end) = (f.start, f.end);
+        let reaching = self.reaching_writes(program, var, at);
         let mut ok = true;
+        let mut stored: Vec<(Vec<u32>, Id)> = Vec::new();
         for i in start..=end {
             let inst = &program.insts[i];
             if program.is_debug_inst(inst) {
@@ -898,7 +948,7 @@ impl FnLiveness {
             }
             match inst.class.opcode {
                 Op::Variable => {
-                    if let Some(&init) = ids.first() {
+                    if let Some(&init) = ids.first().filter(|_| reaching.contains(&i)) {
                         if !matches!(
                             program.constants.get(&init),
                             Some(Constant::Int(_) | Constant::Float(_) | Constant::Bool(_))
@@ -907,13 +957,28 @@ impl FnLiveness {
                         {
                             ok = false;
                         }
+                        stored.push((Vec::new(), init));
                     }
                 }
+                // A store that cannot reach `at` does not give the value read there.
+                Op::Store if !reaching.contains(&i) => {}
                 Op::Store => {
                     let value = ids.get(1).copied().unwrap_or(0);
                     if !self.remat_ssa(program, value, depth + 1) {
                         ok = false;
                     }
+                    let path = ids
+                        .first()
+                        .and_then(|p| self.roots.get(p))
+                        .map(|p| p.path.clone())
+                        .unwrap_or_default();
+                    let clash = stored
+                        .iter()
+                        .any(|(q, v)| *v != value && (q.starts_with(&path) || path.starts_with(q)));
+                    if clash {
+                        ok = false;
+                    }
+                    stored.push((path, value));
                 }
                 Op::Load => {}
                 Op::AccessChain | Op::InBoundsAccessChain | Op::PtrAccessChain => {
@@ -930,8 +995,65 @@ impl FnLiveness {
                 break;
             }
         }
-        self.remat.insert(key, ok);
+        self.remat_at.insert(key, ok);
         ok
+    }
+
+    /// The writes to `var` (stores, and its `OpVariable` when it has an
+    /// initializer) that can give the value read at `at`: walking back from
+    /// `at` along every path, up to a store of the whole variable.
+    fn reaching_writes(&self, program: &Program, var: Id, at: usize) -> HashSet<usize> {
+        let f = self.function(program);
+        let mut found = HashSet::new();
+        let Some(b0) = f.block_of(at) else {
+            return found;
+        };
+        let whole = |i: usize| -> Option<bool> {
+            let inst = &program.insts[i];
+            match inst.class.opcode {
+                Op::Store => {
+                    let p = id_operands(inst).next().and_then(|p| self.roots.get(&p))?;
+                    (p.var == var).then_some(p.exact && p.path.is_empty())
+                }
+                Op::Variable if inst.result_id == Some(var) => {
+                    (inst.operands.len() > 1).then_some(true)
+                }
+                _ => None,
+            }
+        };
+        // (block, last instruction to look at)
+        let mut work: Vec<(usize, usize)> = vec![(b0, at)];
+        let mut seen: HashSet<usize> = HashSet::new();
+        while let Some((b, last)) = work.pop() {
+            let block = &f.blocks[b];
+            let mut killed = false;
+            for i in (block.start..last).rev() {
+                if let Some(w) = whole(i) {
+                    found.insert(i);
+                    if w {
+                        killed = true;
+                        break;
+                    }
+                }
+            }
+            if killed {
+                continue;
+            }
+            if b == 0 {
+                // The entry block holds the variables and their initializers.
+                if let Some(&d) = program.defs.get(&var) {
+                    if whole(d) == Some(true) {
+                        found.insert(d);
+                    }
+                }
+            }
+            for &p in &self.preds[b] {
+                if seen.insert(p) {
+                    work.push((p, f.blocks[p].end + 1));
+                }
+            }
+        }
+        found
     }
 }
 
