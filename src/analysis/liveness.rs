@@ -1243,6 +1243,45 @@ mod tests {
                 "{rel}: {second:?}"
             );
         }
+        // The same classes in HLSL (rtlint's compiler) and WGSL (naga).
+        for (rel, names_of) in [
+            (
+                "fixtures/live/classes.hlsl",
+                [
+                    "fromBuiltin",
+                    "fromUniform",
+                    "fromStorage",
+                    "fromTexture",
+                    "fromImage",
+                    "fromPayload",
+                ],
+            ),
+            (
+                "fixtures/live/classes.wgsl",
+                [
+                    "from_builtin",
+                    "from_uniform",
+                    "from_storage",
+                    "from_texture",
+                    "from_load",
+                    "from_payload",
+                ],
+            ),
+        ] {
+            let sites = live_sites(&program(rel));
+            let remat = |k: usize, name: &str| {
+                sites[k]
+                    .values
+                    .iter()
+                    .find(|v| v.name == name)
+                    .map(|v| v.rematerializable)
+            };
+            for name in &names_of[..5] {
+                assert_eq!(remat(0, name), Some(true), "{rel}: {name}");
+            }
+            assert_eq!(remat(0, names_of[5]), None, "{rel}");
+            assert_eq!(remat(1, names_of[5]), Some(false), "{rel}");
+        }
         // buffer_reference loads are as recomputable as storage-buffer loads.
         let s = one_site("fixtures/live/reference.rgen.spv");
         assert_eq!(names(&s), [("albedo", 16, true), ("scale", 16, true)]);
@@ -1263,5 +1302,22 @@ mod tests {
             assert_eq!(names(&s), [("k", 4, true)], "{rel}");
             assert_eq!(s.line, Some(10), "{rel}");
         }
+    }
+
+    /// `rtlint live` names the source file the debug info gives, not the
+    /// module, and says when a value has no known line.
+    #[test]
+    fn live_report_names_the_source() {
+        let r = live_report(&[program("fixtures/live/loop_local.rgen.gV.spv")]);
+        let text = crate::report::live::human(&r);
+        assert!(
+            text.contains("fixtures/live/loop_local.rgen:23: trace_ray"),
+            "{text}"
+        );
+        assert!(!text.contains(".spv"), "{text}");
+        assert!(!text.contains("line ?"), "{text}");
+        let r = live_report(&[program("fixtures/live/lets.wgsl")]);
+        let text = crate::report::live::human(&r);
+        assert!(!text.contains("line ?"), "{text}");
     }
 }
