@@ -142,4 +142,14 @@ mod tests {
         // The iterative pipeline's closest-hit shader traces only a shadow ray.
         assert!(run("fixtures/RT020/good.pipeline.toml").is_empty());
     }
+
+    /// naga calls one trace helper per payload from every shader: the finding
+    /// points at the closest hit's own call, not the raygen's.
+    #[test]
+    fn wgsl_finding_at_the_closest_hits_call() {
+        let d = run("shaders/reflect_recursive.pipeline.toml");
+        assert_eq!(d.len(), 1, "{d:?}");
+        let l = &d[0].primary.as_ref().unwrap().location;
+        assert_eq!((l.line, l.column), (78, 9));
+    }
 }
