@@ -154,8 +154,13 @@ impl Builder {
         for p in &outcome.rerun {
             lines.push_str(&format!("cargo:rerun-if-changed={}\n", p.display()));
         }
+        // A header's finding is found once per shader including it: say it once.
+        let mut said = BTreeSet::new();
         for d in outcome.diagnostics.iter().filter(|d| d.code.is_some()) {
-            lines.push_str(&format!("cargo:warning={}\n", one_line(d)));
+            let line = one_line(d);
+            if said.insert(line.clone()) {
+                lines.push_str(&format!("cargo:warning={line}\n"));
+            }
         }
         out.write_all(lines.as_bytes())
             .and_then(|_| out.flush())
@@ -170,9 +175,11 @@ impl Builder {
                     &mut Sources::default(),
                 )
             })?;
+        let mut said_failing = BTreeSet::new();
         let failing: Vec<Diagnostic> = outcome
             .diagnostics
             .iter()
+            .filter(|d| said_failing.insert(one_line(d)))
             .filter(|d| {
                 d.code.is_none()
                     || d.severity == Severity::Error

@@ -673,10 +673,12 @@ impl Gen<'_> {
                         Self::array(&Self::scalar(*sc), *comps),
                     )
                 }
-                _ => return Err(format!(
+                _ => {
+                    return Err(format!(
                     "member `{name}` needs {} bytes but only {room} are free at offset {offset}",
                     t.size
-                )),
+                ))
+                }
             };
             if head.size + last.size > room {
                 return Err(format!(
@@ -981,7 +983,7 @@ pub fn generate(programs: &[Program], options: &Options) -> Result<String, Vec<D
             let doc = format!(
                 "/// {} `{}` ({}): {}, {} bytes.\n",
                 capitalize(&roles.join(", ")),
-                t.lay.name,
+                t.lay.name.trim_start_matches("type."),
                 t.location,
                 t.rule,
                 t.size
