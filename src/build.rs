@@ -589,6 +589,7 @@ impl std::error::Error for Error {}
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::analysis::layout::layout_type;
 
     fn scratch(name: &str) -> PathBuf {
         let dir = std::env::temp_dir().join(format!("rtlint-build-{name}-{}", std::process::id()));
@@ -597,22 +598,228 @@ mod tests {
         dir
     }
 
+    /// Runs a builder; the cargo instructions it printed and its result.
+    fn run(b: Builder) -> (String, Result<(), Error>) {
+        let mut out = Vec::new();
+        let r = b.run_to(&mut out);
+        (String::from_utf8(out).unwrap(), r)
+    }
+
+    /// `size_of::<Name>() == N` lines of a generated file.
+    fn size_of(text: &str, name: &str) -> Option<u64> {
+        let key = format!("size_of::<{name}>() == ");
+        let at = text.find(&key)? + key.len();
+        text[at..].split(')').next()?.parse().ok()
+    }
+
+    fn struct_body<'a>(text: &'a str, name: &str) -> &'a str {
+        let start = text.find(&format!("pub struct {name} {{")).unwrap();
+        let end = start + text[start..].find("\n}").unwrap();
+        &text[start..end]
+    }
+
     #[test]
-    fn example_crate_shaders() {
+    fn example_shaders_rerun_on_includes_and_write_one_module_per_entry_point() {
         let out = scratch("example");
-        let mut lines = Vec::new();
-        Builder::new()
+        let (lines, r) = run(Builder::new()
             .shaders("examples/build-script/shaders")
+            .pipeline("examples/build-script/shaders/main.pipeline.toml")
             .emit_spirv()
             .generate_layouts("layouts.rs")
-            .out_dir(&out)
-            .run_to(&mut lines)
-            .unwrap();
-        let lines = String::from_utf8(lines).unwrap();
-        println!("{lines}");
-        println!(
-            "{}",
-            std::fs::read_to_string(out.join("layouts.rs")).unwrap()
+            .out_dir(&out));
+        r.unwrap();
+        for f in [
+            "shaders",
+            "shaders/raygen.hlsl",
+            "shaders/miss.hlsl",
+            "shaders/closesthit.hlsl",
+            "shaders/include/common.hlsli",
+            "shaders/main.pipeline.toml",
+        ] {
+            let line = format!("cargo:rerun-if-changed=examples/build-script/{f}\n");
+            assert_eq!(lines.matches(&line).count(), 1, "{f}: {lines}");
+        }
+        assert!(!lines.contains("cargo:warning"), "{lines}");
+        let mut written: Vec<String> = std::fs::read_dir(&out)
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .collect();
+        written.sort();
+        assert_eq!(
+            written,
+            [
+                "closesthit.ClosestHit.spv",
+                "layouts.rs",
+                "miss.Miss.spv",
+                "raygen.RayGen.spv"
+            ]
         );
+        let spv = std::fs::read(out.join("miss.Miss.spv")).unwrap();
+        let words = crate::program::words_from_bytes(&spv, Path::new("miss.Miss.spv")).unwrap();
+        let program = crate::program::parse(&words, Path::new("miss"), Language::Hlsl).unwrap();
+        assert_eq!(program.entry_points.len(), 1);
+        assert_eq!(program.entry_points[0].name, "Miss");
+        let _ = std::fs::remove_dir_all(&out);
+    }
+
+    /// The cbuffer rule at its trickiest: a float after an array shares the
+    /// array's last row, and so does one after a float3x3.
+    #[test]
+    fn cbuffer_follows_declared_offsets_with_split_last_elements() {
+        let out = scratch("cbuffer");
+        let (_, r) = run(Builder::new()
+            .shaders("tests/hlsl/cbuffer_packing.hlsl")
+            .generate_layouts("layouts.rs")
+            .out_dir(&out));
+        r.unwrap();
+        let text = std::fs::read_to_string(out.join("layouts.rs")).unwrap();
+        let packed = struct_body(&text, "Packed");
+        for field in [
+            "/// offset 0\n    pub a: glam::Vec3,",
+            "/// offset 12\n    pub b: f32,",
+            "/// offset 16\n    pub c: [[f32; 4]; 2],",
+            "/// offset 48\n    pub c_last: f32,",
+            "/// offset 52\n    pub d: f32,",
+            "/// offset 56\n    pub e: glam::Vec2,",
+            "/// offset 64\n    pub m: [[f32; 4]; 2],",
+            "/// offset 96\n    pub m_last: [f32; 3],",
+            "/// offset 108\n    pub tail: f32,",
+        ] {
+            assert!(packed.contains(field), "{field} in\n{packed}");
+        }
+        // The size: whole 16-byte rows, as the layout analysis counts them.
+        let program =
+            front::load(Path::new("tests/hlsl/cbuffer_packing.hlsl"), Language::Hlsl).unwrap();
+        for (var, name) in [("Packed", "Packed"), ("$Globals", "Globals")] {
+            let g = program
+                .globals
+                .iter()
+                .find(|g| g.name.as_deref() == Some(var))
+                .unwrap();
+            let t = layout_type(&program, g.ty, var).unwrap();
+            assert_eq!(size_of(&text, name), Some(t.hlsl_rows * 16), "{name}");
+        }
+        assert_eq!(size_of(&text, "Packed"), Some(112));
+        assert!(
+            text.contains("const _: () = assert!(core::mem::offset_of!(Packed, m_last) == 96);")
+        );
+        let _ = std::fs::remove_dir_all(&out);
+    }
+
+    #[test]
+    fn wgsl_payload_and_uniform_sizes_are_the_layout_analysis_sizes() {
+        let out = scratch("wgsl");
+        let (_, r) = run(Builder::new()
+            .shaders("shaders/reflect_recursive.wgsl")
+            .glam(false)
+            .bytemuck(true)
+            .generate_layouts("layouts.rs")
+            .out_dir(&out));
+        r.unwrap();
+        let text = std::fs::read_to_string(out.join("layouts.rs")).unwrap();
+        assert!(!text.contains("glam::"), "{text}");
+        assert!(text.contains("#[derive(bytemuck::Pod, bytemuck::Zeroable)]\n"));
+        let program =
+            front::load(Path::new("shaders/reflect_recursive.wgsl"), Language::Wgsl).unwrap();
+        let params = program
+            .globals
+            .iter()
+            .find(|g| g.name.as_deref() == Some("params"))
+            .unwrap();
+        let t = layout_type(&program, params.ty, "params").unwrap();
+        assert_eq!(size_of(&text, "Params"), t.wgsl_size);
+        let ray = program
+            .globals
+            .iter()
+            .find(|g| g.name.as_deref() == Some("ray"))
+            .unwrap();
+        let t = layout_type(&program, ray.ty, "ray").unwrap();
+        assert_eq!(size_of(&text, "Radiance"), Some(t.scalar_size));
+        assert!(
+            struct_body(&text, "Radiance").contains("pub color: [f32; 3],"),
+            "{text}"
+        );
+        let _ = std::fs::remove_dir_all(&out);
+    }
+
+    #[test]
+    fn bad_hlsl_fails_with_file_and_position() {
+        let dir = scratch("bad");
+        std::fs::write(
+            dir.join("bad.hlsl"),
+            "[shader(\"miss\")]\nvoid Miss(inout float4 p)\n{\n    p = ;\n}\n",
+        )
+        .unwrap();
+        let (lines, r) = run(Builder::new().shaders(&dir).out_dir(&dir));
+        let e = r.unwrap_err();
+        let text = e.to_string();
+        let at = format!("{}:4:", dir.join("bad.hlsl").display());
+        assert!(text.contains(&at), "{text}");
+        assert!(
+            format!("{e:?}").contains(&at),
+            "Debug is what `main` prints"
+        );
+        assert!(lines.contains(&format!("cargo:rerun-if-changed={}", dir.display())));
+        assert_eq!(e.diagnostics().len(), 1);
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    #[test]
+    fn glsl_is_refused_with_a_way_out() {
+        let dir = scratch("glsl");
+        std::fs::write(dir.join("a.rgen"), "#version 460\nvoid main() {}\n").unwrap();
+        let (_, r) = run(Builder::new().shaders(&dir).out_dir(&dir));
+        let text = r.unwrap_err().to_string();
+        assert!(
+            text.contains("GLSL input is not supported by rtlint::build yet"),
+            "{text}"
+        );
+        assert!(text.contains("glslangValidator"), "{text}");
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    #[test]
+    fn warnings_fail_only_when_denied_and_two_layouts_under_one_name_fail() {
+        let dir = scratch("warn");
+        let shader = |payload: &str| {
+            format!(
+                "struct Payload {{ {payload} }};\nRaytracingAccelerationStructure s : register(t0);\n\
+                 [shader(\"raygeneration\")]\nvoid R()\n{{\n    RayDesc r;\n    r.Origin = 0; r.Direction = float3(0, 0, 1); r.TMin = 0; r.TMax = 1;\n    Payload p = (Payload)0;\n    TraceRay(s, 0, 0xFF, 0, 1, 0, r, p);\n}}\n"
+            )
+        };
+        std::fs::write(dir.join("a.hlsl"), shader("float4 a; float4 b; float4 c;")).unwrap();
+        let (lines, r) = run(Builder::new().shaders(dir.join("a.hlsl")).out_dir(&dir));
+        r.unwrap();
+        let warning = format!(
+            "cargo:warning={}:1: RT001 ray payload `Payload` is 48 bytes, above the 32-byte budget\n",
+            dir.join("a.hlsl").display()
+        );
+        assert!(lines.contains(&warning), "{lines}");
+        let (_, r) = run(Builder::new()
+            .shaders(dir.join("a.hlsl"))
+            .deny_warnings(true)
+            .out_dir(&dir));
+        assert!(r.unwrap_err().to_string().contains("warning[RT001]"));
+
+        std::fs::write(dir.join("b.hlsl"), shader("float a;")).unwrap();
+        let (_, r) = run(Builder::new()
+            .shaders(&dir)
+            .generate_layouts("layouts.rs")
+            .out_dir(&dir));
+        let text = r.unwrap_err().to_string();
+        assert!(text.contains("`Payload` at"), "{text}");
+        assert!(text.contains("rename one"), "{text}");
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    #[test]
+    fn rust_names() {
+        assert_eq!(layouts_names("type.Camera"), "Camera");
+        assert_eq!(layouts_names("type.$Globals"), "Globals");
+        assert_eq!(layouts_names("type.ConstantBuffer.params"), "Params");
+    }
+
+    fn layouts_names(s: &str) -> String {
+        layouts::rust_type_name(s)
     }
 }
