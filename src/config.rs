@@ -5,6 +5,18 @@ use crate::shader::Language;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
+/// `[hlsl]`: how sources that include other files are compiled.
+#[derive(Clone, Debug, Default, serde::Deserialize)]
+#[serde(deny_unknown_fields, rename_all = "kebab-case")]
+pub struct SourceOptions {
+    /// Searched after the including file's folder; relative to the config.
+    #[serde(default)]
+    pub include_dirs: Vec<PathBuf>,
+    /// `NAME = "VALUE"`.
+    #[serde(default)]
+    pub defines: BTreeMap<String, String>,
+}
+
 /// A rule's configured level.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Deserialize)]
 #[serde(rename_all = "lowercase")]
@@ -47,6 +59,24 @@ pub struct Config {
     /// Languages for other file extensions: `rgen = "hlsl"`.
     #[serde(default)]
     pub languages: BTreeMap<String, String>,
+    /// Rules to run instead of the default set: codes, names or groups.
+    #[serde(default)]
+    pub select: Option<Vec<String>>,
+    /// Rules to run besides the selected ones.
+    #[serde(default)]
+    pub extend_select: Vec<String>,
+    /// Rules not to run.
+    #[serde(default)]
+    pub ignore: Vec<String>,
+    /// Globs (relative to this file's folder) of paths a directory walk skips.
+    #[serde(default)]
+    pub exclude: Vec<String>,
+    /// Rules not to run on paths matching a glob: `"legacy/*.hlsl" = ["RT001"]`.
+    #[serde(default)]
+    pub per_file_ignores: BTreeMap<String, Vec<String>>,
+    /// Include directories and defines for HLSL and GLSL sources.
+    #[serde(default)]
+    pub hlsl: SourceOptions,
     /// Where the config came from, for messages.
     #[serde(skip)]
     pub path: Option<PathBuf>,
@@ -69,6 +99,12 @@ impl Default for Config {
             deny_warnings: false,
             rules: BTreeMap::new(),
             languages: BTreeMap::new(),
+            select: None,
+            extend_select: Vec::new(),
+            ignore: Vec::new(),
+            exclude: Vec::new(),
+            per_file_ignores: BTreeMap::new(),
+            hlsl: SourceOptions::default(),
             path: None,
             rule_keys: Vec::new(),
         }
@@ -101,11 +137,33 @@ impl Config {
             }
             err
         })?;
-        config.rule_keys = config
+        let selectors = config
             .rules
             .keys()
+            .chain(config.select.iter().flatten())
+            .chain(&config.extend_select)
+            .chain(&config.ignore)
+            .chain(config.per_file_ignores.values().flatten());
+        config.rule_keys = selectors
             .map(|k| (k.clone(), find_location(text, path, k)))
             .collect();
+        for g in config.exclude.iter().chain(config.per_file_ignores.keys()) {
+            if let Err(e) = globset::Glob::new(g) {
+                return Err(config_error(
+                    text,
+                    path,
+                    g,
+                    format!("invalid glob `{g}`: {}", e.kind()),
+                ));
+            }
+        }
+        if let Some(dir) = path.parent() {
+            for d in &mut config.hlsl.include_dirs {
+                if d.is_relative() {
+                    *d = dir.join(&*d);
+                }
+            }
+        }
         for (ext, lang) in &config.languages {
             if Language::parse(lang).is_none() {
                 return Err(config_error(
@@ -141,6 +199,43 @@ impl Config {
             dir = d.parent();
         }
         None
+    }
+
+    /// The folder the config's relative globs and paths start from.
+    pub fn base_dir(&self) -> Option<&Path> {
+        self.path.as_deref().and_then(Path::parent)
+    }
+
+    /// Whether a directory walk skips `path` under `exclude`.
+    pub fn excludes(&self, path: &Path) -> bool {
+        !self.exclude.is_empty()
+            && glob_set(&self.exclude).is_some_and(|g| g.is_match(self.relative(path)))
+    }
+
+    /// The selectors `[per-file-ignores]` applies to `path`.
+    pub fn ignored_for(&self, path: &Path) -> Vec<&str> {
+        let rel = self.relative(path);
+        self.per_file_ignores
+            .iter()
+            .filter(|(g, _)| {
+                globset::Glob::new(g)
+                    .map(|g| g.compile_matcher().is_match(&rel))
+                    .unwrap_or(false)
+            })
+            .flat_map(|(_, rules)| rules.iter().map(String::as_str))
+            .collect()
+    }
+
+    /// `path` relative to the config's folder (both made absolute first).
+    fn relative(&self, path: &Path) -> PathBuf {
+        let abs = |p: &Path| std::path::absolute(p).unwrap_or_else(|_| p.to_path_buf());
+        match self.base_dir() {
+            Some(base) => {
+                let (p, b) = (abs(path), abs(base));
+                p.strip_prefix(&b).map(Path::to_path_buf).unwrap_or(p)
+            }
+            None => path.to_path_buf(),
+        }
     }
 
     /// An error at the first key of `[rules]` that `known` does not accept.
@@ -180,6 +275,16 @@ impl Config {
             .find(|(k, _)| k.trim_start_matches('.').eq_ignore_ascii_case(ext))
             .and_then(|(_, v)| Language::parse(v))
     }
+}
+
+fn glob_set(globs: &[String]) -> Option<globset::GlobSet> {
+    let mut b = globset::GlobSetBuilder::new();
+    for g in globs {
+        b.add(globset::Glob::new(g).ok()?);
+        // `dir` also excludes what is inside it.
+        b.add(globset::Glob::new(&format!("{}/**", g.trim_end_matches('/'))).ok()?);
+    }
+    b.build().ok()
 }
 
 /// The first occurrence of `needle` in the config text.

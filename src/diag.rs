@@ -180,6 +180,8 @@ pub enum InputErrorKind {
     HlslError,
     /// the HLSL uses a construct rtlint's compiler does not support.
     HlslUnsupported,
+    /// glslang rejects the GLSL.
+    GlslError,
 }
 
 impl InputErrorKind {
@@ -197,6 +199,7 @@ impl InputErrorKind {
         InputErrorKind::WgslInternal,
         InputErrorKind::HlslError,
         InputErrorKind::HlslUnsupported,
+        InputErrorKind::GlslError,
     ];
 
     pub fn as_str(self) -> &'static str {
@@ -214,6 +217,7 @@ impl InputErrorKind {
             InputErrorKind::WgslInternal => "wgsl-internal",
             InputErrorKind::HlslError => "hlsl-error",
             InputErrorKind::HlslUnsupported => "hlsl-unsupported",
+            InputErrorKind::GlslError => "glsl-error",
         }
     }
 }
@@ -263,7 +267,12 @@ impl std::error::Error for InputError {}
 /// Reads a UTF-8 text input; an unreadable or non-UTF-8 file is an input error.
 pub fn read_text(path: &Path) -> Result<String, InputError> {
     let bytes = std::fs::read(path).map_err(|e| io_error(path, &e))?;
-    String::from_utf8(bytes).map_err(|e| {
+    text_from_bytes(&bytes, path)
+}
+
+/// Input bytes as UTF-8 text; anything else is an input error.
+pub fn text_from_bytes(bytes: &[u8], path: &Path) -> Result<String, InputError> {
+    String::from_utf8(bytes.to_vec()).map_err(|e| {
         let offset = e.utf8_error().valid_up_to();
         InputError::new(
             InputErrorKind::InvalidUtf8,
@@ -306,6 +315,7 @@ mod tests {
                 "wgsl-internal",
                 "hlsl-error",
                 "hlsl-unsupported",
+                "glsl-error",
             ]
         );
         for (i, a) in names.iter().enumerate() {

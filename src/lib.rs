@@ -16,5 +16,6 @@ pub mod reference;
 pub mod report;
 pub mod rules;
 pub mod shader;
+pub mod suppress;
 #[cfg(feature = "vulkan")]
 pub mod vk;

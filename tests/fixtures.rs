@@ -6,7 +6,7 @@ mod common;
 
 use common::root;
 use rtlint::config::Config;
-use rtlint::lint::{check_input, Input};
+use rtlint::lint::check_input;
 use rtlint::report::{human, Sources};
 use rtlint::shader::Language;
 use std::collections::BTreeSet;
@@ -95,13 +95,7 @@ fn findings_match_markers_and_snapshots() {
     for (module, source) in cases {
         let module = relative(&module);
         let language = Language::from_path(&module).unwrap();
-        let checked = check_input(
-            &Input {
-                path: module.clone(),
-                language,
-            },
-            &config,
-        );
+        let checked = check_input(&module, language, &config);
         assert!(
             checked.program.is_some(),
             "{} did not load: {:?}",

@@ -1,6 +1,7 @@
 //! Rules: one file per rule, one registry table. Rules read the Program and
 //! analysis facts and return typed [`Diagnostic`]s; the report layer makes text.
 
+pub mod rt000_unused_suppression;
 mod rt001_payload_over_budget;
 mod rt002_payload_packing_waste;
 mod rt003_member_straddles_row;
@@ -35,6 +36,8 @@ pub enum Kind {
     Module(fn(&Context) -> Vec<Diagnostic>),
     /// A whole described pipeline (recursion depth, stack size).
     Pipeline(fn(&PipelineContext) -> Vec<Diagnostic>),
+    /// Reported by the lint driver itself (suppressions).
+    Driver,
 }
 
 pub struct Rule {
@@ -51,6 +54,7 @@ pub struct Rule {
 
 /// Every rule, in code order.
 pub static RULES: &[&Rule] = &[
+    &rt000_unused_suppression::RULE,
     &rt001_payload_over_budget::RULE,
     &rt002_payload_packing_waste::RULE,
     &rt003_member_straddles_row::RULE,
@@ -156,8 +160,50 @@ impl<'a> PipelineContext<'a> {
     }
 }
 
-/// The severity a rule reports at under `config`, or `None` when allowed.
-fn configured(rule: &Rule, config: &Config) -> Option<Severity> {
+impl Group {
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Group::Correctness => "correctness",
+            Group::Perf => "perf",
+        }
+    }
+}
+
+/// Whether a selector (`ALL`, a code, a code prefix such as `RT02`, a name
+/// or a group) picks `rule`.
+pub fn selects(selector: &str, rule: &Rule) -> bool {
+    let s = selector.trim();
+    s.eq_ignore_ascii_case("ALL")
+        || s == rule.name
+        || s.eq_ignore_ascii_case(rule.group.as_str())
+        || (s.len() >= 3
+            && s.len() <= rule.code.len()
+            && rule.code[..s.len()].eq_ignore_ascii_case(s))
+}
+
+/// Whether a selector picks any rule (for checking configs and flags).
+pub fn is_selector(selector: &str) -> bool {
+    RULES.iter().any(|r| selects(selector, r))
+}
+
+/// Whether `rule` runs under `config`'s selection (`select`, then
+/// `extend-select`, then `ignore`).
+pub fn enabled(rule: &Rule, config: &Config) -> bool {
+    let any = |list: &[String]| list.iter().any(|s| selects(s, rule));
+    let mut on = match &config.select {
+        Some(list) => any(list),
+        None => true,
+    };
+    on |= any(&config.extend_select);
+    on && !any(&config.ignore)
+}
+
+/// The severity a rule reports at under `config`, or `None` when it does not
+/// run.
+pub fn configured(rule: &Rule, config: &Config) -> Option<Severity> {
+    if !enabled(rule, config) {
+        return None;
+    }
     match config.level(rule.code, rule.name) {
         Some(l) => l.severity(),
         None => Some(rule.level),
@@ -247,6 +293,7 @@ mod tests {
         assert_eq!(
             list,
             [
+                "RT000 unused-suppression",
                 "RT001 payload-over-budget",
                 "RT002 payload-packing-waste",
                 "RT003 member-straddles-row",
