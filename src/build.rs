@@ -38,11 +38,6 @@ use std::fmt;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
-/// File extensions of GLSL sources, which this build cannot compile.
-const GLSL_EXTENSIONS: &[&str] = &[
-    "glsl", "vert", "frag", "comp", "rgen", "rchit", "rmiss", "rahit", "rint", "rcall",
-];
-
 /// Configures one run over a crate's shaders.
 #[derive(Clone, Debug, Default)]
 pub struct Builder {
@@ -195,40 +190,66 @@ impl Builder {
         }
     }
 
+    fn options(&self) -> lint::Options {
+        lint::Options {
+            config: match &self.config {
+                Some(f) => lint::ConfigChoice::File(f.clone()),
+                None => lint::ConfigChoice::Nearest,
+            },
+            overrides: lint::Overrides {
+                deny_warnings: self.deny_warnings,
+                ..lint::Overrides::default()
+            },
+            pipelines: self.pipelines.clone(),
+            front: front::FrontOptions {
+                include_dirs: self.include_dirs.clone(),
+                defines: self.defines.clone(),
+            },
+            ..lint::Options::default()
+        }
+    }
+
     fn execute(&self) -> Outcome {
         let mut run = Run::default();
-        let config = self.load_config(&mut run);
-        run.deny_warnings = self.deny_warnings || config.deny_warnings;
+        let options = self.options();
+        // Findings as `rtlint check` reports them: per-file configs,
+        // suppressions, each finding once.
+        let report = lint::check_paths(&self.shaders, &options);
+        run.diagnostics = report.diagnostics;
+        run.deny_warnings = report.deny_warnings;
+        for (path, text) in &report.embedded {
+            run.sources.add_embedded(path, text);
+        }
+        // Folders too: a new file in them reruns the build script.
+        for p in self.shaders.iter().chain(&report.files) {
+            run.rerun(p);
+        }
+        match &self.config {
+            Some(c) => run.rerun(c),
+            None => {
+                for f in &report.files {
+                    if let Some(c) = Config::discover(f) {
+                        run.rerun(&relative(&c));
+                    }
+                }
+            }
+        }
         let out_dir = self
             .out_dir
             .clone()
             .or_else(|| std::env::var_os("OUT_DIR").map(PathBuf::from));
-        let needs_out = self.emit_spirv || self.layouts.is_some();
-        if needs_out && out_dir.is_none() {
+        if (self.emit_spirv || self.layouts.is_some()) && out_dir.is_none() {
             run.error(
                 Path::new("OUT_DIR"),
                 "`OUT_DIR` is not set: run from a cargo build script or call `.out_dir(...)`",
             );
         }
 
-        // Folders: a new file in them reruns the build script too.
-        for p in &self.shaders {
-            run.rerun(p);
-        }
-        let (glsl, paths): (Vec<PathBuf>, Vec<PathBuf>) =
-            self.shaders.iter().cloned().partition(|p| is_glsl(p));
-        for p in &glsl {
-            run.diagnostics.push(glsl_error(p));
-        }
-        let inputs = lint::collect_inputs(&paths, &config, None);
-        run.diagnostics
-            .extend(inputs.errors.iter().map(|e| (*e.0).clone()));
-        for p in &inputs.skipped {
-            if is_glsl(p) {
-                run.diagnostics.push(glsl_error(p));
-            }
-        }
-        let options = hlsl::HlslOptions {
+        // The modules again, for what the report does not carry: the files
+        // each shader included, SPIR-V per entry point, layouts. Inputs that
+        // failed to load are already reported.
+        let inputs = lint::inputs(&self.shaders, &options);
+        let hlsl_options = hlsl::HlslOptions {
             include_dirs: self.include_dirs.clone(),
             defines: self.defines.clone(),
             entry: None,
@@ -236,44 +257,29 @@ impl Builder {
         let mut programs: Vec<Program> = Vec::new();
         let mut spirv_names: BTreeMap<String, PathBuf> = BTreeMap::new();
         for input in &inputs.files {
-            run.rerun(&input.path);
-            let program = match load(&input.path, input.language, &options) {
-                Ok(p) => p,
-                Err(e) => {
-                    run.diagnostics.push(*e.0);
-                    continue;
-                }
+            let Ok(program) = lint::load(input, &options) else {
+                continue;
             };
             run.rerun_files_of(&program);
-            run.sources.add_program(&program);
-            run.diagnostics
-                .extend(crate::rules::check_program(&program, &config));
             if let (true, Some(dir)) = (self.emit_spirv, &out_dir) {
-                if let Err(e) = emit_spirv(input, &options, dir, &mut spirv_names) {
+                let mut hlsl_options = hlsl_options.clone();
+                hlsl_options
+                    .include_dirs
+                    .splice(0..0, input.config.hlsl.include_dirs.iter().cloned());
+                if let Err(e) = emit_spirv(input, &program, &hlsl_options, dir, &mut spirv_names) {
                     run.diagnostics.push(*e.0);
                 }
             }
             programs.push(program);
         }
-        let mut pipelines = inputs.pipelines.clone();
-        for p in &self.pipelines {
-            if !pipelines.contains(p) {
-                pipelines.push(p.clone());
-            }
-        }
-        for p in &pipelines {
+        for p in &report.pipelines {
             run.rerun(p);
-            match crate::pipeline::load(p) {
-                Ok(pipeline) => {
-                    for program in &pipeline.programs {
-                        run.rerun(&program.path);
-                        run.rerun_files_of(program);
-                        run.sources.add_program(program);
-                    }
-                    let ctx = crate::rules::PipelineContext::new(&pipeline, &config);
-                    run.diagnostics.extend(crate::rules::check_pipeline(&ctx));
+            // The shaders a description names, wherever they are.
+            if let Ok(pipeline) = crate::pipeline::load(p) {
+                for program in &pipeline.programs {
+                    run.rerun(&program.path);
+                    run.rerun_files_of(program);
                 }
-                Err(e) => run.diagnostics.push(*e.0),
             }
         }
         if let (Some(file), Some(dir)) = (&self.layouts, &out_dir) {
@@ -281,10 +287,9 @@ impl Builder {
                 glam: !self.no_glam,
                 bytemuck: self.bytemuck,
             };
-            let target = dir.join(file);
             match layouts::generate(&programs, &options) {
                 Ok(text) => {
-                    if let Err(e) = write_if_changed(&target, text.as_bytes()) {
+                    if let Err(e) = write_if_changed(&dir.join(file), text.as_bytes()) {
                         run.diagnostics.push(*e.0);
                     }
                 }
@@ -298,24 +303,18 @@ impl Builder {
             deny_warnings: run.deny_warnings,
         }
     }
+}
 
-    fn load_config(&self, run: &mut Run) -> Config {
-        let path = self
-            .config
-            .clone()
-            .or_else(|| self.shaders.first().and_then(|p| Config::discover(p)));
-        let Some(path) = path else {
-            return Config::default();
-        };
-        run.rerun(&path);
-        match lint::load_config(&path) {
-            Ok(c) => c,
-            Err(e) => {
-                run.diagnostics.push(*e.0);
-                Config::default()
-            }
-        }
-    }
+/// `path` relative to the current folder when it is inside it: cargo runs
+/// build scripts in the package folder, and relative lines read better.
+fn relative(path: &Path) -> PathBuf {
+    std::env::current_dir()
+        .ok()
+        .and_then(|cwd| {
+            let cwd = std::fs::canonicalize(cwd).ok()?;
+            path.strip_prefix(&cwd).ok().map(Path::to_path_buf)
+        })
+        .unwrap_or_else(|| path.to_path_buf())
 }
 
 /// What one run found, before it is printed.
@@ -379,44 +378,10 @@ fn one_line(d: &Diagnostic) -> String {
     text.replace(['\n', '\r'], " ")
 }
 
-fn is_glsl(p: &Path) -> bool {
-    p.extension()
-        .and_then(|e| e.to_str())
-        .is_some_and(|e| GLSL_EXTENSIONS.contains(&e.to_ascii_lowercase().as_str()))
-}
-
-fn glsl_error(p: &Path) -> Diagnostic {
-    *InputError::new(
-        InputErrorKind::UnsupportedLanguage,
-        p,
-        "GLSL input is not supported by rtlint::build yet",
-    )
-    .with_note("compile it to SPIR-V first (`glslangValidator -V --target-env vulkan1.2 -g`) and pass the `.spv`")
-    .0
-}
-
-/// Compiles one input into a Program, HLSL with the builder's include
-/// folders and defines.
-fn load(
-    path: &Path,
-    language: Language,
-    options: &hlsl::HlslOptions,
-) -> Result<Program, InputError> {
-    match language {
-        Language::Hlsl => {
-            let m = hlsl::compile_file(path, options)?;
-            let mut program = crate::program::parse(&m.words, path, Language::Hlsl)?;
-            program.attach_named_decls(&m.decls);
-            Ok(program)
-        }
-        Language::Glsl => Err(InputError(Box::new(glsl_error(path)))),
-        _ => front::load(path, language),
-    }
-}
-
 /// Writes each entry point of `input` as its own module into `dir`.
 fn emit_spirv(
     input: &lint::Input,
+    program: &Program,
     options: &hlsl::HlslOptions,
     dir: &Path,
     names: &mut BTreeMap<String, PathBuf>,
@@ -441,17 +406,23 @@ fn emit_spirv(
             }
             out
         }
+        // glslang writes one entry point per file.
+        Language::Glsl => {
+            let entry = program
+                .entry_points
+                .first()
+                .map(|e| e.name.as_str())
+                .unwrap_or("main");
+            vec![(format!("{stem}.{entry}.spv"), program.words.clone())]
+        }
+        // A module as it is, under its own name.
         Language::Spirv => {
-            let bytes = std::fs::read(path).map_err(|e| front::io_error(path, &e))?;
             let name = path
                 .file_name()
                 .map(|s| s.to_string_lossy().into_owned())
                 .unwrap_or_default();
-            let target = dir.join(&name);
-            claim(names, &name, path)?;
-            return write_if_changed(&target, &bytes);
+            vec![(name, program.words.clone())]
         }
-        Language::Glsl => return Err(InputError(Box::new(glsl_error(path)))),
     };
     for (name, words) in modules {
         claim(names, &name, path)?;
@@ -765,16 +736,52 @@ mod tests {
     }
 
     #[test]
-    fn glsl_is_refused_with_a_way_out() {
+    fn glsl_goes_through_glslang() {
+        if std::process::Command::new(front::glsl::glslang())
+            .arg("--version")
+            .output()
+            .is_err()
+        {
+            eprintln!("glslangValidator is not installed: GLSL not tested");
+            return;
+        }
         let dir = scratch("glsl");
-        std::fs::write(dir.join("a.rgen"), "#version 460\nvoid main() {}\n").unwrap();
-        let (_, r) = run(Builder::new().shaders(&dir).out_dir(&dir));
-        let text = r.unwrap_err().to_string();
+        std::fs::write(
+            dir.join("trace.rgen"),
+            "#version 460\n#extension GL_EXT_ray_tracing : require\n\
+             struct Payload { vec3 color; uint depth; mat4 m; };\n\
+             layout(location = 0) rayPayloadEXT Payload p;\n\
+             layout(binding = 0) uniform accelerationStructureEXT tlas;\n\
+             layout(binding = 1, std140) uniform Params { vec3 tint; float scale; mat4 view; } params;\n\
+             void main() {\n    p.depth = 0u;\n    p.color = params.tint * params.scale;\n\
+             traceRayEXT(tlas, 0u, 0xFFu, 0u, 1u, 0u, vec3(0.0), 0.0, vec3(0.0, 0.0, 1.0), 1.0, 0);\n}\n",
+        )
+        .unwrap();
+        let (lines, r) = run(Builder::new()
+            .shaders(&dir)
+            .emit_spirv()
+            .generate_layouts("layouts.rs")
+            .out_dir(&dir));
+        r.unwrap();
+        assert!(lines.contains("trace.rgen"), "{lines}");
+        let spv = std::fs::read(dir.join("trace.main.spv")).unwrap();
+        assert_eq!(&spv[..4], &crate::program::MAGIC.to_le_bytes());
+        let text = std::fs::read_to_string(dir.join("layouts.rs")).unwrap();
+        // std140: the vec3 and the float share a row, the mat4 is a glam Mat4.
+        let params = struct_body(&text, "Params");
+        assert!(params.contains("pub tint: glam::Vec3,"), "{text}");
         assert!(
-            text.contains("GLSL input is not supported by rtlint::build yet"),
+            params.contains("/// offset 16\n    pub view: glam::Mat4,"),
             "{text}"
         );
-        assert!(text.contains("glslangValidator"), "{text}");
+        assert_eq!(size_of(&text, "Params"), Some(80));
+        // The payload's scalar size: 12 + 4 + 64; its mat4 sits at 16 in an
+        // 80-byte type, so glam's 16-byte-aligned Mat4 fits.
+        assert_eq!(size_of(&text, "Payload"), Some(80));
+        assert!(
+            struct_body(&text, "Payload").contains("pub m: glam::Mat4,"),
+            "{text}"
+        );
         let _ = std::fs::remove_dir_all(&dir);
     }
 

@@ -612,7 +612,12 @@ fn a_struct_in_a_shared_header_is_reported_once() {
     std::fs::write(d.join("a.hlsl"), shader("A")).unwrap();
     std::fs::write(d.join("b.hlsl"), shader("B")).unwrap();
     let o = check_in(&d, &["."]);
-    assert_eq!(findings(&o), ["payload.hlsli:1:8: warning[RT001]"], "{}", text(&o));
+    assert_eq!(
+        findings(&o),
+        ["payload.hlsli:1:8: warning[RT001]"],
+        "{}",
+        text(&o)
+    );
     let o = check_in(&d, &["--select", "RT001", "a.hlsl", "b.hlsl", "a.hlsl"]);
     assert_eq!(findings(&o).len(), 1, "{}", text(&o));
     assert!(text(&o).contains("in 2 files"), "{}", text(&o));
