@@ -209,7 +209,7 @@ impl Builder {
         }
     }
 
-    fn execute(&self) -> Outcome {
+    fn execute(&self) -> Run {
         let mut run = Run::default();
         let options = self.options();
         // Findings as `rtlint check` reports them: per-file configs,
@@ -249,11 +249,6 @@ impl Builder {
         // each shader included, SPIR-V per entry point, layouts. Inputs that
         // failed to load are already reported.
         let inputs = lint::inputs(&self.shaders, &options);
-        let hlsl_options = hlsl::HlslOptions {
-            include_dirs: self.include_dirs.clone(),
-            defines: self.defines.clone(),
-            entry: None,
-        };
         let mut programs: Vec<Program> = Vec::new();
         let mut spirv_names: BTreeMap<String, PathBuf> = BTreeMap::new();
         for input in &inputs.files {
@@ -262,10 +257,23 @@ impl Builder {
             };
             run.rerun_files_of(&program);
             if let (true, Some(dir)) = (self.emit_spirv, &out_dir) {
-                let mut hlsl_options = hlsl_options.clone();
-                hlsl_options
-                    .include_dirs
-                    .splice(0..0, input.config.hlsl.include_dirs.iter().cloned());
+                // The config's `[hlsl]` folders and defines first, as `check` has them.
+                let hlsl = &input.config.hlsl;
+                let hlsl_options = hlsl::HlslOptions {
+                    include_dirs: hlsl
+                        .include_dirs
+                        .iter()
+                        .chain(&self.include_dirs)
+                        .cloned()
+                        .collect(),
+                    defines: hlsl
+                        .defines
+                        .iter()
+                        .map(|(k, v)| (k.clone(), v.clone()))
+                        .chain(self.defines.iter().cloned())
+                        .collect(),
+                    entry: None,
+                };
                 if let Err(e) = emit_spirv(input, &program, &hlsl_options, dir, &mut spirv_names) {
                     run.diagnostics.push(*e.0);
                 }
@@ -296,12 +304,7 @@ impl Builder {
                 Err(errors) => run.diagnostics.extend(errors),
             }
         }
-        Outcome {
-            rerun: run.rerun,
-            diagnostics: run.diagnostics,
-            sources: run.sources,
-            deny_warnings: run.deny_warnings,
-        }
+        run
     }
 }
 
@@ -323,13 +326,6 @@ struct Run {
     /// Files and folders cargo watches, in the order first seen.
     rerun: Vec<PathBuf>,
     seen: BTreeSet<PathBuf>,
-    diagnostics: Vec<Diagnostic>,
-    sources: Sources,
-    deny_warnings: bool,
-}
-
-struct Outcome {
-    rerun: Vec<PathBuf>,
     diagnostics: Vec<Diagnostic>,
     sources: Sources,
     deny_warnings: bool,
