@@ -644,12 +644,12 @@ mod tests {
         for field in [
             "/// offset 0\n    pub a: glam::Vec3,",
             "/// offset 12\n    pub b: f32,",
-            "/// offset 16\n    pub c: [[f32; 4]; 2],",
-            "/// offset 48\n    pub c_last: f32,",
+            "/// offset 16; elements 0..2 with their padding\n    pub c: [[f32; 4]; 2],",
+            "/// offset 48; `c` element 2, which the next member packs after\n    pub c_last: f32,",
             "/// offset 52\n    pub d: f32,",
             "/// offset 56\n    pub e: glam::Vec2,",
-            "/// offset 64\n    pub m: [[f32; 4]; 2],",
-            "/// offset 96\n    pub m_last: [f32; 3],",
+            "/// offset 64; 3 columns of 3, 16 bytes apart; columns 0..2 with their padding\n    pub m: [[f32; 4]; 2],",
+            "/// offset 96; `m` column 2, which the next member packs after\n    pub m_last: [f32; 3],",
             "/// offset 108\n    pub tail: f32,",
         ] {
             assert!(packed.contains(field), "{field} in\n{packed}");
@@ -767,7 +767,9 @@ mod tests {
         let params = struct_body(&text, "Params");
         assert!(params.contains("pub tint: glam::Vec3,"), "{text}");
         assert!(
-            params.contains("/// offset 16\n    pub view: glam::Mat4,"),
+            params.contains(
+                "/// offset 16; 4 columns of 4, 16 bytes apart\n    pub view: glam::Mat4,"
+            ),
             "{text}"
         );
         assert_eq!(size_of(&text, "Params"), Some(80));

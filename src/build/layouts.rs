@@ -452,6 +452,26 @@ struct Field {
     ty: RustTy,
     offset: u64,
     pad: bool,
+    /// What the doc comment adds to the offset.
+    note: String,
+}
+
+/// How a matrix's memory reads: its columns or its rows, in the source's terms.
+fn matrix_note(lay: &Lay) -> String {
+    match lay {
+        Lay::Matrix {
+            vectors,
+            comps,
+            stride,
+            glam_order,
+            ..
+        } => format!(
+            "; {vectors} {} of {comps}, {stride} bytes apart",
+            if *glam_order { "columns" } else { "rows" }
+        ),
+        Lay::Array { elem, .. } => matrix_note(elem),
+        _ => String::new(),
+    }
 }
 
 struct Gen<'a> {
@@ -625,6 +645,7 @@ impl Gen<'_> {
                 },
                 offset: from,
                 pad: true,
+                note: String::new(),
             });
             *pads += 1;
         };
@@ -649,6 +670,7 @@ impl Gen<'_> {
                     ty: t,
                     offset,
                     pad: false,
+                    note: matrix_note(lay),
                 });
                 continue;
             }
@@ -687,11 +709,25 @@ impl Gen<'_> {
                 ));
             }
             let last_offset = offset + head.size;
+            let (what, n) = match lay {
+                Lay::Matrix {
+                    glam_order,
+                    vectors,
+                    ..
+                } => (if *glam_order { "columns" } else { "rows" }, *vectors),
+                Lay::Array { len, .. } => ("elements", *len),
+                _ => ("elements", 0),
+            };
+            let note = matrix_note(lay);
             out.push(Field {
                 name: field.clone(),
                 ty: head,
                 offset,
                 pad: false,
+                note: format!(
+                    "{note}; {what} 0..{} with their padding",
+                    n.saturating_sub(1)
+                ),
             });
             at = last_offset + last.size;
             out.push(Field {
@@ -699,6 +735,11 @@ impl Gen<'_> {
                 ty: last,
                 offset: last_offset,
                 pad: false,
+                note: format!(
+                    "; `{name}` {} {}, which the next member packs after",
+                    what.trim_end_matches('s'),
+                    n.saturating_sub(1)
+                ),
             });
         }
         if at < slot {
@@ -759,7 +800,7 @@ impl Gen<'_> {
         t.push_str(&format!("pub struct {name} {{\n"));
         for f in &fields {
             if !f.pad {
-                t.push_str(&format!("    /// offset {}\n", f.offset));
+                t.push_str(&format!("    /// offset {}{}\n", f.offset, f.note));
             }
             t.push_str(&format!("    pub {}: {},\n", f.name, f.ty.text));
         }
@@ -960,6 +1001,9 @@ pub fn generate(programs: &[Program], options: &Options) -> Result<String, Vec<D
         }
         d
     };
+    // First every top-level type, so their names are reserved before any
+    // nested type is named.
+    let mut unique: Vec<(&Program, Top)> = Vec::new();
     for p in programs {
         let tops = match tops(p) {
             Ok(t) => t,
@@ -990,38 +1034,30 @@ pub fn generate(programs: &[Program], options: &Options) -> Result<String, Vec<D
                 continue;
             }
             seen.insert(t.name.clone(), (t.lay.clone(), t.size, t.location.clone()));
-            let roles: Vec<&str> = t.kinds.iter().map(|k| k.words()).collect();
-            let doc = format!(
-                "/// {} `{}` ({}): {}, {} bytes.\n",
-                capitalize(&roles.join(", ")),
-                t.lay.name.trim_start_matches("type."),
-                t.location,
-                t.rule,
-                t.size
-            );
-            if gen.taken.contains_key(&t.name) {
-                errors.push(error(
-                    p,
-                    None,
-                    format!(
-                        "`{}` at {} has the name of a nested type generated earlier; rename one",
-                        t.name, t.location
-                    ),
-                ));
-                continue;
-            }
             gen.taken.insert(t.name.clone(), ());
-            match gen.render(&t.name, &t.lay, t.size, Align16::Allowed, &doc) {
-                Ok((text, _)) => gen.items.push(text),
-                Err(e) => errors.push(error(
-                    p,
-                    None,
-                    format!(
-                        "cannot generate a Rust type for `{}` at {}: {e}",
-                        t.name, t.location
-                    ),
-                )),
-            }
+            unique.push((p, t));
+        }
+    }
+    for (p, t) in unique {
+        let roles: Vec<&str> = t.kinds.iter().map(|k| k.words()).collect();
+        let doc = format!(
+            "/// {} `{}` ({}): {}, {} bytes.\n",
+            capitalize(&roles.join(", ")),
+            t.lay.name.trim_start_matches("type."),
+            t.location,
+            t.rule,
+            t.size
+        );
+        match gen.render(&t.name, &t.lay, t.size, Align16::Allowed, &doc) {
+            Ok((text, _)) => gen.items.push(text),
+            Err(e) => errors.push(error(
+                p,
+                None,
+                format!(
+                    "cannot generate a Rust type for `{}` at {}: {e}",
+                    t.name, t.location
+                ),
+            )),
         }
     }
     if !errors.is_empty() {
