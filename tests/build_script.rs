@@ -3,8 +3,10 @@
 //! `default-features = false` and is built with `cargo build`. Checks that
 //! the build script reruns on a shader edit and on an edit of an included file
 //! (and not otherwise), that a finding appears as `cargo:warning`, that an
-//! error finding and bad HLSL fail the build, and that the generated types'
-//! sizes are those `rtlint layout` reports.
+//! error finding and bad HLSL fail the build, that the generated types'
+//! sizes are those `rtlint layout` reports, and that the types generated for
+//! `tests/build_script/interfaces.hlsl` (padded arrays, matrices, nested
+//! structs) compile with their size and offset assertions.
 //!
 //! The example's target folder is `target/build-script-example`, so reruns
 //! reuse the build.
@@ -298,4 +300,31 @@ fn example_crate_builds_reruns_warns_and_fails() {
     c.edit("shaders/closesthit.hlsl", |_| closest_hit.clone());
     let b = c.build();
     assert!(b.ok, "{}", b.text);
+
+    // Harder layouts: the crate compiles their generated types, so every
+    // size and offset assertion holds, and the sizes are rtlint layout's.
+    std::fs::copy(
+        repo().join("tests/build_script/interfaces.hlsl"),
+        c.path("shaders/interfaces.hlsl"),
+    )
+    .unwrap();
+    let b = c.build();
+    assert!(b.ok && b.ran_build_script(), "{}", b.text);
+    let generated = c.layouts();
+    for field in [
+        "pub world: [[f32; 4]; 4],",
+        "pub view: glam::Mat4,",
+        "pub lights: [LightStride32; 2],",
+        "pub lights_last: Light,",
+        "pub counts_last: glam::IVec2,",
+        "pub enabled: u32,",
+        "pub inner: Inner,",
+    ] {
+        assert!(
+            generated.contains(field),
+            "{field} missing from\n{generated}"
+        );
+    }
+    assert!(generated_sizes(&generated).contains(&("Scene".to_string(), 336)));
+    assert_sizes_match_rtlint_layout(&c);
 }
