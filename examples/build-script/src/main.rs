@@ -27,7 +27,11 @@ fn main() {
     println!("Camera {} bytes", bytes.len());
     println!("Push {} bytes", bytemuck::bytes_of(&push).len());
     println!("Payload {} bytes", std::mem::size_of::<Payload>());
-    for (name, spv) in [("raygen", RAYGEN), ("miss", MISS), ("closesthit", CLOSEST_HIT)] {
+    for (name, spv) in [
+        ("raygen", RAYGEN),
+        ("miss", MISS),
+        ("closesthit", CLOSEST_HIT),
+    ] {
         println!("{name}: {} bytes of SPIR-V", spv.len());
     }
 }
