@@ -17,6 +17,36 @@ pub struct SourceOptions {
     pub defines: BTreeMap<String, String>,
 }
 
+/// One rule's entry under `[rules]`.
+#[derive(Clone, Debug, PartialEq, serde::Deserialize)]
+#[serde(untagged)]
+pub enum RuleSetting {
+    Level(Level),
+    Table {
+        #[serde(default)]
+        level: Option<Level>,
+        /// The rule's own options; the rule says which it reads.
+        #[serde(flatten)]
+        options: BTreeMap<String, toml::Value>,
+    },
+}
+
+impl RuleSetting {
+    pub fn level(&self) -> Option<Level> {
+        match self {
+            RuleSetting::Level(l) => Some(*l),
+            RuleSetting::Table { level, .. } => *level,
+        }
+    }
+
+    pub fn options(&self) -> Option<&BTreeMap<String, toml::Value>> {
+        match self {
+            RuleSetting::Level(_) => None,
+            RuleSetting::Table { options, .. } => Some(options),
+        }
+    }
+}
+
 /// A rule's configured level.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Deserialize)]
 #[serde(rename_all = "lowercase")]
@@ -36,12 +66,13 @@ impl Level {
     }
 }
 
-#[derive(Clone, Debug, serde::Deserialize)]
+#[derive(Clone, Debug, Default, serde::Deserialize)]
 #[serde(deny_unknown_fields, rename_all = "kebab-case")]
 pub struct Config {
-    /// RT001: ray payloads above this many bytes (scalar size) are reported.
-    #[serde(default = "default_payload_budget")]
-    pub payload_budget: u64,
+    /// RT001: ray payloads above this many bytes (scalar size) are reported
+    /// (the rule's default when unset; `[rules.RT001] budget` wins).
+    #[serde(default)]
+    pub payload_budget: Option<u64>,
     /// RT010: bytes of state live across one trace call (the rule's default
     /// when unset).
     #[serde(default)]
@@ -53,9 +84,11 @@ pub struct Config {
     /// Warnings fail the run too.
     #[serde(default)]
     pub deny_warnings: bool,
-    /// Rule levels by code (`RT001`) or name (`payload-over-budget`).
+    /// Per rule, by code (`RT001`) or name (`payload-over-budget`): a level
+    /// (`RT003 = "allow"`) or a table with a level and the rule's options
+    /// (`[rules.RT001]` `level = "error"`, `budget = 48`).
     #[serde(default)]
-    pub rules: BTreeMap<String, Level>,
+    pub rules: BTreeMap<String, RuleSetting>,
     /// Languages for other file extensions: `rgen = "hlsl"`.
     #[serde(default)]
     pub languages: BTreeMap<String, String>,
@@ -84,31 +117,9 @@ pub struct Config {
     /// point at an unknown one.
     #[serde(skip)]
     rule_keys: Vec<(String, Option<Location>)>,
-}
-
-fn default_payload_budget() -> u64 {
-    32
-}
-
-impl Default for Config {
-    fn default() -> Self {
-        Config {
-            payload_budget: default_payload_budget(),
-            live_state_budget: None,
-            stack_limit: None,
-            deny_warnings: false,
-            rules: BTreeMap::new(),
-            languages: BTreeMap::new(),
-            select: None,
-            extend_select: Vec::new(),
-            ignore: Vec::new(),
-            exclude: Vec::new(),
-            per_file_ignores: BTreeMap::new(),
-            hlsl: SourceOptions::default(),
-            path: None,
-            rule_keys: Vec::new(),
-        }
-    }
+    /// The file's text, for pointing at what the rules reject.
+    #[serde(skip)]
+    text: Option<String>,
 }
 
 pub const FILE_NAME: &str = "rtlint.toml";
@@ -175,6 +186,7 @@ impl Config {
             }
         }
         config.path = Some(path.to_path_buf());
+        config.text = Some(text.to_string());
         Ok(config)
     }
 
@@ -260,10 +272,68 @@ impl Config {
 
     /// The configured level of a rule, by code or by name.
     pub fn level(&self, code: &str, name: &str) -> Option<Level> {
+        self.setting(code, name).and_then(RuleSetting::level)
+    }
+
+    fn setting(&self, code: &str, name: &str) -> Option<&RuleSetting> {
         self.rules
-            .get(code)
-            .or_else(|| self.rules.get(name))
-            .copied()
+            .iter()
+            .find(|(k, _)| k.eq_ignore_ascii_case(code))
+            .or_else(|| self.rules.iter().find(|(k, _)| *k == name))
+            .map(|(_, v)| v)
+    }
+
+    /// A rule's option from its `[rules.CODE]` (or `[rules.name]`) table.
+    pub fn option(&self, code: &str, name: &str, key: &str) -> Option<&toml::Value> {
+        self.setting(code, name)?.options()?.get(key)
+    }
+
+    /// Sets a rule's option (the command line's overrides).
+    pub fn set_option(&mut self, code: &str, key: &str, value: toml::Value) {
+        let entry = self
+            .rules
+            .entry(code.to_string())
+            .or_insert(RuleSetting::Table {
+                level: None,
+                options: BTreeMap::new(),
+            });
+        if let RuleSetting::Level(l) = entry {
+            *entry = RuleSetting::Table {
+                level: Some(*l),
+                options: BTreeMap::new(),
+            };
+        }
+        if let RuleSetting::Table { options, .. } = entry {
+            options.insert(key.to_string(), value);
+        }
+    }
+
+    /// An error at the first option of a `[rules.X]` table that `known`
+    /// (rule key, option) does not accept.
+    pub fn check_rule_options(&self, known: impl Fn(&str, &str) -> bool) -> Result<(), InputError> {
+        let path = self.path.as_deref().unwrap_or(Path::new(FILE_NAME));
+        for (rule, setting) in &self.rules {
+            for key in setting.options().into_iter().flat_map(|o| o.keys()) {
+                if !known(rule, key) {
+                    let err = InputError::new(
+                        InputErrorKind::InvalidConfig,
+                        path,
+                        format!("rule `{rule}` has no option `{key}`"),
+                    );
+                    return Err(
+                        match self
+                            .text
+                            .as_deref()
+                            .and_then(|t| find_location(t, path, key))
+                        {
+                            Some(l) => err.at(l, "here"),
+                            None => err,
+                        },
+                    );
+                }
+            }
+        }
+        Ok(())
     }
 
     /// The language configured for a path's extension.
@@ -319,7 +389,7 @@ mod tests {
             Path::new("rtlint.toml"),
         )
         .unwrap();
-        assert_eq!(c.payload_budget, 48);
+        assert_eq!(c.payload_budget, Some(48));
         assert_eq!(c.level("RT003", "member-straddles-row"), Some(Level::Allow));
         assert_eq!(
             c.level("RT002", "payload-packing-waste"),

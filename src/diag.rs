@@ -48,6 +48,15 @@ impl Label {
     }
 }
 
+/// A mechanical fix: the text that replaces the declaration at `location`
+/// (so that a later `--fix` can apply it).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Fix {
+    /// The declaration the replacement is for; `None` without debug info.
+    pub location: Option<Location>,
+    pub replacement: String,
+}
+
 /// One finding or one input error.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Diagnostic {
@@ -68,8 +77,8 @@ pub struct Diagnostic {
     pub subject: Option<String>,
     pub notes: Vec<String>,
     pub help: Option<String>,
-    /// A mechanical fix, as replacement text (e.g. a reordered struct).
-    pub fix: Option<String>,
+    /// A mechanical fix (e.g. a reordered struct).
+    pub fix: Option<Fix>,
 }
 
 impl Diagnostic {
@@ -130,8 +139,12 @@ impl Diagnostic {
         self
     }
 
-    pub fn with_fix(mut self, fix: impl Into<String>) -> Self {
-        self.fix = Some(fix.into());
+    /// A fix: `replacement` for the declaration at `location`.
+    pub fn with_fix(mut self, location: Option<Location>, replacement: impl Into<String>) -> Self {
+        self.fix = Some(Fix {
+            location,
+            replacement: replacement.into(),
+        });
         self
     }
 

@@ -12,6 +12,7 @@ pub mod front;
 pub mod lint;
 pub mod pipeline;
 pub mod program;
+#[cfg(feature = "vulkan")]
 pub mod reference;
 pub mod report;
 pub mod rules;

@@ -136,8 +136,9 @@ pub fn check_paths(paths: &[PathBuf], options: &Options) -> Report {
                 }
                 owned.push(f.path.clone());
             }
+            // Suppressions are judged only in inputs that were analysed.
+            owned.push(c.path.clone());
         }
-        owned.push(c.path.clone());
         diagnostics.extend(c.diagnostics);
     }
     let pipelines: Vec<Checked> = inputs
@@ -152,12 +153,15 @@ pub fn check_paths(paths: &[PathBuf], options: &Options) -> Report {
         || inputs.files.iter().any(|i| i.config.deny_warnings)
         || inputs.pipelines.iter().any(|(_, c)| c.deny_warnings);
     let mut seen = HashSet::new();
+    // The same finding from several modules (a struct in a shared header)
+    // once; a finding without a position belongs to its own input.
     diagnostics.retain(|d| {
         seen.insert((
             d.code,
             d.name,
             d.message.clone(),
             d.primary.as_ref().map(|l| l.location.clone()),
+            d.primary.is_none().then(|| d.file.clone()),
             d.subject.clone(),
         ))
     });
@@ -304,7 +308,7 @@ impl Configs {
         config.extend_select.extend(o.extend_select.iter().cloned());
         config.ignore.extend(o.ignore.iter().cloned());
         if let Some(b) = o.payload_budget {
-            config.payload_budget = b;
+            config.set_option("RT001", "budget", toml::Value::Integer(b as i64));
         }
         config.deny_warnings |= o.deny_warnings;
         let c = Arc::new(config);
@@ -318,6 +322,7 @@ impl Configs {
 pub fn load_config(path: &Path) -> Result<Config, InputError> {
     let config = Config::load(path)?;
     config.check_rule_names(crate::rules::is_selector)?;
+    config.check_rule_options(crate::rules::has_option)?;
     Ok(config)
 }
 
@@ -490,7 +495,11 @@ fn walk(
             }
         } else if p
             .extension()
-            .is_some_and(|e| e.eq_ignore_ascii_case("hlsli") || e.eq_ignore_ascii_case("glsl"))
+            .is_some_and(|e| e.eq_ignore_ascii_case("hlsli"))
+            || (p
+                .extension()
+                .is_some_and(|e| e.eq_ignore_ascii_case("glsl"))
+                && front::glsl::stage_extension(&p).is_none())
         {
             // A header: analysed through the shaders that include it.
             inputs.skipped.push(p);
@@ -534,20 +543,19 @@ fn is_loop(e: &ignore::Error) -> bool {
 }
 
 /// The language a file's name says: `.hlsl`, `.wgsl`, `.spv`, and GLSL's
-/// ray-tracing stage extensions.
+/// ray-tracing stage extensions (also as `name.rgen.glsl`).
 fn language_from_name(p: &Path) -> Option<Language> {
     Language::from_path(p).or_else(|| {
-        let ext = p.extension()?.to_str()?.to_ascii_lowercase();
-        front::glsl::RAY_TRACING_EXTENSIONS
-            .contains(&ext.as_str())
-            .then_some(Language::Glsl)
+        front::glsl::stage_extension(p)
+            .filter(|e| front::glsl::RAY_TRACING_EXTENSIONS.contains(e))
+            .map(|_| Language::Glsl)
     })
 }
 
 /// A GLSL compute, fragment or other stage that uses ray queries.
 fn ray_query_glsl(p: &Path) -> Option<Language> {
-    let ext = p.extension()?.to_str()?.to_ascii_lowercase();
-    if !front::glsl::RAY_QUERY_EXTENSIONS.contains(&ext.as_str()) {
+    let ext = front::glsl::stage_extension(p)?;
+    if !front::glsl::RAY_QUERY_EXTENSIONS.contains(&ext) {
         return None;
     }
     let text = std::fs::read(p).ok()?;

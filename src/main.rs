@@ -246,12 +246,18 @@ fn run(cli: Cli) -> Result<u8, String> {
         Command::Rules => {
             let mut out = std::io::stdout().lock();
             for r in rtlint::rules::RULES {
+                let level = if r.group.on_by_default() {
+                    r.level.as_str()
+                } else {
+                    "off"
+                };
                 let _ = writeln!(
                     out,
-                    "{}  {:<28} {:<8} {}",
+                    "{}  {:<28} {:<8} {:<12} {}",
                     r.code,
                     r.name,
-                    r.level.as_str(),
+                    level,
+                    r.group.as_str(),
                     r.summary
                 );
             }
@@ -259,7 +265,7 @@ fn run(cli: Cli) -> Result<u8, String> {
         }
         Command::Rule { code } => match rtlint::rules::find(&code) {
             Some(r) => {
-                print!("{}", r.doc);
+                print!("{}", r.page());
                 Ok(0)
             }
             None => Err(format!("unknown rule `{code}` (`rtlint rules` lists them)")),

@@ -16,6 +16,20 @@ pub const RAY_TRACING_EXTENSIONS: &[&str] = &["rgen", "rchit", "rmiss", "rahit",
 /// Extensions of other GLSL stages, linted when the file uses `rayQueryEXT`.
 pub const RAY_QUERY_EXTENSIONS: &[&str] = &["comp", "frag", "vert", "mesh", "task"];
 
+/// The stage extension of a GLSL file: `rgen` for `a.rgen` and for
+/// `a.rgen.glsl` (glslang needs the stage, and tells it from the extension).
+pub fn stage_extension(path: &Path) -> Option<&'static str> {
+    let name = path.file_name()?.to_str()?.to_ascii_lowercase();
+    let mut parts = name.rsplit('.');
+    let last = parts.next()?;
+    let ext = if last == "glsl" { parts.next()? } else { last };
+    RAY_TRACING_EXTENSIONS
+        .iter()
+        .chain(RAY_QUERY_EXTENSIONS)
+        .find(|e| **e == ext)
+        .copied()
+}
+
 /// The glslang program to run.
 pub fn glslang() -> PathBuf {
     std::env::var_os("RTLINT_GLSLANG")
@@ -30,11 +44,7 @@ pub fn compile(
     text: &str,
     options: &FrontOptions,
 ) -> Result<(Vec<u32>, Option<PathBuf>), InputError> {
-    let ext = path
-        .extension()
-        .and_then(|e| e.to_str())
-        .unwrap_or("")
-        .to_ascii_lowercase();
+    let ext = stage_extension(path).unwrap_or("glsl");
     let dir = tempdir(path)?;
     // glslang reads a file: the text goes into one named like the input, so
     // the stage still follows from the extension.

@@ -4,7 +4,6 @@
 
 pub mod glsl;
 pub mod hlsl;
-pub mod slang;
 pub mod wgsl;
 
 use crate::diag::InputError;

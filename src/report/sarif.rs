@@ -19,7 +19,7 @@ pub fn render(diagnostics: &[Diagnostic]) -> String {
                 "name": r.name,
                 "shortDescription": { "text": r.summary },
                 "fullDescription": { "text": r.summary },
-                "help": { "text": r.doc, "markdown": r.doc },
+                "help": { "text": r.page(), "markdown": r.page() },
                 "defaultConfiguration": { "level": level(r.level) },
                 "properties": { "tags": [r.group.as_str()] },
             });
