@@ -21,8 +21,9 @@
 //! warning under `deny_warnings`) or an input cannot be read. See
 //! `docs/build.md`.
 //!
-//! This module sits on top of the layers, beside the CLI: it drives the
-//! front-ends, the rules and the human report.
+//! This module sits on top of the layers, beside the CLI: findings come from
+//! [`lint::check_paths`], the modules for includes, SPIR-V and layouts from
+//! [`lint::load`], the rendered failure from the human report.
 
 mod layouts;
 
@@ -59,8 +60,9 @@ impl Builder {
         Self::default()
     }
 
-    /// A shader file or a folder searched recursively for `.hlsl`, `.wgsl`
-    /// and `.spv` files (`.hlsli` headers are read through their includers).
+    /// A shader file or a folder walked as `rtlint check` walks it: HLSL,
+    /// WGSL, GLSL (through glslang) and SPIR-V; `.hlsli` headers are read
+    /// through the shaders that include them.
     pub fn shaders(mut self, path: impl Into<PathBuf>) -> Self {
         self.shaders.push(path.into());
         self
@@ -73,20 +75,20 @@ impl Builder {
         self
     }
 
-    /// An `#include` folder for HLSL, searched after the including file's own.
+    /// An `#include` folder for HLSL and GLSL, searched after the including
+    /// file's own folder and the config's `[hlsl]` folders.
     pub fn include_dir(mut self, path: impl Into<PathBuf>) -> Self {
         self.include_dirs.push(path.into());
         self
     }
 
-    /// An HLSL `#define NAME VALUE`.
+    /// A `#define NAME VALUE` for HLSL and GLSL.
     pub fn define(mut self, name: impl Into<String>, value: impl Into<String>) -> Self {
         self.defines.push((name.into(), value.into()));
         self
     }
 
-    /// The `rtlint.toml` to use; by default one is searched for upwards from
-    /// the first shader path.
+    /// The `rtlint.toml` for every input; by default each file's nearest.
     pub fn config(mut self, path: impl Into<PathBuf>) -> Self {
         self.config = Some(path.into());
         self
