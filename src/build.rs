@@ -735,19 +735,21 @@ mod tests {
 
     #[test]
     fn glsl_goes_through_glslang() {
-        if std::process::Command::new(front::glsl::glslang())
-            .arg("--version")
-            .output()
-            .is_err()
-        {
-            eprintln!("glslangValidator is not installed: GLSL not tested");
+        if !rtlint_testkit::tool(&front::glsl::glslang().to_string_lossy()) {
             return;
         }
         let dir = scratch("glsl");
+        std::fs::create_dir_all(dir.join("include")).unwrap();
+        std::fs::write(
+            dir.join("include/payload.glsl"),
+            "struct Payload { vec3 color; uint depth; mat4 m; };\n",
+        )
+        .unwrap();
         std::fs::write(
             dir.join("trace.rgen"),
             "#version 460\n#extension GL_EXT_ray_tracing : require\n\
-             struct Payload { vec3 color; uint depth; mat4 m; };\n\
+             #extension GL_GOOGLE_include_directive : require\n\
+             #include \"include/payload.glsl\"\n\
              layout(location = 0) rayPayloadEXT Payload p;\n\
              layout(binding = 0) uniform accelerationStructureEXT tlas;\n\
              layout(binding = 1, std140) uniform Params { vec3 tint; float scale; mat4 view; } params;\n\
@@ -761,7 +763,9 @@ mod tests {
             .generate_layouts("layouts.rs")
             .out_dir(&dir));
         r.unwrap();
-        assert!(lines.contains("trace.rgen"), "{lines}");
+        assert!(lines.contains("trace.rgen\n"), "{lines}");
+        // The included file too, as glslang's debug info names it.
+        assert!(lines.contains("payload.glsl\n"), "{lines}");
         let spv = std::fs::read(dir.join("trace.main.spv")).unwrap();
         assert_eq!(&spv[..4], &crate::program::MAGIC.to_le_bytes());
         let text = std::fs::read_to_string(dir.join("layouts.rs")).unwrap();
