@@ -29,7 +29,11 @@ pub fn chain(steps: &[ChainStep], name: impl Fn(usize) -> String) -> String {
         .iter()
         .map(|s| {
             let name = name(s.node);
-            if s.repeat > 0 {
+            if s.unbounded && s.level > 0 {
+                format!("{name} at levels {} and deeper, without bound", s.level)
+            } else if s.unbounded {
+                format!("{name} at a level without bound")
+            } else if s.repeat > 0 {
                 format!("{name} at levels {}–{}", s.level, s.level as u64 + s.repeat)
             } else {
                 format!("{name} at level {}", s.level)

@@ -162,14 +162,29 @@ pub fn trace_graph(pipeline: &Pipeline) -> TraceGraph {
             if !reach.contains(&f.id) {
                 continue;
             }
-            let location = program.site_location(site.inst);
+            // A site in a helper (naga wraps every `traceRay` in one per
+            // payload, called from several shaders) is placed and its
+            // operands folded at this shader's call.
+            let chain = crate::program::cfg::call_chains(
+                program,
+                shader.function,
+                f.id,
+                super::liveness::MAX_CHAINS,
+            )
+            .into_iter()
+            .next()
+            .unwrap_or_default();
+            let location = program
+                .location_in(site.inst, &chain)
+                .or_else(|| program.site_location(site.inst));
             let mut targets: Vec<usize> = Vec::new();
             let kind = match site.kind {
                 SiteKind::TraceRay => EdgeKind::Trace,
                 SiteKind::ExecuteCallable => EdgeKind::Callable,
                 _ => continue,
             };
-            if let (EdgeKind::Trace, Some(t)) = (kind, site.trace) {
+            let operands = program.trace_operands_in(site, &chain).or(site.trace);
+            if let (EdgeKind::Trace, Some(t)) = (kind, operands) {
                 let flags = t.ray_flags.constant().unwrap_or(0);
                 let dynamic_flags = t.ray_flags.constant().is_none();
                 let opaque = !dynamic_flags

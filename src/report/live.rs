@@ -11,10 +11,12 @@ pub fn human(report: &LiveReport) -> String {
         return s;
     }
     for site in &report.sites {
-        let at = match (site.line, site.column) {
-            (Some(l), Some(c)) if c > 0 => format!("{}:{l}:{c}", site.path.display()),
-            (Some(l), _) => format!("{}:{l}", site.path.display()),
-            _ => site.path.display().to_string(),
+        // A line belongs to the source file the debug info names, not to
+        // the module.
+        let at = match &site.location {
+            Some(l) if l.column > 0 => format!("{}:{}:{}", l.path.display(), l.line, l.column),
+            Some(l) => format!("{}:{}", l.path.display(), l.line),
+            None => site.path.display().to_string(),
         };
         let _ = writeln!(
             s,
@@ -33,10 +35,13 @@ pub fn human(report: &LiveReport) -> String {
             let _ = writeln!(s, "  payload `{}`: {} ({size}, not counted)", p.name, p.ty);
         }
         for v in &site.values {
-            let line = |l: Option<u32>| l.map(|l| l.to_string()).unwrap_or("?".into());
+            let line = |what: &str, l: Option<u32>| {
+                l.map(|l| format!("{what} line {l}"))
+                    .unwrap_or(format!("{what} at no known line"))
+            };
             let _ = writeln!(
                 s,
-                "  {:>4} B  {:<16} {:<10} {:<8} defined line {}, used line {}{}",
+                "  {:>4} B  {:<16} {:<10} {:<8} {}, {}{}",
                 v.size,
                 v.name,
                 v.ty,
@@ -44,8 +49,8 @@ pub fn human(report: &LiveReport) -> String {
                     Storage::Ssa => "value",
                     Storage::Variable => "variable",
                 },
-                line(v.def_line),
-                line(v.use_line),
+                line("defined", v.def_line),
+                line("used", v.use_line),
                 if v.rematerializable {
                     "  (rematerializable)"
                 } else {
