@@ -206,6 +206,7 @@ impl Builder {
             front: front::FrontOptions {
                 include_dirs: self.include_dirs.clone(),
                 defines: self.defines.clone(),
+                ..front::FrontOptions::default()
             },
             ..lint::Options::default()
         }

@@ -41,6 +41,18 @@ struct Common {
     /// Define a macro for HLSL and GLSL sources: NAME or NAME=VALUE.
     #[arg(short = 'D', value_name = "NAME[=VALUE]")]
     define: Vec<String>,
+    /// HLSL: only this entry point.
+    #[arg(short = 'E', long = "entry", value_name = "NAME")]
+    entry: Option<String>,
+    /// HLSL: the entry point's stage when it has no `[shader(...)]`: a DXC
+    /// profile (`ps_6_5`, `cs_6_5`, `lib_6_3`) or a stage name.
+    #[arg(
+        short = 'T',
+        long = "stage",
+        value_name = "PROFILE",
+        requires = "entry"
+    )]
+    stage: Option<String>,
     /// The name standard input (`-`) is linted under; its extension picks the language.
     #[arg(long, value_name = "PATH")]
     stdin_filename: Option<PathBuf>,
@@ -304,6 +316,16 @@ fn options(common: &Common) -> Result<lint::Options, String> {
         front: rtlint::front::FrontOptions {
             include_dirs: common.include.clone(),
             defines: common.define.iter().map(|d| split_define(d)).collect(),
+            entry: common.entry.clone(),
+            stage: match common
+                .stage
+                .as_deref()
+                .map(rtlint::front::hlsl::parse_stage)
+            {
+                Some(Ok(s)) => s,
+                Some(Err(e)) => return Err(format!("-T: {e}")),
+                None => None,
+            },
         },
         respect_gitignore: !common.no_gitignore,
         stdin,

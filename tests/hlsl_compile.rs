@@ -1141,3 +1141,50 @@ fn ray_queries_are_passed_to_helpers_as_their_variable() {
     );
     assert_eq!(named(&m.words, "committed<1>").len(), 1);
 }
+
+/// `rtlint check` and `rtlint compile` take the entry point and its stage.
+#[test]
+fn cli_names_a_classic_entry_point_with_its_stage() {
+    let file = shader("classic/pixel_rayquery.hlsl");
+    let run = |args: &[&str]| {
+        Command::new(env!("CARGO_BIN_EXE_rtlint"))
+            .args(args)
+            .arg(&file)
+            .env("NO_COLOR", "1")
+            .output()
+            .unwrap()
+    };
+    let ok = run(&["check", "-E", "main", "-T", "ps_6_5"]);
+    assert!(
+        ok.status.success(),
+        "{}",
+        String::from_utf8_lossy(&ok.stdout)
+    );
+    let none = run(&["check"]);
+    assert_eq!(none.status.code(), Some(2));
+    let bad = run(&["check", "-E", "main", "-T", "vs_6_0"]);
+    assert_eq!(bad.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&bad.stderr).contains("not supported: vertex shaders"));
+    let out = std::env::temp_dir().join(format!("rtlint-classic-{}.spv", std::process::id()));
+    let compiled = Command::new(env!("CARGO_BIN_EXE_rtlint"))
+        .args(["compile", "-E", "main", "-T", "ps_6_5", "-o"])
+        .arg(&out)
+        .arg(&file)
+        .output()
+        .unwrap();
+    assert!(
+        compiled.status.success(),
+        "{}",
+        String::from_utf8_lossy(&compiled.stderr)
+    );
+    let bytes = std::fs::read(&out).unwrap();
+    let words: Vec<u32> = bytes
+        .chunks_exact(4)
+        .map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]]))
+        .collect();
+    // OpEntryPoint (15) Fragment (4) named main.
+    assert!(instructions(&words)
+        .iter()
+        .any(|(op, ops)| *op == 15 && ops[0] == 4 && string_at(&ops[2..]) == "main"));
+    let _ = std::fs::remove_file(&out);
+}
