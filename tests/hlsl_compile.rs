@@ -1188,3 +1188,24 @@ fn cli_names_a_classic_entry_point_with_its_stage() {
         .any(|(op, ops)| *op == 15 && ops[0] == 4 && string_at(&ops[2..]) == "main"));
     let _ = std::fs::remove_file(&out);
 }
+
+#[test]
+fn descriptor_heaps_are_typed_arrays_sharing_a_binding() {
+    compile_all("descriptor_heaps.hlsl");
+    let m = hlsl::compile_file(&shader("descriptor_heaps.hlsl"), &HlslOptions::default()).unwrap();
+    let heaps = named(&m.words, "ResourceDescriptorHeap");
+    // One array per element type (a texture and a structured buffer).
+    assert_eq!(heaps.len(), 2);
+    let insts = instructions(&m.words);
+    let binding = |id: u32| {
+        insts
+            .iter()
+            .find(|(op, ops)| *op == 71 && ops[0] == id && ops[1] == 33)
+            .map(|(_, ops)| ops[2])
+            .unwrap()
+    };
+    // After `material` (0) and `output` (1): resources at 2, samplers at 3.
+    assert_eq!(binding(heaps[0]), 2);
+    assert_eq!(binding(heaps[1]), 2);
+    assert_eq!(binding(named(&m.words, "SamplerDescriptorHeap")[0]), 3);
+}

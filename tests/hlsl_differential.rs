@@ -539,6 +539,10 @@ const NOT_RUN: &[(&str, &str)] = &[
     ),
     ("include", "a folder of include files"),
     (
+        "descriptor_heaps.hlsl",
+        "descriptor heaps: tests/hlsl_compile.rs checks the arrays and bindings",
+    ),
+    (
         "cbuffer_struct_tail.hlsl",
         "a member after a struct in a cbuffer: tests/hlsl_compile.rs checks the offsets \
          (diff_cbuffer.hlsl compares the same rule with Slang on the driver)",

@@ -11,6 +11,7 @@ mod debug;
 mod decl;
 mod expr;
 mod func;
+mod heaps;
 mod methods;
 mod pixel;
 mod place;
@@ -194,6 +195,9 @@ pub struct Lowerer<'a> {
     method_templates: HashMap<String, Vec<&'a Function>>,
     /// Instances of struct templates (`S<float>`), declared where first used.
     instance_structs: HashMap<String, &'a StructDecl>,
+    /// Descriptor-heap arrays by element type, and the heaps' (set, binding).
+    heap_vars: HashMap<Ty, Id>,
+    heap_bindings: ((u32, u32), (u32, u32)),
     /// Stage-restricted operations used in helpers: (name, stages, position).
     fn_stage_uses: HashMap<usize, Vec<(String, Vec<Stage>, Pos)>>,
     /// Helpers whose signatures use something unsupported: the error, given
@@ -482,6 +486,8 @@ impl<'a> Lowerer<'a> {
             needed: Vec::new(),
             unusable: HashMap::new(),
             fn_stage_uses: HashMap::new(),
+            heap_vars: HashMap::new(),
+            heap_bindings: ((0, 0), (0, 0)),
             specialized: HashMap::new(),
             usings: items
                 .iter()

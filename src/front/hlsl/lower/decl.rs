@@ -729,6 +729,10 @@ impl<'a> Lowerer<'a> {
             let binding = self.auto_binding(&mut used, &mut next_auto);
             self.declare_cbuffer(&[], "$Globals", pos, Some(binding), &globals_members)?;
         }
+        // The descriptor heaps' bindings (used only if the heaps are).
+        let resources = self.auto_binding(&mut used, &mut next_auto);
+        let samplers = self.auto_binding(&mut used, &mut next_auto);
+        self.heap_bindings = (resources, samplers);
         Ok(())
     }
 

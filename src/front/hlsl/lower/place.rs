@@ -206,6 +206,15 @@ impl<'a> Lowerer<'a> {
             ExprKind::Call(name, args) if self.returns_resource(name) => {
                 self.resource_call(name, args, e.pos)
             }
+            // `(Texture2D<float4>)ResourceDescriptorHeap[i]`.
+            ExprKind::Cast(tref, inner) if Self::heap_index(inner).is_some() => {
+                let ns = self.f.cur_ns.clone();
+                let t = self.resolve_ty(tref, &ns)?;
+                match Self::heap_index(inner) {
+                    Some((sampler, idx)) => self.heap_place(sampler, idx, &t, e.pos),
+                    None => Err(Error::new(e.pos, "expected a descriptor heap element")),
+                }
+            }
             _ => Ok(Place::Value(self.expr(e)?)),
         }
     }

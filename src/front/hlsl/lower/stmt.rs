@@ -302,7 +302,10 @@ impl<'a> Lowerer<'a> {
             // `Texture2D t = textures[i];`: a name for the resource it is
             // initialized with (as DXC's legalization makes of it).
             let place = match &v.init {
-                Some(init) if !v.mods.is_static => self.place(init)?,
+                Some(init) if !v.mods.is_static => match Self::heap_index(init) {
+                    Some((sampler, idx)) => self.heap_place(sampler, idx, &t, init.pos)?,
+                    None => self.place(init)?,
+                },
                 _ => {
                     return Err(unsupported(
                         v.pos,
