@@ -1209,3 +1209,24 @@ fn descriptor_heaps_are_typed_arrays_sharing_a_binding() {
     assert_eq!(binding(heaps[1]), 2);
     assert_eq!(binding(named(&m.words, "SamplerDescriptorHeap")[0]), 3);
 }
+
+#[test]
+fn typed_buffers_are_texel_buffers() {
+    compile_all("texel_buffers.hlsl");
+    let m = hlsl::compile_file(&shader("texel_buffers.hlsl"), &HlslOptions::default()).unwrap();
+    let insts = instructions(&m.words);
+    // OpTypeImage (25) with Dim Buffer (5): sampled 1 (Buffer) and 2 (RWBuffer).
+    let images: Vec<(u32, u32)> = insts
+        .iter()
+        .filter(|(op, ops)| *op == 25 && ops[2] == 5)
+        .map(|(_, ops)| (ops[6], ops[7]))
+        .collect();
+    assert!(images.contains(&(1, 0)));
+    // RWBuffer<float> → R32f (3), RWBuffer<uint2> → Rg32ui (35).
+    assert!(
+        images.contains(&(2, 3)) && images.contains(&(2, 35)),
+        "{images:?}"
+    );
+    // OpImageFetch (95) without image operands (no mip level in a texel buffer).
+    assert!(insts.iter().any(|(op, ops)| *op == 95 && ops.len() == 4));
+}

@@ -539,6 +539,10 @@ const NOT_RUN: &[(&str, &str)] = &[
     ),
     ("include", "a folder of include files"),
     (
+        "texel_buffers.hlsl",
+        "texel buffers (rtlint::vk binds no buffer views): tests/hlsl_compile.rs checks the images",
+    ),
+    (
         "descriptor_heaps.hlsl",
         "descriptor heaps: tests/hlsl_compile.rs checks the arrays and bindings",
     ),

@@ -55,6 +55,8 @@ pub enum Dim {
     D2Array,
     D1Array,
     CubeArray,
+    /// `Buffer<T>` / `RWBuffer<T>`: texel buffers.
+    Buffer,
 }
 
 #[derive(Clone, Debug, PartialEq, Eq, Hash)]

@@ -98,7 +98,15 @@ impl<'a> Lowerer<'a> {
                     Dim::D2Array => (spirv::Dim::Dim2D, 1),
                     Dim::D1Array => (spirv::Dim::Dim1D, 1),
                     Dim::CubeArray => (spirv::Dim::DimCube, 1),
+                    Dim::Buffer => (spirv::Dim::DimBuffer, 0),
                 };
+                if *dim == Dim::Buffer {
+                    self.cap(if *rw {
+                        Capability::ImageBuffer
+                    } else {
+                        Capability::SampledBuffer
+                    });
+                }
                 if *dim == Dim::CubeArray {
                     self.cap(if *rw {
                         Capability::ImageCubeArray

@@ -513,7 +513,7 @@ impl<'a> Lowerer<'a> {
             },
             "Texture1D" | "Texture2D" | "Texture3D" | "TextureCube" | "Texture2DArray"
             | "Texture1DArray" | "TextureCubeArray" | "RWTexture1D" | "RWTexture2D"
-            | "RWTexture3D" | "RWTexture2DArray" | "RWTexture1DArray" => {
+            | "RWTexture3D" | "RWTexture2DArray" | "RWTexture1DArray" | "Buffer" | "RWBuffer" => {
                 let rw = name.starts_with("RW");
                 let dim = match name.trim_start_matches("RW") {
                     "Texture1D" => Dim::D1,
@@ -522,6 +522,7 @@ impl<'a> Lowerer<'a> {
                     "TextureCube" => Dim::Cube,
                     "Texture1DArray" => Dim::D1Array,
                     "TextureCubeArray" => Dim::CubeArray,
+                    "Buffer" => Dim::Buffer,
                     _ => Dim::D2Array,
                 };
                 let (sc, n) = match targ_ty(self, 0, Ty::Vec(Sc::Float, 4))? {
@@ -542,9 +543,7 @@ impl<'a> Lowerer<'a> {
                     fmt: None,
                 }
             }
-            "Buffer"
-            | "RWBuffer"
-            | "AppendStructuredBuffer"
+            "AppendStructuredBuffer"
             | "ConsumeStructuredBuffer"
             | "Texture2DMS"
             | "string"

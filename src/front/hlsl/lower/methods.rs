@@ -288,20 +288,23 @@ impl<'a> Lowerer<'a> {
         let im = self.image(ptr, t)?;
         let v4 = Ty::Vec(*sc, 4);
         let vt = self.ty_id(&v4)?;
-        let lod = match lod {
-            Some(l) => l,
-            None => self.const_i32(0),
-        };
-        let id = self.inst(
-            Op::ImageFetch,
-            Some(vt),
-            vec![
-                Operand::IdRef(im),
-                Operand::IdRef(coord),
-                Operand::ImageOperands(spirv::ImageOperands::LOD),
-                Operand::IdRef(lod),
-            ],
-        )?;
+        let mut ops = vec![Operand::IdRef(im), Operand::IdRef(coord)];
+        // Texel buffers have no mip levels.
+        if !matches!(
+            t,
+            Ty::Texture {
+                dim: Dim::Buffer,
+                ..
+            }
+        ) {
+            let lod = match lod {
+                Some(l) => l,
+                None => self.const_i32(0),
+            };
+            ops.push(Operand::ImageOperands(spirv::ImageOperands::LOD));
+            ops.push(Operand::IdRef(lod));
+        }
+        let id = self.inst(Op::ImageFetch, Some(vt), ops)?;
         let texel = if *n == 1 {
             Ty::Sc(*sc)
         } else {
@@ -329,6 +332,10 @@ impl<'a> Lowerer<'a> {
             Ty::Vec(Sc::Float, cn)
         };
         match name {
+            _ if dim == Dim::Buffer && name.starts_with("Sample") => Err(Error::new(
+                pos,
+                format!("a Buffer has no `{name}`; use Load or []"),
+            )),
             "Sample" if self.f.cur_stage.is_some_and(|s| s != Stage::Fragment) => Err(unsupported(
                 pos,
                 "`Sample` (implicit level of detail) outside pixel shaders; use `SampleLevel`",
@@ -394,6 +401,11 @@ impl<'a> Lowerer<'a> {
                 }
                 let id = self.inst(Op::ImageSampleExplicitLod, Some(vt), ops)?;
                 Ok(Some(self.shrink(Val { id, ty: v4 }, &texel)?))
+            }
+            "Load" if dim == Dim::Buffer && !rw => {
+                self.arity(name, args, 1, pos)?;
+                let c = self.expr_as(&args[0], &Ty::Sc(Sc::Int))?;
+                Ok(Some(self.fetch(ptr, t, c.id, None)?))
             }
             "Load" if matches!(dim, Dim::Cube | Dim::CubeArray) => Err(Error::new(
                 pos,
@@ -461,7 +473,7 @@ impl<'a> Lowerer<'a> {
                 };
                 let qtid = self.ty_id(&qt)?;
                 let im = self.image(ptr, t)?;
-                let size = if rw {
+                let size = if rw || dim == Dim::Buffer {
                     self.op(Op::ImageQuerySize, qtid, &[im])?
                 } else {
                     let lod = match mip {

@@ -441,7 +441,7 @@ impl<'a> Lowerer<'a> {
 
     pub(super) fn coord_size(&self, dim: Dim, sampling: bool) -> u8 {
         match dim {
-            Dim::D1 => 1,
+            Dim::D1 | Dim::Buffer => 1,
             Dim::D2 | Dim::D1Array => 2,
             Dim::D3 | Dim::D2Array => 3,
             Dim::Cube => {
