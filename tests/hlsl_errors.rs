@@ -618,3 +618,11 @@ fn rendered_errors_match_the_snapshot() {
     }
     common::snapshot("hlsl_errors__rendered", &all);
 }
+
+#[test]
+fn ray_queries_are_not_returned_from_functions() {
+    assert_eq!(
+        err("RaytracingAccelerationStructure s;\nRayQuery<0> trace(RayDesc r)\n{\n    RayQuery<0> q;\n    q.TraceRayInline(s, 0, 0xff, r);\n    return q;\n}\n[numthreads(1,1,1)]\nvoid m()\n{\n    RayDesc r = (RayDesc)0;\n    RayQuery<0> q = trace(r);\n}"),
+        "main.hlsl:2:1: not supported: functions returning a RayQuery"
+    );
+}

@@ -216,6 +216,13 @@ impl<'a> Lowerer<'a> {
     /// A function's return type and parameters.
     fn signature(&mut self, f: &Function) -> Result<(Ty, Vec<Param>)> {
         let ret = self.resolve_ty(&f.ret, &f.ns)?;
+        if ret.is_opaque() {
+            // Ray queries and hit objects cannot be copied out of a function.
+            return Err(unsupported(
+                f.ret.pos,
+                format!("functions returning a {}", self.ty_name(&ret)),
+            ));
+        }
         let mut params = Vec::new();
         for p in &f.params {
             let t = self.resolve_ty(&p.ty, &f.ns)?;

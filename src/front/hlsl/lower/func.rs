@@ -48,6 +48,12 @@ impl<'a> Lowerer<'a> {
         let sig = self.funcs[k].clone();
         let f = sig.func;
         self.f = FnCtx::new(k, &f.ns, sig.stage, sig.ret.clone());
+        if sig.ret.is_opaque() {
+            return Err(unsupported(
+                f.ret.pos,
+                format!("functions returning a {}", self.ty_name(&sig.ret)),
+            ));
+        }
         let ret_id = self.ty_id(&sig.ret)?;
         // A pixel entry point is lowered as an ordinary function (`src.NAME`,
         // as DXC names it) that a wrapper calls; see `pixel_wrapper`.

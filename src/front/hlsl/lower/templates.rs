@@ -323,6 +323,10 @@ impl<'a> Lowerer<'a> {
             }
             None => (format!("{}{suffix}", f.name), format!("{}{suffix}", f.name)),
         };
+        if let Some(e) = self.unusable.get(&key) {
+            // The instance exists but its signature is refused.
+            return Err(e.clone());
+        }
         if let Some(c) = self.fn_by_name.get(&key).cloned() {
             let mut all = Vec::new();
             if let Some(p) = this {
