@@ -1230,3 +1230,23 @@ fn typed_buffers_are_texel_buffers() {
     // OpImageFetch (95) without image operands (no mip level in a texel buffer).
     assert!(insts.iter().any(|(op, ops)| *op == 95 && ops.len() == 4));
 }
+
+#[test]
+fn a_returned_ray_query_is_the_callers_variable() {
+    compile_all("rayquery_return.hlsl");
+    let m = hlsl::compile_file(&shader("rayquery_return.hlsl"), &HlslOptions::default()).unwrap();
+    let insts = instructions(&m.words);
+    // No OpReturnValue (254): the function returns void and makes the query
+    // in its last parameter, a Function pointer to the ray query type.
+    assert!(!insts.iter().any(|(op, _)| *op == 254));
+    let f = named(&m.words, "traceScene<RayQuery<1>>")[0];
+    let at = insts
+        .iter()
+        .position(|(op, ops)| *op == 54 && ops[1] == f)
+        .unwrap();
+    let params: Vec<_> = insts[at + 1..]
+        .iter()
+        .take_while(|(op, _)| *op == 55)
+        .collect();
+    assert_eq!(params.len(), 2);
+}

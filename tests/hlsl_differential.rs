@@ -539,6 +539,10 @@ const NOT_RUN: &[(&str, &str)] = &[
     ),
     ("include", "a folder of include files"),
     (
+        "rayquery_return.hlsl",
+        "a function returning a ray query: tests/hlsl_compile.rs checks the call",
+    ),
+    (
         "texel_buffers.hlsl",
         "texel buffers (rtlint::vk binds no buffer views): tests/hlsl_compile.rs checks the images",
     ),

@@ -620,9 +620,9 @@ fn rendered_errors_match_the_snapshot() {
 }
 
 #[test]
-fn ray_queries_are_not_returned_from_functions() {
+fn ray_queries_are_returned_only_as_one_local() {
     assert_eq!(
-        err("RaytracingAccelerationStructure s;\nRayQuery<0> trace(RayDesc r)\n{\n    RayQuery<0> q;\n    q.TraceRayInline(s, 0, 0xff, r);\n    return q;\n}\n[numthreads(1,1,1)]\nvoid m()\n{\n    RayDesc r = (RayDesc)0;\n    RayQuery<0> q = trace(r);\n}"),
-        "main.hlsl:2:1: not supported: functions returning a RayQuery"
+        err("RaytracingAccelerationStructure s;\nRayQuery<0> trace(RayDesc r, bool b)\n{\n    RayQuery<0> q;\n    RayQuery<0> p;\n    if (b) return p;\n    return q;\n}\n[numthreads(1,1,1)]\nvoid m()\n{\n    RayDesc r = (RayDesc)0;\n    RayQuery<0> q = trace(r, true);\n}"),
+        "main.hlsl:2:1: not supported: functions returning a RayQuery other than one local variable"
     );
 }

@@ -98,6 +98,9 @@ struct FnSig<'a> {
     /// Parameters bound to a resource variable (a specialized copy, see
     /// `specialize`): (parameter index, the variable's place).
     bound: Vec<(usize, Place)>,
+    /// A function returning a ray query: the type and the local it returns,
+    /// which is the caller's variable passed as a last, hidden parameter.
+    ret_slot: Option<(Ty, String)>,
     /// Default values of the trailing parameters that have one.
     defaults: Vec<&'a Expr>,
     /// For methods: the struct whose `this` is the first parameter.
@@ -136,6 +139,12 @@ struct FnCtx {
     this_place: Option<Place>,
     /// Resource-returning helpers being inlined (see `resource_call`).
     inline_depth: u32,
+    /// In a function returning a ray query: the returned local's name and
+    /// the hidden parameter that holds it.
+    ret_slot: Option<(String, Place)>,
+    /// The variable a call returning a ray query writes (set by the declaration
+    /// it initializes).
+    ret_dest: Option<(Id, Ty)>,
 }
 
 impl FnCtx {
@@ -151,6 +160,8 @@ impl FnCtx {
             term: false,
             this_place: None,
             inline_depth: 0,
+            ret_slot: None,
+            ret_dest: None,
         }
     }
 }

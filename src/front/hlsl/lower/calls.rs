@@ -1245,12 +1245,25 @@ impl<'a> Lowerer<'a> {
             let k = self.specialize(k, &bound);
             (k, self.funcs[k].clone())
         };
-        let passed: Vec<Id> = temps
+        let mut passed: Vec<Id> = temps
             .iter()
             .enumerate()
             .filter(|(i, _)| !sig.bound.iter().any(|(b, _)| b == i))
             .map(|(_, t)| *t)
             .collect();
+        if let Some((t, _)) = &sig.ret_slot {
+            match self.f.ret_dest.take() {
+                Some((var, dt)) if dt == *t => passed.push(var),
+                _ => return Err(unsupported(
+                    pos,
+                    format!(
+                        "`{name}` returns a {}: call it only to initialize a variable of that type",
+                        self.ty_name(t)
+                    ),
+                )
+                .len(name.len() as u32)),
+            }
+        }
         let rt = self.ty_id(&sig.ret)?;
         if self.f.term {
             self.start_block(None)?;

@@ -186,8 +186,15 @@ impl<'a> Lowerer<'a> {
                 d => d,
             };
             let idx = self.funcs.len();
+            let ret_slot = ret
+                .is_opaque()
+                .then(|| ret_slot_name(f))
+                .flatten()
+                .map(|n| (ret.clone(), n));
+            let ret = if ret_slot.is_some() { Ty::Void } else { ret };
             self.funcs.push(FnSig {
                 name: f.name.clone(),
+                ret_slot,
                 defaults,
                 bound: Vec::new(),
                 params,
@@ -216,11 +223,15 @@ impl<'a> Lowerer<'a> {
     /// A function's return type and parameters.
     fn signature(&mut self, f: &Function) -> Result<(Ty, Vec<Param>)> {
         let ret = self.resolve_ty(&f.ret, &f.ns)?;
-        if ret.is_opaque() {
-            // Ray queries and hit objects cannot be copied out of a function.
+        if ret.is_opaque() && (ret == Ty::HitObject || ret_slot_name(f).is_none()) {
+            // Opaque values cannot be copied out of a function; a ray query
+            // returned as one named local is the caller's variable (`ret_slot`).
             return Err(unsupported(
                 f.ret.pos,
-                format!("functions returning a {}", self.ty_name(&ret)),
+                format!(
+                    "functions returning a {} other than one local variable",
+                    self.ty_name(&ret)
+                ),
             ));
         }
         let mut params = Vec::new();
@@ -316,8 +327,15 @@ impl<'a> Lowerer<'a> {
             let name = format!("{}::{}", sd.name, f.name);
             let idx = self.funcs.len();
             let id = self.b.id();
+            let ret_slot = ret
+                .is_opaque()
+                .then(|| ret_slot_name(f))
+                .flatten()
+                .map(|n| (ret.clone(), n));
+            let ret = if ret_slot.is_some() { Ty::Void } else { ret };
             self.funcs.push(FnSig {
                 name: name.clone(),
+                ret_slot,
                 defaults: defaults_of(f)?,
                 bound: Vec::new(),
                 params,
@@ -1347,6 +1365,43 @@ impl<'a> Lowerer<'a> {
             .insert(v.name.clone(), Global::Const(Val { id, ty: t.clone() }));
         Ok(())
     }
+}
+
+/// The local a function returns in every `return` (`return q;`), if one.
+pub(super) fn ret_slot_name(f: &Function) -> Option<String> {
+    fn walk(s: &Stmt, out: &mut Vec<Option<String>>) {
+        match &s.kind {
+            StmtKind::Return(Some(Expr {
+                kind: ExprKind::Ident(n),
+                ..
+            })) => out.push(Some(n.clone())),
+            StmtKind::Return(_) => out.push(None),
+            StmtKind::Block(b) => b.iter().for_each(|s| walk(s, out)),
+            StmtKind::If(_, a, b) => {
+                walk(a, out);
+                if let Some(b) = b {
+                    walk(b, out);
+                }
+            }
+            StmtKind::For(i, _, _, b) => {
+                if let Some(i) = i {
+                    walk(i, out);
+                }
+                walk(b, out);
+            }
+            StmtKind::While(_, b) | StmtKind::DoWhile(b, _) => walk(b, out),
+            StmtKind::Switch(_, cases) => cases
+                .iter()
+                .for_each(|c| c.body.iter().for_each(|s| walk(s, out))),
+            _ => {}
+        }
+    }
+    let mut out = Vec::new();
+    f.body.as_ref()?.iter().for_each(|s| walk(s, &mut out));
+    let first = out.first()?.clone()?;
+    out.iter()
+        .all(|n| n.as_deref() == Some(first.as_str()))
+        .then_some(first)
 }
 
 /// The default values of `f`'s trailing parameters; every parameter after one

@@ -99,6 +99,11 @@ impl<'a> Lowerer<'a> {
                 };
                 ptys.push(self.b.type_pointer(None, class, t));
             }
+            if let Some((t, _)) = &sig.ret_slot {
+                // The caller's ray query variable, where the result is made.
+                let tid = self.ty_id(t)?;
+                ptys.push(self.b.type_pointer(None, StorageClass::Function, tid));
+            }
             let fty = self.b.type_function(ret_id, ptys.clone());
             self.b
                 .begin_function(ret_id, Some(sig.id), spirv::FunctionControl::NONE, fty)?;
@@ -156,6 +161,18 @@ impl<'a> Lowerer<'a> {
                         class,
                     },
                 );
+            }
+            if let Some((t, name)) = &sig.ret_slot {
+                let pty = ptys.next().unwrap_or_default();
+                let id = self.b.function_parameter(pty)?;
+                self.b.name(id, name.clone());
+                let slot = Place::Ptr {
+                    ptr: id,
+                    ty: t.clone(),
+                    layout: Layout::None,
+                    class: StorageClass::Function,
+                };
+                self.f.ret_slot = Some((name.clone(), slot));
             }
             self.start_block(None)?;
         }

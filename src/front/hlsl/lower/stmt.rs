@@ -125,6 +125,19 @@ impl<'a> Lowerer<'a> {
                         }
                         self.b.ret()?;
                     }
+                    // `return q;` of the local a ray query is made in (`ret_slot`).
+                    (
+                        Some(Expr {
+                            kind: ExprKind::Ident(n),
+                            ..
+                        }),
+                        true,
+                    ) if self.f.ret_slot.as_ref().is_some_and(|(r, _)| r == n) => {
+                        if self.f.term {
+                            self.start_block(None)?;
+                        }
+                        self.b.ret()?;
+                    }
                     (Some(e), true) => return Err(Error::new(e.pos, "this function returns void")),
                     (None, false) => return Err(Error::new(s.pos, "missing return value").len(6)),
                 }
@@ -394,6 +407,37 @@ impl<'a> Lowerer<'a> {
                 );
                 return Ok(());
             }
+        }
+        if let Some((name, slot)) = self.f.ret_slot.clone() {
+            if name == v.name && slot.ty() == &t && v.init.is_none() {
+                // The returned ray query lives in the caller's variable.
+                self.bind(&v.name, slot);
+                return Ok(());
+            }
+        }
+        if let (Ty::RayQuery(_), Some(init)) = (&t, &v.init) {
+            // `RayQuery<F> q = make(...);`: made in `q` by a function returning it.
+            let var = self.local_var(&t, &v.name)?;
+            self.bind(
+                &v.name,
+                Place::Ptr {
+                    ptr: var,
+                    ty: t.clone(),
+                    layout: Layout::None,
+                    class: StorageClass::Function,
+                },
+            );
+            self.f.ret_dest = Some((var, t.clone()));
+            let r = self.call_expr(init);
+            let unused = self.f.ret_dest.take();
+            r?;
+            if unused.is_some() {
+                return Err(unsupported(
+                    init.pos,
+                    "initializing a RayQuery other than by a function returning one",
+                ));
+            }
+            return Ok(());
         }
         if t == Ty::HitObject {
             // Made in place: `HitObject h = HitObject::TraceRay(...)`; a Nop without initializer.
