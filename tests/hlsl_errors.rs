@@ -240,7 +240,7 @@ fn matrices_in_component_intrinsics_are_refused() {
 fn templated_methods_are_refused() {
     assert_eq!(
         err("ByteAddressBuffer b;\n[numthreads(1,1,1)]\nvoid m()\n{\n    float4x4 v = b.Load<float4x4>(0);\n}"),
-        "main.hlsl:5:20: not supported: `Load<float4x4>` (only 32-bit scalars and vectors)"
+        "main.hlsl:5:20: not supported: `Load<float4x4>` (only 32-bit scalars, vectors, and structs and arrays of them)"
     );
 }
 

@@ -5,6 +5,7 @@ ByteAddressBuffer indicesA : register(t0);
 ByteAddressBuffer indicesB : register(t1);
 StructuredBuffer<float3> positions : register(t2);
 Texture2D<float4> albedo : register(t3);
+Texture2D<float4> layers[2] : register(t4);
 SamplerState linearSampler : register(s0);
 RWStructuredBuffer<float4> output : register(u0);
 
@@ -30,5 +31,7 @@ void Main(uint3 id : SV_DispatchThreadID)
     float3 a = centroid(indicesA, positions, id.x);
     float3 b = centroid(indicesB, positions, id.x);
     float3 c = centroid(indicesA, positions, id.x + 1);
-    output[id.x] = float4(a + b + c, 0) + shade(albedo, linearSampler, a.xy);
+    // An element of a texture array may be passed (images and samplers only).
+    output[id.x] = float4(a + b + c, 0) + shade(albedo, linearSampler, a.xy)
+        + shade(layers[id.x % 2], linearSampler, b.xy);
 }

@@ -11,6 +11,21 @@ static const float3 directions[6] = {
     float3(0, -1, 0), float3(0, 0, 1), float3(0, 0, -1)
 };
 
+// Sized by its initializer at global scope.
+static const float2 offsets[] = { float2(0, 1), float2(1, 0), float2(-1, 0) };
+
+namespace sh
+{
+    static const float Pi = 3.141592654;
+    // Computed at the start of the entry point, in its namespace.
+    static const float SqrtPi = sqrt(Pi);
+}
+
+// A template and non-template overloads share a name.
+template<typename T>
+float max3(T v) { return max(v.x, max(v.y, v.z)); }
+float max3(float a, float b, float c) { return max(a, max(b, c)); }
+
 struct Unused
 {
     uint material : 24;
@@ -47,5 +62,6 @@ void Main(uint3 id : SV_DispatchThreadID)
             best.weight = w;
         }
     }
-    output[id.x] = float4(best.direction, best.weight + sizeof(best));
+    float extra = offsets[2].x + sh::SqrtPi + max3(best.direction) + max3(1.0, 2.0, 3.0);
+    output[id.x] = float4(best.direction, best.weight + sizeof(best) + extra);
 }

@@ -54,6 +54,13 @@ bool anyHit(RayQuery<FLAGS> q)
 RWStructuredBuffer<float4> output : register(u0);
 ByteAddressBuffer vertexData : register(t0);
 
+struct PackedVertex
+{
+    float3 position;
+    uint normal;
+    float2 uv[2];
+};
+
 [numthreads(8, 1, 1)]
 void Main(uint3 id : SV_DispatchThreadID)
 {
@@ -78,5 +85,7 @@ void Main(uint3 id : SV_DispatchThreadID)
     float3 position = vertexData.Load<float3>(id.x * 12);
     uint2 packed = vertexData.Load<uint2>(id.x * 8 + 4096);
     r += position.x + packed.y;
+    PackedVertex pv = vertexData.Load<PackedVertex>(id.x * sizeof(PackedVertex));
+    r += pv.position.y + pv.uv[1].x + pv.normal;
     output[id.x] = float4(p.sum(), s3 + q.sum() + average(values) + average<8>(values) + r);
 }

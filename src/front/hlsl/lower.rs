@@ -231,7 +231,8 @@ pub struct Lowerer<'a> {
     /// Scalar constant id → its bits.
     const_ids: HashMap<Id, u32>,
     /// Static globals whose initializers run at the start of each entry point.
-    deferred_inits: Vec<(Id, Ty, &'a Expr)>,
+    /// (variable, type, initializer, its namespace).
+    deferred_inits: Vec<(Id, Ty, &'a Expr, String)>,
     /// Pointers into resource arrays indexed with `NonUniformResourceIndex`.
     nonuniform_ptrs: HashSet<Id>,
     /// Globals with source positions, for debug info: (variable, name, type, position).

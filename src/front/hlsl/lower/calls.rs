@@ -209,9 +209,15 @@ impl<'a> Lowerer<'a> {
         if let Some(r) = self.ser_call(name, args, pos)? {
             return Ok(r);
         }
-        if self.find_user(name).is_none() {
+        let user_fits = self.find_user(name).is_some_and(|c| {
+            c.iter().any(|k| {
+                let f = &self.funcs[*k];
+                (f.params.len() - f.defaults.len()..=f.params.len()).contains(&args.len())
+            })
+        });
+        if !user_fits {
             // A template takes the call when one fits the arguments (a user
-            // template may share an intrinsic's name, `TraceRay`).
+            // template may share an intrinsic's or an overload's name).
             if let Some(ts) = self.find_fn_template(name) {
                 let fits = ts.iter().any(|f| {
                     let required = f.params.iter().take_while(|p| p.init.is_none()).count();
@@ -1215,8 +1221,10 @@ impl<'a> Lowerer<'a> {
             }
             if p.ty.is_resource() {
                 // Passed as the resource variable itself, which SPIR-V's
-                // logical addressing allows only for whole variables.
-                if !self.resource_vars.contains(&v.id) {
+                // logical addressing allows for whole variables and, for
+                // images and samplers, for elements of arrays of them.
+                let element_ok = matches!(p.ty, Ty::Texture { .. } | Ty::Sampler | Ty::SamplerCmp);
+                if !element_ok && !self.resource_vars.contains(&v.id) {
                     return Err(unsupported(
                         a.pos(),
                         "passing an element of a resource array to a function",
@@ -1254,14 +1262,16 @@ impl<'a> Lowerer<'a> {
         if let Some((t, _)) = &sig.ret_slot {
             match self.f.ret_dest.take() {
                 Some((var, dt)) if dt == *t => passed.push(var),
-                _ => return Err(unsupported(
-                    pos,
-                    format!(
+                _ => {
+                    return Err(unsupported(
+                        pos,
+                        format!(
                         "`{name}` returns a {}: call it only to initialize a variable of that type",
                         self.ty_name(t)
                     ),
-                )
-                .len(name.len() as u32)),
+                    )
+                    .len(name.len() as u32))
+                }
             }
         }
         let rt = self.ty_id(&sig.ret)?;

@@ -1137,7 +1137,20 @@ impl<'a> Lowerer<'a> {
             None => t,
         };
         let res = t.is_resource();
-        let t = self.apply_dims(t, &v.dims, v.pos, res)?;
+        let t = match (&v.init, v.dims.first()) {
+            // `static const float4 a[] = {...}`: sized by its initializer.
+            (
+                Some(Expr {
+                    kind: ExprKind::InitList(items),
+                    ..
+                }),
+                Some(None),
+            ) if !res => {
+                let inner = self.apply_dims(t, &v.dims[1..], v.pos, res)?;
+                Ty::Array(Box::new(inner), items.len() as u32)
+            }
+            _ => self.apply_dims(t, &v.dims, v.pos, res)?,
+        };
         self.decls.push((
             NamedDecl::Global(v.name.clone()),
             self.loc(v.pos, v.name.len() as u32),
@@ -1289,7 +1302,9 @@ impl<'a> Lowerer<'a> {
         self.global_decls
             .push((var, v.name.clone(), t.clone(), v.pos));
         if let Some(e) = deferred {
-            self.deferred_inits.push((var, t.clone(), e));
+            let scope = v.name.rsplit_once("::").map(|(n, _)| format!("{n}::"));
+            self.deferred_inits
+                .push((var, t.clone(), e, scope.unwrap_or_default()));
         }
         self.globals.insert(
             v.name.clone(),

@@ -44,6 +44,27 @@ impl<'a> Lowerer<'a> {
         Ok(())
     }
 
+    /// Static globals with non-constant initializers, computed at the start
+    /// of an entry point (as DXC does): each in its own namespace, seeing
+    /// globals only.
+    pub(super) fn run_deferred_inits(&mut self) -> Result<()> {
+        let scopes = std::mem::replace(&mut self.f.scopes, vec![HashMap::new()]);
+        let ns = self.f.cur_ns.clone();
+        for (var, t, e, scope) in self.deferred_inits.clone() {
+            self.f.cur_ns = scope;
+            self.line(e.pos);
+            let v = self.expr_as(e, &t)?;
+            self.use_global(var);
+            if self.f.term {
+                self.start_block(None)?;
+            }
+            self.b.store(var, v.id, None, [])?;
+        }
+        self.f.cur_ns = ns;
+        self.f.scopes = scopes;
+        Ok(())
+    }
+
     pub(super) fn lower_function(&mut self, k: usize) -> Result<()> {
         let sig = self.funcs[k].clone();
         let f = sig.func;
@@ -72,15 +93,7 @@ impl<'a> Lowerer<'a> {
             self.line(f.pos);
             self.f.this_place = None;
             self.bind_entry_params(f, &sig, stage)?;
-            for (var, t, e) in self.deferred_inits.clone() {
-                self.line(e.pos);
-                let v = self.expr_as(e, &t)?;
-                self.use_global(var);
-                if self.f.term {
-                    self.start_block(None)?;
-                }
-                self.b.store(var, v.id, None, [])?;
-            }
+            self.run_deferred_inits()?;
         } else {
             let mut ptys = Vec::new();
             let is_bound = |i: usize| sig.bound.iter().any(|(b, _)| *b == i);

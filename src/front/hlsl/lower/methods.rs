@@ -729,11 +729,14 @@ impl<'a> Lowerer<'a> {
         let (sc, n) = match t {
             Ty::Sc(s) if s != Sc::Bool && !s.is_64() => (s, 1),
             Ty::Vec(s, n) if s != Sc::Bool && !s.is_64() => (s, n),
+            Ty::Struct(_) | Ty::Array(..) => {
+                return self.load_packed(*ptr, &t, args, pos).map(Some);
+            }
             _ => {
                 return Err(unsupported(
                     pos,
                     format!(
-                        "`Load<{}>` (only 32-bit scalars and vectors)",
+                        "`Load<{}>` (only 32-bit scalars, vectors, and structs and arrays of them)",
                         self.ty_name(&t)
                     ),
                 ))
@@ -822,5 +825,83 @@ impl<'a> Lowerer<'a> {
         };
         let id = self.inst(op, Some(rid), ops)?;
         Ok(Val { id, ty: rt })
+    }
+
+    /// `Load<S>` of a struct or array: its 32-bit leaves packed one word each,
+    /// in declaration order (the layout `sizeof` gives), then put together.
+    fn load_packed(&mut self, var: Id, t: &Ty, args: &'a [Expr], pos: Pos) -> Result<Val> {
+        fn leaves(t: &Ty, structs: &[StructDef], out: &mut Vec<Sc>) -> bool {
+            match t {
+                Ty::Sc(s) if *s != Sc::Bool && !s.is_64() => out.push(*s),
+                Ty::Vec(s, n) if *s != Sc::Bool && !s.is_64() => {
+                    out.extend(std::iter::repeat_n(*s, *n as usize))
+                }
+                Ty::Array(e, n) => {
+                    for _ in 0..*n {
+                        if !leaves(e, structs, out) {
+                            return false;
+                        }
+                    }
+                }
+                Ty::Struct(k) => {
+                    for f in &structs[*k as usize].fields {
+                        if !leaves(&f.ty, structs, out) {
+                            return false;
+                        }
+                    }
+                }
+                _ => return false,
+            }
+            true
+        }
+        let mut scalars = Vec::new();
+        if !leaves(t, &self.structs, &mut scalars) {
+            return Err(unsupported(
+                pos,
+                format!(
+                    "`Load<{}>`: members other than 32-bit scalars, vectors, structs and arrays",
+                    self.ty_name(t)
+                ),
+            ));
+        }
+        self.arity("Load", args, 1, pos)?;
+        let u = Ty::Sc(Sc::Uint);
+        let ut = self.ty_id(&u)?;
+        let pty = self.b.type_pointer(None, StorageClass::StorageBuffer, ut);
+        let addr = self.expr_as(&args[0], &u)?;
+        let two = Val {
+            id: self.const_u32(2),
+            ty: u.clone(),
+        };
+        let word = self.binary(BinOp::Shr, addr, two, pos)?;
+        let zero = self.const_u32(0);
+        let mut vals = Vec::new();
+        for (i, s) in scalars.iter().enumerate() {
+            let off = Val {
+                id: self.const_u32(i as u32),
+                ty: u.clone(),
+            };
+            let w = self.binary(BinOp::Add, word.clone(), off, pos)?;
+            let ptr = self.inst(
+                Op::AccessChain,
+                Some(pty),
+                vec![
+                    Operand::IdRef(var),
+                    Operand::IdRef(zero),
+                    Operand::IdRef(w.id),
+                ],
+            )?;
+            let id = self.b.load(ut, None, ptr, None, [])?;
+            let st = Ty::Sc(*s);
+            let id = if *s == Sc::Uint {
+                id
+            } else {
+                let sid = self.ty_id(&st)?;
+                self.op(Op::Bitcast, sid, &[id])?
+            };
+            vals.push(Val { id, ty: st });
+        }
+        let mut it = vals.into_iter();
+        self.build(t, &mut it, pos)
     }
 }

@@ -35,15 +35,7 @@ impl<'a> Lowerer<'a> {
         self.b.name(id, sig.name.clone());
         self.start_block(None)?;
         self.line(f.pos);
-        for (var, t, e) in self.deferred_inits.clone() {
-            self.line(e.pos);
-            let v = self.expr_as(e, &t)?;
-            self.use_global(var);
-            if self.f.term {
-                self.start_block(None)?;
-            }
-            self.b.store(var, v.id, None, [])?;
-        }
+        self.run_deferred_inits()?;
         let mut io = Io::default();
         let mut args = Vec::new();
         let mut outs = Vec::new();
