@@ -27,6 +27,7 @@ mod context;
 mod descriptors;
 mod error;
 mod image;
+mod interface;
 mod pipeline;
 mod stack_query;
 mod validation;
@@ -40,6 +41,9 @@ pub use context::{Context, ContextOptions, DeviceInfo, RayTracingLimits};
 pub use descriptors::{Binding, BindingKind, Resource};
 pub use error::{Error, Result};
 pub use image::StorageImage;
+pub use interface::{
+    reflect as reflect_interface, DescriptorCount, DescriptorKind, LayoutBinding, PipelineInterface,
+};
 pub use pipeline::{
     ComputePipeline, Group, GroupStackSizes, RayTracingPipeline, RayTracingPipelineDesc, SbtLayout,
     SbtRegion, ShaderBindingTable, ShaderStage, Stage,

@@ -2,62 +2,16 @@
 //! the driver for every shader's stack size, in the stack report's order.
 
 use super::{
-    Binding, BindingKind, Context, Group, RayTracingPipeline, RayTracingPipelineDesc, Result,
-    ShaderStage, Stage,
+    Context, Error, Group, RayTracingPipeline, RayTracingPipelineDesc, Result, ShaderStage, Stage,
 };
 use crate::pipeline::{HitGroupKind, Pipeline, Slot};
-use crate::program::scalar::scalar_size;
-use crate::program::Type;
 use std::collections::BTreeMap;
-
-/// Descriptor bindings (set 0) and push-constant bytes the pipeline's
-/// shaders declare, so the layout matches them.
-fn interface(pipeline: &Pipeline) -> (Vec<Binding>, u32) {
-    use spirv::StorageClass as C;
-    let mut bindings: BTreeMap<u32, BindingKind> = BTreeMap::new();
-    let mut push = 0u32;
-    for p in &pipeline.programs {
-        for g in &p.globals {
-            let kind = match (g.storage, p.ty(g.ty)) {
-                (C::UniformConstant, Some(Type::AccelerationStructure)) => {
-                    BindingKind::AccelerationStructure
-                }
-                (C::UniformConstant, Some(Type::Image)) => BindingKind::StorageImage,
-                (C::StorageBuffer, _) => BindingKind::StorageBuffer,
-                (C::Uniform, _) => {
-                    if p.decoration(g.ty, spirv::Decoration::BufferBlock).is_some() {
-                        BindingKind::StorageBuffer
-                    } else {
-                        BindingKind::UniformBuffer
-                    }
-                }
-                (C::PushConstant, _) => {
-                    let size = scalar_size(p, g.ty).unwrap_or(0);
-                    push = push.max(size.next_multiple_of(4) as u32);
-                    continue;
-                }
-                _ => continue,
-            };
-            if g.set.unwrap_or(0) == 0 {
-                if let Some(b) = g.binding {
-                    bindings.entry(b).or_insert(kind);
-                }
-            }
-        }
-    }
-    (
-        bindings
-            .into_iter()
-            .map(|(b, k)| Binding::new(b, k))
-            .collect(),
-        push,
-    )
-}
 
 /// The driver's stack size for every shader of the pipeline, by its slot and
 /// stage. The pipeline is created with its declared recursion depth, else
 /// `depth` (the depth the caller found it needs). Comparing the numbers with
-/// the model is the caller's business.
+/// the model is the caller's business. The pipeline layout is reflected
+/// from the shaders (every set, descriptor type and push constant they use).
 pub fn driver_stack_sizes<'p>(
     ctx: &Context,
     pipeline: &'p Pipeline,
@@ -113,22 +67,23 @@ pub fn driver_stack_sizes<'p>(
             groups.push(Group::General(s));
         }
     }
-    let (bindings, push_constant_size) = interface(pipeline);
+    let interface = super::interface::reflect(pipeline).map_err(Error::Invalid)?;
     let depth = pipeline
         .max_recursion_depth
         .or(depth)
         .unwrap_or(1)
         .min(ctx.limits().max_ray_recursion_depth);
-    let rt = RayTracingPipeline::new(
+    let rt = RayTracingPipeline::with_interface(
         ctx,
         &RayTracingPipelineDesc {
             stages: &stages,
             groups: &groups,
             max_recursion_depth: depth,
-            bindings: &bindings,
-            push_constant_size,
+            bindings: &[],
+            push_constant_size: 0,
             stack_size: None,
         },
+        &interface,
     )?;
     let sizes = rt.group_stack_sizes();
     let mut out = BTreeMap::new();
