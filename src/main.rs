@@ -101,6 +101,18 @@ enum Command {
     },
     /// List every rule.
     Rules,
+    /// (Internal) `stack --driver` runs this in a child process per
+    /// pipeline, so that a driver crash cannot take rtlint down: creates the
+    /// pipeline and prints the driver's stack sizes as JSON.
+    #[command(hide = true, name = "driver-stack-sizes")]
+    DriverStackSizes {
+        /// A pipeline description.
+        #[arg(long)]
+        pipeline: Option<PathBuf>,
+        /// Loose shaders, as `LANG:PATH`.
+        #[arg(long)]
+        shader: Vec<String>,
+    },
     /// Print a rule's documentation.
     Rule {
         /// Code (RT001) or name (payload-over-budget).
@@ -148,6 +160,7 @@ fn run(cli: Cli) -> Result<u8, String> {
             output,
             whole,
         } => compile(file, entry, include, define, output, whole),
+        Command::DriverStackSizes { pipeline, shader } => driver_stack_sizes(pipeline, shader),
         Command::Rules => {
             let mut out = std::io::stdout().lock();
             for r in rtlint::rules::RULES {
@@ -389,35 +402,39 @@ fn stack(common: Common, driver: bool) -> Result<u8, String> {
             pipelines.push(rtlint::pipeline::Pipeline::from_programs(programs));
         }
     }
-    #[cfg(feature = "vulkan")]
-    let device = if driver {
-        Some(rtlint::vk::Context::new().map_err(|e| format!("--driver: {e}"))?)
-    } else {
-        None
-    };
     #[cfg(not(feature = "vulkan"))]
     if driver {
         return Err("--driver needs rtlint built with the `vulkan` feature".into());
     }
+    #[cfg_attr(not(feature = "vulkan"), allow(unused_variables))]
+    let loose: Vec<String> = inputs
+        .files
+        .iter()
+        .map(|f| format!("{}:{}", f.language.as_str(), f.path.display()))
+        .collect();
     let mut reports = Vec::new();
     for p in &pipelines {
         #[allow(unused_mut)]
         let mut r = rtlint::analysis::stack_report(p);
         #[cfg(feature = "vulkan")]
-        if let Some(ctx) = &device {
-            let depth = rtlint::analysis::recursion_report(p).required_depth;
-            let sizes = rtlint::vk::driver_stack_sizes(ctx, p, depth).map_err(|e| {
-                format!(
-                    "--driver: creating the pipeline on {} failed: {e}",
-                    ctx.info().name
+        if driver {
+            match driver_in_child(p, &loose) {
+                Ok(d) => {
+                    let sizes = d.sizes.iter().map(|&(slot, stage, b)| ((slot, stage), b)).collect();
+                    rtlint::analysis::stack::attach_driver(&mut r, p, &sizes);
+                    r.assumptions
+                        .push(format!("driver: {} ({})", d.device, d.driver));
+                }
+                Err(message) => problems.push(*rtlint::diag::InputError::new(
+                    "driver",
+                    &p.path
+                        .clone()
+                        .or_else(|| p.programs.first().map(|q| q.path.clone()))
+                        .unwrap_or_default(),
+                    format!("--driver: {message}"),
                 )
-            })?;
-            rtlint::analysis::stack::attach_driver(&mut r, p, &sizes);
-            r.assumptions.push(format!(
-                "driver: {} ({})",
-                ctx.info().name,
-                ctx.info().driver
-            ));
+                .0),
+            }
         }
         reports.push(r);
     }
@@ -460,6 +477,13 @@ fn print_report<T: serde::Serialize>(
     match format {
         Format::Json => {
             let mut v = serde_json::to_value(value).map_err(|e| e.to_string())?;
+            if !v.is_object() && !problems.is_empty() {
+                // Several reports print as an array, which has no room for
+                // the errors: they go to stderr, in text.
+                let mut err = StandardStream::stderr(color_choice());
+                report::human::render(problems, &mut Sources::default(), &mut err)
+                    .map_err(|e| e.to_string())?;
+            }
             if let Some(obj) = v.as_object_mut() {
                 obj.insert(
                     "errors".into(),
@@ -550,4 +574,122 @@ fn compile(
         ));
     }
     Ok(0)
+}
+
+/// What the child process of `stack --driver` reports for one pipeline.
+#[derive(serde::Serialize, serde::Deserialize)]
+struct DriverSizes {
+    device: String,
+    driver: String,
+    sizes: Vec<(rtlint::pipeline::Slot, rtlint::shader::Stage, u64)>,
+    validation_errors: Vec<String>,
+}
+
+/// How long one pipeline's creation may take in the child.
+const DRIVER_CHILD_TIMEOUT: std::time::Duration = std::time::Duration::from_secs(120);
+
+#[cfg(feature = "vulkan")]
+/// Runs `driver-stack-sizes` for one pipeline in a child process: a driver
+/// that crashes or hangs costs that pipeline its driver figures, with a
+/// message, and nothing else. Validation errors (`RTLINT_VK_VALIDATION=1`)
+/// are errors too: the layout rtlint built does not match the shaders.
+fn driver_in_child(
+    p: &rtlint::pipeline::Pipeline,
+    loose: &[String],
+) -> Result<DriverSizes, String> {
+    let exe = std::env::current_exe().map_err(|e| format!("cannot find rtlint itself: {e}"))?;
+    let mut command = std::process::Command::new(exe);
+    command.arg("driver-stack-sizes");
+    match &p.path {
+        Some(path) => {
+            command.arg("--pipeline").arg(path);
+        }
+        None => {
+            for s in loose {
+                command.arg("--shader").arg(s);
+            }
+        }
+    }
+    let o = rtlint::vk::run_command(command, DRIVER_CHILD_TIMEOUT)
+        .map_err(|e| format!("cannot start a child process: {e}"))?;
+    let last_line = |t: &str| {
+        t.lines()
+            .rev()
+            .find(|l| l.starts_with("error: "))
+            .map(|l| l.trim_start_matches("error: ").to_string())
+            .unwrap_or_else(|| t.lines().last().unwrap_or("").to_string())
+    };
+    if o.timed_out {
+        return Err(format!(
+            "creating the pipeline on the device took over {} s; the child was killed",
+            DRIVER_CHILD_TIMEOUT.as_secs()
+        ));
+    }
+    if let Some(sig) = o.signal {
+        return Err(format!(
+            "the driver crashed while creating the pipeline (signal {sig}{})",
+            match sig {
+                11 => ", SIGSEGV",
+                7 => ", SIGBUS",
+                6 => ", SIGABRT",
+                _ => "",
+            }
+        ));
+    }
+    if !o.success() {
+        return Err(last_line(&o.stderr));
+    }
+    let d: DriverSizes = serde_json::from_str(&o.stdout)
+        .map_err(|e| format!("unreadable answer from the child process: {e}"))?;
+    if let Some(first) = d.validation_errors.first() {
+        return Err(format!(
+            "the validation layer reported {} error(s) on this pipeline; the first: {first}",
+            d.validation_errors.len()
+        ));
+    }
+    Ok(d)
+}
+
+/// The child's side of [`driver_in_child`].
+fn driver_stack_sizes(pipeline: Option<PathBuf>, shaders: Vec<String>) -> Result<u8, String> {
+    let p = match pipeline {
+        Some(path) => rtlint::pipeline::load(&path).map_err(|e| e.0.message.clone())?,
+        None => {
+            let mut programs = Vec::new();
+            for s in &shaders {
+                let (lang, path) = s
+                    .split_once(':')
+                    .ok_or_else(|| format!("`{s}` is not LANG:PATH"))?;
+                let lang = Language::parse(lang).ok_or_else(|| format!("unknown language `{lang}`"))?;
+                programs.push(
+                    rtlint::front::load(std::path::Path::new(path), lang)
+                        .map_err(|e| e.0.message.clone())?,
+                );
+            }
+            rtlint::pipeline::Pipeline::from_programs(programs)
+        }
+    };
+    driver_stack_sizes_of(&p)
+}
+
+#[cfg(feature = "vulkan")]
+fn driver_stack_sizes_of(p: &rtlint::pipeline::Pipeline) -> Result<u8, String> {
+    let ctx = rtlint::vk::Context::new().map_err(|e| e.to_string())?;
+    let depth = rtlint::analysis::recursion_report(p).required_depth;
+    let sizes = rtlint::vk::driver_stack_sizes(&ctx, p, depth)
+        .map_err(|e| format!("creating the pipeline on {} failed: {e}", ctx.info().name))?;
+    let d = DriverSizes {
+        device: ctx.info().name.clone(),
+        driver: ctx.info().driver.clone(),
+        sizes: sizes.into_iter().map(|((slot, stage), b)| (slot, stage, b)).collect(),
+        validation_errors: ctx.validation_errors(),
+    };
+    drop(ctx);
+    println!("{}", serde_json::to_string(&d).map_err(|e| e.to_string())?);
+    Ok(0)
+}
+
+#[cfg(not(feature = "vulkan"))]
+fn driver_stack_sizes_of(_: &rtlint::pipeline::Pipeline) -> Result<u8, String> {
+    Err("--driver needs rtlint built with the `vulkan` feature".into())
 }
