@@ -24,9 +24,10 @@ rtlint=$(realpath "$dev/rtlint")
 tmp=$(mktemp -d)
 one() {
     p=$1
-    key=$(echo "$p" | tr '/' '_')
+    key=k$(echo "$p" | tr '/.' '__')
     if timeout 60 "$rtlint" stack --driver --format json "$p" >"$tmp/$key.json" 2>"$tmp/$key.err"; then
-        python3 -c 'import json,sys; print(json.dumps(json.load(open(sys.argv[1]))))' "$tmp/$key.json" >"$tmp/$key.line"
+        # One line per pipeline (strings in JSON hold no raw newline).
+        { tr -d '\n' <"$tmp/$key.json"; echo; } >"$tmp/$key.line"
     else
         echo "FAILED $p (rc $?): $(tail -c 2000 "$tmp/$key.err" | tr '\n' ' ')" >"$tmp/$key.fail"
     fi
@@ -39,5 +40,6 @@ export rtlint tmp
 } | sort | xargs -P 8 -I{} bash -c 'one "$@"' _ {}
 cat "$tmp"/*.line >"$out/driver.jsonl" 2>/dev/null
 cat "$tmp"/*.fail >"$out/failures.txt" 2>/dev/null
+tar czf "$out/raw.tgz" -C "$tmp" . 2>/dev/null
 echo "pipelines measured: $(wc -l <"$out/driver.jsonl"); failed: $(cat "$out/failures.txt" | wc -l)"
 head -5 "$out/failures.txt"

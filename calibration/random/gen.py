@@ -59,6 +59,10 @@ def knobs(seed, split):
     k["proc_kind"] = rng.choice(["leaf", "shadow"])
     k["miss_trace"] = rng.random() < 0.15
     k["extra_miss"] = rng.random() < 0.3
+    # How values live across calls are used afterwards: folded into one sum
+    # (a compiler can add them up before the call) or each on its own.
+    k["rg_use"] = rng.choice(["sum", "each"])
+    k["ch_use"] = rng.choice(["sum", "each"])
     uses_shadow = "shadow" in k["ch_kind"] or k["miss_trace"] or (
         k["procedural"] and k["proc_kind"] == "shadow"
     )
@@ -129,6 +133,8 @@ def g_raygen(k):
         if k["rg_mode"] == "straight":
             s += f"    payload.data[0] = 0u;\n    {tr}\n"
         s += f"    result.value[idx] = uint({use}{arr_use}) + payload.data[{1 % w}]{call_use};\n"
+        if k["rg_use"] == "each":
+            s += "".join(f"    result.value[idx + {i + 1}u] = uint(v{i});\n" for i in range(n))
     else:
         for i in range(n):
             init = "0.0" if k["rg_live_src"] == "payload" else f"values.v[idx + {i}u]"
@@ -138,7 +144,7 @@ def g_raygen(k):
         s += f"    for (uint bounce = 0u; bounce < {k['rg_bounces']}u; bounce++) {{\n"
         s += f"        payload.data[0] = 0u;\n        {g_trace(0, 0, primary_flags(k), direction='vec3(0.0, float(bounce) * 0.1, -1.0)')}\n"
         for i in range(n):
-            s += f"        v{i} = v{i} * 0.5 + float(payload.data[{i % w}]);\n"
+            s += f"        v{i} = v{i} * 0.5 + float(payload.data[{i % w}]) * {i}.5;\n"
         if a:
             s += f"        arr[bounce % {a}u] += float(payload.data[{w - 1}]);\n"
         s += "    " + call.replace("\n    ", "\n        ") if call else ""
@@ -209,6 +215,8 @@ def g_closest_hit(k, kind, procedural):
     if call:
         extra += f" + cd.data[{cw - 1}]"
     s += f"    payload.data[{w - 1}] += uint({use}){extra};\n"
+    if k["ch_use"] == "each":
+        s += "".join(f"    payload.data[{i % w}] += uint(v{i});\n" for i in range(n))
     return s + "}\n"
 
 
@@ -309,6 +317,8 @@ def h_raygen(k):
         if k["rg_mode"] == "straight":
             s += "    payload.data[0] = 0;\n" + h_trace("payload", 0, h_flags(k))
         s += f"    result[idx] = (uint)({use}{arr_use}) + payload.data[{1 % w}]{call_use};\n"
+        if k["rg_use"] == "each":
+            s += "".join(f"    result[idx + {i + 1}] = (uint)v{i};\n" for i in range(n))
     else:
         for i in range(n):
             init = "0.0" if k["rg_live_src"] == "payload" else f"values[idx + {i}]"
@@ -319,7 +329,7 @@ def h_raygen(k):
         s += "        payload.data[0] = 0;\n"
         s += h_trace("payload", 0, h_flags(k), direction="float3(0.0, (float)bounce * 0.1, -1.0)", indent="        ")
         for i in range(n):
-            s += f"        v{i} = v{i} * 0.5 + (float)payload.data[{i % w}];\n"
+            s += f"        v{i} = v{i} * 0.5 + (float)payload.data[{i % w}] * {i}.5;\n"
         if a:
             s += f"        arr[bounce % {a}] += (float)payload.data[{w - 1}];\n"
         if call:
@@ -386,6 +396,8 @@ def h_closest_hit(k, kind, procedural, name):
     if call:
         extra += f" + cd.data[{cw - 1}]"
     s += f"    payload.data[{w - 1}] += (uint)({use}){extra};\n"
+    if k["ch_use"] == "each":
+        s += "".join(f"    payload.data[{i % w}] += (uint)v{i};\n" for i in range(n))
     return s + "}\n"
 
 

@@ -50,6 +50,11 @@ pub struct Breakdown {
     pub incoming_callable_data: u64,
     /// Function-local arrays (kept in memory, not registers).
     pub local_arrays: u64,
+    /// The part of `live_state` that is function-local arrays, max over
+    /// sites.
+    pub live_arrays: u64,
+    /// Trace and callable sites the entry point reaches.
+    pub call_sites: u64,
 }
 
 #[derive(Clone, Debug, serde::Serialize)]
@@ -224,6 +229,9 @@ pub fn breakdown_with(program: &Program, entry: &str, sites: &[LiveSite]) -> Bre
             continue;
         }
         let size = site.payload.map_or(0, |p| global_size(program, p));
+        if matches!(site.kind, SiteKind::TraceRay | SiteKind::ExecuteCallable) {
+            b.call_sites += 1;
+        }
         match site.kind {
             SiteKind::TraceRay => b.outgoing_payload = b.outgoing_payload.max(size),
             SiteKind::ExecuteCallable => b.callable_data = b.callable_data.max(size),
@@ -288,6 +296,13 @@ pub fn breakdown_with(program: &Program, entry: &str, sites: &[LiveSite]) -> Bre
         .filter(|s| s.entry == entry && s.kind != crate::analysis::liveness::LiveSiteKind::RayQuery)
     {
         let kept = site.live_bytes - site.rematerializable_bytes;
+        let arrays: u64 = site
+            .values
+            .iter()
+            .filter(|v| !v.rematerializable && is_array_variable(program, v.id))
+            .map(|v| v.size)
+            .sum();
+        b.live_arrays = b.live_arrays.max(arrays);
         b.live_state_total = b.live_state_total.max(site.live_bytes);
         b.live_state = b.live_state.max(kept);
         if in_loop(program, site.chain.first().copied().unwrap_or(site.inst)) {
@@ -295,6 +310,20 @@ pub fn breakdown_with(program: &Program, entry: &str, sites: &[LiveSite]) -> Bre
         }
     }
     b
+}
+
+/// Whether `id` is a function-local variable of array type.
+fn is_array_variable(program: &Program, id: u32) -> bool {
+    let Some(def) = program.def(id) else {
+        return false;
+    };
+    if def.class.opcode != spirv::Op::Variable {
+        return false;
+    }
+    matches!(
+        def.result_type.and_then(|t| program.ty(t)),
+        Some(Type::Pointer { pointee, .. }) if matches!(program.ty(*pointee), Some(Type::Array { .. }))
+    )
 }
 
 /// Whether instruction `inst` lies in a loop of its function.

@@ -199,7 +199,18 @@ fn descriptor(
     let kind = match (storage, program.ty(elem)) {
         (C::UniformConstant, Some(Type::AccelerationStructure)) => DescriptorKind::AccelerationStructure,
         (C::UniformConstant, Some(Type::Sampler)) => DescriptorKind::Sampler,
-        (C::UniformConstant, Some(Type::SampledImage)) => DescriptorKind::CombinedImageSampler,
+        (C::UniformConstant, Some(Type::SampledImage)) => {
+            // glslang declares `samplerBuffer` as a sampled image of a
+            // buffer image: Vulkan binds that as a uniform texel buffer.
+            let image = program.def(elem).and_then(|i| match i.operands.first() {
+                Some(rspirv::dr::Operand::IdRef(id)) => Some(*id),
+                _ => None,
+            });
+            match image.map(|i| image_kind(program, i)).transpose()? {
+                Some(DescriptorKind::UniformTexelBuffer) => DescriptorKind::UniformTexelBuffer,
+                _ => DescriptorKind::CombinedImageSampler,
+            }
+        }
         (C::UniformConstant, Some(Type::Image)) => image_kind(program, elem)?,
         (C::UniformConstant, _) => return Ok(None),
         (C::StorageBuffer, _) => DescriptorKind::StorageBuffer,

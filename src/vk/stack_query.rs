@@ -7,6 +7,26 @@ use super::{
 use crate::pipeline::{HitGroupKind, Pipeline, Slot};
 use std::collections::BTreeMap;
 
+/// The module with an `OpSource` language newer than SPIR-V 1.5's list
+/// (WGSL is 10, Slang 11) set to 0, Unknown: it is debug information no
+/// driver reads, and older validators reject the module for it.
+fn known_source_language(words: &[u32]) -> Vec<u32> {
+    let mut out = words.to_vec();
+    let mut at = 5;
+    while at < out.len() {
+        let count = (out[at] >> 16) as usize;
+        if count == 0 {
+            break;
+        }
+        // OpSource (3): language, version, ...
+        if out[at] & 0xffff == 3 && count >= 3 && out.get(at + 1).is_some_and(|&l| l > 9) {
+            out[at + 1] = 0;
+        }
+        at += count;
+    }
+    out
+}
+
 /// The driver's stack size for every shader of the pipeline, by its slot and
 /// stage. The pipeline is created with its declared recursion depth, else
 /// `depth` (the depth the caller found it needs). Comparing the numbers with
@@ -17,14 +37,20 @@ pub fn driver_stack_sizes<'p>(
     pipeline: &'p Pipeline,
     depth: Option<u32>,
 ) -> Result<BTreeMap<(Slot, Stage), u64>> {
+    let modules: Vec<Vec<u32>> = pipeline
+        .programs
+        .iter()
+        .map(|p| known_source_language(&p.words))
+        .collect();
     let mut stages: Vec<ShaderStage> = Vec::new();
     let mut stage_of = |sref: &'p crate::pipeline::ShaderRef| -> Option<u32> {
-        let program = pipeline.program(sref)?;
+        pipeline.program(sref)?;
+        let words = modules.get(sref.program)?;
         if !sref.stage.is_ray_tracing() {
             return None;
         }
         stages.push(ShaderStage {
-            spirv: &program.words,
+            spirv: words,
             entry_point: &sref.entry,
             stage: sref.stage,
         });
