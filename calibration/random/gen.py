@@ -10,7 +10,7 @@ recursion, shadow rays, and one to three miss shaders. Even seeds are GLSL
 description; rtlint compiles it). Seeds below --split are the fitting set,
 the rest the held-out set.
 
-    calibration/random/gen.py [--seeds 320] [--split 160] [--out DIR]
+    calibration/random/gen.py [--seeds 480] [--split 320] [--out DIR]
 
 writes DIR/sNNN/sNNN.pipeline.toml and its shaders, and DIR/manifest.csv with the
 knobs of every seed. DIR defaults to calibration/random/out (not committed:
@@ -524,8 +524,8 @@ def write_hlsl(k, d):
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--seeds", type=int, default=320)
-    ap.add_argument("--split", type=int, default=160)
+    ap.add_argument("--seeds", type=int, default=480)
+    ap.add_argument("--split", type=int, default=320)
     ap.add_argument("--out", default=os.path.join(os.path.dirname(os.path.abspath(__file__)), "out"))
     args = ap.parse_args()
     if os.path.isdir(args.out):

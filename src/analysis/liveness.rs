@@ -272,7 +272,28 @@ pub struct FnLiveness {
     defined_out: Vec<HashSet<Id>>,
     preds: Vec<Vec<usize>>,
     remat: HashMap<Id, bool>,
+    /// Pointers to one member of a local struct variable (an access chain
+    /// with one constant index): variable and member.
+    member_ptr: HashMap<Id, (Id, u64)>,
+    /// Members of each local struct variable.
+    var_members: HashMap<Id, usize>,
+    /// The debug-info instruction set, whose instructions touch no value.
+    debug_set: Option<Id>,
 }
+
+/// Whether `inst` is a `NonSemantic.Shader.DebugInfo.100` instruction
+/// (`DebugDeclare`, `DebugValue`, …): it names a variable, it neither
+/// reads nor writes it.
+fn is_debug_info(program: &Program, inst: &Instruction) -> bool {
+    inst.class.opcode == Op::ExtInst
+        && program.debug_info_set.is_some()
+        && matches!(inst.operands.first(), Some(Operand::IdRef(set)) if Some(*set) == program.debug_info_set)
+}
+
+/// Members of local struct variables stored since the last read, walking
+/// backwards through one block: once every member is stored, the variable
+/// is overwritten as a whole (HLSL's `RayDesc ray; ray.Origin = …; …`).
+type Pending = HashMap<Id, HashSet<u64>>;
 
 impl FnLiveness {
     pub fn new(program: &Program, func: usize) -> FnLiveness {
@@ -314,6 +335,33 @@ impl FnLiveness {
                 }
             }
         }
+        let mut member_ptr = HashMap::new();
+        let mut var_members = HashMap::new();
+        for inst in &program.insts[f.start..=f.end] {
+            let Some(r) = inst.result_id else { continue };
+            match inst.class.opcode {
+                Op::Variable => {
+                    if let Some(Type::Pointer { pointee, .. }) =
+                        inst.result_type.and_then(|t| program.ty(t))
+                    {
+                        if let Some(Type::Struct { members }) = program.ty(*pointee) {
+                            var_members.insert(r, members.len());
+                        }
+                    }
+                }
+                Op::AccessChain | Op::InBoundsAccessChain => {
+                    let ids: Vec<Id> = id_operands(inst).collect();
+                    if let [base, index] = ids[..] {
+                        if vars.contains(&base) {
+                            if let Some(i) = program.const_u64(index) {
+                                member_ptr.insert(r, (base, i));
+                            }
+                        }
+                    }
+                }
+                _ => {}
+            }
+        }
         let mut fl = FnLiveness {
             func,
             vars,
@@ -323,6 +371,9 @@ impl FnLiveness {
             defined_out: vec![HashSet::new(); n],
             preds,
             remat: HashMap::new(),
+            member_ptr,
+            var_members,
+            debug_set: program.debug_info_set,
         };
         fl.solve(program);
         fl
@@ -337,8 +388,14 @@ impl FnLiveness {
     }
 
     /// Backward transfer of one instruction over the live set.
-    fn step_back(&self, inst: &Instruction, live: &mut HashSet<Id>) {
+    fn step_back(&self, inst: &Instruction, live: &mut HashSet<Id>, pending: &mut Pending) {
         let op = inst.class.opcode;
+        if op == Op::ExtInst
+            && self.debug_set.is_some()
+            && matches!(inst.operands.first(), Some(Operand::IdRef(set)) if Some(*set) == self.debug_set)
+        {
+            return;
+        }
         if let Some(r) = inst.result_id {
             live.remove(&r);
         }
@@ -391,15 +448,47 @@ impl FnLiveness {
                 };
                 if reads {
                     live.insert(v);
+                    pending.remove(&v);
+                }
+            }
+        }
+        // A store to one member: once every member is stored before the
+        // next read, the variable is dead before these stores.
+        if op == Op::Store {
+            if let Some(Operand::IdRef(ptr)) = inst.operands.first() {
+                if let Some(&(v, i)) = self.member_ptr.get(ptr) {
+                    let stored = pending.entry(v).or_default();
+                    stored.insert(i);
+                    if self.var_members.get(&v).is_some_and(|&n| stored.len() >= n) {
+                        live.remove(&v);
+                        pending.remove(&v);
+                    }
                 }
             }
         }
     }
 
-    /// Variables an instruction may write.
-    fn writes(&self, inst: &Instruction) -> Vec<Id> {
+    /// Variables an instruction may write. A constant initializer does not
+    /// count: until something else is stored, the variable holds a
+    /// constant, which is recomputed rather than kept across a call.
+    fn writes(&self, program: &Program, inst: &Instruction) -> Vec<Id> {
+        if is_debug_info(program, inst) {
+            return Vec::new();
+        }
         match inst.class.opcode {
-            Op::Variable if inst.operands.len() > 1 => inst.result_id.into_iter().collect(),
+            Op::Variable if inst.operands.len() > 1 => {
+                let constant = matches!(
+                    inst.operands.get(1),
+                    Some(Operand::IdRef(init))
+                        if program.constants.contains_key(init)
+                            || program.spec_constants.contains_key(init)
+                );
+                if constant {
+                    Vec::new()
+                } else {
+                    inst.result_id.into_iter().collect()
+                }
+            }
             Op::Load | Op::AccessChain | Op::InBoundsAccessChain | Op::PtrAccessChain => Vec::new(),
             _ => id_operands(inst)
                 .filter_map(|id| self.root(id))
@@ -443,11 +532,12 @@ impl FnLiveness {
                     }
                 }
                 let mut live = out.clone();
+                let mut pending = Pending::new();
                 for inst in program.insts[f.blocks[b].start..=f.blocks[b].end]
                     .iter()
                     .rev()
                 {
-                    self.step_back(inst, &mut live);
+                    self.step_back(inst, &mut live, &mut pending);
                 }
                 if out != self.live_out[b] || live != live_in[b] {
                     self.live_out[b] = out;
@@ -468,7 +558,7 @@ impl FnLiveness {
                     d.extend(self.defined_out[p].iter().copied());
                 }
                 for inst in &program.insts[f.blocks[b].start..=f.blocks[b].end] {
-                    d.extend(self.writes(inst));
+                    d.extend(self.writes(program, inst));
                 }
                 if d != self.defined_out[b] {
                     self.defined_out[b] = d;
@@ -485,8 +575,9 @@ impl FnLiveness {
             return HashSet::new();
         };
         let mut live = self.live_out[b].clone();
+        let mut pending = Pending::new();
         for k in (inst + 1..=f.blocks[b].end).rev() {
-            self.step_back(&program.insts[k], &mut live);
+            self.step_back(&program.insts[k], &mut live, &mut pending);
         }
         live
     }
@@ -502,7 +593,7 @@ impl FnLiveness {
             d.extend(self.defined_out[p].iter().copied());
         }
         for k in f.blocks[b].start..inst {
-            d.extend(self.writes(&program.insts[k]));
+            d.extend(self.writes(program, &program.insts[k]));
         }
         d
     }
