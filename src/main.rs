@@ -597,7 +597,12 @@ fn driver_in_child(
     p: &rtlint::pipeline::Pipeline,
     loose: &[String],
 ) -> Result<DriverSizes, String> {
-    let exe = std::env::current_exe().map_err(|e| format!("cannot find rtlint itself: {e}"))?;
+    // RTLINT_DRIVER_CHILD names another program to run as the child (the
+    // tests use it to stand in for a driver that crashes).
+    let exe = match std::env::var_os("RTLINT_DRIVER_CHILD") {
+        Some(p) => PathBuf::from(p),
+        None => std::env::current_exe().map_err(|e| format!("cannot find rtlint itself: {e}"))?,
+    };
     let mut command = std::process::Command::new(exe);
     command.arg("driver-stack-sizes");
     match &p.path {

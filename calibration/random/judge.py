@@ -54,15 +54,21 @@ def table(name, shaders, pipelines):
 
     def line(label, ss):
         if not ss:
-            return f"| {name} | {label} | 0 | | | | |"
+            return f"| {name} | {label} | 0 | | | | | |"
         exact = sum(s["model"] == s["driver"] for s in ss)
         w = sum(within(s["model"], s["driver"]) for s in ss)
-        under = sum(s["model"] < s["driver"] for s in ss)
-        worst = max(ss, key=lambda s: abs(s["model"] - s["driver"]) / max(s["driver"], 1))
-        pct = (worst["model"] - worst["driver"]) / max(worst["driver"], 1) * 100
+        under = [s for s in ss if s["model"] < s["driver"]]
+
+        def rel(s):
+            return (s["model"] - s["driver"]) / max(s["driver"], 1) * 100
+
+        over = max(ss, key=rel)
+        worst_under = min(under, key=rel) if under else None
         return (
             f"| {name} | {label} | {len(ss)} | {exact} ({exact / len(ss):.0%}) | {w} ({w / len(ss):.0%}) "
-            f"| {pct:+.0f} % ({worst['model']} vs {worst['driver']}) | {under} |"
+            f"| {rel(over):+.0f} % ({over['model']} vs {over['driver']}) "
+            + (f"| {rel(worst_under):+.0f} % ({worst_under['model']} vs {worst_under['driver']}) " if worst_under else "| — ")
+            + f"| {len(under)} |"
         )
 
     rows = [line("all shaders", shaders), line("non-zero shaders", nz)]
@@ -109,8 +115,8 @@ def main():
             feats.append({"pipeline": k, "set": g, "group": s["group"], "stage": s["stage"],
                           "driver": d, "model": s["driver_model_bytes"], "full": s["model_bytes"], **s["breakdown"]})
         pipes.append({"name": k, "recommended": rep["recommended"], "chain": chain.get(k)})
-    print("| set | shaders | count | exact | within ±15 % | worst | under-predictions |")
-    print("|---|---|---:|---:|---:|---|---:|")
+    print("| set | shaders | count | exact | within ±15 % | worst over | worst under | under-predictions |")
+    print("|---|---|---:|---:|---:|---|---|---:|")
     notes = []
     for g, (shaders, pipes) in groups.items():
         rows, n, measured, below = table(g, shaders, pipes)
