@@ -420,20 +420,26 @@ fn stack(common: Common, driver: bool) -> Result<u8, String> {
         if driver {
             match driver_in_child(p, &loose) {
                 Ok(d) => {
-                    let sizes = d.sizes.iter().map(|&(slot, stage, b)| ((slot, stage), b)).collect();
+                    let sizes = d
+                        .sizes
+                        .iter()
+                        .map(|&(slot, stage, b)| ((slot, stage), b))
+                        .collect();
                     rtlint::analysis::stack::attach_driver(&mut r, p, &sizes);
                     r.assumptions
                         .push(format!("driver: {} ({})", d.device, d.driver));
                 }
-                Err(message) => problems.push(*rtlint::diag::InputError::new(
-                    "driver",
-                    &p.path
-                        .clone()
-                        .or_else(|| p.programs.first().map(|q| q.path.clone()))
-                        .unwrap_or_default(),
-                    format!("--driver: {message}"),
-                )
-                .0),
+                Err(message) => problems.push(
+                    *rtlint::diag::InputError::new(
+                        "driver",
+                        &p.path
+                            .clone()
+                            .or_else(|| p.programs.first().map(|q| q.path.clone()))
+                            .unwrap_or_default(),
+                        format!("--driver: {message}"),
+                    )
+                    .0,
+                ),
             }
         }
         reports.push(r);
@@ -665,7 +671,8 @@ fn driver_stack_sizes(pipeline: Option<PathBuf>, shaders: Vec<String>) -> Result
                 let (lang, path) = s
                     .split_once(':')
                     .ok_or_else(|| format!("`{s}` is not LANG:PATH"))?;
-                let lang = Language::parse(lang).ok_or_else(|| format!("unknown language `{lang}`"))?;
+                let lang =
+                    Language::parse(lang).ok_or_else(|| format!("unknown language `{lang}`"))?;
                 programs.push(
                     rtlint::front::load(std::path::Path::new(path), lang)
                         .map_err(|e| e.0.message.clone())?,
@@ -686,7 +693,10 @@ fn driver_stack_sizes_of(p: &rtlint::pipeline::Pipeline) -> Result<u8, String> {
     let d = DriverSizes {
         device: ctx.info().name.clone(),
         driver: ctx.info().driver.clone(),
-        sizes: sizes.into_iter().map(|((slot, stage), b)| (slot, stage, b)).collect(),
+        sizes: sizes
+            .into_iter()
+            .map(|((slot, stage), b)| (slot, stage, b))
+            .collect(),
         validation_errors: ctx.validation_errors(),
     };
     drop(ctx);

@@ -241,7 +241,10 @@ fn driver_creates_every_pipeline_without_a_validation_error() {
                 .any(|e| e.file_name().to_string_lossy().contains("validation"))
         })
         .unwrap_or(false);
-    assert!(layer, "the Khronos validation layer is not installed (scripts/setup)");
+    assert!(
+        layer,
+        "the Khronos validation layer is not installed (scripts/setup)"
+    );
     let pipelines = all_descriptions();
     // Textures, samplers and bindless arrays in several sets, in HLSL and GLSL.
     for name in ["textured_hlsl.pipeline.toml", "bindless.pipeline.toml"] {
@@ -264,7 +267,11 @@ fn driver_creates_every_pipeline_without_a_validation_error() {
     let reports = reports.as_array().unwrap();
     assert_eq!(reports.len(), pipelines.len());
     for r in reports {
-        assert!(r["driver"].is_object(), "no driver figures: {}", r["pipeline"]);
+        assert!(
+            r["driver"].is_object(),
+            "no driver figures: {}",
+            r["pipeline"]
+        );
     }
 }
 
@@ -296,9 +303,15 @@ fn a_driver_crash_is_an_error_for_that_pipeline_only() {
     // rtlint itself survives, reports both pipelines' models and an error
     // for each crashed creation.
     assert_eq!(o.status.code(), Some(2), "{stdout}{stderr}");
-    assert_eq!(stdout.matches("pipeline fixtures/pipelines/").count(), 2, "{stdout}");
     assert_eq!(
-        stdout.matches("the driver crashed while creating the pipeline (signal 11, SIGSEGV)").count(),
+        stdout.matches("pipeline fixtures/pipelines/").count(),
+        2,
+        "{stdout}"
+    );
+    assert_eq!(
+        stdout
+            .matches("the driver crashed while creating the pipeline (signal 11, SIGSEGV)")
+            .count(),
         2,
         "{stdout}{stderr}"
     );

@@ -204,7 +204,11 @@ pub fn driver_model(stage: Stage, b: &Breakdown) -> u64 {
     let kept = match stage {
         Stage::RayGeneration if looped > 0 => looped,
         Stage::RayGeneration if b.call_sites > 1 => {
-            let outlived = if b.outlived_payloads > 0 { FOLDED_SCALARS } else { 0 };
+            let outlived = if b.outlived_payloads > 0 {
+                FOLDED_SCALARS
+            } else {
+                0
+            };
             scalars.min(FOLDED_SCALARS).max(outlived)
         }
         Stage::RayGeneration | Stage::Callable => 0,
@@ -821,7 +825,7 @@ pub fn render_human(r: &StackReport) -> String {
     }
     let _ = writeln!(
         s,
-        "  (bytes; model = driver* + live + arrays; driver* = the payload-driven part a driver reports; live = state across traces that cannot be recomputed; query = the driver's own figure with --driver)"
+        "  (bytes; model = every live value kept, plus a safety margin; driver* = what the NVIDIA driver is modelled to report; live = state across traces that cannot be recomputed; query = the driver's own figure with --driver)"
     );
     let _ = writeln!(s);
     let mut block = |title: &str, f: &Formulas| {
@@ -932,7 +936,11 @@ mod tests {
             (224, 128),
             (256, 160),
         ] {
-            assert_eq!(driver_model(Stage::RayGeneration, &b(p, 0)), rg, "payload {p}");
+            assert_eq!(
+                driver_model(Stage::RayGeneration, &b(p, 0)),
+                rg,
+                "payload {p}"
+            );
         }
         // Live state across calls in ray generation: folded away across a
         // single trace, 8 bytes across several, all of it (rounded up to

@@ -97,7 +97,10 @@ pub fn reflect(pipeline: &Pipeline) -> Result<PipelineInterface, String> {
             match g.storage {
                 C::PushConstant => {
                     let size = block_extent(program, g.ty).ok_or_else(|| {
-                        format!("{who}: cannot size push-constant block `{}`", program.display_name(g.id))
+                        format!(
+                            "{who}: cannot size push-constant block `{}`",
+                            program.display_name(g.id)
+                        )
                     })?;
                     out.push_constant_size = out.push_constant_size.max(size.next_multiple_of(4));
                     out.push_constant_stages.insert(s.stage);
@@ -157,7 +160,11 @@ pub fn reflect(pipeline: &Pipeline) -> Result<PipelineInterface, String> {
 fn used_globals(program: &Program, s: &ShaderRef) -> HashSet<Id> {
     let globals: HashSet<Id> = program.globals.iter().map(|g| g.id).collect();
     let mut used = HashSet::new();
-    if let Some(e) = program.entry_points.iter().find(|e| e.name == s.entry && e.stage == s.stage) {
+    if let Some(e) = program
+        .entry_points
+        .iter()
+        .find(|e| e.name == s.entry && e.stage == s.stage)
+    {
         used.extend(e.interface.iter().copied().filter(|i| globals.contains(i)));
     }
     for f in program.reachable_functions(s.function) {
@@ -197,7 +204,9 @@ fn descriptor(
         _ => (ty, DescriptorCount::Fixed(1)),
     };
     let kind = match (storage, program.ty(elem)) {
-        (C::UniformConstant, Some(Type::AccelerationStructure)) => DescriptorKind::AccelerationStructure,
+        (C::UniformConstant, Some(Type::AccelerationStructure)) => {
+            DescriptorKind::AccelerationStructure
+        }
         (C::UniformConstant, Some(Type::Sampler)) => DescriptorKind::Sampler,
         (C::UniformConstant, Some(Type::SampledImage)) => {
             // glslang declares `samplerBuffer` as a sampled image of a
@@ -215,7 +224,10 @@ fn descriptor(
         (C::UniformConstant, _) => return Ok(None),
         (C::StorageBuffer, _) => DescriptorKind::StorageBuffer,
         (C::Uniform, _) => {
-            if program.decoration(elem, spirv::Decoration::BufferBlock).is_some() {
+            if program
+                .decoration(elem, spirv::Decoration::BufferBlock)
+                .is_some()
+            {
                 DescriptorKind::StorageBuffer
             } else {
                 DescriptorKind::UniformBuffer
@@ -266,8 +278,10 @@ fn block_extent(program: &Program, ty: Id) -> Option<u32> {
                     .map(u64::from);
                 let offset = match offset {
                     Some(o) => o,
-                    None => return crate::program::scalar::scalar_size(program, ty)
-                        .and_then(|s| u32::try_from(s).ok()),
+                    None => {
+                        return crate::program::scalar::scalar_size(program, ty)
+                            .and_then(|s| u32::try_from(s).ok())
+                    }
                 };
                 end = end.max(offset + member_size(program, ty, i as u32, m)?);
             }
@@ -336,14 +350,28 @@ mod tests {
         let got: Vec<(u32, u32, DescriptorKind, DescriptorCount, Vec<Stage>)> = i
             .bindings
             .iter()
-            .map(|b| (b.set, b.binding, b.kind, b.count, b.stages.iter().copied().collect()))
+            .map(|b| {
+                (
+                    b.set,
+                    b.binding,
+                    b.kind,
+                    b.count,
+                    b.stages.iter().copied().collect(),
+                )
+            })
             .collect();
         use DescriptorCount::*;
         use DescriptorKind::*;
         assert_eq!(
             got,
             [
-                (0, 0, AccelerationStructure, Fixed(1), vec![Stage::RayGeneration]),
+                (
+                    0,
+                    0,
+                    AccelerationStructure,
+                    Fixed(1),
+                    vec![Stage::RayGeneration]
+                ),
                 (0, 1, StorageImage, Fixed(1), vec![Stage::RayGeneration]),
                 (0, 2, UniformBuffer, Fixed(1), vec![Stage::RayGeneration]),
                 (1, 0, SampledImage, Fixed(1), vec![Stage::ClosestHit]),
@@ -354,5 +382,60 @@ mod tests {
         assert_eq!(i.set_count(), 3);
         assert!(i.has_runtime_array());
         assert_eq!(i.push_constant_size, 0);
+    }
+
+    #[test]
+    fn glsl_bindless_arrays_in_four_sets() {
+        let i = reflect(&load("fixtures/pipelines/bindless.pipeline.toml")).unwrap();
+        use DescriptorCount::*;
+        use DescriptorKind::*;
+        let got: Vec<(u32, u32, DescriptorKind, DescriptorCount)> = i
+            .bindings
+            .iter()
+            .map(|b| (b.set, b.binding, b.kind, b.count))
+            .collect();
+        assert_eq!(
+            got,
+            [
+                (0, 0, AccelerationStructure, Fixed(1)),
+                (0, 1, StorageImage, Fixed(1)),
+                (0, 2, UniformBuffer, Fixed(1)),
+                (1, 0, SampledImage, Runtime),
+                (1, 1, Sampler, Fixed(1)),
+                (2, 0, StorageBuffer, Runtime),
+                (2, 1, UniformTexelBuffer, Fixed(1)),
+                (2, 2, StorageTexelBuffer, Fixed(1)),
+                (2, 3, CombinedImageSampler, Fixed(4)),
+                (3, 0, CombinedImageSampler, Fixed(1)),
+            ]
+        );
+        // Push constants in ray generation and closest hit, 8 bytes; the
+        // shader record (two uints) read by the closest hit.
+        assert_eq!(i.push_constant_size, 8);
+        assert_eq!(
+            i.push_constant_stages.iter().copied().collect::<Vec<_>>(),
+            [Stage::RayGeneration, Stage::ClosestHit]
+        );
+        assert_eq!(i.shader_record_size, 8);
+        let env = &i.bindings.last().unwrap().stages;
+        assert_eq!(env.iter().copied().collect::<Vec<_>>(), [Stage::Miss]);
+    }
+
+    #[test]
+    fn conflicting_declarations_are_an_error() {
+        // The same set and binding as a storage image in one shader and a
+        // uniform buffer in another: no layout serves both.
+        let mut p = load("fixtures/pipelines/bindless.pipeline.toml");
+        let rgen = p.raygen[0].program;
+        let g = p.programs[rgen]
+            .globals
+            .iter_mut()
+            .find(|g| g.binding == Some(1) && g.set == Some(0))
+            .unwrap();
+        g.set = Some(3);
+        g.binding = Some(0);
+        let e = reflect(&p).unwrap_err();
+        assert!(e.contains("set 3, binding 0"), "{e}");
+        assert!(e.contains("no pipeline layout serves both"), "{e}");
     }
 }
