@@ -48,6 +48,15 @@ impl Label {
     }
 }
 
+/// A mechanical fix: the text that replaces the declaration at `location`
+/// (so that a later `--fix` can apply it).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Fix {
+    /// The declaration the replacement is for; `None` without debug info.
+    pub location: Option<Location>,
+    pub replacement: String,
+}
+
 /// One finding or one input error.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Diagnostic {
@@ -68,8 +77,8 @@ pub struct Diagnostic {
     pub subject: Option<String>,
     pub notes: Vec<String>,
     pub help: Option<String>,
-    /// A mechanical fix, as replacement text (e.g. a reordered struct).
-    pub fix: Option<String>,
+    /// A mechanical fix (e.g. a reordered struct).
+    pub fix: Option<Fix>,
 }
 
 impl Diagnostic {
@@ -130,8 +139,12 @@ impl Diagnostic {
         self
     }
 
-    pub fn with_fix(mut self, fix: impl Into<String>) -> Self {
-        self.fix = Some(fix.into());
+    /// A fix: `replacement` for the declaration at `location`.
+    pub fn with_fix(mut self, location: Option<Location>, replacement: impl Into<String>) -> Self {
+        self.fix = Some(Fix {
+            location,
+            replacement: replacement.into(),
+        });
         self
     }
 
@@ -150,16 +163,93 @@ impl Diagnostic {
     }
 }
 
+/// The classes of bad input, each with a stable kebab-case name (the
+/// diagnostic's `name` in every output format).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum InputErrorKind {
+    /// a file or folder could not be read.
+    UnreadableFile,
+    /// a text input is not valid UTF-8.
+    InvalidUtf8,
+    /// the language of a file cannot be told from its name.
+    UnknownLanguage,
+    /// this build cannot read the file's language.
+    UnsupportedLanguage,
+    /// `rtlint.toml` is malformed or names something unknown.
+    InvalidConfig,
+    /// a `*.pipeline.toml` description is malformed or names something missing.
+    InvalidPipeline,
+    /// a SPIR-V module is malformed.
+    InvalidSpirv,
+    /// naga cannot parse the WGSL.
+    WgslParse,
+    /// naga's validator rejects the WGSL.
+    WgslValidation,
+    /// naga cannot write the module as SPIR-V.
+    WgslSpirvOut,
+    /// naga panicked on the input.
+    WgslInternal,
+    /// the HLSL is malformed or ill-typed.
+    HlslError,
+    /// the HLSL uses a construct rtlint's compiler does not support.
+    HlslUnsupported,
+    /// glslang rejects the GLSL.
+    GlslError,
+    /// `stack --driver`: the device could not create the pipeline (the
+    /// driver failed or crashed, or the validation layer objected).
+    DriverFailed,
+}
+
+impl InputErrorKind {
+    pub const ALL: &'static [InputErrorKind] = &[
+        InputErrorKind::UnreadableFile,
+        InputErrorKind::InvalidUtf8,
+        InputErrorKind::UnknownLanguage,
+        InputErrorKind::UnsupportedLanguage,
+        InputErrorKind::InvalidConfig,
+        InputErrorKind::InvalidPipeline,
+        InputErrorKind::InvalidSpirv,
+        InputErrorKind::WgslParse,
+        InputErrorKind::WgslValidation,
+        InputErrorKind::WgslSpirvOut,
+        InputErrorKind::WgslInternal,
+        InputErrorKind::HlslError,
+        InputErrorKind::HlslUnsupported,
+        InputErrorKind::GlslError,
+        InputErrorKind::DriverFailed,
+    ];
+
+    pub fn as_str(self) -> &'static str {
+        match self {
+            InputErrorKind::UnreadableFile => "unreadable-file",
+            InputErrorKind::InvalidUtf8 => "invalid-utf8",
+            InputErrorKind::UnknownLanguage => "unknown-language",
+            InputErrorKind::UnsupportedLanguage => "unsupported-language",
+            InputErrorKind::InvalidConfig => "invalid-config",
+            InputErrorKind::InvalidPipeline => "invalid-pipeline",
+            InputErrorKind::InvalidSpirv => "invalid-spirv",
+            InputErrorKind::WgslParse => "wgsl-parse",
+            InputErrorKind::WgslValidation => "wgsl-validation",
+            InputErrorKind::WgslSpirvOut => "wgsl-spirv-out",
+            InputErrorKind::WgslInternal => "wgsl-internal",
+            InputErrorKind::HlslError => "hlsl-error",
+            InputErrorKind::HlslUnsupported => "hlsl-unsupported",
+            InputErrorKind::GlslError => "glsl-error",
+            InputErrorKind::DriverFailed => "driver-failed",
+        }
+    }
+}
+
 /// Bad input: an unreadable file, invalid SPIR-V, source a front-end rejects.
 /// Always exit code 2; carries a diagnostic that names the file and position.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct InputError(pub Box<Diagnostic>);
 
 impl InputError {
-    pub fn new(name: &'static str, file: &Path, message: impl Into<String>) -> Self {
+    pub fn new(kind: InputErrorKind, file: &Path, message: impl Into<String>) -> Self {
         InputError(Box::new(Diagnostic::new(
             Severity::Error,
-            name,
+            kind.as_str(),
             file,
             message,
         )))
@@ -195,10 +285,15 @@ impl std::error::Error for InputError {}
 /// Reads a UTF-8 text input; an unreadable or non-UTF-8 file is an input error.
 pub fn read_text(path: &Path) -> Result<String, InputError> {
     let bytes = std::fs::read(path).map_err(|e| io_error(path, &e))?;
-    String::from_utf8(bytes).map_err(|e| {
+    text_from_bytes(&bytes, path)
+}
+
+/// Input bytes as UTF-8 text; anything else is an input error.
+pub fn text_from_bytes(bytes: &[u8], path: &Path) -> Result<String, InputError> {
+    String::from_utf8(bytes.to_vec()).map_err(|e| {
         let offset = e.utf8_error().valid_up_to();
         InputError::new(
-            "invalid-utf8",
+            InputErrorKind::InvalidUtf8,
             path,
             format!("file is not valid UTF-8 (byte offset {offset})"),
         )
@@ -206,5 +301,47 @@ pub fn read_text(path: &Path) -> Result<String, InputError> {
 }
 
 pub fn io_error(path: &Path, e: &std::io::Error) -> InputError {
-    InputError::new("unreadable-file", path, format!("cannot read file: {e}"))
+    InputError::new(
+        InputErrorKind::UnreadableFile,
+        path,
+        format!("cannot read file: {e}"),
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The names are a contract with every consumer of the JSON, SARIF and
+    /// GitHub output: they never change silently.
+    #[test]
+    fn input_error_kinds_snapshot() {
+        let names: Vec<&str> = InputErrorKind::ALL.iter().map(|k| k.as_str()).collect();
+        assert_eq!(
+            names,
+            [
+                "unreadable-file",
+                "invalid-utf8",
+                "unknown-language",
+                "unsupported-language",
+                "invalid-config",
+                "invalid-pipeline",
+                "invalid-spirv",
+                "wgsl-parse",
+                "wgsl-validation",
+                "wgsl-spirv-out",
+                "wgsl-internal",
+                "hlsl-error",
+                "hlsl-unsupported",
+                "glsl-error",
+                "driver-failed",
+            ]
+        );
+        for (i, a) in names.iter().enumerate() {
+            assert!(a
+                .chars()
+                .all(|c| c.is_ascii_lowercase() || c.is_ascii_digit() || c == '-'));
+            assert!(!names[i + 1..].contains(a), "{a} twice");
+        }
+    }
 }

@@ -4,15 +4,19 @@
 //! [`diag::Diagnostic`]s → reports. See `docs/architecture.md`.
 
 pub mod analysis;
+pub mod build;
 pub mod config;
 pub mod diag;
+pub mod explain;
 pub mod front;
 pub mod lint;
 pub mod pipeline;
 pub mod program;
+#[cfg(feature = "vulkan")]
 pub mod reference;
 pub mod report;
 pub mod rules;
 pub mod shader;
+pub mod suppress;
 #[cfg(feature = "vulkan")]
 pub mod vk;

@@ -3,7 +3,7 @@
 //! that pipeline rather than for every shader in a folder. See
 //! `docs/pipeline.md` for the format.
 
-use crate::diag::{InputError, Location};
+use crate::diag::{InputError, InputErrorKind, Location};
 use crate::front;
 use crate::program::{Id, Program};
 use crate::shader::Language;
@@ -249,7 +249,7 @@ pub fn parse(text: &str, path: &Path) -> Result<Pipeline, InputError> {
     let cx = Cx { text, path };
     let raw: RawPipeline = toml::from_str(text).map_err(|e| {
         let err = InputError::new(
-            "invalid-pipeline",
+            InputErrorKind::InvalidPipeline,
             path,
             format!("invalid pipeline description: {}", e.message().trim_end()),
         );
@@ -301,7 +301,7 @@ pub fn parse(text: &str, path: &Path) -> Result<Pipeline, InputError> {
     }
     if raw.raygen.is_empty() {
         return Err(InputError::new(
-            "invalid-pipeline",
+            InputErrorKind::InvalidPipeline,
             path,
             "pipeline description has no `[[raygen]]` shader",
         ));
@@ -391,7 +391,7 @@ impl Cx<'_> {
     }
 
     fn error(&self, span: Range<usize>, msg: impl Into<String>) -> InputError {
-        InputError::new("invalid-pipeline", self.path, msg).at(self.loc(span), "here")
+        InputError::new(InputErrorKind::InvalidPipeline, self.path, msg).at(self.loc(span), "here")
     }
 
     fn u32(&self, v: &Spanned<i64>, key: &str) -> Result<u32, InputError> {

@@ -71,7 +71,9 @@ fn mutated_spirv_never_panics() {
                 match rtlint::program::parse(&w, Path::new("m.spv"), Language::Spirv) {
                     Ok(p) => {
                         let _ = rtlint::rules::check_program(&p, &config);
-                        let _ = rtlint::analysis::layout::FileLayouts::new(&p).render_human();
+                        let _ = rtlint::report::layout::human(
+                            &rtlint::analysis::layout::FileLayouts::new(&p),
+                        );
                         true
                     }
                     Err(e) => {

@@ -43,12 +43,15 @@ fn stack_on_every_pipeline_with_and_without_the_driver() {
     ];
     args.extend(pipelines().iter().map(|p| p.to_string_lossy().into_owned()));
     let with: Vec<&str> = args.iter().map(String::as_str).collect();
-    let reports = json(&with);
-    let reports = reports.as_array().expect("one report per pipeline");
+    let out = json(&with);
+    assert_eq!(out["version"], 1);
+    let reports = out["pipelines"]
+        .as_array()
+        .expect("one report per pipeline");
     assert_eq!(reports.len(), pipelines().len());
     let without: Vec<&str> = with.iter().copied().filter(|a| *a != "--driver").collect();
     let models = json(&without);
-    for (r, m) in reports.iter().zip(models.as_array().unwrap()) {
+    for (r, m) in reports.iter().zip(models["pipelines"].as_array().unwrap()) {
         for key in [
             "required_depth",
             "declared_depth",
@@ -94,12 +97,15 @@ fn stack_on_every_pipeline_with_and_without_the_driver() {
 
 #[test]
 fn stack_numbers_for_the_reference_pipeline() {
-    let r = json(&[
+    let out = json(&[
         "stack",
         "--format",
         "json",
         "shaders/reflect_iterative.pipeline.toml",
     ]);
+    // One shape whatever the number of inputs.
+    let r = &out["pipelines"][0];
+    assert_eq!(out["pipelines"].as_array().unwrap().len(), 1);
     assert_eq!(r["required_depth"], 1);
     assert_eq!(r["declared_depth"], 1);
     let stages: Vec<(&str, u64)> = r["shaders"]
@@ -263,9 +269,10 @@ fn driver_creates_every_pipeline_without_a_validation_error() {
     let stderr = String::from_utf8_lossy(&o.stderr);
     assert_eq!(o.status.code(), Some(0), "{stderr}");
     assert!(!stderr.contains("validation"), "{stderr}");
-    let reports: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
-    let reports = reports.as_array().unwrap();
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let reports = v["pipelines"].as_array().unwrap();
     assert_eq!(reports.len(), pipelines.len());
+    assert_eq!(v["errors"].as_array().map(Vec::len), Some(0));
     for r in reports {
         assert!(
             r["driver"].is_object(),
@@ -331,9 +338,59 @@ fn json_with_several_inputs_still_reports_input_errors() {
         .output()
         .unwrap();
     assert_eq!(o.status.code(), Some(2));
-    let reports: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
-    assert_eq!(reports.as_array().map(Vec::len), Some(2));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(v["pipelines"].as_array().map(Vec::len), Some(2));
+    let errors = v["errors"].as_array().unwrap();
+    assert_eq!(errors.len(), 1, "{errors:?}");
+    assert!(
+        errors[0].to_string().contains("missing.pipeline.toml"),
+        "{errors:?}"
+    );
+}
+
+#[test]
+fn driver_numbers_from_the_measurement_csv() {
+    // What the H200 reported for the reference pipeline, kept in the
+    // repository: raygen 64, miss 0, closest hit 0.
+    let v = json(&[
+        "stack",
+        "--driver-numbers",
+        "calibration/random/nvidia-h200.csv",
+        "--format",
+        "json",
+        "shaders/reflect_iterative.pipeline.toml",
+    ]);
+    let r = &v["pipelines"][0];
+    let measured: Vec<u64> = r["shaders"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|s| s["driver_bytes"].as_u64().unwrap())
+        .collect();
+    assert_eq!(measured, [64, 0, 0]);
+    let chain = r["driver"]["exact_call_chain"].as_u64().unwrap();
+    assert_eq!(chain, 64);
+    assert!(r["recommended"].as_u64().unwrap() >= chain);
+    // A malformed CSV is an input error with its line, not a panic.
+    let dir = std::env::temp_dir().join(format!("rtlint-csv-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let bad = dir.join("bad.csv");
+    std::fs::write(
+        &bad,
+        "pipeline,group,stage,entry,driver_bytes\nx,raygen 0,ray_generation,main,lots\n",
+    )
+    .unwrap();
+    let o = rtlint()
+        .args(["stack", "--driver-numbers"])
+        .arg(&bad)
+        .arg("shaders/reflect_iterative.pipeline.toml")
+        .output()
+        .unwrap();
+    let _ = std::fs::remove_dir_all(&dir);
+    assert_eq!(o.status.code(), Some(2));
     let stderr = String::from_utf8_lossy(&o.stderr);
-    assert!(stderr.contains("missing.pipeline.toml"), "{stderr}");
-    assert!(stderr.contains("cannot read file"), "{stderr}");
+    assert!(
+        stderr.contains("bad.csv:2: `lots` is not a byte count"),
+        "{stderr}"
+    );
 }

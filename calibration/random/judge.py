@@ -24,20 +24,19 @@ ROOT = os.path.dirname(os.path.dirname(HERE))
 
 
 def key(path):
-    m = re.search(r"/out/(s\d+)/", path)
-    if m:
-        return "random/" + m.group(1)
     return os.path.relpath(path, ROOT)
 
 
-def model_reports(rtlint, paths):
+def model_reports(rtlint, paths, extra=()):
     out = []
     for i in range(0, len(paths), 64):
         chunk = paths[i : i + 64]
-        r = subprocess.run([rtlint, "stack", "--format", "json", *chunk], capture_output=True, text=True)
+        r = subprocess.run([rtlint, "stack", *extra, "--format", "json", *chunk], capture_output=True, text=True)
         if r.returncode != 0:
             sys.exit(f"rtlint failed:\n{r.stderr}")
         v = json.loads(r.stdout)
+        if isinstance(v, dict) and "pipelines" in v:
+            v = v["pipelines"]
         out.extend(v if isinstance(v, list) else [v])
     return out
 
@@ -85,22 +84,22 @@ def main():
     ap.add_argument("--features", help="write a per-shader CSV of features and figures here")
     args = ap.parse_args()
     driver = {}
-    chain = {}
     for r in csv.DictReader(open(args.csv)):
         driver[(r["pipeline"], r["group"], r["stage"])] = int(r["driver_bytes"])
-        # Without an exact chain (recursion unbounded at compile time) the
-        # driver's own default for the declared depth is the reference.
-        ref = r["driver_exact_call_chain"] or r["driver_vulkan_default"]
-        chain[r["pipeline"]] = int(ref) if ref else None
     sets = {}
     for r in csv.DictReader(open(args.manifest)):
-        sets["random/s%03d" % int(r["seed"])] = r["set"]
-    paths = []
-    for p in sorted(chain):
-        if p.startswith("random/"):
-            paths.append(os.path.join(HERE, "out", p[7:], p[7:] + ".pipeline.toml"))
-        elif os.path.exists(os.path.join(ROOT, p)):
-            paths.append(os.path.join(ROOT, p))
+        s = "s%03d" % int(r["seed"])
+        sets[f"calibration/random/out/{s}/{s}.pipeline.toml"] = r["set"]
+    pipelines = sorted({k[0] for k in driver})
+    paths = [os.path.join(ROOT, p) for p in pipelines if os.path.exists(os.path.join(ROOT, p))]
+    # The exact call chain of the driver's own numbers (its default for the
+    # declared depth where recursion is unbounded at compile time), through
+    # rtlint's current call graph.
+    chain = {}
+    for rep in model_reports(args.rtlint, paths, ["--driver-numbers", args.csv]):
+        d = rep.get("driver") or {}
+        ref = d.get("exact_call_chain")
+        chain[key(rep["pipeline"])] = ref if ref is not None else d.get("vulkan_default")
     groups = {"fit": ([], []), "heldout": ([], []), "repository": ([], [])}
     feats = []
     for rep in model_reports(args.rtlint, paths):

@@ -21,22 +21,65 @@ const FLAG_SKIP_CLOSEST_HIT: u64 = 0x8;
 const FLAG_SKIP_TRIANGLES: u64 = 0x100;
 const FLAG_SKIP_AABBS: u64 = 0x200;
 
+/// Something the analysis had to assume, said in the report.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum Assumption {
+    /// No pipeline description: every trace may reach every hit group and
+    /// miss shader.
+    Undescribed,
+    /// A trace whose SBT offset or stride is not a compile-time constant may
+    /// reach every hit group.
+    DynamicSbtOffset { at: Option<Location> },
+    /// A trace whose miss index is not a compile-time constant may reach
+    /// every miss shader.
+    DynamicMissIndex { at: Option<Location> },
+    /// No declared depth: the default formulas use the required depth only.
+    NoDeclaredDepth,
+    /// Recursion with no bound known at compile time, and why.
+    UnboundedRecursion(super::recursion::NoGuard),
+    /// A depth counter with no constant initial value: 0 was assumed.
+    InitialValueAssumed { counter: String },
+    /// The driver's numbers come from this device.
+    Driver { device: String, driver: String },
+    /// The recommended stack was below what the driver's own numbers need
+    /// and was raised to it.
+    RecommendationRaised { from: u64, to: u64 },
+}
+
+impl Assumption {
+    /// The order reports list them in: undescribed pipelines first, then
+    /// traces by position.
+    fn sort_key(&self) -> (u8, bool, String, u8) {
+        match self {
+            Assumption::Undescribed => (0, false, String::new(), 0),
+            Assumption::DynamicSbtOffset { at } => (
+                1,
+                at.is_none(),
+                at.as_ref().map(|l| l.to_string()).unwrap_or_default(),
+                0,
+            ),
+            Assumption::DynamicMissIndex { at } => (
+                1,
+                at.is_none(),
+                at.as_ref().map(|l| l.to_string()).unwrap_or_default(),
+                1,
+            ),
+            _ => (2, false, String::new(), 0),
+        }
+    }
+}
+
+/// A trace that selects a hit group or miss shader the pipeline lacks.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum OutOfRange {
+    HitGroup { index: u64, count: usize },
+    Miss { index: u64, count: usize },
+}
+
 #[derive(Clone, Debug)]
 pub struct Node {
     pub shader: ShaderRef,
     pub slot: Slot,
-}
-
-impl Node {
-    /// `closesthit `main` (hit group 0)`-style name for messages.
-    pub fn describe(&self) -> String {
-        format!(
-            "{} `{}` ({})",
-            self.shader.stage.as_str(),
-            self.shader.entry,
-            self.slot
-        )
-    }
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -61,9 +104,9 @@ pub struct TraceGraph {
     pub nodes: Vec<Node>,
     pub edges: Vec<Edge>,
     /// What the graph had to assume (unresolved SBT operands, no description).
-    pub assumptions: Vec<String>,
+    pub assumptions: Vec<Assumption>,
     /// Sites selecting a group or miss shader the pipeline does not have.
-    pub out_of_range: Vec<(Option<Location>, String)>,
+    pub out_of_range: Vec<(Option<Location>, OutOfRange)>,
 }
 
 impl TraceGraph {
@@ -106,9 +149,7 @@ pub fn trace_graph(pipeline: &Pipeline) -> TraceGraph {
         });
     }
     if !pipeline.described() {
-        g.assumptions.push(
-            "no pipeline description: every trace may reach every hit group and miss shader".into(),
-        );
+        g.assumptions.push(Assumption::Undescribed);
     }
     let described = pipeline.described();
     for from in 0..g.nodes.len() {
@@ -124,18 +165,29 @@ pub fn trace_graph(pipeline: &Pipeline) -> TraceGraph {
             if !reach.contains(&f.id) {
                 continue;
             }
-            let location = program.site_location(site.inst);
-            let at = location
-                .as_ref()
-                .map(|l| format!(" at {l}"))
-                .unwrap_or_default();
+            // A site in a helper (naga wraps every `traceRay` in one per
+            // payload, called from several shaders) is placed and its
+            // operands folded at this shader's call.
+            let chain = crate::program::cfg::call_chains(
+                program,
+                shader.function,
+                f.id,
+                super::liveness::MAX_CHAINS,
+            )
+            .into_iter()
+            .next()
+            .unwrap_or_default();
+            let location = program
+                .location_in(site.inst, &chain)
+                .or_else(|| program.site_location(site.inst));
             let mut targets: Vec<usize> = Vec::new();
             let kind = match site.kind {
                 SiteKind::TraceRay => EdgeKind::Trace,
                 SiteKind::ExecuteCallable => EdgeKind::Callable,
                 _ => continue,
             };
-            if let (EdgeKind::Trace, Some(t)) = (kind, site.trace) {
+            let operands = program.trace_operands_in(site, &chain).or(site.trace);
+            if let (EdgeKind::Trace, Some(t)) = (kind, operands) {
                 let flags = t.ray_flags.constant().unwrap_or(0);
                 let dynamic_flags = t.ray_flags.constant().is_none();
                 let opaque = !dynamic_flags
@@ -144,38 +196,38 @@ pub fn trace_graph(pipeline: &Pipeline) -> TraceGraph {
                 let skip_ch = !dynamic_flags && flags & FLAG_SKIP_CLOSEST_HIT != 0;
                 let skip_tri = !dynamic_flags && flags & FLAG_SKIP_TRIANGLES != 0;
                 let skip_aabb = !dynamic_flags && flags & FLAG_SKIP_AABBS != 0;
-                let groups: Vec<usize> = match (
-                    described,
-                    const_of(t.sbt_offset),
-                    const_of(t.sbt_stride),
-                ) {
-                    (true, Some(off), Some(stride)) => {
-                        let mut v = Vec::new();
-                        for &inst in &pipeline.instance_sbt_offsets {
-                            for geo in 0..u64::from(pipeline.geometries_per_instance) {
-                                let idx = u64::from(inst) + off + stride * geo;
-                                if (idx as usize) < pipeline.hit_groups.len() {
-                                    if !v.contains(&(idx as usize)) {
-                                        v.push(idx as usize);
-                                    }
-                                } else {
-                                    g.out_of_range.push((
+                let groups: Vec<usize> =
+                    match (described, const_of(t.sbt_offset), const_of(t.sbt_stride)) {
+                        (true, Some(off), Some(stride)) => {
+                            let mut v = Vec::new();
+                            for &inst in &pipeline.instance_sbt_offsets {
+                                for geo in 0..u64::from(pipeline.geometries_per_instance) {
+                                    let idx = u64::from(inst) + off + stride * geo;
+                                    if (idx as usize) < pipeline.hit_groups.len() {
+                                        if !v.contains(&(idx as usize)) {
+                                            v.push(idx as usize);
+                                        }
+                                    } else {
+                                        g.out_of_range.push((
                                             location.clone(),
-                                            format!("trace{at} selects hit group {idx}, the pipeline has {}", pipeline.hit_groups.len()),
+                                            OutOfRange::HitGroup {
+                                                index: idx,
+                                                count: pipeline.hit_groups.len(),
+                                            },
                                         ));
+                                    }
                                 }
                             }
+                            v
                         }
-                        v
-                    }
-                    (true, _, _) => {
-                        g.assumptions.push(format!(
-                                "trace{at} has a SBT offset or stride unknown at compile time: it may reach every hit group"
-                            ));
-                        (0..pipeline.hit_groups.len()).collect()
-                    }
-                    _ => (0..pipeline.hit_groups.len()).collect(),
-                };
+                        (true, _, _) => {
+                            g.assumptions.push(Assumption::DynamicSbtOffset {
+                                at: location.clone(),
+                            });
+                            (0..pipeline.hit_groups.len()).collect()
+                        }
+                        _ => (0..pipeline.hit_groups.len()).collect(),
+                    };
                 for (n, node) in g.nodes.iter().enumerate() {
                     let Slot::HitGroup(gi) = node.slot else {
                         continue;
@@ -203,18 +255,18 @@ pub fn trace_graph(pipeline: &Pipeline) -> TraceGraph {
                         if (m as usize) >= pipeline.miss.len() {
                             g.out_of_range.push((
                                 location.clone(),
-                                format!(
-                                    "trace{at} selects miss shader {m}, the pipeline has {}",
-                                    pipeline.miss.len()
-                                ),
+                                OutOfRange::Miss {
+                                    index: m,
+                                    count: pipeline.miss.len(),
+                                },
                             ));
                         }
                         vec![m as usize]
                     }
                     (true, None) => {
-                        g.assumptions.push(format!(
-                            "trace{at} has a miss index unknown at compile time: it may reach every miss shader"
-                        ));
+                        g.assumptions.push(Assumption::DynamicMissIndex {
+                            at: location.clone(),
+                        });
                         (0..pipeline.miss.len()).collect()
                     }
                     _ => (0..pipeline.miss.len()).collect(),
@@ -250,7 +302,7 @@ pub fn trace_graph(pipeline: &Pipeline) -> TraceGraph {
             }
         }
     }
-    g.assumptions.sort();
+    g.assumptions.sort_by_key(Assumption::sort_key);
     g.assumptions.dedup();
     g
 }
@@ -278,7 +330,12 @@ mod tests {
         let mut v: Vec<_> = g
             .edges
             .iter()
-            .map(|e| (g.nodes[e.from].describe(), g.nodes[e.to].describe()))
+            .map(|e| {
+                (
+                    crate::explain::node(&g.nodes[e.from]),
+                    crate::explain::node(&g.nodes[e.to]),
+                )
+            })
             .collect();
         v.sort();
         v

@@ -203,6 +203,27 @@ fn payload_info(program: &Program, id: Id) -> PayloadInfo {
     }
 }
 
+/// The type of element `i` of a composite type.
+fn element_type(program: &Program, ty: Id, i: u32) -> Option<Id> {
+    match program.ty(ty)? {
+        Type::Struct { members } => members.get(i as usize).copied(),
+        Type::Vector { elem, .. } | Type::Array { elem, .. } => Some(*elem),
+        Type::Matrix { column, .. } => Some(*column),
+        _ => None,
+    }
+}
+
+/// How many elements a composite type has, when fixed.
+fn element_count(program: &Program, ty: Id) -> Option<u32> {
+    match program.ty(ty)? {
+        Type::Struct { members } => Some(members.len() as u32),
+        Type::Vector { count, .. } => Some(*count),
+        Type::Matrix { columns, .. } => Some(*columns),
+        Type::Array { len, .. } => len.value().map(|n| n.min(u32::MAX as u64) as u32),
+        _ => None,
+    }
+}
+
 fn pointee(program: &Program, ptr_ty: Id) -> Option<Id> {
     match program.ty(ptr_ty)? {
         Type::Pointer { pointee, .. } => Some(*pointee),
@@ -258,66 +279,95 @@ fn id_operands(inst: &Instruction) -> impl Iterator<Item = Id> + '_ {
     })
 }
 
+/// What backward liveness tracks: an SSA value (empty path), or part of a
+/// function-local variable, named by the constant access-chain indices that
+/// reach it from the variable (empty: all of it).
+type Place = (Id, Vec<u32>);
+
+/// A pointer into a function-local variable.
+#[derive(Clone, Debug)]
+struct LocalPtr {
+    var: Id,
+    /// Constant indices from the variable, up to the first dynamic one.
+    path: Vec<u32>,
+    /// Whether every index was constant (the pointer names exactly `path`).
+    exact: bool,
+}
+
+/// Parts are tracked separately up to this many elements per composite.
+const MAX_SPLIT: u32 = 64;
+
 /// Liveness facts of one function.
 pub struct FnLiveness {
     func: usize,
     /// Function-local `OpVariable`s.
     vars: HashSet<Id>,
-    /// Pointer ids derived from a local variable, to the variable.
-    roots: HashMap<Id, Id>,
+    /// Pointer ids derived from a local variable.
+    roots: HashMap<Id, LocalPtr>,
     /// SSA values that count as state: defined here, not pointers to locals.
     ssa: HashSet<Id>,
-    live_out: Vec<HashSet<Id>>,
+    live_out: Vec<HashSet<Place>>,
     /// Variables possibly written at each block's end.
     defined_out: Vec<HashSet<Id>>,
     preds: Vec<Vec<usize>>,
     remat: HashMap<Id, bool>,
-    /// Pointers to one member of a local struct variable (an access chain
-    /// with one constant index): variable and member.
-    member_ptr: HashMap<Id, (Id, u64)>,
-    /// Members of each local struct variable.
-    var_members: HashMap<Id, usize>,
-    /// The debug-info instruction set, whose instructions touch no value.
-    debug_set: Option<Id>,
+    /// Variables' rematerialisation as read at an instruction.
+    remat_at: HashMap<(Id, usize), bool>,
 }
-
-/// Whether `inst` is a `NonSemantic.Shader.DebugInfo.100` instruction
-/// (`DebugDeclare`, `DebugValue`, …): it names a variable, it neither
-/// reads nor writes it.
-fn is_debug_info(program: &Program, inst: &Instruction) -> bool {
-    inst.class.opcode == Op::ExtInst
-        && program.debug_info_set.is_some()
-        && matches!(inst.operands.first(), Some(Operand::IdRef(set)) if Some(*set) == program.debug_info_set)
-}
-
-/// Members of local struct variables stored since the last read, walking
-/// backwards through one block: once every member is stored, the variable
-/// is overwritten as a whole (HLSL's `RayDesc ray; ray.Origin = …; …`).
-type Pending = HashMap<Id, HashSet<u64>>;
 
 impl FnLiveness {
     pub fn new(program: &Program, func: usize) -> FnLiveness {
         let f = &program.functions[func];
         let mut vars = HashSet::new();
-        let mut roots = HashMap::new();
+        let mut roots: HashMap<Id, LocalPtr> = HashMap::new();
         let mut ssa = HashSet::new();
         for inst in &program.insts[f.start..=f.end] {
             let Some(r) = inst.result_id else { continue };
+            if program.is_debug_inst(inst) {
+                continue;
+            }
             match inst.class.opcode {
                 Op::Variable => {
                     vars.insert(r);
-                    roots.insert(r, r);
+                    roots.insert(
+                        r,
+                        LocalPtr {
+                            var: r,
+                            path: Vec::new(),
+                            exact: true,
+                        },
+                    );
                 }
                 Op::AccessChain
                 | Op::InBoundsAccessChain
                 | Op::PtrAccessChain
                 | Op::CopyObject
                 | Op::Bitcast => {
-                    let base = id_operands(inst).next();
-                    if let Some(root) = base.and_then(|b| roots.get(&b).copied()) {
-                        roots.insert(r, root);
-                    } else {
-                        ssa.insert(r);
+                    let ids: Vec<Id> = id_operands(inst).collect();
+                    match ids.first().and_then(|b| roots.get(b)).cloned() {
+                        Some(mut ptr) => {
+                            let chain = matches!(
+                                inst.class.opcode,
+                                Op::AccessChain | Op::InBoundsAccessChain
+                            );
+                            if inst.class.opcode == Op::PtrAccessChain
+                                || inst.class.opcode == Op::Bitcast
+                            {
+                                ptr.exact = false;
+                            }
+                            if chain {
+                                for &ix in &ids[1..] {
+                                    match program.const_u64(ix) {
+                                        Some(c) if ptr.exact => ptr.path.push(c as u32),
+                                        _ => ptr.exact = false,
+                                    }
+                                }
+                            }
+                            roots.insert(r, ptr);
+                        }
+                        None => {
+                            ssa.insert(r);
+                        }
                     }
                 }
                 Op::Label | Op::Function => {}
@@ -335,33 +385,6 @@ impl FnLiveness {
                 }
             }
         }
-        let mut member_ptr = HashMap::new();
-        let mut var_members = HashMap::new();
-        for inst in &program.insts[f.start..=f.end] {
-            let Some(r) = inst.result_id else { continue };
-            match inst.class.opcode {
-                Op::Variable => {
-                    if let Some(Type::Pointer { pointee, .. }) =
-                        inst.result_type.and_then(|t| program.ty(t))
-                    {
-                        if let Some(Type::Struct { members }) = program.ty(*pointee) {
-                            var_members.insert(r, members.len());
-                        }
-                    }
-                }
-                Op::AccessChain | Op::InBoundsAccessChain => {
-                    let ids: Vec<Id> = id_operands(inst).collect();
-                    if let [base, index] = ids[..] {
-                        if vars.contains(&base) {
-                            if let Some(i) = program.const_u64(index) {
-                                member_ptr.insert(r, (base, i));
-                            }
-                        }
-                    }
-                }
-                _ => {}
-            }
-        }
         let mut fl = FnLiveness {
             func,
             vars,
@@ -371,9 +394,7 @@ impl FnLiveness {
             defined_out: vec![HashSet::new(); n],
             preds,
             remat: HashMap::new(),
-            member_ptr,
-            var_members,
-            debug_set: program.debug_info_set,
+            remat_at: HashMap::new(),
         };
         fl.solve(program);
         fl
@@ -384,45 +405,33 @@ impl FnLiveness {
     }
 
     fn root(&self, id: Id) -> Option<Id> {
-        self.roots.get(&id).copied()
+        self.roots.get(&id).map(|p| p.var)
     }
 
-    /// Backward transfer of one instruction over the live set.
-    fn step_back(&self, inst: &Instruction, live: &mut HashSet<Id>, pending: &mut Pending) {
-        let op = inst.class.opcode;
-        if op == Op::ExtInst
-            && self.debug_set.is_some()
-            && matches!(inst.operands.first(), Some(Operand::IdRef(set)) if Some(*set) == self.debug_set)
-        {
+    /// Backward transfer of one instruction over the live set. Debug-info
+    /// instructions (`DebugDeclare`, `DebugValue`) neither read nor write.
+    fn step_back(&self, program: &Program, inst: &Instruction, live: &mut HashSet<Place>) {
+        if program.is_debug_inst(inst) {
             return;
         }
+        let op = inst.class.opcode;
         if let Some(r) = inst.result_id {
-            live.remove(&r);
+            live.remove(&(r, Vec::new()));
+            // An initializer writes the whole variable.
+            if op == Op::Variable {
+                live.retain(|(v, _)| *v != r);
+            }
         }
         match op {
             // Phi operands are used on the incoming edge, handled by `solve`.
             Op::Phi => return,
-            Op::Store => {
+            Op::Store | Op::CopyMemory | Op::CopyMemorySized => {
                 if let Some(Operand::IdRef(ptr)) = inst.operands.first() {
-                    if self.vars.contains(ptr) {
-                        live.remove(ptr);
+                    if let Some(p) = self.roots.get(ptr).filter(|p| p.exact) {
+                        self.kill(program, live, p);
                     }
                 }
             }
-            Op::CopyMemory | Op::CopyMemorySized => {
-                if let Some(Operand::IdRef(ptr)) = inst.operands.first() {
-                    if self.vars.contains(ptr) {
-                        live.remove(ptr);
-                    }
-                }
-                if let Some(Operand::IdRef(src)) = inst.operands.get(1) {
-                    if let Some(v) = self.root(*src) {
-                        live.insert(v);
-                    }
-                }
-            }
-            // An initializer writes the whole variable; the result id was
-            // removed above.
             _ => {}
         }
         let derives = matches!(
@@ -435,9 +444,9 @@ impl FnLiveness {
         );
         for (k, id) in id_operands(inst).enumerate() {
             if self.ssa.contains(&id) {
-                live.insert(id);
+                live.insert((id, Vec::new()));
             }
-            if let Some(v) = self.root(id) {
+            if let Some(p) = self.roots.get(&id) {
                 // Deriving a pointer reads nothing; a store's target is
                 // written, not read; anything else may read the variable.
                 let reads = match op {
@@ -447,32 +456,71 @@ impl FnLiveness {
                     _ => true,
                 };
                 if reads {
-                    live.insert(v);
-                    pending.remove(&v);
+                    live.insert((p.var, p.path.clone()));
                 }
             }
         }
-        // A store to one member: once every member is stored before the
-        // next read, the variable is dead before these stores.
-        if op == Op::Store {
-            if let Some(Operand::IdRef(ptr)) = inst.operands.first() {
-                if let Some(&(v, i)) = self.member_ptr.get(ptr) {
-                    let stored = pending.entry(v).or_default();
-                    stored.insert(i);
-                    if self.var_members.get(&v).is_some_and(|&n| stored.len() >= n) {
-                        live.remove(&v);
-                        pending.remove(&v);
-                    }
+    }
+
+    /// A write of exactly `ptr`'s part: that part and everything inside it
+    /// is dead before the write; a live enclosing part stays live only in
+    /// the pieces the write does not cover.
+    fn kill(&self, program: &Program, live: &mut HashSet<Place>, ptr: &LocalPtr) {
+        let parts: Vec<Vec<u32>> = live
+            .iter()
+            .filter(|(v, _)| *v == ptr.var)
+            .map(|(_, q)| q.clone())
+            .collect();
+        for q in parts {
+            if q.starts_with(&ptr.path) {
+                live.remove(&(ptr.var, q));
+            } else if ptr.path.starts_with(&q) {
+                if let Some(pieces) = self.split(program, ptr.var, &q, &ptr.path) {
+                    live.remove(&(ptr.var, q));
+                    live.extend(pieces.into_iter().map(|p| (ptr.var, p)));
                 }
             }
         }
+    }
+
+    /// The parts of `outer` not inside `inner` (a longer path below it), as
+    /// the siblings met on the way down; `None` when a composite on the way
+    /// has no known, small element count.
+    fn split(
+        &self,
+        program: &Program,
+        var: Id,
+        outer: &[u32],
+        inner: &[u32],
+    ) -> Option<Vec<Vec<u32>>> {
+        let mut ty = program
+            .def(var)
+            .and_then(|d| d.result_type)
+            .and_then(|t| pointee(program, t))?;
+        for &i in outer {
+            ty = element_type(program, ty, i)?;
+        }
+        let mut out = Vec::new();
+        for depth in outer.len()..inner.len() {
+            let n = element_count(program, ty)?;
+            if n > MAX_SPLIT {
+                return None;
+            }
+            for j in (0..n).filter(|&j| j != inner[depth]) {
+                let mut piece = inner[..depth].to_vec();
+                piece.push(j);
+                out.push(piece);
+            }
+            ty = element_type(program, ty, inner[depth])?;
+        }
+        Some(out)
     }
 
     /// Variables an instruction may write. A constant initializer does not
     /// count: until something else is stored, the variable holds a
     /// constant, which is recomputed rather than kept across a call.
     fn writes(&self, program: &Program, inst: &Instruction) -> Vec<Id> {
-        if is_debug_info(program, inst) {
+        if program.is_debug_inst(inst) {
             return Vec::new();
         }
         match inst.class.opcode {
@@ -518,26 +566,26 @@ impl FnLiveness {
                 }
             }
         }
-        let mut live_in: Vec<HashSet<Id>> = vec![HashSet::new(); n];
+        let mut live_in: Vec<HashSet<Place>> = vec![HashSet::new(); n];
         let mut changed = true;
         let mut rounds = 0;
         while changed && rounds < 10_000 {
             changed = false;
             rounds += 1;
             for b in (0..n).rev() {
-                let mut out: HashSet<Id> = phi_uses[b].iter().copied().collect();
+                let mut out: HashSet<Place> =
+                    phi_uses[b].iter().map(|&v| (v, Vec::new())).collect();
                 for &s in &f.blocks[b].succs {
                     if let Some(li) = live_in.get(s) {
-                        out.extend(li.iter().copied());
+                        out.extend(li.iter().cloned());
                     }
                 }
                 let mut live = out.clone();
-                let mut pending = Pending::new();
                 for inst in program.insts[f.blocks[b].start..=f.blocks[b].end]
                     .iter()
                     .rev()
                 {
-                    self.step_back(inst, &mut live, &mut pending);
+                    self.step_back(program, inst, &mut live);
                 }
                 if out != self.live_out[b] || live != live_in[b] {
                     self.live_out[b] = out;
@@ -570,16 +618,47 @@ impl FnLiveness {
 
     /// Ids live just after instruction `inst` (SSA values and variables).
     pub fn live_after(&self, program: &Program, inst: usize) -> HashSet<Id> {
+        self.places_after(program, inst)
+            .into_iter()
+            .map(|(id, _)| id)
+            .collect()
+    }
+
+    /// SSA values and parts of variables live just after instruction `inst`.
+    fn places_after(&self, program: &Program, inst: usize) -> HashSet<Place> {
         let f = self.function(program);
         let Some(b) = f.block_of(inst) else {
             return HashSet::new();
         };
         let mut live = self.live_out[b].clone();
-        let mut pending = Pending::new();
         for k in (inst + 1..=f.blocks[b].end).rev() {
-            self.step_back(&program.insts[k], &mut live, &mut pending);
+            self.step_back(program, &program.insts[k], &mut live);
         }
         live
+    }
+
+    /// Bytes of the live parts of variable `var` (of type `ty`): all of it
+    /// when the whole is live, else the sum of the outermost live parts.
+    fn live_part_size(program: &Program, ty: Id, paths: &[&Vec<u32>]) -> u64 {
+        let whole = scalar_size(program, ty).unwrap_or(0);
+        if paths.iter().any(|p| p.is_empty()) {
+            return whole;
+        }
+        let outer = paths
+            .iter()
+            .filter(|p| !paths.iter().any(|q| q.len() < p.len() && p.starts_with(q)));
+        let mut sum = 0;
+        for p in outer {
+            let mut t = ty;
+            for &i in p.iter() {
+                match element_type(program, t, i) {
+                    Some(e) => t = e,
+                    None => return whole,
+                }
+            }
+            sum += scalar_size(program, t).unwrap_or(0);
+        }
+        sum.min(whole)
     }
 
     /// Variables possibly written before instruction `inst`.
@@ -600,7 +679,8 @@ impl FnLiveness {
 
     /// The values live across instruction `inst`, described.
     pub fn live_across(&mut self, program: &Program, inst: usize) -> Vec<LiveValue> {
-        let live = self.live_after(program, inst);
+        let places = self.places_after(program, inst);
+        let live: HashSet<Id> = places.iter().map(|(id, _)| *id).collect();
         let defined = self.defined_before(program, inst);
         let result = program.insts.get(inst).and_then(|i| i.result_id);
         let mut ids: Vec<Id> = live
@@ -633,23 +713,41 @@ impl FnLiveness {
                 _ => {}
             }
             let rematerializable = if is_var {
-                self.remat_var(program, id, 0)
+                self.remat_var(program, id, inst, 0)
             } else {
                 self.remat_ssa(program, id, 0)
             };
             let def = if is_var {
                 self.var_def_location(program, id)
             } else {
-                program
-                    .defs
-                    .get(&id)
-                    .and_then(|&i| program.inst_location(i))
+                program.defs.get(&id).and_then(|&i| {
+                    program.inst_location(i).or_else(|| {
+                        // A builtin or resource loaded where the compiler
+                        // gave no line (naga's entry-point prologue): where
+                        // the global is declared.
+                        let inst = &program.insts[i];
+                        let ptr = id_operands(inst).next()?;
+                        (inst.class.opcode == Op::Load
+                            && program.globals.iter().any(|g| g.id == ptr))
+                        .then(|| program.var_location(ptr))
+                        .flatten()
+                    })
+                })
             };
             let use_at = self.first_use_after(program, inst, id);
             out.push(LiveValue {
                 name: value_name(program, id, def.as_ref()),
                 ty: program.type_name(ty),
-                size: scalar_size(program, ty).unwrap_or(0),
+                size: if is_var {
+                    let paths: Vec<&Vec<u32>> = places
+                        .iter()
+                        .filter(|(v, _)| *v == id)
+                        .map(|(_, p)| p)
+                        .collect();
+                    FnLiveness::live_part_size(program, ty, &paths)
+                } else {
+                    scalar_size(program, ty).unwrap_or(0)
+                },
                 rematerializable,
                 storage: if is_var {
                     Storage::Variable
@@ -666,7 +764,10 @@ impl FnLiveness {
         out
     }
 
-    fn reads(&self, inst: &Instruction, id: Id) -> bool {
+    fn reads(&self, program: &Program, inst: &Instruction, id: Id) -> bool {
+        if program.is_debug_inst(inst) {
+            return false;
+        }
         if inst.class.opcode == Op::Phi {
             return id_operands(inst).step_by(2).any(|x| x == id);
         }
@@ -689,7 +790,7 @@ impl FnLiveness {
         let b0 = f.block_of(inst)?;
         let mut found = None;
         for k in inst + 1..=f.blocks[b0].end {
-            if self.reads(&program.insts[k], id) {
+            if self.reads(program, &program.insts[k], id) {
                 found = Some(k);
                 break;
             }
@@ -702,7 +803,7 @@ impl FnLiveness {
                     continue;
                 }
                 for k in f.blocks[b].start..=f.blocks[b].end {
-                    if self.reads(&program.insts[k], id) {
+                    if self.reads(program, &program.insts[k], id) {
                         found = Some(k);
                         break 'bfs;
                     }
@@ -755,11 +856,26 @@ impl FnLiveness {
         let name = format!("{op:?}");
         let r = match op {
             Op::Phi | Op::FunctionCall | Op::FunctionParameter | Op::Variable => false,
-            _ if name.starts_with("Atomic") || name.starts_with("RayQuery") => false,
+            // A clock reads time, and subgroup operations depend on which
+            // invocations are active: neither gives the same value again.
+            Op::ReadClockKHR => false,
+            _ if name.starts_with("Atomic")
+                || name.starts_with("RayQuery")
+                || name.starts_with("GroupNonUniform")
+                || name.starts_with("Subgroup")
+                || name.starts_with("Group") =>
+            {
+                false
+            }
             Op::Load => {
                 let ptr = id_operands(inst).next().unwrap_or(0);
                 match self.root(ptr) {
-                    Some(v) => self.remat_var(program, v, depth + 1),
+                    Some(v) => self.remat_var(program, v, i, depth + 1),
+                    // A buffer_reference pointer is an address computed like
+                    // any value: the load is recomputable when it is.
+                    None if self.physical_pointer(program, ptr) => {
+                        self.remat_ssa(program, ptr, depth + 1)
+                    }
                     None => self.remat_global_ptr(program, ptr, depth + 1),
                 }
             }
@@ -776,6 +892,19 @@ impl FnLiveness {
         };
         self.remat.insert(id, r);
         r
+    }
+
+    /// Whether `ptr` is a `PhysicalStorageBuffer` pointer (GLSL
+    /// `buffer_reference`, HLSL `vk::RawBufferLoad`).
+    fn physical_pointer(&self, program: &Program, ptr: Id) -> bool {
+        let ty = program.def(ptr).and_then(|d| d.result_type);
+        matches!(
+            ty.and_then(|t| program.ty(t)),
+            Some(Type::Pointer {
+                storage: StorageClass::PhysicalStorageBuffer,
+                ..
+            })
+        )
     }
 
     fn remat_global_ptr(&mut self, program: &Program, ptr: Id, depth: u32) -> bool {
@@ -806,26 +935,34 @@ impl FnLiveness {
         }
     }
 
-    /// A variable is recomputable when every write stores a recomputable
-    /// value and nothing else (a call, an atomic) gets its address.
-    fn remat_var(&mut self, program: &Program, var: Id, depth: u32) -> bool {
-        let key = var;
-        if let Some(&r) = self.remat.get(&key) {
+    /// A variable read at instruction `at` is recomputable when the writes
+    /// that reach `at` store recomputable values, no two of them store
+    /// different values into the same part (a merge of paths, like a phi, or
+    /// a value that changed), and nothing else (a call, an atomic) gets its
+    /// address.
+    fn remat_var(&mut self, program: &Program, var: Id, at: usize, depth: u32) -> bool {
+        let key = (var, at);
+        if let Some(&r) = self.remat_at.get(&key) {
             return r;
         }
-        self.remat.insert(key, false);
+        self.remat_at.insert(key, false);
         let f = self.function(program);
         let (start, end) = (f.start, f.end);
+        let reaching = self.reaching_writes(program, var, at);
         let mut ok = true;
+        let mut stored: Vec<(Vec<u32>, Id)> = Vec::new();
         for i in start..=end {
             let inst = &program.insts[i];
+            if program.is_debug_inst(inst) {
+                continue;
+            }
             let ids: Vec<Id> = id_operands(inst).collect();
             if !ids.iter().any(|x| self.root(*x) == Some(var)) && inst.result_id != Some(var) {
                 continue;
             }
             match inst.class.opcode {
                 Op::Variable => {
-                    if let Some(&init) = ids.first() {
+                    if let Some(&init) = ids.first().filter(|_| reaching.contains(&i)) {
                         if !matches!(
                             program.constants.get(&init),
                             Some(Constant::Int(_) | Constant::Float(_) | Constant::Bool(_))
@@ -834,13 +971,28 @@ impl FnLiveness {
                         {
                             ok = false;
                         }
+                        stored.push((Vec::new(), init));
                     }
                 }
+                // A store that cannot reach `at` does not give the value read there.
+                Op::Store if !reaching.contains(&i) => {}
                 Op::Store => {
                     let value = ids.get(1).copied().unwrap_or(0);
                     if !self.remat_ssa(program, value, depth + 1) {
                         ok = false;
                     }
+                    let path = ids
+                        .first()
+                        .and_then(|p| self.roots.get(p))
+                        .map(|p| p.path.clone())
+                        .unwrap_or_default();
+                    let clash = stored
+                        .iter()
+                        .any(|(q, v)| *v != value && (q.starts_with(&path) || path.starts_with(q)));
+                    if clash {
+                        ok = false;
+                    }
+                    stored.push((path, value));
                 }
                 Op::Load => {}
                 Op::AccessChain | Op::InBoundsAccessChain | Op::PtrAccessChain => {
@@ -857,64 +1009,66 @@ impl FnLiveness {
                 break;
             }
         }
-        self.remat.insert(key, ok);
+        self.remat_at.insert(key, ok);
         ok
     }
-}
 
-/// The human form of `rtlint live`.
-pub fn render_human(report: &LiveReport) -> String {
-    use std::fmt::Write;
-    let mut s = String::new();
-    if report.sites.is_empty() {
-        s.push_str("no trace, callable or ray-query sites\n");
-        return s;
-    }
-    for site in &report.sites {
-        let at = match (site.line, site.column) {
-            (Some(l), Some(c)) if c > 0 => format!("{}:{l}:{c}", site.path.display()),
-            (Some(l), _) => format!("{}:{l}", site.path.display()),
-            _ => site.path.display().to_string(),
+    /// The writes to `var` (stores, and its `OpVariable` when it has an
+    /// initializer) that can give the value read at `at`: walking back from
+    /// `at` along every path, up to a store of the whole variable.
+    fn reaching_writes(&self, program: &Program, var: Id, at: usize) -> HashSet<usize> {
+        let f = self.function(program);
+        let mut found = HashSet::new();
+        let Some(b0) = f.block_of(at) else {
+            return found;
         };
-        let _ = writeln!(
-            s,
-            "{at}: {} in `{}` ({}): {} bytes live, {} rematerializable",
-            site.kind.as_str(),
-            site.entry,
-            site.stage.as_str(),
-            site.live_bytes,
-            site.rematerializable_bytes
-        );
-        if let Some(p) = &site.payload {
-            let size = p
-                .size
-                .map(|b| format!("{b} bytes"))
-                .unwrap_or("unsized".into());
-            let _ = writeln!(s, "  payload `{}`: {} ({size}, not counted)", p.name, p.ty);
-        }
-        for v in &site.values {
-            let line = |l: Option<u32>| l.map(|l| l.to_string()).unwrap_or("?".into());
-            let _ = writeln!(
-                s,
-                "  {:>4} B  {:<16} {:<10} {:<8} defined line {}, used line {}{}",
-                v.size,
-                v.name,
-                v.ty,
-                match v.storage {
-                    Storage::Ssa => "value",
-                    Storage::Variable => "variable",
-                },
-                line(v.def_line),
-                line(v.use_line),
-                if v.rematerializable {
-                    "  (rematerializable)"
-                } else {
-                    ""
+        let whole = |i: usize| -> Option<bool> {
+            let inst = &program.insts[i];
+            match inst.class.opcode {
+                Op::Store => {
+                    let p = id_operands(inst).next().and_then(|p| self.roots.get(&p))?;
+                    (p.var == var).then_some(p.exact && p.path.is_empty())
                 }
-            );
+                Op::Variable if inst.result_id == Some(var) => {
+                    (inst.operands.len() > 1).then_some(true)
+                }
+                _ => None,
+            }
+        };
+        // (block, last instruction to look at)
+        let mut work: Vec<(usize, usize)> = vec![(b0, at)];
+        let mut seen: HashSet<usize> = HashSet::new();
+        while let Some((b, last)) = work.pop() {
+            let block = &f.blocks[b];
+            let mut killed = false;
+            for i in (block.start..last).rev() {
+                if let Some(w) = whole(i) {
+                    found.insert(i);
+                    if w {
+                        killed = true;
+                        break;
+                    }
+                }
+            }
+            if killed {
+                continue;
+            }
+            if b == 0 {
+                // The entry block holds the variables and their initializers.
+                if let Some(&d) = program.defs.get(&var) {
+                    if whole(d) == Some(true) {
+                        found.insert(d);
+                    }
+                }
+            }
+            for &p in &self.preds[b] {
+                if seen.insert(p) {
+                    work.push((p, f.blocks[p].end + 1));
+                }
+            }
         }
+        found
     }
-    s
 }
 
 #[cfg(test)]
@@ -1018,7 +1172,7 @@ mod tests {
         assert_eq!(json["sites"][0]["kind"], "trace_ray");
         assert_eq!(json["sites"][0]["live_bytes"], 28);
         assert_eq!(json["sites"][0]["values"][0]["name"], "b");
-        assert!(render_human(&r).contains("28 bytes live"));
+        assert!(crate::report::live::human(&r).contains("28 bytes live"));
     }
 
     #[test]
@@ -1037,5 +1191,147 @@ mod tests {
             .find(|s| s.kind == LiveSiteKind::TraceRay)
             .unwrap();
         assert_eq!(names(trace), [("uv", 8, true)]);
+    }
+
+    /// Debug info never changes the answer: `-g`, `-gV` (DebugDeclare and
+    /// DebugValue name every local), WGSL and rtlint's HLSL alike. Loop-local
+    /// state written at the top of each iteration is not live, a struct
+    /// written field by field no more than one built whole.
+    #[test]
+    fn loop_locals_are_dead_whatever_the_debug_info() {
+        for rel in [
+            "fixtures/live/loop_local.rgen.spv",
+            "fixtures/live/loop_local.rgen.gV.spv",
+        ] {
+            let sites = live_sites(&program(rel));
+            assert_eq!(sites.len(), 2, "{rel}");
+            assert_eq!(
+                names(&sites[0]),
+                [("acc", 12, false), ("dir", 12, false), ("i", 4, false)],
+                "{rel}"
+            );
+            assert_eq!(
+                names(&sites[1]),
+                [("acc", 12, false), ("i", 4, false)],
+                "{rel}"
+            );
+        }
+        let s = one_site("fixtures/live/loop_local.hlsl");
+        assert_eq!(names(&s), [("acc", 12, false), ("i", 4, false)]);
+        let s = one_site("fixtures/live/loop_local.wgsl");
+        let n = names(&s);
+        assert!(!n.iter().any(|v| v.0 == "ray" || v.0 == "dir"), "{n:?}");
+        assert!(n.contains(&("acc", 12, false)) && n.contains(&("i", 4, false)));
+    }
+
+    /// One value per rematerialisation class (docs/stack.md), with and
+    /// without NonSemantic debug info.
+    #[test]
+    fn rematerialisation_classes() {
+        for rel in [
+            "fixtures/live/classes.rgen.spv",
+            "fixtures/live/classes.rgen.gV.spv",
+        ] {
+            let sites = live_sites(&program(rel));
+            assert_eq!(
+                names(&sites[0]),
+                [
+                    ("fromBuiltin", 16, true),
+                    ("fromImage", 16, true),
+                    ("fromStorage", 16, true),
+                    ("fromTexture", 16, true),
+                    ("fromUniform", 16, true),
+                    ("fromClock", 8, false),
+                    ("fromRealtime", 8, false),
+                ]
+                .iter()
+                .copied()
+                .collect::<std::collections::BTreeSet<_>>()
+                .into_iter()
+                .collect::<Vec<_>>(),
+                "{rel}"
+            );
+            let second = names(&sites[1]);
+            assert!(
+                second.contains(&("fromPayload", 16, false)),
+                "{rel}: {second:?}"
+            );
+        }
+        // The same classes in HLSL (rtlint's compiler) and WGSL (naga).
+        for (rel, names_of) in [
+            (
+                "fixtures/live/classes.hlsl",
+                [
+                    "fromBuiltin",
+                    "fromUniform",
+                    "fromStorage",
+                    "fromTexture",
+                    "fromImage",
+                    "fromPayload",
+                ],
+            ),
+            (
+                "fixtures/live/classes.wgsl",
+                [
+                    "from_builtin",
+                    "from_uniform",
+                    "from_storage",
+                    "from_texture",
+                    "from_load",
+                    "from_payload",
+                ],
+            ),
+        ] {
+            let sites = live_sites(&program(rel));
+            let remat = |k: usize, name: &str| {
+                sites[k]
+                    .values
+                    .iter()
+                    .find(|v| v.name == name)
+                    .map(|v| v.rematerializable)
+            };
+            for name in &names_of[..5] {
+                assert_eq!(remat(0, name), Some(true), "{rel}: {name}");
+            }
+            assert_eq!(remat(0, names_of[5]), None, "{rel}");
+            assert_eq!(remat(1, names_of[5]), Some(false), "{rel}");
+        }
+        // buffer_reference loads are as recomputable as storage-buffer loads.
+        let s = one_site("fixtures/live/reference.rgen.spv");
+        assert_eq!(names(&s), [("albedo", 16, true), ("scale", 16, true)]);
+    }
+
+    /// glslang -g copies a Latin-1 comment byte into OpSource; spirv-val
+    /// accepts the module, and so does rtlint (each bad byte read as `?`).
+    #[test]
+    fn non_utf8_source_is_read() {
+        let p = program("fixtures/live/latin1.rgen.spv");
+        let text = p.files.iter().find_map(|f| f.text.clone()).unwrap();
+        assert!(text.contains("// Gr??e: a Latin-1 comment"), "{text}");
+        for rel in [
+            "fixtures/live/latin1.rgen.spv",
+            "fixtures/live/latin1.rgen.gV.spv",
+        ] {
+            let s = one_site(rel);
+            assert_eq!(names(&s), [("k", 4, true)], "{rel}");
+            assert_eq!(s.line, Some(10), "{rel}");
+        }
+    }
+
+    /// `rtlint live` names the source file the debug info gives, not the
+    /// module, and says when a value has no known line.
+    #[test]
+    fn live_report_names_the_source() {
+        let r = live_report(&[program("fixtures/live/loop_local.rgen.gV.spv")]);
+        let text = crate::report::live::human(&r);
+        assert!(
+            text.contains("fixtures/live/loop_local.rgen:23: trace_ray"),
+            "{text}"
+        );
+        assert!(!text.contains(".spv"), "{text}");
+        assert!(!text.contains("line ?"), "{text}");
+        let r = live_report(&[program("fixtures/live/lets.wgsl")]);
+        let text = crate::report::live::human(&r);
+        assert!(!text.contains("line ?"), "{text}");
     }
 }

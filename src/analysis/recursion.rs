@@ -19,16 +19,93 @@ use rspirv::dr::{Instruction, Operand};
 use spirv::{Op, StorageClass};
 use std::collections::{BTreeMap, HashSet};
 
+/// Where a loop or recursion bound comes from.
+#[derive(Clone, Debug, PartialEq, Eq, PartialOrd, Ord)]
+pub enum BoundSource {
+    Constant(i64),
+    /// A specialization constant: its value in the pipeline description, else
+    /// its default.
+    SpecConstant {
+        name: String,
+        value: i64,
+        described: bool,
+    },
+    /// A push-constant, uniform, storage-buffer or shader-record value that
+    /// the pipeline description gives.
+    Described {
+        kind: ValueKind,
+        key: String,
+        value: i64,
+    },
+}
+
+/// Where a value that is not a constant is read from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
+pub enum ValueKind {
+    PushConstant,
+    Uniform,
+    StorageBuffer,
+    ShaderRecord,
+}
+
+/// Why a bound is not known at compile time.
+#[derive(Clone, Debug, PartialEq, Eq, PartialOrd, Ord)]
+pub enum UnknownBound {
+    /// An id the module does not define.
+    UnknownValue,
+    RuntimeValue,
+    /// A value the pipeline description could give but does not.
+    NotDescribed {
+        kind: ValueKind,
+        name: String,
+    },
+}
+
+/// Why no depth guard was recognised on a trace that closes a cycle.
+#[derive(Clone, Debug, PartialEq, Eq, PartialOrd, Ord)]
+pub enum NoGuard {
+    ModuleMissing,
+    TraceMissing,
+    OutsideFunction,
+    /// The counter is compared with a bound that is not known.
+    BoundUnknown {
+        counter: String,
+        bound: UnknownBound,
+    },
+    /// The counter guards the trace but the traced copy does not grow.
+    CounterDoesNotGrow {
+        counter: String,
+    },
+    /// No dominating comparison of a counter (named when one was seen) with a
+    /// known bound.
+    NoComparison {
+        counter: Option<String>,
+    },
+}
+
+/// Why no bound was recognised on a loop that traces.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum NoLoopBound {
+    NotIncremented {
+        counter: String,
+    },
+    BoundUnknown {
+        counter: String,
+        bound: UnknownBound,
+    },
+    NoCounter,
+}
+
 /// A recognised depth guard on a trace that closes a cycle.
-#[derive(Clone, Debug, serde::Serialize)]
+#[derive(Clone, Debug)]
 pub struct Guard {
     /// `payload.depth`-style name of the counter.
     pub counter: String,
     /// `<` or `<=`: the trace happens while `counter op bound`.
     pub op: &'static str,
     pub bound: i64,
-    /// Where the bound comes from, in words.
-    pub bound_source: String,
+    /// Where the bound comes from.
+    pub bound_source: BoundSource,
     /// How much the counter grows per trace.
     pub step: i64,
     /// The counter's value where the cycle is entered.
@@ -37,7 +114,6 @@ pub struct Guard {
     pub initial_assumed: bool,
     /// How many times the cycle can trace in one chain.
     pub traces: u64,
-    #[serde(skip)]
     pub location: Option<Location>,
 }
 
@@ -48,7 +124,7 @@ pub struct CycleSite {
     pub inst: usize,
     pub location: Option<Location>,
     /// The guard, or why none was recognised.
-    pub guard: Result<Guard, String>,
+    pub guard: Result<Guard, NoGuard>,
 }
 
 /// A strongly connected part of the trace graph with a cycle.
@@ -67,6 +143,9 @@ pub struct ChainStep {
     pub level: u32,
     /// Further levels reached by a bounded cycle through this node.
     pub repeat: u64,
+    /// No level bounds this step: it is on an unbounded cycle, or reached
+    /// from one (then `level` means nothing).
+    pub unbounded: bool,
     /// The trace that invoked it.
     pub via: Option<Location>,
 }
@@ -96,23 +175,6 @@ pub struct RecursionReport {
 }
 
 impl RecursionReport {
-    /// `raygeneration `main` → closesthit `main` ×4 → miss `main``.
-    pub fn chain_text(&self) -> String {
-        let parts: Vec<String> = self
-            .chain
-            .iter()
-            .map(|s| {
-                let name = self.graph.nodes[s.node].describe();
-                if s.repeat > 0 {
-                    format!("{name} at levels {}–{}", s.level, s.level as u64 + s.repeat)
-                } else {
-                    format!("{name} at level {}", s.level)
-                }
-            })
-            .collect();
-        parts.join(" → ")
-    }
-
     pub fn unbounded_cycle(&self) -> Option<&Cycle> {
         self.cycles.iter().find(|c| c.extra_levels.is_none())
     }
@@ -279,14 +341,17 @@ pub fn recursion_report(pipeline: &Pipeline) -> RecursionReport {
             Some((k, _)) => (traces[k].to, traces[k].location.clone()),
             None => (sccs[c][0], None),
         };
-        let level = match entry[c] {
-            Lv::At(l) => l as u32,
-            _ => 0,
+        let (level, unbounded) = match (entry[c], extra[c]) {
+            (Lv::At(l), Some(_)) => (l as u32, false),
+            // Entered at a known level, but the cycle through it has no bound.
+            (Lv::At(l), None) => (l as u32, true),
+            _ => (0, true),
         };
         chain.push(ChainStep {
             node,
             level,
             repeat: extra[c].unwrap_or(0),
+            unbounded,
             via,
         });
         cur = pred[c].map(|(_, from)| from);
@@ -335,30 +400,230 @@ fn ids(inst: &Instruction) -> impl Iterator<Item = Id> + '_ {
 enum Counter {
     /// A member path of the incoming payload.
     Payload { var: Id, path: Vec<u64> },
-    /// A function-local variable.
-    Local(Id),
+    /// A variable (local, private, or the payload a shader traces) or a
+    /// member of one.
+    Var { var: Id, path: Vec<u64> },
 }
 
 fn global(program: &Program, id: Id) -> Option<&crate::program::Global> {
     program.globals.iter().find(|g| g.id == id)
 }
 
-/// The base variable and constant member path of a pointer.
+/// How far value and pointer resolution follows copies and calls.
+const MAX_RESOLVE: u32 = 24;
+
+/// The base variable and constant member path of a pointer: through access
+/// chains (indices folded), copies, and function parameters whose every
+/// call passes the same place (`inout` parameters, glslang's
+/// copy-in/copy-out temporaries).
 fn pointer_path(program: &Program, ptr: Id) -> Option<(Id, Vec<u64>)> {
+    place_of(program, ptr, 0)
+}
+
+fn place_of(program: &Program, ptr: Id, depth: u32) -> Option<(Id, Vec<u64>)> {
+    if depth > MAX_RESOLVE {
+        return None;
+    }
     let inst = program.def(ptr)?;
     match inst.class.opcode {
         Op::Variable => Some((ptr, Vec::new())),
         Op::AccessChain | Op::InBoundsAccessChain => {
             let v: Vec<Id> = ids(inst).collect();
             let (&base, idx) = v.split_first()?;
-            let (root, mut path) = pointer_path(program, base)?;
+            let (root, mut path) = place_of(program, base, depth + 1)?;
             for &i in idx {
-                path.push(program.const_u64(i)?);
+                path.push(program.fold(i)?);
             }
             Some((root, path))
         }
-        Op::CopyObject => pointer_path(program, ids(inst).next()?),
+        Op::CopyObject => place_of(program, ids(inst).next()?, depth + 1),
+        Op::FunctionParameter => {
+            let fi = program.function_of(*program.defs.get(&ptr)?)?;
+            let f = program.functions.get(fi)?;
+            let k = f.params.iter().position(|&p| p == ptr)?;
+            let mut place = None;
+            for call in program.callers(f.id) {
+                let arg = ids(&program.insts[call]).nth(1 + k)?;
+                let here = place_of(program, arg, depth + 1)?;
+                if place.as_ref().is_some_and(|p| *p != here) {
+                    return None;
+                }
+                place = Some(here);
+            }
+            place
+        }
         _ => None,
+    }
+}
+
+fn is_local(program: &Program, var: Id) -> bool {
+    program.def(var).is_some_and(|d| {
+        d.class.opcode == Op::Variable
+            && matches!(
+                d.operands.first(),
+                Some(Operand::StorageClass(StorageClass::Function))
+            )
+    })
+}
+
+/// Where a value comes from, as far as copies can be followed.
+#[derive(Clone, Debug, PartialEq, Eq)]
+enum Source {
+    /// Computed: this SSA value.
+    Value(Id),
+    /// Read from a global variable's member (the incoming payload, a
+    /// push constant) at the time of the copy.
+    Read(Id, Vec<u64>),
+}
+
+/// Every value a place can hold, following whole-struct copies, composite
+/// construction and insertion, and local variables (flow-insensitive: every
+/// write in the module counts).
+fn values_of(program: &Program, place: (Id, Vec<u64>)) -> Vec<Source> {
+    let mut out = Vec::new();
+    let mut seen = HashSet::new();
+    stored_values(program, &place, &mut out, &mut seen, 0);
+    out
+}
+
+fn stored_values(
+    program: &Program,
+    place: &(Id, Vec<u64>),
+    out: &mut Vec<Source>,
+    seen: &mut HashSet<(Id, Vec<u64>)>,
+    depth: u32,
+) {
+    if depth > MAX_RESOLVE || !seen.insert(place.clone()) {
+        return;
+    }
+    let (var, path) = place;
+    if let Some(Operand::IdRef(init)) = program.def(*var).and_then(|d| d.operands.get(1)) {
+        component(program, *init, path, out, seen, depth + 1);
+    }
+    for inst in &program.insts {
+        if program.is_debug_inst(inst) {
+            continue;
+        }
+        let (dst, src_value, src_ptr) = match inst.class.opcode {
+            Op::Store => {
+                let v: Vec<Id> = ids(inst).collect();
+                match v.as_slice() {
+                    [d, s, ..] => (*d, Some(*s), None),
+                    _ => continue,
+                }
+            }
+            Op::CopyMemory | Op::CopyMemorySized => {
+                let v: Vec<Id> = ids(inst).collect();
+                match v.as_slice() {
+                    [d, s, ..] => (*d, None, Some(*s)),
+                    _ => continue,
+                }
+            }
+            _ => continue,
+        };
+        let Some((dv, dp)) = place_of(program, dst, 0) else {
+            continue;
+        };
+        if dv != *var || !path.starts_with(&dp) {
+            continue;
+        }
+        let rest = &path[dp.len()..];
+        if let Some(value) = src_value {
+            component(program, value, rest, out, seen, depth + 1);
+        } else if let Some((sv, mut sp)) = src_ptr.and_then(|p| place_of(program, p, 0)) {
+            sp.extend_from_slice(rest);
+            read_place(program, (sv, sp), out, seen, depth + 1);
+        }
+    }
+}
+
+/// The sources of a load from `place`: a local's stored values, else the
+/// read itself.
+fn read_place(
+    program: &Program,
+    place: (Id, Vec<u64>),
+    out: &mut Vec<Source>,
+    seen: &mut HashSet<(Id, Vec<u64>)>,
+    depth: u32,
+) {
+    if is_local(program, place.0) {
+        stored_values(program, &place, out, seen, depth + 1);
+    } else {
+        out.push(Source::Read(place.0, place.1));
+    }
+}
+
+/// The sources of element `path` of composite value `value`.
+fn component(
+    program: &Program,
+    value: Id,
+    path: &[u64],
+    out: &mut Vec<Source>,
+    seen: &mut HashSet<(Id, Vec<u64>)>,
+    depth: u32,
+) {
+    if depth > MAX_RESOLVE {
+        return;
+    }
+    let value = strip_conversions(program, value);
+    let Some(inst) = program.def(value) else {
+        return;
+    };
+    let v: Vec<Id> = ids(inst).collect();
+    match inst.class.opcode {
+        Op::Load => {
+            if let Some((var, mut p)) = v.first().and_then(|&ptr| place_of(program, ptr, 0)) {
+                p.extend_from_slice(path);
+                read_place(program, (var, p), out, seen, depth + 1);
+            }
+        }
+        Op::CompositeConstruct if !path.is_empty() => {
+            // Struct and array constructors take one operand per element.
+            if let Some(&e) = v.get(path[0] as usize) {
+                component(program, e, &path[1..], out, seen, depth + 1);
+            }
+        }
+        Op::CompositeInsert if !path.is_empty() => {
+            let lits: Vec<u64> = inst
+                .operands
+                .iter()
+                .filter_map(|o| match o {
+                    Operand::LiteralBit32(x) => Some(*x as u64),
+                    _ => None,
+                })
+                .collect();
+            if let [obj, composite, ..] = v.as_slice() {
+                if path.starts_with(&lits) {
+                    component(program, *obj, &path[lits.len()..], out, seen, depth + 1);
+                } else if !lits.starts_with(path) {
+                    component(program, *composite, path, out, seen, depth + 1);
+                }
+            }
+        }
+        Op::CompositeExtract => {
+            let mut p: Vec<u64> = inst
+                .operands
+                .iter()
+                .filter_map(|o| match o {
+                    Operand::LiteralBit32(x) => Some(*x as u64),
+                    _ => None,
+                })
+                .collect();
+            p.extend_from_slice(path);
+            if let Some(&c) = v.first() {
+                component(program, c, &p, out, seen, depth + 1);
+            }
+        }
+        _ if !path.is_empty() => {
+            if let Some(Constant::Composite(parts)) = program.constants.get(&value) {
+                if let Some(&e) = parts.get(path[0] as usize) {
+                    component(program, e, &path[1..], out, seen, depth + 1);
+                }
+            } else if program.constants.get(&value) == Some(&Constant::Null) {
+                out.push(Source::Value(value));
+            }
+        }
+        _ => out.push(Source::Value(value)),
     }
 }
 
@@ -379,73 +644,78 @@ fn strip_conversions(program: &Program, mut id: Id) -> Id {
     id
 }
 
-/// Stores to a local variable (whole-variable stores only).
-fn stores_to(program: &Program, f: &Function, var: Id) -> Vec<Id> {
-    program.insts[f.start..=f.end]
-        .iter()
-        .filter(|i| i.class.opcode == Op::Store)
-        .filter_map(|i| {
-            let v: Vec<Id> = ids(i).collect();
-            (v.first() == Some(&var))
-                .then(|| v.get(1).copied())
-                .flatten()
-        })
-        .collect()
-}
-
-fn counter_of(program: &Program, id: Id, depth: u32) -> Option<Counter> {
-    if depth > 8 {
-        return None;
-    }
+/// The counter a value reads: a member of the incoming payload (loaded
+/// directly, through a local copy of it or of the whole payload, or through
+/// an `inout` parameter), else the variable or member it is loaded from.
+fn counter_of(program: &Program, id: Id) -> Option<Counter> {
     let id = strip_conversions(program, id);
     let inst = program.def(id)?;
     if inst.class.opcode != Op::Load {
         return None;
     }
-    let ptr = ids(inst).next()?;
-    let (var, path) = pointer_path(program, ptr)?;
-    if let Some(g) = global(program, var) {
-        return (g.storage == StorageClass::IncomingRayPayloadKHR)
-            .then_some(Counter::Payload { var, path });
+    let (var, path) = pointer_path(program, ids(inst).next()?)?;
+    let incoming = |v: Id| {
+        global(program, v).is_some_and(|g| g.storage == StorageClass::IncomingRayPayloadKHR)
+    };
+    if incoming(var) {
+        return Some(Counter::Payload { var, path });
     }
-    if !path.is_empty() {
-        return None;
-    }
-    // A local copy of the payload counter (`uint depth = payload.depth;`).
-    let f = program
-        .function_of(*program.defs.get(&var)?)
-        .and_then(|i| program.functions.get(i))?;
-    let stores = stores_to(program, f, var);
-    if let [only] = stores.as_slice() {
-        if let Some(c @ Counter::Payload { .. }) = counter_of(program, *only, depth + 1) {
-            return Some(c);
+    if is_local(program, var) {
+        // A local copy of the payload counter (`uint depth = payload.depth;`,
+        // `Payload p = payload; p.depth`): every value it holds is that read.
+        let sources = values_of(program, (var, path.clone()));
+        if let Some(Source::Read(v, p)) = sources.first() {
+            if incoming(*v) && sources.iter().all(|s| *s == sources[0]) {
+                return Some(Counter::Payload {
+                    var: *v,
+                    path: p.clone(),
+                });
+            }
         }
     }
-    Some(Counter::Local(var))
+    Some(Counter::Var { var, path })
+}
+
+/// Whether `value` is `counter + c` with a constant `c > 0`; `c`.
+fn step_of(program: &Program, value: Id, counter: &Counter) -> Option<i64> {
+    let add = program.def(strip_conversions(program, value))?;
+    if add.class.opcode != Op::IAdd {
+        return None;
+    }
+    let ops: Vec<Id> = ids(add).collect();
+    [(0, 1), (1, 0)].iter().find_map(|&(x, c)| {
+        let (&x, &c) = (ops.get(x)?, ops.get(c)?);
+        let step = signed(program, c, program.fold(c)?);
+        (step > 0 && counter_of(program, x).as_ref() == Some(counter)).then_some(step)
+    })
 }
 
 fn counter_name(program: &Program, c: &Counter) -> String {
-    match c {
-        Counter::Local(v) => program.display_name(*v),
-        Counter::Payload { var, path } => {
-            let mut s = program.display_name(*var);
-            let mut ty = global(program, *var).map(|g| g.ty);
-            for &k in path {
-                match ty.and_then(|t| program.ty(t)) {
-                    Some(Type::Struct { members }) => {
-                        s.push('.');
-                        s.push_str(&program.member_name(ty.unwrap_or(0), k as u32));
-                        ty = members.get(k as usize).copied();
-                    }
-                    _ => {
-                        s.push_str(&format!("[{k}]"));
-                        ty = None;
-                    }
-                }
+    let (Counter::Payload { var, path } | Counter::Var { var, path }) = c;
+    let mut s = program.display_name(*var);
+    let mut ty = global(program, *var).map(|g| g.ty).or_else(|| {
+        program
+            .def(*var)
+            .and_then(|d| d.result_type)
+            .and_then(|t| match program.ty(t) {
+                Some(Type::Pointer { pointee, .. }) => Some(*pointee),
+                _ => None,
+            })
+    });
+    for &k in path {
+        match ty.and_then(|t| program.ty(t)) {
+            Some(Type::Struct { members }) => {
+                s.push('.');
+                s.push_str(&program.member_name(ty.unwrap_or(0), k as u32));
+                ty = members.get(k as usize).copied();
             }
-            s
+            _ => {
+                s.push_str(&format!("[{k}]"));
+                ty = None;
+            }
         }
     }
+    s
 }
 
 /// Names a description may use for a uniform or push-constant member:
@@ -508,32 +778,39 @@ fn bound_of(
     program: &Program,
     id: Id,
     constants: &BTreeMap<String, DescribedConstant>,
-) -> Result<(i64, String), String> {
+) -> Result<(i64, BoundSource), UnknownBound> {
     let id = strip_conversions(program, id);
     if let Some(Constant::Int(v)) = program.constants.get(&id) {
-        return Ok((
-            signed(program, id, *v),
-            format!("the constant {}", *v as i64),
-        ));
+        return Ok((signed(program, id, *v), BoundSource::Constant(*v as i64)));
+    }
+    // A local holding one constant (unoptimised output).
+    if let Some(v) = program.fold(id) {
+        let v = signed(program, id, v);
+        return Ok((v, BoundSource::Constant(v)));
     }
     if let Some(Constant::Int(v)) = program.spec_constants.get(&id) {
         let name = program.display_name(id);
         if let Some(c) = constants.get(&name) {
             return Ok((
                 c.value,
-                format!(
-                    "specialization constant `{name}` = {} from the description",
-                    c.value
-                ),
+                BoundSource::SpecConstant {
+                    name,
+                    value: c.value,
+                    described: true,
+                },
             ));
         }
         return Ok((
             *v as i64,
-            format!("specialization constant `{name}` (default {})", *v as i64),
+            BoundSource::SpecConstant {
+                name,
+                value: *v as i64,
+                described: false,
+            },
         ));
     }
     let Some(inst) = program.def(id) else {
-        return Err("an unknown value".into());
+        return Err(UnknownBound::UnknownValue);
     };
     if inst.class.opcode == Op::Load {
         let ptr = ids(inst).next().unwrap_or(0);
@@ -541,27 +818,29 @@ fn bound_of(
             .and_then(|(v, _)| global(program, v))
             .map(|g| g.storage);
         let kind = match storage {
-            Some(StorageClass::PushConstant) => "push constant",
-            Some(StorageClass::Uniform) => "uniform value",
-            Some(StorageClass::StorageBuffer) => "storage buffer value",
-            Some(StorageClass::ShaderRecordBufferKHR) => "shader record value",
-            _ => return Err("a value computed at run time".into()),
+            Some(StorageClass::PushConstant) => ValueKind::PushConstant,
+            Some(StorageClass::Uniform) => ValueKind::Uniform,
+            Some(StorageClass::StorageBuffer) => ValueKind::StorageBuffer,
+            Some(StorageClass::ShaderRecordBufferKHR) => ValueKind::ShaderRecord,
+            _ => return Err(UnknownBound::RuntimeValue),
         };
         let keys = member_keys(program, ptr);
         for k in &keys {
             if let Some(c) = constants.get(k) {
                 return Ok((
                     c.value,
-                    format!("{kind} `{k}` = {} from the description", c.value),
+                    BoundSource::Described {
+                        kind,
+                        key: k.clone(),
+                        value: c.value,
+                    },
                 ));
             }
         }
         let name = keys.first().cloned().unwrap_or_else(|| "?".into());
-        return Err(format!(
-            "{kind} `{name}`, which the pipeline description does not give"
-        ));
+        return Err(UnknownBound::NotDescribed { kind, name });
     }
-    Err("a value computed at run time".into())
+    Err(UnknownBound::RuntimeValue)
 }
 
 fn signed(program: &Program, id: Id, v: u64) -> i64 {
@@ -715,29 +994,27 @@ fn recognise_guard(
     scc: usize,
     node: usize,
     site_inst: usize,
-) -> Result<Guard, String> {
+) -> Result<Guard, NoGuard> {
     let shader = &graph.nodes[node].shader;
-    let program = pipeline
-        .program(shader)
-        .ok_or_else(|| "the shader's module is missing".to_string())?;
+    let program = pipeline.program(shader).ok_or(NoGuard::ModuleMissing)?;
     let site = program
         .sites
         .iter()
         .find(|s| s.inst == site_inst)
-        .ok_or_else(|| "the trace is missing".to_string())?;
+        .ok_or(NoGuard::TraceMissing)?;
     let out_payload = site.payload.unwrap_or(0);
     // Every point from the trace up the call chain to the entry point.
     let g = program
         .functions
         .get(site.function)
-        .ok_or_else(|| "the trace is outside a function".to_string())?;
+        .ok_or(NoGuard::OutsideFunction)?;
     let chains = call_chains(program, shader.function, g.id, super::liveness::MAX_CHAINS);
     let mut points = vec![site_inst];
     if let Some(chain) = chains.first() {
         points.extend(chain.iter().rev().copied());
     }
     let mut seen_counter: Option<String> = None;
-    let mut why_not: Option<String> = None;
+    let mut why_not: Option<NoGuard> = None;
     for &p in &points {
         let Some(f) = program
             .function_of(p)
@@ -746,15 +1023,18 @@ fn recognise_guard(
             continue;
         };
         for (rel, term) in dominating_relations(program, f, p) {
-            let Some(counter @ Counter::Payload { .. }) = counter_of(program, rel.lhs, 0) else {
+            let Some(counter @ Counter::Payload { .. }) = counter_of(program, rel.lhs) else {
                 continue;
             };
             let name = counter_name(program, &counter);
             seen_counter.get_or_insert(name.clone());
             let (bound, bound_source) = match bound_of(program, rel.rhs, &pipeline.constants) {
                 Ok(b) => b,
-                Err(e) => {
-                    why_not = Some(format!("`{name}` is compared with {e}"));
+                Err(bound) => {
+                    why_not = Some(NoGuard::BoundUnknown {
+                        counter: name,
+                        bound,
+                    });
                     continue;
                 }
             };
@@ -762,9 +1042,7 @@ fn recognise_guard(
                 continue;
             };
             let Some(step) = growth(program, shader.function, out_payload, &counter) else {
-                why_not = Some(format!(
-                    "`{name}` guards the trace but the traced payload's counter does not grow by a constant"
-                ));
+                why_not = Some(NoGuard::CounterDoesNotGrow { counter: name });
                 continue;
             };
             let (initial, initial_assumed) =
@@ -790,53 +1068,26 @@ fn recognise_guard(
             });
         }
     }
-    Err(why_not.unwrap_or_else(|| match seen_counter {
-        Some(c) => format!("no comparison of `{c}` with a known bound dominates the trace"),
-        None => "no depth counter comparison dominates the trace".into(),
+    Err(why_not.unwrap_or(NoGuard::NoComparison {
+        counter: seen_counter,
     }))
 }
 
 /// By how much the traced payload's copy of the counter exceeds the
-/// incoming one: a store `out.path = counter + c` with `c > 0`.
-fn growth(program: &Program, entry: Id, out_payload: Id, counter: &Counter) -> Option<i64> {
+/// incoming one: the traced payload's member holds `counter + c`, `c > 0`,
+/// stored directly or through a copy (a fresh payload written field by
+/// field, a constructed one, an `inout` parameter).
+fn growth(program: &Program, _entry: Id, out_payload: Id, counter: &Counter) -> Option<i64> {
     let Counter::Payload { path, .. } = counter else {
         return None;
     };
-    for fid in program.reachable_functions(entry) {
-        let f = program.function(fid)?;
-        for inst in &program.insts[f.start..=f.end] {
-            if inst.class.opcode != Op::Store {
-                continue;
-            }
-            let v: Vec<Id> = ids(inst).collect();
-            let [ptr, value, ..] = v.as_slice() else {
-                continue;
-            };
-            if pointer_path(program, *ptr) != Some((out_payload, path.clone())) {
-                continue;
-            }
-            let value = strip_conversions(program, *value);
-            let Some(add) = program.def(value) else {
-                continue;
-            };
-            if add.class.opcode != Op::IAdd {
-                continue;
-            }
-            let ops: Vec<Id> = ids(add).collect();
-            for (x, c) in [(0, 1), (1, 0)] {
-                let (Some(&x), Some(&c)) = (ops.get(x), ops.get(c)) else {
-                    continue;
-                };
-                let Some(step) = program.const_u64(c).map(|s| signed(program, c, s)) else {
-                    continue;
-                };
-                if step > 0 && counter_of(program, x, 0).as_ref() == Some(counter) {
-                    return Some(step);
-                }
-            }
-        }
-    }
-    None
+    values_of(program, (out_payload, path.clone()))
+        .into_iter()
+        .filter_map(|s| match s {
+            Source::Value(v) => step_of(program, v, counter),
+            Source::Read(..) => None,
+        })
+        .max()
 }
 
 /// The constant the counter member gets in shaders that enter the cycle.
@@ -855,22 +1106,11 @@ fn initial_value(
         let shader = &graph.nodes[e.from].shader;
         let program = pipeline.program(shader)?;
         let payload = program.sites.iter().find(|s| s.inst == e.inst)?.payload?;
-        for fid in program.reachable_functions(shader.function) {
-            let Some(f) = program.function(fid) else {
-                continue;
-            };
-            for inst in &program.insts[f.start..=f.end] {
-                if inst.class.opcode != Op::Store {
-                    continue;
-                }
-                let v: Vec<Id> = ids(inst).collect();
-                if let [ptr, val, ..] = v.as_slice() {
-                    if pointer_path(program, *ptr) == Some((payload, path.to_vec())) {
-                        if let Some(c) = program.const_u64(*val) {
-                            let c = signed(program, *val, c);
-                            value = Some(value.map_or(c, |v: i64| v.min(c)));
-                        }
-                    }
+        for source in values_of(program, (payload, path.to_vec())) {
+            if let Source::Value(val) = source {
+                if let Some(c) = program.fold(val) {
+                    let c = signed(program, val, c);
+                    value = Some(value.map_or(c, |v: i64| v.min(c)));
                 }
             }
         }
@@ -881,12 +1121,12 @@ fn initial_value(
 // ---------------------------------------------------------------------------
 // Loops that trace.
 
-#[derive(Clone, Debug, serde::Serialize)]
+#[derive(Clone, Debug)]
 pub struct LoopBound {
     pub counter: String,
     pub op: &'static str,
     pub bound: i64,
-    pub bound_source: String,
+    pub bound_source: BoundSource,
 }
 
 /// A loop whose body traces (or calls a function that does).
@@ -899,7 +1139,7 @@ pub struct TraceLoop {
     pub location: Option<Location>,
     pub site_location: Option<Location>,
     /// The recognised bound, or why none was.
-    pub bound: Result<LoopBound, String>,
+    pub bound: Result<LoopBound, NoLoopBound>,
 }
 
 /// Loops around trace sites in every entry point of a program; bounds come
@@ -963,8 +1203,8 @@ fn loop_bound(
     f: &Function,
     body: &HashSet<usize>,
     constants: &BTreeMap<String, DescribedConstant>,
-) -> Result<LoopBound, String> {
-    let mut why: Option<String> = None;
+) -> Result<LoopBound, NoLoopBound> {
+    let mut why: Option<NoLoopBound> = None;
     let mut blocks: Vec<usize> = body.iter().copied().collect();
     blocks.sort_unstable();
     for b in blocks {
@@ -987,14 +1227,12 @@ fn loop_bound(
         let mut rels = Vec::new();
         relations(program, *cond, stay, &mut rels, 0);
         for rel in rels {
-            let Some(Counter::Local(var)) = counter_of(program, rel.lhs, 0) else {
+            let Some(counter) = counter_of(program, rel.lhs) else {
                 continue;
             };
-            let name = program.display_name(var);
-            if !increments(program, f, body, var) {
-                why.get_or_insert(format!(
-                    "`{name}` is compared but not incremented by a constant in the loop"
-                ));
+            let name = counter_name(program, &counter);
+            if !increments(program, f, body, &counter) {
+                why.get_or_insert(NoLoopBound::NotIncremented { counter: name });
                 continue;
             }
             match bound_of(program, rel.rhs, constants) {
@@ -1006,33 +1244,31 @@ fn loop_bound(
                         bound_source,
                     })
                 }
-                Err(e) => why = Some(format!("the loop runs while `{name}` is below {e}")),
+                Err(bound) => {
+                    why = Some(NoLoopBound::BoundUnknown {
+                        counter: name,
+                        bound,
+                    })
+                }
             }
         }
     }
-    Err(why.unwrap_or_else(|| "no exit compares a counter with a bound".into()))
+    Err(why.unwrap_or(NoLoopBound::NoCounter))
 }
 
-/// Whether the loop stores `var = var + c` (c > 0) somewhere in its body.
-fn increments(program: &Program, f: &Function, body: &HashSet<usize>, var: Id) -> bool {
+/// Whether the loop stores `counter + c` (c > 0) into the counter somewhere
+/// in its body (a local, a member of the traced payload, `prd.depth++`).
+fn increments(program: &Program, f: &Function, body: &HashSet<usize>, counter: &Counter) -> bool {
+    let (Counter::Payload { var, path } | Counter::Var { var, path }) = counter;
     body.iter().any(|&b| {
         program.insts[f.blocks[b].start..=f.blocks[b].end]
             .iter()
             .any(|inst| {
                 let v: Vec<Id> = ids(inst).collect();
-                if inst.class.opcode != Op::Store || v.first() != Some(&var) {
-                    return false;
-                }
-                let Some(add) = v.get(1).and_then(|x| program.def(*x)) else {
-                    return false;
-                };
-                let ops: Vec<Id> = ids(add).collect();
-                add.class.opcode == Op::IAdd
-                    && ops.len() == 2
-                    && [(0, 1), (1, 0)].iter().any(|&(x, c)| {
-                        program.const_u64(ops[c]).is_some_and(|s| s > 0)
-                            && counter_of(program, ops[x], 0) == Some(Counter::Local(var))
-                    })
+                inst.class.opcode == Op::Store
+                    && v.len() >= 2
+                    && pointer_path(program, v[0]) == Some((*var, path.clone()))
+                    && step_of(program, v[1], counter).is_some()
             })
     })
 }
@@ -1063,12 +1299,12 @@ mod tests {
         );
         assert!(!g.initial_assumed);
         assert!(
-            g.bound_source.contains("pushConst.maxDepth"),
-            "{}",
+            matches!(&g.bound_source, BoundSource::Described { kind: ValueKind::PushConstant, key, .. } if key == "pushConst.maxDepth"),
+            "{:?}",
             g.bound_source
         );
         assert_eq!(
-            r.chain_text(),
+            crate::explain::recursion_chain(&r),
             "raygeneration `main` (raygen 0) at level 0 → closesthit `main` (hit group 0) at levels 1–4 → miss `main` (miss 1) at level 5"
         );
         assert_eq!(r.recursive_sites.len(), 2);
@@ -1084,6 +1320,16 @@ mod tests {
         let why = c.sites[0].guard.as_ref().unwrap_err();
         assert_eq!(
             why,
+            &NoGuard::BoundUnknown {
+                counter: "payload.depth".into(),
+                bound: UnknownBound::NotDescribed {
+                    kind: ValueKind::PushConstant,
+                    name: "pushConst.maxDepth".into()
+                }
+            }
+        );
+        assert_eq!(
+            why.to_string(),
             "`payload.depth` is compared with push constant `pushConst.maxDepth`, which the pipeline description does not give"
         );
     }
@@ -1103,7 +1349,11 @@ mod tests {
         assert_eq!((b.counter.as_str(), b.op, b.bound), ("bounce", "<=", 4));
         assert_eq!(
             b.bound_source,
-            "specialization constant `MAX_BOUNCES` (default 4)"
+            BoundSource::SpecConstant {
+                name: "MAX_BOUNCES".into(),
+                value: 4,
+                described: false
+            }
         );
     }
 
@@ -1118,7 +1368,7 @@ mod tests {
         assert_eq!((b.counter.as_str(), b.bound), ("bounce", 8));
         let none = trace_loops(&p.programs[0], &BTreeMap::new());
         assert_eq!(
-            none[0].bound.as_ref().unwrap_err(),
+            none[0].bound.as_ref().unwrap_err().to_string(),
             "the loop runs while `bounce` is below uniform value `params.max_bounces`, which the pipeline description does not give"
         );
     }
@@ -1151,7 +1401,106 @@ mod tests {
         );
         assert_eq!(
             g.bound_source,
-            "uniform value `params.max_depth` = 4 from the description"
+            BoundSource::Described {
+                kind: ValueKind::Uniform,
+                key: "params.max_depth".into(),
+                value: 4
+            }
         );
+    }
+
+    fn loose(rels: &[&str]) -> Pipeline {
+        let programs = rels
+            .iter()
+            .map(|rel| {
+                let path = Path::new(env!("CARGO_MANIFEST_DIR")).join(rel);
+                let lang = crate::shader::Language::from_path(&path).unwrap();
+                crate::front::load(&path, lang).unwrap()
+            })
+            .collect();
+        Pipeline::from_programs(programs)
+    }
+
+    /// GLSL through glslang with `-g` and `-gV`: a guard in a helper that
+    /// takes the payload `inout` (glslang's copy-in temporaries), a shadow
+    /// ray whose flags sit in a local (skip closest hit: no recursion), a
+    /// raygen loop counting bounces in the payload (`prd.depth++`).
+    #[test]
+    fn glsl_guards_through_inout_locals_and_payload_counters() {
+        for v in ["g", "gV"] {
+            let p = loose(&[
+                &format!("fixtures/guards/loop.rgen.{v}.spv"),
+                &format!("fixtures/guards/hit.rchit.{v}.spv"),
+                &format!("fixtures/guards/miss.rmiss.{v}.spv"),
+            ]);
+            let r = recursion_report(&p);
+            // depth < 3 from 0: hit at levels 1–4, the shadow ray's miss at 5.
+            assert_eq!(r.required_depth, Some(5), "{v}");
+            assert_eq!(r.cycles.len(), 1, "{v}");
+            assert_eq!(
+                r.cycles[0].sites.len(),
+                1,
+                "{v}: the shadow ray closes no cycle"
+            );
+            let g = r.cycles[0].sites[0].guard.as_ref().unwrap();
+            assert_eq!((g.bound, g.step, g.traces), (3, 1, 3), "{v}");
+            assert!(!g.initial_assumed, "{v}");
+            let loops = trace_loops(&p.programs[0], &p.constants);
+            assert_eq!(loops.len(), 1, "{v}");
+            let b = loops[0].bound.as_ref().unwrap();
+            assert_eq!(
+                (b.counter.as_str(), b.op, b.bound),
+                ("prd.depth", "<", 10),
+                "{v}"
+            );
+        }
+    }
+
+    /// HLSL through rtlint: the traced payload is a fresh local written field
+    /// by field from the incoming one (`next.depth = payload.depth + 1`);
+    /// the shadow ray's flags sit in a local (skip closest hit: no cycle).
+    #[test]
+    fn hlsl_guard_through_a_fresh_payload() {
+        let r = recursion_report(&loose(&["fixtures/guards/fresh.hlsl"]));
+        // Hit at levels 1–4, the deepest hit's shadow ray reaches a miss at 5.
+        assert_eq!(r.required_depth, Some(5));
+        assert_eq!(r.cycles[0].sites.len(), 1);
+        let g = r.cycles[0].sites[0].guard.as_ref().unwrap();
+        assert_eq!((g.bound, g.step, g.initial, g.traces), (3, 1, 0, 3));
+        assert!(!g.initial_assumed);
+    }
+
+    /// WGSL: the traced payload is constructed (`Payload(…, incoming.depth +
+    /// 1u)`), and the shadow ray's flags come through a `var` and naga's
+    /// helper's `RayDesc` parameter.
+    #[test]
+    fn wgsl_guard_through_a_constructed_payload() {
+        let r = recursion_report(&loose(&["fixtures/guards/constructed.wgsl"]));
+        assert_eq!(r.required_depth, Some(6));
+        assert_eq!(r.cycles[0].sites.len(), 1);
+        let g = r.cycles[0].sites[0].guard.as_ref().unwrap();
+        assert_eq!(
+            (g.counter.as_str(), g.bound, g.traces),
+            ("incoming.depth", 4, 4)
+        );
+        // The recursive trace is the closest hit's, not the raygen's.
+        assert_eq!(
+            r.cycles[0].sites[0].location.as_ref().map(|l| l.line),
+            Some(38)
+        );
+    }
+
+    /// An unbounded chain says so at every step past the cycle; no shader is
+    /// placed "at level 0" after it.
+    #[test]
+    fn unbounded_chain_has_no_level_past_the_cycle() {
+        let r = recursion_report(&pipeline("fixtures/RT024/bad.pipeline.toml"));
+        assert_eq!(r.required_depth, None);
+        let text = crate::explain::recursion_chain(&r);
+        assert!(
+            text.contains("at levels 1 and deeper, without bound"),
+            "{text}"
+        );
+        assert!(!text.contains("(miss 0) at level 0"), "{text}");
     }
 }

@@ -15,9 +15,9 @@
 //! maximum the Vulkan spec recommends setting explicitly. The assumptions
 //! are in `docs/stack.md`.
 
-use super::callgraph::EdgeKind;
+use super::callgraph::{Assumption, EdgeKind};
 use super::liveness::{live_sites, LiveSite};
-use super::recursion::{recursion_report, RecursionReport};
+use super::recursion::{recursion_report, ChainStep, NoGuard, RecursionReport};
 use crate::pipeline::Pipeline;
 use crate::pipeline::Slot;
 use crate::program::scalar::scalar_size;
@@ -107,8 +107,9 @@ pub struct StackReport {
     pub required_depth: Option<u32>,
     pub declared_depth: Option<u32>,
     pub device_max_depth: u32,
-    /// The chain that needs the required depth, in words.
-    pub depth_chain: String,
+    /// The chain that needs the required depth (nodes index `shaders`).
+    #[serde(skip)]
+    pub depth_chain: Vec<ChainStep>,
     pub shaders: Vec<ShaderStack>,
     pub vulkan_default: Option<u64>,
     pub vulkan_default_required: Option<u64>,
@@ -124,7 +125,9 @@ pub struct StackReport {
     pub driver_comparable: Formulas,
     /// The same formulas over the driver's own numbers, when queried.
     pub driver: Option<Formulas>,
-    pub assumptions: Vec<String>,
+    /// What the model had to assume; reports put them in words.
+    #[serde(skip)]
+    pub assumptions: Vec<Assumption>,
 }
 
 /// Vulkan's default: `RG + min(1, D) × max(CH, MS, IS + AH) + max(0, D − 1)
@@ -646,7 +649,7 @@ pub fn stack_report_with(pipeline: &Pipeline, rec: &RecursionReport) -> StackRep
         .map(|v| align(v, 16));
     let mut assumptions = rec.graph.assumptions.clone();
     if pipeline.max_recursion_depth.is_none() {
-        assumptions.push("no declared depth: default formulas use the required depth only".into());
+        assumptions.push(Assumption::NoDeclaredDepth);
     }
     if let Some(c) = rec.unbounded_cycle() {
         let why = c
@@ -654,19 +657,16 @@ pub fn stack_report_with(pipeline: &Pipeline, rec: &RecursionReport) -> StackRep
             .iter()
             .find_map(|s| s.guard.as_ref().err())
             .cloned()
-            .unwrap_or_default();
-        assumptions.push(format!(
-            "recursion is unbounded at compile time ({why}): no exact call-chain value"
-        ));
+            .unwrap_or(NoGuard::NoComparison { counter: None });
+        assumptions.push(Assumption::UnboundedRecursion(why));
     }
     for c in &rec.cycles {
         for s in &c.sites {
             if let Ok(g) = &s.guard {
                 if g.initial_assumed {
-                    assumptions.push(format!(
-                        "no constant initial value of `{}` found: 0 assumed",
-                        g.counter
-                    ));
+                    assumptions.push(Assumption::InitialValueAssumed {
+                        counter: g.counter.clone(),
+                    });
                 }
             }
         }
@@ -676,7 +676,7 @@ pub fn stack_report_with(pipeline: &Pipeline, rec: &RecursionReport) -> StackRep
         required_depth: rec.required_depth,
         declared_depth: pipeline.max_recursion_depth,
         device_max_depth: pipeline.device_max_recursion_depth,
-        depth_chain: rec.chain_text(),
+        depth_chain: rec.chain.clone(),
         shaders,
         vulkan_default: model.vulkan_default,
         vulkan_default_required: model.vulkan_default_required,
@@ -718,165 +718,15 @@ pub fn attach_driver(
         if let Some(needed) = f.exact_call_chain.or(f.vulkan_default) {
             let needed = align(needed, 16);
             if report.recommended.is_some_and(|r| r < needed) {
-                report.assumptions.push(format!(
-                    "recommendation raised from {} B to {needed} B, what the driver's own numbers need",
-                    report.recommended.unwrap_or(0)
-                ));
+                report.assumptions.push(Assumption::RecommendationRaised {
+                    from: report.recommended.unwrap_or(0),
+                    to: needed,
+                });
                 report.recommended = Some(needed);
             }
         }
         report.driver = Some(f);
     }
-}
-
-fn formula_text(m: &StageMax, depth: u32) -> String {
-    format!(
-        "{} + min(1, {depth}) × max({}, {}, {} + {}) + max(0, {depth} − 1) × max({}, {}) + 2 × {} = {}",
-        m.raygen,
-        m.closest_hit,
-        m.miss,
-        m.intersection,
-        m.any_hit,
-        m.closest_hit,
-        m.miss,
-        m.callable,
-        vulkan_default(m, depth)
-    )
-}
-
-fn opt(v: Option<u64>) -> String {
-    v.map_or("—".into(), |v| format!("{v} B"))
-}
-
-/// The human form of `rtlint stack`.
-pub fn render_human(r: &StackReport) -> String {
-    use std::fmt::Write;
-    let mut s = String::new();
-    if let Some(p) = &r.pipeline {
-        let _ = writeln!(s, "pipeline {p}");
-    } else {
-        let _ = writeln!(
-            s,
-            "no pipeline description: every shader given is assumed reachable"
-        );
-    }
-    let depth = |d: Option<u32>| d.map_or("unbounded at compile time".into(), |d| d.to_string());
-    let _ = writeln!(
-        s,
-        "recursion depth: required {}, declared {}, device limit {}",
-        depth(r.required_depth),
-        r.declared_depth
-            .map_or("not given".into(), |d| d.to_string()),
-        r.device_max_depth
-    );
-    if !r.depth_chain.is_empty() {
-        let _ = writeln!(s, "  deepest chain: {}", r.depth_chain);
-    }
-    let _ = writeln!(s);
-    let names: Vec<String> = r
-        .shaders
-        .iter()
-        .map(|sh| {
-            let file = std::path::Path::new(&sh.file)
-                .file_name()
-                .map(|f| f.to_string_lossy().into_owned())
-                .unwrap_or_default();
-            format!("{} `{}` {}", sh.stage.as_str(), sh.entry, file)
-        })
-        .collect();
-    let w = names
-        .iter()
-        .map(|n| n.chars().count())
-        .max()
-        .unwrap_or(6)
-        .max(6);
-    let _ = writeln!(
-        s,
-        "{:<w$}  {:<12} {:>6} {:>7} {:>5} {:>6} {:>7} {:>4} {:>5} {:>8} {:>6}",
-        "shader",
-        "group",
-        "model",
-        "driver*",
-        "live",
-        "arrays",
-        "payload",
-        "in",
-        "attrs",
-        "callable",
-        "query"
-    );
-    for (sh, name) in r.shaders.iter().zip(&names) {
-        let b = &sh.breakdown;
-        let _ = writeln!(
-            s,
-            "{:<w$}  {:<12} {:>6} {:>7} {:>5} {:>6} {:>7} {:>4} {:>5} {:>8} {:>6}",
-            name,
-            sh.group,
-            sh.model_bytes,
-            sh.driver_model_bytes,
-            b.live_state,
-            b.local_arrays,
-            b.outgoing_payload,
-            b.incoming_payload,
-            b.hit_attributes,
-            b.callable_data,
-            sh.driver_bytes.map_or("—".into(), |d| d.to_string()),
-        );
-    }
-    let _ = writeln!(
-        s,
-        "  (bytes; model = every live value kept, plus a safety margin; driver* = what the NVIDIA driver is modelled to report; live = state across traces that cannot be recomputed; query = the driver's own figure with --driver)"
-    );
-    let _ = writeln!(s);
-    let mut block = |title: &str, f: &Formulas| {
-        let _ = writeln!(s, "{title}:");
-        if let Some(d) = r.declared_depth {
-            let _ = writeln!(
-                s,
-                "  Vulkan/DXR default, declared depth {d}: {}",
-                formula_text(&f.stage_max, d)
-            );
-        }
-        if let Some(d) = r.required_depth {
-            let _ = writeln!(
-                s,
-                "  Vulkan/DXR default, required depth {d}: {}",
-                formula_text(&f.stage_max, d)
-            );
-        }
-        let _ = writeln!(s, "  exact call-chain maximum: {}", opt(f.exact_call_chain));
-    };
-    block("full model", &r.model);
-    block("driver-comparable part", &r.driver_comparable);
-    if let Some(d) = &r.driver {
-        block("driver's own numbers", d);
-    }
-    let _ = writeln!(s);
-    match r.recommended {
-        Some(v) => {
-            let _ = writeln!(
-                s,
-                "recommended: vkCmdSetRayTracingPipelineStackSizeKHR(cmd, {v}) / SetPipelineStackSize({v})"
-            );
-            if let Some(d) = r.vulkan_default {
-                if d > v {
-                    let _ = writeln!(
-                        s,
-                        "  {} B ({:.0} %) below the default of {d} B",
-                        d - v,
-                        100.0 * (d - v) as f64 / d as f64
-                    );
-                }
-            }
-        }
-        None => {
-            let _ = writeln!(s, "recommended: none (recursion unbounded at compile time)");
-        }
-    }
-    for a in &r.assumptions {
-        let _ = writeln!(s, "note: {a}");
-    }
-    s
 }
 
 #[cfg(test)]
@@ -1056,7 +906,7 @@ mod tests {
         }
         assert_eq!(json["shaders"][0]["stage"], "ray_generation");
         assert!(json["shaders"][0]["driver_bytes"].is_null());
-        let text = render_human(&r);
+        let text = crate::report::stack::human(&r);
         assert!(text.contains("required 5, declared 5"), "{text}");
         assert!(
             text.contains(
@@ -1147,7 +997,7 @@ mod tests {
             let program = crate::front::load(f, lang).unwrap();
             let p = Pipeline::from_programs(vec![program]);
             let r = stack_report(&p);
-            assert!(render_human(&r).contains("no pipeline description"));
+            assert!(crate::report::stack::human(&r).contains("no pipeline description"));
             let _ = super::super::liveness::live_report(&p.programs);
         }
     }
@@ -1224,7 +1074,7 @@ mod tests {
         let d = r.driver.as_ref().unwrap();
         assert_eq!(d.vulkan_default, Some(4 + 4 + 4));
         assert_eq!(d.exact_call_chain, Some(12));
-        assert!(render_human(&r).contains("driver's own numbers"));
+        assert!(crate::report::stack::human(&r).contains("driver's own numbers"));
         let json = serde_json::to_value(&r).unwrap();
         assert_eq!(json["shaders"][0]["driver_bytes"], 4);
     }

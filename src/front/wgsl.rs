@@ -1,7 +1,7 @@
 //! WGSL through naga: parse, validate with every capability, write SPIR-V with
 //! debug info so each instruction carries its WGSL line and column.
 
-use crate::diag::InputError;
+use crate::diag::{InputError, InputErrorKind};
 use crate::program::NamedDecl;
 use crate::shader::{line_col, Location};
 use naga::back::spv;
@@ -32,7 +32,7 @@ fn guard<T>(
             .or_else(|| payload.downcast_ref::<String>().cloned())
             .unwrap_or_default();
         Err(InputError::new(
-            "wgsl-internal",
+            InputErrorKind::WgslInternal,
             path,
             format!("naga failed to {what} this module (internal error: {msg})"),
         ))
@@ -44,7 +44,7 @@ fn parse_unguarded(
     path: &Path,
 ) -> Result<(naga::Module, naga::valid::ModuleInfo), InputError> {
     let module = naga::front::wgsl::parse_str(source).map_err(|e| {
-        let mut err = InputError::new("wgsl-parse", path, e.message().to_string());
+        let mut err = InputError::new(InputErrorKind::WgslParse, path, e.message().to_string());
         let mut labels = e.labels();
         if let Some((span, label)) = labels.next() {
             err = err.at(span_location(path, source, span), label);
@@ -211,7 +211,7 @@ pub fn write_spirv(
     guard(path, "write SPIR-V for", || {
         spv::write_vec(module, info, &options, None).map_err(|e| {
             InputError::new(
-                "wgsl-spirv-out",
+                InputErrorKind::WgslSpirvOut,
                 path,
                 format!("naga could not write SPIR-V for this module: {e}"),
             )
@@ -233,7 +233,7 @@ fn validation_error(
         cause = c.source();
     }
     let mut err = InputError::new(
-        "wgsl-validation",
+        InputErrorKind::WgslValidation,
         path,
         format!("invalid WGSL module: {message}"),
     );

@@ -1,7 +1,7 @@
 //! SPIR-V binaries: bytes to words, with the endianness the magic number says.
 //! Structural checks (opcodes, ids) happen when the Program is built.
 
-use crate::diag::InputError;
+use crate::diag::{InputError, InputErrorKind};
 use std::path::Path;
 
 pub const MAGIC: u32 = 0x0723_0203;
@@ -9,7 +9,7 @@ pub const MAGIC: u32 = 0x0723_0203;
 pub fn words_from_bytes(bytes: &[u8], path: &Path) -> Result<Vec<u32>, InputError> {
     if bytes.len() < 20 {
         return Err(InputError::new(
-            "invalid-spirv",
+            InputErrorKind::InvalidSpirv,
             path,
             format!(
                 "SPIR-V module is {} bytes, shorter than the 5-word header",
@@ -19,7 +19,7 @@ pub fn words_from_bytes(bytes: &[u8], path: &Path) -> Result<Vec<u32>, InputErro
     }
     if bytes.len() % 4 != 0 {
         return Err(InputError::new(
-            "invalid-spirv",
+            InputErrorKind::InvalidSpirv,
             path,
             format!(
                 "SPIR-V module is {} bytes, not a whole number of 32-bit words (truncated at word {})",
@@ -35,7 +35,7 @@ pub fn words_from_bytes(bytes: &[u8], path: &Path) -> Result<Vec<u32>, InputErro
         u32::from_be_bytes
     } else {
         return Err(InputError::new(
-            "invalid-spirv",
+            InputErrorKind::InvalidSpirv,
             path,
             format!(
                 "not a SPIR-V module: word 0 is {:#010x}, expected the magic number {MAGIC:#010x}",

@@ -4,7 +4,7 @@
 
 use super::debug::resolve_path;
 use super::*;
-use crate::diag::InputError;
+use crate::diag::{InputError, InputErrorKind};
 use rspirv::binary::{Consumer, ParseAction};
 use rspirv::dr::{self, ModuleHeader};
 use std::path::Path;
@@ -48,7 +48,7 @@ impl Consumer for Collect {
 }
 
 fn err(path: &Path, msg: impl Into<String>) -> InputError {
-    InputError::new("invalid-spirv", path, msg)
+    InputError::new(InputErrorKind::InvalidSpirv, path, msg)
 }
 
 /// Parses and checks a module. `language` is the front-end's language; a
@@ -96,7 +96,11 @@ pub fn parse(words: &[u32], path: &Path, language: Language) -> Result<Program, 
         header: None,
         insts: Vec::new(),
     };
-    if let Err(e) = rspirv::binary::parse_words(words, &mut c) {
+    // Compilers copy source bytes into strings unchecked (glslang `-g` keeps
+    // a Latin-1 comment), and spirv-val accepts that: parse a copy whose
+    // strings have each invalid byte replaced by `?`.
+    let cleaned = valid_utf8_strings(words, &offsets);
+    if let Err(e) = rspirv::binary::parse_words(cleaned.as_deref().unwrap_or(words), &mut c) {
         use rspirv::binary::ParseState as S;
         let at = |n: usize| offsets.get(n).copied().unwrap_or(words.len() as u32);
         let msg = match e {
@@ -153,6 +157,7 @@ pub fn parse(words: &[u32], path: &Path, language: Language) -> Result<Program, 
             decl_pos: HashMap::new(),
             defs: HashMap::new(),
             debug_info_set: None,
+            debug_sets: Vec::new(),
         },
         strings: HashMap::new(),
         file_of_string: HashMap::new(),
@@ -166,9 +171,65 @@ pub fn parse(words: &[u32], path: &Path, language: Language) -> Result<Program, 
     b.collect()?;
     b.functions()?;
     b.link_debug_composites();
+    b.drop_impossible_positions();
     b.sites();
     super::textdecl::fill(&mut b.p);
     Ok(b.p)
+}
+
+/// The word within an instruction where its literal string starts, for the
+/// instructions that carry one.
+fn string_word(op: Op, count: usize) -> Option<usize> {
+    let at = match op {
+        Op::String | Op::Name | Op::ExtInstImport => 2,
+        Op::MemberName | Op::EntryPoint => 3,
+        Op::SourceContinued | Op::SourceExtension | Op::Extension | Op::ModuleProcessed => 1,
+        Op::Source => 4,
+        _ => return None,
+    };
+    (at < count).then_some(at)
+}
+
+/// A copy of the module with every string's invalid UTF-8 bytes replaced by
+/// `?` (same length, so no word moves); `None` when every string is valid.
+fn valid_utf8_strings(words: &[u32], offsets: &[u32]) -> Option<Vec<u32>> {
+    let mut out: Option<Vec<u32>> = None;
+    for &at in offsets {
+        let at = at as usize;
+        let count = (words[at] >> 16) as usize;
+        let Some(op) = Op::from_u32(words[at] & 0xffff) else {
+            continue;
+        };
+        let Some(k) = string_word(op, count) else {
+            continue;
+        };
+        let mut bytes: Vec<u8> = words[at + k..at + count]
+            .iter()
+            .flat_map(|w| w.to_le_bytes())
+            .collect();
+        let len = bytes.iter().position(|&b| b == 0).unwrap_or(bytes.len());
+        let mut changed = false;
+        let mut start = 0;
+        while start < len {
+            match std::str::from_utf8(&bytes[start..len]) {
+                Ok(_) => break,
+                Err(e) => {
+                    let bad = start + e.valid_up_to();
+                    let n = e.error_len().unwrap_or(len - bad);
+                    bytes[bad..bad + n].fill(b'?');
+                    start = bad + n;
+                    changed = true;
+                }
+            }
+        }
+        if changed {
+            let out = out.get_or_insert_with(|| words.to_vec());
+            for (j, c) in bytes.chunks_exact(4).enumerate() {
+                out[at + k + j] = u32::from_le_bytes([c[0], c[1], c[2], c[3]]);
+            }
+        }
+    }
+    out
 }
 
 fn opname(words: &[u32], offset: u32) -> String {
@@ -230,6 +291,31 @@ impl Builder<'_> {
                 self.word(inst)
             ),
         )
+    }
+
+    /// Positions on line 0 or past the end of their file's embedded text
+    /// (glslang 12 `-gV` writes both) are no positions.
+    fn drop_impossible_positions(&mut self) {
+        let lines: Vec<Option<usize>> = self
+            .p
+            .files
+            .iter()
+            .map(|f| f.text.as_ref().map(|t| t.lines().count()))
+            .collect();
+        let possible = |p: &SrcPos| {
+            p.line > 0
+                && lines
+                    .get(p.file as usize)
+                    .copied()
+                    .flatten()
+                    .is_none_or(|n| p.line as usize <= n)
+        };
+        for loc in &mut self.p.locs {
+            if loc.as_ref().is_some_and(|p| !possible(p)) {
+                *loc = None;
+            }
+        }
+        self.p.decl_pos.retain(|_, p| possible(p));
     }
 
     /// Every id used must be defined somewhere in the module and below the bound.
@@ -385,8 +471,15 @@ impl Builder<'_> {
                     }
                 }
                 Op::ExtInstImport => {
-                    if str_at(&inst, 0) == Some("NonSemantic.Shader.DebugInfo.100") {
+                    let set = str_at(&inst, 0).unwrap_or("");
+                    if set == "NonSemantic.Shader.DebugInfo.100" {
                         self.p.debug_info_set = inst.result_id;
+                    }
+                    if set.starts_with("NonSemantic.")
+                        || set == "OpenCL.DebugInfo.100"
+                        || set == "DebugInfo"
+                    {
+                        self.p.debug_sets.extend(inst.result_id);
                     }
                 }
                 Op::EntryPoint => {
@@ -581,6 +674,19 @@ impl Builder<'_> {
     fn type_or_constant(&mut self, i: usize, inst: &dr::Instruction) -> Result<(), InputError> {
         let op = inst.class.opcode;
         let r = inst.result_id.unwrap_or(0);
+        if op == Op::TypeForwardPointer {
+            // `buffer_reference` structs point to themselves: the pointer type
+            // is named before its `OpTypePointer`, which later replaces this.
+            if let (Some(ptr), Some(Operand::StorageClass(storage))) =
+                (id_at(inst, 0), inst.operands.get(1))
+            {
+                self.p.types.entry(ptr).or_insert(Type::Pointer {
+                    storage: *storage,
+                    pointee: 0,
+                });
+            }
+            return Ok(());
+        }
         let ty = match op {
             Op::TypeVoid => Some(Type::Void),
             Op::TypeBool => Some(Type::Bool),
@@ -939,4 +1045,41 @@ pub fn is_terminator(op: Op) -> bool {
             | Op::IgnoreIntersectionKHR
             | Op::TerminateRayKHR
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// glslang 12 `-gV` gives `main` line 0; such positions, and lines past
+    /// the end of the file, are dropped rather than relayed.
+    #[test]
+    fn no_position_on_line_zero_or_past_the_end() {
+        let path =
+            Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/live/loop_local.rgen.gV.spv");
+        let bytes = std::fs::read(&path).unwrap();
+        let words = super::super::words_from_bytes(&bytes, &path).unwrap();
+        let p = parse(&words, &path, Language::Spirv).unwrap();
+        // The module does say line 0 for `main` (DebugFunction's line).
+        let zero_line_function = p.insts.iter().any(|i| {
+            i.class.opcode == Op::ExtInst
+                && lit_at(i, 1) == Some(debug_info_op::FUNCTION)
+                && id_at(i, 5).and_then(|c| p.const_u64(c)) == Some(0)
+        });
+        assert!(zero_line_function);
+        let lines = std::fs::read_to_string(path.with_file_name("loop_local.rgen"))
+            .unwrap()
+            .lines()
+            .count() as u32;
+        let all = p.locs.iter().flatten().chain(p.decl_pos.values());
+        for pos in all {
+            assert!(pos.line >= 1 && pos.line <= lines, "{pos:?}");
+        }
+        let main = p
+            .functions
+            .iter()
+            .find(|f| f.name.as_deref() == Some("main"))
+            .unwrap();
+        assert!(p.decl_location(Decl::Func(main.id)).is_none());
+    }
 }

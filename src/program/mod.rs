@@ -10,6 +10,7 @@ mod binary;
 mod build;
 pub mod cfg;
 pub mod debug;
+mod fold;
 pub mod scalar;
 mod textdecl;
 pub mod types;
@@ -229,9 +230,20 @@ pub struct Program {
     pub defs: HashMap<Id, usize>,
     /// The id of the `NonSemantic.Shader.DebugInfo.100` import, if any.
     pub debug_info_set: Option<Id>,
+    /// Imports of instruction sets without semantics (`NonSemantic.*`,
+    /// `OpenCL.DebugInfo.100`, `DebugInfo`): their instructions only describe
+    /// the code, so no analysis may count them as reads or writes.
+    pub debug_sets: Vec<Id>,
 }
 
 impl Program {
+    /// Whether `inst` is an extended instruction of a set without semantics
+    /// (`DebugDeclare`, `DebugValue`, `DebugScope`, …): debug info, not code.
+    pub fn is_debug_inst(&self, inst: &Instruction) -> bool {
+        inst.class.opcode == Op::ExtInst
+            && matches!(inst.operands.first(), Some(Operand::IdRef(set)) if self.debug_sets.contains(set))
+    }
+
     pub fn name(&self, id: Id) -> Option<&str> {
         self.names.get(&id).map(String::as_str)
     }
@@ -291,6 +303,9 @@ impl Program {
         }
         if let Some(Constant::Int(v)) = self.spec_constants.get(&id) {
             return OperandValue::Spec { id, default: *v };
+        }
+        if let Some(v) = self.fold(id) {
+            return OperandValue::Const(v);
         }
         OperandValue::Dynamic(id)
     }

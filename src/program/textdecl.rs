@@ -126,7 +126,7 @@ pub fn fill(program: &mut Program) {
     ) {
         return;
     }
-    let texts: Vec<(u32, String)> = program
+    let mut texts: Vec<(u32, String)> = program
         .files
         .iter()
         .enumerate()
@@ -137,6 +137,8 @@ pub fn fill(program: &mut Program) {
                 .map(|t| (i as u32, t))
         })
         .collect();
+    add_included(program, &mut texts);
+    drop_misplaced(program, &texts);
     let structs: Vec<(u32, Vec<u32>)> = program
         .types
         .iter()
@@ -169,7 +171,12 @@ pub fn fill(program: &mut Program) {
         };
         program.decl_pos.insert(Decl::Type(id), pos(at, name.len()));
         for k in members {
-            if program.decl_pos.contains_key(&Decl::Member(id, k)) {
+            // Debug info placing the member inside this body is kept.
+            if program.decl_pos.get(&Decl::Member(id, k)).is_some_and(|p| {
+                p.file == file
+                    && p.line >= line_col(text, body).0
+                    && p.line <= line_col(text, end).0
+            }) {
                 continue;
             }
             let Some(m) = program.member_names.get(&(id, k)).cloned() else {
@@ -189,6 +196,77 @@ pub fn fill(program: &mut Program) {
     }
 }
 
+/// Adds the files `#include`d by the sources (glslang 12 `-gV` names only the
+/// main file), found beside the including file, transitively.
+fn add_included(program: &mut Program, texts: &mut Vec<(u32, String)>) {
+    let mut k = 0;
+    while k < texts.len() && program.files.len() < 256 {
+        let (file, text) = texts[k].clone();
+        k += 1;
+        let dir = program.files[file as usize]
+            .path
+            .parent()
+            .map(std::path::Path::to_path_buf)
+            .unwrap_or_default();
+        for line in text.lines() {
+            let Some(rest) = line.trim_start().strip_prefix('#') else {
+                continue;
+            };
+            let Some(rest) = rest.trim_start().strip_prefix("include") else {
+                continue;
+            };
+            let rest = rest.trim();
+            let Some(name) = rest
+                .strip_prefix('"')
+                .and_then(|r| r.split('"').next())
+                .or_else(|| rest.strip_prefix('<').and_then(|r| r.split('>').next()))
+            else {
+                continue;
+            };
+            let path = super::debug::normalize(&dir.join(name.replace('\\', "/")));
+            if program.files.iter().any(|f| f.path == path) {
+                continue;
+            }
+            let Ok(included) = std::fs::read_to_string(&path) else {
+                continue;
+            };
+            program.files.push(super::SourceFile { path, text: None });
+            texts.push(((program.files.len() - 1) as u32, included));
+        }
+    }
+}
+
+/// Drops struct and member positions whose line does not name the
+/// declaration (glslang 12 `-gV` with `#include`: lines of the wrong file,
+/// several members on one line).
+fn drop_misplaced(program: &mut Program, texts: &[(u32, String)]) {
+    let names_it = |pos: &SrcPos, name: &str| -> bool {
+        let Some((_, text)) = texts.iter().find(|(f, _)| *f == pos.file) else {
+            return true; // no text to check against
+        };
+        let Some(line) = text.lines().nth(pos.line.saturating_sub(1) as usize) else {
+            return false;
+        };
+        !words(line.as_bytes(), 0, line.len(), name).is_empty()
+    };
+    let wrong: Vec<Decl> = program
+        .decl_pos
+        .iter()
+        .filter(|(d, p)| {
+            let name = match d {
+                Decl::Type(id) => program.names.get(id),
+                Decl::Member(id, k) => program.member_names.get(&(*id, *k)),
+                _ => None,
+            };
+            name.is_some_and(|n| !n.is_empty() && !names_it(p, n))
+        })
+        .map(|(d, _)| *d)
+        .collect();
+    for d in wrong {
+        program.decl_pos.remove(&d);
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -203,5 +281,33 @@ mod tests {
         // A second definition makes it ambiguous.
         let t2 = format!("{t}\nstruct P {{ int y; }};");
         assert_eq!(find_struct(&strip_comments(&t2), "P"), None);
+    }
+
+    /// glslang 12 `-gV` with `#include` names only the main file and places
+    /// the struct and its members on lines of it; `-g` names both files. Both
+    /// end with the header's lines, one per member.
+    #[test]
+    fn included_struct_lands_in_the_header() {
+        for v in ["g", "gV"] {
+            let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+                .join(format!("fixtures/include/main.rgen.{v}.spv"));
+            let p = crate::front::load(&path, crate::shader::Language::Spirv).unwrap();
+            let ty = *p
+                .names
+                .iter()
+                .find(|(id, n)| *n == "Payload" && matches!(p.ty(**id), Some(Type::Struct { .. })))
+                .unwrap()
+                .0;
+            let at = |d: Decl| {
+                let l = p.decl_location(d).unwrap();
+                (
+                    l.path.file_name().unwrap().to_str().unwrap().to_string(),
+                    l.line,
+                )
+            };
+            assert_eq!(at(Decl::Type(ty)), ("payload.glsl".to_string(), 2), "{v}");
+            let lines: Vec<u32> = (0..5).map(|k| at(Decl::Member(ty, k)).1).collect();
+            assert_eq!(lines, [3, 4, 5, 6, 7], "{v}");
+        }
     }
 }

@@ -41,7 +41,7 @@ pub use child::{
 pub use context::{Context, ContextOptions, DeviceInfo, RayTracingLimits};
 pub use descriptors::{Binding, BindingKind, Resource};
 pub use error::{Error, Result};
-pub use image::StorageImage;
+pub use image::{Sampler, StorageImage};
 pub use interface::{
     reflect as reflect_interface, DescriptorCount, DescriptorKind, LayoutBinding, PipelineInterface,
 };

@@ -1,7 +1,7 @@
 //! Internal errors: a position and a message; they become an [`InputError`] in
 //! one place, [`Error::into_input_error`], at the front-end's boundary.
 
-use crate::diag::{InputError, Label, Location};
+use crate::diag::{InputError, InputErrorKind, Label, Location};
 use std::path::{Path, PathBuf};
 
 /// A position in one of the files read for a compile (index into the file table).
@@ -64,9 +64,9 @@ impl Error {
                 .unwrap_or_else(|| main.to_path_buf())
         };
         let name = if self.message.starts_with("not supported") {
-            "hlsl-unsupported"
+            InputErrorKind::HlslUnsupported
         } else {
-            "hlsl-error"
+            InputErrorKind::HlslError
         };
         let label = if self.label.is_empty() {
             "here".to_string()

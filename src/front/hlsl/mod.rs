@@ -14,7 +14,7 @@ pub mod types;
 
 pub use crate::shader::Stage;
 
-use crate::diag::InputError;
+use crate::diag::{InputError, InputErrorKind};
 use crate::program::NamedDecl;
 use crate::shader::Location;
 use std::path::{Path, PathBuf};
@@ -108,7 +108,7 @@ fn entry_indices(
                 "no entry points: mark one with [shader(\"...\")] or [numthreads(...)]".to_string()
             }
         };
-        return Err(InputError::new("hlsl-error", path, msg));
+        return Err(InputError::new(InputErrorKind::HlslError, path, msg));
     }
     Ok(picked)
 }
@@ -123,7 +123,7 @@ fn with_stack<T: Send>(f: impl FnOnce() -> Result<T, InputError> + Send) -> Resu
             .spawn_scoped(s, f)
             .map_err(|e| {
                 InputError::new(
-                    "hlsl-error",
+                    InputErrorKind::HlslError,
                     Path::new(""),
                     format!("cannot start the compiler thread: {e}"),
                 )
@@ -156,17 +156,13 @@ fn compile_source_inner(
         // A fresh module per entry point, holding only what it reaches.
         let mut l = lower::Lowerer::new(&items, &files);
         l.declare().map_err(|e| e.into_input_error(&files, path))?;
-        let k = l
-            .entry_function(&name)
-            .ok_or_else(|| InputError::new("hlsl-error", path, "entry point vanished"))?;
+        let k = l.entry_function(&name).ok_or_else(|| {
+            InputError::new(InputErrorKind::HlslError, path, "entry point vanished")
+        })?;
         let (words, _) = l
             .finish(&[k])
             .map_err(|e| e.into_input_error(&files, path))?;
-        out.push(CompiledEntry {
-            name,
-            stage: stage,
-            words,
-        });
+        out.push(CompiledEntry { name, stage, words });
     }
     Ok(out)
 }
