@@ -804,6 +804,18 @@ mod tests {
     }
 
     #[test]
+    fn shader_records_widen_the_stride() {
+        // NVIDIA: a 32-byte handle and 8 bytes of shader record round up
+        // to the 32-byte handle alignment: 64.
+        let l = SbtLayout::new(&limits(32, 32, 64)).with_record(8, &limits(32, 32, 64));
+        assert_eq!(l.stride, 64);
+        assert_eq!(l.offsets(1, 1, 2, 0), (vec![0, 64, 128, 256], 256));
+        // No record: the handle alone.
+        let l = SbtLayout::new(&limits(32, 16, 32)).with_record(0, &limits(32, 16, 32));
+        assert_eq!(l.stride, 32);
+    }
+
+    #[test]
     fn stride_rounds_handle_size_up_to_handle_alignment() {
         let l = SbtLayout::new(&limits(24, 16, 64));
         assert_eq!(l.stride, 32);

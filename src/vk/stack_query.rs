@@ -141,3 +141,35 @@ pub fn driver_stack_sizes<'p>(
     }
     Ok(out)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::known_source_language;
+
+    #[test]
+    fn newer_source_languages_become_unknown() {
+        // Header, OpSource WGSL (10) version 1, OpCapability Shader.
+        let words = [
+            0x0723_0203,
+            0x0001_0400,
+            0,
+            8,
+            0,
+            (3 << 16) | 3,
+            10,
+            1,
+            (2 << 16) | 17,
+            1,
+        ];
+        let out = known_source_language(&words);
+        assert_eq!(out[6], 0);
+        assert_eq!(out[..6], words[..6]);
+        assert_eq!(out[7..], words[7..]);
+        // GLSL (2) stays; a truncated module is left alone, not a panic.
+        let glsl = [0x0723_0203, 0x0001_0400, 0, 8, 0, (3 << 16) | 3, 2, 460];
+        assert_eq!(known_source_language(&glsl), glsl);
+        let cut = [0x0723_0203, 0x0001_0400, 0, 8, 0, (9 << 16) | 3, 10];
+        assert_eq!(known_source_language(&cut)[6], 0);
+        assert!(known_source_language(&[0x0723_0203]).len() == 1);
+    }
+}
