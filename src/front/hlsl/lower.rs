@@ -10,6 +10,7 @@ mod consts;
 mod debug;
 mod decl;
 mod expr;
+mod formats;
 mod func;
 mod heaps;
 mod methods;
