@@ -4,7 +4,7 @@
 //! Prints a table; `cargo bench --bench check`.
 
 use rtlint::config::Config;
-use rtlint::lint::{check_input, Input};
+use rtlint::lint::check_input;
 use rtlint::shader::Language;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
@@ -59,13 +59,9 @@ fn main() {
     let (mut total_ours, mut total_peer) = (Duration::ZERO, Duration::ZERO);
     for f in &files {
         let language = Language::from_path(f).unwrap();
-        let input = Input {
-            path: f.clone(),
-            language,
-        };
         let words = rtlint::front::compile_path(f, language).unwrap().words;
         let ours = time(30, || {
-            let c = check_input(&input, &config);
+            let c = check_input(f, language, &config);
             assert!(c.program.is_some());
         });
         let (peer_name, peer) = if language == Language::Wgsl {

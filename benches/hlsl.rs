@@ -5,7 +5,7 @@
 //! `cargo bench --bench hlsl`.
 
 use rtlint::front::hlsl::{self, HlslOptions};
-use rtlint::front::slang::Slang;
+use rtlint_testkit::Slang;
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
@@ -65,7 +65,7 @@ fn main() {
             }
         };
         for entry in entries {
-            let stage = rtlint::front::slang::stage_name(entry.stage);
+            let stage = rtlint_testkit::stage_name(entry.stage);
             if let Err(e) = slang.compile_hlsl(file, &entry.name, stage, &[]) {
                 let first = e.lines().next().unwrap_or("").to_string();
                 left_out.push(format!("{name}:{}: Slang: {first}", entry.name));

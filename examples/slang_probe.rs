@@ -2,7 +2,7 @@
 //! `cargo run --example slang_probe -- FILE ENTRY STAGE OUT.spv`
 fn main() {
     let a: Vec<String> = std::env::args().collect();
-    let s = rtlint::front::slang::Slang::find().unwrap();
+    let s = rtlint_testkit::Slang::find().unwrap();
     let w = s
         .compile_hlsl(std::path::Path::new(&a[1]), &a[2], &a[3], &a[5..])
         .unwrap();

@@ -5,6 +5,48 @@ use crate::shader::Language;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
+/// `[hlsl]`: how sources that include other files are compiled.
+#[derive(Clone, Debug, Default, serde::Deserialize)]
+#[serde(deny_unknown_fields, rename_all = "kebab-case")]
+pub struct SourceOptions {
+    /// Searched after the including file's folder; relative to the config.
+    #[serde(default)]
+    pub include_dirs: Vec<PathBuf>,
+    /// `NAME = "VALUE"`.
+    #[serde(default)]
+    pub defines: BTreeMap<String, String>,
+}
+
+/// One rule's entry under `[rules]`.
+#[derive(Clone, Debug, PartialEq, serde::Deserialize)]
+#[serde(untagged)]
+pub enum RuleSetting {
+    Level(Level),
+    Table {
+        #[serde(default)]
+        level: Option<Level>,
+        /// The rule's own options; the rule says which it reads.
+        #[serde(flatten)]
+        options: BTreeMap<String, toml::Value>,
+    },
+}
+
+impl RuleSetting {
+    pub fn level(&self) -> Option<Level> {
+        match self {
+            RuleSetting::Level(l) => Some(*l),
+            RuleSetting::Table { level, .. } => *level,
+        }
+    }
+
+    pub fn options(&self) -> Option<&BTreeMap<String, toml::Value>> {
+        match self {
+            RuleSetting::Level(_) => None,
+            RuleSetting::Table { options, .. } => Some(options),
+        }
+    }
+}
+
 /// A rule's configured level.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Deserialize)]
 #[serde(rename_all = "lowercase")]
@@ -24,12 +66,13 @@ impl Level {
     }
 }
 
-#[derive(Clone, Debug, serde::Deserialize)]
+#[derive(Clone, Debug, Default, serde::Deserialize)]
 #[serde(deny_unknown_fields, rename_all = "kebab-case")]
 pub struct Config {
-    /// RT001: ray payloads above this many bytes (scalar size) are reported.
-    #[serde(default = "default_payload_budget")]
-    pub payload_budget: u64,
+    /// RT001: ray payloads above this many bytes (scalar size) are reported
+    /// (the rule's default when unset; `[rules.RT001] budget` wins).
+    #[serde(default)]
+    pub payload_budget: Option<u64>,
     /// RT010: bytes of state live across one trace call (the rule's default
     /// when unset).
     #[serde(default)]
@@ -41,12 +84,32 @@ pub struct Config {
     /// Warnings fail the run too.
     #[serde(default)]
     pub deny_warnings: bool,
-    /// Rule levels by code (`RT001`) or name (`payload-over-budget`).
+    /// Per rule, by code (`RT001`) or name (`payload-over-budget`): a level
+    /// (`RT003 = "allow"`) or a table with a level and the rule's options
+    /// (`[rules.RT001]` `level = "error"`, `budget = 48`).
     #[serde(default)]
-    pub rules: BTreeMap<String, Level>,
+    pub rules: BTreeMap<String, RuleSetting>,
     /// Languages for other file extensions: `rgen = "hlsl"`.
     #[serde(default)]
     pub languages: BTreeMap<String, String>,
+    /// Rules to run instead of the default set: codes, names or groups.
+    #[serde(default)]
+    pub select: Option<Vec<String>>,
+    /// Rules to run besides the selected ones.
+    #[serde(default)]
+    pub extend_select: Vec<String>,
+    /// Rules not to run.
+    #[serde(default)]
+    pub ignore: Vec<String>,
+    /// Globs (relative to this file's folder) of paths a directory walk skips.
+    #[serde(default)]
+    pub exclude: Vec<String>,
+    /// Rules not to run on paths matching a glob: `"legacy/*.hlsl" = ["RT001"]`.
+    #[serde(default)]
+    pub per_file_ignores: BTreeMap<String, Vec<String>>,
+    /// Include directories and defines for HLSL and GLSL sources.
+    #[serde(default)]
+    pub hlsl: SourceOptions,
     /// Where the config came from, for messages.
     #[serde(skip)]
     pub path: Option<PathBuf>,
@@ -54,25 +117,9 @@ pub struct Config {
     /// point at an unknown one.
     #[serde(skip)]
     rule_keys: Vec<(String, Option<Location>)>,
-}
-
-fn default_payload_budget() -> u64 {
-    32
-}
-
-impl Default for Config {
-    fn default() -> Self {
-        Config {
-            payload_budget: default_payload_budget(),
-            live_state_budget: None,
-            stack_limit: None,
-            deny_warnings: false,
-            rules: BTreeMap::new(),
-            languages: BTreeMap::new(),
-            path: None,
-            rule_keys: Vec::new(),
-        }
-    }
+    /// The file's text, for pointing at what the rules reject.
+    #[serde(skip)]
+    text: Option<String>,
 }
 
 pub const FILE_NAME: &str = "rtlint.toml";
@@ -101,11 +148,33 @@ impl Config {
             }
             err
         })?;
-        config.rule_keys = config
+        let selectors = config
             .rules
             .keys()
+            .chain(config.select.iter().flatten())
+            .chain(&config.extend_select)
+            .chain(&config.ignore)
+            .chain(config.per_file_ignores.values().flatten());
+        config.rule_keys = selectors
             .map(|k| (k.clone(), find_location(text, path, k)))
             .collect();
+        for g in config.exclude.iter().chain(config.per_file_ignores.keys()) {
+            if let Err(e) = globset::Glob::new(g) {
+                return Err(config_error(
+                    text,
+                    path,
+                    g,
+                    format!("invalid glob `{g}`: {}", e.kind()),
+                ));
+            }
+        }
+        if let Some(dir) = path.parent() {
+            for d in &mut config.hlsl.include_dirs {
+                if d.is_relative() {
+                    *d = dir.join(&*d);
+                }
+            }
+        }
         for (ext, lang) in &config.languages {
             if Language::parse(lang).is_none() {
                 return Err(config_error(
@@ -117,6 +186,7 @@ impl Config {
             }
         }
         config.path = Some(path.to_path_buf());
+        config.text = Some(text.to_string());
         Ok(config)
     }
 
@@ -143,6 +213,43 @@ impl Config {
         None
     }
 
+    /// The folder the config's relative globs and paths start from.
+    pub fn base_dir(&self) -> Option<&Path> {
+        self.path.as_deref().and_then(Path::parent)
+    }
+
+    /// Whether a directory walk skips `path` under `exclude`.
+    pub fn excludes(&self, path: &Path) -> bool {
+        !self.exclude.is_empty()
+            && glob_set(&self.exclude).is_some_and(|g| g.is_match(self.relative(path)))
+    }
+
+    /// The selectors `[per-file-ignores]` applies to `path`.
+    pub fn ignored_for(&self, path: &Path) -> Vec<&str> {
+        let rel = self.relative(path);
+        self.per_file_ignores
+            .iter()
+            .filter(|(g, _)| {
+                globset::Glob::new(g)
+                    .map(|g| g.compile_matcher().is_match(&rel))
+                    .unwrap_or(false)
+            })
+            .flat_map(|(_, rules)| rules.iter().map(String::as_str))
+            .collect()
+    }
+
+    /// `path` relative to the config's folder (both made absolute first).
+    fn relative(&self, path: &Path) -> PathBuf {
+        let abs = |p: &Path| std::path::absolute(p).unwrap_or_else(|_| p.to_path_buf());
+        match self.base_dir() {
+            Some(base) => {
+                let (p, b) = (abs(path), abs(base));
+                p.strip_prefix(&b).map(Path::to_path_buf).unwrap_or(p)
+            }
+            None => path.to_path_buf(),
+        }
+    }
+
     /// An error at the first key of `[rules]` that `known` does not accept.
     /// The config is data: the rule registry is consulted by its caller.
     pub fn check_rule_names(&self, known: impl Fn(&str) -> bool) -> Result<(), InputError> {
@@ -165,10 +272,68 @@ impl Config {
 
     /// The configured level of a rule, by code or by name.
     pub fn level(&self, code: &str, name: &str) -> Option<Level> {
+        self.setting(code, name).and_then(RuleSetting::level)
+    }
+
+    fn setting(&self, code: &str, name: &str) -> Option<&RuleSetting> {
         self.rules
-            .get(code)
-            .or_else(|| self.rules.get(name))
-            .copied()
+            .iter()
+            .find(|(k, _)| k.eq_ignore_ascii_case(code))
+            .or_else(|| self.rules.iter().find(|(k, _)| *k == name))
+            .map(|(_, v)| v)
+    }
+
+    /// A rule's option from its `[rules.CODE]` (or `[rules.name]`) table.
+    pub fn option(&self, code: &str, name: &str, key: &str) -> Option<&toml::Value> {
+        self.setting(code, name)?.options()?.get(key)
+    }
+
+    /// Sets a rule's option (the command line's overrides).
+    pub fn set_option(&mut self, code: &str, key: &str, value: toml::Value) {
+        let entry = self
+            .rules
+            .entry(code.to_string())
+            .or_insert(RuleSetting::Table {
+                level: None,
+                options: BTreeMap::new(),
+            });
+        if let RuleSetting::Level(l) = entry {
+            *entry = RuleSetting::Table {
+                level: Some(*l),
+                options: BTreeMap::new(),
+            };
+        }
+        if let RuleSetting::Table { options, .. } = entry {
+            options.insert(key.to_string(), value);
+        }
+    }
+
+    /// An error at the first option of a `[rules.X]` table that `known`
+    /// (rule key, option) does not accept.
+    pub fn check_rule_options(&self, known: impl Fn(&str, &str) -> bool) -> Result<(), InputError> {
+        let path = self.path.as_deref().unwrap_or(Path::new(FILE_NAME));
+        for (rule, setting) in &self.rules {
+            for key in setting.options().into_iter().flat_map(|o| o.keys()) {
+                if !known(rule, key) {
+                    let err = InputError::new(
+                        InputErrorKind::InvalidConfig,
+                        path,
+                        format!("rule `{rule}` has no option `{key}`"),
+                    );
+                    return Err(
+                        match self
+                            .text
+                            .as_deref()
+                            .and_then(|t| find_location(t, path, key))
+                        {
+                            Some(l) => err.at(l, "here"),
+                            None => err,
+                        },
+                    );
+                }
+            }
+        }
+        Ok(())
     }
 
     /// The language configured for a path's extension.
@@ -180,6 +345,16 @@ impl Config {
             .find(|(k, _)| k.trim_start_matches('.').eq_ignore_ascii_case(ext))
             .and_then(|(_, v)| Language::parse(v))
     }
+}
+
+fn glob_set(globs: &[String]) -> Option<globset::GlobSet> {
+    let mut b = globset::GlobSetBuilder::new();
+    for g in globs {
+        b.add(globset::Glob::new(g).ok()?);
+        // `dir` also excludes what is inside it.
+        b.add(globset::Glob::new(&format!("{}/**", g.trim_end_matches('/'))).ok()?);
+    }
+    b.build().ok()
 }
 
 /// The first occurrence of `needle` in the config text.
@@ -214,7 +389,7 @@ mod tests {
             Path::new("rtlint.toml"),
         )
         .unwrap();
-        assert_eq!(c.payload_budget, 48);
+        assert_eq!(c.payload_budget, Some(48));
         assert_eq!(c.level("RT003", "member-straddles-row"), Some(Level::Allow));
         assert_eq!(
             c.level("RT002", "payload-packing-waste"),

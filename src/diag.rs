@@ -48,6 +48,15 @@ impl Label {
     }
 }
 
+/// A mechanical fix: the text that replaces the declaration at `location`
+/// (so that a later `--fix` can apply it).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Fix {
+    /// The declaration the replacement is for; `None` without debug info.
+    pub location: Option<Location>,
+    pub replacement: String,
+}
+
 /// One finding or one input error.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Diagnostic {
@@ -68,8 +77,8 @@ pub struct Diagnostic {
     pub subject: Option<String>,
     pub notes: Vec<String>,
     pub help: Option<String>,
-    /// A mechanical fix, as replacement text (e.g. a reordered struct).
-    pub fix: Option<String>,
+    /// A mechanical fix (e.g. a reordered struct).
+    pub fix: Option<Fix>,
 }
 
 impl Diagnostic {
@@ -130,8 +139,12 @@ impl Diagnostic {
         self
     }
 
-    pub fn with_fix(mut self, fix: impl Into<String>) -> Self {
-        self.fix = Some(fix.into());
+    /// A fix: `replacement` for the declaration at `location`.
+    pub fn with_fix(mut self, location: Option<Location>, replacement: impl Into<String>) -> Self {
+        self.fix = Some(Fix {
+            location,
+            replacement: replacement.into(),
+        });
         self
     }
 
@@ -180,6 +193,8 @@ pub enum InputErrorKind {
     HlslError,
     /// the HLSL uses a construct rtlint's compiler does not support.
     HlslUnsupported,
+    /// glslang rejects the GLSL.
+    GlslError,
 }
 
 impl InputErrorKind {
@@ -197,6 +212,7 @@ impl InputErrorKind {
         InputErrorKind::WgslInternal,
         InputErrorKind::HlslError,
         InputErrorKind::HlslUnsupported,
+        InputErrorKind::GlslError,
     ];
 
     pub fn as_str(self) -> &'static str {
@@ -214,6 +230,7 @@ impl InputErrorKind {
             InputErrorKind::WgslInternal => "wgsl-internal",
             InputErrorKind::HlslError => "hlsl-error",
             InputErrorKind::HlslUnsupported => "hlsl-unsupported",
+            InputErrorKind::GlslError => "glsl-error",
         }
     }
 }
@@ -263,7 +280,12 @@ impl std::error::Error for InputError {}
 /// Reads a UTF-8 text input; an unreadable or non-UTF-8 file is an input error.
 pub fn read_text(path: &Path) -> Result<String, InputError> {
     let bytes = std::fs::read(path).map_err(|e| io_error(path, &e))?;
-    String::from_utf8(bytes).map_err(|e| {
+    text_from_bytes(&bytes, path)
+}
+
+/// Input bytes as UTF-8 text; anything else is an input error.
+pub fn text_from_bytes(bytes: &[u8], path: &Path) -> Result<String, InputError> {
+    String::from_utf8(bytes.to_vec()).map_err(|e| {
         let offset = e.utf8_error().valid_up_to();
         InputError::new(
             InputErrorKind::InvalidUtf8,
@@ -306,6 +328,7 @@ mod tests {
                 "wgsl-internal",
                 "hlsl-error",
                 "hlsl-unsupported",
+                "glsl-error",
             ]
         );
         for (i, a) in names.iter().enumerate() {

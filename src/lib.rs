@@ -11,9 +11,11 @@ pub mod front;
 pub mod lint;
 pub mod pipeline;
 pub mod program;
+#[cfg(feature = "vulkan")]
 pub mod reference;
 pub mod report;
 pub mod rules;
 pub mod shader;
+pub mod suppress;
 #[cfg(feature = "vulkan")]
 pub mod vk;

@@ -1,43 +1,398 @@
-//! The linting driver shared by the CLI and the build-script API: find the
-//! inputs, load each into a Program, run the rules.
+//! The linting driver shared by the CLI, the build-script API and editors:
+//! find the inputs, pick each one's config, load each into a Program, run the
+//! rules, apply suppressions. [`check_paths`] is the one entry point.
 
 use crate::config::Config;
-use crate::diag::{Diagnostic, InputError, InputErrorKind};
-use crate::front;
+use crate::diag::{Diagnostic, InputError, InputErrorKind, Severity};
+use crate::front::{self, FrontOptions};
 use crate::program::Program;
 use crate::shader::Language;
+use rayon::prelude::*;
+use std::collections::{BTreeMap, HashMap, HashSet};
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
-#[derive(Clone, Debug, PartialEq, Eq)]
+/// Which `rtlint.toml` applies to a file.
+#[derive(Clone, Debug, Default)]
+pub enum ConfigChoice {
+    /// The nearest `rtlint.toml` in the file's folder or above it.
+    #[default]
+    Nearest,
+    /// This file, for every input.
+    File(PathBuf),
+    /// None: the defaults.
+    Defaults,
+}
+
+/// What the command line adds on top of each config.
+#[derive(Clone, Debug, Default)]
+pub struct Overrides {
+    pub select: Option<Vec<String>>,
+    pub extend_select: Vec<String>,
+    pub ignore: Vec<String>,
+    pub payload_budget: Option<u64>,
+    pub deny_warnings: bool,
+}
+
+/// How to lint.
+#[derive(Clone, Debug)]
+pub struct Options {
+    pub config: ConfigChoice,
+    pub overrides: Overrides,
+    /// Treat named files (and shader-like files in walked folders) as this.
+    pub language: Option<Language>,
+    /// Pipeline descriptions to apply besides those found in the walk.
+    pub pipelines: Vec<PathBuf>,
+    /// `-I`/`-D` for HLSL and GLSL, after the config's.
+    pub front: FrontOptions,
+    /// Skip what `.gitignore`, `.ignore` and `.git/info/exclude` ignore.
+    pub respect_gitignore: bool,
+    /// The contents of standard input, read when a path is `-`.
+    pub stdin: Option<Vec<u8>>,
+    /// The name standard input is linted under (`--stdin-filename`).
+    pub stdin_filename: Option<PathBuf>,
+}
+
+impl Default for Options {
+    fn default() -> Self {
+        Options {
+            config: ConfigChoice::Nearest,
+            overrides: Overrides::default(),
+            language: None,
+            pipelines: Vec::new(),
+            front: FrontOptions::default(),
+            respect_gitignore: true,
+            stdin: None,
+            stdin_filename: None,
+        }
+    }
+}
+
+/// The outcome of a run: findings and input errors in a stable order.
+#[derive(Debug, Default)]
+pub struct Report {
+    /// Findings and input errors: inputs in walk order, each input's findings
+    /// in rule order; duplicates (a header's struct seen by several modules)
+    /// once.
+    pub diagnostics: Vec<Diagnostic>,
+    /// Shader files read.
+    pub files: Vec<PathBuf>,
+    /// Pipeline descriptions read.
+    pub pipelines: Vec<PathBuf>,
+    /// Files in walked folders that are not shaders on their own.
+    pub skipped: Vec<PathBuf>,
+    /// Source text the modules embed, for showing snippets of files that are
+    /// not on disk.
+    pub embedded: Vec<(PathBuf, String)>,
+    /// Warnings fail the run (any config or the command line said so).
+    pub deny_warnings: bool,
+}
+
+impl Report {
+    /// 0 clean, 1 findings at the failing level, 2 input errors.
+    pub fn exit_code(&self) -> u8 {
+        if self.diagnostics.iter().any(|d| d.code.is_none()) {
+            2
+        } else if self.diagnostics.iter().any(|d| {
+            d.severity == Severity::Error || (self.deny_warnings && d.severity == Severity::Warning)
+        }) {
+            1
+        } else {
+            0
+        }
+    }
+
+    /// Nothing was linted.
+    pub fn is_empty(&self) -> bool {
+        self.files.is_empty() && self.pipelines.is_empty()
+    }
+}
+
+/// Lints `paths` (files, folders, or `-` for standard input).
+pub fn check_paths(paths: &[PathBuf], options: &Options) -> Report {
+    let mut configs = Configs::new(options);
+    let inputs = collect(paths, options, &mut configs);
+    let mut report = Report {
+        files: inputs.files.iter().map(|i| i.path.clone()).collect(),
+        pipelines: inputs.pipelines.iter().map(|(p, _)| p.clone()).collect(),
+        skipped: inputs.skipped.clone(),
+        ..Report::default()
+    };
+    let mut diagnostics: Vec<Diagnostic> = configs.errors.clone();
+    diagnostics.extend(inputs.errors.iter().map(|e| (*e.0).clone()));
+    // Files in parallel; collected in input order, so output is the same
+    // whatever the thread count.
+    let checked: Vec<Checked> = inputs
+        .files
+        .par_iter()
+        .map(|input| check_input_with(input, &input.config, options))
+        .collect();
+    let mut owned: Vec<PathBuf> = Vec::new();
+    let mut programs = Vec::new();
+    for c in checked {
+        if let Some(p) = c.program {
+            for f in &p.files {
+                if let Some(t) = &f.text {
+                    report.embedded.push((f.path.clone(), t.clone()));
+                }
+                owned.push(f.path.clone());
+            }
+            // Suppressions are judged only in inputs that were analysed.
+            owned.push(c.path.clone());
+            programs.push(p);
+        }
+        diagnostics.extend(c.diagnostics);
+    }
+    let pipelines: Vec<Checked> = inputs
+        .pipelines
+        .par_iter()
+        .map(|(p, config)| check_pipeline(p, config))
+        .collect();
+    for c in pipelines {
+        diagnostics.extend(c.diagnostics);
+    }
+    // Shaders no description uses get the pipeline rules under the
+    // every-trace-reaches-every-shader assumption.
+    let described: Vec<PathBuf> = inputs
+        .pipelines
+        .iter()
+        .flat_map(|(p, _)| described_shaders(p))
+        .collect();
+    let loose_config = match inputs.files.first() {
+        Some(i) => i.config.clone(),
+        None => configs.for_path(Path::new(".")),
+    };
+    diagnostics.extend(check_loose(programs, &described, &loose_config));
+    report.deny_warnings = options.overrides.deny_warnings
+        || inputs.files.iter().any(|i| i.config.deny_warnings)
+        || inputs.pipelines.iter().any(|(_, c)| c.deny_warnings);
+    let mut seen = HashSet::new();
+    // The same finding from several modules (a struct in a shared header)
+    // once; a finding without a position belongs to its own input.
+    diagnostics.retain(|d| {
+        seen.insert((
+            d.code,
+            d.name,
+            d.message.clone(),
+            d.primary.as_ref().map(|l| l.location.clone()),
+            d.primary.is_none().then(|| d.file.clone()),
+            d.subject.clone(),
+        ))
+    });
+    owned.sort();
+    owned.dedup();
+    let owned: Vec<(PathBuf, Arc<Config>)> = owned
+        .into_iter()
+        .map(|p| {
+            let c = configs.for_path(&p);
+            (p, c)
+        })
+        .collect();
+    report.diagnostics = apply_suppressions(diagnostics, &owned, &report.embedded);
+    report
+}
+
+/// One input file and the config that applies to it.
+#[derive(Clone, Debug)]
 pub struct Input {
     pub path: PathBuf,
     pub language: Language,
-}
-
-/// Loads `rtlint.toml` and checks its rule names against the registry.
-pub fn load_config(path: &Path) -> Result<Config, InputError> {
-    let config = Config::load(path)?;
-    config.check_rule_names(|k| crate::rules::find(k).is_some())?;
-    Ok(config)
+    pub config: Arc<Config>,
+    /// Standard input's contents, for the input named `-`.
+    pub contents: Option<Arc<Vec<u8>>>,
 }
 
 /// What walking the paths found.
 #[derive(Debug, Default)]
 pub struct Inputs {
     pub files: Vec<Input>,
-    /// Pipeline descriptions (`*.pipeline.toml`).
-    pub pipelines: Vec<PathBuf>,
-    /// Paths that could not be used (missing, unknown language when named).
+    /// Pipeline descriptions (`*.pipeline.toml`) with their configs.
+    pub pipelines: Vec<(PathBuf, Arc<Config>)>,
+    /// Paths that could not be used, and configs that could not be read.
     pub errors: Vec<InputError>,
-    /// Files skipped inside directories, for `--verbose`.
+    /// Files in walked folders that are not shaders on their own.
     pub skipped: Vec<PathBuf>,
 }
 
-/// Walks `paths`: files are taken as named, directories recursively (sorted,
-/// so output is stable), picking files by extension.
-pub fn collect_inputs(paths: &[PathBuf], config: &Config, forced: Option<Language>) -> Inputs {
+/// Walks `paths` as [`check_paths`] does, without linting: what the other
+/// commands (`layout`, `live`, `stack`) read.
+pub fn inputs(paths: &[PathBuf], options: &Options) -> Inputs {
+    let mut configs = Configs::new(options);
+    let mut inputs = collect(paths, options, &mut configs);
+    let mut errors: Vec<InputError> = configs
+        .errors
+        .into_iter()
+        .map(|d| InputError(Box::new(d)))
+        .collect();
+    errors.append(&mut inputs.errors);
+    inputs.errors = errors;
+    inputs
+}
+
+/// Loads one input into a Program, with the config's and the options'
+/// include directories and defines.
+pub fn load(input: &Input, options: &Options) -> Result<Program, InputError> {
+    let front_options = front_options(&input.config, options);
+    let contents = input.contents.as_deref().map(|v| v.as_slice());
+    front::load_input(&input.path, contents, input.language, &front_options)
+}
+
+fn front_options(config: &Config, options: &Options) -> FrontOptions {
+    let mut front_options = FrontOptions {
+        include_dirs: config.hlsl.include_dirs.clone(),
+        defines: config
+            .hlsl
+            .defines
+            .iter()
+            .map(|(k, v)| (k.clone(), v.clone()))
+            .collect(),
+    };
+    front_options
+        .include_dirs
+        .extend(options.front.include_dirs.iter().cloned());
+    front_options
+        .defines
+        .extend(options.front.defines.iter().cloned());
+    front_options
+}
+
+/// Configs by folder, loaded once each.
+struct Configs {
+    choice: ConfigChoice,
+    overrides: Overrides,
+    by_file: HashMap<PathBuf, Arc<Config>>,
+    by_dir: HashMap<PathBuf, Arc<Config>>,
+    errors: Vec<Diagnostic>,
+}
+
+impl Configs {
+    fn new(options: &Options) -> Self {
+        Configs {
+            choice: options.config.clone(),
+            overrides: options.overrides.clone(),
+            by_file: HashMap::new(),
+            by_dir: HashMap::new(),
+            errors: Vec::new(),
+        }
+    }
+
+    /// The config for a file or folder.
+    fn for_path(&mut self, path: &Path) -> Arc<Config> {
+        let file = match &self.choice {
+            ConfigChoice::Defaults => None,
+            ConfigChoice::File(f) => Some(f.clone()),
+            ConfigChoice::Nearest => {
+                let abs = std::path::absolute(path).unwrap_or_else(|_| path.to_path_buf());
+                let dir = if abs.is_dir() {
+                    abs.clone()
+                } else {
+                    abs.parent().map(Path::to_path_buf).unwrap_or_default()
+                };
+                if let Some(c) = self.by_dir.get(&dir) {
+                    return c.clone();
+                }
+                let found = Config::discover(&dir);
+                let c = self.load(found);
+                self.by_dir.insert(dir, c.clone());
+                return c;
+            }
+        };
+        self.load(file)
+    }
+
+    fn load(&mut self, file: Option<PathBuf>) -> Arc<Config> {
+        let key = file.clone().unwrap_or_default();
+        if let Some(c) = self.by_file.get(&key) {
+            return c.clone();
+        }
+        let mut config = match &file {
+            Some(f) => match load_config(f) {
+                Ok(c) => c,
+                Err(e) => {
+                    self.errors.push(*e.0);
+                    Config::default()
+                }
+            },
+            None => Config::default(),
+        };
+        let o = &self.overrides;
+        if o.select.is_some() {
+            config.select = o.select.clone();
+        }
+        config.extend_select.extend(o.extend_select.iter().cloned());
+        config.ignore.extend(o.ignore.iter().cloned());
+        if let Some(b) = o.payload_budget {
+            config.set_option("RT001", "budget", toml::Value::Integer(b as i64));
+        }
+        config.deny_warnings |= o.deny_warnings;
+        let c = Arc::new(config);
+        self.by_file.insert(key, c.clone());
+        c
+    }
+}
+
+/// Loads `rtlint.toml` and checks the rules and selectors it names against
+/// the registry.
+pub fn load_config(path: &Path) -> Result<Config, InputError> {
+    let config = Config::load(path)?;
+    config.check_rule_names(crate::rules::is_selector)?;
+    config.check_rule_options(crate::rules::has_option)?;
+    Ok(config)
+}
+
+/// Checks selectors given on the command line.
+pub fn check_selectors(selectors: &[String]) -> Result<(), String> {
+    match selectors.iter().find(|s| !crate::rules::is_selector(s)) {
+        Some(s) => Err(format!(
+            "unknown rule or group `{s}` (`rtlint rules` lists them)"
+        )),
+        None => Ok(()),
+    }
+}
+
+/// Walks `paths`: files as named, folders recursively in sorted order,
+/// following links once (a link back up the tree is not walked again) and
+/// skipping what `.gitignore` and the config's `exclude` say.
+fn collect(paths: &[PathBuf], options: &Options, configs: &mut Configs) -> Inputs {
     let mut inputs = Inputs::default();
+    let mut seen: HashSet<PathBuf> = HashSet::new();
+    let add_pipeline = |p: PathBuf, inputs: &mut Inputs, configs: &mut Configs| {
+        let key = std::fs::canonicalize(&p).unwrap_or_else(|_| p.clone());
+        if !inputs
+            .pipelines
+            .iter()
+            .any(|(q, _)| std::fs::canonicalize(q).unwrap_or_else(|_| q.clone()) == key)
+        {
+            let c = configs.for_path(&p);
+            inputs.pipelines.push((p, c));
+        }
+    };
     for p in paths {
+        if p.as_os_str() == "-" {
+            let name = options
+                .stdin_filename
+                .clone()
+                .unwrap_or_else(|| PathBuf::from("-"));
+            let config = configs.for_path(&name);
+            match options
+                .language
+                .or_else(|| config.language_for(&name))
+                .or_else(|| language_from_name(&name))
+            {
+                Some(language) => inputs.files.push(Input {
+                    path: name,
+                    language,
+                    config,
+                    contents: Some(Arc::new(options.stdin.clone().unwrap_or_default())),
+                }),
+                None => inputs.errors.push(InputError::new(
+                    InputErrorKind::UnknownLanguage,
+                    &name,
+                    "cannot tell the language of standard input: pass --stdin-filename with a shader extension, or --lang",
+                )),
+            }
+            continue;
+        }
         let meta = match std::fs::metadata(p) {
             Ok(m) => m,
             Err(e) => {
@@ -46,58 +401,182 @@ pub fn collect_inputs(paths: &[PathBuf], config: &Config, forced: Option<Languag
             }
         };
         if meta.is_dir() {
-            walk(p, config, forced, &mut inputs);
-        } else if is_pipeline(p) {
-            inputs.pipelines.push(p.clone());
-        } else {
-            match language_of(p, config, forced) {
-                Some(language) => inputs.files.push(Input {
-                    path: p.clone(),
-                    language,
-                }),
-                None => inputs.errors.push(InputError::new(
-                    InputErrorKind::UnknownLanguage,
-                    p,
-                    "cannot tell the shader language from the file extension; pass --lang or map the extension under [languages] in rtlint.toml",
-                )),
-            }
+            walk(p, options, configs, &mut inputs, &mut seen);
+            continue;
         }
+        if is_pipeline(p) {
+            add_pipeline(p.clone(), &mut inputs, configs);
+            continue;
+        }
+        let p = &tidy(p);
+        let key = std::fs::canonicalize(p).unwrap_or_else(|_| p.clone());
+        if !seen.insert(key) {
+            continue;
+        }
+        let config = configs.for_path(p);
+        match options
+            .language
+            .or_else(|| config.language_for(p))
+            .or_else(|| language_from_name(p))
+            .or_else(|| ray_query_glsl(p))
+        {
+            Some(language) => inputs.files.push(Input {
+                path: p.clone(),
+                language,
+                config,
+                contents: None,
+            }),
+            None => inputs.errors.push(InputError::new(
+                InputErrorKind::UnknownLanguage,
+                p,
+                "cannot tell the shader language from the file extension; pass --lang or map the extension under [languages] in rtlint.toml",
+            )),
+        }
+    }
+    for p in &options.pipelines {
+        add_pipeline(p.clone(), &mut inputs, configs);
     }
     inputs
 }
 
-fn walk(dir: &Path, config: &Config, forced: Option<Language>, inputs: &mut Inputs) {
-    let mut entries: Vec<PathBuf> = match std::fs::read_dir(dir) {
-        Ok(rd) => rd.filter_map(|e| e.ok().map(|e| e.path())).collect(),
-        Err(e) => {
-            inputs.errors.push(front::io_error(dir, &e));
-            return;
-        }
-    };
-    entries.sort();
-    for p in entries {
-        let name = p.file_name().and_then(|n| n.to_str()).unwrap_or("");
-        if name.starts_with('.') || name == "target" {
+fn walk(
+    dir: &Path,
+    options: &Options,
+    configs: &mut Configs,
+    inputs: &mut Inputs,
+    seen: &mut HashSet<PathBuf>,
+) {
+    let respect = options.respect_gitignore;
+    let walker = ignore::WalkBuilder::new(dir)
+        .follow_links(true)
+        .hidden(true)
+        .ignore(respect)
+        .git_ignore(respect)
+        .git_exclude(respect)
+        .git_global(false)
+        .parents(respect)
+        .require_git(false)
+        .sort_by_file_path(|a, b| a.cmp(b))
+        .filter_entry(|e| e.file_name() != "target")
+        .build();
+    let mut found: Vec<(PathBuf, PathBuf)> = Vec::new();
+    for entry in walker {
+        let entry = match entry {
+            Ok(e) => e,
+            // A link that leads back up the tree: already walked.
+            Err(e) if is_loop(&e) => continue,
+            Err(e) => {
+                inputs.errors.push(InputError::new(
+                    InputErrorKind::UnreadableFile,
+                    dir,
+                    format!("cannot walk the folder: {e}"),
+                ));
+                continue;
+            }
+        };
+        if !entry.file_type().is_some_and(|t| t.is_file()) {
             continue;
         }
-        if p.is_dir() {
-            walk(&p, config, forced, inputs);
-        } else if is_pipeline(&p) {
-            inputs.pipelines.push(p);
+        let p = tidy(entry.path());
+        let key = std::fs::canonicalize(&p).unwrap_or_else(|_| p.clone());
+        found.push((p, key));
+    }
+    // A file reached through a link and by its own path is read once, under
+    // the path without links when there is one.
+    let direct = |p: &Path, key: &Path| {
+        std::path::absolute(p).is_ok_and(|a| crate::program::debug::normalize(&a) == key)
+    };
+    let mut chosen: HashMap<PathBuf, PathBuf> = HashMap::new();
+    for (p, key) in &found {
+        match chosen.get(key) {
+            Some(q) if direct(q, key) || !direct(p, key) => {}
+            _ => {
+                chosen.insert(key.clone(), p.clone());
+            }
+        }
+    }
+    for (p, key) in found {
+        if chosen.get(&key) != Some(&p) || !seen.insert(key) {
+            continue;
+        }
+        let config = configs.for_path(&p);
+        if config.excludes(&p) {
+            continue;
+        }
+        if is_pipeline(&p) {
+            if !inputs.pipelines.iter().any(|(q, _)| *q == p) {
+                inputs.pipelines.push((p, config));
+            }
         } else if p
             .extension()
             .is_some_and(|e| e.eq_ignore_ascii_case("hlsli"))
+            || (p
+                .extension()
+                .is_some_and(|e| e.eq_ignore_ascii_case("glsl"))
+                && front::glsl::stage_extension(&p).is_none())
         {
             // A header: analysed through the shaders that include it.
             inputs.skipped.push(p);
-        } else if let Some(language) =
-            language_of(&p, config, None).or(forced.filter(|_| is_shader_like(&p)))
+        } else if let Some(language) = config
+            .language_for(&p)
+            .or_else(|| language_from_name(&p))
+            .or_else(|| options.language.filter(|_| is_shader_like(&p)))
+            .or_else(|| ray_query_glsl(&p))
         {
-            inputs.files.push(Input { path: p, language });
+            inputs.files.push(Input {
+                path: p,
+                language,
+                config,
+                contents: None,
+            });
         } else {
             inputs.skipped.push(p);
         }
     }
+}
+
+/// A path without `.` components: `./a/b` is `a/b`, as debug info names it.
+fn tidy(p: &Path) -> PathBuf {
+    let t: PathBuf = p
+        .components()
+        .filter(|c| !matches!(c, std::path::Component::CurDir))
+        .collect();
+    if t.as_os_str().is_empty() {
+        PathBuf::from(".")
+    } else {
+        t
+    }
+}
+
+fn is_loop(e: &ignore::Error) -> bool {
+    match e {
+        ignore::Error::Loop { .. } => true,
+        ignore::Error::WithPath { err, .. } | ignore::Error::WithDepth { err, .. } => is_loop(err),
+        _ => false,
+    }
+}
+
+/// The language a file's name says: `.hlsl`, `.wgsl`, `.spv`, and GLSL's
+/// ray-tracing stage extensions (also as `name.rgen.glsl`).
+fn language_from_name(p: &Path) -> Option<Language> {
+    Language::from_path(p).or_else(|| {
+        front::glsl::stage_extension(p)
+            .filter(|e| front::glsl::RAY_TRACING_EXTENSIONS.contains(e))
+            .map(|_| Language::Glsl)
+    })
+}
+
+/// A GLSL compute, fragment or other stage that uses ray queries.
+fn ray_query_glsl(p: &Path) -> Option<Language> {
+    let ext = front::glsl::stage_extension(p)?;
+    if !front::glsl::RAY_QUERY_EXTENSIONS.contains(&ext) {
+        return None;
+    }
+    let text = std::fs::read(p).ok()?;
+    let needle = b"rayQueryEXT";
+    text.windows(needle.len())
+        .any(|w| w == needle)
+        .then_some(Language::Glsl)
 }
 
 pub fn is_pipeline(p: &Path) -> bool {
@@ -111,14 +590,8 @@ pub fn is_pipeline(p: &Path) -> bool {
 fn is_shader_like(p: &Path) -> bool {
     !matches!(
         p.extension().and_then(|e| e.to_str()),
-        Some("md" | "toml" | "txt" | "json" | "sh" | "py" | "rs" | "png" | "ppm")
+        Some("md" | "toml" | "txt" | "json" | "sh" | "py" | "rs" | "png" | "ppm" | "yml" | "yaml")
     ) && p.extension().is_some()
-}
-
-fn language_of(p: &Path, config: &Config, forced: Option<Language>) -> Option<Language> {
-    forced
-        .or_else(|| config.language_for(p))
-        .or_else(|| Language::from_path(p))
 }
 
 /// One input's outcome.
@@ -129,11 +602,24 @@ pub struct Checked {
     pub diagnostics: Vec<Diagnostic>,
 }
 
-/// Loads and checks one input; a bad input becomes one error diagnostic.
-pub fn check_input(input: &Input, config: &Config) -> Checked {
-    match front::load(&input.path, input.language) {
+/// Loads and checks one file with `config`; a bad input becomes one error
+/// diagnostic.
+pub fn check_input(path: &Path, language: Language, config: &Config) -> Checked {
+    let input = Input {
+        path: path.to_path_buf(),
+        language,
+        config: Arc::new(config.clone()),
+        contents: None,
+    };
+    check_input_with(&input, config, &Options::default())
+}
+
+fn check_input_with(input: &Input, config: &Config, options: &Options) -> Checked {
+    match load(input, options) {
         Ok(program) => {
-            let diagnostics = crate::rules::check_program(&program, config);
+            let ignored = config.ignored_for(&input.path);
+            let mut diagnostics = crate::rules::check_program(&program, config);
+            drop_ignored(&mut diagnostics, &ignored);
             Checked {
                 path: input.path.clone(),
                 program: Some(program),
@@ -148,15 +634,30 @@ pub fn check_input(input: &Input, config: &Config) -> Checked {
     }
 }
 
+/// Removes findings of rules that `[per-file-ignores]` turns off.
+fn drop_ignored(diagnostics: &mut Vec<Diagnostic>, ignored: &[&str]) {
+    if ignored.is_empty() {
+        return;
+    }
+    diagnostics.retain(|d| {
+        let Some(rule) = d.code.and_then(crate::rules::find) else {
+            return true;
+        };
+        !ignored.iter().any(|s| crate::rules::selects(s, rule))
+    });
+}
+
 /// Loads a pipeline description and runs the pipeline rules on it.
 pub fn check_pipeline(path: &Path, config: &Config) -> Checked {
     match crate::pipeline::load(path) {
         Ok(pipeline) => {
             let ctx = crate::rules::PipelineContext::new(&pipeline, config);
+            let mut diagnostics = crate::rules::check_pipeline(&ctx);
+            drop_ignored(&mut diagnostics, &config.ignored_for(path));
             Checked {
                 path: path.to_path_buf(),
                 program: None,
-                diagnostics: crate::rules::check_pipeline(&ctx),
+                diagnostics,
             }
         }
         Err(e) => Checked {
@@ -225,6 +726,95 @@ pub fn check_loose(
         );
     }
     out
+}
+
+/// Drops findings that a suppression allows, and reports every suppression
+/// in the linted sources that allowed nothing (RT000).
+fn apply_suppressions(
+    diagnostics: Vec<Diagnostic>,
+    owned: &[(PathBuf, Arc<Config>)],
+    embedded: &[(PathBuf, String)],
+) -> Vec<Diagnostic> {
+    let embedded: HashMap<&Path, &str> = embedded
+        .iter()
+        .map(|(p, t)| (p.as_path(), t.as_str()))
+        .collect();
+    // Each suppression with, per selector, whether it allowed a finding.
+    let mut files: BTreeMap<PathBuf, Vec<(crate::suppress::Suppression, Vec<bool>)>> =
+        BTreeMap::new();
+    let load = |path: &Path, files: &mut BTreeMap<PathBuf, Vec<_>>| {
+        if files.contains_key(path) {
+            return;
+        }
+        let text = std::fs::read_to_string(path)
+            .ok()
+            .or_else(|| embedded.get(path).map(|t| t.to_string()));
+        let list = text
+            .map(|t| {
+                crate::suppress::parse(&t)
+                    .into_iter()
+                    .map(|s| {
+                        let n = s.selectors.len();
+                        (s, vec![false; n])
+                    })
+                    .collect()
+            })
+            .unwrap_or_default();
+        files.insert(path.to_path_buf(), list);
+    };
+    let mut kept = Vec::new();
+    for d in diagnostics {
+        let (Some(code), Some(primary)) = (d.code, &d.primary) else {
+            kept.push(d);
+            continue;
+        };
+        let Some(rule) = crate::rules::find(code) else {
+            kept.push(d);
+            continue;
+        };
+        let at = &primary.location;
+        load(&at.path, &mut files);
+        let mut allowed = false;
+        if let Some(list) = files.get_mut(&at.path) {
+            for (s, used) in list.iter_mut() {
+                if at.line < s.covers.0 || at.line > s.covers.1 {
+                    continue;
+                }
+                for (k, sel) in s.selectors.iter().enumerate() {
+                    if crate::rules::selects(sel, rule) {
+                        used[k] = true;
+                        allowed = true;
+                    }
+                }
+            }
+        }
+        if !allowed {
+            kept.push(d);
+        }
+    }
+    // Unused suppressions, in the files this run linted.
+    let rule = &crate::rules::rt000_unused_suppression::RULE;
+    for (path, config) in owned {
+        load(path, &mut files);
+        let Some(severity) = crate::rules::configured(rule, config) else {
+            continue;
+        };
+        for (s, used) in files.get(path.as_path()).into_iter().flatten() {
+            let unused: Vec<&str> = s
+                .selectors
+                .iter()
+                .zip(used)
+                .filter(|(_, u)| !**u)
+                .map(|(sel, _)| sel.as_str())
+                .collect();
+            if !unused.is_empty() {
+                kept.push(crate::rules::rt000_unused_suppression::finding(
+                    path, s, &unused, severity,
+                ));
+            }
+        }
+    }
+    kept
 }
 
 #[cfg(test)]

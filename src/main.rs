@@ -1,11 +1,10 @@
 //! The `rtlint` command line.
 
 use clap::{Parser, Subcommand};
-use codespan_reporting::term::termcolor::{ColorChoice, StandardStream};
-use rtlint::config::Config;
-use rtlint::diag::{Diagnostic, InputError, Severity};
+use codespan_reporting::term::termcolor::{self, ColorChoice, StandardStream, WriteColor};
+use rtlint::diag::{Diagnostic, InputError};
 use rtlint::lint;
-use rtlint::report::{self, Format, Sources, Summary};
+use rtlint::report::{self, Sources, Summary};
 use rtlint::shader::Language;
 use std::io::Write;
 use std::path::PathBuf;
@@ -24,44 +23,137 @@ struct Cli {
 
 #[derive(clap::Args, Clone)]
 struct Common {
-    /// Shader files or directories (walked recursively).
+    /// Shader files or directories (walked recursively); `-` reads standard input.
     #[arg(required = true)]
     paths: Vec<PathBuf>,
-    /// Output format: human, json, github or sarif.
-    #[arg(long, default_value = "human")]
-    format: String,
-    /// Read this config instead of the nearest rtlint.toml.
-    #[arg(long)]
+    /// Read this config for every file instead of each file's nearest rtlint.toml.
+    #[arg(long, conflicts_with = "no_config")]
     config: Option<PathBuf>,
-    /// Treat every named file as this language (hlsl, wgsl, spirv).
+    /// Read no rtlint.toml: the defaults.
     #[arg(long)]
-    lang: Option<String>,
+    no_config: bool,
+    /// Treat every named file as this language.
+    #[arg(long, value_enum)]
+    lang: Option<LangArg>,
+    /// Include directory for HLSL and GLSL sources.
+    #[arg(short = 'I', value_name = "DIR")]
+    include: Vec<PathBuf>,
+    /// Define a macro for HLSL and GLSL sources: NAME or NAME=VALUE.
+    #[arg(short = 'D', value_name = "NAME[=VALUE]")]
+    define: Vec<String>,
+    /// The name standard input (`-`) is linted under; its extension picks the language.
+    #[arg(long, value_name = "PATH")]
+    stdin_filename: Option<PathBuf>,
+    /// Walk into what .gitignore, .ignore and .git/info/exclude ignore.
+    #[arg(long)]
+    no_gitignore: bool,
     /// Also say which files were skipped.
     #[arg(short, long)]
     verbose: bool,
 }
 
+#[derive(clap::ValueEnum, Clone, Copy, Debug)]
+enum LangArg {
+    Hlsl,
+    Wgsl,
+    Spirv,
+    Glsl,
+}
+
+impl LangArg {
+    fn language(self) -> Language {
+        match self {
+            LangArg::Hlsl => Language::Hlsl,
+            LangArg::Wgsl => Language::Wgsl,
+            LangArg::Spirv => Language::Spirv,
+            LangArg::Glsl => Language::Glsl,
+        }
+    }
+}
+
+/// Output formats of `check`.
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+enum CheckFormat {
+    /// Findings with source snippets (codespan-reporting).
+    #[value(alias = "full", alias = "text")]
+    Human,
+    /// One line per finding: `path:line:col: level[CODE] message`.
+    Concise,
+    Json,
+    /// GitHub Actions workflow commands (annotations).
+    Github,
+    /// SARIF 2.1.0.
+    Sarif,
+}
+
+/// Output formats of `layout`, `live` and `stack`.
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+enum ReportFormat {
+    #[value(alias = "text")]
+    Human,
+    Json,
+}
+
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+enum ColorArg {
+    Auto,
+    Always,
+    Never,
+}
+
+/// `rtlint check`.
+#[derive(clap::Args, Clone)]
+struct CheckArgs {
+    #[command(flatten)]
+    common: Common,
+    #[arg(long, value_enum, default_value = "human")]
+    format: CheckFormat,
+    /// Run only these rules: codes, code prefixes, names, groups or ALL (comma-separated).
+    #[arg(long, value_delimiter = ',', value_name = "RULES")]
+    select: Option<Vec<String>>,
+    /// Run these rules too.
+    #[arg(long, value_delimiter = ',', value_name = "RULES")]
+    extend_select: Vec<String>,
+    /// Do not run these rules.
+    #[arg(long, value_delimiter = ',', value_name = "RULES")]
+    ignore: Vec<String>,
+    /// Ray payloads above this many bytes are reported (RT001).
+    #[arg(long)]
+    payload_budget: Option<u64>,
+    /// Warnings fail the run (exit 1) too, and so does finding no file to lint.
+    #[arg(long)]
+    deny_warnings: bool,
+    /// Exit 0 even when findings fail the run (input errors still exit 2).
+    #[arg(long)]
+    exit_zero: bool,
+    /// Count findings per rule instead of listing them.
+    #[arg(long)]
+    statistics: bool,
+    /// Print findings only: no summary line, no notes.
+    #[arg(short, long)]
+    quiet: bool,
+    /// Colour: auto honours NO_COLOR, FORCE_COLOR and CLICOLOR_FORCE.
+    #[arg(long, value_enum, default_value = "auto")]
+    color: ColorArg,
+    /// Write the report to this file instead of standard output.
+    #[arg(long, short = 'o', value_name = "FILE")]
+    output_file: Option<PathBuf>,
+    /// Also apply this pipeline description (`*.pipeline.toml` files in
+    /// the walked directories are applied too).
+    #[arg(long)]
+    pipeline: Vec<PathBuf>,
+}
+
 #[derive(Subcommand)]
 enum Command {
     /// Lint shaders and report best-practice violations.
-    Check {
-        #[command(flatten)]
-        common: Common,
-        /// Ray payloads above this many bytes are reported (RT001).
-        #[arg(long)]
-        payload_budget: Option<u64>,
-        /// Warnings fail the run (exit 1) too.
-        #[arg(long)]
-        deny_warnings: bool,
-        /// Also apply this pipeline description (`*.pipeline.toml` files in
-        /// the walked directories are applied too).
-        #[arg(long)]
-        pipeline: Vec<PathBuf>,
-    },
+    Check(Box<CheckArgs>),
     /// Values kept alive across each trace, callable and ray-query site.
     Live {
         #[command(flatten)]
         common: Common,
+        #[arg(long, value_enum, default_value = "human")]
+        format: ReportFormat,
     },
     /// Recursion depth and stack size of a described pipeline (or of loose
     /// shaders, assuming every trace reaches every shader).
@@ -72,11 +164,15 @@ enum Command {
         /// reports (`vkGetRayTracingShaderGroupStackSizeKHR`) beside the model.
         #[arg(long)]
         driver: bool,
+        #[arg(long, value_enum, default_value = "human")]
+        format: ReportFormat,
     },
     /// Print payload, attribute and shader-record layouts with the best member order.
     Layout {
         #[command(flatten)]
         common: Common,
+        #[arg(long, value_enum, default_value = "human")]
+        format: ReportFormat,
     },
     /// Compile HLSL to SPIR-V with rtlint's own compiler.
     Compile {
@@ -131,15 +227,14 @@ fn main() -> ExitCode {
 
 fn run(cli: Cli) -> Result<u8, String> {
     match cli.command {
-        Command::Check {
+        Command::Check(args) => check(*args),
+        Command::Live { common, format } => live(common, format),
+        Command::Stack {
             common,
-            payload_budget,
-            deny_warnings,
-            pipeline,
-        } => check(common, payload_budget, deny_warnings, pipeline),
-        Command::Live { common } => live(common),
-        Command::Stack { common, driver } => stack(common, driver),
-        Command::Layout { common } => layout(common),
+            driver,
+            format,
+        } => stack(common, driver, format),
+        Command::Layout { common, format } => layout(common, format),
         Command::Compile {
             file,
             entry,
@@ -151,12 +246,18 @@ fn run(cli: Cli) -> Result<u8, String> {
         Command::Rules => {
             let mut out = std::io::stdout().lock();
             for r in rtlint::rules::RULES {
+                let level = if r.group.on_by_default() {
+                    r.level.as_str()
+                } else {
+                    "off"
+                };
                 let _ = writeln!(
                     out,
-                    "{}  {:<28} {:<8} {}",
+                    "{}  {:<28} {:<8} {:<12} {}",
                     r.code,
                     r.name,
-                    r.level.as_str(),
+                    level,
+                    r.group.as_str(),
                     r.summary
                 );
             }
@@ -164,7 +265,7 @@ fn run(cli: Cli) -> Result<u8, String> {
         }
         Command::Rule { code } => match rtlint::rules::find(&code) {
             Some(r) => {
-                print!("{}", r.doc);
+                print!("{}", r.page());
                 Ok(0)
             }
             None => Err(format!("unknown rule `{code}` (`rtlint rules` lists them)")),
@@ -172,223 +273,243 @@ fn run(cli: Cli) -> Result<u8, String> {
     }
 }
 
-/// Settings shared by every subcommand that reads shaders.
-struct Setup {
-    format: Format,
-    config: Config,
-    inputs: lint::Inputs,
-    /// Input errors found before any file was read (bad config).
-    errors: Vec<Diagnostic>,
-}
-
-fn setup(common: &Common) -> Result<Setup, String> {
-    let format = Format::parse(&common.format).ok_or_else(|| {
-        format!(
-            "unknown format `{}` (expected human, json, github or sarif)",
-            common.format
-        )
-    })?;
-    let forced = match &common.lang {
-        Some(l) => Some(
-            Language::parse(l)
-                .ok_or_else(|| format!("unknown language `{l}` (expected hlsl, wgsl or spirv)"))?,
-        ),
-        None => None,
+/// The lint options every subcommand that reads shaders shares.
+fn options(common: &Common) -> Result<lint::Options, String> {
+    let config = match (&common.config, common.no_config) {
+        (Some(f), _) => lint::ConfigChoice::File(f.clone()),
+        (None, true) => lint::ConfigChoice::Defaults,
+        (None, false) => lint::ConfigChoice::Nearest,
     };
-    let mut errors = Vec::new();
-    let config_path = common
-        .config
-        .clone()
-        .or_else(|| common.paths.first().and_then(|p| Config::discover(p)));
-    let config = match config_path {
-        Some(p) => match lint::load_config(&p) {
-            Ok(c) => c,
-            Err(e) => {
-                errors.push(*e.0);
-                Config::default()
-            }
-        },
-        None => Config::default(),
+    let stdin = if common.paths.iter().any(|p| p.as_os_str() == "-") {
+        let mut bytes = Vec::new();
+        std::io::Read::read_to_end(&mut std::io::stdin(), &mut bytes)
+            .map_err(|e| format!("cannot read standard input: {e}"))?;
+        Some(bytes)
+    } else {
+        None
     };
-    let inputs = lint::collect_inputs(&common.paths, &config, forced);
-    Ok(Setup {
-        format,
+    Ok(lint::Options {
         config,
-        inputs,
-        errors,
+        language: common.lang.map(LangArg::language),
+        front: rtlint::front::FrontOptions {
+            include_dirs: common.include.clone(),
+            defines: common.define.iter().map(|d| split_define(d)).collect(),
+        },
+        respect_gitignore: !common.no_gitignore,
+        stdin,
+        stdin_filename: common.stdin_filename.clone(),
+        ..lint::Options::default()
     })
 }
 
-fn check(
-    common: Common,
-    payload_budget: Option<u64>,
-    deny_warnings: bool,
-    pipelines: Vec<PathBuf>,
-) -> Result<u8, String> {
-    let Setup {
-        format,
-        mut config,
-        mut inputs,
-        errors,
-    } = setup(&common)?;
-    inputs.pipelines.extend(pipelines);
-    if let Some(b) = payload_budget {
-        config.payload_budget = b;
+fn split_define(d: &str) -> (String, String) {
+    match d.split_once('=') {
+        Some((n, v)) => (n.to_string(), v.to_string()),
+        None => (d.to_string(), "1".to_string()),
     }
-    config.deny_warnings |= deny_warnings;
-    let mut diagnostics = errors;
-    diagnostics.extend(inputs.errors.iter().map(|e| (*e.0).clone()));
-    let mut sources = Sources::default();
-    let mut programs = Vec::new();
-    for input in &inputs.files {
-        let checked = lint::check_input(input, &config);
-        if let Some(p) = checked.program {
-            sources.add_program(&p);
-            programs.push(p);
-        }
-        diagnostics.extend(checked.diagnostics);
-    }
-    let mut described = Vec::new();
-    for p in &inputs.pipelines {
-        diagnostics.extend(lint::check_pipeline(p, &config).diagnostics);
-        described.extend(lint::described_shaders(p));
-    }
-    diagnostics.extend(lint::check_loose(programs, &described, &config));
-    let summary = Summary::count(inputs.files.len() + inputs.pipelines.len(), &diagnostics);
-    emit(
-        format,
-        &diagnostics,
-        &summary,
-        &mut sources,
-        common.verbose.then_some(&inputs.skipped),
-    )?;
-    Ok(exit_code(&diagnostics, &config))
 }
 
-fn exit_code(diagnostics: &[Diagnostic], config: &Config) -> u8 {
-    if diagnostics.iter().any(|d| d.code.is_none()) {
-        2
-    } else if diagnostics.iter().any(|d| {
-        d.severity == Severity::Error || (config.deny_warnings && d.severity == Severity::Warning)
-    }) {
-        1
-    } else {
-        0
+fn check(args: CheckArgs) -> Result<u8, String> {
+    for list in [
+        args.select.as_deref().unwrap_or(&[]),
+        &args.extend_select,
+        &args.ignore,
+    ] {
+        lint::check_selectors(list)?;
     }
+    let mut options = options(&args.common)?;
+    options.pipelines = args.pipeline.clone();
+    options.overrides = lint::Overrides {
+        select: args.select.clone(),
+        extend_select: args.extend_select.clone(),
+        ignore: args.ignore.clone(),
+        payload_budget: args.payload_budget,
+        deny_warnings: args.deny_warnings,
+    };
+    let report = lint::check_paths(&args.common.paths, &options);
+    let mut sources = Sources::default();
+    for (p, t) in &report.embedded {
+        sources.add_embedded(p, t);
+    }
+    let summary = Summary::count(
+        report.files.len() + report.pipelines.len(),
+        &report.diagnostics,
+    );
+    let color = color_choice(args.color, args.output_file.is_some());
+    let result = match &args.output_file {
+        Some(path) => {
+            let file = std::fs::File::create(path)
+                .map_err(|e| format!("cannot write {}: {e}", path.display()))?;
+            let mut w = std::io::BufWriter::new(file);
+            if color == ColorChoice::Always {
+                let mut out = termcolor::Ansi::new(&mut w);
+                emit(&args, &report, &summary, &mut sources, &mut out)
+            } else {
+                let mut out = termcolor::NoColor::new(&mut w);
+                emit(&args, &report, &summary, &mut sources, &mut out)
+            }
+            .and_then(|()| w.flush())
+        }
+        None => {
+            let mut out = StandardStream::stdout(color);
+            emit(&args, &report, &summary, &mut sources, &mut out).and_then(|()| out.flush())
+        }
+    };
+    match result {
+        Ok(()) => {}
+        // A reader that stopped reading (`| head`) is not an error.
+        Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => return Ok(0),
+        Err(e) => return Err(format!("cannot write output: {e}")),
+    }
+    if report.is_empty() {
+        eprintln!("warning: no files to lint");
+        if args.deny_warnings {
+            return Ok(2);
+        }
+    }
+    let code = report.exit_code();
+    Ok(if args.exit_zero && code == 1 { 0 } else { code })
 }
 
 fn emit(
-    format: Format,
-    diagnostics: &[Diagnostic],
+    args: &CheckArgs,
+    report: &lint::Report,
     summary: &Summary,
     sources: &mut Sources,
-    skipped: Option<&Vec<PathBuf>>,
-) -> Result<(), String> {
-    let io = |e: std::io::Error| format!("cannot write output: {e}");
-    match format {
-        Format::Human => {
-            let mut out = StandardStream::stdout(color_choice());
-            if let Some(skipped) = skipped {
-                for p in skipped {
+    out: &mut dyn WriteColor,
+) -> std::io::Result<()> {
+    let diagnostics = &report.diagnostics;
+    if args.statistics {
+        // Input errors are still shown in full: they are not statistics.
+        let errors: Vec<Diagnostic> = diagnostics
+            .iter()
+            .filter(|d| d.code.is_none())
+            .cloned()
+            .collect();
+        write!(out, "{}", report::statistics(diagnostics))?;
+        report::human::render(&errors, sources, out)?;
+        return Ok(());
+    }
+    match args.format {
+        CheckFormat::Human => {
+            if args.common.verbose && !args.quiet {
+                for p in &report.skipped {
                     writeln!(
                         out,
                         "note: skipped {} (not a shader on its own)",
                         p.display()
-                    )
-                    .map_err(io)?;
+                    )?;
                 }
             }
-            report::human::render(diagnostics, sources, &mut out).map_err(io)?;
-            writeln!(out, "{}", report::human::summary_line(summary)).map_err(io)?;
+            report::human::render(diagnostics, sources, out)?;
+            if !args.quiet {
+                writeln!(out, "{}", report::human::summary_line(summary))?;
+            }
         }
-        Format::Json => println!("{}", report::json::render(diagnostics, summary)),
-        Format::Github => print!("{}", report::github(diagnostics)),
-        Format::Sarif => println!("{}", report::sarif::render(diagnostics)),
+        CheckFormat::Concise => {
+            write!(out, "{}", report::concise(diagnostics))?;
+            if !args.quiet {
+                writeln!(out, "{}", report::human::summary_line(summary))?;
+            }
+        }
+        CheckFormat::Json => writeln!(out, "{}", report::json::render(diagnostics, summary))?,
+        CheckFormat::Github => write!(out, "{}", report::github(diagnostics))?,
+        CheckFormat::Sarif => writeln!(out, "{}", report::sarif::render(diagnostics))?,
     }
     Ok(())
 }
 
-fn color_choice() -> ColorChoice {
-    if std::env::var_os("NO_COLOR").is_some()
-        || !std::io::IsTerminal::is_terminal(&std::io::stdout())
-    {
-        ColorChoice::Never
-    } else {
-        ColorChoice::Auto
+/// `--color`, with `auto` honouring NO_COLOR, then FORCE_COLOR and
+/// CLICOLOR_FORCE, then whether the output is a terminal.
+fn color_choice(arg: ColorArg, to_file: bool) -> ColorChoice {
+    let set = |name: &str| std::env::var_os(name).is_some_and(|v| !v.is_empty() && v != "0");
+    match arg {
+        ColorArg::Always => ColorChoice::Always,
+        ColorArg::Never => ColorChoice::Never,
+        ColorArg::Auto if std::env::var_os("NO_COLOR").is_some_and(|v| !v.is_empty()) => {
+            ColorChoice::Never
+        }
+        ColorArg::Auto if set("FORCE_COLOR") || set("CLICOLOR_FORCE") => ColorChoice::Always,
+        ColorArg::Auto if to_file || !std::io::IsTerminal::is_terminal(&std::io::stdout()) => {
+            ColorChoice::Never
+        }
+        ColorArg::Auto => ColorChoice::Auto,
     }
 }
 
-fn layout(common: Common) -> Result<u8, String> {
-    let Setup {
-        format,
-        inputs,
-        errors,
-        ..
-    } = setup(&common)?;
-    if matches!(format, Format::Github | Format::Sarif) {
-        return Err("`rtlint layout` prints human or json".into());
-    }
-    let mut problems: Vec<Diagnostic> = errors;
-    problems.extend(inputs.errors.iter().map(|e| (*e.0).clone()));
-    let mut files = Vec::new();
-    for p in load_programs(&inputs, &mut problems) {
-        files.push(rtlint::analysis::layout::FileLayouts::new(&p));
-    }
-    match format {
-        Format::Json => {
-            let errors: Vec<_> = problems.iter().map(report::json::diagnostic).collect();
-            let files: Vec<_> = files.iter().map(report::layout::json).collect();
-            let v = serde_json::json!({ "files": files, "errors": errors });
-            println!("{}", serde_json::to_string_pretty(&v).unwrap_or_default());
-        }
-        _ => {
-            let mut out = StandardStream::stdout(color_choice());
-            for f in &files {
-                write!(out, "{}", report::layout::human(f)).map_err(|e| e.to_string())?;
-            }
-            let mut sources = Sources::default();
-            report::human::render(&problems, &mut sources, &mut out).map_err(|e| e.to_string())?;
-        }
-    }
-    Ok(if problems.is_empty() { 0 } else { 2 })
+/// What `layout`, `live` and `stack` read: loaded Programs, the pipeline
+/// descriptions found, and input errors.
+struct Loaded {
+    programs: Vec<rtlint::program::Program>,
+    pipelines: Vec<PathBuf>,
+    problems: Vec<Diagnostic>,
 }
 
-fn live(common: Common) -> Result<u8, String> {
-    let Setup {
-        format,
-        inputs,
-        errors,
-        ..
-    } = setup(&common)?;
-    let mut problems: Vec<Diagnostic> = errors;
-    problems.extend(inputs.errors.iter().map(|e| (*e.0).clone()));
-    let programs = load_programs(&inputs, &mut problems);
+fn load(common: &Common) -> Result<Loaded, String> {
+    let options = options(common)?;
+    let inputs = lint::inputs(&common.paths, &options);
+    let mut problems: Vec<Diagnostic> = inputs.errors.iter().map(|e| (*e.0).clone()).collect();
+    let mut programs = Vec::new();
+    for input in &inputs.files {
+        match lint::load(input, &options) {
+            Ok(p) => programs.push(p),
+            Err(InputError(d)) => problems.push(*d),
+        }
+    }
+    Ok(Loaded {
+        programs,
+        pipelines: inputs.pipelines.into_iter().map(|(p, _)| p).collect(),
+        problems,
+    })
+}
+
+fn layout(common: Common, format: ReportFormat) -> Result<u8, String> {
+    let Loaded {
+        programs, problems, ..
+    } = load(&common)?;
+    let files: Vec<_> = programs
+        .iter()
+        .map(rtlint::analysis::layout::FileLayouts::new)
+        .collect();
+    let json = || {
+        let files: Vec<_> = files.iter().map(report::layout::json).collect();
+        serde_json::json!({ "version": 1, "files": files })
+    };
+    let human = || files.iter().map(report::layout::human).collect::<String>();
+    print_report(format, json, human, &problems)
+}
+
+fn live(common: Common, format: ReportFormat) -> Result<u8, String> {
+    let Loaded {
+        programs, problems, ..
+    } = load(&common)?;
     let report = rtlint::analysis::live_report(&programs);
-    print_report(format, &report, report::live::human(&report), &problems)
+    let json = || {
+        let mut v = serde_json::to_value(&report).unwrap_or_default();
+        if let Some(o) = v.as_object_mut() {
+            o.insert("version".into(), 1.into());
+        }
+        v
+    };
+    print_report(format, json, || report::live::human(&report), &problems)
 }
 
-fn stack(common: Common, driver: bool) -> Result<u8, String> {
-    let Setup {
-        format,
-        inputs,
-        errors,
-        ..
-    } = setup(&common)?;
-    let mut problems: Vec<Diagnostic> = errors;
-    problems.extend(inputs.errors.iter().map(|e| (*e.0).clone()));
+fn stack(common: Common, driver: bool, format: ReportFormat) -> Result<u8, String> {
+    let Loaded {
+        programs,
+        pipelines: descriptions,
+        mut problems,
+    } = load(&common)?;
     let mut pipelines = Vec::new();
-    for p in &inputs.pipelines {
+    for p in &descriptions {
         match rtlint::pipeline::load(p) {
             Ok(p) => pipelines.push(p),
             Err(InputError(d)) => problems.push(*d),
         }
     }
     // Loose shaders: one conservative pipeline over all of them.
-    if !inputs.files.is_empty() {
-        let programs = load_programs(&inputs, &mut problems);
-        if !programs.is_empty() {
-            pipelines.push(rtlint::pipeline::Pipeline::from_programs(programs));
-        }
+    if !programs.is_empty() {
+        pipelines.push(rtlint::pipeline::Pipeline::from_programs(programs));
     }
     #[cfg(feature = "vulkan")]
     let device = if driver {
@@ -422,65 +543,60 @@ fn stack(common: Common, driver: bool) -> Result<u8, String> {
         }
         reports.push(r);
     }
-    let human: String = reports
-        .iter()
-        .map(report::stack::human)
-        .collect::<Vec<_>>()
-        .join("\n");
-    let value = if reports.len() == 1 {
-        report::stack::json(&reports[0])
-    } else {
-        reports.iter().map(report::stack::json).collect()
+    // One shape whatever the number of inputs: a list of pipeline reports.
+    let json = || {
+        let list: Vec<_> = reports.iter().map(report::stack::json).collect();
+        serde_json::json!({ "version": 1, "pipelines": list })
     };
-    print_report(format, &value, human, &problems)
+    let human = || {
+        reports
+            .iter()
+            .map(report::stack::human)
+            .collect::<Vec<_>>()
+            .join("\n")
+    };
+    print_report(format, json, human, &problems)
 }
 
-/// Loads every input into a Program; the ones that fail become input errors.
-fn load_programs(
-    inputs: &lint::Inputs,
-    problems: &mut Vec<Diagnostic>,
-) -> Vec<rtlint::program::Program> {
-    let mut programs = Vec::new();
-    for input in &inputs.files {
-        match rtlint::front::load(&input.path, input.language) {
-            Ok(p) => programs.push(p),
-            Err(InputError(d)) => problems.push(*d),
-        }
-    }
-    programs
-}
-
-/// Prints a report as JSON or text, then any input errors; exit 2 on errors.
-fn print_report<T: serde::Serialize>(
-    format: Format,
-    value: &T,
-    human: String,
+/// Prints a report as JSON (with the input errors under `errors`) or text
+/// followed by the input errors; exit 2 on input errors.
+fn print_report(
+    format: ReportFormat,
+    json: impl FnOnce() -> serde_json::Value,
+    human: impl FnOnce() -> String,
     problems: &[Diagnostic],
 ) -> Result<u8, String> {
-    match format {
-        Format::Json => {
-            let mut v = serde_json::to_value(value).map_err(|e| e.to_string())?;
+    let result = match format {
+        ReportFormat::Json => {
+            let mut v = json();
             if let Some(obj) = v.as_object_mut() {
                 obj.insert(
                     "errors".into(),
-                    serde_json::to_value(
-                        problems
-                            .iter()
-                            .map(report::json::diagnostic)
-                            .collect::<Vec<_>>(),
-                    )
-                    .map_err(|e| e.to_string())?,
+                    problems
+                        .iter()
+                        .map(|d| {
+                            serde_json::to_value(report::json::diagnostic(d)).unwrap_or_default()
+                        })
+                        .collect(),
                 );
             }
-            println!("{}", serde_json::to_string_pretty(&v).unwrap_or_default());
+            let mut out = std::io::stdout().lock();
+            writeln!(
+                out,
+                "{}",
+                serde_json::to_string_pretty(&v).unwrap_or_default()
+            )
         }
-        Format::Human => {
-            let mut out = StandardStream::stdout(color_choice());
-            write!(out, "{human}").map_err(|e| e.to_string())?;
-            report::human::render(problems, &mut Sources::default(), &mut out)
-                .map_err(|e| e.to_string())?;
+        ReportFormat::Human => {
+            let mut out = StandardStream::stdout(color_choice(ColorArg::Auto, false));
+            write!(out, "{}", human())
+                .and_then(|()| report::human::render(problems, &mut Sources::default(), &mut out))
         }
-        _ => return Err("this command prints human or json".into()),
+    };
+    match result {
+        Ok(()) => {}
+        Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => return Ok(0),
+        Err(e) => return Err(format!("cannot write output: {e}")),
     }
     Ok(if problems.is_empty() { 0 } else { 2 })
 }
@@ -496,13 +612,7 @@ fn compile(
     use rtlint::front::hlsl;
     let options = hlsl::HlslOptions {
         include_dirs: include,
-        defines: define
-            .iter()
-            .map(|d| match d.split_once('=') {
-                Some((n, v)) => (n.to_string(), v.to_string()),
-                None => (d.clone(), "1".to_string()),
-            })
-            .collect(),
+        defines: define.iter().map(|d| split_define(d)).collect(),
         entry,
     };
     let write = |path: &std::path::Path, words: &[u32]| -> Result<(), String> {
@@ -510,7 +620,7 @@ fn compile(
         std::fs::write(path, bytes).map_err(|e| format!("cannot write {}: {e}", path.display()))
     };
     let report = |e: InputError| -> Result<u8, String> {
-        let mut out = StandardStream::stderr(color_choice());
+        let mut out = StandardStream::stderr(color_choice(ColorArg::Auto, false));
         let mut sources = Sources::default();
         report::human::render(&[*e.0], &mut sources, &mut out).map_err(|e| e.to_string())?;
         Ok(2)

@@ -31,6 +31,7 @@ impl Language {
             "wgsl" => Some(Language::Wgsl),
             "spv" | "spirv" => Some(Language::Spirv),
             "hlsl" | "hlsli" => Some(Language::Hlsl),
+            "rgen" | "rchit" | "rmiss" | "rahit" | "rint" | "rcall" => Some(Language::Glsl),
             _ => None,
         }
     }

@@ -25,9 +25,12 @@ fn one_module_per_entry_point_into_a_directory() {
         "{}",
         String::from_utf8_lossy(&o.stderr)
     );
+    let validate = rtlint_testkit::tool("spirv-val");
     for entry in ["RayGen", "Miss", "ShadowMiss", "ClosestHit"] {
         let words = common::read_words(&d.join(format!("{entry}.spv")));
-        common::spirv_val(&words).unwrap_or_else(|e| panic!("{entry}: {e}"));
+        if validate {
+            common::spirv_val(&words).unwrap_or_else(|e| panic!("{entry}: {e}"));
+        }
         let p = rtlint::program::parse(&words, &d.join("m.spv"), rtlint::shader::Language::Spirv)
             .unwrap();
         assert_eq!(p.entry_points.len(), 1);
@@ -81,7 +84,9 @@ fn entry_whole_module_defines_and_ambiguity() {
         String::from_utf8_lossy(&o.stderr)
     );
     let a = common::read_words(&d.join("a.spv"));
-    common::spirv_val(&a).unwrap();
+    if rtlint_testkit::tool("spirv-val") {
+        common::spirv_val(&a).unwrap();
+    }
     // VALUE + INC folds or stays as 7 and 1: either way a constant 7 is there.
     let p = rtlint::program::parse(&a, &d.join("a.spv"), rtlint::shader::Language::Spirv).unwrap();
     assert!(p.constants.values().any(

@@ -6,7 +6,7 @@ mod common;
 
 use common::root;
 use rtlint::config::Config;
-use rtlint::lint::{check_input, Input};
+use rtlint::lint::check_input;
 use rtlint::report::{human, Sources};
 use rtlint::shader::Language;
 use std::collections::BTreeSet;
@@ -84,24 +84,22 @@ fn relative(p: &Path) -> PathBuf {
     p.strip_prefix(root()).unwrap_or(p).to_path_buf()
 }
 
+/// Rendered text with the crate root taken off every path, so snapshots read
+/// as a user in the crate root would see them (no working directory is
+/// changed: tests run in parallel).
+fn relative_text(text: &str) -> String {
+    text.replace(&format!("{}/", root().display()), "")
+}
+
 #[test]
 fn findings_match_markers_and_snapshots() {
-    // Paths relative to the crate root, as a user would type them.
-    std::env::set_current_dir(root()).unwrap();
     let config = Config::default();
     let cases = cases();
     assert!(cases.len() >= 20, "fixtures missing: {}", cases.len());
     let mut failures = Vec::new();
     for (module, source) in cases {
-        let module = relative(&module);
         let language = Language::from_path(&module).unwrap();
-        let checked = check_input(
-            &Input {
-                path: module.clone(),
-                language,
-            },
-            &config,
-        );
+        let checked = check_input(&module, language, &config);
         assert!(
             checked.program.is_some(),
             "{} did not load: {:?}",
@@ -141,8 +139,10 @@ fn findings_match_markers_and_snapshots() {
         }
         let mut buf = codespan_reporting::term::termcolor::NoColor::new(Vec::new());
         human::render(&checked.diagnostics, &mut sources, &mut buf).unwrap();
-        let text = String::from_utf8(buf.into_inner()).unwrap();
-        let name = module.to_string_lossy().replace(['/', '\\'], "__");
+        let text = relative_text(&String::from_utf8(buf.into_inner()).unwrap());
+        let name = relative(&module)
+            .to_string_lossy()
+            .replace(['/', '\\'], "__");
         common::snapshot(&name, &text);
     }
     assert!(failures.is_empty(), "{}", failures.join("\n"));
@@ -152,9 +152,8 @@ fn findings_match_markers_and_snapshots() {
 /// wherever they land, and the rendered output matches its snapshot.
 #[test]
 fn pipeline_findings_match_markers_and_snapshots() {
-    std::env::set_current_dir(root()).unwrap();
     let config = Config::default();
-    let mut tomls: Vec<PathBuf> = std::fs::read_dir("fixtures")
+    let mut tomls: Vec<PathBuf> = std::fs::read_dir(root().join("fixtures"))
         .unwrap()
         .map(|e| e.unwrap().path())
         .filter(|d| d.file_name().unwrap().to_str().unwrap().starts_with("RT"))
@@ -194,8 +193,9 @@ fn pipeline_findings_match_markers_and_snapshots() {
         }
         let mut buf = codespan_reporting::term::termcolor::NoColor::new(Vec::new());
         human::render(&checked.diagnostics, &mut Sources::default(), &mut buf).unwrap();
-        let name = toml.to_string_lossy().replace(['/', '\\'], "__");
-        common::snapshot(&name, &String::from_utf8(buf.into_inner()).unwrap());
+        let name = relative(&toml).to_string_lossy().replace(['/', '\\'], "__");
+        let text = relative_text(&String::from_utf8(buf.into_inner()).unwrap());
+        common::snapshot(&name, &text);
     }
     assert!(failures.is_empty(), "{}", failures.join("\n"));
 }
@@ -240,11 +240,15 @@ fn every_rule_has_bad_and_good_fixtures() {
 #[test]
 fn glsl_fixture_modules_are_current_and_valid() {
     // Every GLSL fixture has both compiled forms, and each passes spirv-val.
+    let validate = rtlint_testkit::tool("spirv-val");
     for e in std::fs::read_dir(root().join("fixtures/glsl")).unwrap() {
         let p = e.unwrap().path();
         let name = p.file_name().unwrap().to_str().unwrap().to_string();
         if name.ends_with(".spv") {
-            common::spirv_val(&common::read_words(&p)).unwrap_or_else(|e| panic!("{name}: {e}"));
+            if validate {
+                common::spirv_val(&common::read_words(&p))
+                    .unwrap_or_else(|e| panic!("{name}: {e}"));
+            }
             continue;
         }
         if name.ends_with(".sh") {
@@ -263,6 +267,9 @@ fn glsl_fixture_modules_are_current_and_valid() {
 
 #[test]
 fn wgsl_fixtures_compile_to_valid_spirv_except_the_null_ray_query() {
+    if !rtlint_testkit::tool("spirv-val") {
+        return;
+    }
     for e in std::fs::read_dir(root().join("fixtures/wgsl")).unwrap() {
         let p = e.unwrap().path();
         let text = std::fs::read_to_string(&p).unwrap();

@@ -1,7 +1,10 @@
 //! Bad HLSL: every error names the file, line and column of the construct, and
 //! out-of-scope constructs say "not supported: ...". Nothing panics.
 
+mod common;
+
 use rtlint::front::hlsl::{self, pp::MemLoader, HlslOptions};
+use rtlint::report::{human, Sources};
 use std::path::{Path, PathBuf};
 
 /// Compiles `main.hlsl` (plus extra in-memory files); returns "line:col: message".
@@ -412,4 +415,72 @@ fn pixel_shader_interface_errors() {
         err(&format!("{PS}float4 ps(float3x3 m : M) : SV_Target {{ return 0; }}")),
         "main.hlsl:2:20: not supported: `float3x3` as a pixel shader input (scalars and vectors only)"
     );
+}
+
+/// Errors as a user sees them: rendered by the report layer with their source
+/// snippets, labels and notes. One snapshot holds every case, in order.
+#[test]
+fn rendered_errors_match_the_snapshot() {
+    let rg = |body: &str| format!("{RG}{body}\n}}");
+    let cases: Vec<Vec<(&str, String)>> = vec![
+        vec![("main.hlsl", rg("    x = 1;"))],
+        vec![("main.hlsl", rg("    float3 v = float2(1, 2);"))],
+        vec![("main.hlsl", rg("    float x = (1 + ;"))],
+        vec![("main.hlsl", rg("    switch (1) { case 1: break; case 1: break; }"))],
+        vec![(
+            "main.hlsl",
+            "float f(float x) { return f(x); }\n[numthreads(1,1,1)]\nvoid m() { float y = f(1.0); }"
+                .into(),
+        )],
+        vec![
+            ("dir/main.hlsl", "#include \"a.hlsli\"\n".into()),
+            ("dir/a.hlsli", "\n#include \"missing.hlsli\"\n".into()),
+        ],
+        vec![(
+            "main.hlsl",
+            "#define BAD(x) (x + undefinedThing)\n[shader(\"raygeneration\")]\nvoid rg()\n{\n    float f = BAD(1.0);\n}"
+                .into(),
+        )],
+        vec![
+            (
+                "main.hlsl",
+                "#include \"lib.hlsli\"\n[numthreads(1,1,1)]\nvoid m() { float y = helper(1.0); }"
+                    .into(),
+            ),
+            ("lib.hlsli", "float helper(float x)\n{\n    return x + nope;\n}".into()),
+        ],
+        vec![("main.hlsl", "#pragma pack_matrix(row_major)\n".into())],
+        vec![("main.hlsl", "float f(float x) { return x; }".into())],
+    ];
+    let mut all = String::new();
+    for files in &cases {
+        let mut loader = MemLoader(
+            files
+                .iter()
+                .map(|(p, t)| (PathBuf::from(p), t.clone()))
+                .collect(),
+        );
+        let (path, text) = &files[0];
+        let e = hlsl::compile_source(Path::new(path), text, &mut loader, &HlslOptions::default())
+            .err()
+            .unwrap_or_else(|| panic!("expected an error for:\n{text}"));
+        let mut sources = Sources::default();
+        for (p, t) in files {
+            sources.add_embedded(Path::new(p), t);
+        }
+        let mut buf = codespan_reporting::term::termcolor::NoColor::new(Vec::new());
+        human::render(std::slice::from_ref(e.diagnostic()), &mut sources, &mut buf).unwrap();
+        let rendered = String::from_utf8(buf.into_inner()).unwrap();
+        // Every positioned error shows its line of source.
+        if let Some(l) = &e.diagnostic().primary {
+            let file = files
+                .iter()
+                .find(|(p, _)| Path::new(p) == l.location.path)
+                .expect("the error is in one of the files");
+            let line = file.1.lines().nth(l.location.line as usize - 1).unwrap();
+            assert!(rendered.contains(line), "{rendered}");
+        }
+        all.push_str(&format!("=== {path}\n{rendered}"));
+    }
+    common::snapshot("hlsl_errors__rendered", &all);
 }

@@ -217,19 +217,11 @@ fn deep_nesting_and_macro_bombs_end_in_errors() {
 }
 
 /// Mutated shaders the compiler accepts must give valid SPIR-V: an accepted
-/// input never becomes an invalid module. Needs spirv-val (skipped without it
-/// unless CI=true).
+/// input never becomes an invalid module. Needs spirv-val (the skip policy
+/// of `rtlint_testkit::require`).
 #[test]
 fn accepted_mutations_validate() {
-    if std::process::Command::new("spirv-val")
-        .arg("--version")
-        .output()
-        .is_err()
-    {
-        assert!(
-            std::env::var("CI").as_deref() != Ok("true"),
-            "spirv-val is required in CI"
-        );
+    if !rtlint_testkit::tool("spirv-val") {
         return;
     }
     let files = shaders();

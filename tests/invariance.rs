@@ -317,6 +317,9 @@ fn compare(what: &str, facts: &BTreeMap<Mode, Value>, differences: &mut Vec<(Str
 
 #[test]
 fn analyses_do_not_depend_on_debug_info() {
+    if !rtlint_testkit::tool("glslangValidator") || !rtlint_testkit::tool("spirv-val") {
+        return;
+    }
     let out = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("invariance");
     let _ = std::fs::remove_dir_all(&out);
     let glsl = compile_glsl_tree(&out);
@@ -555,8 +558,9 @@ fn coded_lines(d: &[Diagnostic]) -> Vec<String> {
 /// [`KNOWN_ACROSS_COMPILERS`] says.
 #[test]
 fn hlsl_compilers_agree() {
-    let slang = rtlint::front::slang::Slang::find()
-        .expect("Slang is required (scripts/setup installs slangpy)");
+    let Some(slang) = rtlint_testkit::slang() else {
+        return;
+    };
     let mut files = Vec::new();
     files_under(&root().join("fixtures"), &mut files);
     files_under(&root().join("tests/hlsl"), &mut files);

@@ -4,6 +4,7 @@ mod common;
 
 #[test]
 fn bundled_wgsl_shaders_are_valid_and_clean() {
+    let validate = rtlint_testkit::tool("spirv-val");
     let mut n = 0;
     for e in std::fs::read_dir(common::root().join("shaders")).unwrap() {
         let p = e.unwrap().path();
@@ -13,7 +14,9 @@ fn bundled_wgsl_shaders_are_valid_and_clean() {
         n += 1;
         let text = std::fs::read_to_string(&p).unwrap();
         let words = rtlint::front::wgsl::compile(&text, &p).unwrap();
-        common::spirv_val(&words).unwrap_or_else(|e| panic!("{}: {e}", p.display()));
+        if validate {
+            common::spirv_val(&words).unwrap_or_else(|e| panic!("{}: {e}", p.display()));
+        }
         let program = rtlint::front::load(&p, rtlint::shader::Language::Wgsl).unwrap();
         let findings = rtlint::rules::check_program(&program, &rtlint::config::Config::default());
         assert!(findings.is_empty(), "{}: {findings:?}", p.display());

@@ -43,12 +43,15 @@ fn stack_on_every_pipeline_with_and_without_the_driver() {
     ];
     args.extend(pipelines().iter().map(|p| p.to_string_lossy().into_owned()));
     let with: Vec<&str> = args.iter().map(String::as_str).collect();
-    let reports = json(&with);
-    let reports = reports.as_array().expect("one report per pipeline");
+    let out = json(&with);
+    assert_eq!(out["version"], 1);
+    let reports = out["pipelines"]
+        .as_array()
+        .expect("one report per pipeline");
     assert_eq!(reports.len(), pipelines().len());
     let without: Vec<&str> = with.iter().copied().filter(|a| *a != "--driver").collect();
     let models = json(&without);
-    for (r, m) in reports.iter().zip(models.as_array().unwrap()) {
+    for (r, m) in reports.iter().zip(models["pipelines"].as_array().unwrap()) {
         for key in [
             "required_depth",
             "declared_depth",
@@ -94,12 +97,15 @@ fn stack_on_every_pipeline_with_and_without_the_driver() {
 
 #[test]
 fn stack_numbers_for_the_reference_pipeline() {
-    let r = json(&[
+    let out = json(&[
         "stack",
         "--format",
         "json",
         "shaders/reflect_iterative.pipeline.toml",
     ]);
+    // One shape whatever the number of inputs.
+    let r = &out["pipelines"][0];
+    assert_eq!(out["pipelines"].as_array().unwrap().len(), 1);
     assert_eq!(r["required_depth"], 1);
     assert_eq!(r["declared_depth"], 1);
     let stages: Vec<(&str, u64)> = r["shaders"]

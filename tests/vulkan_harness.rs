@@ -3,8 +3,8 @@
 //! (read back through ray queries in a compute pipeline), and the child
 //! process runner.
 //!
-//! Like the smoke test, these fail rather than skip when there is no
-//! ray-tracing device.
+//! Like the smoke test, these need a ray-tracing device (the skip policy of
+//! `rtlint_testkit::require`: a failure in CI, a `skipped:` line elsewhere).
 
 #![cfg(feature = "vulkan")]
 
@@ -16,7 +16,6 @@ use rtlint::vk::{
     BindingKind, Buffer, ComputePipeline, Context, ContextOptions, Error, Geometry, Group,
     Instance, RayTracingPipeline, RayTracingPipelineDesc, Resource, ShaderStage, Stage,
 };
-use std::path::Path;
 use std::time::{Duration, Instant};
 
 /// `RayQueryIntersection` values as naga's WGSL names them.
@@ -36,13 +35,6 @@ const BOX_TRANSFORM: [[f32; 4]; 3] = [
     [0.0, 0.0, 1.0, -3.0],
 ];
 
-fn open_device() -> Context {
-    match Context::new() {
-        Ok(ctx) => ctx,
-        Err(e) => panic!("no usable ray-tracing device (install lavapipe with scripts/setup): {e}"),
-    }
-}
-
 /// With `RTLINT_VK_VALIDATION=1` and the Khronos layer installed, any
 /// validation error fails the test that caused it.
 fn assert_valid(ctx: &Context) {
@@ -52,6 +44,9 @@ fn assert_valid(ctx: &Context) {
 
 #[test]
 fn missing_device_is_an_error_naming_what_is_missing() {
+    let Some(real) = common::device() else {
+        return;
+    };
     let options = ContextOptions {
         device_name: Some("no such device".into()),
         ..ContextOptions::default()
@@ -61,7 +56,6 @@ fn missing_device_is_an_error_naming_what_is_missing() {
         panic!("expected NoDevice, got {err:?}");
     };
     // Every device present is named with the reason it was passed over.
-    let real = open_device();
     assert!(
         reasons
             .iter()
@@ -78,25 +72,35 @@ fn missing_device_is_an_error_naming_what_is_missing() {
 /// The driver ignores `OpSource`, so under validation it is set to Unknown.
 fn for_validation(ctx: &Context, mut words: Vec<u32>) -> Vec<u32> {
     if ctx.validation_enabled() {
-        common::unknown_source_language(&mut words);
+        rtlint_testkit::unknown_source_language(&mut words);
     }
     words
 }
 
-/// The messenger collects what the layer reports. Needs the Khronos layer
-/// (Debian: vulkan-validationlayers), which scripts/setup installs; without
-/// it the test fails.
-#[test]
-fn validation_layer_reports_misuse() {
+/// A device under the Khronos validation layer (Debian:
+/// vulkan-validationlayers, which scripts/setup installs), under the skip
+/// policy.
+fn validating_device() -> Option<Context> {
+    common::device()?;
     let ctx = Context::with_options(&ContextOptions {
         validation: true,
         ..ContextOptions::default()
     })
     .expect("a device opens with validation asked for");
-    assert!(
-        ctx.validation_enabled(),
-        "VK_LAYER_KHRONOS_validation is not installed: run scripts/setup"
-    );
+    let layer = if ctx.validation_enabled() {
+        Ok(ctx)
+    } else {
+        Err("not installed (scripts/setup installs vulkan-validationlayers)")
+    };
+    rtlint_testkit::require("VK_LAYER_KHRONOS_validation", layer)
+}
+
+/// The messenger collects what the layer reports.
+#[test]
+fn validation_layer_reports_misuse() {
+    let Some(ctx) = validating_device() else {
+        return;
+    };
     assert_valid(&ctx);
     // A zero-sized buffer breaks VUID-VkBufferCreateInfo-size-00912.
     let info = raw::BufferCreateInfo::default()
@@ -117,17 +121,13 @@ fn validation_layer_reports_misuse() {
 /// deliberately leaked buffer shows. Needs the layer, like the test above.
 #[test]
 fn teardown_leaves_no_objects_behind() {
-    let open = || {
-        Context::with_options(&ContextOptions {
-            validation: true,
-            ..ContextOptions::default()
-        })
-        .expect("a device opens with validation asked for")
+    let Some(ctx) = validating_device() else {
+        return;
     };
-    let ctx = open();
+    let open = || validating_device().expect("the layer was there a moment ago");
     let log = ctx
         .validation_log()
-        .expect("VK_LAYER_KHRONOS_validation is not installed: run scripts/setup");
+        .expect("a validating context has a log");
     let scene = Scene::reflection();
     let blas = AccelerationStructure::bottom_level(
         &ctx,
@@ -139,8 +139,11 @@ fn teardown_leaves_no_objects_behind() {
     )
     .unwrap();
     let tlas = AccelerationStructure::top_level(&ctx, &[Instance::identity(&blas)]).unwrap();
-    let rays = [Ray::new([0.5, 0.5, 0.5], [0.0, -1.0, 0.0])];
-    assert_eq!(probe(&ctx, &tlas, &rays)[0].kind, TRIANGLE);
+    // A compute pipeline too, where the device has ray queries (the probe's).
+    if ctx.info().ray_query {
+        let rays = [Ray::new([0.5, 0.5, 0.5], [0.0, -1.0, 0.0])];
+        assert_eq!(probe(&ctx, &tlas, &rays)[0].kind, TRIANGLE);
+    }
     // The context first, then what was made from it.
     drop(ctx);
     drop((blas, tlas));
@@ -218,7 +221,7 @@ struct Probe {
 }
 
 fn probe(ctx: &Context, tlas: &AccelerationStructure, rays: &[Ray]) -> Vec<Probe> {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/shaders/ray_probe.wgsl");
+    let path = common::root().join("tests/shaders/ray_probe.wgsl");
     let source = std::fs::read_to_string(&path).unwrap();
     let spirv = rtlint::front::wgsl::compile(&source, &path).expect("the probe shader compiles");
     let spirv = for_validation(ctx, spirv);
@@ -275,11 +278,12 @@ fn probe(ctx: &Context, tlas: &AccelerationStructure, rays: &[Ray]) -> Vec<Probe
 /// field the acceleration structures feed back.
 #[test]
 fn ray_queries_see_triangles_aabbs_transforms_and_masks() {
-    let ctx = open_device();
-    if !ctx.info().ray_query {
-        // NVIDIA's driver (FIELD-NOTES) has ray-tracing pipelines but not
-        // VK_KHR_ray_query; this test has nothing to run there.
-        eprintln!("{} has no VK_KHR_ray_query", ctx.info().name);
+    let Some(ctx) = common::device() else {
+        return;
+    };
+    // NVIDIA's driver (FIELD-NOTES) has ray-tracing pipelines but not
+    // VK_KHR_ray_query; this test has nothing to run there.
+    if !common::has_ray_query(&ctx) {
         return;
     }
     let scene = Scene::reflection();
@@ -425,7 +429,7 @@ fn ray_queries_see_triangles_aabbs_transforms_and_masks() {
 }
 
 fn load_spv(name: &str) -> Vec<u32> {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+    let path = common::root()
         .join("tests/shaders/procedural")
         .join(format!("{name}.spv"));
     let bytes = std::fs::read(&path).expect("committed SPIR-V (tests/shaders/procedural/build.sh)");
@@ -438,7 +442,9 @@ fn load_spv(name: &str) -> Vec<u32> {
 /// triangles by an instance transform and chosen by its SBT record offset.
 #[test]
 fn procedural_and_any_hit_groups_trace_as_the_geometry_says() {
-    let ctx = open_device();
+    let Some(ctx) = common::device() else {
+        return;
+    };
     let names = [
         ("probe.rgen", Stage::RayGeneration),
         ("probe.rmiss", Stage::Miss),
@@ -645,6 +651,9 @@ fn procedural_and_any_hit_groups_trace_as_the_geometry_says() {
 /// lavapipe goes on computing until the process ends.
 #[test]
 fn fence_timeout_is_an_error_not_a_hang() {
+    if common::device().is_none() {
+        return;
+    }
     if let Some(outcome) = run_in_child_with_timeout(
         "fence_timeout_is_an_error_not_a_hang",
         Duration::from_secs(120),
@@ -664,7 +673,7 @@ fn fence_timeout_is_an_error_not_a_hang() {
         ..ContextOptions::default()
     })
     .unwrap();
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/shaders/spin.wgsl");
+    let path = common::root().join("tests/shaders/spin.wgsl");
     let source = std::fs::read_to_string(&path).unwrap();
     let spirv = for_validation(&ctx, rtlint::front::wgsl::compile(&source, &path).unwrap());
     let bindings = [
@@ -724,6 +733,9 @@ fn child_process_reports_a_crash() {
 /// can be moved into children without losing results.
 #[test]
 fn child_process_runs_gpu_work() {
+    if common::device().is_none() {
+        return;
+    }
     if let Some(outcome) = run_in_child("child_process_runs_gpu_work") {
         assert!(outcome.success(), "{outcome:?}");
         assert!(
@@ -734,7 +746,9 @@ fn child_process_runs_gpu_work() {
         );
         return;
     }
-    let ctx = open_device();
+    let Some(ctx) = common::device() else {
+        return;
+    };
     let scene = Scene::reflection();
     let blas = AccelerationStructure::bottom_level(
         &ctx,

@@ -1,8 +1,9 @@
 //! Runs the WGSL reflection pipeline on the Vulkan driver (lavapipe here) and
 //! compares its image with the CPU reference renderer.
 //!
-//! These tests fail, never skip, without a ray-tracing device: the project's
-//! claim that its reference shaders are correct rests on them.
+//! The project's claim that its reference shaders are correct rests on
+//! these: without a ray-tracing device they fail in CI, and elsewhere print
+//! why they skipped (`rtlint_testkit::require`).
 
 #![cfg(feature = "vulkan")]
 
@@ -50,7 +51,7 @@ fn bindings() -> [Binding; 4] {
 }
 
 fn compile_shader(ctx: &Context) -> Vec<u32> {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join(SHADER);
+    let path = common::root().join(SHADER);
     let source = std::fs::read_to_string(&path).expect("the reference shader is readable");
     let words =
         rtlint::front::wgsl::compile(&source, &path).expect("the reference shader compiles");
@@ -62,16 +63,9 @@ fn compile_shader(ctx: &Context) -> Vec<u32> {
 /// The driver ignores `OpSource`, so under validation it is set to Unknown.
 fn for_validation(ctx: &Context, mut words: Vec<u32>) -> Vec<u32> {
     if ctx.validation_enabled() {
-        common::unknown_source_language(&mut words);
+        rtlint_testkit::unknown_source_language(&mut words);
     }
     words
-}
-
-fn open_device() -> Context {
-    match Context::new() {
-        Ok(ctx) => ctx,
-        Err(e) => panic!("no usable ray-tracing device (install lavapipe with scripts/setup): {e}"),
-    }
 }
 
 /// With `RTLINT_VK_VALIDATION=1` and the Khronos layer installed, any
@@ -263,7 +257,9 @@ fn assert_matches(c: &Comparison) {
 #[test]
 fn reflection_pipeline_matches_cpu_reference() {
     let start = Instant::now();
-    let ctx = open_device();
+    let Some(ctx) = common::device() else {
+        return;
+    };
     let device_time = start.elapsed();
     let spirv = compile_shader(&ctx);
     let scene = Scene::reflection();
@@ -308,7 +304,9 @@ fn reflection_pipeline_matches_cpu_reference() {
 /// ample on every driver measured).
 #[test]
 fn explicit_stack_size_renders_the_same() {
-    let ctx = open_device();
+    let Some(ctx) = common::device() else {
+        return;
+    };
     let spirv = compile_shader(&ctx);
     let scene = Scene::reflection();
     let gpu = render_on_gpu(&ctx, &spirv, &scene, PARAMS, Some(1024));
@@ -414,7 +412,9 @@ fn check_semantics(scene: &Scene, image: &[u32]) {
 /// test checks the answers are present and plausible instead.
 #[test]
 fn group_stack_size_query() {
-    let ctx = open_device();
+    let Some(ctx) = common::device() else {
+        return;
+    };
     let spirv = compile_shader(&ctx);
     let pipeline = create_pipeline(&ctx, &spirv, None);
     let sizes = pipeline.group_stack_sizes();

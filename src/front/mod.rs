@@ -2,8 +2,8 @@
 //! (`OpString`/`OpLine`, or `NonSemantic.Shader.DebugInfo.100`) leads back to the
 //! original source.
 
+pub mod glsl;
 pub mod hlsl;
-pub mod slang;
 pub mod wgsl;
 
 use crate::diag::InputError;
@@ -25,59 +25,108 @@ pub struct Compiled {
     pub words: Vec<u32>,
     /// Declaration positions the SPIR-V's own debug info lacks.
     pub decls: Vec<(NamedDecl, Location)>,
+    /// The scratch file an external compiler read instead of `path`.
+    pub scratch_source: Option<PathBuf>,
+}
+
+/// Options for front-ends that read more than one file.
+#[derive(Clone, Debug, Default)]
+pub struct FrontOptions {
+    /// `-I` directories (HLSL and GLSL), after the including file's folder.
+    pub include_dirs: Vec<PathBuf>,
+    /// `-D NAME=VALUE` (HLSL and GLSL).
+    pub defines: Vec<(String, String)>,
 }
 
 /// Reads and compiles one file to SPIR-V.
 pub fn compile_path(path: &Path, language: Language) -> Result<Compiled, InputError> {
+    compile_input(path, None, language, &FrontOptions::default())
+}
+
+/// Compiles one input to SPIR-V: the file at `path`, or `contents` (standard
+/// input) under that name.
+pub fn compile_input(
+    path: &Path,
+    contents: Option<&[u8]>,
+    language: Language,
+    options: &FrontOptions,
+) -> Result<Compiled, InputError> {
+    let text = || -> Result<String, InputError> {
+        match contents {
+            Some(bytes) => crate::diag::text_from_bytes(bytes, path),
+            None => read_text(path),
+        }
+    };
+    let compiled = |language, words, decls| Compiled {
+        path: path.to_path_buf(),
+        language,
+        input_language: language,
+        words,
+        decls,
+        scratch_source: None,
+    };
     match language {
         Language::Wgsl => {
-            let text = read_text(path)?;
+            let text = text()?;
             let (module, info) = wgsl::parse(&text, path)?;
             let words = wgsl::write_spirv(&module, &info, &text, path)?;
-            Ok(Compiled {
-                path: path.to_path_buf(),
-                language: Language::Wgsl,
-                input_language: Language::Wgsl,
+            Ok(compiled(
+                Language::Wgsl,
                 words,
-                decls: wgsl::declarations(&module, &text, path),
-            })
+                wgsl::declarations(&module, &text, path),
+            ))
         }
         Language::Spirv => {
-            let bytes = std::fs::read(path).map_err(|e| io_error(path, &e))?;
+            let bytes = match contents {
+                Some(b) => b.to_vec(),
+                None => std::fs::read(path).map_err(|e| io_error(path, &e))?,
+            };
             let words = crate::program::words_from_bytes(&bytes, path)?;
-            Ok(Compiled {
-                path: path.to_path_buf(),
-                language: Language::Spirv,
-                input_language: Language::Spirv,
-                words,
-                decls: Vec::new(),
-            })
+            Ok(compiled(Language::Spirv, words, Vec::new()))
         }
         Language::Hlsl => {
-            let m = hlsl::compile_file(path, &hlsl::HlslOptions::default())?;
-            Ok(Compiled {
-                path: path.to_path_buf(),
-                language: Language::Hlsl,
-                input_language: Language::Hlsl,
-                words: m.words,
-                decls: m.decls,
-            })
+            let text = text()?;
+            let hlsl_options = hlsl::HlslOptions {
+                include_dirs: options.include_dirs.clone(),
+                defines: options.defines.clone(),
+                ..hlsl::HlslOptions::default()
+            };
+            let m =
+                hlsl::compile_source_whole(path, &text, &mut hlsl::pp::FsLoader, &hlsl_options)?;
+            Ok(compiled(Language::Hlsl, m.words, m.decls))
         }
-        Language::Glsl => Err(InputError::new(
-            InputErrorKind::UnsupportedLanguage,
-            path,
-            format!(
-                "{} input is not supported by this build of rtlint",
-                language.as_str()
-            ),
-        )),
+        Language::Glsl => {
+            let text = text()?;
+            let (words, scratch) = glsl::compile(path, &text, options)?;
+            let mut c = compiled(Language::Glsl, words, Vec::new());
+            c.scratch_source = scratch;
+            Ok(c)
+        }
     }
 }
 
 /// Compiles one file and builds its [`Program`](crate::program::Program).
 pub fn load(path: &Path, language: Language) -> Result<crate::program::Program, InputError> {
-    let c = compile_path(path, language)?;
+    load_input(path, None, language, &FrontOptions::default())
+}
+
+/// Compiles one input and builds its Program; debug info that names the
+/// front-end's scratch copy names the input instead.
+pub fn load_input(
+    path: &Path,
+    contents: Option<&[u8]>,
+    language: Language,
+    options: &FrontOptions,
+) -> Result<crate::program::Program, InputError> {
+    let c = compile_input(path, contents, language, options)?;
     let mut program = crate::program::parse(&c.words, &c.path, c.language)?;
     program.attach_named_decls(&c.decls);
+    if let Some(scratch) = &c.scratch_source {
+        for f in &mut program.files {
+            if f.path == *scratch {
+                f.path = path.to_path_buf();
+            }
+        }
+    }
     Ok(program)
 }

@@ -72,7 +72,11 @@ pub fn render(
             cs.notes
                 .push(format!("note: `rtlint rule {code}` explains this rule"));
         }
-        term::emit_to_write_style(out, &config, &files, &cs).map_err(std::io::Error::other)?;
+        term::emit_to_write_style(out, &config, &files, &cs).map_err(|e| match e {
+            // Keep the kind: a closed pipe is not an error to report.
+            codespan_reporting::files::Error::Io(e) => e,
+            e => std::io::Error::other(e),
+        })?;
     }
     Ok(())
 }

@@ -21,7 +21,9 @@ pub struct JsonDiagnostic<'a> {
     pub labels: Vec<JsonLabel>,
     pub notes: &'a [String],
     pub help: Option<&'a str>,
+    /// Replacement text for the declaration at `fix_location`.
     pub fix: Option<&'a str>,
+    pub fix_location: Option<JsonLabel>,
 }
 
 #[derive(serde::Serialize)]
@@ -59,7 +61,17 @@ pub fn diagnostic(d: &Diagnostic) -> JsonDiagnostic<'_> {
             .collect(),
         notes: &d.notes,
         help: d.help.as_deref(),
-        fix: d.fix.as_deref(),
+        fix: d.fix.as_ref().map(|f| f.replacement.as_str()),
+        fix_location: d
+            .fix
+            .as_ref()
+            .and_then(|f| f.location.as_ref())
+            .map(|l| JsonLabel {
+                path: l.path.display().to_string(),
+                line: l.line,
+                column: l.column,
+                message: "replace this declaration".into(),
+            }),
     }
 }
 

@@ -150,6 +150,51 @@ pub fn byte_range(text: &str, loc: &Location) -> Option<std::ops::Range<usize>> 
     Some(start..start + len)
 }
 
+/// One line per finding: `path:line:col: level[CODE] message`.
+pub fn concise(diagnostics: &[Diagnostic]) -> String {
+    let mut out = String::new();
+    for d in diagnostics {
+        let (path, line, col, _, _) = d.position();
+        let mut at = path.display().to_string();
+        if line > 0 {
+            at.push_str(&format!(":{line}"));
+            if col > 0 {
+                at.push_str(&format!(":{col}"));
+            }
+        }
+        let code = d.code.unwrap_or(d.name);
+        let mut message = d.message.clone();
+        if let Some(s) = d.subject.as_ref().filter(|_| d.primary.is_none()) {
+            message.push_str(&format!(" ({s})"));
+        }
+        out.push_str(&format!(
+            "{at}: {}[{code}] {message}\n",
+            d.severity.as_str()
+        ));
+    }
+    out
+}
+
+/// Findings counted per rule, most frequent first (`--statistics`).
+pub fn statistics(diagnostics: &[Diagnostic]) -> String {
+    let mut counts: Vec<(&str, &str, usize)> = Vec::new();
+    for d in diagnostics {
+        let code = d.code.unwrap_or("input");
+        match counts
+            .iter_mut()
+            .find(|(c, n, _)| *c == code && *n == d.name)
+        {
+            Some(e) => e.2 += 1,
+            None => counts.push((code, d.name, 1)),
+        }
+    }
+    counts.sort_by(|a, b| b.2.cmp(&a.2).then(a.0.cmp(b.0)).then(a.1.cmp(b.1)));
+    counts
+        .iter()
+        .map(|(c, n, k)| format!("{k:>6}  {c:<6} {n}\n"))
+        .collect()
+}
+
 /// `::warning title=rtlint (RT001),file=…,line=…,col=…::message` lines.
 pub fn github(diagnostics: &[Diagnostic]) -> String {
     let mut out = String::new();
@@ -173,14 +218,18 @@ pub fn github(diagnostics: &[Diagnostic]) -> String {
             props.push_str(&format!(",line={line},endLine={}", end_line.max(line)));
             if col > 0 {
                 props.push_str(&format!(",col={col}"));
-                if end_line <= line && end_col > col {
-                    props.push_str(&format!(",endColumn={end_col}"));
+                // GitHub highlights `col..endColumn` on a single line.
+                if end_line <= line {
+                    props.push_str(&format!(",endColumn={}", end_col.max(col)));
                 }
             }
         }
         let mut message = d.message.clone();
         if let Some(s) = d.subject.as_ref().filter(|_| d.primary.is_none()) {
             message.push_str(&format!(" ({s})"));
+        }
+        if let Some(h) = &d.help {
+            message.push_str(&format!("\nhelp: {h}"));
         }
         out.push_str(&format!("::{level} {props}::{}\n", escape_data(&message)));
     }

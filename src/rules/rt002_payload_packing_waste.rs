@@ -1,16 +1,65 @@
-use super::{indent, Context, Group, Kind, Rule};
+use super::{indent, Context};
 use crate::analysis::layout::Role;
-use crate::diag::{Diagnostic, Severity};
+use crate::diag::Diagnostic;
 
-pub static RULE: Rule = Rule {
-    code: "RT002",
-    name: "payload-packing-waste",
-    group: Group::Perf,
-    level: Severity::Warning,
-    summary: "payload member order wastes 16-byte rows",
-    doc: include_str!("../../rules/RT002.md"),
-    kind: Kind::Module(check),
-};
+super::declare_rule! {
+    /// ## What it does
+    ///
+    /// Lays out each ray payload and callable-data struct under HLSL's 16-byte
+    /// packing (no scalar or vector crosses a 16-byte row; structs, arrays and
+    /// matrices start a new row; the last member is not padded) and compares the
+    /// declared member order with the best possible order. When another order needs
+    /// fewer bytes, it reports both sizes and offers the reordered struct. Among
+    /// equally small orders it picks the one that moves members least (the
+    /// lexicographically smallest list of declared positions). The search is exact
+    /// for structs of up to 16 members.
+    ///
+    /// ## Why is this bad?
+    ///
+    /// Shaders compiled with 16-byte packing (DXC's cbuffer rules, and the way many
+    /// engines share payload structs with constant buffers) store each row of the
+    /// payload as a register quadruple. Padding inside those rows is stored, copied
+    /// and spilled like data, so a badly ordered payload costs the same as a larger
+    /// one.
+    ///
+    /// ## Example
+    ///
+    /// ```hlsl
+    /// struct Payload {
+    ///     float3 color;     // row 0, bytes 0..12
+    ///     float2 uv;        // would cross row 0: moved to row 1
+    ///     float distance;   // row 1
+    /// };                    // 28 bytes, 2 rows, 4 bytes padding
+    /// ```
+    ///
+    /// Use instead:
+    ///
+    /// ```hlsl
+    /// struct Payload {
+    ///     float3 color;
+    ///     float distance;   // fills row 0
+    ///     float2 uv;        // row 1
+    /// };                    // 24 bytes
+    /// ```
+    ///
+    /// ## How to fix
+    ///
+    /// Reorder the members as the help shows. Put vectors of three next to a scalar,
+    /// pair two-component vectors, and put structs and arrays first or last.
+    ///
+    /// ## Options
+    ///
+    /// None.
+    ///
+    /// ## References
+    ///
+    /// - Microsoft, "Packing rules for constant variables" (HLSL).
+    "RT002" "payload-packing-waste" {
+        group: Perf,
+        summary: "payload member order wastes 16-byte rows",
+        kind: super::Kind::Module(check),
+    }
+}
 
 fn check(ctx: &Context) -> Vec<Diagnostic> {
     let mut out = Vec::new();
@@ -55,7 +104,7 @@ fn check(ctx: &Context) -> Vec<Diagnostic> {
                 t.hlsl_padding
             ))
             .with_help(format!("reorder the members:\n{}", indent(&decl)))
-            .with_fix(decl);
+            .with_fix(ctx.type_location(t), decl);
         out.push(d);
     }
     out

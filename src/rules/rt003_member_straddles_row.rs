@@ -1,16 +1,60 @@
-use super::{Context, Group, Kind, Rule};
+use super::Context;
 use crate::analysis::layout::Role;
-use crate::diag::{Diagnostic, Severity};
+use crate::diag::Diagnostic;
 
-pub static RULE: Rule = Rule {
-    code: "RT003",
-    name: "member-straddles-row",
-    group: Group::Perf,
-    level: Severity::Warning,
-    summary: "payload member crosses a 16-byte row",
-    doc: include_str!("../../rules/RT003.md"),
-    kind: Kind::Module(check),
-};
+super::declare_rule! {
+    /// ## What it does
+    ///
+    /// Reports a scalar or vector member of a payload, callable-data or hit-attribute
+    /// struct that, placed where its declared order puts it, crosses a 16-byte row.
+    /// Under HLSL 16-byte packing such a member is moved to the next row and the bytes
+    /// before it become padding; in the tight layout drivers use for payloads it is
+    /// split across two registers quadruples.
+    ///
+    /// ## Why is this bad?
+    ///
+    /// A member split across rows needs two register quadruples to read or write, and
+    /// the padding that 16-byte packing inserts before it is stored and copied with
+    /// the payload on every trace.
+    ///
+    /// ## Example
+    ///
+    /// ```glsl
+    /// struct Payload {
+    ///     vec3 color;   // bytes 0..12
+    ///     vec2 uv;      // bytes 12..20: crosses the row at 16
+    /// };
+    /// ```
+    ///
+    /// Use instead:
+    ///
+    /// ```glsl
+    /// struct Payload {
+    ///     vec2 uv;
+    ///     vec3 color;   // bytes 8..20 still crosses: pair it with a scalar instead
+    /// };
+    /// ```
+    ///
+    /// or better, put a scalar after `color` (see RT002, which computes the best order).
+    ///
+    /// ## How to fix
+    ///
+    /// Place the member where its row has room, usually by moving a scalar next to a
+    /// three-component vector, or apply the order RT002 suggests.
+    ///
+    /// ## Options
+    ///
+    /// None.
+    ///
+    /// ## References
+    ///
+    /// - Microsoft, "Packing rules for constant variables" (HLSL).
+    "RT003" "member-straddles-row" {
+        group: Perf,
+        summary: "payload member crosses a 16-byte row",
+        kind: super::Kind::Module(check),
+    }
+}
 
 fn check(ctx: &Context) -> Vec<Diagnostic> {
     let mut out = Vec::new();

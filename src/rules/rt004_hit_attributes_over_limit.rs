@@ -1,16 +1,51 @@
-use super::{Context, Group, Kind, Rule};
+use super::Context;
 use crate::analysis::layout::Role;
-use crate::diag::{Diagnostic, Severity};
+use crate::diag::Diagnostic;
 
-pub static RULE: Rule = Rule {
-    code: "RT004",
-    name: "hit-attributes-over-limit",
-    group: Group::Correctness,
-    level: Severity::Error,
-    summary: "hit attributes larger than the 32-byte limit",
-    doc: include_str!("../../rules/RT004.md"),
-    kind: Kind::Module(check),
-};
+super::declare_rule! {
+    /// ## What it does
+    ///
+    /// Reports a hit-attribute type (`HitAttributeKHR`, HLSL's attribute struct
+    /// passed to `ReportHit`) larger than 32 bytes.
+    ///
+    /// ## Why is this bad?
+    ///
+    /// 32 bytes is D3D12's fixed `D3D12_RAYTRACING_MAX_ATTRIBUTE_SIZE_IN_BYTES` and
+    /// the `maxRayHitAttributeSize` of every Vulkan driver we have measured (lavapipe,
+    /// NVIDIA). Pipeline creation fails, or the attributes are silently truncated, on
+    /// a driver that does not allow more.
+    ///
+    /// ## Example
+    ///
+    /// ```glsl
+    /// hitAttributeEXT struct { vec3 normal; vec3 position; vec2 uv; } attribs; // 32 + 8 bytes
+    /// ```
+    ///
+    /// Use instead:
+    ///
+    /// ```glsl
+    /// hitAttributeEXT struct { vec2 uv; float t; } attribs; // recompute normal and position in the hit shader
+    /// ```
+    ///
+    /// ## How to fix
+    ///
+    /// Report only what the closest-hit shader cannot recompute cheaply (barycentrics,
+    /// a primitive-local id, a distance) and derive normals and positions there.
+    ///
+    /// ## Options
+    ///
+    /// None.
+    ///
+    /// ## References
+    ///
+    /// - Vulkan specification, `maxRayHitAttributeSize`.
+    /// - DirectX Raytracing functional spec, "Intersection attributes".
+    "RT004" "hit-attributes-over-limit" {
+        group: Correctness,
+        summary: "hit attributes larger than the 32-byte limit",
+        kind: super::Kind::Module(check),
+    }
+}
 
 /// `maxRayHitAttributeSize` on every driver we know, and D3D12's fixed limit.
 pub const LIMIT: u64 = 32;

@@ -1,18 +1,58 @@
-use super::{Context, Group, Kind, Rule};
-use crate::diag::{Diagnostic, Severity};
+use super::Context;
+use crate::diag::Diagnostic;
 use crate::program::{Constant, Type};
 use rspirv::dr::Operand;
 use spirv::Op;
 
-pub static RULE: Rule = Rule {
-    code: "RT005",
-    name: "ray-query-null-constant",
-    group: Group::Correctness,
-    level: Severity::Error,
-    summary: "ray-query object initialised from OpConstantNull",
-    doc: include_str!("../../rules/RT005.md"),
-    kind: Kind::Module(check),
-};
+super::declare_rule! {
+    /// ## What it does
+    ///
+    /// Reports a ray-query object that is stored from, or initialised with,
+    /// `OpConstantNull`.
+    ///
+    /// ## Why is this bad?
+    ///
+    /// A ray query is an opaque object and cannot have a null value: `spirv-val`
+    /// rejects the module ("cannot have a null value") and Mesa fails to compile it.
+    /// naga 30 emits exactly this for a WGSL `var rq: ray_query;` declared inside a
+    /// loop body, and naga's own validator does not notice, so the shader passes
+    /// `wgpu` validation and fails at pipeline creation.
+    ///
+    /// ## Example
+    ///
+    /// ```wgsl
+    /// for (var i = 0u; i < 4u; i++) {
+    ///     var rq: ray_query;           // emitted as OpStore %rq (OpConstantNull)
+    ///     rayQueryInitialize(&rq, tlas, desc);
+    /// }
+    /// ```
+    ///
+    /// Use instead:
+    ///
+    /// ```wgsl
+    /// var rq: ray_query;               // declared once at the top of the function
+    /// for (var i = 0u; i < 4u; i++) {
+    ///     rayQueryInitialize(&rq, tlas, desc);
+    /// }
+    /// ```
+    ///
+    /// ## How to fix
+    ///
+    /// Declare the ray query at the top of the function, outside any loop.
+    ///
+    /// ## Options
+    ///
+    /// None.
+    ///
+    /// ## References
+    ///
+    /// - SPIR-V specification, `OpTypeRayQueryKHR` (no null value).
+    "RT005" "ray-query-null-constant" {
+        group: Correctness,
+        summary: "ray-query object initialised from OpConstantNull",
+        kind: super::Kind::Module(check),
+    }
+}
 
 fn check(ctx: &Context) -> Vec<Diagnostic> {
     let p = ctx.program;

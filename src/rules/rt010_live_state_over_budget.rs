@@ -2,12 +2,9 @@
 //! than the budget allows.
 
 use crate::analysis::liveness::LiveSite;
-use crate::diag::{Diagnostic, Severity};
+use crate::diag::Diagnostic;
 use crate::program::Program;
 
-pub const CODE: &str = "RT010";
-pub const NAME: &str = "live-state-over-budget";
-pub const LEVEL: Severity = Severity::Warning;
 /// Sixteen 32-bit values: what fits in a closest-hit shader's 32-B stack
 /// step twice over.
 pub const DEFAULT_BUDGET_BYTES: u64 = 64;
@@ -79,21 +76,88 @@ pub fn check(program: &Program, sites: &[LiveSite], budget_bytes: u64) -> Vec<Di
     out
 }
 
-pub static RULE: super::Rule = super::Rule {
-    code: CODE,
-    name: NAME,
-    group: super::Group::Perf,
-    level: LEVEL,
-    summary: "state kept alive across a trace call above the budget",
-    doc: include_str!("../../rules/RT010.md"),
-    kind: super::Kind::Module(run),
-};
+super::declare_rule! {
+    /// ## What it does
+    ///
+    /// Finds trace and callable sites across which a shader keeps more state
+    /// than a budget (default 64 bytes). It counts the values that are defined
+    /// before the call and used after it — SSA values and the live parts of
+    /// local variables, through loops, phis and calls — whose value cannot be
+    /// recomputed after the call. Each live value is listed with its size, and
+    /// values that could be recomputed (see *Rematerialisation classes* in
+    /// `docs/stack.md`: builtins, push constants, uniform, storage and
+    /// `buffer_reference` loads, texture reads, constants) are marked and not
+    /// counted. Ray-query loops are not reported: an inline query is no shader
+    /// call, so its state stays in registers (`rtlint live` still lists them).
+    /// The answer does not depend on the debug info the compiler emitted (none,
+    /// `-g`, `-gV`).
+    ///
+    /// ## Why is this bad?
+    ///
+    /// A driver suspends the shader at every `TraceRay`/`traceRayEXT`/`traceRay`
+    /// and `CallShader`/`executeCallableEXT`. Everything still needed afterwards is
+    /// spilled to the ray stack and reloaded: more memory traffic per ray, a
+    /// larger stack per thread, fewer threads in flight. NVIDIA keeps this state
+    /// outside the stack size it reports, so the cost does not show up in
+    /// `vkGetRayTracingShaderGroupStackSizeKHR` — only in performance.
+    ///
+    /// ## Example
+    ///
+    /// ```glsl
+    /// traceRayEXT(tlas, gl_RayFlagsOpaqueEXT, 0xFF, 0, 0, 0, o, 0.001, d, 100.0, 0);
+    /// mat4 frame = mat4(hit, hit.yzwx, hit.zwxy, hit.wxyz);   // 64 bytes
+    /// vec4 tint = hit * 0.5;                                  // 16 bytes
+    /// // ... more values derived from the first hit ...
+    /// traceRayEXT(tlas, gl_RayFlagsOpaqueEXT, 0xFF, 0, 0, 0, o, 0.001, dir, 100.0, 0);
+    /// vec4 c = frame * hit + tint + ...;
+    /// ```
+    ///
+    /// ```
+    /// warning[RT010]: 128 bytes of state are live across the trace in `main`, above the 64-byte budget
+    /// ```
+    ///
+    /// Use instead: keep the one value everything derives from and compute the
+    /// rest after the trace:
+    ///
+    /// ```glsl
+    /// vec4 first = hit;                                       // 16 bytes
+    /// traceRayEXT(tlas, gl_RayFlagsOpaqueEXT, 0xFF, 0, 0, 0, o, 0.001, dir, 100.0, 0);
+    /// mat4 frame = mat4(first, first.yzwx, first.zwxy, first.wxyz);
+    /// ```
+    ///
+    /// ## How to fix
+    ///
+    /// Recompute values after the trace from builtins and buffers; carry what the
+    /// hit shader produces in the payload instead of keeping copies; move work
+    /// that depends on the trace's result after it. `rtlint live FILE` lists every
+    /// live value with its size and where it is defined and used.
+    ///
+    /// ## Options
+    ///
+    /// `budget` under `[rules.RT010]` in `rtlint.toml`, or the top-level
+    /// `live-state-budget`: bytes that cannot be recomputed (default 64). There
+    /// is no command-line flag for it.
+    ///
+    /// Fixtures: `fixtures/RT010/bad.rgen`, `fixtures/RT010/good.rgen`; the live
+    /// sets behind it: `fixtures/live/`. Precision on public shaders:
+    /// `docs/rules-precision.md`.
+    "RT010" "live-state-over-budget" {
+        group: Perf,
+        summary: "state kept alive across a trace call above the budget",
+        kind: super::Kind::Module(run),
+        options: [super::RuleOption {
+            name: "budget",
+            default: "64",
+            doc: "bytes live across one call that cannot be recomputed (top-level `live-state-budget` too)",
+        }],
+    }
+}
 
 fn run(ctx: &super::Context) -> Vec<Diagnostic> {
     check(
         ctx.program,
         &crate::analysis::liveness::live_sites(ctx.program),
-        ctx.config.live_state_budget.unwrap_or(DEFAULT_BUDGET_BYTES),
+        super::option_u64(ctx.config, &RULE, "budget", ctx.config.live_state_budget),
     )
 }
 

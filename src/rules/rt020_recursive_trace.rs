@@ -3,13 +3,10 @@
 
 use crate::analysis::callgraph::EdgeKind;
 use crate::analysis::recursion::RecursionReport;
-use crate::diag::{Diagnostic, Severity};
+use crate::diag::Diagnostic;
 use crate::pipeline::Pipeline;
 use crate::shader::Stage;
 
-pub const CODE: &str = "RT020";
-pub const NAME: &str = "recursive-trace";
-pub const LEVEL: Severity = Severity::Warning;
 
 /// One finding per trace site in a closest-hit or miss shader whose ray can
 /// reach a closest-hit shader. Shadow rays that skip closest-hit shaders
@@ -65,15 +62,56 @@ pub fn check(pipeline: &Pipeline, rec: &RecursionReport) -> Vec<Diagnostic> {
     out
 }
 
-pub static RULE: super::Rule = super::Rule {
-    code: CODE,
-    name: NAME,
-    group: super::Group::Perf,
-    level: LEVEL,
-    summary: "trace call from a closest-hit or miss shader",
-    doc: include_str!("../../rules/RT020.md"),
-    kind: super::Kind::Pipeline(run),
-};
+super::declare_rule! {
+    /// ## What it does
+    ///
+    /// Finds traces in closest-hit or miss shaders that can invoke a closest-hit
+    /// shader again, making every bounce one more level of recursion. Shadow rays
+    /// that skip closest-hit shaders (`SkipClosestHitShader`), or that can reach
+    /// only miss shaders, add one fixed level and are not reported.
+    ///
+    /// ## Why is this bad?
+    ///
+    /// Every recursion level keeps the calling shader's state and payload on the
+    /// stack, and the pipeline must declare `maxPipelineRayRecursionDepth` for the
+    /// deepest chain — the default stack grows with the declared depth. The same
+    /// image can be rendered with a loop in the ray generation shader at depth 1
+    /// (2 with shadow rays from the hit): rtlint's recursive and iterative
+    /// reference pipelines give bit-identical images on lavapipe and NVIDIA.
+    ///
+    /// ## Example
+    ///
+    /// ```glsl
+    /// // closest hit
+    /// if (payload.depth < pushConst.maxDepth) {
+    ///     reflected.depth = payload.depth + 1u;
+    ///     traceRayEXT(tlas, gl_RayFlagsOpaqueEXT, 0xFF, 0, 0, 0, hitPos, 0.001,
+    ///                 reflect(gl_WorldRayDirectionEXT, normal), 100.0, 1);
+    ///     color += 0.5 * reflected.color;
+    /// }
+    /// ```
+    ///
+    /// ```
+    /// warning[RT020]: closest-hit shader `main` traces a ray that can invoke a closest-hit shader again
+    ///   = note: the pipeline needs recursion depth 5: raygeneration `main` (raygen 0) at level 0 → closesthit `main` (hit group 0) at levels 1–4 → miss `main` (miss 1) at level 5
+    /// ```
+    ///
+    /// Use instead: the closest-hit shader returns the surface (normal, distance,
+    /// reflectivity) in the payload and the ray generation shader loops over
+    /// bounces (`fixtures/pipelines/iterative/`).
+    ///
+    /// ## How to fix
+    ///
+    /// Loop over bounces in the ray generation shader and return the hit in the
+    /// payload; keep only fixed-depth traces (shadow rays) in hit shaders.
+    ///
+    /// Fixtures: `fixtures/RT020/bad.pipeline.toml`, `fixtures/RT020/good.pipeline.toml`.
+    "RT020" "recursive-trace" {
+        group: Perf,
+        summary: "trace call from a closest-hit or miss shader",
+        kind: super::Kind::Pipeline(run),
+    }
+}
 
 fn run(ctx: &super::PipelineContext) -> Vec<Diagnostic> {
     check(ctx.pipeline, &ctx.recursion)

@@ -3,12 +3,9 @@
 
 use crate::analysis::recursion::RecursionReport;
 use crate::analysis::stack::{vulkan_default, StackReport};
-use crate::diag::{Diagnostic, Severity};
+use crate::diag::Diagnostic;
 use crate::pipeline::Pipeline;
 
-pub const CODE: &str = "RT022";
-pub const NAME: &str = "depth-overdeclared";
-pub const LEVEL: Severity = Severity::Warning;
 
 /// A finding when the declared depth exceeds the (bounded) required depth.
 pub fn check(pipeline: &Pipeline, rec: &RecursionReport, stack: &StackReport) -> Vec<Diagnostic> {
@@ -46,15 +43,51 @@ pub fn check(pipeline: &Pipeline, rec: &RecursionReport, stack: &StackReport) ->
     ))]
 }
 
-pub static RULE: super::Rule = super::Rule {
-    code: CODE,
-    name: NAME,
-    group: super::Group::Perf,
-    level: LEVEL,
-    summary: "declared recursion depth above what the pipeline needs",
-    doc: include_str!("../../rules/RT022.md"),
-    kind: super::Kind::Pipeline(run),
-};
+super::declare_rule! {
+    /// ## What it does
+    ///
+    /// Reports a declared `maxPipelineRayRecursionDepth` above the depth the
+    /// described pipeline needs, with the default stack size at both depths.
+    ///
+    /// ## Why is this bad?
+    ///
+    /// When the application does not set the stack size itself, the driver sizes
+    /// it by the default formula, in which every declared level beyond the first
+    /// adds the largest closest-hit or miss stack — memory reserved per thread
+    /// and never used. With large payloads this is what makes the default stack
+    /// dangerous (see RT025).
+    ///
+    /// ## Example
+    ///
+    /// ```toml
+    /// # the iterative pipeline needs depth 2
+    /// max_recursion_depth = 8
+    /// ```
+    ///
+    /// ```
+    /// warning[RT022]: declared recursion depth 8 is above the 2 the pipeline needs
+    ///   = note: the default stack is 256 bytes per thread at depth 8 and 64 at depth 2 (driver-comparable model)
+    /// ```
+    ///
+    /// Use instead:
+    ///
+    /// ```toml
+    /// max_recursion_depth = 2
+    /// ```
+    ///
+    /// ## How to fix
+    ///
+    /// Declare the required depth, or set the stack size explicitly with
+    /// `vkCmdSetRayTracingPipelineStackSizeKHR` / `SetPipelineStackSize` to the
+    /// value `rtlint stack` recommends.
+    ///
+    /// Fixtures: `fixtures/RT022/bad.pipeline.toml`, `fixtures/RT022/good.pipeline.toml`.
+    "RT022" "depth-overdeclared" {
+        group: Perf,
+        summary: "declared recursion depth above what the pipeline needs",
+        kind: super::Kind::Pipeline(run),
+    }
+}
 
 fn run(ctx: &super::PipelineContext) -> Vec<Diagnostic> {
     check(ctx.pipeline, &ctx.recursion, &ctx.stack)

@@ -2,12 +2,9 @@
 //! depth is above what devices support (31 on lavapipe, NVIDIA and DXR).
 
 use crate::analysis::recursion::RecursionReport;
-use crate::diag::{Diagnostic, Severity};
+use crate::diag::Diagnostic;
 use crate::pipeline::Pipeline;
 
-pub const CODE: &str = "RT023";
-pub const NAME: &str = "depth-exceeds-device-limit";
-pub const LEVEL: Severity = Severity::Error;
 
 /// `device_limit` is `maxRayRecursionDepth` (31 on the devices measured;
 /// the description's `device_max_recursion_depth` overrides it).
@@ -57,15 +54,49 @@ pub fn check(pipeline: &Pipeline, rec: &RecursionReport, device_limit: u32) -> V
     out
 }
 
-pub static RULE: super::Rule = super::Rule {
-    code: CODE,
-    name: NAME,
-    group: super::Group::Correctness,
-    level: LEVEL,
-    summary: "recursion depth above the device limit",
-    doc: include_str!("../../rules/RT023.md"),
-    kind: super::Kind::Pipeline(run),
-};
+super::declare_rule! {
+    /// ## What it does
+    ///
+    /// Reports a declared recursion depth, or a required one, above the device's
+    /// `maxRayRecursionDepth` (31 on lavapipe, NVIDIA and in DXR; set
+    /// `device_max_recursion_depth` in the description for another device).
+    ///
+    /// ## Why is this bad?
+    ///
+    /// A declared depth above 31 fails pipeline creation on NVIDIA
+    /// (`VK_ERROR_INITIALIZATION_FAILED`) while lavapipe accepts it — the pipeline
+    /// works on one driver and not on another. A required depth above the limit
+    /// cannot be declared at all: the deepest rays recurse past the declared depth,
+    /// which crashes lavapipe and hangs NVIDIA GPUs.
+    ///
+    /// ## Example
+    ///
+    /// ```toml
+    /// # 38 reflections and a shadow ray
+    /// max_recursion_depth = 40
+    /// ```
+    ///
+    /// ```
+    /// error[RT023]: declared recursion depth 40 exceeds the device limit of 31
+    /// error[RT023]: pipeline needs recursion depth 40, above the device limit of 31
+    /// ```
+    ///
+    /// Use instead: bound the recursion to at most 29 reflections (depth 31), or
+    /// loop over bounces in the ray generation shader.
+    ///
+    /// ## How to fix
+    ///
+    /// Declare at most the device limit and bound the recursion in the shaders;
+    /// for deep bounce counts, use the iterative loop (depth 1 or 2 for any
+    /// number of bounces).
+    ///
+    /// Fixtures: `fixtures/RT023/bad.pipeline.toml`, `fixtures/RT023/good.pipeline.toml`.
+    "RT023" "depth-exceeds-device-limit" {
+        group: Correctness,
+        summary: "recursion depth above the device limit",
+        kind: super::Kind::Pipeline(run),
+    }
+}
 
 fn run(ctx: &super::PipelineContext) -> Vec<Diagnostic> {
     check(

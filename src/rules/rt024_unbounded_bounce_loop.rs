@@ -2,12 +2,9 @@
 //! cycle, whose bound is not known at compile time.
 
 use crate::analysis::recursion::{trace_loops, RecursionReport};
-use crate::diag::{Diagnostic, Severity};
+use crate::diag::Diagnostic;
 use crate::pipeline::Pipeline;
 
-pub const CODE: &str = "RT024";
-pub const NAME: &str = "unbounded-bounce-loop";
-pub const LEVEL: Severity = Severity::Warning;
 
 /// Loops around traces in every program of the pipeline (bounds may come
 /// from its `[constants]`), and recursion cycles without a recognised guard.
@@ -72,15 +69,70 @@ pub fn check(pipeline: &Pipeline, rec: &RecursionReport) -> Vec<Diagnostic> {
     out
 }
 
-pub static RULE: super::Rule = super::Rule {
-    code: CODE,
-    name: NAME,
-    group: super::Group::Perf,
-    level: LEVEL,
-    summary: "bounce loop or recursion with no bound known at compile time",
-    doc: include_str!("../../rules/RT024.md"),
-    kind: super::Kind::Pipeline(run),
-};
+super::declare_rule! {
+    /// ## What it does
+    ///
+    /// Finds loops around traces whose iteration count is not bounded at compile
+    /// time, and recursion cycles (a closest-hit shader that can reach itself)
+    /// without a recognised depth guard. A loop is bounded when an exit compares a
+    /// counter, incremented by a constant in the loop, with a constant, a
+    /// specialization constant, or a push-constant / uniform value the pipeline
+    /// description gives under `[constants]`. A cycle is bounded when each trace
+    /// closing it is dominated by a comparison of a depth counter carried in the
+    /// payload with such a bound and the traced payload's counter grows by a
+    /// constant. The note says what was found instead.
+    ///
+    /// ## Why is this bad?
+    ///
+    /// A loop that ends only when a ray misses can run for as long as the scene
+    /// lets rays bounce: per-pixel cost without limit, and GPU time-outs on
+    /// pathological views. A recursion cycle without a guard needs an unbounded
+    /// depth: no declared `maxPipelineRayRecursionDepth` is provably enough, and
+    /// rtlint cannot compute an exact stack size for it.
+    ///
+    /// ## Example
+    ///
+    /// ```glsl
+    /// while (true) {
+    ///     traceRayEXT(tlas, gl_RayFlagsOpaqueEXT, 0xFF, 0, 0, 0, origin, 0.001, dir, 100.0, 0);
+    ///     if (hit.w <= 0.0) break;
+    ///     // ...
+    /// }
+    /// ```
+    ///
+    /// ```
+    /// warning[RT024]: loop around a trace in `main` has no bound known at compile time
+    ///   = note: no exit compares a counter with a bound
+    /// ```
+    ///
+    /// Use instead:
+    ///
+    /// ```glsl
+    /// const int MAX_BOUNCES = 8;
+    /// for (int bounce = 0; bounce < MAX_BOUNCES; bounce++) { ... }
+    /// ```
+    ///
+    /// A bound read from a uniform (`params.max_bounces`) or a push constant
+    /// (`pushConst.maxDepth`) counts once the description gives its value:
+    ///
+    /// ```toml
+    /// [constants]
+    /// "pushConst.maxDepth" = 3
+    /// ```
+    ///
+    /// ## How to fix
+    ///
+    /// Compare the bounce counter with a constant, or give the bound under
+    /// `[constants]` in the pipeline description.
+    ///
+    /// Fixtures: `fixtures/RT024/bad.pipeline.toml` (both cases),
+    /// `fixtures/RT024/good.pipeline.toml`.
+    "RT024" "unbounded-bounce-loop" {
+        group: Perf,
+        summary: "bounce loop or recursion with no bound known at compile time",
+        kind: super::Kind::Pipeline(run),
+    }
+}
 
 fn run(ctx: &super::PipelineContext) -> Vec<Diagnostic> {
     check(ctx.pipeline, &ctx.recursion)

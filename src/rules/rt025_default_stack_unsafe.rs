@@ -2,12 +2,9 @@
 //! for the declared depth is larger than a device is known to survive.
 
 use crate::analysis::stack::StackReport;
-use crate::diag::{Diagnostic, Severity};
+use crate::diag::Diagnostic;
 use crate::pipeline::Pipeline;
 
-pub const CODE: &str = "RT025";
-pub const NAME: &str = "default-stack-unsafe";
-pub const LEVEL: Severity = Severity::Error;
 pub use crate::analysis::stack::NVIDIA_KNOWN_SAFE_STACK_BYTES as DEFAULT_LIMIT_BYTES;
 
 /// A finding when the Vulkan default stack, from the driver-comparable
@@ -61,21 +58,80 @@ pub fn check(pipeline: &Pipeline, stack: &StackReport, limit_bytes: u64) -> Vec<
     vec![d.with_help(help)]
 }
 
-pub static RULE: super::Rule = super::Rule {
-    code: CODE,
-    name: NAME,
-    group: super::Group::Correctness,
-    level: LEVEL,
-    summary: "default pipeline stack above what the device is known to survive",
-    doc: include_str!("../../rules/RT025.md"),
-    kind: super::Kind::Pipeline(run),
-};
+super::declare_rule! {
+    /// ## What it does
+    ///
+    /// Computes the stack size a driver picks by default for the described
+    /// pipeline — the Vulkan/DXR default formula over the per-shader sizes a
+    /// driver reports (rtlint's driver-comparable model, calibrated on NVIDIA) with
+    /// the declared depth — and reports it when it is above the largest stack
+    /// measured to run (14,702 bytes per thread). It prints the exact call-chain
+    /// value to set instead when that value fits.
+    ///
+    /// ## Why is this bad?
+    ///
+    /// The default formula multiplies the largest closest-hit stack by the
+    /// declared depth, however deep the shaders really recurse. Measured on an
+    /// NVIDIA H200 (driver 580.159.04): a pipeline stack of 14,746 bytes per thread
+    /// loses the device at the first trace (`VK_ERROR_DEVICE_LOST`) and 14,702 runs,
+    /// whatever the dispatch size. FIELD-NOTES record the same failure on an H100
+    /// for a 256-byte payload at depth 29–31 (a default of 15,936–17,024 bytes).
+    ///
+    /// Setting a smaller stack is not automatically safe either: with 30 levels of
+    /// real recursion, explicit stacks of 4,096 and 5,056 bytes hung the GPU, while
+    /// the exact call-chain value ran. Set the value the call chain needs.
+    ///
+    /// ## Example
+    ///
+    /// ```toml
+    /// # a 512-byte payload; the closest-hit shader reflects up to 30 times
+    /// max_recursion_depth = 31
+    /// ```
+    ///
+    /// ```
+    /// error[RT025]: default pipeline stack of 17280 bytes per thread is above the 14702 bytes known to run
+    ///   = help: reduce the recursion depth or the payload until the call chain fits, then set the stack explicitly
+    /// ```
+    ///
+    /// Here the guard really allows 30 reflections, so the deepest call chain
+    /// needs the same 17,280 bytes. When the declared depth is only a generous
+    /// upper bound (the guard allows 2 reflections), the help gives the exact
+    /// call-chain value to set instead:
+    /// `vkCmdSetRayTracingPipelineStackSizeKHR(cmd, 2048)`.
+    ///
+    /// Use instead: a smaller payload (past 128 bytes every byte is on the
+    /// stack), fewer levels (depth 8: 4,768 bytes), or the iterative loop; then
+    /// set the stack size explicitly to the value `rtlint stack` recommends.
+    ///
+    /// ## How to fix
+    ///
+    /// Set the stack size explicitly with `vkCmdSetRayTracingPipelineStackSizeKHR`
+    /// / `SetPipelineStackSize` to the exact call-chain value, and reduce the
+    /// declared depth or the payload until that value is small.
+    ///
+    /// ## Options
+    ///
+    /// - `stack-limit` in `rtlint.toml` (bytes per thread; default 14,702, the
+    ///   largest stack measured to run on an NVIDIA H200).
+    ///
+    /// Fixtures: `fixtures/RT025/bad.pipeline.toml`, `fixtures/RT025/good.pipeline.toml`.
+    "RT025" "default-stack-unsafe" {
+        group: Correctness,
+        summary: "default pipeline stack above what the device is known to survive",
+        kind: super::Kind::Pipeline(run),
+        options: [super::RuleOption {
+            name: "limit",
+            default: "14702",
+            doc: "the largest default pipeline stack, in bytes per thread, the device is known to run (top-level `stack-limit` too)",
+        }],
+    }
+}
 
 fn run(ctx: &super::PipelineContext) -> Vec<Diagnostic> {
     check(
         ctx.pipeline,
         &ctx.stack,
-        ctx.config.stack_limit.unwrap_or(DEFAULT_LIMIT_BYTES),
+        super::option_u64(ctx.config, &RULE, "limit", ctx.config.stack_limit),
     )
 }
 

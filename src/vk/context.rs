@@ -73,6 +73,10 @@ pub struct DeviceInfo {
     /// `primitive_index` needs `geometryShader`.
     pub geometry_shader: bool,
     pub shader_int64: bool,
+    /// `shaderStorageImageReadWithoutFormat` and `…WriteWithoutFormat`,
+    /// enabled when the device has both: storage images whose SPIR-V type
+    /// names no format (HLSL `RWTexture2D<float3>`, Slang's images) need them.
+    pub storage_image_without_format: bool,
     pub ray_tracing: RayTracingLimits,
     pub min_storage_buffer_offset_alignment: u64,
     pub min_uniform_buffer_offset_alignment: u64,
@@ -440,6 +444,8 @@ fn examine(
             ray_query,
             geometry_shader: core.geometry_shader == vk::TRUE,
             shader_int64: core.shader_int64 == vk::TRUE,
+            storage_image_without_format: core.shader_storage_image_read_without_format == vk::TRUE
+                && core.shader_storage_image_write_without_format == vk::TRUE,
             ray_tracing: RayTracingLimits {
                 shader_group_handle_size: rt_props.shader_group_handle_size,
                 shader_group_handle_alignment: rt_props.shader_group_handle_alignment,
@@ -471,7 +477,9 @@ fn create_device(instance: &ash::Instance, c: &Candidate) -> Result<ash::Device>
         .queue_priorities(&priorities)];
     let core = vk::PhysicalDeviceFeatures::default()
         .geometry_shader(c.info.geometry_shader)
-        .shader_int64(c.info.shader_int64);
+        .shader_int64(c.info.shader_int64)
+        .shader_storage_image_read_without_format(c.info.storage_image_without_format)
+        .shader_storage_image_write_without_format(c.info.storage_image_without_format);
     let mut f12 = vk::PhysicalDeviceVulkan12Features::default()
         .buffer_device_address(true)
         .descriptor_indexing(true)

@@ -15,6 +15,10 @@ pub enum BindingKind {
     StorageBuffer,
     UniformBuffer,
     StorageImage,
+    /// A `Texture2D` read through a separate sampler.
+    SampledImage,
+    /// A `SamplerState`.
+    Sampler,
 }
 
 impl BindingKind {
@@ -24,6 +28,8 @@ impl BindingKind {
             BindingKind::StorageBuffer => vk::DescriptorType::STORAGE_BUFFER,
             BindingKind::UniformBuffer => vk::DescriptorType::UNIFORM_BUFFER,
             BindingKind::StorageImage => vk::DescriptorType::STORAGE_IMAGE,
+            BindingKind::SampledImage => vk::DescriptorType::SAMPLED_IMAGE,
+            BindingKind::Sampler => vk::DescriptorType::SAMPLER,
         }
     }
 }
@@ -47,8 +53,12 @@ pub enum Resource<'a> {
     AccelerationStructure(&'a AccelerationStructure),
     /// A storage or uniform buffer, whichever the binding says.
     Buffer(&'a Buffer),
-    /// An image view in `GENERAL` layout; the harness does not create images.
+    /// An image view in `GENERAL` layout ([`StorageImage::view`](super::StorageImage::view)).
     StorageImage(vk::ImageView),
+    /// An image view in `GENERAL` layout, to be sampled.
+    SampledImage(vk::ImageView),
+    /// [`Sampler::raw`](super::Sampler::raw).
+    Sampler(vk::Sampler),
 }
 
 /// Set layout, pool, the set itself and the pipeline layout over it.
@@ -190,11 +200,18 @@ impl Descriptors {
                     }
                     structures.push((*binding, [a.raw()]))
                 }
-                (BindingKind::StorageImage, Resource::StorageImage(view)) => image_infos.push((
+                (BindingKind::StorageImage, Resource::StorageImage(view))
+                | (BindingKind::SampledImage, Resource::SampledImage(view)) => image_infos.push((
                     *binding,
+                    b.kind,
                     [vk::DescriptorImageInfo::default()
                         .image_view(*view)
                         .image_layout(vk::ImageLayout::GENERAL)],
+                )),
+                (BindingKind::Sampler, Resource::Sampler(sampler)) => image_infos.push((
+                    *binding,
+                    b.kind,
+                    [vk::DescriptorImageInfo::default().sampler(*sampler)],
                 )),
                 (kind, r) => {
                     return Err(Error::Invalid(format!(
@@ -219,12 +236,12 @@ impl Descriptors {
                     .buffer_info(info),
             );
         }
-        for (binding, info) in &image_infos {
+        for (binding, kind, info) in &image_infos {
             writes.push(
                 vk::WriteDescriptorSet::default()
                     .dst_set(self.set)
                     .dst_binding(*binding)
-                    .descriptor_type(vk::DescriptorType::STORAGE_IMAGE)
+                    .descriptor_type(kind.descriptor_type())
                     .image_info(info),
             );
         }

@@ -1,4 +1,5 @@
-//! Storage images that shaders write and the host reads back.
+//! Storage images that shaders write and the host reads back (or fills, to be
+//! sampled), and samplers.
 
 use super::buffer::Buffer;
 use super::context::{Context, Shared};
@@ -7,7 +8,8 @@ use ash::vk;
 use std::sync::Arc;
 
 /// A 2D `R32G32B32A32_SFLOAT` image in `GENERAL` layout, cleared to zero, for
-/// a `RWTexture2D<float4>` / `rgba32f` storage image binding.
+/// a `RWTexture2D<float4>` / `rgba32f` storage image binding, or, filled with
+/// [`StorageImage::write`], for a sampled `Texture2D` binding.
 pub struct StorageImage {
     shared: Arc<Shared>,
     image: vk::Image,
@@ -58,6 +60,7 @@ impl StorageImage {
             .tiling(vk::ImageTiling::OPTIMAL)
             .usage(
                 vk::ImageUsageFlags::STORAGE
+                    | vk::ImageUsageFlags::SAMPLED
                     | vk::ImageUsageFlags::TRANSFER_SRC
                     | vk::ImageUsageFlags::TRANSFER_DST,
             )
@@ -151,6 +154,47 @@ impl StorageImage {
         (self.width, self.height)
     }
 
+    /// Replaces every texel, row by row; `texels` holds width × height of them.
+    pub fn write(&self, ctx: &Context, texels: &[[f32; 4]]) -> Result<()> {
+        let n = self.width as usize * self.height as usize;
+        if texels.len() != n {
+            return Err(Error::Invalid(format!(
+                "a {}×{} image takes {n} texels, given {}",
+                self.width,
+                self.height,
+                texels.len()
+            )));
+        }
+        let staging = Buffer::from_data(ctx, vk::BufferUsageFlags::TRANSFER_SRC, texels)?;
+        let device = &self.shared.device;
+        let copy = vk::BufferImageCopy::default()
+            .buffer_offset(staging.offset())
+            .image_subresource(
+                vk::ImageSubresourceLayers::default()
+                    .aspect_mask(vk::ImageAspectFlags::COLOR)
+                    .layer_count(1),
+            )
+            .image_extent(vk::Extent3D {
+                width: self.width,
+                height: self.height,
+                depth: 1,
+            });
+        self.shared.submit("image upload", |cmd| {
+            // SAFETY: cmd is recording; image and buffer are live, and earlier
+            // work on the image finished with its own submission.
+            unsafe {
+                device.cmd_copy_buffer_to_image(
+                    cmd,
+                    staging.raw(),
+                    self.image,
+                    vk::ImageLayout::GENERAL,
+                    &[copy],
+                )
+            }
+        })?;
+        Ok(())
+    }
+
     /// The texels, row by row. Call after the work that wrote them has
     /// finished (every harness submission waits on its fence).
     pub fn read(&self, ctx: &Context) -> Result<Vec<[f32; 4]>> {
@@ -203,5 +247,51 @@ impl Drop for StorageImage {
             d.destroy_image(self.image, None);
             d.free_memory(self.memory, None);
         }
+    }
+}
+
+/// A sampler with nearest filtering and clamp-to-edge addressing, for a
+/// `SamplerState` binding.
+pub struct Sampler {
+    shared: Arc<Shared>,
+    sampler: vk::Sampler,
+}
+
+impl std::fmt::Debug for Sampler {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Sampler").finish_non_exhaustive()
+    }
+}
+
+impl Sampler {
+    pub fn nearest(ctx: &Context) -> Result<Sampler> {
+        let info = vk::SamplerCreateInfo::default()
+            .mag_filter(vk::Filter::NEAREST)
+            .min_filter(vk::Filter::NEAREST)
+            .mipmap_mode(vk::SamplerMipmapMode::NEAREST)
+            .address_mode_u(vk::SamplerAddressMode::CLAMP_TO_EDGE)
+            .address_mode_v(vk::SamplerAddressMode::CLAMP_TO_EDGE)
+            .address_mode_w(vk::SamplerAddressMode::CLAMP_TO_EDGE);
+        // SAFETY: valid device and create info.
+        let sampler = unsafe { ctx.shared.device.create_sampler(&info, None) }
+            .map_err(vk_err("vkCreateSampler"))?;
+        Ok(Sampler {
+            shared: ctx.shared.clone(),
+            sampler,
+        })
+    }
+
+    pub fn raw(&self) -> vk::Sampler {
+        self.sampler
+    }
+}
+
+impl Drop for Sampler {
+    fn drop(&mut self) {
+        if self.shared.hung() {
+            return;
+        }
+        // SAFETY: submissions are waited for, so nothing uses the sampler.
+        unsafe { self.shared.device.destroy_sampler(self.sampler, None) };
     }
 }

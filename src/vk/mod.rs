@@ -39,7 +39,7 @@ pub use child::{
 pub use context::{Context, ContextOptions, DeviceInfo, RayTracingLimits};
 pub use descriptors::{Binding, BindingKind, Resource};
 pub use error::{Error, Result};
-pub use image::StorageImage;
+pub use image::{Sampler, StorageImage};
 pub use pipeline::{
     ComputePipeline, Group, GroupStackSizes, RayTracingPipeline, RayTracingPipelineDesc, SbtLayout,
     SbtRegion, ShaderBindingTable, ShaderStage, Stage,

@@ -1,8 +1,6 @@
-//! Slang as an optional external compiler, loaded at run time.
-//!
-//! rtlint needs no external compiler; Slang is used when a user asks for it
-//! and as the reference compiler rtlint's own HLSL front-end is checked
-//! against. `pip install slangpy` ships `libslang-compiler.so`; its C API
+//! Slang, loaded at run time: the second HLSL compiler rtlint's own is
+//! checked against (tests, benches, examples; never the library).
+//! `pip install slangpy` ships `libslang-compiler.so`; its C API
 //! (`spCreateSession`, `spCompile`, …) is driven with slangc-style arguments.
 
 use libloading::{Library, Symbol};
@@ -26,8 +24,8 @@ pub struct Slang {
 }
 
 /// The Slang stage name of a ray-tracing or compute entry point.
-pub fn stage_name(stage: crate::shader::Stage) -> &'static str {
-    use crate::shader::Stage as S;
+pub fn stage_name(stage: rtlint::shader::Stage) -> &'static str {
+    use rtlint::shader::Stage as S;
     match stage {
         S::RayGeneration => "raygeneration",
         S::Intersection => "intersection",
