@@ -800,11 +800,17 @@ fn apply_suppressions(
             continue;
         };
         for (s, used) in files.get(path.as_path()).into_iter().flatten() {
+            // A selector is judged only when a rule it names ran on the file.
+            let ran = |sel: &str| {
+                crate::rules::RULES.iter().any(|r| {
+                    crate::rules::selects(sel, r) && crate::rules::configured(r, config).is_some()
+                })
+            };
             let unused: Vec<&str> = s
                 .selectors
                 .iter()
                 .zip(used)
-                .filter(|(_, u)| !**u)
+                .filter(|(sel, u)| !**u && ran(sel))
                 .map(|(sel, _)| sel.as_str())
                 .collect();
             if !unused.is_empty() {

@@ -5,7 +5,8 @@
 
 mod common;
 
-use common::{in_ci, root, rtlint};
+use common::{root, rtlint};
+use rtlint_testkit::require;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
 
@@ -165,15 +166,18 @@ fn glsl_sources_are_linted_and_their_suppressions_found() {
         .arg(&spv)
         .arg(d.join("allowed.rgen"))
         .output();
-    match g {
-        Ok(g) if g.status.success() => {
-            std::fs::remove_file(d.join("allowed.rgen")).unwrap();
-            let o = check_in(&d, &["allowed.rgen.spv"]);
-            assert!(findings(&o).is_empty(), "{}", text(&o));
-            assert_eq!(o.status.code(), Some(0), "{}", text(&o));
+    let compiled = g.map_err(|e| e.to_string()).and_then(|g| {
+        if g.status.success() {
+            Ok(())
+        } else {
+            Err(text(&g))
         }
-        _ if in_ci() => panic!("glslangValidator is missing: run scripts/setup"),
-        _ => eprintln!("skipped the .spv half: glslangValidator is missing"),
+    });
+    if require("glslangValidator", compiled).is_some() {
+        std::fs::remove_file(d.join("allowed.rgen")).unwrap();
+        let o = check_in(&d, &["allowed.rgen.spv"]);
+        assert!(findings(&o).is_empty(), "{}", text(&o));
+        assert_eq!(o.status.code(), Some(0), "{}", text(&o));
     }
 }
 
@@ -444,19 +448,18 @@ fn a_closed_output_pipe_ends_quietly() {
 #[test]
 fn sarif_is_valid_against_the_official_schema() {
     let schema = Path::new("/usr/local/share/rtlint/sarif-schema-2.1.0.json");
-    let have_validator = schema.is_file()
-        && Command::new("python3")
-            .args(["-c", "import jsonschema"])
-            .status()
-            .is_ok_and(|s| s.success());
-    if !have_validator {
-        assert!(
-            !in_ci(),
-            "the SARIF schema or jsonschema is missing: run scripts/setup"
-        );
-        eprintln!(
-            "skipped: the SARIF schema or jsonschema is missing (scripts/setup installs them)"
-        );
+    let have_validator = if !schema.is_file() {
+        Err(format!("{} is missing", schema.display()))
+    } else if !Command::new("python3")
+        .args(["-c", "import jsonschema"])
+        .status()
+        .is_ok_and(|s| s.success())
+    {
+        Err("python3 cannot import jsonschema".to_string())
+    } else {
+        Ok(())
+    };
+    if require("the SARIF schema validator", have_validator).is_none() {
         return;
     }
     let d = scratch("sarif dir");
@@ -587,10 +590,8 @@ fn the_ci_recipe_is_valid_yaml() {
         .arg(&file)
         .output()
         .unwrap();
-    if !o.status.success() && String::from_utf8_lossy(&o.stderr).contains("No module named 'yaml'")
-    {
-        assert!(!in_ci(), "PyYAML is missing: run scripts/setup");
-        eprintln!("skipped: PyYAML is missing");
+    let missing = String::from_utf8_lossy(&o.stderr).contains("No module named 'yaml'");
+    if missing && require("PyYAML", Err::<(), _>("python3 cannot import yaml")).is_none() {
         return;
     }
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));

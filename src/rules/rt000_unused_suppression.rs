@@ -12,7 +12,9 @@ super::declare_rule! {
     /// Reports a suppression that allowed nothing in this run: a
     /// `// rtlint: allow(...)` comment (or a WGSL
     /// `diagnostic(off, rtlint.rule_name)` filter) on a line where none of the
-    /// rules it names reported a finding, on that line or the next.
+    /// rules it names reported a finding, on that line or the next. Only rules
+    /// that ran are judged: with `--select RT001`, a suppression of RT003 is
+    /// left alone.
     ///
     /// ## Why is this bad?
     ///
