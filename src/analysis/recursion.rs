@@ -1503,4 +1503,13 @@ mod tests {
         );
         assert!(!text.contains("(miss 0) at level 0"), "{text}");
     }
+
+    /// A helper called twice with different flags is folded per call: only
+    /// flags every call agrees on prune targets.
+    #[test]
+    fn helper_called_with_different_flags() {
+        let r = recursion_report(&loose(&["fixtures/guards/two_calls.wgsl"]));
+        assert_eq!(r.required_depth, None);
+        assert_eq!(r.cycles.len(), 1);
+    }
 }

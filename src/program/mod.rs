@@ -178,7 +178,7 @@ pub struct RtSite {
     pub sbt_index: Option<OperandValue>,
 }
 
-#[derive(Clone, Copy, Debug, serde::Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
 pub struct TraceOperands {
     pub ray_flags: OperandValue,
     pub cull_mask: OperandValue,
