@@ -294,6 +294,18 @@ struct LocalPtr {
     exact: bool,
 }
 
+/// What a function does with each pointer parameter, as its callers see it.
+#[derive(Clone, Debug, Default)]
+struct ParamEffect {
+    /// The parts it may read before writing them; `None` when not known.
+    reads: Option<Vec<Vec<u32>>>,
+    /// The parts it writes on every path to its return.
+    writes: Vec<Vec<u32>>,
+}
+
+/// Per parameter of a function.
+type ExposedParams = Vec<ParamEffect>;
+
 /// Parts are tracked separately up to this many elements per composite.
 const MAX_SPLIT: u32 = 64;
 
@@ -302,8 +314,11 @@ pub struct FnLiveness {
     func: usize,
     /// Function-local `OpVariable`s.
     vars: HashSet<Id>,
-    /// Pointer ids derived from a local variable.
+    /// Pointer ids derived from a local variable or a pointer parameter.
     roots: HashMap<Id, LocalPtr>,
+    /// For each `OpFunctionCall` (by instruction index), the parts each
+    /// pointer argument's callee parameter may read before writing.
+    call_reads: HashMap<usize, ExposedParams>,
     /// SSA values that count as state: defined here, not pointers to locals.
     ssa: HashSet<Id>,
     live_out: Vec<HashSet<Place>>,
@@ -312,11 +327,147 @@ pub struct FnLiveness {
     preds: Vec<Vec<usize>>,
     remat: HashMap<Id, bool>,
     /// Variables' rematerialisation as read at an instruction.
-    remat_at: HashMap<(Id, usize), bool>,
+    remat_at: HashMap<(Id, usize, Vec<Vec<u32>>), bool>,
 }
 
 impl FnLiveness {
     pub fn new(program: &Program, func: usize) -> FnLiveness {
+        Self::build(program, func, &mut HashMap::new(), 0)
+    }
+
+    /// The parts of each pointer parameter of function `func` that it may
+    /// read before writing them (`None`: not a pointer, or not known).
+    fn exposed_params(
+        program: &Program,
+        func: usize,
+        memo: &mut HashMap<usize, ExposedParams>,
+        depth: u32,
+    ) -> ExposedParams {
+        if let Some(e) = memo.get(&func) {
+            return e.clone();
+        }
+        let f = &program.functions[func];
+        let unknown: ExposedParams = vec![ParamEffect::default(); f.params.len()];
+        if depth > 16 {
+            return unknown;
+        }
+        memo.insert(func, unknown);
+        let fl = Self::build(program, func, memo, depth + 1);
+        let entry = f.blocks.first().map(|b| b.start);
+        let live = entry.map(|i| fl.places_after(program, i)).unwrap_or_default();
+        let exposed: ExposedParams = f
+            .params
+            .iter()
+            .map(|p| {
+                if !fl.roots.contains_key(p) {
+                    return ParamEffect::default();
+                }
+                let reads = live
+                    .iter()
+                    .filter(|(v, _)| v == p)
+                    .map(|(_, path)| path.clone())
+                    .collect();
+                ParamEffect {
+                    reads: Some(reads),
+                    writes: fl.written_on_every_path(program, *p),
+                }
+            })
+            .collect();
+        memo.insert(func, exposed.clone());
+        exposed
+    }
+
+    /// The parts of pointer parameter (or variable) `var` that every path
+    /// from the function's entry to a return writes: stores of exactly
+    /// that part, and the writes of calls that pass it.
+    fn written_on_every_path(&self, program: &Program, var: Id) -> Vec<Vec<u32>> {
+        let f = self.function(program);
+        let n = f.blocks.len();
+        let own = |b: usize| -> Vec<Vec<u32>> {
+            let mut w = Vec::new();
+            for i in f.blocks[b].start..=f.blocks[b].end {
+                let inst = &program.insts[i];
+                match inst.class.opcode {
+                    Op::Store => {
+                        let t = id_operands(inst).next().and_then(|t| self.roots.get(&t));
+                        if let Some(t) = t.filter(|t| t.var == var && t.exact) {
+                            w.push(t.path.clone());
+                        }
+                    }
+                    Op::FunctionCall => {
+                        for (k, a) in id_operands(inst).enumerate().skip(1) {
+                            let Some(t) = self.roots.get(&a).filter(|t| t.var == var && t.exact)
+                            else {
+                                continue;
+                            };
+                            let e = self.call_reads.get(&i).and_then(|e| e.get(k - 1));
+                            for x in e.map(|e| e.writes.as_slice()).unwrap_or_default() {
+                                let mut path = t.path.clone();
+                                path.extend_from_slice(x);
+                                w.push(path);
+                            }
+                        }
+                    }
+                    _ => {}
+                }
+            }
+            w
+        };
+        let own: Vec<Vec<Vec<u32>>> = (0..n).map(own).collect();
+        // Forward must-analysis: `None` is "everything" (not reached yet).
+        let mut out: Vec<Option<HashSet<Vec<u32>>>> = vec![None; n];
+        let mut changed = true;
+        let mut rounds = 0;
+        while changed && rounds < 1000 {
+            changed = false;
+            rounds += 1;
+            for b in 0..n {
+                let mut inset: Option<HashSet<Vec<u32>>> = if b == 0 {
+                    Some(HashSet::new())
+                } else {
+                    None
+                };
+                for &p in &self.preds[b] {
+                    if let Some(o) = &out[p] {
+                        inset = Some(match inset {
+                            None => o.clone(),
+                            Some(i) => i.intersection(o).cloned().collect(),
+                        });
+                    }
+                }
+                let Some(mut set) = inset else { continue };
+                set.extend(own[b].iter().cloned());
+                if out[b].as_ref() != Some(&set) {
+                    out[b] = Some(set);
+                    changed = true;
+                }
+            }
+        }
+        let mut must: Option<HashSet<Vec<u32>>> = None;
+        for b in 0..n {
+            if !matches!(
+                program.insts[f.blocks[b].end].class.opcode,
+                Op::Return | Op::ReturnValue
+            ) {
+                continue;
+            }
+            let o = out[b].clone().unwrap_or_default();
+            must = Some(match must {
+                None => o,
+                Some(m) => m.intersection(&o).cloned().collect(),
+            });
+        }
+        let mut v: Vec<Vec<u32>> = must.unwrap_or_default().into_iter().collect();
+        v.sort();
+        v
+    }
+
+    fn build(
+        program: &Program,
+        func: usize,
+        memo: &mut HashMap<usize, ExposedParams>,
+        depth: u32,
+    ) -> FnLiveness {
         let f = &program.functions[func];
         let mut vars = HashSet::new();
         let mut roots: HashMap<Id, LocalPtr> = HashMap::new();
@@ -327,6 +478,24 @@ impl FnLiveness {
                 continue;
             }
             match inst.class.opcode {
+                // A pointer parameter is tracked like a variable (its
+                // contents belong to the caller, which counts them).
+                Op::FunctionParameter
+                    if matches!(
+                        inst.result_type.and_then(|t| program.ty(t)),
+                        Some(Type::Pointer { storage, .. })
+                            if *storage != StorageClass::PhysicalStorageBuffer
+                    ) =>
+                {
+                    roots.insert(
+                        r,
+                        LocalPtr {
+                            var: r,
+                            path: Vec::new(),
+                            exact: true,
+                        },
+                    );
+                }
                 Op::Variable => {
                     vars.insert(r);
                     roots.insert(
@@ -385,10 +554,25 @@ impl FnLiveness {
                 }
             }
         }
+        // What each call reads through the pointers it passes.
+        let mut call_reads = HashMap::new();
+        for i in f.start..=f.end {
+            let inst = &program.insts[i];
+            if inst.class.opcode != Op::FunctionCall {
+                continue;
+            }
+            let callee = id_operands(inst)
+                .next()
+                .and_then(|c| program.function_index(c));
+            if let Some(c) = callee {
+                call_reads.insert(i, Self::exposed_params(program, c, memo, depth));
+            }
+        }
         let mut fl = FnLiveness {
             func,
             vars,
             roots,
+            call_reads,
             ssa,
             live_out: vec![HashSet::new(); n],
             defined_out: vec![HashSet::new(); n],
@@ -410,7 +594,8 @@ impl FnLiveness {
 
     /// Backward transfer of one instruction over the live set. Debug-info
     /// instructions (`DebugDeclare`, `DebugValue`) neither read nor write.
-    fn step_back(&self, program: &Program, inst: &Instruction, live: &mut HashSet<Place>) {
+    fn step_back(&self, program: &Program, at: usize, live: &mut HashSet<Place>) {
+        let inst = &program.insts[at];
         if program.is_debug_inst(inst) {
             return;
         }
@@ -455,8 +640,41 @@ impl FnLiveness {
                     Op::Variable => false,
                     _ => true,
                 };
-                if reads {
-                    live.insert((p.var, p.path.clone()));
+                if !reads {
+                    continue;
+                }
+                // A call writes what the callee writes on every path, then
+                // reads only what it may read before writing (an `out`
+                // parameter's temporary is not read).
+                let effect = (op == Op::FunctionCall && k > 0 && p.exact)
+                    .then(|| self.call_reads.get(&at)?.get(k - 1))
+                    .flatten();
+                if let Some(e) = effect {
+                    for w in &e.writes {
+                        let mut path = p.path.clone();
+                        path.extend_from_slice(w);
+                        self.kill(
+                            program,
+                            live,
+                            &LocalPtr {
+                                var: p.var,
+                                path,
+                                exact: true,
+                            },
+                        );
+                    }
+                }
+                match effect.and_then(|e| e.reads.as_ref()) {
+                    Some(parts) => {
+                        for q in parts {
+                            let mut path = p.path.clone();
+                            path.extend_from_slice(q);
+                            live.insert((p.var, path));
+                        }
+                    }
+                    None => {
+                        live.insert((p.var, p.path.clone()));
+                    }
                 }
             }
         }
@@ -567,11 +785,8 @@ impl FnLiveness {
                     }
                 }
                 let mut live = out.clone();
-                for inst in program.insts[f.blocks[b].start..=f.blocks[b].end]
-                    .iter()
-                    .rev()
-                {
-                    self.step_back(program, inst, &mut live);
+                for k in (f.blocks[b].start..=f.blocks[b].end).rev() {
+                    self.step_back(program, k, &mut live);
                 }
                 if out != self.live_out[b] || live != live_in[b] {
                     self.live_out[b] = out;
@@ -618,7 +833,7 @@ impl FnLiveness {
         };
         let mut live = self.live_out[b].clone();
         for k in (inst + 1..=f.blocks[b].end).rev() {
-            self.step_back(program, &program.insts[k], &mut live);
+            self.step_back(program, k, &mut live);
         }
         live
     }
@@ -699,7 +914,12 @@ impl FnLiveness {
                 _ => {}
             }
             let rematerializable = if is_var {
-                self.remat_var(program, id, inst, 0)
+                let parts: Vec<Vec<u32>> = places
+                    .iter()
+                    .filter(|(v, _)| *v == id)
+                    .map(|(_, p)| p.clone())
+                    .collect();
+                self.remat_var(program, id, inst, &parts, 0)
             } else {
                 self.remat_ssa(program, id, 0)
             };
@@ -856,7 +1076,18 @@ impl FnLiveness {
             Op::Load => {
                 let ptr = id_operands(inst).next().unwrap_or(0);
                 match self.root(ptr) {
-                    Some(v) => self.remat_var(program, v, i, depth + 1),
+                    // The caller's value: not known here.
+                    Some(v) if !self.vars.contains(&v) => false,
+                    Some(v) => {
+                        let part = self.roots.get(&ptr).map(|p| p.path.clone());
+                        self.remat_var(
+                            program,
+                            v,
+                            i,
+                            &part.into_iter().collect::<Vec<_>>(),
+                            depth + 1,
+                        )
+                    }
                     // A buffer_reference pointer is an address computed like
                     // any value: the load is recomputable when it is.
                     None if self.physical_pointer(program, ptr) => {
@@ -925,13 +1156,23 @@ impl FnLiveness {
     /// that reach `at` store recomputable values, no two of them store
     /// different values into the same part (a merge of paths, like a phi, or
     /// a value that changed), and nothing else (a call, an atomic) gets its
-    /// address.
-    fn remat_var(&mut self, program: &Program, var: Id, at: usize, depth: u32) -> bool {
-        let key = (var, at);
+    /// address. Only writes to the `parts` read count (all of them when
+    /// `parts` is empty or holds the whole variable).
+    fn remat_var(
+        &mut self,
+        program: &Program,
+        var: Id,
+        at: usize,
+        parts: &[Vec<u32>],
+        depth: u32,
+    ) -> bool {
+        let mut parts = parts.to_vec();
+        parts.sort();
+        let key = (var, at, parts.clone());
         if let Some(&r) = self.remat_at.get(&key) {
             return r;
         }
-        self.remat_at.insert(key, false);
+        self.remat_at.insert(key.clone(), false);
         let f = self.function(program);
         let (start, end) = (f.start, f.end);
         let reaching = self.reaching_writes(program, var, at);
@@ -964,18 +1205,22 @@ impl FnLiveness {
                 Op::Store if !reaching.contains(&i) => {}
                 Op::Store => {
                     let value = ids.get(1).copied().unwrap_or(0);
-                    if !self.remat_ssa(program, value, depth + 1) {
-                        ok = false;
-                    }
                     let path = ids
                         .first()
                         .and_then(|p| self.roots.get(p))
                         .map(|p| p.path.clone())
                         .unwrap_or_default();
+                    let overlaps = parts.is_empty()
+                        || parts
+                            .iter()
+                            .any(|q| q.starts_with(&path) || path.starts_with(q));
+                    if !overlaps {
+                        continue;
+                    }
                     let clash = stored
                         .iter()
                         .any(|(q, v)| *v != value && (q.starts_with(&path) || path.starts_with(q)));
-                    if clash {
+                    if clash || !self.remat_ssa(program, value, depth + 1) {
                         ok = false;
                     }
                     stored.push((path, value));
