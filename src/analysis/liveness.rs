@@ -354,7 +354,9 @@ impl FnLiveness {
         memo.insert(func, unknown);
         let fl = Self::build(program, func, memo, depth + 1);
         let entry = f.blocks.first().map(|b| b.start);
-        let live = entry.map(|i| fl.places_after(program, i)).unwrap_or_default();
+        let live = entry
+            .map(|i| fl.places_after(program, i))
+            .unwrap_or_default();
         let exposed: ExposedParams = f
             .params
             .iter()
@@ -422,11 +424,8 @@ impl FnLiveness {
             changed = false;
             rounds += 1;
             for b in 0..n {
-                let mut inset: Option<HashSet<Vec<u32>>> = if b == 0 {
-                    Some(HashSet::new())
-                } else {
-                    None
-                };
+                let mut inset: Option<HashSet<Vec<u32>>> =
+                    if b == 0 { Some(HashSet::new()) } else { None };
                 for &p in &self.preds[b] {
                     if let Some(o) = &out[p] {
                         inset = Some(match inset {
@@ -444,14 +443,14 @@ impl FnLiveness {
             }
         }
         let mut must: Option<HashSet<Vec<u32>>> = None;
-        for b in 0..n {
+        for (block, o) in f.blocks.iter().zip(&out) {
             if !matches!(
-                program.insts[f.blocks[b].end].class.opcode,
+                program.insts[block.end].class.opcode,
                 Op::Return | Op::ReturnValue
             ) {
                 continue;
             }
-            let o = out[b].clone().unwrap_or_default();
+            let o = o.clone().unwrap_or_default();
             must = Some(match must {
                 None => o,
                 Some(m) => m.intersection(&o).cloned().collect(),
@@ -1564,5 +1563,28 @@ mod tests {
         let r = live_report(&[program("fixtures/live/lets.wgsl")]);
         let text = crate::report::live::human(&r);
         assert!(!text.contains("line ?"), "{text}");
+    }
+
+    /// `out` arguments pass through temporaries the callee writes on every
+    /// path without reading: not live. An `inout` one the callee reads is.
+    #[test]
+    fn out_argument_temporaries_are_not_live() {
+        for rel in [
+            "fixtures/live/out_params.rgen.spv",
+            "fixtures/live/out_params.rgen.gV.spv",
+            "fixtures/live/out_params.hlsl",
+        ] {
+            let s = one_site(rel);
+            assert_eq!(
+                names(&s),
+                [
+                    ("acc", 12, false),
+                    ("i", 4, false),
+                    ("seed", 4, false),
+                    ("weight", 4, false)
+                ],
+                "{rel}"
+            );
+        }
     }
 }
