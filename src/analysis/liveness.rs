@@ -141,6 +141,10 @@ pub fn live_sites(program: &Program) -> Vec<LiveSite> {
                 points.extend(chain.iter().rev().copied());
                 let mut values: Vec<LiveValue> = Vec::new();
                 let mut seen: HashSet<Id> = HashSet::new();
+                // Parts behind the previous level's pointer parameters that
+                // it still needs after the site: the caller's memory, counted
+                // where the caller passes it.
+                let mut carried: Vec<(usize, Vec<u32>)> = Vec::new();
                 for &p in &points {
                     let Some(fi) = program.function_of(p) else {
                         continue;
@@ -148,11 +152,13 @@ pub fn live_sites(program: &Program) -> Vec<LiveSite> {
                     let fl = cache
                         .entry(fi)
                         .or_insert_with(|| FnLiveness::new(program, fi));
-                    for v in fl.live_across(program, p) {
+                    let extra = fl.arguments_of(program, p, &carried);
+                    for v in fl.live_across(program, p, &extra) {
                         if seen.insert(v.id) {
                             values.push(v);
                         }
                     }
+                    carried = fl.param_parts_across(program, p, &extra);
                 }
                 // The query object is the site's own state, like a payload.
                 values.retain(|v| Some(v.id) != site.payload);
@@ -319,6 +325,13 @@ pub struct FnLiveness {
     /// For each `OpFunctionCall` (by instruction index), the parts each
     /// pointer argument's callee parameter may read before writing.
     call_reads: HashMap<usize, ExposedParams>,
+    /// `OpLoad`s of a whole local part whose only use is the store right
+    /// after them into another local part (a copy, such as glslang's
+    /// copy-in of an `inout` argument), by the store's instruction index:
+    /// the load's index.
+    copies: HashMap<usize, usize>,
+    /// The loads of `copies`.
+    copy_loads: HashSet<usize>,
     /// SSA values that count as state: defined here, not pointers to locals.
     ssa: HashSet<Id>,
     live_out: Vec<HashSet<Place>>,
@@ -553,6 +566,46 @@ impl FnLiveness {
                 }
             }
         }
+        // Copies from one local part to another: `%v = OpLoad %a; OpStore %b %v`
+        // with `%v` used nowhere else and nothing between the two.
+        let mut uses: HashMap<Id, usize> = HashMap::new();
+        for inst in &program.insts[f.start..=f.end] {
+            if program.is_debug_inst(inst) {
+                continue;
+            }
+            for id in id_operands(inst) {
+                *uses.entry(id).or_default() += 1;
+            }
+        }
+        let mut copies = HashMap::new();
+        for block in &f.blocks {
+            let body: Vec<usize> = (block.start..=block.end)
+                .filter(|&i| {
+                    let inst = &program.insts[i];
+                    !program.is_debug_inst(inst)
+                        && !matches!(inst.class.opcode, Op::Line | Op::NoLine)
+                })
+                .collect();
+            for w in body.windows(2) {
+                let (load, store) = (&program.insts[w[0]], &program.insts[w[1]]);
+                if load.class.opcode != Op::Load || store.class.opcode != Op::Store {
+                    continue;
+                }
+                let (Some(v), Some(src)) = (load.result_id, id_operands(load).next()) else {
+                    continue;
+                };
+                let ops: Vec<Id> = id_operands(store).collect();
+                let exact = |p: Id| roots.get(&p).is_some_and(|r| r.exact);
+                if ops.len() == 2
+                    && ops[1] == v
+                    && uses.get(&v) == Some(&1)
+                    && exact(src)
+                    && exact(ops[0])
+                {
+                    copies.insert(w[1], w[0]);
+                }
+            }
+        }
         // What each call reads through the pointers it passes.
         let mut call_reads = HashMap::new();
         for i in f.start..=f.end {
@@ -572,6 +625,8 @@ impl FnLiveness {
             vars,
             roots,
             call_reads,
+            copy_loads: copies.values().copied().collect(),
+            copies,
             ssa,
             live_out: vec![HashSet::new(); n],
             defined_out: vec![HashSet::new(); n],
@@ -605,6 +660,44 @@ impl FnLiveness {
             if op == Op::Variable {
                 live.retain(|(v, _)| *v != r);
             }
+        }
+        if let Some(&load) = self.copies.get(&at) {
+            // A copy: the parts of the target live after it were the same
+            // parts of the source.
+            let ops: Vec<Id> = id_operands(inst).collect();
+            let src_ptr = id_operands(&program.insts[load]).next();
+            if let (Some(dst), Some(src)) = (
+                self.roots.get(&ops[0]),
+                src_ptr.and_then(|p| self.roots.get(&p)),
+            ) {
+                let wanted: Vec<Vec<u32>> = live
+                    .iter()
+                    .filter(|(v, _)| *v == dst.var)
+                    .filter_map(|(_, q)| {
+                        if let Some(rest) = q.strip_prefix(dst.path.as_slice()) {
+                            Some(rest.to_vec())
+                        } else if dst.path.starts_with(q) {
+                            Some(Vec::new())
+                        } else {
+                            None
+                        }
+                    })
+                    .collect();
+                self.kill(program, live, dst);
+                for r in wanted {
+                    let mut path = src.path.clone();
+                    path.extend(r);
+                    live.insert((src.var, path));
+                }
+                return;
+            }
+        }
+        if op == Op::Load && self.copy_loads.contains(&at) {
+            // Its read is the copy's, handled at the store.
+            if let Some(r) = inst.result_id {
+                live.remove(&(r, Vec::new()));
+            }
+            return;
         }
         match op {
             // Phi operands are used on the incoming edge, handled by `solve`.
@@ -878,8 +971,60 @@ impl FnLiveness {
     }
 
     /// The values live across instruction `inst`, described.
-    pub fn live_across(&mut self, program: &Program, inst: usize) -> Vec<LiveValue> {
-        let places = self.places_after(program, inst);
+    /// The places in this function that call `call` passes for the
+    /// callee's parameter parts in `params` (parameter index, path).
+    fn arguments_of(
+        &self,
+        program: &Program,
+        call: usize,
+        params: &[(usize, Vec<u32>)],
+    ) -> Vec<Place> {
+        let inst = &program.insts[call];
+        if inst.class.opcode != Op::FunctionCall {
+            return Vec::new();
+        }
+        let args: Vec<Id> = id_operands(inst).skip(1).collect();
+        params
+            .iter()
+            .filter_map(|(k, path)| {
+                let root = self.roots.get(args.get(*k)?)?;
+                let mut p = root.path.clone();
+                if root.exact {
+                    p.extend_from_slice(path);
+                }
+                Some((root.var, p))
+            })
+            .collect()
+    }
+
+    /// Parts behind this function's pointer parameters live across
+    /// instruction `inst` (with `extra` places also live), by parameter
+    /// index.
+    fn param_parts_across(
+        &self,
+        program: &Program,
+        inst: usize,
+        extra: &[Place],
+    ) -> Vec<(usize, Vec<u32>)> {
+        let f = self.function(program);
+        let mut places = self.places_after(program, inst);
+        places.extend(extra.iter().cloned());
+        let mut out: Vec<(usize, Vec<u32>)> = places
+            .into_iter()
+            .filter_map(|(v, path)| Some((f.params.iter().position(|&p| p == v)?, path)))
+            .collect();
+        out.sort();
+        out
+    }
+
+    pub fn live_across(
+        &mut self,
+        program: &Program,
+        inst: usize,
+        extra: &[Place],
+    ) -> Vec<LiveValue> {
+        let mut places = self.places_after(program, inst);
+        places.extend(extra.iter().cloned());
         let live: HashSet<Id> = places.iter().map(|(id, _)| *id).collect();
         let defined = self.defined_before(program, inst);
         let result = program.insts.get(inst).and_then(|i| i.result_id);
@@ -1585,6 +1730,28 @@ mod tests {
                 ],
                 "{rel}"
             );
+        }
+    }
+
+    /// Parts behind a pointer parameter that the callee needs after its
+    /// trace are live, counted at the caller's argument (glslang's and
+    /// rtlint's temporaries for a struct passed by value).
+    #[test]
+    fn state_behind_a_parameter_is_live() {
+        for rel in [
+            "fixtures/live/param_state.rgen.spv",
+            "fixtures/live/param_state.rgen.gV.spv",
+            "fixtures/live/param_state.hlsl",
+        ] {
+            let s = one_site(rel);
+            assert_eq!(s.live_bytes - s.rematerializable_bytes, 40, "{rel}: {s:?}");
+            let kept: Vec<(u64, &str)> = s
+                .values
+                .iter()
+                .filter(|v| !v.rematerializable)
+                .map(|v| (v.size, v.ty.as_str()))
+                .collect();
+            assert!(kept.contains(&(24, "Ray")), "{rel}: {kept:?}");
         }
     }
 }
