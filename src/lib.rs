@@ -4,6 +4,7 @@
 //! [`diag::Diagnostic`]s → reports. See `docs/architecture.md`.
 
 pub mod analysis;
+pub mod build;
 pub mod config;
 pub mod diag;
 pub mod explain;

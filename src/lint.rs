@@ -128,9 +128,9 @@ pub fn check_paths(paths: &[PathBuf], options: &Options) -> Report {
         .map(|input| check_input_with(input, &input.config, options))
         .collect();
     let mut owned: Vec<PathBuf> = Vec::new();
-    let mut programs = Vec::new();
+    let mut programs: Vec<Program> = Vec::new();
     for c in checked {
-        if let Some(p) = c.program {
+        if let Some(p) = &c.program {
             for f in &p.files {
                 if let Some(t) = &f.text {
                     report.embedded.push((f.path.clone(), t.clone()));
@@ -139,9 +139,9 @@ pub fn check_paths(paths: &[PathBuf], options: &Options) -> Report {
             }
             // Suppressions are judged only in inputs that were analysed.
             owned.push(c.path.clone());
-            programs.push(p);
         }
         diagnostics.extend(c.diagnostics);
+        programs.extend(c.program);
     }
     let pipelines: Vec<Checked> = inputs
         .pipelines
@@ -151,18 +151,16 @@ pub fn check_paths(paths: &[PathBuf], options: &Options) -> Report {
     for c in pipelines {
         diagnostics.extend(c.diagnostics);
     }
-    // Shaders no description uses get the pipeline rules under the
-    // every-trace-reaches-every-shader assumption.
+    // Shaders no description uses still get the pipeline rules, under the
+    // assumption that every trace reaches every shader.
     let described: Vec<PathBuf> = inputs
         .pipelines
         .iter()
         .flat_map(|(p, _)| described_shaders(p))
         .collect();
-    let loose_config = match inputs.files.first() {
-        Some(i) => i.config.clone(),
-        None => configs.for_path(Path::new(".")),
-    };
-    diagnostics.extend(check_loose(programs, &described, &loose_config));
+    if let Some(first) = inputs.files.first() {
+        diagnostics.extend(check_loose(programs, &described, &first.config));
+    }
     report.deny_warnings = options.overrides.deny_warnings
         || inputs.files.iter().any(|i| i.config.deny_warnings)
         || inputs.pipelines.iter().any(|(_, c)| c.deny_warnings);
@@ -668,66 +666,6 @@ pub fn check_pipeline(path: &Path, config: &Config) -> Checked {
     }
 }
 
-/// The shader files a pipeline description uses (nothing when it cannot be
-/// read: `check_pipeline` reports that).
-pub fn described_shaders(path: &Path) -> Vec<PathBuf> {
-    crate::pipeline::load(path)
-        .map(|p| p.programs.iter().map(|p| canonical(&p.path)).collect())
-        .unwrap_or_default()
-}
-
-fn canonical(p: &Path) -> PathBuf {
-    std::fs::canonicalize(p).unwrap_or_else(|_| p.to_path_buf())
-}
-
-/// Runs the pipeline rules (RT020–RT025) on shaders no description uses:
-/// the shaders of each folder form one pipeline in which every trace may
-/// reach every hit group and miss shader, and each finding says so.
-pub fn check_loose(
-    programs: Vec<Program>,
-    described: &[PathBuf],
-    config: &Config,
-) -> Vec<Diagnostic> {
-    let mut groups: Vec<(PathBuf, Vec<Program>)> = Vec::new();
-    for p in programs {
-        if described.contains(&canonical(&p.path)) {
-            continue;
-        }
-        let has_rt = p.entry_points.iter().any(|e| e.stage.is_ray_tracing());
-        if !has_rt {
-            continue;
-        }
-        // A file holding a ray generation shader and others (WGSL, HLSL) is
-        // a pipeline of its own; one-stage modules pipeline with their folder.
-        let whole = p
-            .entry_points
-            .iter()
-            .any(|e| e.stage == crate::shader::Stage::RayGeneration)
-            && p.entry_points.len() > 1;
-        let dir = if whole {
-            p.path.clone()
-        } else {
-            p.path.parent().map(Path::to_path_buf).unwrap_or_default()
-        };
-        match groups.iter_mut().find(|(d, _)| *d == dir) {
-            Some((_, g)) => g.push(p),
-            None => groups.push((dir, vec![p])),
-        }
-    }
-    let mut out = Vec::new();
-    for (_, programs) in groups {
-        let pipeline = crate::pipeline::Pipeline::from_programs(programs);
-        let ctx = crate::rules::PipelineContext::new(&pipeline, config);
-        let note = crate::analysis::callgraph::Assumption::Undescribed.to_string();
-        out.extend(
-            crate::rules::check_pipeline(&ctx)
-                .into_iter()
-                .map(|d| d.with_note(note.clone())),
-        );
-    }
-    out
-}
-
 /// Drops findings that a suppression allows, and reports every suppression
 /// in the linted sources that allowed nothing (RT000).
 fn apply_suppressions(
@@ -821,6 +759,66 @@ fn apply_suppressions(
         }
     }
     kept
+}
+
+/// The shader files a pipeline description uses (nothing when it cannot be
+/// read: `check_pipeline` reports that).
+pub fn described_shaders(path: &Path) -> Vec<PathBuf> {
+    crate::pipeline::load(path)
+        .map(|p| p.programs.iter().map(|p| canonical(&p.path)).collect())
+        .unwrap_or_default()
+}
+
+fn canonical(p: &Path) -> PathBuf {
+    std::fs::canonicalize(p).unwrap_or_else(|_| p.to_path_buf())
+}
+
+/// Runs the pipeline rules (RT020–RT025) on shaders no description uses:
+/// the shaders of each folder form one pipeline in which every trace may
+/// reach every hit group and miss shader, and each finding says so.
+pub fn check_loose(
+    programs: Vec<Program>,
+    described: &[PathBuf],
+    config: &Config,
+) -> Vec<Diagnostic> {
+    let mut groups: Vec<(PathBuf, Vec<Program>)> = Vec::new();
+    for p in programs {
+        if described.contains(&canonical(&p.path)) {
+            continue;
+        }
+        let has_rt = p.entry_points.iter().any(|e| e.stage.is_ray_tracing());
+        if !has_rt {
+            continue;
+        }
+        // A file holding a ray generation shader and others (WGSL, HLSL) is
+        // a pipeline of its own; one-stage modules pipeline with their folder.
+        let whole = p
+            .entry_points
+            .iter()
+            .any(|e| e.stage == crate::shader::Stage::RayGeneration)
+            && p.entry_points.len() > 1;
+        let dir = if whole {
+            p.path.clone()
+        } else {
+            p.path.parent().map(Path::to_path_buf).unwrap_or_default()
+        };
+        match groups.iter_mut().find(|(d, _)| *d == dir) {
+            Some((_, g)) => g.push(p),
+            None => groups.push((dir, vec![p])),
+        }
+    }
+    let mut out = Vec::new();
+    for (_, programs) in groups {
+        let pipeline = crate::pipeline::Pipeline::from_programs(programs);
+        let ctx = crate::rules::PipelineContext::new(&pipeline, config);
+        let note = crate::analysis::callgraph::Assumption::Undescribed.to_string();
+        out.extend(
+            crate::rules::check_pipeline(&ctx)
+                .into_iter()
+                .map(|d| d.with_note(note.clone())),
+        );
+    }
+    out
 }
 
 #[cfg(test)]

@@ -48,7 +48,9 @@ const FORBIDDEN: &[(&str, &[&str])] = &[
         "explain.rs",
         &["front", "rules", "report", "config", "lint", "vk"],
     ),
-    ("rules", &["front", "report", "lint", "vk"]),
+    ("rules", &["front", "report", "lint", "vk", "build"]),
+    ("lint.rs", &["report", "vk", "build"]),
+    ("report", &["vk", "build"]),
     (
         "config.rs",
         &[
