@@ -1708,6 +1708,9 @@ mod tests {
         let r = live_report(&[program("fixtures/live/lets.wgsl")]);
         let text = crate::report::live::human(&r);
         assert!(!text.contains("line ?"), "{text}");
+        // A WGSL builtin argument is defined where the entry point names it.
+        let id = r.sites[0].values.iter().find(|v| v.name == "id").unwrap();
+        assert_eq!(id.def_line, Some(20), "{text}");
     }
 
     /// `out` arguments pass through temporaries the callee writes on every
