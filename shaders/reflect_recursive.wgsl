@@ -1,7 +1,12 @@
 // Recursive mirror reflections: the closest-hit shader traces the reflected
-// ray itself, so the pipeline needs recursion depth max_bounces + 1 and every
-// level keeps a payload on the ray stack. Same scene, camera and shading as
+// ray itself, and a shadow ray when the scene has a light, so the pipeline
+// needs recursion depth max_bounces + 2 and every level keeps a payload on
+// the ray stack. Same scene, camera, shading and ray origins as
 // reflect_iterative.wgsl; the two must produce the same image.
+//
+// naga gives every trace miss index 0, so the shadow ray shares the one miss
+// shader: it runs only on a miss and overwrites the -1 the caller left in
+// the payload; a hit runs no shader (SKIP_CLOSEST_HIT_SHADER).
 enable wgpu_ray_tracing_pipeline;
 enable primitive_index;
 
@@ -9,18 +14,26 @@ struct Params {
     width: u32,
     height: u32,
     max_bounces: u32,
-    _pad: u32,
+    // FLAG_LIGHT | FLAG_ROBUST
+    flags: u32,
+    camera: vec4<f32>,
+    // xyz: unit direction towards the light, w: ambient
+    light: vec4<f32>,
+    // t_min, t_max, throughput cut-off, fixed origin epsilon
+    ray: vec4<f32>,
 }
 
 struct Surface {
     normal_reflectivity: vec4<f32>,
-    albedo: vec4<f32>,
+    albedo_roughness: vec4<f32>,
 }
 
-// Radiance gathered along the ray, and how many bounces led to it.
+// Radiance gathered along the ray, how many bounces led to it, and the
+// product of the reflectivities on the way.
 struct Radiance {
     color: vec3<f32>,
     depth: u32,
+    throughput: f32,
 }
 
 @group(0) @binding(0) var tlas: acceleration_structure;
@@ -30,6 +43,12 @@ struct Radiance {
 
 var<ray_payload> ray: Radiance;
 var<incoming_ray_payload> incoming: Radiance;
+
+const FLAG_LIGHT: u32 = 1u;
+const FLAG_ROBUST: u32 = 2u;
+const RAY_FLAG_OPAQUE: u32 = 0x01u;
+// OPAQUE | ACCEPT_FIRST_HIT_AND_END_SEARCH | SKIP_CLOSEST_HIT_SHADER
+const SHADOW_FLAGS: u32 = 0x0Du;
 
 fn sky(dir: vec3<f32>) -> vec3<f32> {
     let k = 0.5 * (dir.y + 1.0);
@@ -41,14 +60,26 @@ fn pack_rgba8(c: vec3<f32>) -> u32 {
     return v.x | (v.y << 8u) | (v.z << 16u) | (255u << 24u);
 }
 
+// Wächter & Binder, Ray Tracing Gems ch. 6: move the origin a few ulps
+// along the normal; a fixed epsilon when FLAG_ROBUST is off.
+fn offset_ray(p: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
+    if (params.flags & FLAG_ROBUST) == 0u {
+        return p + n * params.ray.w;
+    }
+    let of_i = vec3<i32>(256.0 * n);
+    let p_i = bitcast<vec3<f32>>(bitcast<vec3<i32>>(p) + select(of_i, -of_i, p < vec3<f32>(0.0)));
+    return select(p_i, p + (1.0 / 65536.0) * n, abs(p) < vec3<f32>(1.0 / 32.0));
+}
+
 @ray_generation
 fn raygen(@builtin(ray_invocation_id) id: vec3<u32>) {
     let size = vec2<f32>(f32(params.width), f32(params.height));
     let uv = (vec2<f32>(id.xy) + 0.5) / size * 2.0 - 1.0;
-    let origin = vec3<f32>(0.0, 1.0, 4.0);
+    let origin = params.camera.xyz;
     let dir = normalize(vec3<f32>(uv.x, -uv.y, -1.5));
     ray.depth = 0u;
-    traceRay(tlas, RayDesc(0x01u, 0xFFu, 0.001, 100.0, origin, dir), &ray);
+    ray.throughput = 1.0;
+    traceRay(tlas, RayDesc(RAY_FLAG_OPAQUE, 0xFFu, params.ray.x, params.ray.y, origin, dir), &ray);
     image[id.y * params.width + id.x] = pack_rgba8(ray.color);
 }
 
@@ -61,21 +92,38 @@ fn miss(@builtin(world_ray_direction) dir: vec3<f32>) {
 @closest_hit
 @incoming_payload(incoming)
 fn closest_hit(
+    @builtin(instance_custom_data) first: u32,
     @builtin(primitive_index) prim: u32,
     @builtin(ray_t_current_max) t: f32,
     @builtin(world_ray_origin) origin: vec3<f32>,
     @builtin(world_ray_direction) dir: vec3<f32>,
 ) {
-    let s = surfaces[prim];
-    let normal = s.normal_reflectivity.xyz;
+    let s = surfaces[first + prim];
     let reflectivity = s.normal_reflectivity.w;
-    let shade = max(dot(normal, -dir), 0.0);
-    var color = s.albedo.xyz * shade * (1.0 - reflectivity);
+    let n = select(-s.normal_reflectivity.xyz, s.normal_reflectivity.xyz, dot(s.normal_reflectivity.xyz, dir) < 0.0);
+    let p = origin + dir * t;
+    var shade: f32;
+    if (params.flags & FLAG_LIGHT) != 0u {
+        let ndl = dot(n, params.light.xyz);
+        var visible = 0.0;
+        if ndl > 0.0 {
+            ray.color = vec3<f32>(-1.0);
+            traceRay(tlas, RayDesc(SHADOW_FLAGS, 0xFFu, params.ray.x, params.ray.y, offset_ray(p, n), params.light.xyz), &ray);
+            if ray.color.x >= 0.0 {
+                visible = 1.0;
+            }
+        }
+        shade = params.light.w + ndl * visible;
+    } else {
+        shade = max(dot(n, -dir), 0.0);
+    }
+    var color = s.albedo_roughness.xyz * shade * (1.0 - reflectivity);
     // The guard that bounds the recursion: depth grows by one per level.
-    if reflectivity > 0.0 && incoming.depth < params.max_bounces {
-        let hit = origin + dir * t + normal * 0.001;
+    let next = incoming.throughput * reflectivity;
+    if reflectivity > 0.0 && next >= params.ray.z && incoming.depth < params.max_bounces {
         ray.depth = incoming.depth + 1u;
-        traceRay(tlas, RayDesc(0x01u, 0xFFu, 0.001, 100.0, hit, reflect(dir, normal)), &ray);
+        ray.throughput = next;
+        traceRay(tlas, RayDesc(RAY_FLAG_OPAQUE, 0xFFu, params.ray.x, params.ray.y, offset_ray(p, n), reflect(dir, n)), &ray);
         color += reflectivity * ray.color;
     }
     incoming.color = color;

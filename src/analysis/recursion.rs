@@ -1365,7 +1365,7 @@ mod tests {
         let loops = trace_loops(&p.programs[0], &p.constants);
         assert_eq!(loops.len(), 1);
         let b = loops[0].bound.as_ref().unwrap();
-        assert_eq!((b.counter.as_str(), b.bound), ("bounce", 8));
+        assert_eq!((b.counter.as_str(), b.bound), ("bounce", 3));
         let none = trace_loops(&p.programs[0], &BTreeMap::new());
         assert_eq!(
             none[0].bound.as_ref().unwrap_err().to_string(),
