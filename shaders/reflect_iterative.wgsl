@@ -39,6 +39,8 @@ struct HitInfo {
 @group(0) @binding(3) var<uniform> params: Params;
 
 var<ray_payload> hit: HitInfo;
+// Shadow rays get a payload of their own (only `t` is used).
+var<ray_payload> shadow: HitInfo;
 var<incoming_ray_payload> incoming: HitInfo;
 
 const MISS_T: f32 = -1.0;
@@ -76,6 +78,8 @@ fn raygen(@builtin(ray_invocation_id) id: vec3<u32>) {
     var origin = params.camera.xyz;
     var dir = normalize(vec3<f32>(uv.x, -uv.y, -1.5));
     var color = vec3<f32>(0.0);
+    // The product of the reflectivities so far; the path stops once it is
+    // not above the cut-off.
     var throughput = 1.0;
     for (var bounce = 0u; bounce <= params.max_bounces; bounce++) {
         traceRay(tlas, RayDesc(RAY_FLAG_OPAQUE, 0xFFu, params.ray.x, params.ray.y, origin, dir), &hit);
@@ -83,32 +87,32 @@ fn raygen(@builtin(ray_invocation_id) id: vec3<u32>) {
             color += throughput * sky(dir);
             break;
         }
-        let albedo = hit.albedo;
-        let reflectivity = hit.reflectivity;
+        // What this surface adds per unit of light, and the next ray (the
+        // shadow ray starts where the reflection does), all before the
+        // shadow trace: the state kept across it stays within 64 bytes.
         let n = select(-hit.normal, hit.normal, dot(hit.normal, dir) < 0.0);
-        let p = origin + dir * hit.t;
-        var shade: f32;
+        let base = throughput * (1.0 - hit.reflectivity) * hit.albedo;
+        throughput *= hit.reflectivity;
+        origin = offset_ray(origin + dir * hit.t, n);
+        let ndl = dot(n, params.light.xyz);
+        let headlight = max(dot(n, -dir), 0.0);
+        dir = reflect(dir, n);
         if (params.flags & FLAG_LIGHT) != 0u {
-            let ndl = dot(n, params.light.xyz);
-            var visible = 0.0;
+            color += base * params.light.w;
             if ndl > 0.0 {
-                hit.t = 0.0;
-                traceRay(tlas, RayDesc(SHADOW_FLAGS, 0xFFu, params.ray.x, params.ray.y, offset_ray(p, n), params.light.xyz), &hit);
-                if hit.t < 0.0 {
-                    visible = 1.0;
+                let lit = base * ndl;
+                shadow.t = 0.0;
+                traceRay(tlas, RayDesc(SHADOW_FLAGS, 0xFFu, params.ray.x, params.ray.y, origin, params.light.xyz), &shadow);
+                if shadow.t < 0.0 {
+                    color += lit;
                 }
             }
-            shade = params.light.w + ndl * visible;
         } else {
-            shade = max(dot(n, -dir), 0.0);
+            color += base * headlight;
         }
-        color += throughput * (albedo * shade * (1.0 - reflectivity));
-        throughput *= reflectivity;
-        if reflectivity <= 0.0 || throughput < params.ray.z {
+        if !(throughput > params.ray.z) {
             break;
         }
-        origin = offset_ray(p, n);
-        dir = reflect(dir, n);
     }
     image[id.y * params.width + id.x] = pack_rgba8(color);
 }

@@ -6,7 +6,9 @@
 //
 // naga gives every trace miss index 0, so the shadow ray shares the one miss
 // shader: it runs only on a miss and overwrites the -1 the caller left in
-// the payload; a hit runs no shader (SKIP_CLOSEST_HIT_SHADER).
+// the payload; a hit runs no shader (SKIP_CLOSEST_HIT_SHADER). The shadow
+// payload is a variable of its own, so naga's per-payload trace helper has
+// constant flags at each site.
 enable wgpu_ray_tracing_pipeline;
 enable primitive_index;
 
@@ -42,6 +44,8 @@ struct Radiance {
 @group(0) @binding(3) var<uniform> params: Params;
 
 var<ray_payload> ray: Radiance;
+// Shadow rays get a payload of their own (only `color.x` is used).
+var<ray_payload> shadow: Radiance;
 var<incoming_ray_payload> incoming: Radiance;
 
 const FLAG_LIGHT: u32 = 1u;
@@ -101,29 +105,28 @@ fn closest_hit(
     let s = surfaces[first + prim];
     let reflectivity = s.normal_reflectivity.w;
     let n = select(-s.normal_reflectivity.xyz, s.normal_reflectivity.xyz, dot(s.normal_reflectivity.xyz, dir) < 0.0);
-    let p = origin + dir * t;
-    var shade: f32;
+    let base = (1.0 - reflectivity) * s.albedo_roughness.xyz;
+    let start = offset_ray(origin + dir * t, n);
+    var color: vec3<f32>;
     if (params.flags & FLAG_LIGHT) != 0u {
         let ndl = dot(n, params.light.xyz);
-        var visible = 0.0;
+        color = base * params.light.w;
         if ndl > 0.0 {
-            ray.color = vec3<f32>(-1.0);
-            traceRay(tlas, RayDesc(SHADOW_FLAGS, 0xFFu, params.ray.x, params.ray.y, offset_ray(p, n), params.light.xyz), &ray);
-            if ray.color.x >= 0.0 {
-                visible = 1.0;
+            shadow.color = vec3<f32>(-1.0);
+            traceRay(tlas, RayDesc(SHADOW_FLAGS, 0xFFu, params.ray.x, params.ray.y, start, params.light.xyz), &shadow);
+            if shadow.color.x >= 0.0 {
+                color += base * ndl;
             }
         }
-        shade = params.light.w + ndl * visible;
     } else {
-        shade = max(dot(n, -dir), 0.0);
+        color = base * max(dot(n, -dir), 0.0);
     }
-    var color = s.albedo_roughness.xyz * shade * (1.0 - reflectivity);
     // The guard that bounds the recursion: depth grows by one per level.
     let next = incoming.throughput * reflectivity;
-    if reflectivity > 0.0 && next >= params.ray.z && incoming.depth < params.max_bounces {
+    if next > params.ray.z && incoming.depth < params.max_bounces {
         ray.depth = incoming.depth + 1u;
         ray.throughput = next;
-        traceRay(tlas, RayDesc(RAY_FLAG_OPAQUE, 0xFFu, params.ray.x, params.ray.y, offset_ray(p, n), reflect(dir, n)), &ray);
+        traceRay(tlas, RayDesc(RAY_FLAG_OPAQUE, 0xFFu, params.ray.x, params.ray.y, start, reflect(dir, n)), &ray);
         color += reflectivity * ray.color;
     }
     incoming.color = color;

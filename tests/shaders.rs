@@ -26,7 +26,8 @@ fn bundled_wgsl_shaders_are_valid_and_clean() {
 
 /// The README's first command: the three shaders and two pipeline
 /// descriptions lint with one finding, the recursion the recursive
-/// reference exists to show (its depth guard recognised: depth 4).
+/// reference exists to show (its depth guard recognised: depth 5, three
+/// bounces and a shadow ray).
 #[test]
 fn main_job_reports_the_recursive_reference() {
     let o = common::rtlint()
@@ -45,6 +46,6 @@ fn main_job_reports_the_recursive_reference() {
     assert!(v["diagnostics"][0]["notes"][0]
         .as_str()
         .unwrap()
-        .contains("needs recursion depth 4"));
+        .contains("needs recursion depth 5"));
     assert_eq!(v["summary"]["files"], 5);
 }

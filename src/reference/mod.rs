@@ -34,7 +34,7 @@ pub struct Params {
     pub light: Option<Light>,
     pub t_min: f32,
     pub t_max: f32,
-    /// A path stops once its throughput falls below this.
+    /// A path goes on while its throughput is above this.
     pub cutoff: f32,
     /// The fixed offset along the normal when `robust` is off.
     pub epsilon: f32,
@@ -206,15 +206,15 @@ pub fn intersect(
     (best, margin)
 }
 
-/// What a hit shader computes before reflecting: the normal facing the
-/// incoming ray, the hit point, and the surface's own colour (diffuse with
-/// the light or headlight, times `1 - reflectivity`), tracing the shadow ray
-/// when there is a light.
+/// What a hit adds, as both shaders compute it: the normal facing the
+/// incoming ray, where the next rays start (`from`), and the surface's own
+/// colour per unit of `weight` (the iterative shader's throughput; 1 in the
+/// recursive one), tracing the shadow ray when there is a light.
 struct Shading {
     normal: Vec3,
-    point: Vec3,
+    from: Vec3,
     local: Vec3,
-    surface: Surface,
+    reflectivity: f32,
 }
 
 fn shade(
@@ -223,6 +223,7 @@ fn shade(
     origin: Vec3,
     dir: Vec3,
     hit: Hit,
+    weight: Option<f32>,
     segments: &mut Vec<Segment>,
 ) -> Shading {
     let surface = scene.surfaces[hit.triangle as usize];
@@ -231,13 +232,18 @@ fn shade(
     } else {
         -surface.normal
     };
-    let point = origin + dir * hit.t;
-    let k = match params.light {
+    let r = surface.reflectivity;
+    // Iterative: `throughput * (1 - r) * albedo`; recursive: `(1 - r) * albedo`.
+    let base = match weight {
+        Some(w) => w * (1.0 - r) * surface.albedo,
+        None => (1.0 - r) * surface.albedo,
+    };
+    let from = params.next_origin(origin + dir * hit.t, n);
+    let local = match params.light {
         Some(light) => {
             let ndl = n.dot(light.direction);
-            let mut visible = 0.0f32;
+            let mut c = base * light.ambient;
             if ndl > 0.0 {
-                let from = params.next_origin(point, n);
                 let (blocker, edge_margin) =
                     intersect(scene, from, light.direction, params.t_min, params.t_max);
                 segments.push(Segment {
@@ -248,19 +254,18 @@ fn shade(
                     edge_margin,
                 });
                 if blocker.is_none() {
-                    visible = 1.0;
+                    c += base * ndl;
                 }
             }
-            light.ambient + ndl * visible
+            c
         }
-        None => n.dot(-dir).max(0.0),
+        None => base * n.dot(-dir).max(0.0),
     };
-    let local = surface.albedo * k * (1.0 - surface.reflectivity);
     Shading {
         normal: n,
-        point,
+        from,
         local,
-        surface,
+        reflectivity: r,
     }
 }
 
@@ -284,14 +289,21 @@ pub fn trace_iterative(scene: &Scene, params: &Params, x: u32, y: u32) -> PixelP
             color += throughput * sky(dir);
             break;
         };
-        let s = shade(scene, params, origin, dir, hit, &mut segments);
-        let r = s.surface.reflectivity;
-        color += throughput * s.local;
-        throughput *= r;
-        if r <= 0.0 || throughput < params.cutoff {
+        let s = shade(
+            scene,
+            params,
+            origin,
+            dir,
+            hit,
+            Some(throughput),
+            &mut segments,
+        );
+        color += s.local;
+        throughput *= s.reflectivity;
+        origin = s.from;
+        if !(throughput > params.cutoff) {
             break;
         }
-        origin = params.next_origin(s.point, s.normal);
         dir = reflect(dir, s.normal);
     }
     PixelPath { color, segments }
@@ -333,16 +345,15 @@ fn radiance(
     let Some(hit) = hit else {
         return sky(dir);
     };
-    let s = shade(scene, params, origin, dir, hit, segments);
-    let r = s.surface.reflectivity;
+    let s = shade(scene, params, origin, dir, hit, None, segments);
+    let r = s.reflectivity;
     let mut color = s.local;
     let next = throughput * r;
-    if r > 0.0 && next >= params.cutoff && depth < params.max_bounces {
-        let from = params.next_origin(s.point, s.normal);
+    if next > params.cutoff && depth < params.max_bounces {
         let child = radiance(
             scene,
             params,
-            from,
+            s.from,
             reflect(dir, s.normal),
             depth + 1,
             next,
