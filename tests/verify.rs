@@ -110,9 +110,8 @@ fn check_flags_the_shallow_pipeline_statically() {
 fn broken_copy(dir: &Path) {
     let root = common::root().join("shaders");
     std::fs::create_dir_all(dir.join("scenes")).unwrap();
-    for f in ["reflect_iterative.pipeline.toml"] {
-        std::fs::copy(root.join(f), dir.join(f)).unwrap();
-    }
+    let pipeline = "reflect_iterative.pipeline.toml";
+    std::fs::copy(root.join(pipeline), dir.join(pipeline)).unwrap();
     for f in ["mirror.toml", "showcase.toml"] {
         std::fs::copy(root.join("scenes").join(f), dir.join("scenes").join(f)).unwrap();
     }

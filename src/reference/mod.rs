@@ -301,7 +301,8 @@ pub fn trace_iterative(scene: &Scene, params: &Params, x: u32, y: u32) -> PixelP
         color += s.local;
         throughput *= s.reflectivity;
         origin = s.from;
-        if !(throughput > params.cutoff) {
+        // The shaders' `!(throughput > cutoff)`: a NaN throughput stops too.
+        if throughput.partial_cmp(&params.cutoff) != Some(std::cmp::Ordering::Greater) {
             break;
         }
         dir = reflect(dir, s.normal);

@@ -507,7 +507,7 @@ fn render_case(
     let (cpu, margins) = reference::render(&scene, &params, method);
     let end = wait(running)?;
     note_device(report, &end);
-    if !end.code.is_some_and(|c| c == 0) {
+    if end.code != Some(0) {
         return Ok((None, Outcome::Fail(end.describe()), None));
     }
     let bytes = std::fs::read(&image_path)
