@@ -1,5 +1,6 @@
-//! `rtlint verify` on the Vulkan device: the reference shaders match the CPU
-//! reference, recursive and iterative images are identical, the pipeline
+//! `rtlint verify` on the Vulkan device: the reference shaders (WGSL, and
+//! HLSL through rtlint's compiler) match the CPU reference, recursive and
+//! iterative images and both languages' images are identical, the pipeline
 //! declared too shallow crashes its child and passes as an expected failure,
 //! and a shader that disagrees with the reference fails with images. Under
 //! the skip policy (`common::device()`): without a ray-tracing device these
@@ -62,8 +63,16 @@ fn reference_shaders_pass_and_the_shallow_pipeline_fails_as_expected() {
             pass("iterative", "showcase"),
             pass("recursive", "mirror"),
             pass("recursive", "showcase"),
+            pass("iterative-hlsl", "mirror"),
+            pass("iterative-hlsl", "showcase"),
+            pass("recursive-hlsl", "mirror"),
+            pass("recursive-hlsl", "showcase"),
             pass("recursive = iterative", "mirror"),
             pass("recursive = iterative", "showcase"),
+            pass("iterative-hlsl = iterative", "mirror"),
+            pass("iterative-hlsl = iterative", "showcase"),
+            pass("recursive-hlsl = recursive", "mirror"),
+            pass("recursive-hlsl = recursive", "showcase"),
             (
                 "recursive-depth-1".into(),
                 "showcase".into(),
@@ -79,7 +88,7 @@ fn reference_shaders_pass_and_the_shallow_pipeline_fails_as_expected() {
         "{stdout}"
     );
     let csv = std::fs::read_to_string(out.join("verify.csv")).unwrap();
-    assert_eq!(csv.lines().count(), 8, "{csv}");
+    assert_eq!(csv.lines().count(), 16, "{csv}");
     assert!(csv.starts_with("shader,case,pixels,max diff"), "{csv}");
     let md = std::fs::read_to_string(out.join("verify.md")).unwrap();
     assert!(md.contains("| recursive | mirror | 4096 |"), "{md}");

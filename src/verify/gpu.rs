@@ -93,7 +93,14 @@ pub fn render<'p>(
         });
         Ok(stages.len() as u32 - 1)
     };
-    for s in pipeline.raygen.iter().chain(&pipeline.miss) {
+    // Only what the scene needs: without a light no shadow ray is traced, so
+    // the shadow miss shaders (every miss after the first) are left out.
+    let misses = if scene.light.is_some() {
+        &pipeline.miss[..]
+    } else {
+        &pipeline.miss[..pipeline.miss.len().min(1)]
+    };
+    for s in pipeline.raygen.iter().chain(misses) {
         groups.push(Group::General(add(s)?));
     }
     for g in &pipeline.hit_groups {
