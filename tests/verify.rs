@@ -96,22 +96,34 @@ fn reference_shaders_pass_and_the_shallow_pipeline_fails_as_expected() {
     std::fs::remove_dir_all(&out).unwrap();
 }
 
-/// The shallow description `verify` runs as its expected failure is an
-/// error for `rtlint check` too.
+/// The pipeline `verify` runs as its expected failure, the recursive
+/// reference declared with depth 1, is an error for `rtlint check` too.
 #[test]
 fn check_flags_the_shallow_pipeline_statically() {
+    let dir = out_dir("shallow");
+    std::fs::create_dir_all(&dir).unwrap();
+    let shaders = common::root().join("shaders");
+    let text = std::fs::read_to_string(shaders.join("reflect_recursive.pipeline.toml")).unwrap();
+    let wgsl = shaders.join("reflect_recursive.wgsl");
+    let shallow = text
+        .replace("max_recursion_depth = 5", "max_recursion_depth = 1")
+        .replace(
+            "\"reflect_recursive.wgsl\"",
+            &format!("{:?}", wgsl.display().to_string()),
+        );
+    assert_ne!(text, shallow);
+    let toml = dir.join("shallow.pipeline.toml");
+    std::fs::write(&toml, shallow).unwrap();
     let o = common::rtlint()
-        .args([
-            "check",
-            "--format",
-            "concise",
-            "fixtures/verify/reflect_recursive_shallow.pipeline.toml",
-        ])
+        .args(["check", "--format", "concise"])
+        .arg(&toml)
         .output()
         .unwrap();
     let stdout = String::from_utf8_lossy(&o.stdout);
     assert_eq!(o.status.code(), Some(1), "{stdout}");
     assert!(stdout.contains("error[RT021]"), "{stdout}");
+    assert!(stdout.contains("needs recursion depth 5"), "{stdout}");
+    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 /// Copies the bundled shaders folder with the iterative shader's sky made a

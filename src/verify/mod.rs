@@ -59,9 +59,10 @@ struct RawShader {
 struct RawExpectedFailure {
     name: String,
     pipeline: PathBuf,
+    /// Declared instead of the description's own depth.
+    max_recursion_depth: u32,
     reference: String,
     scene: String,
-    why: String,
 }
 
 /// One row of the table.
@@ -75,14 +76,34 @@ pub enum CaseKind {
     },
     /// The GPU images of two render cases are identical.
     Identical { a: String, b: String },
-    /// A run that must crash the child (the pipeline declares too little
-    /// recursion depth); it fails if the child runs clean.
+    /// A run that must crash the child: the pipeline declared with
+    /// `depth`, less recursion depth than it needs. It fails if the child
+    /// runs clean.
     ExpectedCrash {
         pipeline: PathBuf,
         method: Method,
         scene: PathBuf,
-        why: String,
+        depth: u32,
     },
+}
+
+impl CaseKind {
+    /// What a case runs on the device: pipeline, scene, and the recursion
+    /// depth declared instead of the description's.
+    pub fn runs(&self) -> Option<(&Path, &Path, Option<u32>)> {
+        match self {
+            CaseKind::Render {
+                pipeline, scene, ..
+            } => Some((pipeline, scene, None)),
+            CaseKind::ExpectedCrash {
+                pipeline,
+                scene,
+                depth,
+                ..
+            } => Some((pipeline, scene, Some(*depth))),
+            CaseKind::Identical { .. } => None,
+        }
+    }
 }
 
 #[derive(Clone, Debug, PartialEq)]
@@ -175,7 +196,7 @@ impl Manifest {
                     pipeline: dir.join(&f.pipeline),
                     method: method(&f.reference, &path.display().to_string())?,
                     scene: scene(&f.scene),
-                    why: f.why.clone(),
+                    depth: f.max_recursion_depth,
                 },
             });
         }
@@ -213,9 +234,13 @@ pub fn setup(
     manifest: &Manifest,
     pipeline_path: &Path,
     scene_path: &Path,
+    depth: Option<u32>,
 ) -> Result<(crate::pipeline::Pipeline, Scene, Params), String> {
-    let pipeline = crate::pipeline::load(pipeline_path)
+    let mut pipeline = crate::pipeline::load(pipeline_path)
         .map_err(|e| format!("{}: {}", pipeline_path.display(), e.0.message.trim_end()))?;
+    if depth.is_some() {
+        pipeline.max_recursion_depth = depth;
+    }
     let scene = Scene::load(scene_path)?;
     let bounces = pipeline
         .constant("params.max_bounces")
@@ -393,14 +418,8 @@ pub fn run(
         .map_err(|e| format!("cannot create {}: {e}", options.out.display()))?;
     // Inputs are checked before any GPU work: a bad scene is a usage error.
     for c in &cases {
-        if let CaseKind::Render {
-            pipeline, scene, ..
-        }
-        | CaseKind::ExpectedCrash {
-            pipeline, scene, ..
-        } = &c.kind
-        {
-            setup(&manifest, pipeline, scene)?;
+        if let Some((pipeline, scene, depth)) = c.kind.runs() {
+            setup(&manifest, pipeline, scene, depth)?;
         }
     }
     let mut report = Report::default();
@@ -447,18 +466,26 @@ pub fn run(
                 }
             }
             CaseKind::ExpectedCrash {
-                pipeline, scene, ..
+                pipeline,
+                scene,
+                depth,
+                ..
             } => {
-                let (_, _, params) = setup(&manifest, pipeline, scene)?;
+                let (p, _, params) = setup(&manifest, pipeline, scene, Some(*depth))?;
+                // What `rtlint check` reports statically (RT021).
+                let needs = match crate::analysis::recursion_report(&p).required_depth {
+                    Some(n) => format!("rtlint check: needs depth {n}, declared {depth} (RT021)"),
+                    None => "rtlint check: recursion depth unbounded (RT024)".into(),
+                };
                 let image = options.out.join(format!("{}.rgba", file_name(&case.name)));
                 let end = wait(spawn((options.child)(&case.name, &image))?)?;
                 let _ = std::fs::remove_file(&image);
                 note_device(&mut report, &end);
                 let o = if end.signal.is_some() && !end.timed_out {
-                    Outcome::ExpectedFailure(format!("caught: {}", end.describe()))
+                    Outcome::ExpectedFailure(format!("caught: {}; {needs}", end.describe()))
                 } else if end.code == Some(0) {
                     Outcome::Fail(format!(
-                        "the pipeline declared with too little depth ran clean ({}×{})",
+                        "the pipeline declared with depth {depth} ran clean ({}×{}); {needs}",
                         params.width, params.height
                     ))
                 } else {
@@ -499,7 +526,7 @@ fn render_case(
     scene_path: &Path,
     report: &mut Report,
 ) -> Result<CaseResult, String> {
-    let (_, scene, params) = setup(manifest, pipeline, scene_path)?;
+    let (_, scene, params) = setup(manifest, pipeline, scene_path, None)?;
     let image_path = options.out.join(format!("{}.rgba", file_name(&case.name)));
     let _ = std::fs::remove_file(&image_path);
     // The CPU reference renders while the child runs.
@@ -569,16 +596,10 @@ pub fn child_main(
         .iter()
         .find(|c| c.name == name)
         .ok_or_else(|| format!("no verify case `{name}`"))?;
-    let (pipeline, scene_path) = match &case.kind {
-        CaseKind::Render {
-            pipeline, scene, ..
-        }
-        | CaseKind::ExpectedCrash {
-            pipeline, scene, ..
-        } => (pipeline, scene),
-        CaseKind::Identical { .. } => return Err(format!("`{name}` runs nothing")),
+    let Some((pipeline, scene_path, depth)) = case.kind.runs() else {
+        return Err(format!("`{name}` runs nothing"));
     };
-    let (pipeline, scene, params) = setup(&manifest, pipeline, scene_path)?;
+    let (pipeline, scene, params) = setup(&manifest, pipeline, scene_path, depth)?;
     let ctx = crate::vk::Context::with_options(&crate::vk::ContextOptions {
         device_name: device.map(str::to_string),
         ..Default::default()
@@ -715,11 +736,8 @@ mod tests {
             .iter()
             .any(|c| matches!(c.kind, CaseKind::ExpectedCrash { .. })));
         for c in &m.cases {
-            if let CaseKind::Render {
-                pipeline, scene, ..
-            } = &c.kind
-            {
-                setup(&m, pipeline, scene).unwrap();
+            if let Some((pipeline, scene, depth)) = c.kind.runs() {
+                setup(&m, pipeline, scene, depth).unwrap();
             }
         }
         // Selecting an identity case brings the renders it compares.
