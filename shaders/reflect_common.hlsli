@@ -30,15 +30,8 @@ struct ParamsData
 };
 ConstantBuffer<ParamsData> params : register(b3);
 
-// Shadow rays: the shadow miss shader (miss index 1) marks the light visible.
-struct ShadowInfo
-{
-    float visible;
-};
-
 static const uint FLAG_LIGHT = 1;
 static const uint FLAG_ROBUST = 2;
-static const uint SHADOW_FLAGS = RAY_FLAG_FORCE_OPAQUE | RAY_FLAG_ACCEPT_FIRST_HIT_AND_END_SEARCH | RAY_FLAG_SKIP_CLOSEST_HIT_SHADER;
 
 float3 sky(float3 dir)
 {
@@ -68,23 +61,4 @@ float3 camera_dir(uint2 id)
     float2 size = float2(params.width, params.height);
     float2 uv = (float2(id) + 0.5) / size * 2.0 - 1.0;
     return normalize(float3(uv.x, -uv.y, -1.5));
-}
-
-float shadow_ray(float3 origin)
-{
-    RayDesc ray;
-    ray.Origin = origin;
-    ray.Direction = params.light.xyz;
-    ray.TMin = params.ray.x;
-    ray.TMax = params.ray.y;
-    ShadowInfo shadow;
-    shadow.visible = 0.0;
-    TraceRay(tlas, SHADOW_FLAGS, 0xFF, 0, 1, 1, ray, shadow);
-    return shadow.visible;
-}
-
-[shader("miss")]
-void shadow_miss(inout ShadowInfo shadow)
-{
-    shadow.visible = 1.0;
 }

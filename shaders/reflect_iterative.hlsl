@@ -3,7 +3,7 @@
 // reports the surface, so the pipeline needs recursion depth 1. Shadow rays
 // (when the scene has a light) are traced from raygen with their own payload
 // and miss shader (miss index 1). Same math as reflect_iterative.wgsl.
-#include "reflect_common.hlsli"
+#include "reflect_shadow.hlsli"
 
 struct HitInfo
 {

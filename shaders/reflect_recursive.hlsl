@@ -3,7 +3,7 @@
 // (miss index 1, its own payload) when the scene has a light, so the
 // pipeline needs recursion depth max_bounces + 2. Same math as
 // reflect_recursive.wgsl; the image must equal the iterative one.
-#include "reflect_common.hlsli"
+#include "reflect_shadow.hlsli"
 
 // Radiance gathered along the ray, how many bounces led to it, and the
 // product of the reflectivities on the way.

@@ -705,13 +705,16 @@ fn verify(args: VerifyArgs) -> Result<u8, String> {
         let [case, image] = child.as_slice() else {
             return Err("--child takes a case and an image path".into());
         };
-        verify::child_main(
+        return match verify::child_main(
             &args.shaders,
             case,
             std::path::Path::new(image),
             args.device.as_deref(),
-        )?;
-        return Ok(0);
+        ) {
+            Ok(()) => Ok(0),
+            Err(e) if e == verify::SKIP => Ok(verify::SKIP_CODE as u8),
+            Err(e) => Err(e),
+        };
     }
     if args.extremes {
         return Err("--extremes: the numerical-extremes matrix is not implemented yet".into());

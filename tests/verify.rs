@@ -43,9 +43,16 @@ fn rows(stdout: &str) -> Vec<(String, String, String)> {
 
 #[test]
 fn reference_shaders_pass_and_the_shallow_pipeline_fails_as_expected() {
-    if common::device().is_none() {
+    let Some(ctx) = common::device() else {
         return;
-    }
+    };
+    // Ray-query cases are skipped, and say so, where the device has none.
+    let query = if ctx.info().ray_query {
+        "pass"
+    } else {
+        "skipped"
+    };
+    drop(ctx);
     let out = out_dir("bundled");
     let o = common::rtlint()
         .args(["verify", "--out"])
@@ -55,31 +62,37 @@ fn reference_shaders_pass_and_the_shallow_pipeline_fails_as_expected() {
     let stdout = String::from_utf8_lossy(&o.stdout);
     eprintln!("{stdout}{}", String::from_utf8_lossy(&o.stderr));
     assert_eq!(o.status.code(), Some(0), "{stdout}");
-    let pass = |s: &str, c: &str| (s.to_string(), c.to_string(), "pass".to_string());
-    assert_eq!(
-        rows(&stdout),
-        [
-            pass("iterative", "mirror"),
-            pass("iterative", "showcase"),
-            pass("recursive", "mirror"),
-            pass("recursive", "showcase"),
-            pass("iterative-hlsl", "mirror"),
-            pass("iterative-hlsl", "showcase"),
-            pass("recursive-hlsl", "mirror"),
-            pass("recursive-hlsl", "showcase"),
-            pass("recursive = iterative", "mirror"),
-            pass("recursive = iterative", "showcase"),
-            pass("iterative-hlsl = iterative", "mirror"),
-            pass("iterative-hlsl = iterative", "showcase"),
-            pass("recursive-hlsl = recursive", "mirror"),
-            pass("recursive-hlsl = recursive", "showcase"),
-            (
-                "recursive-depth-1".into(),
-                "showcase".into(),
-                "pass (expected failure)".into()
-            ),
-        ]
-    );
+    let row = |s: &str, c: &str, r: &str| (s.to_string(), c.to_string(), r.to_string());
+    let mut expected = Vec::new();
+    for (shader, result) in [
+        ("iterative", "pass"),
+        ("recursive", "pass"),
+        ("iterative-hlsl", "pass"),
+        ("recursive-hlsl", "pass"),
+        ("rayquery", query),
+        ("rayquery-hlsl", query),
+    ] {
+        for scene in ["mirror", "showcase"] {
+            expected.push(row(shader, scene, result));
+        }
+    }
+    for (pair, result) in [
+        ("recursive = iterative", "pass"),
+        ("iterative-hlsl = iterative", "pass"),
+        ("recursive-hlsl = recursive", "pass"),
+        ("rayquery = iterative", query),
+        ("rayquery-hlsl = iterative", query),
+    ] {
+        for scene in ["mirror", "showcase"] {
+            expected.push(row(pair, scene, result));
+        }
+    }
+    expected.push(row(
+        "recursive-depth-1",
+        "showcase",
+        "pass (expected failure)",
+    ));
+    assert_eq!(rows(&stdout), expected);
     // The crash was caught and named.
     assert!(
         stdout.contains(
@@ -88,7 +101,7 @@ fn reference_shaders_pass_and_the_shallow_pipeline_fails_as_expected() {
         "{stdout}"
     );
     let csv = std::fs::read_to_string(out.join("verify.csv")).unwrap();
-    assert_eq!(csv.lines().count(), 16, "{csv}");
+    assert_eq!(csv.lines().count(), expected.len() + 1, "{csv}");
     assert!(csv.starts_with("shader,case,pixels,max diff"), "{csv}");
     let md = std::fs::read_to_string(out.join("verify.md")).unwrap();
     assert!(md.contains("| recursive | mirror | 4096 |"), "{md}");

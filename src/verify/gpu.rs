@@ -5,8 +5,8 @@
 use crate::pipeline::{HitGroupKind, Pipeline};
 use crate::reference::{Params, Scene};
 use crate::vk::{
-    raw, AccelerationStructure, Binding, BindingKind, Buffer, Context, Geometry, Group, Instance,
-    RayTracingPipeline, RayTracingPipelineDesc, Resource, ShaderStage,
+    raw, AccelerationStructure, Binding, BindingKind, Buffer, ComputePipeline, Context, Geometry,
+    Group, Instance, RayTracingPipeline, RayTracingPipelineDesc, Resource, ShaderStage,
 };
 use std::time::{Duration, Instant};
 
@@ -143,6 +143,49 @@ pub fn render<'p>(
     ];
     let trace = rt
         .trace_rays(&resources, params.width, params.height, 1)
+        .map_err(vk)?;
+    Ok(Rendered {
+        image: image.read_u32(),
+        trace,
+        total: start.elapsed(),
+    })
+}
+
+/// Dispatches the compute shader `entry` (8 × 8 workgroups, one invocation
+/// per pixel) over `params`' image of `scene`.
+pub fn render_compute(
+    ctx: &Context,
+    words: &[u32],
+    entry: &str,
+    scene: &Scene,
+    params: &Params,
+) -> Result<Rendered, String> {
+    let start = Instant::now();
+    let vk = |e: crate::vk::Error| e.to_string();
+    let gpu_scene = GpuScene::new(ctx, scene).map_err(vk)?;
+    let pipeline = ComputePipeline::new(ctx, words, entry, &BINDINGS).map_err(vk)?;
+    let pixels = u64::from(params.width) * u64::from(params.height);
+    let image =
+        Buffer::new(ctx, pixels * 4, raw::BufferUsageFlags::STORAGE_BUFFER, 1).map_err(vk)?;
+    let uniform = Buffer::from_data(
+        ctx,
+        raw::BufferUsageFlags::UNIFORM_BUFFER,
+        &params.to_words(),
+    )
+    .map_err(vk)?;
+    let resources = [
+        (0, Resource::AccelerationStructure(&gpu_scene.tlas)),
+        (1, Resource::Buffer(&image)),
+        (2, Resource::Buffer(&gpu_scene.surfaces)),
+        (3, Resource::Buffer(&uniform)),
+    ];
+    let trace = pipeline
+        .dispatch(
+            &resources,
+            params.width.div_ceil(8),
+            params.height.div_ceil(8),
+            1,
+        )
         .map_err(vk)?;
     Ok(Rendered {
         image: image.read_u32(),

@@ -30,6 +30,11 @@ pub const TOLERANCE: u8 = 1;
 /// How long one child may run.
 pub const CHILD_TIMEOUT: Duration = Duration::from_secs(120);
 
+/// The exit code of a child whose device cannot run its case, and the
+/// error [`child_main`] returns then (the CLI maps it to that code).
+pub const SKIP_CODE: i32 = 77;
+pub const SKIP: &str = "skipped: the device cannot run this case";
+
 /// The manifest's file name inside the shaders folder.
 pub const MANIFEST: &str = "verify.toml";
 
@@ -48,7 +53,12 @@ struct RawManifest {
 #[serde(deny_unknown_fields)]
 struct RawShader {
     name: String,
-    pipeline: PathBuf,
+    /// A ray-tracing pipeline description, or
+    pipeline: Option<PathBuf>,
+    /// a compute shader (ray queries) with its entry point and bounces.
+    compute: Option<PathBuf>,
+    entry: Option<String>,
+    max_bounces: Option<u32>,
     reference: String,
     scenes: Vec<String>,
     identical_to: Option<String>,
@@ -65,12 +75,25 @@ struct RawExpectedFailure {
     scene: String,
 }
 
+/// What runs on the device.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Source {
+    /// A ray-tracing pipeline description.
+    Pipeline(PathBuf),
+    /// A compute shader using ray queries: one invocation per pixel.
+    Compute {
+        file: PathBuf,
+        entry: String,
+        max_bounces: u32,
+    },
+}
+
 /// One row of the table.
 #[derive(Clone, Debug, PartialEq)]
 pub enum CaseKind {
-    /// Render `scene` with the pipeline and compare with the CPU reference.
+    /// Render `scene` and compare with the CPU reference.
     Render {
-        pipeline: PathBuf,
+        source: Source,
         method: Method,
         scene: PathBuf,
     },
@@ -80,7 +103,7 @@ pub enum CaseKind {
     /// `depth`, less recursion depth than it needs. It fails if the child
     /// runs clean.
     ExpectedCrash {
-        pipeline: PathBuf,
+        source: Source,
         method: Method,
         scene: PathBuf,
         depth: u32,
@@ -90,17 +113,15 @@ pub enum CaseKind {
 impl CaseKind {
     /// What a case runs on the device: pipeline, scene, and the recursion
     /// depth declared instead of the description's.
-    pub fn runs(&self) -> Option<(&Path, &Path, Option<u32>)> {
+    pub fn runs(&self) -> Option<(&Source, &Path, Option<u32>)> {
         match self {
-            CaseKind::Render {
-                pipeline, scene, ..
-            } => Some((pipeline, scene, None)),
+            CaseKind::Render { source, scene, .. } => Some((source, scene, None)),
             CaseKind::ExpectedCrash {
-                pipeline,
+                source,
                 scene,
                 depth,
                 ..
-            } => Some((pipeline, scene, Some(*depth))),
+            } => Some((source, scene, Some(*depth))),
             CaseKind::Identical { .. } => None,
         }
     }
@@ -151,13 +172,28 @@ impl Manifest {
         let mut cases = Vec::new();
         for s in &raw.shader {
             let m = method(&s.reference, &path.display().to_string())?;
+            let source = match (&s.pipeline, &s.compute) {
+                (Some(p), None) => Source::Pipeline(dir.join(p)),
+                (None, Some(c)) => Source::Compute {
+                    file: dir.join(c),
+                    entry: s.entry.clone().unwrap_or_else(|| "main".into()),
+                    max_bounces: s.max_bounces.unwrap_or(3),
+                },
+                _ => {
+                    return Err(format!(
+                        "{}: shader `{}` needs one of `pipeline` and `compute`",
+                        path.display(),
+                        s.name
+                    ))
+                }
+            };
             for sc in &s.scenes {
                 cases.push(Case {
                     name: format!("{}/{sc}", s.name),
                     shader: s.name.clone(),
                     scene: sc.clone(),
                     kind: CaseKind::Render {
-                        pipeline: dir.join(&s.pipeline),
+                        source: source.clone(),
                         method: m,
                         scene: scene(sc),
                     },
@@ -193,7 +229,7 @@ impl Manifest {
                 shader: f.name.clone(),
                 scene: f.scene.clone(),
                 kind: CaseKind::ExpectedCrash {
-                    pipeline: dir.join(&f.pipeline),
+                    source: Source::Pipeline(dir.join(&f.pipeline)),
                     method: method(&f.reference, &path.display().to_string())?,
                     scene: scene(&f.scene),
                     depth: f.max_recursion_depth,
@@ -230,26 +266,54 @@ impl Manifest {
 }
 
 /// What the CPU and GPU render for a case: the scene and the uniform values.
+/// A case's shaders, loaded.
+pub enum Loaded {
+    Pipeline(crate::pipeline::Pipeline),
+    Compute { words: Vec<u32>, entry: String },
+}
+
 pub fn setup(
     manifest: &Manifest,
-    pipeline_path: &Path,
+    source: &Source,
     scene_path: &Path,
     depth: Option<u32>,
-) -> Result<(crate::pipeline::Pipeline, Scene, Params), String> {
-    let mut pipeline = crate::pipeline::load(pipeline_path)
-        .map_err(|e| format!("{}: {}", pipeline_path.display(), e.0.message.trim_end()))?;
-    if depth.is_some() {
-        pipeline.max_recursion_depth = depth;
-    }
+) -> Result<(Loaded, Scene, Params), String> {
+    let (loaded, bounces) = match source {
+        Source::Pipeline(path) => {
+            let mut pipeline = crate::pipeline::load(path)
+                .map_err(|e| format!("{}: {}", path.display(), e.0.message.trim_end()))?;
+            if depth.is_some() {
+                pipeline.max_recursion_depth = depth;
+            }
+            let bounces = pipeline
+                .constant("params.max_bounces")
+                .map(|c| c.value)
+                .unwrap_or(3);
+            let bounces = u32::try_from(bounces)
+                .map_err(|_| format!("{}: bad params.max_bounces", path.display()))?;
+            (Loaded::Pipeline(pipeline), bounces)
+        }
+        Source::Compute {
+            file,
+            entry,
+            max_bounces,
+        } => {
+            let language = crate::shader::Language::from_path(file)
+                .ok_or_else(|| format!("{}: not a shader file", file.display()))?;
+            let compiled = crate::front::compile_path(file, language)
+                .map_err(|e| format!("{}: {}", file.display(), e.0.message.trim_end()))?;
+            (
+                Loaded::Compute {
+                    words: compiled.words,
+                    entry: entry.clone(),
+                },
+                *max_bounces,
+            )
+        }
+    };
     let scene = Scene::load(scene_path)?;
-    let bounces = pipeline
-        .constant("params.max_bounces")
-        .map(|c| c.value)
-        .unwrap_or(3);
-    let bounces = u32::try_from(bounces)
-        .map_err(|_| format!("{}: bad params.max_bounces", pipeline_path.display()))?;
     let params = Params::for_scene(&scene, manifest.width, manifest.height, bounces);
-    Ok((pipeline, scene, params))
+    Ok((loaded, scene, params))
 }
 
 /// How to run verify.
@@ -268,6 +332,8 @@ pub enum Outcome {
     Fail(String),
     /// An expected failure that did fail as expected.
     ExpectedFailure(String),
+    /// The device cannot run the case (ray queries on NVIDIA's driver).
+    Skipped(String),
 }
 
 /// One row of the verify table.
@@ -418,8 +484,8 @@ pub fn run(
         .map_err(|e| format!("cannot create {}: {e}", options.out.display()))?;
     // Inputs are checked before any GPU work: a bad scene is a usage error.
     for c in &cases {
-        if let Some((pipeline, scene, depth)) = c.kind.runs() {
-            setup(&manifest, pipeline, scene, depth)?;
+        if let Some((source, scene, depth)) = c.kind.runs() {
+            setup(&manifest, source, scene, depth)?;
         }
     }
     let mut report = Report::default();
@@ -429,7 +495,7 @@ pub fn run(
         let start = Instant::now();
         let (comparison, outcome) = match &case.kind {
             CaseKind::Render {
-                pipeline,
+                source,
                 method,
                 scene,
             } => {
@@ -437,7 +503,7 @@ pub fn run(
                     options,
                     &manifest,
                     case,
-                    pipeline,
+                    source,
                     *method,
                     scene,
                     &mut report,
@@ -462,20 +528,38 @@ pub fn run(
                         };
                         (Some(c), o)
                     }
-                    _ => (None, Outcome::Fail(format!("{a} or {b} produced no image"))),
+                    _ => {
+                        let skipped = report.rows.iter().any(|r| {
+                            (&r.case.name == a || &r.case.name == b)
+                                && matches!(r.outcome, Outcome::Skipped(_))
+                        });
+                        let o = if skipped {
+                            Outcome::Skipped(format!("{a} or {b} was skipped"))
+                        } else {
+                            Outcome::Fail(format!("{a} or {b} produced no image"))
+                        };
+                        (None, o)
+                    }
                 }
             }
             CaseKind::ExpectedCrash {
-                pipeline,
+                source,
                 scene,
                 depth,
                 ..
             } => {
-                let (p, _, params) = setup(&manifest, pipeline, scene, Some(*depth))?;
+                let (loaded, _, params) = setup(&manifest, source, scene, Some(*depth))?;
                 // What `rtlint check` reports statically (RT021).
-                let needs = match crate::analysis::recursion_report(&p).required_depth {
-                    Some(n) => format!("rtlint check: needs depth {n}, declared {depth} (RT021)"),
-                    None => "rtlint check: recursion depth unbounded (RT024)".into(),
+                let needs = match &loaded {
+                    Loaded::Pipeline(p) => {
+                        match crate::analysis::recursion_report(p).required_depth {
+                            Some(n) => {
+                                format!("rtlint check: needs depth {n}, declared {depth} (RT021)")
+                            }
+                            None => "rtlint check: recursion depth unbounded (RT024)".into(),
+                        }
+                    }
+                    Loaded::Compute { .. } => "a compute shader has no recursion depth".into(),
                 };
                 let image = options.out.join(format!("{}.rgba", file_name(&case.name)));
                 let end = wait(spawn((options.child)(&case.name, &image))?)?;
@@ -521,12 +605,12 @@ fn render_case(
     options: &Options<'_>,
     manifest: &Manifest,
     case: &Case,
-    pipeline: &Path,
+    source: &Source,
     method: Method,
     scene_path: &Path,
     report: &mut Report,
 ) -> Result<CaseResult, String> {
-    let (_, scene, params) = setup(manifest, pipeline, scene_path, None)?;
+    let (_, scene, params) = setup(manifest, source, scene_path, None)?;
     let image_path = options.out.join(format!("{}.rgba", file_name(&case.name)));
     let _ = std::fs::remove_file(&image_path);
     // The CPU reference renders while the child runs.
@@ -534,6 +618,14 @@ fn render_case(
     let (cpu, margins) = reference::render(&scene, &params, method);
     let end = wait(running)?;
     note_device(report, &end);
+    if end.code == Some(SKIP_CODE) {
+        let why = end
+            .stdout
+            .lines()
+            .find_map(|l| l.strip_prefix("skip: "))
+            .unwrap_or("the device cannot run it");
+        return Ok((None, Outcome::Skipped(why.to_string()), None));
+    }
     if end.code != Some(0) {
         return Ok((None, Outcome::Fail(end.describe()), None));
     }
@@ -596,17 +688,26 @@ pub fn child_main(
         .iter()
         .find(|c| c.name == name)
         .ok_or_else(|| format!("no verify case `{name}`"))?;
-    let Some((pipeline, scene_path, depth)) = case.kind.runs() else {
+    let Some((source, scene_path, depth)) = case.kind.runs() else {
         return Err(format!("`{name}` runs nothing"));
     };
-    let (pipeline, scene, params) = setup(&manifest, pipeline, scene_path, depth)?;
+    let (loaded, scene, params) = setup(&manifest, source, scene_path, depth)?;
     let ctx = crate::vk::Context::with_options(&crate::vk::ContextOptions {
         device_name: device.map(str::to_string),
         ..Default::default()
     })
     .map_err(|e| e.to_string())?;
     println!("device: {}", ctx.info().name);
-    let rendered = gpu::render(&ctx, &pipeline, None, &scene, &params)?;
+    let rendered = match &loaded {
+        Loaded::Pipeline(p) => gpu::render(&ctx, p, None, &scene, &params)?,
+        Loaded::Compute { words, entry } => {
+            if !ctx.info().ray_query {
+                println!("skip: {} has no VK_KHR_ray_query", ctx.info().name);
+                return Err(SKIP.into());
+            }
+            gpu::render_compute(&ctx, words, entry, &scene, &params)?
+        }
+    };
     println!("trace: {:.3}", rendered.trace.as_secs_f64() * 1000.0);
     println!("total: {:.3}", rendered.total.as_secs_f64() * 1000.0);
     let bytes: Vec<u8> = rendered
@@ -657,6 +758,7 @@ impl Row {
                 Outcome::Pass => "pass".into(),
                 Outcome::Fail(_) => "FAIL".into(),
                 Outcome::ExpectedFailure(_) => "pass (expected failure)".into(),
+                Outcome::Skipped(_) => "skipped".into(),
             },
         ]
     }
@@ -691,6 +793,7 @@ impl Report {
                 Outcome::ExpectedFailure(why) => {
                     out.push_str(&format!("expected failure {}: {why}\n", r.case.name))
                 }
+                Outcome::Skipped(why) => out.push_str(&format!("skipped {}: {why}\n", r.case.name)),
                 Outcome::Pass => {}
             }
         }
@@ -736,8 +839,8 @@ mod tests {
             .iter()
             .any(|c| matches!(c.kind, CaseKind::ExpectedCrash { .. })));
         for c in &m.cases {
-            if let Some((pipeline, scene, depth)) = c.kind.runs() {
-                setup(&m, pipeline, scene, depth).unwrap();
+            if let Some((source, scene, depth)) = c.kind.runs() {
+                setup(&m, source, scene, depth).unwrap();
             }
         }
         // Selecting an identity case brings the renders it compares.
