@@ -268,7 +268,7 @@ impl Manifest {
 /// What the CPU and GPU render for a case: the scene and the uniform values.
 /// A case's shaders, loaded.
 pub enum Loaded {
-    Pipeline(crate::pipeline::Pipeline),
+    Pipeline(Box<crate::pipeline::Pipeline>),
     Compute { words: Vec<u32>, entry: String },
 }
 
@@ -291,7 +291,7 @@ pub fn setup(
                 .unwrap_or(3);
             let bounces = u32::try_from(bounces)
                 .map_err(|_| format!("{}: bad params.max_bounces", path.display()))?;
-            (Loaded::Pipeline(pipeline), bounces)
+            (Loaded::Pipeline(Box::new(pipeline)), bounces)
         }
         Source::Compute {
             file,
