@@ -71,6 +71,7 @@ fn reference_shaders_pass_and_the_shallow_pipeline_fails_as_expected() {
         ("recursive-hlsl", "pass"),
         ("rayquery", query),
         ("rayquery-hlsl", query),
+        ("glossy", "pass"),
     ] {
         for scene in ["mirror", "showcase"] {
             expected.push(row(shader, scene, result));

@@ -38,6 +38,8 @@ pub struct Params {
     pub cutoff: f32,
     /// The fixed offset along the normal when `robust` is off.
     pub epsilon: f32,
+    /// Rays per pixel of the glossy shader (1–16).
+    pub samples: u32,
 }
 
 impl Params {
@@ -55,6 +57,7 @@ impl Params {
             t_max: 1e4,
             cutoff: 1.0 / 256.0,
             epsilon: 1e-3,
+            samples: 4,
         }
     }
 
@@ -64,7 +67,8 @@ impl Params {
     pub fn to_words(&self) -> [u32; 16] {
         let f = |x: f32| x.to_bits();
         let flags = if self.light.is_some() { FLAG_LIGHT } else { 0 }
-            | if self.robust { FLAG_ROBUST } else { 0 };
+            | if self.robust { FLAG_ROBUST } else { 0 }
+            | (self.samples.min(255) << 8);
         let (l, ambient) = self
             .light
             .map(|l| (l.direction, l.ambient))
@@ -365,11 +369,142 @@ fn radiance(
     color
 }
 
+/// The PCG hash the glossy shader draws its numbers from (Jarzynski & Olano 2020).
+pub fn pcg(v: u32) -> u32 {
+    let state = v.wrapping_mul(747_796_405).wrapping_add(2_891_336_453);
+    let word = ((state >> ((state >> 28) + 4)) ^ state).wrapping_mul(277_803_737);
+    (word >> 22) ^ word
+}
+
+/// A uniform number in [0, 1) with 24 bits, advancing the seed.
+pub fn rand(seed: &mut u32) -> f32 {
+    *seed = pcg(*seed);
+    (*seed >> 8) as f32 * (1.0 / 16_777_216.0)
+}
+
+/// The glossy shader's `sample_vndf`: a GGX visible normal (Heitz 2018) for
+/// the tangent-space view `ve` and roughness `alpha`.
+pub fn sample_vndf(ve: Vec3, alpha: f32, u1: f32, u2: f32) -> Vec3 {
+    // A grazing view (ve.z = 0) with alpha = 0 would normalise zero.
+    let vh = Vec3::new(alpha * ve.x, alpha * ve.y, ve.z.max(1e-7)).normalize();
+    let lensq = vh.x * vh.x + vh.y * vh.y;
+    let t1 = if lensq > 0.0 {
+        Vec3::new(-vh.y, vh.x, 0.0) * (1.0 / lensq.sqrt())
+    } else {
+        Vec3::X
+    };
+    let t2 = vh.cross(t1);
+    let r = u1.sqrt();
+    let phi = 6.283_185_5 * u2;
+    let p1 = r * phi.cos();
+    let s = 0.5 * (1.0 + vh.z);
+    let p2 = (1.0 - s) * (1.0 - p1 * p1).sqrt() + s * (r * phi.sin());
+    let nh = p1 * t1 + p2 * t2 + (0.0f32).max(1.0 - p1 * p1 - p2 * p2).sqrt() * vh;
+    Vec3::new(alpha * nh.x, alpha * nh.y, nh.z.max(0.0)).normalize()
+}
+
+/// Follows `reflect_glossy`: the iterative loop with GGX-sampled reflections
+/// off rough surfaces, `params.samples` paths per pixel averaged.
+pub fn trace_glossy(scene: &Scene, params: &Params, x: u32, y: u32) -> PixelPath {
+    let samples = params.samples.clamp(1, 16);
+    let mut sum = Vec3::ZERO;
+    let mut segments = Vec::new();
+    for sample in 0..samples {
+        let mut seed = pcg(y * params.width + x) ^ pcg(sample.wrapping_add(0x9E37_79B9));
+        let mut origin = params.camera;
+        let mut dir = camera_dir(params, x, y);
+        let mut t_max = params.t_max;
+        let mut throughput = 1.0f32;
+        for _bounce in 0..=params.max_bounces {
+            let (hit, edge_margin) = intersect(scene, origin, dir, params.t_min, t_max);
+            segments.push(Segment {
+                origin,
+                dir,
+                hit,
+                shadow: false,
+                edge_margin,
+            });
+            let Some(hit) = hit else {
+                sum += throughput * sky(dir);
+                break;
+            };
+            let surface = scene.surfaces[hit.triangle as usize];
+            let n = if surface.normal.dot(dir) < 0.0 {
+                surface.normal
+            } else {
+                -surface.normal
+            };
+            let base = throughput * (1.0 - surface.reflectivity) * surface.albedo;
+            throughput *= surface.reflectivity;
+            let roughness = surface.roughness;
+            origin = params.next_origin(origin + dir * hit.t, n);
+            let light = params.light.unwrap_or(Light {
+                direction: Vec3::ZERO,
+                ambient: 0.0,
+            });
+            let ndl = n.dot(light.direction);
+            let headlight = n.dot(-dir).max(0.0);
+            if roughness > 0.0 {
+                let sgn = if n.z >= 0.0 { 1.0f32 } else { -1.0 };
+                let a = -1.0 / (sgn + n.z);
+                let b = n.x * n.y * a;
+                let tx = Vec3::new(1.0 + sgn * n.x * n.x * a, sgn * b, -sgn * n.x);
+                let ty = Vec3::new(b, sgn + n.y * n.y * a, -n.y);
+                let alpha = roughness * roughness;
+                let ve = Vec3::new((-dir).dot(tx), (-dir).dot(ty), (-dir).dot(n));
+                let u1 = rand(&mut seed);
+                let u2 = rand(&mut seed);
+                let m = sample_vndf(ve, alpha, u1, u2);
+                dir = reflect(dir, tx * m.x + ty * m.y + n * m.z);
+                let nl = n.dot(dir);
+                if nl > 0.0 {
+                    let a2 = alpha * alpha;
+                    throughput *= 2.0 * nl / (nl + (a2 + (1.0 - a2) * nl * nl).sqrt());
+                } else {
+                    throughput = 0.0;
+                }
+                t_max = params.t_max / (1.0 + 64.0 * roughness);
+            } else {
+                dir = reflect(dir, n);
+                t_max = params.t_max;
+            }
+            if params.light.is_some() {
+                sum += base * light.ambient;
+                if ndl > 0.0 {
+                    let lit = base * ndl;
+                    let (blocker, edge_margin) =
+                        intersect(scene, origin, light.direction, params.t_min, params.t_max);
+                    segments.push(Segment {
+                        origin,
+                        dir: light.direction,
+                        hit: blocker,
+                        shadow: true,
+                        edge_margin,
+                    });
+                    if blocker.is_none() {
+                        sum += lit;
+                    }
+                }
+            } else {
+                sum += base * headlight;
+            }
+            if throughput.partial_cmp(&params.cutoff) != Some(std::cmp::Ordering::Greater) {
+                break;
+            }
+        }
+    }
+    PixelPath {
+        color: sum / samples as f32,
+        segments,
+    }
+}
+
 /// Which shader's math to follow.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Method {
     Iterative,
     Recursive,
+    Glossy,
 }
 
 /// One pixel's path by `method`.
@@ -377,6 +512,7 @@ pub fn trace_pixel(scene: &Scene, params: &Params, method: Method, x: u32, y: u3
     match method {
         Method::Iterative => trace_iterative(scene, params, x, y),
         Method::Recursive => trace_recursive(scene, params, x, y),
+        Method::Glossy => trace_glossy(scene, params, x, y),
     }
 }
 
@@ -432,7 +568,7 @@ mod tests {
         let s = showcase();
         let p = Params::for_scene(&s, 64, 32, 3);
         let w = p.to_words();
-        assert_eq!(&w[..4], &[64, 32, 3, FLAG_LIGHT | FLAG_ROBUST]);
+        assert_eq!(&w[..4], &[64, 32, 3, FLAG_LIGHT | FLAG_ROBUST | 4 << 8]);
         assert_eq!(f32::from_bits(w[4]), s.camera.x);
         assert_eq!(f32::from_bits(w[13]), 1e4);
     }
@@ -472,6 +608,44 @@ mod tests {
                 }
             }
             assert!(kinds.iter().all(|&k| k > 100), "{}: {kinds:?}", scene.name);
+        }
+    }
+
+    #[test]
+    fn vndf_samples_are_finite_at_the_extremes() {
+        // alpha = 0 gives the normal; grazing and head-on views stay finite.
+        let n = sample_vndf(Vec3::new(0.6, 0.0, 0.8), 0.0, 0.3, 0.7);
+        assert_eq!(n, Vec3::Z);
+        for ve in [
+            Vec3::Z,
+            Vec3::new(1.0, 0.0, 0.0),
+            Vec3::new(0.0, 0.999_999, 0.001),
+        ] {
+            for alpha in [0.0, 1e-8, 0.25, 1.0] {
+                for (u1, u2) in [(0.0, 0.0), (0.999_999_9, 0.999_999_9), (0.5, 0.25)] {
+                    let m = sample_vndf(ve, alpha, u1, u2);
+                    assert!(m.is_finite() && m.z >= 0.0, "{ve} {alpha} {u1} {u2}: {m}");
+                }
+            }
+        }
+        // The hash and the numbers drawn from it are reproducible.
+        let mut seed = 7;
+        let (a, b) = (rand(&mut seed), rand(&mut seed));
+        assert!(a != b && (0.0..1.0).contains(&a) && (0.0..1.0).contains(&b));
+        assert_eq!(pcg(0), 129708002);
+    }
+
+    #[test]
+    fn glossy_without_roughness_is_the_mirror_image() {
+        let scene = mirror();
+        let p = Params::for_scene(&scene, 32, 32, 3);
+        for i in 0..32 * 32 {
+            let (x, y) = (i % 32, i / 32);
+            assert_eq!(
+                pack_rgba8(trace_glossy(&scene, &p, x, y).color),
+                pack_rgba8(trace_iterative(&scene, &p, x, y).color),
+                "({x}, {y})"
+            );
         }
     }
 

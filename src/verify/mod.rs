@@ -148,8 +148,9 @@ fn method(name: &str, what: &str) -> Result<Method, String> {
     match name {
         "iterative" => Ok(Method::Iterative),
         "recursive" => Ok(Method::Recursive),
+        "glossy" => Ok(Method::Glossy),
         other => Err(format!(
-            "{what}: unknown reference `{other}` (expected `iterative` or `recursive`)"
+            "{what}: unknown reference `{other}` (expected `iterative`, `recursive` or `glossy`)"
         )),
     }
 }
