@@ -39,8 +39,13 @@ float3 sky(float3 dir)
     return lerp(float3(1.0, 1.0, 1.0), float3(0.5, 0.7, 1.0), k);
 }
 
+// RGBA8 with alpha 255; a colour with an infinite or NaN channel is written
+// as 0 (alpha 0), so the image counts them. The exponent bits are tested:
+// a compiler may assume no NaN in `c != c`.
 uint pack_rgba8(float3 c)
 {
+    if (any((asuint(c) & 0x7F800000u) == 0x7F800000u))
+        return 0u;
     uint3 v = uint3(clamp(c, float3(0.0, 0.0, 0.0), float3(1.0, 1.0, 1.0)) * 255.0 + 0.5);
     return v.x | (v.y << 8) | (v.z << 16) | (255u << 24);
 }

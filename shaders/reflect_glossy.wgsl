@@ -58,7 +58,13 @@ fn sky(dir: vec3<f32>) -> vec3<f32> {
     return mix(vec3<f32>(1.0, 1.0, 1.0), vec3<f32>(0.5, 0.7, 1.0), k);
 }
 
+// RGBA8 with alpha 255; a colour with an infinite or NaN channel is written
+// as 0 (alpha 0), so the image counts them. The exponent bits are tested:
+// a compiler may assume no NaN in `c != c`.
 fn pack_rgba8(c: vec3<f32>) -> u32 {
+    if any((bitcast<vec3<u32>>(c) & vec3<u32>(0x7F800000u)) == vec3<u32>(0x7F800000u)) {
+        return 0u;
+    }
     let v = vec3<u32>(clamp(c, vec3<f32>(0.0), vec3<f32>(1.0)) * 255.0 + 0.5);
     return v.x | (v.y << 8u) | (v.z << 16u) | (255u << 24u);
 }

@@ -716,9 +716,6 @@ fn verify(args: VerifyArgs) -> Result<u8, String> {
             Err(e) => Err(e),
         };
     }
-    if args.extremes {
-        return Err("--extremes: the numerical-extremes matrix is not implemented yet".into());
-    }
     let exe = std::env::current_exe().map_err(|e| format!("cannot find rtlint itself: {e}"))?;
     let make_child = |case: &str, image: &std::path::Path| {
         let mut c = std::process::Command::new(&exe);
@@ -737,6 +734,7 @@ fn verify(args: VerifyArgs) -> Result<u8, String> {
         shaders: args.shaders.clone(),
         out: args.out.clone(),
         filter: args.filter.clone(),
+        extremes: args.extremes,
         child: &make_child,
     };
     let bar = indicatif::ProgressBar::new(0);
@@ -755,10 +753,24 @@ fn verify(args: VerifyArgs) -> Result<u8, String> {
     let device = report.device.as_deref().unwrap_or("no device answered");
     let _ = writeln!(out, "device: {device}");
     let _ = write!(out, "{}", report.text());
-    for (name, text) in [
+    let mut files = vec![
         ("verify.csv", report.csv()),
         ("verify.md", report.markdown()),
-    ] {
+    ];
+    if args.extremes {
+        let matrix = verify::Report {
+            device: report.device.clone(),
+            rows: report
+                .rows
+                .iter()
+                .filter(|r| r.case.name.starts_with("extremes/"))
+                .cloned()
+                .collect(),
+        };
+        files.push(("extremes.csv", matrix.csv()));
+        files.push(("extremes.md", matrix.markdown()));
+    }
+    for (name, text) in files {
         let path = args.out.join(name);
         std::fs::write(&path, text).map_err(|e| format!("cannot write {}: {e}", path.display()))?;
     }

@@ -1137,7 +1137,7 @@ mod tests {
         );
         assert_eq!((s.live_bytes, s.rematerializable_bytes), (72, 20));
         assert_eq!(s.chain.len(), 1);
-        assert_eq!((s.line, s.column), (Some(85), Some(9)));
+        assert_eq!((s.line, s.column), (Some(91), Some(9)));
         // Across the shadow trace the shader keeps what it lights (`lit`)
         // instead of the normal and albedo: 64 bytes, within RT010's budget.
         let shadow = &sites[1];

@@ -137,6 +137,27 @@ pub struct PixelPath {
 }
 
 impl PixelPath {
+    /// Rays that left a triangle and hit that same (planar) triangle again:
+    /// self-intersections. Returns (such rays, rays that left a surface).
+    pub fn self_hits(&self) -> (usize, usize) {
+        let (mut own, mut secondary) = (0, 0);
+        let camera = self.segments.first().map(|s| s.origin);
+        let mut from: Option<u32> = None;
+        for s in &self.segments {
+            if !s.shadow && Some(s.origin) == camera {
+                // A primary ray (each sample of the glossy shader has one).
+                from = s.hit.map(|h| h.triangle);
+                continue;
+            }
+            secondary += 1;
+            own += usize::from(from.is_some() && s.hit.map(|h| h.triangle) == from);
+            if !s.shadow {
+                from = s.hit.map(|h| h.triangle);
+            }
+        }
+        (own, secondary)
+    }
+
     /// The smallest edge margin of any of its rays.
     pub fn edge_margin(&self) -> f32 {
         self.segments
@@ -153,8 +174,12 @@ pub fn sky(dir: Vec3) -> Vec3 {
 }
 
 /// Packs a colour as the shaders do: clamp, scale to 255, round half up,
-/// RGBA8 with alpha 255 in the top byte.
+/// RGBA8 with alpha 255 in the top byte; 0 for a non-finite colour.
 pub fn pack_rgba8(c: Vec3) -> u32 {
+    // An infinite or NaN channel is written as 0 (alpha 0).
+    if !c.is_finite() {
+        return 0;
+    }
     let ch = |x: f32| (x.clamp(0.0, 1.0) * 255.0 + 0.5) as u32;
     ch(c.x) | (ch(c.y) << 8) | (ch(c.z) << 16) | (255 << 24)
 }
@@ -550,6 +575,8 @@ mod tests {
     #[test]
     fn packing_rounds_and_clamps() {
         assert_eq!(pack_rgba8(Vec3::new(0.0, 1.0, 2.0)), 0xFFFF_FF00);
+        assert_eq!(pack_rgba8(Vec3::new(0.0, f32::NAN, 0.0)), 0);
+        assert_eq!(pack_rgba8(Vec3::new(f32::INFINITY, 0.0, 0.0)), 0);
         // 0.5 * 255 + 0.5 = 128.0 → 128; just below rounds down.
         assert_eq!(
             unpack_rgba8(pack_rgba8(Vec3::new(0.5, 0.498, -1.0))),

@@ -373,6 +373,16 @@ impl Scene {
         s
     }
 
+    /// The same scene with every material's roughness set to `roughness`.
+    pub fn with_roughness(&self, roughness: f32) -> Scene {
+        let mut s = self.clone();
+        for m in &mut s.materials {
+            m.roughness = roughness;
+        }
+        s.flatten();
+        s
+    }
+
     /// Rebuilds the world-space triangles, surfaces and BVH from the instances.
     fn flatten(&mut self) {
         self.triangles.clear();

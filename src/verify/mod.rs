@@ -88,6 +88,64 @@ pub enum Source {
     },
 }
 
+/// One cell of the numerical-extremes matrix: a variant of the scene or the
+/// ray parameters, rendered with robust origins or the fixed epsilon.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Extreme {
+    /// `translate=1e3`, `tmax=inf`, `tmin=1e-3`, `roughness=0.5`, `grazing`.
+    pub variant: String,
+    pub robust: bool,
+}
+
+/// The variants of the matrix, each rendered both ways.
+pub const EXTREMES: [&str; 14] = [
+    "translate=0",
+    "translate=1e3",
+    "translate=1e4",
+    "translate=1e5",
+    "translate=1e6",
+    "tmax=1e-3",
+    "tmax=1e4",
+    "tmax=inf",
+    "tmin=1e-3",
+    "roughness=0",
+    "roughness=1e-4",
+    "roughness=0.5",
+    "roughness=1",
+    "grazing",
+];
+
+impl Extreme {
+    /// Changes the scene and the parameters as the variant says.
+    pub fn apply(&self, scene: &mut Scene, params: &mut Params) -> Result<(), String> {
+        params.robust = self.robust;
+        let number = |v: &str| -> Result<f32, String> {
+            if v == "inf" {
+                Ok(f32::INFINITY)
+            } else {
+                v.parse::<f32>()
+                    .map_err(|_| format!("bad extreme value `{v}` in `{}`", self.variant))
+            }
+        };
+        match self.variant.split_once('=') {
+            Some(("translate", v)) => {
+                *scene = scene.translated(reference::Vec3::splat(number(v)?));
+                params.camera = scene.camera;
+            }
+            Some(("tmax", v)) => params.t_max = number(v)?,
+            Some(("tmin", v)) => params.t_min = number(v)?,
+            Some(("roughness", v)) => *scene = scene.with_roughness(number(v)?),
+            None if self.variant == "grazing" => {
+                // Just above the mirror floor: primary rays meet it with N·V → 0.
+                scene.camera.y = 1e-3;
+                params.camera = scene.camera;
+            }
+            _ => return Err(format!("unknown extreme `{}`", self.variant)),
+        }
+        Ok(())
+    }
+}
+
 /// One row of the table.
 #[derive(Clone, Debug, PartialEq)]
 pub enum CaseKind {
@@ -96,6 +154,9 @@ pub enum CaseKind {
         source: Source,
         method: Method,
         scene: PathBuf,
+        /// A cell of the numerical-extremes matrix: how the scene and the
+        /// parameters are changed.
+        extreme: Option<Extreme>,
     },
     /// The GPU images of two render cases are identical.
     Identical { a: String, b: String },
@@ -197,6 +258,7 @@ impl Manifest {
                         source: source.clone(),
                         method: m,
                         scene: scene(sc),
+                        extreme: None,
                     },
                 });
             }
@@ -242,6 +304,54 @@ impl Manifest {
             height: raw.height,
             cases,
         })
+    }
+
+    /// The numerical-extremes matrix: the `iterative` shader (and `glossy`
+    /// for the roughness variants) on the `showcase` scene, every variant
+    /// with robust origins and with the fixed epsilon.
+    pub fn extremes(&self) -> Vec<Case> {
+        let source = |shader: &str| {
+            self.cases.iter().find_map(|c| match &c.kind {
+                CaseKind::Render {
+                    source,
+                    method,
+                    scene,
+                    extreme: None,
+                } if c.shader == shader && c.scene == "showcase" => {
+                    Some((source.clone(), *method, scene.clone()))
+                }
+                _ => None,
+            })
+        };
+        let mut cases = Vec::new();
+        for variant in EXTREMES {
+            let shader = if variant.starts_with("roughness") {
+                "glossy"
+            } else {
+                "iterative"
+            };
+            let Some((source, method, scene)) = source(shader) else {
+                continue;
+            };
+            for robust in [true, false] {
+                let mode = if robust { "robust" } else { "epsilon" };
+                cases.push(Case {
+                    name: format!("extremes/{variant}/{mode}"),
+                    shader: format!("{shader} {mode}"),
+                    scene: variant.to_string(),
+                    kind: CaseKind::Render {
+                        source: source.clone(),
+                        method,
+                        scene: scene.clone(),
+                        extreme: Some(Extreme {
+                            variant: variant.to_string(),
+                            robust,
+                        }),
+                    },
+                });
+            }
+        }
+        cases
     }
 
     /// The cases whose name contains `filter`, plus the render cases an
@@ -322,6 +432,8 @@ pub struct Options<'a> {
     pub shaders: PathBuf,
     pub out: PathBuf,
     pub filter: Option<String>,
+    /// Also run the numerical-extremes matrix ([`Manifest::extremes`]).
+    pub extremes: bool,
     /// Builds the command that runs the named case in a child process (the
     /// child calls [`child_main`] and writes the image to the given file).
     pub child: &'a dyn Fn(&str, &Path) -> Command,
@@ -342,6 +454,11 @@ pub enum Outcome {
 pub struct Row {
     pub case: Case,
     pub comparison: Option<Comparison>,
+    /// Pixels the GPU wrote as non-finite (alpha 0).
+    pub nan: Option<usize>,
+    /// Rays that hit the triangle they left, per ray that left a surface
+    /// (CPU paths), in percent.
+    pub self_hit: Option<f64>,
     pub time: Duration,
     pub outcome: Outcome,
 }
@@ -474,7 +591,15 @@ pub fn run(
     mut progress: impl FnMut(usize, usize, &str),
 ) -> Result<Report, String> {
     let manifest = Manifest::load(&options.shaders)?;
-    let cases = manifest.select(options.filter.as_deref());
+    let mut cases = manifest.select(options.filter.as_deref());
+    if options.extremes {
+        cases.extend(
+            manifest
+                .extremes()
+                .into_iter()
+                .filter(|c| options.filter.as_ref().is_none_or(|f| c.name.contains(f))),
+        );
+    }
     if cases.is_empty() {
         return Err(match &options.filter {
             Some(f) => format!("no verify case matches `{f}`"),
@@ -499,6 +624,7 @@ pub fn run(
                 source,
                 method,
                 scene,
+                extreme,
             } => {
                 let (c, o, image) = render_case(
                     options,
@@ -507,6 +633,7 @@ pub fn run(
                     source,
                     *method,
                     scene,
+                    extreme.as_ref(),
                     &mut report,
                 )?;
                 if let Some(image) = image {
@@ -527,7 +654,7 @@ pub fn run(
                                 c.above, c.max_diff
                             ))
                         };
-                        (Some(c), o)
+                        (Some((c, None, None)), o)
                     }
                     _ => {
                         let skipped = report.rows.iter().any(|r| {
@@ -579,9 +706,15 @@ pub fn run(
                 (None, o)
             }
         };
+        let (comparison, nan, self_hit) = match comparison {
+            Some((c, n, h)) => (Some(c), n, h),
+            None => (None, None, None),
+        };
         report.rows.push(Row {
             case: case.clone(),
             comparison,
+            nan,
+            self_hit,
             time: start.elapsed(),
             outcome,
         });
@@ -600,7 +733,8 @@ fn note_device(report: &mut Report, end: &ChildEnd) {
     }
 }
 
-type CaseResult = (Option<Comparison>, Outcome, Option<Vec<u32>>);
+type Measured = (Comparison, Option<usize>, Option<f64>);
+type CaseResult = (Option<Measured>, Outcome, Option<Vec<u32>>);
 
 fn render_case(
     options: &Options<'_>,
@@ -609,9 +743,13 @@ fn render_case(
     source: &Source,
     method: Method,
     scene_path: &Path,
+    extreme: Option<&Extreme>,
     report: &mut Report,
 ) -> Result<CaseResult, String> {
-    let (_, scene, params) = setup(manifest, source, scene_path, None)?;
+    let (_, mut scene, mut params) = setup(manifest, source, scene_path, None)?;
+    if let Some(e) = extreme {
+        e.apply(&mut scene, &mut params)?;
+    }
     let image_path = options.out.join(format!("{}.rgba", file_name(&case.name)));
     let _ = std::fs::remove_file(&image_path);
     // The CPU reference renders while the child runs.
@@ -660,7 +798,33 @@ fn render_case(
     };
     // The GPU image always; the CPU image and the difference on failure.
     png("gpu", &gpu)?;
-    let outcome = if c.passes() {
+    let nan = gpu.iter().filter(|&&p| p >> 24 == 0).count();
+    if let Some(e) = extreme {
+        // The matrix: no NaN or infinity ever; with robust origins fewer
+        // than 0.1 % of the rays leaving a surface hit it again. The
+        // difference to the CPU is reported, not judged (far from the
+        // origin both sides round differently by design).
+        let (mut own, mut secondary) = (0usize, 0usize);
+        for y in 0..params.height {
+            for x in 0..params.width {
+                let (o, n) = reference::trace_pixel(&scene, &params, method, x, y).self_hits();
+                own += o;
+                secondary += n;
+            }
+        }
+        let rate = 100.0 * own as f64 / secondary.max(1) as f64;
+        let outcome = if nan > 0 {
+            Outcome::Fail(format!("{nan} pixels are NaN or infinite"))
+        } else if e.robust && rate >= 0.1 {
+            Outcome::Fail(format!(
+                "{own} of {secondary} rays ({rate:.3} %) hit the triangle they left"
+            ))
+        } else {
+            Outcome::Pass
+        };
+        return Ok((Some((c, Some(nan), Some(rate))), outcome, Some(gpu)));
+    }
+    let outcome = if c.passes() && nan == 0 {
         Outcome::Pass
     } else {
         png("cpu", &cpu)?;
@@ -672,7 +836,7 @@ fn render_case(
             options.out.display()
         ))
     };
-    Ok((Some(c), outcome, Some(gpu)))
+    Ok((Some((c, Some(nan), None)), outcome, Some(gpu)))
 }
 
 /// The child's side: renders case `name` on the device and writes the
@@ -684,15 +848,23 @@ pub fn child_main(
     device: Option<&str>,
 ) -> Result<(), String> {
     let manifest = Manifest::load(shaders)?;
+    let extremes = manifest.extremes();
     let case = manifest
         .cases
         .iter()
+        .chain(&extremes)
         .find(|c| c.name == name)
         .ok_or_else(|| format!("no verify case `{name}`"))?;
     let Some((source, scene_path, depth)) = case.kind.runs() else {
         return Err(format!("`{name}` runs nothing"));
     };
-    let (loaded, scene, params) = setup(&manifest, source, scene_path, depth)?;
+    let (loaded, mut scene, mut params) = setup(&manifest, source, scene_path, depth)?;
+    if let CaseKind::Render {
+        extreme: Some(e), ..
+    } = &case.kind
+    {
+        e.apply(&mut scene, &mut params)?;
+    }
     let ctx = crate::vk::Context::with_options(&crate::vk::ContextOptions {
         device_name: device.map(str::to_string),
         ..Default::default()
@@ -752,8 +924,8 @@ impl Row {
                     format!("{:.1}", c.psnr)
                 }
             })),
-            "-".into(),
-            "-".into(),
+            or_dash(self.nan.map(|n| n.to_string())),
+            or_dash(self.self_hit.map(|h| format!("{h:.3}"))),
             format!("{:.0} ms", self.time.as_secs_f64() * 1000.0),
             match &self.outcome {
                 Outcome::Pass => "pass".into(),
