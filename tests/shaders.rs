@@ -69,5 +69,5 @@ fn main_job_reports_the_recursive_reference() {
             .unwrap()
             .contains("needs recursion depth 5"));
     }
-    assert_eq!(v["summary"]["files"], 12);
+    assert_eq!(v["summary"]["files"], 14);
 }

@@ -72,6 +72,7 @@ fn reference_shaders_pass_and_the_shallow_pipeline_fails_as_expected() {
         ("rayquery", query),
         ("rayquery-hlsl", query),
         ("glossy", "pass"),
+        ("glossy-hlsl", "pass"),
     ] {
         for scene in ["mirror", "showcase"] {
             expected.push(row(shader, scene, result));
@@ -83,6 +84,7 @@ fn reference_shaders_pass_and_the_shallow_pipeline_fails_as_expected() {
         ("recursive-hlsl = recursive", "pass"),
         ("rayquery = iterative", query),
         ("rayquery-hlsl = iterative", query),
+        ("glossy-hlsl = glossy", "pass"),
     ] {
         for scene in ["mirror", "showcase"] {
             expected.push(row(pair, scene, result));
