@@ -620,22 +620,8 @@ pub fn run(
         progress(i, cases.len(), &case.name);
         let start = Instant::now();
         let (comparison, outcome) = match &case.kind {
-            CaseKind::Render {
-                source,
-                method,
-                scene,
-                extreme,
-            } => {
-                let (c, o, image) = render_case(
-                    options,
-                    &manifest,
-                    case,
-                    source,
-                    *method,
-                    scene,
-                    extreme.as_ref(),
-                    &mut report,
-                )?;
+            CaseKind::Render { .. } => {
+                let (c, o, image) = render_case(options, &manifest, case, &mut report)?;
                 if let Some(image) = image {
                     images.push((case.name.clone(), image));
                 }
@@ -740,12 +726,18 @@ fn render_case(
     options: &Options<'_>,
     manifest: &Manifest,
     case: &Case,
-    source: &Source,
-    method: Method,
-    scene_path: &Path,
-    extreme: Option<&Extreme>,
     report: &mut Report,
 ) -> Result<CaseResult, String> {
+    let CaseKind::Render {
+        source,
+        method,
+        scene: scene_path,
+        extreme,
+    } = &case.kind
+    else {
+        return Err(format!("`{}` is not a render case", case.name));
+    };
+    let (method, extreme) = (*method, extreme.as_ref());
     let (_, mut scene, mut params) = setup(manifest, source, scene_path, None)?;
     if let Some(e) = extreme {
         e.apply(&mut scene, &mut params)?;
