@@ -156,7 +156,15 @@ pub fn live_sites(program: &Program) -> Vec<LiveSite> {
                 }
                 // The query object is the site's own state, like a payload.
                 values.retain(|v| Some(v.id) != site.payload);
-                values.sort_by(|a, b| b.size.cmp(&a.size).then(a.name.cmp(&b.name)));
+                // Largest first; what counts before what can be recomputed;
+                // names only break the remaining ties, so a module without
+                // names lists the same shapes in the same order.
+                values.sort_by(|a, b| {
+                    b.size
+                        .cmp(&a.size)
+                        .then(a.rematerializable.cmp(&b.rematerializable))
+                        .then(a.name.cmp(&b.name))
+                });
                 let location = std::iter::once(site.inst)
                     .chain(chain.iter().rev().copied())
                     .find_map(|i| program.inst_location(i));
