@@ -3,9 +3,11 @@
 
 pub mod callgraph;
 pub mod layout;
+pub mod payload_use;
 pub mod liveness;
 pub mod recursion;
 pub mod stack;
+pub mod trace_sites;
 
 pub use liveness::{live_report, LiveReport};
 pub use recursion::{recursion_report, RecursionReport};

@@ -193,6 +193,21 @@ impl<'a> Context<'a> {
         }
     }
 
+    /// Whether the module's source is HLSL (DXR): its language says so, or,
+    /// for SPIR-V from a compiler that names its own language (Slang), its
+    /// debug info names an `.hlsl` file. HLSL's 16-byte packing rules apply
+    /// only there.
+    pub fn source_is_hlsl(&self) -> bool {
+        self.program.language == crate::shader::Language::Hlsl
+            || (self.program.language == crate::shader::Language::Spirv
+                && self.program.files.iter().any(|f| {
+                    f.path
+                        .extension()
+                        .and_then(|e| e.to_str())
+                        .is_some_and(|e| e.eq_ignore_ascii_case("hlsl") || e.eq_ignore_ascii_case("hlsli"))
+                }))
+    }
+
     /// Trace (or callable) sites that pass one of these variables.
     pub fn sites_using(&self, vars: &[Id]) -> Vec<Location> {
         self.program
