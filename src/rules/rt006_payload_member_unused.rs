@@ -9,6 +9,9 @@ use crate::program::{Decl, Id, SiteKind};
 use crate::shader::Stage;
 use spirv::StorageClass;
 
+/// `SkipClosestHitShaderKHR`.
+const SKIP_CLOSEST_HIT: u64 = 0x8;
+
 super::declare_rule! {
     /// ## What it does
     ///
@@ -18,8 +21,13 @@ super::declare_rule! {
     /// payload has the same layout. It reports a member that no shader reads, or
     /// that no shader writes. Only the shaders the pipeline uses are modelled:
     /// those of the description, or, without one, the shaders of a folder under
-    /// the assumption that every trace reaches every shader. A payload whose
-    /// traces reach no shader with its layout is not judged.
+    /// the assumption that every trace reaches every shader. A payload is not
+    /// judged when its traces reach no shader with its layout, or when they can
+    /// run a closest-hit shader and none with its layout is in the pipeline (a
+    /// folder whose hit shader did not compile). A reached shader that declares
+    /// another layout reads and writes the members that sit at the same offset
+    /// with the same shape (a shadow payload that starts like the main one,
+    /// handed to the main payload's any-hit shader).
     ///
     /// A member is read where a load reaches it through an access chain from the
     /// payload variable, written where a store does. Loading or storing the whole
@@ -91,8 +99,46 @@ struct RayType {
     shape: Shape,
     callers: Vec<View>,
     callees: Vec<View>,
+    /// Shaders its traces reach whose incoming payload has another layout:
+    /// their members that sit at the same offset with the same shape count.
+    aliases: Vec<View>,
     /// Trace sites: program and instruction.
     sites: Vec<(usize, usize)>,
+    /// Some trace may run a closest-hit shader (its flags do not skip it).
+    may_hit: bool,
+    /// A closest-hit shader with this layout is reached.
+    hit_reached: bool,
+}
+
+/// The fields of a payload type: each struct member (or the whole value)
+/// with its offset under the scalar rule and its shape.
+fn fields(program: &crate::program::Program, ty: Id) -> Vec<(u64, Shape)> {
+    match (program.ty(ty), layout::layout_type(program, ty, "")) {
+        (Some(crate::program::Type::Struct { members }), Some(l)) => members
+            .iter()
+            .zip(&l.members)
+            .map(|(m, ml)| (ml.scalar_offset, Shape::from_type(program, *m)))
+            .collect(),
+        _ => vec![(0, Shape::from_type(program, ty))],
+    }
+}
+
+/// Per-field uses of `var` as `v` sees it: struct members, or the whole.
+fn field_uses(program: &crate::program::Program, v: &View, ty: Id) -> Vec<Access> {
+    let uses = payload_use::variable_use(program, v.entry, v.var);
+    if matches!(program.ty(ty), Some(crate::program::Type::Struct { .. })) {
+        uses
+    } else {
+        let mut whole = Access::default();
+        for u in uses {
+            whole.merge(u);
+        }
+        vec![whole]
+    }
+}
+
+fn var_type(program: &crate::program::Program, var: Id) -> Option<Id> {
+    program.globals.iter().find(|g| g.id == var).map(|g| g.ty)
 }
 
 fn run(ctx: &super::PipelineContext) -> Vec<Diagnostic> {
@@ -137,7 +183,10 @@ fn run(ctx: &super::PipelineContext) -> Vec<Diagnostic> {
                     shape: shape.clone(),
                     callers: Vec::new(),
                     callees: Vec::new(),
+                    aliases: Vec::new(),
                     sites: Vec::new(),
+                    may_hit: false,
+                    hit_reached: false,
                 });
                 types.len() - 1
             }
@@ -149,6 +198,11 @@ fn run(ctx: &super::PipelineContext) -> Vec<Diagnostic> {
         if !t.sites.contains(&(e.program, e.inst)) {
             t.sites.push((e.program, e.inst));
         }
+        let skips_hit = site
+            .trace
+            .and_then(|o| o.ray_flags.constant())
+            .is_some_and(|f| f & SKIP_CLOSEST_HIT != 0);
+        t.may_hit |= !skips_hit;
         if !matches!(
             to.shader.stage,
             Stage::ClosestHit | Stage::AnyHit | Stage::Miss
@@ -166,22 +220,29 @@ fn run(ctx: &super::PipelineContext) -> Vec<Diagnostic> {
             let Some(g) = tp.globals.iter().find(|g| g.id == w) else {
                 continue;
             };
-            if payload_use::shape_of(tp, g.ty) != t.shape {
-                continue;
-            }
             let callee = View {
                 program: to.shader.program,
                 entry: to.shader.function,
                 var: w,
             };
-            if !t.callees.contains(&callee) {
-                t.callees.push(callee);
+            let list = if payload_use::shape_of(tp, g.ty) == t.shape {
+                t.hit_reached |= to.shader.stage == Stage::ClosestHit;
+                &mut t.callees
+            } else {
+                &mut t.aliases
+            };
+            if !list.contains(&callee) {
+                list.push(callee);
             }
         }
     }
     let mut out = Vec::new();
     for t in &types {
-        if t.callees.is_empty() {
+        // Not judged: no shader with this layout is reached, or the traces
+        // can run a closest-hit shader and none with this layout is there
+        // (a pipeline missing its hit shader, such as one that failed to
+        // compile).
+        if t.callees.is_empty() || (t.may_hit && !t.hit_reached) {
             continue;
         }
         let first = t.callers[0];
@@ -204,6 +265,32 @@ fn run(ctx: &super::PipelineContext) -> Vec<Diagnostic> {
             {
                 if let Some(u) = uses.get_mut(k) {
                     u.merge(a);
+                }
+            }
+        }
+        // Shaders declaring another layout read and write the members that
+        // sit where theirs do (a shadow payload that starts like the main
+        // one, handed to the same any-hit shader).
+        let own = fields(program, ty);
+        let is_struct_ty = matches!(program.ty(ty), Some(crate::program::Type::Struct { .. }));
+        for v in &t.aliases {
+            let p = &pipeline.programs[v.program];
+            let Some(wty) = var_type(p, v.var) else {
+                continue;
+            };
+            let theirs = fields(p, wty);
+            for (j, a) in field_uses(p, v, wty).into_iter().enumerate() {
+                let Some(f) = theirs.get(j) else { continue };
+                if let Some(k) = own.iter().position(|o| *o == *f) {
+                    if is_struct_ty {
+                        if let Some(u) = uses.get_mut(k) {
+                            u.merge(a);
+                        }
+                    } else {
+                        for u in uses.iter_mut() {
+                            u.merge(a);
+                        }
+                    }
                 }
             }
         }
