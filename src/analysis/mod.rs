@@ -3,8 +3,8 @@
 
 pub mod callgraph;
 pub mod layout;
-pub mod payload_use;
 pub mod liveness;
+pub mod payload_use;
 pub mod recursion;
 pub mod stack;
 pub mod trace_sites;

@@ -93,7 +93,9 @@ pub fn variable_use(program: &Program, entry: Id, var: Id) -> Vec<Access> {
             i.class.opcode == Op::Variable
                 && matches!(
                     i.operands.first(),
-                    Some(Operand::StorageClass(StorageClass::Function | StorageClass::Private))
+                    Some(Operand::StorageClass(
+                        StorageClass::Function | StorageClass::Private
+                    ))
                 )
         })
     };
@@ -112,7 +114,8 @@ pub fn variable_use(program: &Program, entry: Id, var: Id) -> Vec<Access> {
                 };
                 match inst.class.opcode {
                     Op::AccessChain | Op::InBoundsAccessChain => {
-                        let (Some(r), Some(Operand::IdRef(base))) = (inst.result_id, inst.operands.first())
+                        let (Some(r), Some(Operand::IdRef(base))) =
+                            (inst.result_id, inst.operands.first())
                         else {
                             continue;
                         };
@@ -133,7 +136,9 @@ pub fn variable_use(program: &Program, entry: Id, var: Id) -> Vec<Access> {
                         reach.entry(r).or_insert(derived);
                     }
                     Op::CopyObject => {
-                        if let (Some(r), Some(Operand::IdRef(x))) = (inst.result_id, inst.operands.first()) {
+                        if let (Some(r), Some(Operand::IdRef(x))) =
+                            (inst.result_id, inst.operands.first())
+                        {
                             if let Some(&b) = reach.get(x) {
                                 reach.entry(r).or_insert(b);
                             }
@@ -143,7 +148,9 @@ pub fn variable_use(program: &Program, entry: Id, var: Id) -> Vec<Access> {
                         let Some(Operand::IdRef(callee)) = inst.operands.first() else {
                             continue;
                         };
-                        let Some(cf) = program.function(*callee) else { continue };
+                        let Some(cf) = program.function(*callee) else {
+                            continue;
+                        };
                         for (k, arg) in ids().skip(1).enumerate() {
                             if let (Some(&b), Some(&param)) = (reach.get(&arg), cf.params.get(k)) {
                                 reach.entry(param).or_insert(b);
@@ -239,15 +246,17 @@ pub fn variable_use(program: &Program, entry: Id, var: Id) -> Vec<Access> {
                         continue;
                     };
                     let Some(&r) = reach.get(ptr) else { continue };
-                    let Some(result) = inst.result_id else { continue };
+                    let Some(result) = inst.result_id else {
+                        continue;
+                    };
                     match r {
                         Reach::Member(_) => mark(&mut uses, r, READ),
-                        Reach::Whole => read_value(program, f, result, at, &is_copy, &mut |k| {
-                            match k {
+                        Reach::Whole => {
+                            read_value(program, f, result, at, &is_copy, &mut |k| match k {
                                 Some(k) if k < n && !one_member => uses[k].merge(READ),
                                 _ => all(&mut uses, READ),
-                            }
-                        }),
+                            })
+                        }
                     }
                 }
                 Op::Store => {
@@ -432,8 +441,14 @@ void Hit(inout Payload p, in BuiltInTriangleIntersectionAttributes a) {
         assert_eq!(
             rg,
             [
-                Access { read: true, written: true },
-                Access { read: false, written: true },
+                Access {
+                    read: true,
+                    written: true
+                },
+                Access {
+                    read: false,
+                    written: true
+                },
                 Access::default()
             ]
         );
@@ -441,8 +456,14 @@ void Hit(inout Payload p, in BuiltInTriangleIntersectionAttributes a) {
         assert_eq!(
             hit,
             [
-                Access { read: false, written: true },
-                Access { read: true, written: false },
+                Access {
+                    read: false,
+                    written: true
+                },
+                Access {
+                    read: true,
+                    written: false
+                },
                 Access::default()
             ]
         );

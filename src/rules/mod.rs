@@ -204,7 +204,9 @@ impl<'a> Context<'a> {
                     f.path
                         .extension()
                         .and_then(|e| e.to_str())
-                        .is_some_and(|e| e.eq_ignore_ascii_case("hlsl") || e.eq_ignore_ascii_case("hlsli"))
+                        .is_some_and(|e| {
+                            e.eq_ignore_ascii_case("hlsl") || e.eq_ignore_ascii_case("hlsli")
+                        })
                 }))
     }
 

@@ -2,7 +2,7 @@
 //! the full instance mask.
 
 use super::Context;
-use crate::analysis::trace_sites::reached_traces;
+use crate::analysis::trace_sites::{is_bounce, reached_traces};
 use crate::diag::Diagnostic;
 use crate::program::OperandValue;
 use crate::shader::Stage;
@@ -11,7 +11,8 @@ super::declare_rule! {
     /// ## What it does
     ///
     /// Reports a secondary ray — one traced from a closest-hit or miss shader, or
-    /// inside a loop of the ray generation shader (a bounce loop) — whose instance
+    /// inside a loop of the ray generation shader whose origin or direction comes
+    /// from a ray payload (a bounce loop, not a loop over samples) — whose instance
     /// (cull) mask is the constant `0xFF`, so it tests every instance of the scene.
     /// Traces whose mask is not a compile-time constant are not reported.
     ///
@@ -65,15 +66,17 @@ fn check(ctx: &Context) -> Vec<Diagnostic> {
     let mut out: Vec<Diagnostic> = Vec::new();
     let mut seen = Vec::new();
     for t in reached_traces(program) {
+        let site = &program.sites[t.site];
         let secondary = match t.stage {
             Stage::ClosestHit | Stage::Miss => true,
-            Stage::RayGeneration => t.in_loop,
+            // A bounce: in a loop, and the ray starts from or goes where the
+            // previous trace's payload says (not a loop over samples).
+            Stage::RayGeneration => is_bounce(program, site.inst, &t.chain, t.in_loop),
             _ => false,
         };
         if !secondary || t.operands.cull_mask != OperandValue::Const(0xFF) {
             continue;
         }
-        let site = &program.sites[t.site];
         let at = program.location_in(site.inst, &t.chain);
         if seen.contains(&at) {
             continue;

@@ -2,16 +2,20 @@
 //! several closest-hit shaders and never reorders threads.
 
 use crate::analysis::callgraph::EdgeKind;
-use crate::analysis::trace_sites::in_loop_from;
+use crate::analysis::payload_use;
+use crate::analysis::trace_sites::is_bounce_from;
+use spirv::StorageClass;
 use crate::diag::Diagnostic;
 use crate::shader::Stage;
 
 super::declare_rule! {
     /// ## What it does
     ///
-    /// Reports a trace inside a loop of a ray generation shader (a bounce loop)
-    /// that can reach two or more different closest-hit shaders — different
-    /// material paths — when the ray generation shader uses no shader execution
+    /// Reports a trace inside a loop of a ray generation shader whose origin or
+    /// direction comes from a ray payload (a bounce loop, not a loop over
+    /// samples) that can reach two or more different closest-hit shaders declared
+    /// with its payload's layout — different material paths — when the ray
+    /// generation shader uses no shader execution
     /// reordering (`MaybeReorderThread`, `reorderThreadNV`, hit objects).
     ///
     /// This is advice (pedantic), under an assumption the shaders cannot show:
@@ -92,9 +96,18 @@ fn run(ctx: &super::PipelineContext) -> Vec<Diagnostic> {
         let Some(program) = pipeline.programs.get(e.program) else {
             continue;
         };
-        if reorders(program) || !in_loop_from(program, from.shader.function, e.inst) {
+        if reorders(program) || !is_bounce_from(program, from.shader.function, e.inst) {
             continue;
         }
+        // The traced payload's layout: hit shaders declared with another one
+        // belong to another ray type (a shadow ray's).
+        let shape = program
+            .sites
+            .iter()
+            .find(|s| s.inst == e.inst)
+            .and_then(|s| s.payload)
+            .and_then(|v| program.globals.iter().find(|g| g.id == v))
+            .map(|g| payload_use::shape_of(program, g.ty));
         // Distinct closest-hit shaders this trace can reach.
         let mut hits: Vec<(usize, u32)> = Vec::new();
         for t in g
@@ -103,7 +116,21 @@ fn run(ctx: &super::PipelineContext) -> Vec<Diagnostic> {
             .filter(|t| t.kind == EdgeKind::Trace && t.program == e.program && t.inst == e.inst)
         {
             if let Some(n) = g.nodes.get(t.to) {
-                if n.shader.stage == Stage::ClosestHit {
+                let same_type = || {
+                    let Some(tp) = pipeline.programs.get(n.shader.program) else {
+                        return false;
+                    };
+                    let Some(shape) = &shape else { return true };
+                    payload_use::globals_used(
+                        tp,
+                        n.shader.function,
+                        StorageClass::IncomingRayPayloadKHR,
+                    )
+                    .iter()
+                    .filter_map(|w| tp.globals.iter().find(|g| g.id == *w))
+                    .any(|g| payload_use::shape_of(tp, g.ty) == *shape)
+                };
+                if n.shader.stage == Stage::ClosestHit && same_type() {
                     let key = (n.shader.program, n.shader.function);
                     if !hits.contains(&key) {
                         hits.push(key);
