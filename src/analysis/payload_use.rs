@@ -229,11 +229,10 @@ pub fn variable_use(program: &Program, entry: Id, var: Id) -> Vec<Access> {
             && loaded_from(program, val).is_some_and(|s| reach.get(&s) == Some(&Reach::Whole))
     };
     for f in &functions {
-        for (i, inst) in program.insts[f.start..=f.end].iter().enumerate() {
+        for inst in &program.insts[f.start..=f.end] {
             if program.is_debug_inst(inst) {
                 continue;
             }
-            let at = f.start + i;
             let op = inst.class.opcode;
             match op {
                 Op::AccessChain | Op::InBoundsAccessChain | Op::CopyObject | Op::FunctionCall => {
@@ -252,7 +251,7 @@ pub fn variable_use(program: &Program, entry: Id, var: Id) -> Vec<Access> {
                     match r {
                         Reach::Member(_) => mark(&mut uses, r, READ),
                         Reach::Whole => {
-                            read_value(program, f, result, at, &is_copy, &mut |k| match k {
+                            read_value(program, f, result, &is_copy, &mut |k| match k {
                                 Some(k) if k < n && !one_member => uses[k].merge(READ),
                                 _ => all(&mut uses, READ),
                             })
@@ -335,7 +334,6 @@ fn read_value(
     program: &Program,
     f: &crate::program::Function,
     value: Id,
-    _at: usize,
     is_copy: &dyn Fn(Id, Id) -> bool,
     on_read: &mut dyn FnMut(Option<usize>),
 ) {
@@ -400,7 +398,6 @@ pub fn globals_used(program: &Program, entry: Id, storage: StorageClass) -> Vec<
 mod tests {
     use super::*;
     use crate::shader::Language;
-    use std::path::Path;
 
     fn hlsl(src: &str) -> Program {
         let dir = std::env::temp_dir().join(format!("rtlint-payload-use-{}", std::process::id()));
@@ -467,6 +464,5 @@ void Hit(inout Payload p, in BuiltInTriangleIntersectionAttributes a) {
                 Access::default()
             ]
         );
-        let _ = Path::new("");
     }
 }

@@ -37,23 +37,6 @@ pub fn inst_in_loop(program: &Program, inst: usize) -> bool {
     natural_loops(f).iter().any(|(_, body)| body.contains(&b))
 }
 
-/// Whether instruction `inst`, reached from entry function `entry`, runs in
-/// a loop: it sits in one, or a call on some chain from the entry to it does.
-pub fn in_loop_from(program: &Program, entry: crate::program::Id, inst: usize) -> bool {
-    if inst_in_loop(program, inst) {
-        return true;
-    }
-    let Some(f) = program
-        .function_of(inst)
-        .and_then(|i| program.functions.get(i))
-    else {
-        return false;
-    };
-    call_chains(program, entry, f.id, MAX_CHAINS)
-        .iter()
-        .any(|chain| chain.iter().any(|&c| inst_in_loop(program, c)))
-}
-
 /// The traces (`OpTraceRayKHR`) each ray-tracing entry point reaches.
 pub fn reached_traces(program: &Program) -> Vec<ReachedTrace> {
     let mut out = Vec::new();

@@ -436,6 +436,8 @@ mod tests {
                 "RT003 member-straddles-row",
                 "RT004 hit-attributes-over-limit",
                 "RT005 ray-query-null-constant",
+                "RT006 payload-member-unused",
+                "RT008 attributes-larger-than-written",
                 "RT010 live-state-over-budget",
                 "RT020 recursive-trace",
                 "RT021 depth-exceeds-declared",
@@ -443,6 +445,11 @@ mod tests {
                 "RT023 depth-exceeds-device-limit",
                 "RT024 unbounded-bounce-loop",
                 "RT025 default-stack-unsafe",
+                "RT070 full-instance-mask-on-secondary-ray",
+                "RT071 alpha-test-only-any-hit",
+                "RT072 incoherent-rays-without-reorder",
+                "RT073 ray-query-mega-shader",
+                "RT074 trace-ray-for-visibility",
             ]
         );
     }

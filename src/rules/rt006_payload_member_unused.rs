@@ -320,10 +320,13 @@ fn run(ctx: &super::PipelineContext) -> Vec<Diagnostic> {
             .sites
             .first()
             .and_then(|&(p, i)| pipeline.programs[p].site_location(i));
+        let plural = |n: usize, one: &str, many: &str| {
+            format!("{n} {}", if n == 1 { one } else { many })
+        };
         let stages = format!(
-            "{} tracing shader(s) and {} closest-hit, any-hit or miss shader(s) exchange it",
-            t.callers.len(),
-            t.callees.len()
+            "exchanged by {} and {} (closest-hit, any-hit, miss)",
+            plural(t.callers.len(), "tracing shader", "tracing shaders"),
+            plural(t.callees.len() + t.aliases.len(), "shader it reaches", "shaders it reaches"),
         );
         for (k, u) in uses.iter().enumerate() {
             if u.read && u.written {

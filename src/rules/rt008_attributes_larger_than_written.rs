@@ -108,7 +108,7 @@ fn check(ctx: &Context) -> Vec<Diagnostic> {
         } else {
             // A vector or array: the components written.
             let n = uses.len() as u64;
-            let each = if n > 0 { l.scalar_size / n } else { 0 };
+            let each = l.scalar_size.checked_div(n).unwrap_or(0);
             each * uses.iter().filter(|u| u.written).count() as u64
         };
         if written >= l.scalar_size {

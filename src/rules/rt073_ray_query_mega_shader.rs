@@ -106,11 +106,8 @@ fn loops_around(program: &Program, inst: usize, depth: u32, out: &mut Vec<(usize
         .filter(|(_, body)| body.contains(&b))
         .min_by_key(|(_, body)| body.len());
     match inner {
-        Some((header, _)) => {
-            if !out.contains(&(fi, header)) {
-                out.push((fi, header));
-            }
-        }
+        Some((header, _)) if !out.contains(&(fi, header)) => out.push((fi, header)),
+        Some(_) => {}
         None if depth < 3 => {
             for call in program.callers(f.id) {
                 loops_around(program, call, depth + 1, out);
