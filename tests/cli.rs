@@ -232,13 +232,14 @@ fn json_check_contract() {
         "check",
         "--format",
         "json",
-        "fixtures/glsl/payloads.rgen.gV.spv",
+        // HLSL: RT002 and RT003 (whose fix is checked below) judge HLSL
+        // payloads only.
+        "fixtures/hlsl/payloads.hlsl",
     ]);
     let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     let diags = v["diagnostics"].as_array().unwrap();
     let codes: Vec<&str> = diags.iter().map(|d| d["code"].as_str().unwrap()).collect();
-    // RT002 and RT003 judge HLSL payloads only: this is GLSL.
-    assert_eq!(codes, ["RT001"]);
+    assert_eq!(codes, ["RT001", "RT002", "RT003"]);
     let d = &diags[0];
     for key in [
         "code",
@@ -255,8 +256,8 @@ fn json_check_contract() {
     ] {
         assert!(d.get(key).is_some(), "missing key {key}");
     }
-    assert_eq!(d["path"], "fixtures/glsl/payloads.rgen");
-    assert_eq!(d["line"], 6);
+    assert_eq!(d["path"], "fixtures/hlsl/payloads.hlsl");
+    assert_eq!(d["line"], 2);
     assert_eq!(d["severity"], "warning");
     assert_eq!(
         diags[1]["fix"]
@@ -266,7 +267,7 @@ fn json_check_contract() {
             .nth(1)
             .unwrap()
             .trim(),
-        "vec3 color;"
+        "float3 color;"
     );
     assert_eq!(v["summary"]["warnings"], 3);
     assert_eq!(v["summary"]["files"], 1);
