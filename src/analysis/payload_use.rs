@@ -251,9 +251,12 @@ pub fn variable_use(program: &Program, entry: Id, var: Id) -> Vec<Access> {
                     match r {
                         Reach::Member(_) => mark(&mut uses, r, READ),
                         Reach::Whole => {
-                            read_value(program, f, result, &is_copy, &mut |k| match k {
-                                Some(k) if k < n && !one_member => uses[k].merge(READ),
-                                _ => all(&mut uses, READ),
+                            let mut seen = Vec::new();
+                            read_value(program, f, result, n, &[], &is_copy, &mut seen, &mut |k| {
+                                match k {
+                                    Some(k) if k < n && !one_member => uses[k].merge(READ),
+                                    _ => all(&mut uses, READ),
+                                }
                             })
                         }
                     }
@@ -265,7 +268,18 @@ pub fn variable_use(program: &Program, entry: Id, var: Id) -> Vec<Access> {
                         continue;
                     };
                     if let Some(&r) = reach.get(ptr) {
-                        if !is_copy(*ptr, *val) {
+                        if r == Reach::Whole && !one_member {
+                            // A whole value: the members it carries anew
+                            // (not copied from the variable) are written.
+                            let fresh = fresh_members(program, *val, n, &|p| {
+                                reach.get(&p) == Some(&Reach::Whole)
+                            });
+                            for (k, new) in fresh.iter().enumerate() {
+                                if *new {
+                                    uses[k].merge(WRITE);
+                                }
+                            }
+                        } else if !is_copy(*ptr, *val) {
                             mark(&mut uses, r, WRITE);
                         }
                     }
@@ -327,16 +341,79 @@ fn loaded_from(program: &Program, val: Id) -> Option<Id> {
     }
 }
 
+/// Which members of whole value `val` are new rather than copied from the
+/// variable (a value loaded through a pointer `whole` accepts): a
+/// composite built from parts writes every part that is not undefined;
+/// inserting into a value writes the inserted member and keeps the rest.
+fn fresh_members(program: &Program, val: Id, n: usize, whole: &dyn Fn(Id) -> bool) -> Vec<bool> {
+    let mut v = val;
+    let mut inserted = vec![false; n];
+    for _ in 0..64 {
+        let Some(inst) = program.def(v) else { break };
+        match inst.class.opcode {
+            Op::Load => {
+                if matches!(inst.operands.first(), Some(Operand::IdRef(p)) if whole(*p)) {
+                    return inserted;
+                }
+                break;
+            }
+            Op::Undef => return inserted,
+            Op::CopyObject => match inst.operands.first() {
+                Some(Operand::IdRef(x)) => v = *x,
+                _ => break,
+            },
+            Op::CompositeInsert => match (inst.operands.get(1), inst.operands.get(2)) {
+                (Some(Operand::IdRef(base)), Some(Operand::LiteralBit32(k))) => {
+                    if let Some(m) = inserted.get_mut(*k as usize) {
+                        *m = true;
+                    }
+                    v = *base;
+                }
+                _ => break,
+            },
+            Op::CompositeConstruct if inst.operands.len() == n => {
+                for (k, o) in inst.operands.iter().enumerate() {
+                    let undef = matches!(o, Operand::IdRef(x)
+                        if program.def(*x).is_some_and(|d| d.class.opcode == Op::Undef));
+                    inserted[k] |= !undef;
+                }
+                return inserted;
+            }
+            _ => break,
+        }
+    }
+    vec![true; n]
+}
+
 /// Follows the uses of a whole loaded value `value` in function `f`: a
-/// composite extract reads one member (`Some(k)`), a copy into a local that
-/// stands for the variable reads nothing, anything else reads all (`None`).
+/// composite extract reads one member (`Some(k)`), inserting into it keeps
+/// following the members not replaced (`replaced`), a copy into a local that
+/// stands for the variable reads nothing, anything else reads what the value
+/// still carries of the variable.
+#[allow(clippy::too_many_arguments)]
 fn read_value(
     program: &Program,
     f: &crate::program::Function,
     value: Id,
+    n: usize,
+    replaced: &[usize],
     is_copy: &dyn Fn(Id, Id) -> bool,
+    seen: &mut Vec<Id>,
     on_read: &mut dyn FnMut(Option<usize>),
 ) {
+    if seen.contains(&value) || seen.len() > 256 {
+        return;
+    }
+    seen.push(value);
+    let read_rest = |on_read: &mut dyn FnMut(Option<usize>)| {
+        if replaced.is_empty() {
+            on_read(None);
+        } else {
+            for k in (0..n).filter(|k| !replaced.contains(k)) {
+                on_read(Some(k));
+            }
+        }
+    };
     for inst in &program.insts[f.start..=f.end] {
         if program.is_debug_inst(inst) {
             continue;
@@ -351,23 +428,77 @@ fn read_value(
         match inst.class.opcode {
             Op::CompositeExtract if matches!(inst.operands.first(), Some(Operand::IdRef(x)) if *x == value) => {
                 match inst.operands.get(1) {
-                    Some(Operand::LiteralBit32(k)) => on_read(Some(*k as usize)),
-                    _ => on_read(None),
+                    Some(Operand::LiteralBit32(k)) if !replaced.contains(&(*k as usize)) => {
+                        on_read(Some(*k as usize))
+                    }
+                    Some(Operand::LiteralBit32(_)) => {}
+                    _ => read_rest(on_read),
                 }
             }
-            Op::Store => {
-                let Some(Operand::IdRef(ptr)) = inst.operands.first() else {
-                    on_read(None);
+            Op::CompositeInsert
+                if matches!(inst.operands.get(1), Some(Operand::IdRef(x)) if *x == value)
+                    && !matches!(inst.operands.first(), Some(Operand::IdRef(x)) if *x == value) =>
+            {
+                let (Some(r), Some(Operand::LiteralBit32(k))) =
+                    (inst.result_id, inst.operands.get(2))
+                else {
+                    read_rest(on_read);
                     continue;
                 };
-                if !is_copy(*ptr, value) {
-                    on_read(None);
+                let mut more = replaced.to_vec();
+                more.push(*k as usize);
+                read_value(program, f, r, n, &more, is_copy, seen, on_read);
+            }
+            Op::CopyObject | Op::Phi => match inst.result_id {
+                Some(r) => read_value(program, f, r, n, replaced, is_copy, seen, on_read),
+                None => read_rest(on_read),
+            },
+            Op::Store => {
+                let Some(Operand::IdRef(ptr)) = inst.operands.first() else {
+                    read_rest(on_read);
+                    continue;
+                };
+                if !is_copy(*ptr, value) && !is_copy_through(program, *ptr, value, is_copy) {
+                    read_rest(on_read);
                 }
             }
             Op::Name => {}
-            _ => on_read(None),
+            _ => read_rest(on_read),
         }
     }
+}
+
+/// Whether storing `value` (derived from a whole load by inserts) into
+/// `ptr` puts it back where it came from: `ptr` stands for the variable.
+fn is_copy_through(
+    program: &Program,
+    ptr: Id,
+    value: Id,
+    is_copy: &dyn Fn(Id, Id) -> bool,
+) -> bool {
+    // Walk the insert chain back to its load.
+    let mut v = value;
+    for _ in 0..64 {
+        let Some(inst) = program.def(v) else {
+            return false;
+        };
+        match inst.class.opcode {
+            Op::Load => return is_copy(ptr, v),
+            Op::CompositeInsert | Op::CopyObject => {
+                let base = if inst.class.opcode == Op::CompositeInsert {
+                    1
+                } else {
+                    0
+                };
+                match inst.operands.get(base) {
+                    Some(Operand::IdRef(b)) => v = *b,
+                    _ => return false,
+                }
+            }
+            _ => return false,
+        }
+    }
+    false
 }
 
 /// The globals of `storage` that code reachable from `entry` names.
