@@ -4,8 +4,10 @@
 pub mod callgraph;
 pub mod layout;
 pub mod liveness;
+pub mod payload_use;
 pub mod recursion;
 pub mod stack;
+pub mod trace_sites;
 
 pub use liveness::{live_report, LiveReport};
 pub use recursion::{recursion_report, RecursionReport};
