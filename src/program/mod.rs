@@ -13,6 +13,7 @@ pub mod debug;
 mod fold;
 pub mod scalar;
 mod textdecl;
+mod values;
 pub mod types;
 
 pub use binary::{words_from_bytes, MAGIC};
