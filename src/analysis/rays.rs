@@ -530,7 +530,7 @@ pub fn trace_flags(pipeline: &Pipeline, graph: &TraceGraph, t: &TraceTargets) ->
 }
 
 /// The payload type a trace passes.
-fn trace_payload_ty(program: &Program, inst: usize) -> Option<Id> {
+pub fn trace_payload_ty(program: &Program, inst: usize) -> Option<Id> {
     let site = program.sites.iter().find(|s| s.inst == inst)?;
     let var = site.payload?;
     match program.ty(program.def(var)?.result_type?)? {
@@ -592,7 +592,14 @@ pub fn visibility_traces(pipeline: &Pipeline, graph: &TraceGraph) -> Vec<Visibil
                 }
             }
         }
-        if !visibility || !any_writer {
+        // Without a description, a trace that can run closest-hit shaders
+        // but reaches none may be missing its own (a shader of the folder
+        // that could not be read): do not judge it.
+        let skips_closest_hit = flags & flags::SKIP_CLOSEST_HIT != 0;
+        if !visibility
+            || !any_writer
+            || (!pipeline.described() && !skips_closest_hit && closest_hits.is_empty())
+        {
             continue;
         }
         out.push(VisibilityTrace {

@@ -426,6 +426,16 @@ mod tests {
                 "RT023 depth-exceeds-device-limit",
                 "RT024 unbounded-bounce-loop",
                 "RT025 default-stack-unsafe",
+                "RT030 shadow-ray-without-accept-first-hit",
+                "RT031 visibility-ray-runs-closest-hit",
+                "RT032 visibility-ray-large-payload",
+                "RT033 tmin-zero-from-surface",
+                "RT034 unbounded-secondary-tmax",
+                "RT035 invalid-ray-interval",
+                "RT036 degenerate-ray-direction",
+                "RT037 any-hit-with-opaque-geometry",
+                "RT038 opaque-flag-missing",
+                "RT039 cull-flags-on-procedural",
             ]
         );
     }

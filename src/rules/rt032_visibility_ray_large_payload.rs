@@ -7,8 +7,11 @@ super::declare_rule! {
     /// ## What it does
     ///
     /// Finds visibility traces (see RT030) that pass a payload larger than 4
-    /// bytes while the shaders they can run write at most one member of it:
-    /// typically the radiance payload reused to read back a single hit flag.
+    /// bytes while the shaders they can run write at most one member of it,
+    /// and whose payload type other traces of the pipeline use for more than
+    /// a hit flag: the radiance payload reused to read back a single value. A
+    /// payload of the visibility trace's own (which may carry inputs such as
+    /// a random seed for an any-hit shader) is not reported.
     ///
     /// ## Why is this bad?
     ///
@@ -45,7 +48,22 @@ super::declare_rule! {
 
 fn check(ctx: &PipelineContext) -> Vec<Diagnostic> {
     let mut out: Vec<Diagnostic> = Vec::new();
-    for v in rays::visibility_traces(ctx.pipeline, &ctx.recursion.graph) {
+    let g = &ctx.recursion.graph;
+    let visibility = rays::visibility_traces(ctx.pipeline, g);
+    // Payload types that other traces use for more than a hit flag.
+    let shared: Vec<String> = rays::trace_targets(g)
+        .iter()
+        .filter(|t| {
+            !visibility
+                .iter()
+                .any(|v| v.program == t.program && v.inst == t.inst)
+        })
+        .filter_map(|t| {
+            let program = ctx.pipeline.programs.get(t.program)?;
+            rays::trace_payload_ty(program, t.inst).map(|ty| rays::signature(program, ty))
+        })
+        .collect();
+    for v in visibility {
         let Some(program) = ctx.pipeline.programs.get(v.program) else {
             continue;
         };
@@ -53,6 +71,9 @@ fn check(ctx: &PipelineContext) -> Vec<Diagnostic> {
         let Some(size) = scalar_size(program, ty) else {
             continue;
         };
+        if !shared.contains(&rays::signature(program, ty)) {
+            continue;
+        }
         // At most one member written, and not the whole payload.
         if size <= 4 || v.written.len() > 1 || v.written.iter().any(|p| p.is_empty()) {
             continue;
@@ -72,7 +93,9 @@ fn check(ctx: &PipelineContext) -> Vec<Diagnostic> {
         )
         .with_code(CODE)
         .with_primary(v.location.clone(), "visibility trace")
-        .with_note(format!("the shaders it can run write only {member}"))
+        .with_note(format!(
+            "the shaders it can run write only {member}; other traces use the same payload type for more"
+        ))
         .with_help("give visibility traces their own 4-byte payload (a `uint` or `bool`)");
         if !out.iter().any(|o| o.primary == d.primary) {
             out.push(d);
