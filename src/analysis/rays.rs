@@ -88,8 +88,12 @@ pub fn rays(program: &Program) -> Vec<Ray> {
             if !reach.contains(&f.id) {
                 continue;
             }
-            let chains =
-                crate::program::cfg::call_chains(program, ep.function, f.id, super::liveness::MAX_CHAINS);
+            let chains = crate::program::cfg::call_chains(
+                program,
+                ep.function,
+                f.id,
+                super::liveness::MAX_CHAINS,
+            );
             for chain in chains {
                 let location = program
                     .location_in(site.inst, &chain)
@@ -146,7 +150,7 @@ fn ray(
         tmax: scalar(tmax),
         origin_value: program.fold_floats_in(origin, chain),
         direction: program.fold_floats_in(dir, chain),
-        origin: origin_kind(program, origin, chain),
+        origin: origin_kind(program, origin, chain, 0),
         bound: bound(program, dir, chain, site.function),
     })
 }
@@ -207,7 +211,13 @@ fn loads_from(program: &Program, id: Id, chain: &[usize], builtins: &[u32], payl
 }
 
 fn is_hit_distance(program: &Program, id: Id, chain: &[usize]) -> bool {
-    loads_from(program, id, chain, &[BUILTIN_RAY_TMAX, BUILTIN_HIT_T_NV], true)
+    loads_from(
+        program,
+        id,
+        chain,
+        &[BUILTIN_RAY_TMAX, BUILTIN_HIT_T_NV],
+        true,
+    )
 }
 
 /// `direction × t` with `t` a hit distance (either order, or a splat).
@@ -227,7 +237,10 @@ fn is_ray_step(program: &Program, id: Id, chain: &[usize]) -> bool {
     }
 }
 
-fn origin_kind(program: &Program, id: Id, chain: &[usize]) -> Origin {
+fn origin_kind(program: &Program, id: Id, chain: &[usize], depth: u32) -> Origin {
+    if depth > 8 {
+        return Origin::Other;
+    }
     let (src, ch) = program.value_source(id, chain);
     let ops = operand_ids(program, src);
     let hit = match opcode(program, src) {
@@ -242,7 +255,7 @@ fn origin_kind(program: &Program, id: Id, chain: &[usize]) -> Origin {
         }),
         // `.xyz` of a hit point.
         Some(Op::VectorShuffle) if ops.len() == 2 && ops[0] == ops[1] => {
-            return origin_kind(program, ops[0], ch)
+            return origin_kind(program, ops[0], ch, depth + 1)
         }
         _ => false,
     };
@@ -278,7 +291,11 @@ fn bound(program: &Program, dir: Id, chain: &[usize], function: usize) -> Option
         // v / length(v), the divisor possibly splatted.
         let (d, dch) = program.value_source(*ops.get(1)?, ch);
         let d = match opcode(program, d) {
-            Some(Op::CompositeConstruct) => program.value_source(*operand_ids(program, d).first()?, dch).0,
+            Some(Op::CompositeConstruct) => {
+                program
+                    .value_source(*operand_ids(program, d).first()?, dch)
+                    .0
+            }
             _ => d,
         };
         if glsl_op(program, d) != Some(GLSL_LENGTH) {
@@ -310,7 +327,9 @@ fn bound(program: &Program, dir: Id, chain: &[usize], function: usize) -> Option
             };
             let args: Vec<Id> = operand_ids(program, rid).into_iter().skip(1).collect();
             let hit = match glsl_op(program, rid) {
-                Some(GLSL_LENGTH) => args.first().is_some_and(|&a| identity(program, a, &[]) == want),
+                Some(GLSL_LENGTH) => args
+                    .first()
+                    .is_some_and(|&a| identity(program, a, &[]) == want),
                 Some(GLSL_DISTANCE) => match (pair, args.as_slice()) {
                     (Some((x, y)), [a, b]) => {
                         let (a, b) = (identity(program, *a, &[]), identity(program, *b, &[]));
@@ -377,17 +396,19 @@ pub fn payload_use(program: &Program, function: Id) -> PayloadUse {
                     if program.storage_of(root) != Some(StorageClass::IncomingRayPayloadKHR) {
                         continue;
                     }
-                    u.ty = program.def(root).and_then(|d| d.result_type).and_then(|t| {
-                        match program.ty(t) {
-                            Some(Type::Pointer { pointee, .. }) => Some(*pointee),
-                            _ => None,
-                        }
-                    });
+                    u.ty =
+                        program.def(root).and_then(|d| d.result_type).and_then(|t| {
+                            match program.ty(t) {
+                                Some(Type::Pointer { pointee, .. }) => Some(*pointee),
+                                _ => None,
+                            }
+                        });
                     let path = member_path(program, *ptr);
                     let constant = inst.class.opcode == Op::Store
                         && match inst.operands.get(1) {
                             Some(Operand::IdRef(v)) => {
-                                program.fold(*v).is_some() || program.fold_floats_in(*v, &[]).is_some()
+                                program.fold(*v).is_some()
+                                    || program.fold_floats_in(*v, &[]).is_some()
                             }
                             _ => false,
                         };
@@ -421,7 +442,8 @@ pub fn payload_use(program: &Program, function: Id) -> PayloadUse {
 fn member_path(program: &Program, ptr: Id) -> Vec<u32> {
     let mut cur = ptr;
     let mut first = None;
-    while let Some(i) = program.def(cur) {
+    for _ in 0..32 {
+        let Some(i) = program.def(cur) else { break };
         if !matches!(i.class.opcode, Op::AccessChain | Op::InBoundsAccessChain) {
             break;
         }
@@ -447,10 +469,14 @@ pub fn signature(program: &Program, ty: Id) -> String {
         }
         match p.ty(ty) {
             Some(Type::Bool) => "b".into(),
-            Some(Type::Int { width, signed }) => format!("{}{width}", if *signed { "i" } else { "u" }),
+            Some(Type::Int { width, signed }) => {
+                format!("{}{width}", if *signed { "i" } else { "u" })
+            }
             Some(Type::Float { width }) => format!("f{width}"),
             Some(Type::Vector { elem, count }) => format!("v{count}{}", go(p, *elem, depth + 1)),
-            Some(Type::Matrix { column, columns }) => format!("m{columns}{}", go(p, *column, depth + 1)),
+            Some(Type::Matrix { column, columns }) => {
+                format!("m{columns}{}", go(p, *column, depth + 1))
+            }
             Some(Type::Array { elem, len }) => {
                 format!("a{}{}", len.value().unwrap_or(0), go(p, *elem, depth + 1))
             }

@@ -13,8 +13,8 @@ pub mod debug;
 mod fold;
 pub mod scalar;
 mod textdecl;
-mod values;
 pub mod types;
+mod values;
 
 pub use binary::{words_from_bytes, MAGIC};
 pub use build::parse;

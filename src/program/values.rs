@@ -38,8 +38,7 @@ impl Program {
                     .map(|x| (x, cur.1)),
                 Op::CompositeExtract => {
                     let path = literals(&inst.operands);
-                    first_id(&inst.operands)
-                        .and_then(|b| self.element_source(b, &path, cur.1, 0))
+                    first_id(&inst.operands).and_then(|b| self.element_source(b, &path, cur.1, 0))
                 }
                 _ => None,
             };
@@ -92,12 +91,13 @@ impl Program {
 
     /// The id of the `GLSL.std.450` import, if any.
     pub fn glsl_std_set(&self) -> Option<Id> {
-        self.insts.iter().find_map(|i| {
-            (i.class.opcode == Op::ExtInstImport
-                && matches!(i.operands.first(), Some(Operand::LiteralString(s)) if s == "GLSL.std.450"))
-            .then_some(i.result_id)
-            .flatten()
-        })
+        let glsl = |o: Option<&Operand>| matches!(o, Some(Operand::LiteralString(s)) if s == "GLSL.std.450");
+        // Imports come before the memory model.
+        self.insts
+            .iter()
+            .take_while(|i| i.class.opcode != Op::MemoryModel)
+            .find(|i| i.class.opcode == Op::ExtInstImport && glsl(i.operands.first()))
+            .and_then(|i| i.result_id)
     }
 
     /// Element `path` of composite `base`'s source.
@@ -115,7 +115,12 @@ impl Program {
             return None;
         }
         if let Some(Constant::Composite(parts)) = self.constants.get(&base) {
-            return self.element_source(*parts.get(path[0] as usize)?, &path[1..], chain, depth + 1);
+            return self.element_source(
+                *parts.get(path[0] as usize)?,
+                &path[1..],
+                chain,
+                depth + 1,
+            );
         }
         let inst = self.def(base)?;
         match inst.class.opcode {
@@ -129,7 +134,9 @@ impl Program {
                 let (arg, outer) = self.argument(base, chain)?;
                 self.element_source(arg, path, outer, depth + 1)
             }
-            Op::CopyObject => self.element_source(first_id(&inst.operands)?, path, chain, depth + 1),
+            Op::CopyObject => {
+                self.element_source(first_id(&inst.operands)?, path, chain, depth + 1)
+            }
             Op::Load => {
                 let v = self.stored_at(first_id(&inst.operands)?, path)?;
                 Some((v, chain))
@@ -147,6 +154,13 @@ impl Program {
     /// `None` when writes differ, one is not understood, or the variable
     /// escapes into a call.
     fn stored_at(&self, ptr: Id, path: &[u32]) -> Option<Id> {
+        self.stored_at_depth(ptr, path, 0)
+    }
+
+    fn stored_at_depth(&self, ptr: Id, path: &[u32], depth: u32) -> Option<Id> {
+        if depth > MAX_DEPTH {
+            return None;
+        }
         // A pointer into a member: extend the path.
         let def = self.def(ptr)?;
         if matches!(def.class.opcode, Op::AccessChain | Op::InBoundsAccessChain) {
@@ -156,12 +170,14 @@ impl Program {
                 idx.push(u32::try_from(self.const_u64(*i)?).ok()?);
             }
             idx.extend_from_slice(path);
-            return self.stored_at(first_id(&def.operands)?, &idx);
+            return self.stored_at_depth(first_id(&def.operands)?, &idx, depth + 1);
         }
         if self.storage_of(ptr) != Some(StorageClass::Function) {
             return None;
         }
-        let f = self.functions.get(self.function_of(*self.defs.get(&ptr)?)?)?;
+        let f = self
+            .functions
+            .get(self.function_of(*self.defs.get(&ptr)?)?)?;
         // Every pointer into the variable, with its constant index path.
         let mut pointers: Vec<(Id, Vec<u32>)> = vec![(ptr, Vec::new())];
         let mut value: Option<Id> = None;
@@ -176,7 +192,7 @@ impl Program {
             }
         };
         if let Some(Operand::IdRef(init)) = def.operands.get(1) {
-            merge(self.project(*init, path))?;
+            merge(self.project(*init, path, 0))?;
         }
         for inst in &self.insts[f.start..=f.end] {
             if self.is_debug_inst(inst) {
@@ -213,7 +229,7 @@ impl Program {
                     };
                     if at.len() <= path.len() && path[..at.len()] == at[..] {
                         // The store covers the place.
-                        merge(self.project(*stored, &path[at.len()..]))?;
+                        merge(self.project(*stored, &path[at.len()..], 0))?;
                     } else if path.len() < at.len() && at[..path.len()] == path[..] {
                         // The store writes part of the place.
                         return None;
@@ -226,18 +242,21 @@ impl Program {
     }
 
     /// Element `path` of value `id` as an id, when it can be named.
-    fn project(&self, id: Id, path: &[u32]) -> Option<Id> {
+    fn project(&self, id: Id, path: &[u32], depth: u32) -> Option<Id> {
         if path.is_empty() {
             return Some(id);
         }
+        if depth > MAX_DEPTH {
+            return None;
+        }
         if let Some(Constant::Composite(parts)) = self.constants.get(&id) {
-            return self.project(*parts.get(path[0] as usize)?, &path[1..]);
+            return self.project(*parts.get(path[0] as usize)?, &path[1..], depth + 1);
         }
         let inst = self.def(id)?;
         if inst.class.opcode == Op::CompositeConstruct && self.is_struct_or_array(inst.result_type?)
         {
             if let Some(Operand::IdRef(e)) = inst.operands.get(path[0] as usize) {
-                return self.project(*e, &path[1..]);
+                return self.project(*e, &path[1..], depth + 1);
             }
         }
         None
@@ -255,8 +274,20 @@ impl Program {
                         .def(id)
                         .and_then(|i| i.result_type)
                         .and_then(|t| self.ty(t))
-                        .is_some_and(|t| matches!(t, Type::Int { signed: true, width: 32 }));
-                    Some(vec![if signed { *v as u32 as i32 as f64 } else { *v as f64 }])
+                        .is_some_and(|t| {
+                            matches!(
+                                t,
+                                Type::Int {
+                                    signed: true,
+                                    width: 32
+                                }
+                            )
+                        });
+                    Some(vec![if signed {
+                        *v as u32 as i32 as f64
+                    } else {
+                        *v as f64
+                    }])
                 }
                 Constant::Bool(b) => Some(vec![f64::from(u8::from(*b))]),
                 Constant::Null => {
@@ -281,10 +312,7 @@ impl Program {
                 _ => None,
             })
             .collect();
-        let arg = |k: usize| {
-            ids.get(k)
-                .and_then(|&x| self.ffold(x, chain, depth + 1))
-        };
+        let arg = |k: usize| ids.get(k).and_then(|&x| self.ffold(x, chain, depth + 1));
         let zip = |f: fn(f64, f64) -> f64| -> Option<Vec<f64>> {
             let (a, b) = (arg(0)?, arg(1)?);
             if a.len() == b.len() {

@@ -13,9 +13,10 @@ super::declare_rule! {
     ///
     /// Facing is a property of triangles: procedural primitives have no winding,
     /// so the flag does nothing for them and whatever culling it was meant to do
-    /// must happen in the intersection shader. Combining a face-culling flag
-    /// with `SkipTriangles` is not allowed by the SPIR-V ray-tracing
-    /// specification.
+    /// must happen in the intersection shader. A face-culling flag together
+    /// with `SkipTriangles` is not allowed at all: DXR's `RAY_FLAG` reference
+    /// makes `SkipTriangles` mutually exclusive with both culling flags.
+
     ///
     /// ## Example
     ///
@@ -30,6 +31,10 @@ super::declare_rule! {
     /// ## How to fix
     ///
     /// Drop the culling flag, or cull in the intersection shader.
+    ///
+    /// ## References
+    ///
+    /// - DirectX Raytracing, `RAY_FLAG` enumeration (`RAY_FLAG_SKIP_TRIANGLES`).
     "RT039" "cull-flags-on-procedural" {
         group: Suspicious,
         summary: "face-culling ray flags on a trace that reaches only procedural geometry",
@@ -59,7 +64,7 @@ fn check(ctx: &PipelineContext) -> Vec<Diagnostic> {
                 )
                 .with_code(CODE)
                 .with_primary(r.location.clone(), "face-culling ray flag")
-                .with_note("the specification allows at most one of `SkipTriangles`, `CullBackFacingTriangles` and `CullFrontFacingTriangles`")
+                .with_note("`SkipTriangles` is mutually exclusive with `CullBackFacingTriangles` and `CullFrontFacingTriangles`")
                 .with_help("drop the culling flag"),
             );
         }
