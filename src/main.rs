@@ -265,7 +265,7 @@ fn run(cli: Cli) -> Result<u8, String> {
         }
         Command::Rule { code } => match rtlint::rules::find(&code) {
             Some(r) => {
-                print!("{}", r.page());
+                let _ = write!(std::io::stdout().lock(), "{}", r.page());
                 Ok(0)
             }
             None => Err(format!("unknown rule `{code}` (`rtlint rules` lists them)")),
