@@ -1,6 +1,7 @@
 use super::PipelineContext;
 use crate::analysis::rays::{self, flags};
 use crate::diag::Diagnostic;
+use crate::shader::Language;
 
 super::declare_rule! {
     /// ## What it does
@@ -9,7 +10,7 @@ super::declare_rule! {
     /// trace can run writes only constants to the payload (or nothing) and
     /// traces nothing, so the payload can only say "hit" or "missed" — whose
     /// constant ray flags lack `AcceptFirstHitAndEndSearch`
-    /// (`gl_RayFlagsTerminateOnFirstHitEXT`, `RAY_FLAG_ACCEPT_FIRST_HIT_AND_END_SEARCH`, 0x4).
+    /// (`gl_RayFlagsTerminateOnFirstHitEXT`, `RAY_FLAG_ACCEPT_FIRST_HIT_AND_END_SEARCH`, WGSL `RAY_FLAG_TERMINATE_ON_FIRST_HIT`, 0x4).
     ///
     /// Without a pipeline description every trace may reach every shader of
     /// its folder (or file); a shader whose incoming payload has another type
@@ -68,10 +69,20 @@ fn check(ctx: &PipelineContext) -> Vec<Diagnostic> {
             "its shaders only record whether the ray hit; ray flags are {:#x}",
             v.flags
         ))
-        .with_help("add `AcceptFirstHitAndEndSearch` (`gl_RayFlagsTerminateOnFirstHitEXT`) to the ray flags");
+        .with_help(format!("add `{}` to the ray flags", flag_name(program.language)));
         if !out.iter().any(|o| o.primary == d.primary) {
             out.push(d);
         }
     }
     out
+}
+
+/// The flag as the shader's language spells it.
+fn flag_name(language: Language) -> &'static str {
+    match language {
+        Language::Hlsl => "RAY_FLAG_ACCEPT_FIRST_HIT_AND_END_SEARCH",
+        Language::Wgsl => "RAY_FLAG_TERMINATE_ON_FIRST_HIT",
+        Language::Glsl => "gl_RayFlagsTerminateOnFirstHitEXT",
+        Language::Spirv => "TerminateOnFirstHitKHR",
+    }
 }

@@ -1,6 +1,7 @@
 use super::PipelineContext;
 use crate::analysis::rays;
 use crate::diag::Diagnostic;
+use crate::shader::Language;
 
 super::declare_rule! {
     /// ## What it does
@@ -64,10 +65,23 @@ fn check(ctx: &PipelineContext) -> Vec<Diagnostic> {
         .with_code(CODE)
         .with_primary(v.location.clone(), "no `SkipClosestHitShader` flag")
         .with_note(format!("closest-hit shaders it runs: {names}; each only stores constants in the payload"))
-        .with_help("set `SkipClosestHitShader`, initialise the payload to the hit value and store the miss value in the miss shader");
+        .with_help(format!(
+            "set `{}`, initialise the payload to the hit value and store the miss value in the miss shader",
+            flag_name(program.language)
+        ));
         if !out.iter().any(|o| o.primary == d.primary) {
             out.push(d);
         }
     }
     out
+}
+
+/// The flag as the shader's language spells it.
+fn flag_name(language: Language) -> &'static str {
+    match language {
+        Language::Hlsl => "RAY_FLAG_SKIP_CLOSEST_HIT_SHADER",
+        Language::Wgsl => "RAY_FLAG_SKIP_CLOSEST_HIT_SHADER",
+        Language::Glsl => "gl_RayFlagsSkipClosestHitShaderEXT",
+        Language::Spirv => "SkipClosestHitShaderKHR",
+    }
 }
