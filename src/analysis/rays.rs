@@ -663,3 +663,60 @@ pub fn all_procedural(pipeline: &Pipeline, groups: &BTreeSet<usize>) -> bool {
                 .is_some_and(|h| h.kind == HitGroupKind::Procedural)
         })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::shader::Language;
+    use std::path::Path;
+
+    fn load(rel: &str, language: Language) -> Program {
+        crate::front::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join(rel), language).unwrap()
+    }
+
+    /// HLSL's `RayDesc` is written member by member into a local; the
+    /// interval folds through it, the origin is the hit point, and the
+    /// direction `l / length(l)` is bounded by that length.
+    #[test]
+    fn hlsl_ray_desc_members_fold() {
+        let p = load("fixtures/RT034/bad.hlsl", Language::Hlsl);
+        let r = rays(&p);
+        assert_eq!(r.len(), 1, "{r:?}");
+        assert_eq!(r[0].tmin, Some(f64::from(0.001f32)));
+        assert_eq!(r[0].tmax, Some(f64::from(1e30f32)));
+        assert_eq!(r[0].origin, Origin::HitPoint);
+        assert_eq!(r[0].flags, Some(0xC));
+        let bound = r[0].bound.as_ref().and_then(|b| b.location.as_ref());
+        assert_eq!(bound.map(|l| l.line), Some(11));
+    }
+
+    /// naga passes the `RayDesc` to a helper per trace: values fold through
+    /// the call chain; an offset origin is not a bare hit point.
+    #[test]
+    fn wgsl_helper_parameters_fold_per_call() {
+        let p = load("fixtures/RT033/bad.wgsl", Language::Wgsl);
+        let r = rays(&p);
+        assert_eq!(r.len(), 1, "{r:?}");
+        assert_eq!((r[0].tmin, r[0].origin), (Some(0.0), Origin::HitPoint));
+        let p = load("fixtures/RT036/bad.wgsl", Language::Wgsl);
+        assert_eq!(rays(&p)[0].direction, Some(vec![0.0, 0.0, 0.0]));
+        let p = load("fixtures/RT033/good.hlsl", Language::Hlsl);
+        assert_eq!(rays(&p)[0].origin, Origin::Other);
+    }
+
+    /// The shadow trace reaches the shadow closest hit (it only stores 1)
+    /// and not the radiance shaders, whose payload type differs; the
+    /// radiance trace is no visibility test.
+    #[test]
+    fn visibility_traces_by_payload_type() {
+        let p = load("fixtures/RT031/bad.hlsl", Language::Hlsl);
+        let pipeline = Pipeline::from_programs(vec![p]);
+        let g = super::super::callgraph::trace_graph(&pipeline);
+        let v = visibility_traces(&pipeline, &g);
+        assert_eq!(v.len(), 1, "{v:?}");
+        assert_eq!(v[0].closest_hits, ["ShadowHit"]);
+        assert_eq!(v[0].recording_closest_hits, 1);
+        assert_eq!(v[0].flags, flags::TERMINATE_ON_FIRST_HIT);
+        assert_eq!(v[0].written.len(), 1);
+    }
+}
