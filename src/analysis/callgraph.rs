@@ -41,6 +41,9 @@ pub enum Assumption {
     InitialValueAssumed { counter: String },
     /// The driver's numbers come from this device.
     Driver { device: String, driver: String },
+    /// The recommended stack was below what the driver's own numbers need
+    /// and was raised to it.
+    RecommendationRaised { from: u64, to: u64 },
 }
 
 impl Assumption {

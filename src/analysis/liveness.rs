@@ -516,13 +516,27 @@ impl FnLiveness {
         Some(out)
     }
 
-    /// Variables an instruction may write.
+    /// Variables an instruction may write. A constant initializer does not
+    /// count: until something else is stored, the variable holds a
+    /// constant, which is recomputed rather than kept across a call.
     fn writes(&self, program: &Program, inst: &Instruction) -> Vec<Id> {
         if program.is_debug_inst(inst) {
             return Vec::new();
         }
         match inst.class.opcode {
-            Op::Variable if inst.operands.len() > 1 => inst.result_id.into_iter().collect(),
+            Op::Variable if inst.operands.len() > 1 => {
+                let constant = matches!(
+                    inst.operands.get(1),
+                    Some(Operand::IdRef(init))
+                        if program.constants.contains_key(init)
+                            || program.spec_constants.contains_key(init)
+                );
+                if constant {
+                    Vec::new()
+                } else {
+                    inst.result_id.into_iter().collect()
+                }
+            }
             Op::Load | Op::AccessChain | Op::InBoundsAccessChain | Op::PtrAccessChain => Vec::new(),
             _ => id_operands(inst)
                 .filter_map(|id| self.root(id))
