@@ -244,6 +244,8 @@ fn front_options(config: &Config, options: &Options) -> FrontOptions {
             .iter()
             .map(|(k, v)| (k.clone(), v.clone()))
             .collect(),
+        entry: options.front.entry.clone(),
+        stage: options.front.stage,
     };
     front_options
         .include_dirs
@@ -834,7 +836,7 @@ mod tests {
         let d = check_loose(vec![p], &[], &Config::default());
         let rt020: Vec<_> = d.iter().filter(|d| d.code == Some("RT020")).collect();
         assert_eq!(rt020.len(), 1, "{d:?}");
-        assert_eq!(rt020[0].primary.as_ref().unwrap().location.line, 38);
+        assert_eq!(rt020[0].primary.as_ref().unwrap().location.line, 42);
         assert!(rt020[0]
             .notes
             .iter()

@@ -41,6 +41,18 @@ struct Common {
     /// Define a macro for HLSL and GLSL sources: NAME or NAME=VALUE.
     #[arg(short = 'D', value_name = "NAME[=VALUE]")]
     define: Vec<String>,
+    /// HLSL: only this entry point.
+    #[arg(short = 'E', long = "entry", value_name = "NAME")]
+    entry: Option<String>,
+    /// HLSL: the entry point's stage when it has no `[shader(...)]`: a DXC
+    /// profile (`ps_6_5`, `cs_6_5`, `lib_6_3`) or a stage name.
+    #[arg(
+        short = 'T',
+        long = "stage",
+        value_name = "PROFILE",
+        requires = "entry"
+    )]
+    stage: Option<String>,
     /// The name standard input (`-`) is linted under; its extension picks the language.
     #[arg(long, value_name = "PATH")]
     stdin_filename: Option<PathBuf>,
@@ -187,6 +199,15 @@ enum Command {
         /// Compile only this entry point.
         #[arg(short = 'E', long = "entry")]
         entry: Option<String>,
+        /// The entry point's stage when it has no `[shader(...)]`: a DXC
+        /// profile (`ps_6_5`, `cs_6_5`, `lib_6_3`) or a stage name (`pixel`).
+        #[arg(
+            short = 'T',
+            long = "stage",
+            value_name = "PROFILE",
+            requires = "entry"
+        )]
+        stage: Option<String>,
         /// Include directory (searched after the including file's folder).
         #[arg(short = 'I', value_name = "DIR")]
         include: Vec<PathBuf>,
@@ -257,11 +278,12 @@ fn run(cli: Cli) -> Result<u8, String> {
         Command::Compile {
             file,
             entry,
+            stage,
             include,
             define,
             output,
             whole,
-        } => compile(file, entry, include, define, output, whole),
+        } => compile(file, entry, stage, include, define, output, whole),
         Command::DriverStackSizes { pipeline, shader } => driver_stack_sizes(pipeline, shader),
         Command::Rules => {
             let mut out = std::io::stdout().lock();
@@ -314,6 +336,16 @@ fn options(common: &Common) -> Result<lint::Options, String> {
         front: rtlint::front::FrontOptions {
             include_dirs: common.include.clone(),
             defines: common.define.iter().map(|d| split_define(d)).collect(),
+            entry: common.entry.clone(),
+            stage: match common
+                .stage
+                .as_deref()
+                .map(rtlint::front::hlsl::parse_stage)
+            {
+                Some(Ok(s)) => s,
+                Some(Err(e)) => return Err(format!("-T: {e}")),
+                None => None,
+            },
         },
         respect_gitignore: !common.no_gitignore,
         stdin,
@@ -670,13 +702,22 @@ fn print_report(
 fn compile(
     file: PathBuf,
     entry: Option<String>,
+    stage: Option<String>,
     include: Vec<PathBuf>,
     define: Vec<String>,
     output: PathBuf,
     whole: bool,
 ) -> Result<u8, String> {
     use rtlint::front::hlsl;
+    let stage = match stage.as_deref().map(hlsl::parse_stage).transpose() {
+        Ok(s) => s.flatten(),
+        Err(e) => {
+            eprintln!("error: -T: {e}");
+            return Ok(2);
+        }
+    };
     let options = hlsl::HlslOptions {
+        stage,
         include_dirs: include,
         defines: define.iter().map(|d| split_define(d)).collect(),
         entry,
@@ -694,6 +735,9 @@ fn compile(
     if whole {
         return match hlsl::compile_file(&file, &options) {
             Ok(m) => {
+                for w in &m.warnings {
+                    eprintln!("{w}");
+                }
                 write(&output, &m.words)?;
                 eprintln!("{}: {} entry points", output.display(), m.entries.len());
                 Ok(0)
@@ -707,6 +751,9 @@ fn compile(
     };
     if entries.is_empty() {
         return Err(format!("{}: no entry point to compile", file.display()));
+    }
+    for w in &entries[0].warnings {
+        eprintln!("{w}");
     }
     if output.is_dir() {
         for e in &entries {

@@ -286,7 +286,13 @@ impl Builder<'_> {
             .p
             .files
             .iter()
-            .map(|f| f.text.as_ref().map(|t| t.lines().count()))
+            .map(|f| {
+                // glslang `-gV` embeds no text: the file on disk, if any.
+                f.text
+                    .clone()
+                    .or_else(|| std::fs::read_to_string(&f.path).ok())
+                    .map(|t| t.lines().count())
+            })
             .collect();
         let possible = |p: &SrcPos| {
             p.line > 0
@@ -1069,5 +1075,30 @@ mod tests {
             .find(|f| f.name.as_deref() == Some("main"))
             .unwrap();
         assert!(p.decl_location(Decl::Func(main.id)).is_none());
+    }
+
+    /// A `-gV` module whose source on disk is shorter than its positions
+    /// claim (glslang embeds no text with `-gV`): positions past the end of
+    /// the file are dropped.
+    #[test]
+    fn no_position_past_the_end_of_the_file() {
+        let src =
+            Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/live/loop_local.rgen.gV.spv");
+        let dir = std::env::temp_dir().join(format!("rtlint-past-end-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let spv = dir.join("loop_local.rgen.gV.spv");
+        std::fs::copy(&src, &spv).unwrap();
+        std::fs::write(dir.join("loop_local.rgen"), "#version 460\n\n\n\n\n").unwrap();
+        let words = super::super::words_from_bytes(&std::fs::read(&spv).unwrap(), &spv).unwrap();
+        let p = parse(&words, &spv, Language::Spirv).unwrap();
+        let full = parse(&words, &src, Language::Spirv).unwrap();
+        assert!(full.locs.iter().flatten().any(|l| l.line > 5));
+        assert!(p
+            .locs
+            .iter()
+            .flatten()
+            .chain(p.decl_pos.values())
+            .all(|l| l.line <= 5));
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 }
