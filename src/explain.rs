@@ -223,3 +223,21 @@ pub fn struct_declaration(
     s.push_str(if wgsl { "}" } else { "};" });
     s
 }
+
+/// A float constant as messages write it: `0.001`, `100`, `1e30`, `inf`.
+/// Values that a 32-bit float holds exactly are written as the shortest
+/// 32-bit decimal (`0.001`, not `0.0010000000474974513`).
+pub fn float(v: f64) -> String {
+    let narrow = v as f32;
+    if f64::from(narrow) == v {
+        if narrow.is_finite() && narrow != 0.0 && (narrow.abs() >= 1e4 || narrow.abs() < 1e-3) {
+            format!("{narrow:e}")
+        } else {
+            format!("{narrow}")
+        }
+    } else if v.is_finite() && v != 0.0 && (v.abs() >= 1e4 || v.abs() < 1e-3) {
+        format!("{v:e}")
+    } else {
+        format!("{v}")
+    }
+}

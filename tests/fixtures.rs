@@ -148,57 +148,8 @@ fn findings_match_markers_and_snapshots() {
     assert!(failures.is_empty(), "{}", failures.join("\n"));
 }
 
-/// Pipeline descriptions under fixtures/RT0xx: findings match their markers,
-/// wherever they land, and the rendered output matches its snapshot.
-#[test]
-fn pipeline_findings_match_markers_and_snapshots() {
-    let config = Config::default();
-    let mut tomls: Vec<PathBuf> = std::fs::read_dir(root().join("fixtures"))
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .filter(|d| d.file_name().unwrap().to_str().unwrap().starts_with("RT"))
-        .flat_map(|d| std::fs::read_dir(d).unwrap().map(|e| e.unwrap().path()))
-        .filter(|p| rtlint::lint::is_pipeline(p))
-        .collect();
-    tomls.sort();
-    assert!(tomls.len() >= 12, "{tomls:?}");
-    let mut failures = Vec::new();
-    for toml in tomls {
-        let checked = rtlint::lint::check_pipeline(&toml, &config);
-        let actual: BTreeSet<(PathBuf, u32, String)> = checked
-            .diagnostics
-            .iter()
-            .map(|d| {
-                assert!(d.code.is_some(), "{}: {d:?}", toml.display());
-                let p = d
-                    .primary
-                    .as_ref()
-                    .unwrap_or_else(|| panic!("{}: no position: {d:?}", toml.display()));
-                (
-                    p.location.path.clone(),
-                    p.location.line,
-                    d.code.unwrap().to_string(),
-                )
-            })
-            .collect();
-        for d in &checked.diagnostics {
-            style_problems(d, &mut failures);
-        }
-        let expected = placed_markers(&toml);
-        if actual != expected {
-            failures.push(format!(
-                "{}: expected {expected:?}, got {actual:?}",
-                toml.display()
-            ));
-        }
-        let mut buf = codespan_reporting::term::termcolor::NoColor::new(Vec::new());
-        human::render(&checked.diagnostics, &mut Sources::default(), &mut buf).unwrap();
-        let name = relative(&toml).to_string_lossy().replace(['/', '\\'], "__");
-        let text = relative_text(&String::from_utf8(buf.into_inner()).unwrap());
-        common::snapshot(&name, &text);
-    }
-    assert!(failures.is_empty(), "{}", failures.join("\n"));
-}
+// Pipeline descriptions under fixtures/RTnnn/ run with only their rule
+// selected in tests/rule_fixtures.rs.
 
 #[test]
 fn every_rule_has_bad_and_good_fixtures() {

@@ -5,6 +5,7 @@ pub mod callgraph;
 pub mod layout;
 pub mod liveness;
 pub mod payload_use;
+pub mod rays;
 pub mod recursion;
 pub mod stack;
 pub mod trace_sites;

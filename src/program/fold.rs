@@ -67,7 +67,7 @@ impl Program {
 
     /// The argument a call chain passes for function parameter `param`, with
     /// the rest of the chain (outside that call).
-    fn argument<'c>(&self, param: Id, chain: &'c [usize]) -> Option<(Id, &'c [usize])> {
+    pub(super) fn argument<'c>(&self, param: Id, chain: &'c [usize]) -> Option<(Id, &'c [usize])> {
         let f = self
             .functions
             .get(self.function_of(*self.defs.get(&param)?)?)?;

@@ -14,6 +14,7 @@ mod fold;
 pub mod scalar;
 mod textdecl;
 pub mod types;
+mod values;
 
 pub use binary::{words_from_bytes, MAGIC};
 pub use build::parse;
