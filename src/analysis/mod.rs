@@ -4,6 +4,7 @@
 pub mod callgraph;
 pub mod layout;
 pub mod liveness;
+pub mod rayquery;
 pub mod recursion;
 pub mod stack;
 
