@@ -202,10 +202,10 @@ pub enum PathFact {
 }
 
 /// The instructions among `at` (indices of uses of `q`) reached on some path
-/// of their function where `fact` does not hold. A call that is passed the
-/// query, or that may reach a query kept in a private global, counts as
-/// establishing the fact (it may initialise or advance the query), and so
-/// does entering a function that did not declare the query itself.
+/// of their function where `fact` does not hold. A call whose callee (or a
+/// function it calls) initialises or advances the query counts as doing so
+/// (naga wraps each ray-query operation in such a helper); a function that
+/// did not declare the query itself is not judged.
 pub fn reached_without(p: &Program, q: &Query, fact: PathFact, at: &[usize]) -> Vec<usize> {
     let decl = p.defs.get(&q.var).copied();
     let storage = decl.and_then(|d| match p.insts[d].operands.first() {
@@ -214,10 +214,16 @@ pub fn reached_without(p: &Program, q: &Query, fact: PathFact, at: &[usize]) -> 
     });
     let mut out = Vec::new();
     for (fi, f) in p.functions.iter().enumerate() {
-        let here: Vec<usize> = at
-            .iter()
-            .copied()
-            .filter(|&i| f.start <= i && i <= f.end)
+        // The uses in this function, and the calls that reach one.
+        let here: Vec<usize> = (f.start..=f.end)
+            .filter(|&i| {
+                at.contains(&i)
+                    || (p.insts[i].class.opcode == Op::FunctionCall
+                        && matches!(p.insts[i].operands.first(), Some(Operand::IdRef(c)) if {
+                            let funcs = p.reachable_functions(*c);
+                            at.iter().any(|a| p.function_of(*a).is_some_and(|g| funcs.contains(&p.functions[g].id)))
+                        }))
+            })
             .collect();
         if here.is_empty() || f.blocks.is_empty() {
             continue;
@@ -231,7 +237,6 @@ pub fn reached_without(p: &Program, q: &Query, fact: PathFact, at: &[usize]) -> 
         if !fresh {
             continue;
         }
-        let private = storage == Some(StorageClass::Private);
         let names_query = |id: Id| roots(p, id).contains(&q.var);
         // Transfer over instructions start..=end from state `s`; records misses.
         let step = |s: bool, from: usize, to: usize, misses: Option<&mut Vec<usize>>| -> bool {
@@ -256,11 +261,15 @@ pub fn reached_without(p: &Program, q: &Query, fact: PathFact, at: &[usize]) -> 
                         }
                     }
                     Op::FunctionCall => {
-                        let passes = inst.operands.iter().skip(1).any(
-                            |o| matches!(o, Operand::IdRef(x) if roots(p, *x).contains(&q.var)),
-                        );
-                        if passes || private {
-                            s = true;
+                        let (inits, proceeds) = match inst.operands.first() {
+                            Some(Operand::IdRef(callee)) => callee_effects(p, q, *callee),
+                            _ => (false, false),
+                        };
+                        match fact {
+                            PathFact::Initialised => s |= inits,
+                            PathFact::Proceeded if proceeds => s = true,
+                            PathFact::Proceeded if inits => s = false,
+                            PathFact::Proceeded => {}
                         }
                     }
                     _ => {}
@@ -271,8 +280,9 @@ pub fn reached_without(p: &Program, q: &Query, fact: PathFact, at: &[usize]) -> 
         let n = f.blocks.len();
         let mut preds = vec![Vec::new(); n];
         for (b, blk) in f.blocks.iter().enumerate() {
+            let skip = bound_exit(p, f, b);
             for &s in &blk.succs {
-                if s < n {
+                if s < n && Some(s) != skip {
                     preds[s].push(b);
                 }
             }
@@ -314,6 +324,61 @@ pub fn reached_without(p: &Program, q: &Query, fact: PathFact, at: &[usize]) -> 
     out
 }
 
+/// The exit edge of a loop-bounding check that cannot be taken in a loop's
+/// first iteration: naga guards every loop with a counter variable
+/// initialised to a constant, `if all(counter == C) { break; }`, and the exit
+/// is taken only after the counter has run down (never in practice). The
+/// must-facts ignore it, so a `while (Proceed)` loop of WGSL counts as
+/// proceeding.
+fn bound_exit(p: &Program, f: &crate::program::Function, b: usize) -> Option<usize> {
+    let blk = &f.blocks[b];
+    let term = &p.insts[blk.end];
+    let (Op::BranchConditional, [Operand::IdRef(cond), Operand::IdRef(yes), ..]) =
+        (term.class.opcode, term.operands.as_slice())
+    else {
+        return None;
+    };
+    let all = p.def(*cond)?;
+    let test = match (all.class.opcode, all.operands.as_slice()) {
+        (Op::All, [Operand::IdRef(x)]) => p.def(*x)?,
+        _ => return None,
+    };
+    let [Operand::IdRef(a), Operand::IdRef(c)] = test.operands.as_slice() else {
+        return None;
+    };
+    if test.class.opcode != Op::IEqual {
+        return None;
+    }
+    let (k, load) = if p.constants.contains_key(a) { (a, c) } else { (c, a) };
+    let load = p.def(*load)?;
+    let Some(Operand::IdRef(var)) = load.operands.first() else {
+        return None;
+    };
+    let var = p.def(*var)?;
+    match (load.class.opcode, var.class.opcode, var.operands.as_slice()) {
+        (Op::Load, Op::Variable, [_, Operand::IdRef(init)])
+            if p.constants.contains_key(init) && p.constants.get(init) != p.constants.get(k) =>
+        {
+            f.block_by_label(*yes)
+        }
+        _ => None,
+    }
+}
+
+/// Whether function `callee` or a function it calls initialises, and
+/// whether one advances, query `q`.
+fn callee_effects(p: &Program, q: &Query, callee: Id) -> (bool, bool) {
+    let funcs = p.reachable_functions(callee);
+    let inside = |i: &usize| {
+        p.function_of(*i)
+            .is_some_and(|f| funcs.contains(&p.functions[f].id))
+    };
+    (
+        q.inits.iter().any(inside),
+        q.proceeds.iter().any(inside),
+    )
+}
+
 fn reachable_blocks(f: &crate::program::Function) -> HashSet<usize> {
     let mut seen = HashSet::new();
     let mut work = vec![0usize];
@@ -325,9 +390,12 @@ fn reachable_blocks(f: &crate::program::Function) -> HashSet<usize> {
     seen
 }
 
-/// Whether instruction `i` sits in a loop: a natural loop of its function,
-/// or a function called (transitively) from inside one.
-pub fn in_loop(p: &Program, i: usize) -> bool {
+/// Whether instruction `i` repeats without passing any of `resets`: it sits
+/// in a natural loop of its function that holds none of them, or in a
+/// function called (transitively) from inside such a loop. With the query's
+/// initialisations as `resets`, a `Proceed` in a loop that also initialises
+/// the query each iteration is a single `Proceed`.
+pub fn in_loop(p: &Program, i: usize, resets: &[usize]) -> bool {
     let mut seen = HashSet::new();
     let mut work = vec![i];
     while let Some(i) = work.pop() {
@@ -338,10 +406,21 @@ pub fn in_loop(p: &Program, i: usize) -> bool {
             continue;
         };
         let Some(b) = f.block_of(i) else { continue };
-        if cfg::natural_loops(f).iter().any(|(_, body)| body.contains(&b)) {
+        let reset_blocks: Vec<usize> = resets
+            .iter()
+            .filter(|&&r| f.start <= r && r <= f.end)
+            .filter_map(|&r| f.block_of(r))
+            .collect();
+        if cfg::natural_loops(f)
+            .iter()
+            .any(|(_, body)| body.contains(&b) && !reset_blocks.iter().any(|r| body.contains(r)))
+        {
             return true;
         }
-        work.extend(p.callers(f.id));
+        // Each call of a function that initialises the query starts afresh.
+        if reset_blocks.is_empty() {
+            work.extend(p.callers(f.id));
+        }
     }
     false
 }

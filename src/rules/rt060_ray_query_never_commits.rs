@@ -80,7 +80,7 @@ fn check(ctx: &Context) -> Vec<Diagnostic> {
         else {
             continue;
         };
-        let Some(&proceed) = q.proceeds.iter().find(|&&i| rayquery::in_loop(p, i)) else {
+        let Some(&proceed) = q.proceeds.iter().find(|&&i| rayquery::in_loop(p, i, &q.inits)) else {
             continue;
         };
         let flags = q

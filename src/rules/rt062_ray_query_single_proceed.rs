@@ -6,7 +6,8 @@ use crate::explain;
 super::declare_rule! {
     /// ## What it does
     ///
-    /// Finds a ray query advanced by a single `Proceed` outside any loop, when its
+    /// Finds a ray query advanced by a single `Proceed` per initialisation (not
+    /// in a loop, or in a loop that initialises the query again), when its
     /// constant ray flags let non-opaque triangles through (none of
     /// `gl_RayFlagsOpaqueEXT` / `RAY_FLAG_FORCE_OPAQUE`, `CullNoOpaque`,
     /// `SkipTriangles`). Queries whose flags are not known at compile time are not
@@ -52,7 +53,7 @@ super::declare_rule! {
     /// - `GL_EXT_ray_query`: `rayQueryProceedEXT`.
     "RT062" "ray-query-single-proceed" {
         group: Suspicious,
-        summary: "single Proceed outside a loop on a query that can meet non-opaque triangles",
+        summary: "single Proceed per initialisation on a query that can meet non-opaque triangles",
         kind: super::Kind::Module(check),
     }
 }
@@ -70,13 +71,13 @@ fn check(ctx: &Context) -> Vec<Diagnostic> {
         };
         let flags = q.known_flags().find(|f| f & opaque == 0).unwrap_or(0);
         let name = p.display_name(q.var);
-        for &proceed in q.proceeds.iter().filter(|&&i| !rayquery::in_loop(p, i)) {
+        for &proceed in q.proceeds.iter().filter(|&&i| !rayquery::in_loop(p, i, &q.inits)) {
             out.push(
                 ctx.diagnostic(
                     &RULE,
-                    format!("ray query `{name}` proceeds once outside a loop, but its flags let non-opaque triangles stop traversal"),
+                    format!("ray query `{name}` proceeds only once, but its flags let a non-opaque triangle stop traversal early"),
                 )
-                .with_primary(p.site_location(proceed), "single `Proceed`")
+                .with_primary(p.site_location(proceed), "single `Proceed` per initialisation")
                 .with_secondary(p.site_location(init), "initialised without an opaque flag")
                 .with_subject(format!("ray query `{name}`"))
                 .with_note(format!("ray flags: {}", explain::ray_flags(flags, p.language)))
