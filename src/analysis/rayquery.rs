@@ -220,8 +220,15 @@ pub fn reached_without(p: &Program, q: &Query, fact: PathFact, at: &[usize]) -> 
                 at.contains(&i)
                     || (p.insts[i].class.opcode == Op::FunctionCall
                         && matches!(p.insts[i].operands.first(), Some(Operand::IdRef(c)) if {
+                            // A callee that establishes the fact itself is trusted to
+                            // do so before its own uses.
                             let funcs = p.reachable_functions(*c);
-                            at.iter().any(|a| p.function_of(*a).is_some_and(|g| funcs.contains(&p.functions[g].id)))
+                            let (inits, proceeds) = callee_effects(p, q, *c);
+                            let own = match fact {
+                                PathFact::Initialised => inits,
+                                PathFact::Proceeded => proceeds,
+                            };
+                            !own && at.iter().any(|a| p.function_of(*a).is_some_and(|g| funcs.contains(&p.functions[g].id)))
                         }))
             })
             .collect();
