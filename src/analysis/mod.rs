@@ -7,6 +7,7 @@ pub mod liveness;
 pub mod rayquery;
 pub mod recursion;
 pub mod stack;
+pub mod uniformity;
 
 pub use liveness::{live_report, LiveReport};
 pub use recursion::{recursion_report, RecursionReport};
