@@ -85,6 +85,17 @@ fn check(ctx: &Context) -> Vec<Diagnostic> {
     let non_uniform = |id: u32| p.decoration(id, Decoration::NonUniform).is_some();
     let mut out = Vec::new();
     let mut seen = std::collections::HashSet::new();
+    let mut users: std::collections::HashMap<u32, Vec<usize>> = std::collections::HashMap::new();
+    for (i, inst) in p.insts.iter().enumerate() {
+        if p.is_debug_inst(inst) || inst.class.opcode == Op::Name {
+            continue;
+        }
+        for o in &inst.operands {
+            if let Operand::IdRef(x) = o {
+                users.entry(*x).or_default().push(i);
+            }
+        }
+    }
     for (i, inst) in p.insts.iter().enumerate() {
         if !matches!(inst.class.opcode, Op::AccessChain | Op::InBoundsAccessChain) {
             continue;
@@ -102,14 +113,35 @@ fn check(ctx: &Context) -> Vec<Diagnostic> {
             continue;
         }
         let result = inst.result_id.unwrap_or(0);
-        let decorated = non_uniform(*index)
-            || non_uniform(result)
-            || p.insts.iter().any(|u| {
-                u.operands
-                    .iter()
-                    .any(|o| matches!(o, Operand::IdRef(x) if *x == result))
-                    && u.result_id.is_some_and(non_uniform)
-            });
+        // The decoration may sit on the index, the pointer, or what the
+        // access reads through it (Slang decorates the sampled image).
+        let mut decorated = non_uniform(*index);
+        let mut work = vec![result];
+        let mut visited = 0;
+        while let Some(id) = work.pop() {
+            visited += 1;
+            if non_uniform(id) {
+                decorated = true;
+                break;
+            }
+            if visited > 16 {
+                break;
+            }
+            for &u in users.get(&id).map(Vec::as_slice).unwrap_or(&[]) {
+                let ui = &p.insts[u];
+                if matches!(
+                    ui.class.opcode,
+                    Op::Load
+                        | Op::SampledImage
+                        | Op::Image
+                        | Op::CopyObject
+                        | Op::AccessChain
+                        | Op::InBoundsAccessChain
+                ) {
+                    work.extend(ui.result_id);
+                }
+            }
+        }
         if decorated {
             continue;
         }
