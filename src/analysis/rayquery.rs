@@ -257,7 +257,8 @@ pub fn reached_without(p: &Program, q: &Query, fact: PathFact, at: &[usize]) -> 
                         m.push(i);
                     }
                 }
-                let on_q = || matches!(inst.operands.first(), Some(Operand::IdRef(x)) if names_query(*x));
+                let on_q =
+                    || matches!(inst.operands.first(), Some(Operand::IdRef(x)) if names_query(*x));
                 match op {
                     Op::RayQueryInitializeKHR if on_q() => {
                         s = fact == PathFact::Initialised;
@@ -356,7 +357,11 @@ fn bound_exit(p: &Program, f: &crate::program::Function, b: usize) -> Option<usi
     if test.class.opcode != Op::IEqual {
         return None;
     }
-    let (k, load) = if p.constants.contains_key(a) { (a, c) } else { (c, a) };
+    let (k, load) = if p.constants.contains_key(a) {
+        (a, c)
+    } else {
+        (c, a)
+    };
     let load = p.def(*load)?;
     let Some(Operand::IdRef(var)) = load.operands.first() else {
         return None;
@@ -380,10 +385,7 @@ fn callee_effects(p: &Program, q: &Query, callee: Id) -> (bool, bool) {
         p.function_of(*i)
             .is_some_and(|f| funcs.contains(&p.functions[f].id))
     };
-    (
-        q.inits.iter().any(inside),
-        q.proceeds.iter().any(inside),
-    )
+    (q.inits.iter().any(inside), q.proceeds.iter().any(inside))
 }
 
 fn reachable_blocks(f: &crate::program::Function) -> HashSet<usize> {

@@ -227,7 +227,8 @@ pub fn varying(p: &Program) -> Varying {
                 }
                 _ if subgroup_uniform(p, inst) => {}
                 Op::Load => {
-                    let (Some(r), Some(Operand::IdRef(ptr))) = (inst.result_id, inst.operands.first())
+                    let (Some(r), Some(Operand::IdRef(ptr))) =
+                        (inst.result_id, inst.operands.first())
                     else {
                         continue;
                     };

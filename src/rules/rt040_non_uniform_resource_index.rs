@@ -160,7 +160,7 @@ fn check(ctx: &Context) -> Vec<Diagnostic> {
                 format!("descriptor array `{name}` is indexed by a value that varies between invocations, without `NonUniform`"),
             )
             .with_primary(loc, "indexed here")
-            .with_secondary(p.var_location(g.id), "descriptor array declared here")
+            .with_secondary(ctx.resource_location(g.id), "descriptor array declared here")
             .with_subject(format!("descriptor array `{name}`"))
             .with_note("the index derives from a per-invocation value (builtin, payload, attributes, ray query or a buffer read at such an index)")
             .with_help(format!("wrap the index in {marker}")),

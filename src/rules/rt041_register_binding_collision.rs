@@ -146,48 +146,6 @@ fn kind(p: &Program, g: &Global) -> Option<Kind> {
     }
 }
 
-/// Where a resource is declared: its debug-info position, else (glslang
-/// `-g` has none for variables) the one line of the embedded source that
-/// gives a binding and names it, else its first use.
-fn declared(p: &Program, var: u32) -> Option<crate::diag::Location> {
-    if let Some(l) = p.decl_location(crate::program::Decl::Var(var)) {
-        return Some(l);
-    }
-    let name = p.name(var).filter(|n| !n.is_empty());
-    if let Some(name) = name {
-        let word = |line: &str| {
-            line.match_indices(name).any(|(i, _)| {
-                let before = line[..i].chars().next_back();
-                let after = line[i + name.len()..].chars().next();
-                let ident = |c: Option<char>| c.is_some_and(|c| c.is_alphanumeric() || c == '_');
-                !ident(before) && !ident(after)
-            })
-        };
-        let mut found = None;
-        for (fi, f) in p.files.iter().enumerate() {
-            let Some(text) = &f.text else { continue };
-            for (li, line) in text.lines().enumerate() {
-                if line.contains("binding") && word(line) {
-                    if found.is_some() {
-                        return p.var_location(var);
-                    }
-                    found = Some((fi, li));
-                }
-            }
-        }
-        if let Some((fi, li)) = found {
-            return Some(crate::diag::Location {
-                path: p.files[fi].path.clone(),
-                line: li as u32 + 1,
-                column: 0,
-                end_line: li as u32 + 1,
-                end_column: 0,
-            });
-        }
-    }
-    p.var_location(var)
-}
-
 fn check(ctx: &Context) -> Vec<Diagnostic> {
     let p = ctx.program;
     let mut by_slot: BTreeMap<(u32, u32), Vec<(&Global, Kind)>> = BTreeMap::new();
@@ -217,8 +175,8 @@ fn check(ctx: &Context) -> Vec<Diagnostic> {
                     k0.as_str()
                 ),
             )
-            .with_primary(declared(p, other.id), "bound here")
-            .with_secondary(declared(p, first.id), "same set and binding as this")
+            .with_primary(ctx.resource_location(other.id), "bound here")
+            .with_secondary(ctx.resource_location(first.id), "same set and binding as this")
             .with_subject(format!("`{a}` and `{b}`"));
         if p.language == Language::Hlsl {
             d = d.with_note("HLSL register classes (`t`, `u`, `b`, `s`) map to the same Vulkan binding number without `[[vk::binding]]` or a shift option");
