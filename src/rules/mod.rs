@@ -472,6 +472,7 @@ mod tests {
                 "RT025 default-stack-unsafe",
                 "RT040 non-uniform-resource-index",
                 "RT041 register-binding-collision",
+                "RT050 normalize-of-zero",
                 "RT060 ray-query-never-commits",
                 "RT061 ray-query-ignores-procedural",
                 "RT062 ray-query-single-proceed",
