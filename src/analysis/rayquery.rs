@@ -263,10 +263,8 @@ pub fn reached_without(p: &Program, q: &Query, fact: PathFact, at: &[usize]) -> 
                     Op::RayQueryInitializeKHR if on_q() => {
                         s = fact == PathFact::Initialised;
                     }
-                    Op::RayQueryProceedKHR if on_q() => {
-                        if fact == PathFact::Proceeded {
-                            s = true;
-                        }
+                    Op::RayQueryProceedKHR if fact == PathFact::Proceeded && on_q() => {
+                        s = true;
                     }
                     Op::FunctionCall => {
                         let (inits, proceeds) = match inst.operands.first() {
