@@ -195,6 +195,9 @@ pub enum InputErrorKind {
     HlslUnsupported,
     /// glslang rejects the GLSL.
     GlslError,
+    /// `stack --driver`: the device could not create the pipeline (the
+    /// driver failed or crashed, or the validation layer objected).
+    DriverFailed,
 }
 
 impl InputErrorKind {
@@ -213,6 +216,7 @@ impl InputErrorKind {
         InputErrorKind::HlslError,
         InputErrorKind::HlslUnsupported,
         InputErrorKind::GlslError,
+        InputErrorKind::DriverFailed,
     ];
 
     pub fn as_str(self) -> &'static str {
@@ -231,6 +235,7 @@ impl InputErrorKind {
             InputErrorKind::HlslError => "hlsl-error",
             InputErrorKind::HlslUnsupported => "hlsl-unsupported",
             InputErrorKind::GlslError => "glsl-error",
+            InputErrorKind::DriverFailed => "driver-failed",
         }
     }
 }
@@ -329,6 +334,7 @@ mod tests {
                 "hlsl-error",
                 "hlsl-unsupported",
                 "glsl-error",
+                "driver-failed",
             ]
         );
         for (i, a) in names.iter().enumerate() {

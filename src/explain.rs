@@ -177,6 +177,10 @@ impl fmt::Display for Assumption {
                 "no constant initial value of `{counter}` found: 0 assumed"
             ),
             Assumption::Driver { device, driver } => write!(f, "driver: {device} ({driver})"),
+            Assumption::RecommendationRaised { from, to } => write!(
+                f,
+                "recommendation raised from {from} B to {to} B, what the driver's own numbers need"
+            ),
         }
     }
 }

@@ -834,7 +834,7 @@ mod tests {
         let d = check_loose(vec![p], &[], &Config::default());
         let rt020: Vec<_> = d.iter().filter(|d| d.code == Some("RT020")).collect();
         assert_eq!(rt020.len(), 1, "{d:?}");
-        assert_eq!(rt020[0].primary.as_ref().unwrap().location.line, 38);
+        assert_eq!(rt020[0].primary.as_ref().unwrap().location.line, 42);
         assert!(rt020[0]
             .notes
             .iter()

@@ -164,6 +164,12 @@ enum Command {
         /// reports (`vkGetRayTracingShaderGroupStackSizeKHR`) beside the model.
         #[arg(long)]
         driver: bool,
+        /// Take the driver's numbers from this CSV (as
+        /// calibration/random/to_csv.py writes it: pipeline, group, stage,
+        /// entry, driver_bytes, …) instead of a device; a row applies to a
+        /// pipeline whose description path ends with its `pipeline`.
+        #[arg(long, value_name = "CSV", conflicts_with = "driver")]
+        driver_numbers: Option<PathBuf>,
         #[arg(long, value_enum, default_value = "human")]
         format: ReportFormat,
     },
@@ -197,6 +203,18 @@ enum Command {
     },
     /// List every rule.
     Rules,
+    /// (Internal) `stack --driver` runs this in a child process per
+    /// pipeline, so that a driver crash cannot take rtlint down: creates the
+    /// pipeline and prints the driver's stack sizes as JSON.
+    #[command(hide = true, name = "driver-stack-sizes")]
+    DriverStackSizes {
+        /// A pipeline description.
+        #[arg(long)]
+        pipeline: Option<PathBuf>,
+        /// Loose shaders, as `LANG:PATH`.
+        #[arg(long)]
+        shader: Vec<String>,
+    },
     /// Print a rule's documentation.
     Rule {
         /// Code (RT001) or name (payload-over-budget).
@@ -232,8 +250,9 @@ fn run(cli: Cli) -> Result<u8, String> {
         Command::Stack {
             common,
             driver,
+            driver_numbers,
             format,
-        } => stack(common, driver, format),
+        } => stack(common, driver, driver_numbers, format),
         Command::Layout { common, format } => layout(common, format),
         Command::Compile {
             file,
@@ -243,6 +262,7 @@ fn run(cli: Cli) -> Result<u8, String> {
             output,
             whole,
         } => compile(file, entry, include, define, output, whole),
+        Command::DriverStackSizes { pipeline, shader } => driver_stack_sizes(pipeline, shader),
         Command::Rules => {
             let mut out = std::io::stdout().lock();
             for r in rtlint::rules::RULES {
@@ -265,7 +285,7 @@ fn run(cli: Cli) -> Result<u8, String> {
         }
         Command::Rule { code } => match rtlint::rules::find(&code) {
             Some(r) => {
-                print!("{}", r.page());
+                let _ = write!(std::io::stdout().lock(), "{}", r.page());
                 Ok(0)
             }
             None => Err(format!("unknown rule `{code}` (`rtlint rules` lists them)")),
@@ -494,7 +514,16 @@ fn live(common: Common, format: ReportFormat) -> Result<u8, String> {
     print_report(format, json, || report::live::human(&report), &problems)
 }
 
-fn stack(common: Common, driver: bool, format: ReportFormat) -> Result<u8, String> {
+fn stack(
+    common: Common,
+    driver: bool,
+    driver_numbers: Option<PathBuf>,
+    format: ReportFormat,
+) -> Result<u8, String> {
+    let measured = match &driver_numbers {
+        Some(path) => read_driver_numbers(path)?,
+        None => Vec::new(),
+    };
     let Loaded {
         programs,
         pipelines: descriptions,
@@ -511,35 +540,72 @@ fn stack(common: Common, driver: bool, format: ReportFormat) -> Result<u8, Strin
     if !programs.is_empty() {
         pipelines.push(rtlint::pipeline::Pipeline::from_programs(programs));
     }
-    #[cfg(feature = "vulkan")]
-    let device = if driver {
-        Some(rtlint::vk::Context::new().map_err(|e| format!("--driver: {e}"))?)
-    } else {
-        None
-    };
     #[cfg(not(feature = "vulkan"))]
     if driver {
         return Err("--driver needs rtlint built with the `vulkan` feature".into());
     }
+    // The loose shaders, as the child process of `--driver` reloads them.
+    #[cfg_attr(not(feature = "vulkan"), allow(unused_variables))]
+    let loose: Vec<String> = pipelines
+        .last()
+        .filter(|p| p.path.is_none())
+        .map(|p| {
+            p.programs
+                .iter()
+                .map(|q| {
+                    let lang = Language::from_path(&q.path).unwrap_or(Language::Spirv);
+                    format!("{}:{}", lang.as_str(), q.path.display())
+                })
+                .collect()
+        })
+        .unwrap_or_default();
     let mut reports = Vec::new();
     for p in &pipelines {
         #[allow(unused_mut)]
         let mut r = rtlint::analysis::stack_report(p);
         #[cfg(feature = "vulkan")]
-        if let Some(ctx) = &device {
-            let depth = rtlint::analysis::recursion_report(p).required_depth;
-            let sizes = rtlint::vk::driver_stack_sizes(ctx, p, depth).map_err(|e| {
-                format!(
-                    "--driver: creating the pipeline on {} failed: {e}",
-                    ctx.info().name
-                )
-            })?;
-            rtlint::analysis::stack::attach_driver(&mut r, p, &sizes);
-            r.assumptions
-                .push(rtlint::analysis::callgraph::Assumption::Driver {
-                    device: ctx.info().name.clone(),
-                    driver: ctx.info().driver.clone(),
-                });
+        if driver {
+            match driver_in_child(p, &loose) {
+                Ok(d) => {
+                    let sizes = d
+                        .sizes
+                        .iter()
+                        .map(|&(slot, stage, b)| ((slot, stage), b))
+                        .collect();
+                    rtlint::analysis::stack::attach_driver(&mut r, p, &sizes);
+                    r.assumptions
+                        .push(rtlint::analysis::callgraph::Assumption::Driver {
+                            device: d.device,
+                            driver: d.driver,
+                        });
+                }
+                Err(message) => problems.push(
+                    *rtlint::diag::InputError::new(
+                        rtlint::diag::InputErrorKind::DriverFailed,
+                        &p.path
+                            .clone()
+                            .or_else(|| p.programs.first().map(|q| q.path.clone()))
+                            .unwrap_or_default(),
+                        format!("--driver: {message}"),
+                    )
+                    .0,
+                ),
+            }
+        }
+        if driver_numbers.is_some() {
+            let sizes = measured_for(&measured, p);
+            if sizes.is_empty() {
+                problems.push(
+                    *InputError::new(
+                        rtlint::diag::InputErrorKind::DriverFailed,
+                        &p.file(),
+                        "--driver-numbers: no row of the CSV names this pipeline",
+                    )
+                    .0,
+                );
+            } else {
+                rtlint::analysis::stack::attach_driver(&mut r, p, &sizes);
+            }
         }
         reports.push(r);
     }
@@ -660,4 +726,192 @@ fn compile(
         ));
     }
     Ok(0)
+}
+
+/// What the child process of `stack --driver` reports for one pipeline.
+#[derive(serde::Serialize, serde::Deserialize)]
+struct DriverSizes {
+    device: String,
+    driver: String,
+    sizes: Vec<(rtlint::pipeline::Slot, rtlint::shader::Stage, u64)>,
+    validation_errors: Vec<String>,
+}
+
+/// How long one pipeline's creation may take in the child.
+const DRIVER_CHILD_TIMEOUT: std::time::Duration = std::time::Duration::from_secs(120);
+
+#[cfg(feature = "vulkan")]
+/// Runs `driver-stack-sizes` for one pipeline in a child process: a driver
+/// that crashes or hangs costs that pipeline its driver figures, with a
+/// message, and nothing else. Validation errors (`RTLINT_VK_VALIDATION=1`)
+/// are errors too: the layout rtlint built does not match the shaders.
+fn driver_in_child(
+    p: &rtlint::pipeline::Pipeline,
+    loose: &[String],
+) -> Result<DriverSizes, String> {
+    // RTLINT_DRIVER_CHILD names another program to run as the child (the
+    // tests use it to stand in for a driver that crashes).
+    let exe = match std::env::var_os("RTLINT_DRIVER_CHILD") {
+        Some(p) => PathBuf::from(p),
+        None => std::env::current_exe().map_err(|e| format!("cannot find rtlint itself: {e}"))?,
+    };
+    let mut command = std::process::Command::new(exe);
+    command.arg("driver-stack-sizes");
+    match &p.path {
+        Some(path) => {
+            command.arg("--pipeline").arg(path);
+        }
+        None => {
+            for s in loose {
+                command.arg("--shader").arg(s);
+            }
+        }
+    }
+    let o = rtlint::vk::run_command(command, DRIVER_CHILD_TIMEOUT)
+        .map_err(|e| format!("cannot start a child process: {e}"))?;
+    let last_line = |t: &str| {
+        t.lines()
+            .rev()
+            .find(|l| l.starts_with("error: "))
+            .map(|l| l.trim_start_matches("error: ").to_string())
+            .unwrap_or_else(|| t.lines().last().unwrap_or("").to_string())
+    };
+    if o.timed_out {
+        return Err(format!(
+            "creating the pipeline on the device took over {} s; the child was killed",
+            DRIVER_CHILD_TIMEOUT.as_secs()
+        ));
+    }
+    if let Some(sig) = o.signal {
+        return Err(format!(
+            "the driver crashed while creating the pipeline (signal {sig}{})",
+            match sig {
+                11 => ", SIGSEGV",
+                7 => ", SIGBUS",
+                6 => ", SIGABRT",
+                _ => "",
+            }
+        ));
+    }
+    if !o.success() {
+        return Err(last_line(&o.stderr));
+    }
+    let d: DriverSizes = serde_json::from_str(&o.stdout)
+        .map_err(|e| format!("unreadable answer from the child process: {e}"))?;
+    if let Some(first) = d.validation_errors.first() {
+        return Err(format!(
+            "the validation layer reported {} error(s) on this pipeline; the first: {first}",
+            d.validation_errors.len()
+        ));
+    }
+    Ok(d)
+}
+
+/// The child's side of [`driver_in_child`].
+fn driver_stack_sizes(pipeline: Option<PathBuf>, shaders: Vec<String>) -> Result<u8, String> {
+    let p = match pipeline {
+        Some(path) => rtlint::pipeline::load(&path).map_err(|e| e.0.message.clone())?,
+        None => {
+            let mut programs = Vec::new();
+            for s in &shaders {
+                let (lang, path) = s
+                    .split_once(':')
+                    .ok_or_else(|| format!("`{s}` is not LANG:PATH"))?;
+                let lang =
+                    Language::parse(lang).ok_or_else(|| format!("unknown language `{lang}`"))?;
+                programs.push(
+                    rtlint::front::load(std::path::Path::new(path), lang)
+                        .map_err(|e| e.0.message.clone())?,
+                );
+            }
+            rtlint::pipeline::Pipeline::from_programs(programs)
+        }
+    };
+    driver_stack_sizes_of(&p)
+}
+
+#[cfg(feature = "vulkan")]
+fn driver_stack_sizes_of(p: &rtlint::pipeline::Pipeline) -> Result<u8, String> {
+    let ctx = rtlint::vk::Context::new().map_err(|e| e.to_string())?;
+    let depth = rtlint::analysis::recursion_report(p).required_depth;
+    let sizes = rtlint::vk::driver_stack_sizes(&ctx, p, depth)
+        .map_err(|e| format!("creating the pipeline on {} failed: {e}", ctx.info().name))?;
+    let d = DriverSizes {
+        device: ctx.info().name.clone(),
+        driver: ctx.info().driver.clone(),
+        sizes: sizes
+            .into_iter()
+            .map(|((slot, stage), b)| (slot, stage, b))
+            .collect(),
+        validation_errors: ctx.validation_errors(),
+    };
+    drop(ctx);
+    println!("{}", serde_json::to_string(&d).map_err(|e| e.to_string())?);
+    Ok(0)
+}
+
+#[cfg(not(feature = "vulkan"))]
+fn driver_stack_sizes_of(_: &rtlint::pipeline::Pipeline) -> Result<u8, String> {
+    Err("--driver needs rtlint built with the `vulkan` feature".into())
+}
+
+/// One row of a driver-numbers CSV: pipeline key, slot, stage, bytes.
+type MeasuredRow = (String, rtlint::pipeline::Slot, rtlint::shader::Stage, u64);
+
+/// Reads the CSV `--driver-numbers` names (header first; columns pipeline,
+/// group, stage, entry, driver_bytes, …). A malformed row is an error.
+fn read_driver_numbers(path: &std::path::Path) -> Result<Vec<MeasuredRow>, String> {
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| format!("cannot read {}: {e}", path.display()))?;
+    let mut rows = Vec::new();
+    for (n, line) in text.lines().enumerate().skip(1) {
+        if line.trim().is_empty() {
+            continue;
+        }
+        let bad = |what: &str| format!("{}:{}: {what}", path.display(), n + 1);
+        let cols: Vec<&str> = line.split(',').collect();
+        let [pipeline, group, stage, _entry, bytes, ..] = cols[..] else {
+            return Err(bad("expected pipeline,group,stage,entry,driver_bytes"));
+        };
+        let slot = parse_slot(group).ok_or_else(|| bad(&format!("unknown group `{group}`")))?;
+        let stage: rtlint::shader::Stage =
+            serde_json::from_value(serde_json::Value::String(stage.to_string()))
+                .map_err(|_| bad(&format!("unknown stage `{stage}`")))?;
+        let bytes: u64 = bytes
+            .parse()
+            .map_err(|_| bad(&format!("`{bytes}` is not a byte count")))?;
+        rows.push((pipeline.to_string(), slot, stage, bytes));
+    }
+    Ok(rows)
+}
+
+/// `raygen 0`, `miss 1`, `hit group 2`, `callable 0` (as reports print slots).
+fn parse_slot(text: &str) -> Option<rtlint::pipeline::Slot> {
+    use rtlint::pipeline::Slot;
+    let (kind, index) = text.rsplit_once(' ')?;
+    let i: usize = index.parse().ok()?;
+    Some(match kind {
+        "raygen" => Slot::Raygen(i),
+        "miss" => Slot::Miss(i),
+        "hit group" => Slot::HitGroup(i),
+        "callable" => Slot::Callable(i),
+        _ => return None,
+    })
+}
+
+/// The rows of `measured` for pipeline `p`: those whose key its
+/// description's path ends with.
+fn measured_for(
+    measured: &[MeasuredRow],
+    p: &rtlint::pipeline::Pipeline,
+) -> std::collections::BTreeMap<(rtlint::pipeline::Slot, rtlint::shader::Stage), u64> {
+    let Some(path) = &p.path else {
+        return Default::default();
+    };
+    let path = path.to_string_lossy().replace('\\', "/");
+    measured
+        .iter()
+        .filter(|(key, ..)| path == *key || path.ends_with(&format!("/{key}")))
+        .map(|(_, slot, stage, b)| ((*slot, *stage), *b))
+        .collect()
 }

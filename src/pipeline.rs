@@ -18,7 +18,9 @@ use toml::Spanned;
 pub const DEFAULT_DEVICE_MAX_RECURSION_DEPTH: u32 = 31;
 
 /// Where a shader sits in the pipeline.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, serde::Serialize)]
+#[derive(
+    Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, serde::Serialize, serde::Deserialize,
+)]
 #[serde(rename_all = "snake_case", tag = "slot", content = "index")]
 pub enum Slot {
     Raygen(usize),

@@ -49,7 +49,9 @@ impl Language {
 
 /// A shader stage. One enum for every layer: the HLSL compiler, the Program,
 /// pipeline descriptions and the Vulkan harness.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, serde::Serialize)]
+#[derive(
+    Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, serde::Serialize, serde::Deserialize,
+)]
 #[serde(rename_all = "snake_case")]
 pub enum Stage {
     RayGeneration,

@@ -92,7 +92,7 @@ fn compute_semantics_on_the_driver() {
     let expected = [
         I(3),
         I(-3),
-        I(-1),
+        I(1),
         U(1),
         F(3.0),
         F(-1.5),

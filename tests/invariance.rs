@@ -317,6 +317,9 @@ fn compare(what: &str, facts: &BTreeMap<Mode, Value>, differences: &mut Vec<(Str
 
 #[test]
 fn analyses_do_not_depend_on_debug_info() {
+    if !rtlint_testkit::tool("glslangValidator") || !rtlint_testkit::tool("spirv-val") {
+        return;
+    }
     let out = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("invariance");
     let _ = std::fs::remove_dir_all(&out);
     let glsl = compile_glsl_tree(&out);
@@ -490,6 +493,20 @@ const KNOWN_ACROSS_COMPILERS: &[(&str, &str, &str, &str)] = &[
          only its origin (12 B); all recomputable, so the bytes that count agree",
     ),
     (
+        "fixtures/live/param_state.hlsl",
+        "RayGen",
+        "kept bytes",
+        "rtlint passes `r` to `Trace` through a pointer and the analysis does not follow which \
+         parts a callee writes through it, so `r.direction` (never written, recomputable) is \
+         kept; Slang inlines `Trace` and sees it",
+    ),
+    (
+        "fixtures/live/param_state.hlsl",
+        "RayGen",
+        "live bytes",
+        "rtlint keeps `desc` (a `RayDesc`) and `r` in locals, Slang SSA values",
+    ),
+    (
         "fixtures/hlsl/payloads.hlsl",
         "RayGen",
         "live bytes",
@@ -551,8 +568,8 @@ fn coded_lines(d: &[Diagnostic]) -> Vec<String> {
 /// The same HLSL through rtlint's compiler and through Slang (`-g`), every
 /// ray-tracing entry point of the HLSL fixtures and of `tests/hlsl`:
 /// recursion depth, findings and the live bytes that cannot be recomputed
-/// agree; for the fixtures layouts and all live bytes too, except where
-/// [`KNOWN_ACROSS_COMPILERS`] says.
+/// agree, and for the fixtures layouts and all live bytes too, except where
+/// [`KNOWN_ACROSS_COMPILERS`] names the difference.
 #[test]
 fn hlsl_compilers_agree() {
     let Some(slang) = rtlint_testkit::slang() else {
@@ -615,16 +632,23 @@ fn hlsl_compilers_agree() {
                 format!("{v:?}")
             };
             note("live bytes (all, kept)", bytes(&a), bytes(&b));
-            // What RT010 counts never differs.
+            // What RT010 counts, compared for every entry point.
             let kept = |p: &Program| {
                 let mut v: Vec<u64> = live_sites(p)
                     .iter()
                     .map(|s| s.live_bytes - s.rematerializable_bytes)
                     .collect();
                 v.sort();
-                v
+                format!("{v:?}")
             };
-            assert_eq!(kept(&a), kept(&b), "{rel} `{}`: kept bytes", e.name);
+            let (ka, kb) = (kept(&a), kept(&b));
+            if ka != kb {
+                differences.push((
+                    rel.clone(),
+                    e.name.clone(),
+                    format!("kept bytes: rtlint {ka}, Slang {kb}"),
+                ));
+            }
             ours.push(a);
             theirs.push(b);
             entries_compared += 1;

@@ -623,3 +623,11 @@ fn a_struct_in_a_shared_header_is_reported_once() {
     assert_eq!(findings(&o).len(), 1, "{}", text(&o));
     assert!(text(&o).contains("in 2 files"), "{}", text(&o));
 }
+
+/// glslang accepts a Latin-1 comment; so does rtlint, for GLSL sources as for
+/// the modules glslang makes of them.
+#[test]
+fn glsl_sources_need_not_be_utf8() {
+    let o = check_in(&root(), &["fixtures/live/latin1.rgen"]);
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o));
+}

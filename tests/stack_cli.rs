@@ -214,3 +214,183 @@ fn bad_descriptions_point_into_the_toml() {
         }
     }
 }
+
+/// Every pipeline description in the repository, in every folder.
+fn all_descriptions() -> Vec<PathBuf> {
+    let mut out = Vec::new();
+    let mut dirs = vec![
+        common::root().join("shaders"),
+        common::root().join("fixtures"),
+        common::root().join("calibration"),
+    ];
+    while let Some(d) = dirs.pop() {
+        for e in std::fs::read_dir(&d).unwrap().flatten() {
+            let p = e.path();
+            // The generated random pipelines are not in the repository.
+            if p.is_dir() && !p.ends_with("calibration/random") {
+                dirs.push(p);
+            } else if rtlint::lint::is_pipeline(&p) {
+                out.push(p);
+            }
+        }
+    }
+    out.sort();
+    out
+}
+
+#[test]
+fn driver_creates_every_pipeline_without_a_validation_error() {
+    // The Khronos validation layer must be there, or nothing is checked.
+    let layer = std::fs::read_dir("/usr/share/vulkan/explicit_layer.d")
+        .map(|d| {
+            d.flatten()
+                .any(|e| e.file_name().to_string_lossy().contains("validation"))
+        })
+        .unwrap_or(false);
+    assert!(
+        layer,
+        "the Khronos validation layer is not installed (scripts/setup)"
+    );
+    let pipelines = all_descriptions();
+    // Textures, samplers and bindless arrays in several sets, in HLSL and GLSL.
+    for name in ["textured_hlsl.pipeline.toml", "bindless.pipeline.toml"] {
+        assert!(
+            pipelines.iter().any(|p| p.ends_with(name)),
+            "{name} is missing"
+        );
+    }
+    assert!(pipelines.len() >= 70, "{}", pipelines.len());
+    let o = rtlint()
+        .args(["stack", "--driver", "--format", "json"])
+        .args(&pipelines)
+        .env("RTLINT_VK_VALIDATION", "1")
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(0), "{stderr}");
+    assert!(!stderr.contains("validation"), "{stderr}");
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let reports = v["pipelines"].as_array().unwrap();
+    assert_eq!(reports.len(), pipelines.len());
+    assert_eq!(v["errors"].as_array().map(Vec::len), Some(0));
+    for r in reports {
+        assert!(
+            r["driver"].is_object(),
+            "no driver figures: {}",
+            r["pipeline"]
+        );
+    }
+}
+
+#[test]
+fn a_driver_crash_is_an_error_for_that_pipeline_only() {
+    // A child that dies of SIGSEGV, as lavapipe did on a mismatched layout.
+    let dir = std::env::temp_dir().join(format!("rtlint-crash-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let child = dir.join("crash.sh");
+    std::fs::write(&child, "#!/bin/sh\nkill -SEGV $$\n").unwrap();
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        std::fs::set_permissions(&child, std::fs::Permissions::from_mode(0o755)).unwrap();
+    }
+    let o = rtlint()
+        .args([
+            "stack",
+            "--driver",
+            "fixtures/pipelines/callable.pipeline.toml",
+            "fixtures/pipelines/textured_hlsl.pipeline.toml",
+        ])
+        .env("RTLINT_DRIVER_CHILD", &child)
+        .output()
+        .unwrap();
+    let _ = std::fs::remove_dir_all(&dir);
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    // rtlint itself survives, reports both pipelines' models and an error
+    // for each crashed creation.
+    assert_eq!(o.status.code(), Some(2), "{stdout}{stderr}");
+    assert_eq!(
+        stdout.matches("pipeline fixtures/pipelines/").count(),
+        2,
+        "{stdout}"
+    );
+    assert_eq!(
+        stdout
+            .matches("the driver crashed while creating the pipeline (signal 11, SIGSEGV)")
+            .count(),
+        2,
+        "{stdout}{stderr}"
+    );
+}
+
+#[test]
+fn json_with_several_inputs_still_reports_input_errors() {
+    let o = rtlint()
+        .args([
+            "stack",
+            "--format",
+            "json",
+            "fixtures/pipelines/callable.pipeline.toml",
+            "fixtures/pipelines/procedural.pipeline.toml",
+            "fixtures/pipelines/missing.pipeline.toml",
+        ])
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(2));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(v["pipelines"].as_array().map(Vec::len), Some(2));
+    let errors = v["errors"].as_array().unwrap();
+    assert_eq!(errors.len(), 1, "{errors:?}");
+    assert!(
+        errors[0].to_string().contains("missing.pipeline.toml"),
+        "{errors:?}"
+    );
+}
+
+#[test]
+fn driver_numbers_from_the_measurement_csv() {
+    // What the H200 reported for the reference pipeline, kept in the
+    // repository: raygen 64, miss 0, closest hit 0.
+    let v = json(&[
+        "stack",
+        "--driver-numbers",
+        "calibration/random/nvidia-h200.csv",
+        "--format",
+        "json",
+        "shaders/reflect_iterative.pipeline.toml",
+    ]);
+    let r = &v["pipelines"][0];
+    let measured: Vec<u64> = r["shaders"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|s| s["driver_bytes"].as_u64().unwrap())
+        .collect();
+    assert_eq!(measured, [64, 0, 0]);
+    let chain = r["driver"]["exact_call_chain"].as_u64().unwrap();
+    assert_eq!(chain, 64);
+    assert!(r["recommended"].as_u64().unwrap() >= chain);
+    // A malformed CSV is an input error with its line, not a panic.
+    let dir = std::env::temp_dir().join(format!("rtlint-csv-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let bad = dir.join("bad.csv");
+    std::fs::write(
+        &bad,
+        "pipeline,group,stage,entry,driver_bytes\nx,raygen 0,ray_generation,main,lots\n",
+    )
+    .unwrap();
+    let o = rtlint()
+        .args(["stack", "--driver-numbers"])
+        .arg(&bad)
+        .arg("shaders/reflect_iterative.pipeline.toml")
+        .output()
+        .unwrap();
+    let _ = std::fs::remove_dir_all(&dir);
+    assert_eq!(o.status.code(), Some(2));
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        stderr.contains("bad.csv:2: `lots` is not a byte count"),
+        "{stderr}"
+    );
+}

@@ -41,6 +41,9 @@ pub enum Assumption {
     InitialValueAssumed { counter: String },
     /// The driver's numbers come from this device.
     Driver { device: String, driver: String },
+    /// The recommended stack was below what the driver's own numbers need
+    /// and was raised to it.
+    RecommendationRaised { from: u64, to: u64 },
 }
 
 impl Assumption {
@@ -165,15 +168,13 @@ pub fn trace_graph(pipeline: &Pipeline) -> TraceGraph {
             // A site in a helper (naga wraps every `traceRay` in one per
             // payload, called from several shaders) is placed and its
             // operands folded at this shader's call.
-            let chain = crate::program::cfg::call_chains(
+            let chains = crate::program::cfg::call_chains(
                 program,
                 shader.function,
                 f.id,
                 super::liveness::MAX_CHAINS,
-            )
-            .into_iter()
-            .next()
-            .unwrap_or_default();
+            );
+            let chain = chains.first().cloned().unwrap_or_default();
             let location = program
                 .location_in(site.inst, &chain)
                 .or_else(|| program.site_location(site.inst));
@@ -183,7 +184,15 @@ pub fn trace_graph(pipeline: &Pipeline) -> TraceGraph {
                 SiteKind::ExecuteCallable => EdgeKind::Callable,
                 _ => continue,
             };
-            let operands = program.trace_operands_in(site, &chain).or(site.trace);
+            // Operands the shader's calls agree on; else as the site has them.
+            let per_chain: Vec<_> = chains
+                .iter()
+                .map(|c| program.trace_operands_in(site, c))
+                .collect();
+            let operands = match per_chain.first() {
+                Some(first) if per_chain.iter().all(|o| o == first) => first.or(site.trace),
+                _ => site.trace,
+            };
             if let (EdgeKind::Trace, Some(t)) = (kind, operands) {
                 let flags = t.ray_flags.constant().unwrap_or(0);
                 let dynamic_flags = t.ray_flags.constant().is_none();

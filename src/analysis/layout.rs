@@ -413,8 +413,6 @@ pub struct TypeLayout {
     pub optimal_indices: Option<Vec<usize>>,
     pub optimal_hlsl_packed_size: Option<u64>,
     pub optimal_hlsl_rows: Option<u64>,
-    /// The reordered declaration, ready to paste, in the source language.
-    pub optimal_declaration: Option<String>,
 }
 
 /// Lays out one struct (or a lone non-struct value named `var_name`).
@@ -478,10 +476,6 @@ pub fn layout_type(program: &Program, ty: Id, var_name: &str) -> Option<TypeLayo
     } else {
         var_name.to_string()
     };
-    let optimal_declaration = match (&order, is_struct) {
-        (Some(o), true) => Some(render_struct(program, &name, o, &member_layouts)),
-        _ => None,
-    };
     Some(TypeLayout {
         id: ty,
         is_struct,
@@ -500,38 +494,8 @@ pub fn layout_type(program: &Program, ty: Id, var_name: &str) -> Option<TypeLayo
         optimal_indices: order,
         optimal_hlsl_packed_size: optimal_size,
         optimal_hlsl_rows: optimal_size.map(|s| s.div_ceil(ROW)),
-        optimal_declaration,
         members: member_layouts,
     })
-}
-
-/// A struct declaration with members in `order`, in the source's language
-/// (WGSL for WGSL, HLSL otherwise).
-fn render_struct(
-    program: &Program,
-    name: &str,
-    order: &[usize],
-    members: &[MemberLayout],
-) -> String {
-    let mut s = format!("struct {name} {{\n");
-    for &k in order {
-        let m = &members[k];
-        if program.language == crate::shader::Language::Wgsl {
-            s.push_str(&format!("    {}: {},\n", m.name, m.ty));
-        } else {
-            // HLSL puts array extents after the name.
-            match m.ty.find('[') {
-                Some(b) => s.push_str(&format!("    {} {}{};\n", &m.ty[..b], m.name, &m.ty[b..])),
-                None => s.push_str(&format!("    {} {};\n", m.ty, m.name)),
-            }
-        }
-    }
-    s.push_str(if program.language == crate::shader::Language::Wgsl {
-        "}"
-    } else {
-        "};"
-    });
-    s
 }
 
 /// Every type used by a ray-tracing interface variable (payloads, hit
@@ -584,114 +548,6 @@ impl FileLayouts {
             language: program.language,
             types: interface_layouts(program),
         }
-    }
-
-    pub fn render_human(&self) -> String {
-        let mut s = format!("{} ({})\n", self.path, self.language.as_str());
-        if self.types.is_empty() {
-            s.push_str(
-                "  no payload, attribute, callable-data, shader-record or push-constant types\n\n",
-            );
-        }
-        for t in &self.types {
-            let roles: Vec<String> = t
-                .roles
-                .iter()
-                .map(|r| {
-                    serde_json::to_value(r)
-                        .ok()
-                        .and_then(|v| v.as_str().map(String::from))
-                        .unwrap_or_default()
-                })
-                .collect();
-            s.push_str(&format!(
-                "  {}  [{}]  variables: {}\n",
-                t.name,
-                roles.join(", "),
-                t.variables.join(", ")
-            ));
-            let mut sizes = format!(
-                "    scalar {} B · HLSL 16-byte packed {} B in {} row{} ({} B padding)",
-                t.scalar_size,
-                t.hlsl_packed_size,
-                t.hlsl_rows,
-                if t.hlsl_rows == 1 { "" } else { "s" },
-                t.hlsl_padding
-            );
-            if let Some(w) = t.wgsl_size {
-                sizes.push_str(&format!(" · WGSL {w} B"));
-            }
-            s.push_str(&sizes);
-            s.push('\n');
-            let wgsl = t.wgsl_size.is_some();
-            let name_w = t
-                .members
-                .iter()
-                .map(|m| m.name.len())
-                .max()
-                .unwrap_or(4)
-                .max(6);
-            let ty_w = t
-                .members
-                .iter()
-                .map(|m| m.ty.len())
-                .max()
-                .unwrap_or(4)
-                .max(4);
-            s.push_str(&format!(
-                "    {:<name_w$}  {:<ty_w$}  {:>4}  {:>6}  {:>6}  {:>3}{}  straddles\n",
-                "member",
-                "type",
-                "size",
-                "scalar",
-                "packed",
-                "row",
-                if wgsl { "    wgsl" } else { "" }
-            ));
-            for m in &t.members {
-                s.push_str(&format!(
-                    "    {:<name_w$}  {:<ty_w$}  {:>4}  {:>6}  {:>6}  {:>3}{}  {}\n",
-                    m.name,
-                    m.ty,
-                    m.size,
-                    m.scalar_offset,
-                    m.hlsl_packed_offset,
-                    m.row,
-                    m.wgsl_offset
-                        .map(|o| format!("  {o:>6}"))
-                        .unwrap_or_default(),
-                    if m.straddles { "yes" } else { "" }
-                ));
-            }
-            match (
-                &t.optimal_order,
-                t.optimal_hlsl_packed_size,
-                t.optimal_hlsl_rows,
-            ) {
-                (Some(order), Some(size), Some(rows)) if t.is_struct => {
-                    if size < t.hlsl_packed_size {
-                        s.push_str(&format!(
-                            "    optimal order: {} → {size} B in {rows} row{}\n",
-                            order.join(", "),
-                            if rows == 1 { "" } else { "s" }
-                        ));
-                        if let Some(d) = &t.optimal_declaration {
-                            for line in d.lines() {
-                                s.push_str(&format!("      {line}\n"));
-                            }
-                        }
-                    } else {
-                        s.push_str("    optimal order: as declared\n");
-                    }
-                }
-                (None, _, _) if t.is_struct => s.push_str(&format!(
-                    "    optimal order: not searched (more than {EXACT_ORDER_LIMIT} members)\n"
-                )),
-                _ => {}
-            }
-            s.push('\n');
-        }
-        s
     }
 }
 

@@ -141,6 +141,10 @@ pub fn live_sites(program: &Program) -> Vec<LiveSite> {
                 points.extend(chain.iter().rev().copied());
                 let mut values: Vec<LiveValue> = Vec::new();
                 let mut seen: HashSet<Id> = HashSet::new();
+                // Parts behind the previous level's pointer parameters that
+                // it still needs after the site: the caller's memory, counted
+                // where the caller passes it.
+                let mut carried: Vec<(usize, Vec<u32>)> = Vec::new();
                 for &p in &points {
                     let Some(fi) = program.function_of(p) else {
                         continue;
@@ -148,11 +152,13 @@ pub fn live_sites(program: &Program) -> Vec<LiveSite> {
                     let fl = cache
                         .entry(fi)
                         .or_insert_with(|| FnLiveness::new(program, fi));
-                    for v in fl.live_across(program, p) {
+                    let extra = fl.arguments_of(program, p, &carried);
+                    for v in fl.live_across(program, p, &extra) {
                         if seen.insert(v.id) {
                             values.push(v);
                         }
                     }
+                    carried = fl.param_parts_across(program, p, &extra);
                 }
                 // The query object is the site's own state, like a payload.
                 values.retain(|v| Some(v.id) != site.payload);
@@ -294,6 +300,18 @@ struct LocalPtr {
     exact: bool,
 }
 
+/// What a function does with each pointer parameter, as its callers see it.
+#[derive(Clone, Debug, Default)]
+struct ParamEffect {
+    /// The parts it may read before writing them; `None` when not known.
+    reads: Option<Vec<Vec<u32>>>,
+    /// The parts it writes on every path to its return.
+    writes: Vec<Vec<u32>>,
+}
+
+/// Per parameter of a function.
+type ExposedParams = Vec<ParamEffect>;
+
 /// Parts are tracked separately up to this many elements per composite.
 const MAX_SPLIT: u32 = 64;
 
@@ -302,8 +320,18 @@ pub struct FnLiveness {
     func: usize,
     /// Function-local `OpVariable`s.
     vars: HashSet<Id>,
-    /// Pointer ids derived from a local variable.
+    /// Pointer ids derived from a local variable or a pointer parameter.
     roots: HashMap<Id, LocalPtr>,
+    /// For each `OpFunctionCall` (by instruction index), the parts each
+    /// pointer argument's callee parameter may read before writing.
+    call_reads: HashMap<usize, ExposedParams>,
+    /// `OpLoad`s of a whole local part whose only use is the store right
+    /// after them into another local part (a copy, such as glslang's
+    /// copy-in of an `inout` argument), by the store's instruction index:
+    /// the load's index.
+    copies: HashMap<usize, usize>,
+    /// The loads of `copies`.
+    copy_loads: HashSet<usize>,
     /// SSA values that count as state: defined here, not pointers to locals.
     ssa: HashSet<Id>,
     live_out: Vec<HashSet<Place>>,
@@ -312,11 +340,146 @@ pub struct FnLiveness {
     preds: Vec<Vec<usize>>,
     remat: HashMap<Id, bool>,
     /// Variables' rematerialisation as read at an instruction.
-    remat_at: HashMap<(Id, usize), bool>,
+    remat_at: HashMap<(Id, usize, Vec<Vec<u32>>), bool>,
 }
 
 impl FnLiveness {
     pub fn new(program: &Program, func: usize) -> FnLiveness {
+        Self::build(program, func, &mut HashMap::new(), 0)
+    }
+
+    /// The parts of each pointer parameter of function `func` that it may
+    /// read before writing them (`None`: not a pointer, or not known).
+    fn exposed_params(
+        program: &Program,
+        func: usize,
+        memo: &mut HashMap<usize, ExposedParams>,
+        depth: u32,
+    ) -> ExposedParams {
+        if let Some(e) = memo.get(&func) {
+            return e.clone();
+        }
+        let f = &program.functions[func];
+        let unknown: ExposedParams = vec![ParamEffect::default(); f.params.len()];
+        if depth > 16 {
+            return unknown;
+        }
+        memo.insert(func, unknown);
+        let fl = Self::build(program, func, memo, depth + 1);
+        let entry = f.blocks.first().map(|b| b.start);
+        let live = entry
+            .map(|i| fl.places_after(program, i))
+            .unwrap_or_default();
+        let exposed: ExposedParams = f
+            .params
+            .iter()
+            .map(|p| {
+                if !fl.roots.contains_key(p) {
+                    return ParamEffect::default();
+                }
+                let reads = live
+                    .iter()
+                    .filter(|(v, _)| v == p)
+                    .map(|(_, path)| path.clone())
+                    .collect();
+                ParamEffect {
+                    reads: Some(reads),
+                    writes: fl.written_on_every_path(program, *p),
+                }
+            })
+            .collect();
+        memo.insert(func, exposed.clone());
+        exposed
+    }
+
+    /// The parts of pointer parameter (or variable) `var` that every path
+    /// from the function's entry to a return writes: stores of exactly
+    /// that part, and the writes of calls that pass it.
+    fn written_on_every_path(&self, program: &Program, var: Id) -> Vec<Vec<u32>> {
+        let f = self.function(program);
+        let n = f.blocks.len();
+        let own = |b: usize| -> Vec<Vec<u32>> {
+            let mut w = Vec::new();
+            for i in f.blocks[b].start..=f.blocks[b].end {
+                let inst = &program.insts[i];
+                match inst.class.opcode {
+                    Op::Store => {
+                        let t = id_operands(inst).next().and_then(|t| self.roots.get(&t));
+                        if let Some(t) = t.filter(|t| t.var == var && t.exact) {
+                            w.push(t.path.clone());
+                        }
+                    }
+                    Op::FunctionCall => {
+                        for (k, a) in id_operands(inst).enumerate().skip(1) {
+                            let Some(t) = self.roots.get(&a).filter(|t| t.var == var && t.exact)
+                            else {
+                                continue;
+                            };
+                            let e = self.call_reads.get(&i).and_then(|e| e.get(k - 1));
+                            for x in e.map(|e| e.writes.as_slice()).unwrap_or_default() {
+                                let mut path = t.path.clone();
+                                path.extend_from_slice(x);
+                                w.push(path);
+                            }
+                        }
+                    }
+                    _ => {}
+                }
+            }
+            w
+        };
+        let own: Vec<Vec<Vec<u32>>> = (0..n).map(own).collect();
+        // Forward must-analysis: `None` is "everything" (not reached yet).
+        let mut out: Vec<Option<HashSet<Vec<u32>>>> = vec![None; n];
+        let mut changed = true;
+        let mut rounds = 0;
+        while changed && rounds < 1000 {
+            changed = false;
+            rounds += 1;
+            for b in 0..n {
+                let mut inset: Option<HashSet<Vec<u32>>> =
+                    if b == 0 { Some(HashSet::new()) } else { None };
+                for &p in &self.preds[b] {
+                    if let Some(o) = &out[p] {
+                        inset = Some(match inset {
+                            None => o.clone(),
+                            Some(i) => i.intersection(o).cloned().collect(),
+                        });
+                    }
+                }
+                let Some(mut set) = inset else { continue };
+                set.extend(own[b].iter().cloned());
+                if out[b].as_ref() != Some(&set) {
+                    out[b] = Some(set);
+                    changed = true;
+                }
+            }
+        }
+        let mut must: Option<HashSet<Vec<u32>>> = None;
+        for (block, o) in f.blocks.iter().zip(&out) {
+            if !matches!(
+                program.insts[block.end].class.opcode,
+                Op::Return | Op::ReturnValue
+            ) {
+                continue;
+            }
+            let o = o.clone().unwrap_or_default();
+            must = Some(match must {
+                None => o,
+                Some(m) => m.intersection(&o).cloned().collect(),
+            });
+        }
+        let mut v: Vec<Vec<u32>> = must.unwrap_or_default().into_iter().collect();
+        v.sort();
+        v
+    }
+
+    fn build(
+        program: &Program,
+        func: usize,
+        memo: &mut HashMap<usize, ExposedParams>,
+        depth: u32,
+    ) -> FnLiveness {
         let f = &program.functions[func];
         let mut vars = HashSet::new();
         let mut roots: HashMap<Id, LocalPtr> = HashMap::new();
@@ -327,6 +490,24 @@ impl FnLiveness {
                 continue;
             }
             match inst.class.opcode {
+                // A pointer parameter is tracked like a variable (its
+                // contents belong to the caller, which counts them).
+                Op::FunctionParameter
+                    if matches!(
+                        inst.result_type.and_then(|t| program.ty(t)),
+                        Some(Type::Pointer { storage, .. })
+                            if *storage != StorageClass::PhysicalStorageBuffer
+                    ) =>
+                {
+                    roots.insert(
+                        r,
+                        LocalPtr {
+                            var: r,
+                            path: Vec::new(),
+                            exact: true,
+                        },
+                    );
+                }
                 Op::Variable => {
                     vars.insert(r);
                     roots.insert(
@@ -385,10 +566,67 @@ impl FnLiveness {
                 }
             }
         }
+        // Copies from one local part to another: `%v = OpLoad %a; OpStore %b %v`
+        // with `%v` used nowhere else and nothing between the two.
+        let mut uses: HashMap<Id, usize> = HashMap::new();
+        for inst in &program.insts[f.start..=f.end] {
+            if program.is_debug_inst(inst) {
+                continue;
+            }
+            for id in id_operands(inst) {
+                *uses.entry(id).or_default() += 1;
+            }
+        }
+        let mut copies = HashMap::new();
+        for block in &f.blocks {
+            let body: Vec<usize> = (block.start..=block.end)
+                .filter(|&i| {
+                    let inst = &program.insts[i];
+                    !program.is_debug_inst(inst)
+                        && !matches!(inst.class.opcode, Op::Line | Op::NoLine)
+                })
+                .collect();
+            for w in body.windows(2) {
+                let (load, store) = (&program.insts[w[0]], &program.insts[w[1]]);
+                if load.class.opcode != Op::Load || store.class.opcode != Op::Store {
+                    continue;
+                }
+                let (Some(v), Some(src)) = (load.result_id, id_operands(load).next()) else {
+                    continue;
+                };
+                let ops: Vec<Id> = id_operands(store).collect();
+                let exact = |p: Id| roots.get(&p).is_some_and(|r| r.exact);
+                if ops.len() == 2
+                    && ops[1] == v
+                    && uses.get(&v) == Some(&1)
+                    && exact(src)
+                    && exact(ops[0])
+                {
+                    copies.insert(w[1], w[0]);
+                }
+            }
+        }
+        // What each call reads through the pointers it passes.
+        let mut call_reads = HashMap::new();
+        for i in f.start..=f.end {
+            let inst = &program.insts[i];
+            if inst.class.opcode != Op::FunctionCall {
+                continue;
+            }
+            let callee = id_operands(inst)
+                .next()
+                .and_then(|c| program.function_index(c));
+            if let Some(c) = callee {
+                call_reads.insert(i, Self::exposed_params(program, c, memo, depth));
+            }
+        }
         let mut fl = FnLiveness {
             func,
             vars,
             roots,
+            call_reads,
+            copy_loads: copies.values().copied().collect(),
+            copies,
             ssa,
             live_out: vec![HashSet::new(); n],
             defined_out: vec![HashSet::new(); n],
@@ -410,7 +648,8 @@ impl FnLiveness {
 
     /// Backward transfer of one instruction over the live set. Debug-info
     /// instructions (`DebugDeclare`, `DebugValue`) neither read nor write.
-    fn step_back(&self, program: &Program, inst: &Instruction, live: &mut HashSet<Place>) {
+    fn step_back(&self, program: &Program, at: usize, live: &mut HashSet<Place>) {
+        let inst = &program.insts[at];
         if program.is_debug_inst(inst) {
             return;
         }
@@ -421,6 +660,44 @@ impl FnLiveness {
             if op == Op::Variable {
                 live.retain(|(v, _)| *v != r);
             }
+        }
+        if let Some(&load) = self.copies.get(&at) {
+            // A copy: the parts of the target live after it were the same
+            // parts of the source.
+            let ops: Vec<Id> = id_operands(inst).collect();
+            let src_ptr = id_operands(&program.insts[load]).next();
+            if let (Some(dst), Some(src)) = (
+                self.roots.get(&ops[0]),
+                src_ptr.and_then(|p| self.roots.get(&p)),
+            ) {
+                let wanted: Vec<Vec<u32>> = live
+                    .iter()
+                    .filter(|(v, _)| *v == dst.var)
+                    .filter_map(|(_, q)| {
+                        if let Some(rest) = q.strip_prefix(dst.path.as_slice()) {
+                            Some(rest.to_vec())
+                        } else if dst.path.starts_with(q) {
+                            Some(Vec::new())
+                        } else {
+                            None
+                        }
+                    })
+                    .collect();
+                self.kill(program, live, dst);
+                for r in wanted {
+                    let mut path = src.path.clone();
+                    path.extend(r);
+                    live.insert((src.var, path));
+                }
+                return;
+            }
+        }
+        if op == Op::Load && self.copy_loads.contains(&at) {
+            // Its read is the copy's, handled at the store.
+            if let Some(r) = inst.result_id {
+                live.remove(&(r, Vec::new()));
+            }
+            return;
         }
         match op {
             // Phi operands are used on the incoming edge, handled by `solve`.
@@ -455,8 +732,41 @@ impl FnLiveness {
                     Op::Variable => false,
                     _ => true,
                 };
-                if reads {
-                    live.insert((p.var, p.path.clone()));
+                if !reads {
+                    continue;
+                }
+                // A call writes what the callee writes on every path, then
+                // reads only what it may read before writing (an `out`
+                // parameter's temporary is not read).
+                let effect = (op == Op::FunctionCall && k > 0 && p.exact)
+                    .then(|| self.call_reads.get(&at)?.get(k - 1))
+                    .flatten();
+                if let Some(e) = effect {
+                    for w in &e.writes {
+                        let mut path = p.path.clone();
+                        path.extend_from_slice(w);
+                        self.kill(
+                            program,
+                            live,
+                            &LocalPtr {
+                                var: p.var,
+                                path,
+                                exact: true,
+                            },
+                        );
+                    }
+                }
+                match effect.and_then(|e| e.reads.as_ref()) {
+                    Some(parts) => {
+                        for q in parts {
+                            let mut path = p.path.clone();
+                            path.extend_from_slice(q);
+                            live.insert((p.var, path));
+                        }
+                    }
+                    None => {
+                        live.insert((p.var, p.path.clone()));
+                    }
                 }
             }
         }
@@ -516,13 +826,27 @@ impl FnLiveness {
         Some(out)
     }
 
-    /// Variables an instruction may write.
+    /// Variables an instruction may write. A constant initializer does not
+    /// count: until something else is stored, the variable holds a
+    /// constant, which is recomputed rather than kept across a call.
     fn writes(&self, program: &Program, inst: &Instruction) -> Vec<Id> {
         if program.is_debug_inst(inst) {
             return Vec::new();
         }
         match inst.class.opcode {
-            Op::Variable if inst.operands.len() > 1 => inst.result_id.into_iter().collect(),
+            Op::Variable if inst.operands.len() > 1 => {
+                let constant = matches!(
+                    inst.operands.get(1),
+                    Some(Operand::IdRef(init))
+                        if program.constants.contains_key(init)
+                            || program.spec_constants.contains_key(init)
+                );
+                if constant {
+                    Vec::new()
+                } else {
+                    inst.result_id.into_iter().collect()
+                }
+            }
             Op::Load | Op::AccessChain | Op::InBoundsAccessChain | Op::PtrAccessChain => Vec::new(),
             _ => id_operands(inst)
                 .filter_map(|id| self.root(id))
@@ -567,11 +891,8 @@ impl FnLiveness {
                     }
                 }
                 let mut live = out.clone();
-                for inst in program.insts[f.blocks[b].start..=f.blocks[b].end]
-                    .iter()
-                    .rev()
-                {
-                    self.step_back(program, inst, &mut live);
+                for k in (f.blocks[b].start..=f.blocks[b].end).rev() {
+                    self.step_back(program, k, &mut live);
                 }
                 if out != self.live_out[b] || live != live_in[b] {
                     self.live_out[b] = out;
@@ -618,7 +939,7 @@ impl FnLiveness {
         };
         let mut live = self.live_out[b].clone();
         for k in (inst + 1..=f.blocks[b].end).rev() {
-            self.step_back(program, &program.insts[k], &mut live);
+            self.step_back(program, k, &mut live);
         }
         live
     }
@@ -664,8 +985,60 @@ impl FnLiveness {
     }
 
     /// The values live across instruction `inst`, described.
-    pub fn live_across(&mut self, program: &Program, inst: usize) -> Vec<LiveValue> {
-        let places = self.places_after(program, inst);
+    /// The places in this function that call `call` passes for the
+    /// callee's parameter parts in `params` (parameter index, path).
+    fn arguments_of(
+        &self,
+        program: &Program,
+        call: usize,
+        params: &[(usize, Vec<u32>)],
+    ) -> Vec<Place> {
+        let inst = &program.insts[call];
+        if inst.class.opcode != Op::FunctionCall {
+            return Vec::new();
+        }
+        let args: Vec<Id> = id_operands(inst).skip(1).collect();
+        params
+            .iter()
+            .filter_map(|(k, path)| {
+                let root = self.roots.get(args.get(*k)?)?;
+                let mut p = root.path.clone();
+                if root.exact {
+                    p.extend_from_slice(path);
+                }
+                Some((root.var, p))
+            })
+            .collect()
+    }
+
+    /// Parts behind this function's pointer parameters live across
+    /// instruction `inst` (with `extra` places also live), by parameter
+    /// index.
+    fn param_parts_across(
+        &self,
+        program: &Program,
+        inst: usize,
+        extra: &[Place],
+    ) -> Vec<(usize, Vec<u32>)> {
+        let f = self.function(program);
+        let mut places = self.places_after(program, inst);
+        places.extend(extra.iter().cloned());
+        let mut out: Vec<(usize, Vec<u32>)> = places
+            .into_iter()
+            .filter_map(|(v, path)| Some((f.params.iter().position(|&p| p == v)?, path)))
+            .collect();
+        out.sort();
+        out
+    }
+
+    pub fn live_across(
+        &mut self,
+        program: &Program,
+        inst: usize,
+        extra: &[Place],
+    ) -> Vec<LiveValue> {
+        let mut places = self.places_after(program, inst);
+        places.extend(extra.iter().cloned());
         let live: HashSet<Id> = places.iter().map(|(id, _)| *id).collect();
         let defined = self.defined_before(program, inst);
         let result = program.insts.get(inst).and_then(|i| i.result_id);
@@ -699,7 +1072,12 @@ impl FnLiveness {
                 _ => {}
             }
             let rematerializable = if is_var {
-                self.remat_var(program, id, inst, 0)
+                let parts: Vec<Vec<u32>> = places
+                    .iter()
+                    .filter(|(v, _)| *v == id)
+                    .map(|(_, p)| p.clone())
+                    .collect();
+                self.remat_var(program, id, inst, &parts, 0)
             } else {
                 self.remat_ssa(program, id, 0)
             };
@@ -856,7 +1234,18 @@ impl FnLiveness {
             Op::Load => {
                 let ptr = id_operands(inst).next().unwrap_or(0);
                 match self.root(ptr) {
-                    Some(v) => self.remat_var(program, v, i, depth + 1),
+                    // The caller's value: not known here.
+                    Some(v) if !self.vars.contains(&v) => false,
+                    Some(v) => {
+                        let part = self.roots.get(&ptr).map(|p| p.path.clone());
+                        self.remat_var(
+                            program,
+                            v,
+                            i,
+                            &part.into_iter().collect::<Vec<_>>(),
+                            depth + 1,
+                        )
+                    }
                     // A buffer_reference pointer is an address computed like
                     // any value: the load is recomputable when it is.
                     None if self.physical_pointer(program, ptr) => {
@@ -925,13 +1314,23 @@ impl FnLiveness {
     /// that reach `at` store recomputable values, no two of them store
     /// different values into the same part (a merge of paths, like a phi, or
     /// a value that changed), and nothing else (a call, an atomic) gets its
-    /// address.
-    fn remat_var(&mut self, program: &Program, var: Id, at: usize, depth: u32) -> bool {
-        let key = (var, at);
+    /// address. Only writes to the `parts` read count (all of them when
+    /// `parts` is empty or holds the whole variable).
+    fn remat_var(
+        &mut self,
+        program: &Program,
+        var: Id,
+        at: usize,
+        parts: &[Vec<u32>],
+        depth: u32,
+    ) -> bool {
+        let mut parts = parts.to_vec();
+        parts.sort();
+        let key = (var, at, parts.clone());
         if let Some(&r) = self.remat_at.get(&key) {
             return r;
         }
-        self.remat_at.insert(key, false);
+        self.remat_at.insert(key.clone(), false);
         let f = self.function(program);
         let (start, end) = (f.start, f.end);
         let reaching = self.reaching_writes(program, var, at);
@@ -964,18 +1363,22 @@ impl FnLiveness {
                 Op::Store if !reaching.contains(&i) => {}
                 Op::Store => {
                     let value = ids.get(1).copied().unwrap_or(0);
-                    if !self.remat_ssa(program, value, depth + 1) {
-                        ok = false;
-                    }
                     let path = ids
                         .first()
                         .and_then(|p| self.roots.get(p))
                         .map(|p| p.path.clone())
                         .unwrap_or_default();
+                    let overlaps = parts.is_empty()
+                        || parts
+                            .iter()
+                            .any(|q| q.starts_with(&path) || path.starts_with(q));
+                    if !overlaps {
+                        continue;
+                    }
                     let clash = stored
                         .iter()
                         .any(|(q, v)| *v != value && (q.starts_with(&path) || path.starts_with(q)));
-                    if clash {
+                    if clash || !self.remat_ssa(program, value, depth + 1) {
                         ok = false;
                     }
                     stored.push((path, value));
@@ -1319,5 +1722,53 @@ mod tests {
         let r = live_report(&[program("fixtures/live/lets.wgsl")]);
         let text = crate::report::live::human(&r);
         assert!(!text.contains("line ?"), "{text}");
+        // A WGSL builtin argument is defined where the entry point names it.
+        let id = r.sites[0].values.iter().find(|v| v.name == "id").unwrap();
+        assert_eq!(id.def_line, Some(20), "{text}");
+    }
+
+    /// `out` arguments pass through temporaries the callee writes on every
+    /// path without reading: not live. An `inout` one the callee reads is.
+    #[test]
+    fn out_argument_temporaries_are_not_live() {
+        for rel in [
+            "fixtures/live/out_params.rgen.spv",
+            "fixtures/live/out_params.rgen.gV.spv",
+            "fixtures/live/out_params.hlsl",
+        ] {
+            let s = one_site(rel);
+            assert_eq!(
+                names(&s),
+                [
+                    ("acc", 12, false),
+                    ("i", 4, false),
+                    ("seed", 4, false),
+                    ("weight", 4, false)
+                ],
+                "{rel}"
+            );
+        }
+    }
+
+    /// Parts behind a pointer parameter that the callee needs after its
+    /// trace are live, counted at the caller's argument (glslang's and
+    /// rtlint's temporaries for a struct passed by value).
+    #[test]
+    fn state_behind_a_parameter_is_live() {
+        for rel in [
+            "fixtures/live/param_state.rgen.spv",
+            "fixtures/live/param_state.rgen.gV.spv",
+            "fixtures/live/param_state.hlsl",
+        ] {
+            let s = one_site(rel);
+            assert_eq!(s.live_bytes - s.rematerializable_bytes, 40, "{rel}: {s:?}");
+            let kept: Vec<(u64, &str)> = s
+                .values
+                .iter()
+                .filter(|v| !v.rematerializable)
+                .map(|v| (v.size, v.ty.as_str()))
+                .collect();
+            assert!(kept.contains(&(24, "Ray")), "{rel}: {kept:?}");
+        }
     }
 }

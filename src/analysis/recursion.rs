@@ -1461,10 +1461,16 @@ mod tests {
     /// the shadow ray's flags sit in a local (skip closest hit: no cycle).
     #[test]
     fn hlsl_guard_through_a_fresh_payload() {
-        let r = recursion_report(&loose(&["fixtures/guards/fresh.hlsl"]));
+        let p = loose(&["fixtures/guards/fresh.hlsl"]);
+        let r = recursion_report(&p);
         // Hit at levels 1–4, the deepest hit's shadow ray reaches a miss at 5.
         assert_eq!(r.required_depth, Some(5));
         assert_eq!(r.cycles[0].sites.len(), 1);
+        // The raygen's sample loop counts in its payload's member.
+        let loops = trace_loops(&p.programs[0], &p.constants);
+        assert_eq!(loops.len(), 1);
+        let b = loops[0].bound.as_ref().unwrap();
+        assert_eq!((b.op, b.bound), ("<", 2));
         let g = r.cycles[0].sites[0].guard.as_ref().unwrap();
         assert_eq!((g.bound, g.step, g.initial, g.traces), (3, 1, 0, 3));
         assert!(!g.initial_assumed);
@@ -1475,8 +1481,17 @@ mod tests {
     /// helper's `RayDesc` parameter.
     #[test]
     fn wgsl_guard_through_a_constructed_payload() {
-        let r = recursion_report(&loose(&["fixtures/guards/constructed.wgsl"]));
+        let p = loose(&["fixtures/guards/constructed.wgsl"]);
+        let r = recursion_report(&p);
         assert_eq!(r.required_depth, Some(6));
+        let loops = trace_loops(&p.programs[0], &p.constants);
+        let raygen: Vec<_> = loops.iter().filter(|l| l.entry == "raygen").collect();
+        assert_eq!(raygen.len(), 1);
+        let b = raygen[0].bound.as_ref().unwrap();
+        assert_eq!(
+            (b.counter.as_str(), b.op, b.bound),
+            ("bounce.depth", "<", 2)
+        );
         assert_eq!(r.cycles[0].sites.len(), 1);
         let g = r.cycles[0].sites[0].guard.as_ref().unwrap();
         assert_eq!(
@@ -1486,7 +1501,7 @@ mod tests {
         // The recursive trace is the closest hit's, not the raygen's.
         assert_eq!(
             r.cycles[0].sites[0].location.as_ref().map(|l| l.line),
-            Some(38)
+            Some(42)
         );
     }
 
@@ -1502,5 +1517,14 @@ mod tests {
             "{text}"
         );
         assert!(!text.contains("(miss 0) at level 0"), "{text}");
+    }
+
+    /// A helper called twice with different flags is folded per call: only
+    /// flags every call agrees on prune targets.
+    #[test]
+    fn helper_called_with_different_flags() {
+        let r = recursion_report(&loose(&["fixtures/guards/two_calls.wgsl"]));
+        assert_eq!(r.required_depth, None);
+        assert_eq!(r.cycles.len(), 1);
     }
 }

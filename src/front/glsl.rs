@@ -37,11 +37,12 @@ pub fn glslang() -> PathBuf {
         .unwrap_or_else(|| PathBuf::from("glslangValidator"))
 }
 
-/// Compiles `path` (whose text is `text`, from disk or standard input) to
-/// SPIR-V. `source_name` is what glslang writes into the debug info.
+/// Compiles `path` (whose contents are `text`, from disk or standard
+/// input) to SPIR-V; also returns the scratch file glslang read, which the
+/// debug info names.
 pub fn compile(
     path: &Path,
-    text: &str,
+    text: &[u8],
     options: &FrontOptions,
 ) -> Result<(Vec<u32>, Option<PathBuf>), InputError> {
     let ext = stage_extension(path).unwrap_or("glsl");

@@ -96,8 +96,12 @@ pub fn compile_input(
             Ok(compiled(Language::Hlsl, m.words, m.decls))
         }
         Language::Glsl => {
-            let text = text()?;
-            let (words, scratch) = glsl::compile(path, &text, options)?;
+            // glslang takes bytes: a Latin-1 comment is no reason to refuse.
+            let bytes = match contents {
+                Some(b) => b.to_vec(),
+                None => std::fs::read(path).map_err(|e| io_error(path, &e))?,
+            };
+            let (words, scratch) = glsl::compile(path, &bytes, options)?;
             let mut c = compiled(Language::Glsl, words, Vec::new());
             c.scratch_source = scratch;
             Ok(c)

@@ -137,6 +137,39 @@ pub fn declarations(
             ));
         }
     }
+    // Entry-point arguments become input variables of the same name (the
+    // builtin `id` of `fn raygen(@builtin(ray_invocation_id) id: …)`); a
+    // name used by one entry point only is placed at its argument.
+    let mut args: Vec<(&str, &str)> = Vec::new();
+    for ep in &module.entry_points {
+        for a in &ep.function.arguments {
+            if let Some(n) = &a.name {
+                args.push((ep.name.as_str(), n.as_str()));
+            }
+        }
+    }
+    for &(ep, name) in &args {
+        if args.iter().filter(|(_, n)| *n == name).count() > 1
+            || module
+                .global_variables
+                .iter()
+                .any(|(_, g)| g.name.as_deref() == Some(name))
+        {
+            continue;
+        }
+        let Some(start) = find_fn(source, ep) else {
+            continue;
+        };
+        let end = source[start..]
+            .find('{')
+            .map_or(source.len(), |b| start + b);
+        if let Some(at) = find_ident(source, start + ep.len(), end, name) {
+            out.push((
+                NamedDecl::Global(name.to_string()),
+                name_location(path, source, at, name),
+            ));
+        }
+    }
     out
 }
 

@@ -9,21 +9,7 @@ use rspirv::binary::{Consumer, ParseAction};
 use rspirv::dr::{self, ModuleHeader};
 use std::path::Path;
 
-/// `NonSemantic.Shader.DebugInfo.100` instruction numbers we read.
-mod debug_info_op {
-    pub const COMPILATION_UNIT: u32 = 1;
-    pub const TYPE_COMPOSITE: u32 = 10;
-    pub const TYPE_MEMBER: u32 = 11;
-    pub const GLOBAL_VARIABLE: u32 = 18;
-    pub const FUNCTION: u32 = 20;
-    pub const LOCAL_VARIABLE: u32 = 26;
-    pub const DECLARE: u32 = 28;
-    pub const SOURCE: u32 = 35;
-    pub const FUNCTION_DEFINITION: u32 = 101;
-    pub const SOURCE_CONTINUED: u32 = 102;
-    pub const LINE: u32 = 103;
-    pub const NO_LINE: u32 = 104;
-}
+use spirv::NonsemanticShaderDebuginfo100Op as DebugOp;
 
 struct Collect {
     header: Option<ModuleHeader>,
@@ -300,7 +286,13 @@ impl Builder<'_> {
             .p
             .files
             .iter()
-            .map(|f| f.text.as_ref().map(|t| t.lines().count()))
+            .map(|f| {
+                // glslang `-gV` embeds no text: the file on disk, if any.
+                f.text
+                    .clone()
+                    .or_else(|| std::fs::read_to_string(&f.path).ok())
+                    .map(|t| t.lines().count())
+            })
             .collect();
         let possible = |p: &SrcPos| {
             p.line > 0
@@ -545,11 +537,13 @@ impl Builder<'_> {
     }
 
     fn debug_ext_inst(&mut self, i: usize, inst: &dr::Instruction, cur: &mut Option<SrcPos>) {
-        let Some(which) = lit_at(inst, 1) else { return };
+        let Some(which) = lit_at(inst, 1).and_then(DebugOp::from_u32) else {
+            return;
+        };
         // Operands after (set, instruction) are ids; shift by 2.
         let r = inst.result_id.unwrap_or(0);
         match which {
-            debug_info_op::COMPILATION_UNIT => {
+            DebugOp::DebugCompilationUnit => {
                 // Version, DWARF version, source, language (a constant id).
                 let lang = self.const_u32(id_at(inst, 5));
                 if self.p.language == Language::Spirv {
@@ -561,7 +555,7 @@ impl Builder<'_> {
                     };
                 }
             }
-            debug_info_op::SOURCE => {
+            DebugOp::DebugSource => {
                 if let Some(f) = id_at(inst, 2).and_then(|s| self.file_for_string(s)) {
                     if let Some(text) = id_at(inst, 3).and_then(|t| self.strings.get(&t)).cloned() {
                         self.p.files[f as usize].text = Some(text);
@@ -569,7 +563,7 @@ impl Builder<'_> {
                     self.dbg_sources.insert(r, f);
                 }
             }
-            debug_info_op::SOURCE_CONTINUED => {
+            DebugOp::DebugSourceContinued => {
                 // Appends to the most recent DebugSource's text.
                 if let Some(text) = id_at(inst, 2).and_then(|t| self.strings.get(&t)).cloned() {
                     if let Some(f) = self.dbg_sources.values().max().copied() {
@@ -579,7 +573,7 @@ impl Builder<'_> {
                     }
                 }
             }
-            debug_info_op::LINE => {
+            DebugOp::DebugLine => {
                 if let Some(file) = id_at(inst, 2)
                     .and_then(|s| self.dbg_sources.get(&s))
                     .copied()
@@ -597,13 +591,13 @@ impl Builder<'_> {
                     });
                 }
             }
-            debug_info_op::NO_LINE => *cur = None,
-            debug_info_op::TYPE_MEMBER => {
+            DebugOp::DebugNoLine => *cur = None,
+            DebugOp::DebugTypeMember => {
                 if let Some(pos) = self.dbg_pos(inst, 4, 5, 6) {
                     self.dbg_members.insert(r, pos);
                 }
             }
-            debug_info_op::TYPE_COMPOSITE => {
+            DebugOp::DebugTypeComposite => {
                 let name = id_at(inst, 2).and_then(|s| self.strings.get(&s)).cloned();
                 if let (Some(name), Some(pos)) = (name, self.dbg_pos(inst, 4, 5, 6)) {
                     let members = inst.operands.iter().skip(11).filter_map(|o| match o {
@@ -613,29 +607,29 @@ impl Builder<'_> {
                     self.dbg_composites.push((name, pos, members.collect()));
                 }
             }
-            debug_info_op::GLOBAL_VARIABLE => {
+            DebugOp::DebugGlobalVariable => {
                 if let (Some(pos), Some(var)) = (self.dbg_pos(inst, 4, 5, 6), id_at(inst, 9)) {
                     self.p.decl_pos.insert(Decl::Var(var), pos);
                 }
             }
-            debug_info_op::FUNCTION => {
+            DebugOp::DebugFunction => {
                 if let Some(pos) = self.dbg_pos(inst, 4, 5, 6) {
                     self.dbg_functions.insert(r, pos);
                 }
             }
-            debug_info_op::FUNCTION_DEFINITION => {
+            DebugOp::DebugFunctionDefinition => {
                 if let (Some(df), Some(f)) = (id_at(inst, 2), id_at(inst, 3)) {
                     if let Some(pos) = self.dbg_functions.get(&df) {
                         self.p.decl_pos.insert(Decl::Func(f), *pos);
                     }
                 }
             }
-            debug_info_op::LOCAL_VARIABLE => {
+            DebugOp::DebugLocalVariable => {
                 if let Some(pos) = self.dbg_pos(inst, 4, 5, 6) {
                     self.dbg_locals.insert(r, pos);
                 }
             }
-            debug_info_op::DECLARE => {
+            DebugOp::DebugDeclare => {
                 if let (Some(local), Some(var)) = (id_at(inst, 2), id_at(inst, 3)) {
                     if let Some(pos) = self.dbg_locals.get(&local) {
                         self.p.decl_pos.insert(Decl::Var(var), *pos);
@@ -1063,7 +1057,7 @@ mod tests {
         // The module does say line 0 for `main` (DebugFunction's line).
         let zero_line_function = p.insts.iter().any(|i| {
             i.class.opcode == Op::ExtInst
-                && lit_at(i, 1) == Some(debug_info_op::FUNCTION)
+                && lit_at(i, 1) == Some(DebugOp::DebugFunction as u32)
                 && id_at(i, 5).and_then(|c| p.const_u64(c)) == Some(0)
         });
         assert!(zero_line_function);
@@ -1081,5 +1075,30 @@ mod tests {
             .find(|f| f.name.as_deref() == Some("main"))
             .unwrap();
         assert!(p.decl_location(Decl::Func(main.id)).is_none());
+    }
+
+    /// A `-gV` module whose source on disk is shorter than its positions
+    /// claim (glslang embeds no text with `-gV`): positions past the end of
+    /// the file are dropped.
+    #[test]
+    fn no_position_past_the_end_of_the_file() {
+        let src =
+            Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/live/loop_local.rgen.gV.spv");
+        let dir = std::env::temp_dir().join(format!("rtlint-past-end-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let spv = dir.join("loop_local.rgen.gV.spv");
+        std::fs::copy(&src, &spv).unwrap();
+        std::fs::write(dir.join("loop_local.rgen"), "#version 460\n\n\n\n\n").unwrap();
+        let words = super::super::words_from_bytes(&std::fs::read(&spv).unwrap(), &spv).unwrap();
+        let p = parse(&words, &spv, Language::Spirv).unwrap();
+        let full = parse(&words, &src, Language::Spirv).unwrap();
+        assert!(full.locs.iter().flatten().any(|l| l.line > 5));
+        assert!(p
+            .locs
+            .iter()
+            .flatten()
+            .chain(p.decl_pos.values())
+            .all(|l| l.line <= 5));
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 }

@@ -178,7 +178,7 @@ pub struct RtSite {
     pub sbt_index: Option<OperandValue>,
 }
 
-#[derive(Clone, Copy, Debug, serde::Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
 pub struct TraceOperands {
     pub ray_flags: OperandValue,
     pub cull_mask: OperandValue,
@@ -360,7 +360,8 @@ impl Program {
 
     /// An instruction's position; for one without (code a compiler generated,
     /// such as naga's wrapper around each `traceRay`), the position of the
-    /// first call that reaches its function.
+    /// first call that reaches its function (see `location_in` for the call
+    /// in a given chain).
     pub fn site_location(&self, inst: usize) -> Option<Location> {
         let mut inst = inst;
         let mut seen = Vec::new();

@@ -113,7 +113,7 @@ pub fn human(r: &StackReport) -> String {
     }
     let _ = writeln!(
         s,
-        "  (bytes; model = driver* + live + arrays; driver* = the payload-driven part a driver reports; live = state across traces that cannot be recomputed; query = the driver's own figure with --driver)"
+        "  (bytes; model = every live value kept, plus a safety margin; driver* = what the NVIDIA driver is modelled to report; live = state across traces that cannot be recomputed; query = the driver's own figure with --driver)"
     );
     let _ = writeln!(s);
     let mut block = |title: &str, f: &Formulas| {

@@ -79,17 +79,18 @@ pub fn check(program: &Program, sites: &[LiveSite], budget_bytes: u64) -> Vec<Di
 super::declare_rule! {
     /// ## What it does
     ///
-    /// Finds trace and callable sites across which a shader keeps more state than
-    /// a budget (default 64 bytes). It counts the values that are defined before
-    /// the call and used after it — SSA values and the contents of local
-    /// variables, through loops, phis and calls — whose value cannot be recomputed
-    /// after the call. Each live value is listed with its size, and values that
-    /// could be recomputed (see *Rematerialisation classes* in `docs/stack.md`:
-    /// builtins, push constants, uniform, storage and `buffer_reference` loads,
-    /// texture reads, constants) are marked and not counted. Ray-query loops are
-    /// not reported: an inline query is no shader call, so its state stays in
-    /// registers (`rtlint live` still lists them). The answer does not depend on
-    /// the debug info the compiler emitted (none, `-g`, `-gV`).
+    /// Finds trace and callable sites across which a shader keeps more state
+    /// than a budget (default 64 bytes). It counts the values that are defined
+    /// before the call and used after it — SSA values and the live parts of
+    /// local variables, through loops, phis and calls — whose value cannot be
+    /// recomputed after the call. Each live value is listed with its size, and
+    /// values that could be recomputed (see *Rematerialisation classes* in
+    /// `docs/stack.md`: builtins, push constants, uniform, storage and
+    /// `buffer_reference` loads, texture reads, constants) are marked and not
+    /// counted. Ray-query loops are not reported: an inline query is no shader
+    /// call, so its state stays in registers (`rtlint live` still lists them).
+    /// The answer does not depend on the debug info the compiler emitted (none,
+    /// `-g`, `-gV`).
     ///
     /// ## Why is this bad?
     ///
@@ -133,12 +134,13 @@ super::declare_rule! {
     ///
     /// ## Options
     ///
-    /// `budget` under `[rules.RT010]` in `rtlint.toml` (bytes that cannot be
-    /// recomputed, default 64; the top-level `live-state-budget` too). There is no
-    /// command-line flag for it.
+    /// `budget` under `[rules.RT010]` in `rtlint.toml`, or the top-level
+    /// `live-state-budget`: bytes that cannot be recomputed (default 64). There
+    /// is no command-line flag for it.
     ///
     /// Fixtures: `fixtures/RT010/bad.rgen`, `fixtures/RT010/good.rgen`; the live
-    /// sets behind it: `fixtures/live/`.
+    /// sets behind it: `fixtures/live/`. Precision on public shaders:
+    /// `docs/rules-precision.md`.
     "RT010" "live-state-over-budget" {
         group: Perf,
         summary: "state kept alive across a trace call above the budget",

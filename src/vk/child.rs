@@ -59,14 +59,22 @@ pub fn run_in_child_with_timeout(test_name: &str, timeout: Duration) -> Option<C
         return None;
     }
     let exe = std::env::current_exe().expect("the test binary's path is known");
-    let mut child = Command::new(exe)
+    let mut command = Command::new(exe);
+    command
         .args([test_name, "--exact", "--nocapture", "--test-threads=1"])
-        .env(CHILD_ENV, "1")
+        .env(CHILD_ENV, "1");
+    Some(run_command(command, timeout).expect("the test binary can be re-run as a child"))
+}
+
+/// Runs `command` with piped output, killing it after `timeout`, and says
+/// how it ended: a crash (a signal) or a hang is an outcome, not an error.
+/// Only a failure to start or wait for it is an error.
+pub fn run_command(mut command: Command, timeout: Duration) -> std::io::Result<ChildOutcome> {
+    let mut child = command
         .stdin(Stdio::null())
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())
-        .spawn()
-        .expect("the test binary can be re-run as a child");
+        .spawn()?;
     // Drain both pipes while waiting, so a chatty child cannot block on a
     // full pipe.
     let drain = |pipe: Option<Box<dyn Read + Send>>| {
@@ -83,21 +91,21 @@ pub fn run_in_child_with_timeout(test_name: &str, timeout: Duration) -> Option<C
     let start = Instant::now();
     let mut timed_out = false;
     let status = loop {
-        if let Some(status) = child.try_wait().expect("the child can be waited for") {
+        if let Some(status) = child.try_wait()? {
             break status;
         }
         if start.elapsed() > timeout {
             timed_out = true;
             let _ = child.kill();
-            break child.wait().expect("the killed child can be waited for");
+            break child.wait()?;
         }
-        std::thread::sleep(Duration::from_millis(10));
+        std::thread::sleep(Duration::from_millis(5));
     };
     #[cfg(unix)]
     let signal = std::os::unix::process::ExitStatusExt::signal(&status);
     #[cfg(not(unix))]
     let signal = None;
-    Some(ChildOutcome {
+    Ok(ChildOutcome {
         code: status.code(),
         signal,
         timed_out,

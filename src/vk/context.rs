@@ -80,6 +80,12 @@ pub struct DeviceInfo {
     pub ray_tracing: RayTracingLimits,
     pub min_storage_buffer_offset_alignment: u64,
     pub min_uniform_buffer_offset_alignment: u64,
+    /// `maxBoundDescriptorSets`.
+    pub max_bound_descriptor_sets: u32,
+    /// `maxPushConstantsSize`.
+    pub max_push_constants_size: u32,
+    /// `runtimeDescriptorArray` is present and enabled.
+    pub runtime_descriptor_array: bool,
 }
 
 /// Everything the Vulkan objects need to destroy themselves; resources hold an
@@ -141,6 +147,25 @@ struct Candidate {
     physical: vk::PhysicalDevice,
     queue_family: u32,
     info: DeviceInfo,
+    /// Shader features enabled where the device has them, so that shaders
+    /// using descriptor indexing, format-less storage images, 16-bit
+    /// integers or doubles can be created.
+    optional: OptionalFeatures,
+}
+
+/// The optional features the device has (each enabled when present).
+#[derive(Clone, Copy, Debug, Default)]
+struct OptionalFeatures {
+    core: vk::PhysicalDeviceFeatures,
+    runtime_descriptor_array: bool,
+    sampled_image_non_uniform: bool,
+    storage_image_non_uniform: bool,
+    storage_buffer_non_uniform: bool,
+    uniform_buffer_non_uniform: bool,
+    uniform_texel_non_uniform: bool,
+    storage_texel_non_uniform: bool,
+    partially_bound: bool,
+    variable_count: bool,
 }
 
 impl Context {
@@ -459,6 +484,44 @@ fn examine(
             },
             min_storage_buffer_offset_alignment: props.limits.min_storage_buffer_offset_alignment,
             min_uniform_buffer_offset_alignment: props.limits.min_uniform_buffer_offset_alignment,
+            max_bound_descriptor_sets: props.limits.max_bound_descriptor_sets,
+            max_push_constants_size: props.limits.max_push_constants_size,
+            runtime_descriptor_array: f12.runtime_descriptor_array == vk::TRUE,
+        },
+        optional: OptionalFeatures {
+            core: vk::PhysicalDeviceFeatures {
+                shader_storage_image_read_without_format: core
+                    .shader_storage_image_read_without_format,
+                shader_storage_image_write_without_format: core
+                    .shader_storage_image_write_without_format,
+                shader_sampled_image_array_dynamic_indexing: core
+                    .shader_sampled_image_array_dynamic_indexing,
+                shader_storage_image_array_dynamic_indexing: core
+                    .shader_storage_image_array_dynamic_indexing,
+                shader_storage_buffer_array_dynamic_indexing: core
+                    .shader_storage_buffer_array_dynamic_indexing,
+                shader_uniform_buffer_array_dynamic_indexing: core
+                    .shader_uniform_buffer_array_dynamic_indexing,
+                shader_int16: core.shader_int16,
+                shader_float64: core.shader_float64,
+                shader_image_gather_extended: core.shader_image_gather_extended,
+                ..Default::default()
+            },
+            runtime_descriptor_array: f12.runtime_descriptor_array == vk::TRUE,
+            sampled_image_non_uniform: f12.shader_sampled_image_array_non_uniform_indexing
+                == vk::TRUE,
+            storage_image_non_uniform: f12.shader_storage_image_array_non_uniform_indexing
+                == vk::TRUE,
+            storage_buffer_non_uniform: f12.shader_storage_buffer_array_non_uniform_indexing
+                == vk::TRUE,
+            uniform_buffer_non_uniform: f12.shader_uniform_buffer_array_non_uniform_indexing
+                == vk::TRUE,
+            uniform_texel_non_uniform: f12.shader_uniform_texel_buffer_array_non_uniform_indexing
+                == vk::TRUE,
+            storage_texel_non_uniform: f12.shader_storage_texel_buffer_array_non_uniform_indexing
+                == vk::TRUE,
+            partially_bound: f12.descriptor_binding_partially_bound == vk::TRUE,
+            variable_count: f12.descriptor_binding_variable_descriptor_count == vk::TRUE,
         },
     })
 }
@@ -475,7 +538,9 @@ fn create_device(instance: &ash::Instance, c: &Candidate) -> Result<ash::Device>
     let queues = [vk::DeviceQueueCreateInfo::default()
         .queue_family_index(c.queue_family)
         .queue_priorities(&priorities)];
-    let core = vk::PhysicalDeviceFeatures::default()
+    let o = &c.optional;
+    let core = o
+        .core
         .geometry_shader(c.info.geometry_shader)
         .shader_int64(c.info.shader_int64)
         .shader_storage_image_read_without_format(c.info.storage_image_without_format)
@@ -483,7 +548,16 @@ fn create_device(instance: &ash::Instance, c: &Candidate) -> Result<ash::Device>
     let mut f12 = vk::PhysicalDeviceVulkan12Features::default()
         .buffer_device_address(true)
         .descriptor_indexing(true)
-        .scalar_block_layout(true);
+        .scalar_block_layout(true)
+        .runtime_descriptor_array(o.runtime_descriptor_array)
+        .shader_sampled_image_array_non_uniform_indexing(o.sampled_image_non_uniform)
+        .shader_storage_image_array_non_uniform_indexing(o.storage_image_non_uniform)
+        .shader_storage_buffer_array_non_uniform_indexing(o.storage_buffer_non_uniform)
+        .shader_uniform_buffer_array_non_uniform_indexing(o.uniform_buffer_non_uniform)
+        .shader_uniform_texel_buffer_array_non_uniform_indexing(o.uniform_texel_non_uniform)
+        .shader_storage_texel_buffer_array_non_uniform_indexing(o.storage_texel_non_uniform)
+        .descriptor_binding_partially_bound(o.partially_bound)
+        .descriptor_binding_variable_descriptor_count(o.variable_count);
     let mut f13 = vk::PhysicalDeviceVulkan13Features::default()
         .synchronization2(true)
         .maintenance4(true);

@@ -1,11 +1,14 @@
 //! One descriptor set per pipeline, built from a plain binding list and
 //! rewritten before each dispatch so its resources are borrowed for exactly
-//! as long as the GPU uses them.
+//! as long as the GPU uses them; or, for a pipeline that is only created
+//! (the driver's stack sizes), every set a reflected interface names.
 
 use super::accel::AccelerationStructure;
 use super::buffer::Buffer;
 use super::context::Shared;
 use super::error::{vk_err, Error, Result};
+use super::interface::{DescriptorCount, DescriptorKind, PipelineInterface};
+use super::pipeline::stage_flags;
 use ash::vk;
 use std::sync::Arc;
 
@@ -31,6 +34,21 @@ impl BindingKind {
             BindingKind::SampledImage => vk::DescriptorType::SAMPLED_IMAGE,
             BindingKind::Sampler => vk::DescriptorType::SAMPLER,
         }
+    }
+}
+
+fn descriptor_type(kind: DescriptorKind) -> vk::DescriptorType {
+    use vk::DescriptorType as T;
+    match kind {
+        DescriptorKind::Sampler => T::SAMPLER,
+        DescriptorKind::CombinedImageSampler => T::COMBINED_IMAGE_SAMPLER,
+        DescriptorKind::SampledImage => T::SAMPLED_IMAGE,
+        DescriptorKind::StorageImage => T::STORAGE_IMAGE,
+        DescriptorKind::UniformTexelBuffer => T::UNIFORM_TEXEL_BUFFER,
+        DescriptorKind::StorageTexelBuffer => T::STORAGE_TEXEL_BUFFER,
+        DescriptorKind::UniformBuffer => T::UNIFORM_BUFFER,
+        DescriptorKind::StorageBuffer => T::STORAGE_BUFFER,
+        DescriptorKind::AccelerationStructure => T::ACCELERATION_STRUCTURE_KHR,
     }
 }
 
@@ -66,6 +84,9 @@ pub(crate) struct Descriptors {
     shared: Arc<Shared>,
     bindings: Vec<Binding>,
     pub(crate) set_layout: vk::DescriptorSetLayout,
+    /// The set layouts of a reflected interface (set 0, 1, …); no sets are
+    /// allocated for them.
+    reflected: Vec<vk::DescriptorSetLayout>,
     pool: vk::DescriptorPool,
     pub(crate) set: vk::DescriptorSet,
     pub(crate) pipeline_layout: vk::PipelineLayout,
@@ -90,6 +111,7 @@ impl Descriptors {
             shared: shared.clone(),
             bindings: bindings.to_vec(),
             set_layout: vk::DescriptorSetLayout::null(),
+            reflected: Vec::new(),
             pool: vk::DescriptorPool::null(),
             set: vk::DescriptorSet::null(),
             pipeline_layout: vk::PipelineLayout::null(),
@@ -159,8 +181,87 @@ impl Descriptors {
         Ok(this)
     }
 
+    /// Set layouts and the pipeline layout for a reflected interface: every
+    /// set up to the highest one used (empty where no shader uses a set),
+    /// each binding with its descriptor type, count and stages, and the
+    /// push-constant range. A runtime array gets `runtime_count`
+    /// descriptors. Nothing is allocated: such a layout serves pipeline
+    /// creation, not dispatch.
+    pub(crate) fn from_interface(
+        shared: &Arc<Shared>,
+        interface: &PipelineInterface,
+        runtime_count: u32,
+    ) -> Result<Self> {
+        let device = &shared.device;
+        let mut this = Descriptors {
+            shared: shared.clone(),
+            bindings: Vec::new(),
+            set_layout: vk::DescriptorSetLayout::null(),
+            reflected: Vec::new(),
+            pool: vk::DescriptorPool::null(),
+            set: vk::DescriptorSet::null(),
+            pipeline_layout: vk::PipelineLayout::null(),
+        };
+        let flags = |stages: &std::collections::BTreeSet<crate::shader::Stage>| {
+            stages
+                .iter()
+                .fold(vk::ShaderStageFlags::empty(), |f, s| f | stage_flags(*s))
+        };
+        for set in 0..interface.set_count() {
+            let layout_bindings: Vec<_> = interface
+                .bindings
+                .iter()
+                .filter(|b| b.set == set)
+                .map(|b| {
+                    vk::DescriptorSetLayoutBinding::default()
+                        .binding(b.binding)
+                        .descriptor_type(descriptor_type(b.kind))
+                        .descriptor_count(match b.count {
+                            DescriptorCount::Fixed(n) => n,
+                            DescriptorCount::Runtime => runtime_count,
+                        })
+                        .stage_flags(flags(&b.stages))
+                })
+                .collect();
+            // SAFETY: valid device; the handle is kept in `this` at once so
+            // Drop releases it on any later error.
+            let layout = unsafe {
+                device.create_descriptor_set_layout(
+                    &vk::DescriptorSetLayoutCreateInfo::default().bindings(&layout_bindings),
+                    None,
+                )
+            }
+            .map_err(vk_err("vkCreateDescriptorSetLayout"))?;
+            this.reflected.push(layout);
+        }
+        let ranges = [vk::PushConstantRange::default()
+            .stage_flags(flags(&interface.push_constant_stages))
+            .size(interface.push_constant_size)];
+        let ranges = if interface.push_constant_size > 0 {
+            &ranges[..]
+        } else {
+            &[]
+        };
+        // SAFETY: as above.
+        this.pipeline_layout = unsafe {
+            device.create_pipeline_layout(
+                &vk::PipelineLayoutCreateInfo::default()
+                    .set_layouts(&this.reflected)
+                    .push_constant_ranges(ranges),
+                None,
+            )
+        }
+        .map_err(vk_err("vkCreatePipelineLayout"))?;
+        Ok(this)
+    }
+
     /// Points every binding at its resource; each binding needs exactly one.
     pub(crate) fn write(&self, resources: &[(u32, Resource<'_>)]) -> Result<()> {
+        if !self.reflected.is_empty() {
+            return Err(Error::Invalid(
+                "a pipeline made from a reflected interface has no descriptor sets to write".into(),
+            ));
+        }
         for b in &self.bindings {
             let n = resources.iter().filter(|(k, _)| *k == b.binding).count();
             if n != 1 {
@@ -273,6 +374,9 @@ impl Drop for Descriptors {
             d.destroy_descriptor_pool(self.pool, None);
             d.destroy_pipeline_layout(self.pipeline_layout, None);
             d.destroy_descriptor_set_layout(self.set_layout, None);
+            for l in &self.reflected {
+                d.destroy_descriptor_set_layout(*l, None);
+            }
         }
     }
 }

@@ -27,6 +27,7 @@ mod context;
 mod descriptors;
 mod error;
 mod image;
+mod interface;
 mod pipeline;
 mod stack_query;
 mod validation;
@@ -34,12 +35,16 @@ mod validation;
 pub use accel::{Aabb, AccelerationStructure, Geometry, Instance, IDENTITY};
 pub use buffer::{bytes_of, Buffer, Pod};
 pub use child::{
-    run_in_child, run_in_child_with_timeout, ChildOutcome, CHILD_ENV, DEFAULT_CHILD_TIMEOUT,
+    run_command, run_in_child, run_in_child_with_timeout, ChildOutcome, CHILD_ENV,
+    DEFAULT_CHILD_TIMEOUT,
 };
 pub use context::{Context, ContextOptions, DeviceInfo, RayTracingLimits};
 pub use descriptors::{Binding, BindingKind, Resource};
 pub use error::{Error, Result};
 pub use image::{Sampler, StorageImage};
+pub use interface::{
+    reflect as reflect_interface, DescriptorCount, DescriptorKind, LayoutBinding, PipelineInterface,
+};
 pub use pipeline::{
     ComputePipeline, Group, GroupStackSizes, RayTracingPipeline, RayTracingPipelineDesc, SbtLayout,
     SbtRegion, ShaderBindingTable, ShaderStage, Stage,

@@ -12,7 +12,7 @@ use std::time::Duration;
 pub use crate::shader::Stage;
 
 /// The Vulkan stage flag of a shader stage.
-fn stage_flags(stage: Stage) -> vk::ShaderStageFlags {
+pub(crate) fn stage_flags(stage: Stage) -> vk::ShaderStageFlags {
     match stage {
         Stage::RayGeneration => vk::ShaderStageFlags::RAYGEN_KHR,
         Stage::Miss => vk::ShaderStageFlags::MISS_KHR,
@@ -133,6 +133,15 @@ impl SbtLayout {
         }
     }
 
+    /// Records with `bytes` of shader-record data after each handle.
+    pub fn with_record(self, bytes: u32, limits: &super::RayTracingLimits) -> Self {
+        SbtLayout {
+            stride: (self.handle_size + u64::from(bytes))
+                .next_multiple_of(u64::from(limits.shader_group_handle_alignment.max(1))),
+            ..self
+        }
+    }
+
     /// Offsets of the regions (raygen regions, then miss, hit, callable) for
     /// the given record counts, each on a base-alignment boundary, and the
     /// table's total size.
@@ -204,16 +213,53 @@ impl Drop for Modules<'_> {
 
 impl RayTracingPipeline {
     pub fn new(ctx: &Context, desc: &RayTracingPipelineDesc<'_>) -> Result<Self> {
-        let shared = &ctx.shared;
-        let limits = shared.info.ray_tracing;
-        if desc.max_recursion_depth > limits.max_ray_recursion_depth {
+        check_desc(ctx, desc)?;
+        let descriptors = Descriptors::new(&ctx.shared, desc.bindings, desc.push_constant_size)?;
+        Self::create(ctx, desc, descriptors, 0)
+    }
+
+    /// A pipeline whose layout is the reflected `interface` (every set,
+    /// descriptor type, count and stage the shaders use, and their push
+    /// constants; `desc.bindings` and `desc.push_constant_size` are not
+    /// read), with shader records long enough for the shader-record data
+    /// the shaders read. Such a pipeline is for creation and its stack
+    /// sizes: it has no descriptor sets to bind, so it cannot trace.
+    pub fn with_interface(
+        ctx: &Context,
+        desc: &RayTracingPipelineDesc<'_>,
+        interface: &super::interface::PipelineInterface,
+    ) -> Result<Self> {
+        check_desc(ctx, desc)?;
+        let sets = interface.set_count();
+        if sets > ctx.shared.info.max_bound_descriptor_sets {
             return Err(Error::Invalid(format!(
-                "recursion depth {} is above the device's maximum of {}",
-                desc.max_recursion_depth, limits.max_ray_recursion_depth
+                "the shaders use {sets} descriptor sets; the device binds at most {}",
+                ctx.shared.info.max_bound_descriptor_sets
             )));
         }
-        check_groups(desc)?;
-        let descriptors = Descriptors::new(shared, desc.bindings, desc.push_constant_size)?;
+        if interface.push_constant_size > ctx.shared.info.max_push_constants_size {
+            return Err(Error::Invalid(format!(
+                "the shaders read {} bytes of push constants; the device has {}",
+                interface.push_constant_size, ctx.shared.info.max_push_constants_size
+            )));
+        }
+        if interface.has_runtime_array() && !ctx.shared.info.runtime_descriptor_array {
+            return Err(Error::Invalid(
+                "the shaders use a runtime descriptor array; the device lacks runtimeDescriptorArray"
+                    .into(),
+            ));
+        }
+        let descriptors = Descriptors::from_interface(&ctx.shared, interface, RUNTIME_ARRAY_COUNT)?;
+        Self::create(ctx, desc, descriptors, interface.shader_record_size)
+    }
+
+    fn create(
+        ctx: &Context,
+        desc: &RayTracingPipelineDesc<'_>,
+        descriptors: Descriptors,
+        shader_record_size: u32,
+    ) -> Result<Self> {
+        let shared = &ctx.shared;
 
         let mut modules = Modules {
             shared,
@@ -312,7 +358,7 @@ impl RayTracingPipeline {
             }
         };
         drop(modules);
-        let sbt = match build_sbt(ctx, pipeline, desc) {
+        let sbt = match build_sbt(ctx, pipeline, desc, shader_record_size) {
             Ok(sbt) => sbt,
             Err(e) => {
                 // SAFETY: the pipeline is unused.
@@ -481,6 +527,20 @@ unsafe fn bind_set(
     }
 }
 
+/// Descriptors a runtime array gets in a reflected layout.
+const RUNTIME_ARRAY_COUNT: u32 = 16;
+
+fn check_desc(ctx: &Context, desc: &RayTracingPipelineDesc<'_>) -> Result<()> {
+    let limits = ctx.shared.info.ray_tracing;
+    if desc.max_recursion_depth > limits.max_ray_recursion_depth {
+        return Err(Error::Invalid(format!(
+            "recursion depth {} is above the device's maximum of {}",
+            desc.max_recursion_depth, limits.max_ray_recursion_depth
+        )));
+    }
+    check_groups(desc)
+}
+
 fn check_groups(desc: &RayTracingPipelineDesc<'_>) -> Result<()> {
     let stage_of = |i: u32, what: &str, allowed: &[Stage]| -> Result<()> {
         match desc.stages.get(i as usize) {
@@ -536,9 +596,17 @@ fn build_sbt(
     ctx: &Context,
     pipeline: vk::Pipeline,
     desc: &RayTracingPipelineDesc<'_>,
+    shader_record_size: u32,
 ) -> Result<ShaderBindingTable> {
     let shared = &ctx.shared;
-    let layout = SbtLayout::new(&shared.info.ray_tracing);
+    let limits = &shared.info.ray_tracing;
+    let layout = SbtLayout::new(limits).with_record(shader_record_size, limits);
+    if layout.stride > u64::from(limits.max_shader_group_stride) {
+        return Err(Error::Invalid(format!(
+            "shader records of {shader_record_size} bytes make a stride of {} bytes; the device allows {}",
+            layout.stride, limits.max_shader_group_stride
+        )));
+    }
     let (mut raygen, mut miss, mut hit, mut callable) =
         (Vec::new(), Vec::new(), Vec::new(), Vec::new());
     for (k, g) in desc.groups.iter().enumerate() {
@@ -733,6 +801,18 @@ mod tests {
         // Two miss records share one 64-byte region; three hit records need 96.
         assert_eq!(l.offsets(1, 2, 3, 0), (vec![0, 64, 128, 256], 256));
         assert_eq!(l.offsets(2, 1, 1, 1), (vec![0, 64, 128, 192, 256], 320));
+    }
+
+    #[test]
+    fn shader_records_widen_the_stride() {
+        // NVIDIA: a 32-byte handle and 8 bytes of shader record round up
+        // to the 32-byte handle alignment: 64.
+        let l = SbtLayout::new(&limits(32, 32, 64)).with_record(8, &limits(32, 32, 64));
+        assert_eq!(l.stride, 64);
+        assert_eq!(l.offsets(1, 1, 2, 0), (vec![0, 64, 128, 256], 256));
+        // No record: the handle alone.
+        let l = SbtLayout::new(&limits(32, 16, 32)).with_record(0, &limits(32, 16, 32));
+        assert_eq!(l.stride, 32);
     }
 
     #[test]

@@ -2,75 +2,55 @@
 //! the driver for every shader's stack size, in the stack report's order.
 
 use super::{
-    Binding, BindingKind, Context, Group, RayTracingPipeline, RayTracingPipelineDesc, Result,
-    ShaderStage, Stage,
+    Context, Error, Group, RayTracingPipeline, RayTracingPipelineDesc, Result, ShaderStage, Stage,
 };
 use crate::pipeline::{HitGroupKind, Pipeline, Slot};
-use crate::program::scalar::scalar_size;
-use crate::program::Type;
 use std::collections::BTreeMap;
 
-/// Descriptor bindings (set 0) and push-constant bytes the pipeline's
-/// shaders declare, so the layout matches them.
-fn interface(pipeline: &Pipeline) -> (Vec<Binding>, u32) {
-    use spirv::StorageClass as C;
-    let mut bindings: BTreeMap<u32, BindingKind> = BTreeMap::new();
-    let mut push = 0u32;
-    for p in &pipeline.programs {
-        for g in &p.globals {
-            let kind = match (g.storage, p.ty(g.ty)) {
-                (C::UniformConstant, Some(Type::AccelerationStructure)) => {
-                    BindingKind::AccelerationStructure
-                }
-                (C::UniformConstant, Some(Type::Image)) => BindingKind::StorageImage,
-                (C::StorageBuffer, _) => BindingKind::StorageBuffer,
-                (C::Uniform, _) => {
-                    if p.decoration(g.ty, spirv::Decoration::BufferBlock).is_some() {
-                        BindingKind::StorageBuffer
-                    } else {
-                        BindingKind::UniformBuffer
-                    }
-                }
-                (C::PushConstant, _) => {
-                    let size = scalar_size(p, g.ty).unwrap_or(0);
-                    push = push.max(size.next_multiple_of(4) as u32);
-                    continue;
-                }
-                _ => continue,
-            };
-            if g.set.unwrap_or(0) == 0 {
-                if let Some(b) = g.binding {
-                    bindings.entry(b).or_insert(kind);
-                }
-            }
+/// The module with an `OpSource` language newer than SPIR-V 1.5's list
+/// (WGSL is 10, Slang 11) set to 0, Unknown: it is debug information no
+/// driver reads, and older validators reject the module for it.
+fn known_source_language(words: &[u32]) -> Vec<u32> {
+    let mut out = words.to_vec();
+    let mut at = 5;
+    while at < out.len() {
+        let count = (out[at] >> 16) as usize;
+        if count == 0 {
+            break;
         }
+        // OpSource (3): language, version, ...
+        if out[at] & 0xffff == 3 && count >= 3 && out.get(at + 1).is_some_and(|&l| l > 9) {
+            out[at + 1] = 0;
+        }
+        at += count;
     }
-    (
-        bindings
-            .into_iter()
-            .map(|(b, k)| Binding::new(b, k))
-            .collect(),
-        push,
-    )
+    out
 }
 
 /// The driver's stack size for every shader of the pipeline, by its slot and
 /// stage. The pipeline is created with its declared recursion depth, else
 /// `depth` (the depth the caller found it needs). Comparing the numbers with
-/// the model is the caller's business.
+/// the model is the caller's business. The pipeline layout is reflected
+/// from the shaders (every set, descriptor type and push constant they use).
 pub fn driver_stack_sizes<'p>(
     ctx: &Context,
     pipeline: &'p Pipeline,
     depth: Option<u32>,
 ) -> Result<BTreeMap<(Slot, Stage), u64>> {
+    let modules: Vec<Vec<u32>> = pipeline
+        .programs
+        .iter()
+        .map(|p| known_source_language(&p.words))
+        .collect();
     let mut stages: Vec<ShaderStage> = Vec::new();
     let mut stage_of = |sref: &'p crate::pipeline::ShaderRef| -> Option<u32> {
-        let program = pipeline.program(sref)?;
+        pipeline.program(sref)?;
+        let words = modules.get(sref.program)?;
         if !sref.stage.is_ray_tracing() {
             return None;
         }
         stages.push(ShaderStage {
-            spirv: &program.words,
+            spirv: words,
             entry_point: &sref.entry,
             stage: sref.stage,
         });
@@ -113,22 +93,23 @@ pub fn driver_stack_sizes<'p>(
             groups.push(Group::General(s));
         }
     }
-    let (bindings, push_constant_size) = interface(pipeline);
+    let interface = super::interface::reflect(pipeline).map_err(Error::Invalid)?;
     let depth = pipeline
         .max_recursion_depth
         .or(depth)
         .unwrap_or(1)
         .min(ctx.limits().max_ray_recursion_depth);
-    let rt = RayTracingPipeline::new(
+    let rt = RayTracingPipeline::with_interface(
         ctx,
         &RayTracingPipelineDesc {
             stages: &stages,
             groups: &groups,
             max_recursion_depth: depth,
-            bindings: &bindings,
-            push_constant_size,
+            bindings: &[],
+            push_constant_size: 0,
             stack_size: None,
         },
+        &interface,
     )?;
     let sizes = rt.group_stack_sizes();
     let mut out = BTreeMap::new();
@@ -159,4 +140,36 @@ pub fn driver_stack_sizes<'p>(
         }
     }
     Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::known_source_language;
+
+    #[test]
+    fn newer_source_languages_become_unknown() {
+        // Header, OpSource WGSL (10) version 1, OpCapability Shader.
+        let words = [
+            0x0723_0203,
+            0x0001_0400,
+            0,
+            8,
+            0,
+            (3 << 16) | 3,
+            10,
+            1,
+            (2 << 16) | 17,
+            1,
+        ];
+        let out = known_source_language(&words);
+        assert_eq!(out[6], 0);
+        assert_eq!(out[..6], words[..6]);
+        assert_eq!(out[7..], words[7..]);
+        // GLSL (2) stays; a truncated module is left alone, not a panic.
+        let glsl = [0x0723_0203, 0x0001_0400, 0, 8, 0, (3 << 16) | 3, 2, 460];
+        assert_eq!(known_source_language(&glsl), glsl);
+        let cut = [0x0723_0203, 0x0001_0400, 0, 8, 0, (9 << 16) | 3, 10];
+        assert_eq!(known_source_language(&cut)[6], 0);
+        assert!(known_source_language(&[0x0723_0203]).len() == 1);
+    }
 }

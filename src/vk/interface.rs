@@ -1,0 +1,441 @@
+//! The resource interface of a described pipeline, reflected from its
+//! SPIR-V so that the pipeline layout a driver gets matches the shaders:
+//! every descriptor set and binding with its descriptor type and count
+//! (arrays, runtime arrays), the stages that use it, the push-constant
+//! range, and the shader-record bytes the shaders read.
+//!
+//! Pure: no Vulkan here; `descriptors.rs` turns it into layouts.
+
+use crate::pipeline::{Pipeline, ShaderRef};
+use crate::program::{Id, Program, Type};
+use crate::shader::Stage;
+use spirv::StorageClass as C;
+use std::collections::{BTreeMap, BTreeSet, HashSet};
+
+/// A Vulkan descriptor type, as the shaders declare it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub enum DescriptorKind {
+    Sampler,
+    CombinedImageSampler,
+    SampledImage,
+    StorageImage,
+    UniformTexelBuffer,
+    StorageTexelBuffer,
+    UniformBuffer,
+    StorageBuffer,
+    AccelerationStructure,
+}
+
+/// How many descriptors a binding holds.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum DescriptorCount {
+    Fixed(u32),
+    /// A runtime array (`T name[]`): the layout gives it a count of its own
+    /// choosing, and the device needs `runtimeDescriptorArray`.
+    Runtime,
+}
+
+/// One binding of the reflected layout.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct LayoutBinding {
+    pub set: u32,
+    pub binding: u32,
+    pub kind: DescriptorKind,
+    pub count: DescriptorCount,
+    /// Every stage whose entry point uses it.
+    pub stages: BTreeSet<Stage>,
+}
+
+/// What the pipeline layout and shader binding table must provide.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct PipelineInterface {
+    /// Sorted by set, then binding.
+    pub bindings: Vec<LayoutBinding>,
+    /// Bytes of push constants read (0 for none), from offset 0.
+    pub push_constant_size: u32,
+    pub push_constant_stages: BTreeSet<Stage>,
+    /// The largest shader-record block any shader reads, in bytes.
+    pub shader_record_size: u32,
+}
+
+impl PipelineInterface {
+    /// Whether some binding is a runtime array.
+    pub fn has_runtime_array(&self) -> bool {
+        self.bindings
+            .iter()
+            .any(|b| b.count == DescriptorCount::Runtime)
+    }
+
+    /// The number of descriptor sets the layout needs (highest set + 1).
+    pub fn set_count(&self) -> u32 {
+        self.bindings.iter().map(|b| b.set + 1).max().unwrap_or(0)
+    }
+}
+
+/// The interface of every ray-tracing shader in the pipeline, merged. Two
+/// shaders that declare one set and binding with different descriptor
+/// types or counts are an error: no layout can serve both.
+pub fn reflect(pipeline: &Pipeline) -> Result<PipelineInterface, String> {
+    let mut shaders: Vec<&ShaderRef> = Vec::new();
+    shaders.extend(&pipeline.raygen);
+    shaders.extend(&pipeline.miss);
+    for h in &pipeline.hit_groups {
+        shaders.extend(h.closest_hit.iter());
+        shaders.extend(h.any_hit.iter());
+        shaders.extend(h.intersection.iter());
+    }
+    shaders.extend(&pipeline.callable);
+    let mut out = PipelineInterface::default();
+    let mut bindings: BTreeMap<(u32, u32), (LayoutBinding, String)> = BTreeMap::new();
+    for s in shaders {
+        let Some(program) = pipeline.program(s) else {
+            continue;
+        };
+        let used = used_globals(program, s);
+        for g in program.globals.iter().filter(|g| used.contains(&g.id)) {
+            let who = format!("{} `{}` ({})", s.stage.as_str(), s.entry, s.file.display());
+            match g.storage {
+                C::PushConstant => {
+                    let size = block_extent(program, g.ty).ok_or_else(|| {
+                        format!(
+                            "{who}: cannot size push-constant block `{}`",
+                            program.display_name(g.id)
+                        )
+                    })?;
+                    out.push_constant_size = out.push_constant_size.max(size.next_multiple_of(4));
+                    out.push_constant_stages.insert(s.stage);
+                    continue;
+                }
+                C::ShaderRecordBufferKHR => {
+                    let size = block_extent(program, g.ty).unwrap_or(0);
+                    out.shader_record_size = out.shader_record_size.max(size);
+                    continue;
+                }
+                C::UniformConstant | C::Uniform | C::StorageBuffer => {}
+                _ => continue,
+            }
+            let Some((kind, count)) = descriptor(program, g.storage, g.ty)? else {
+                continue;
+            };
+            let (Some(set), Some(binding)) = (g.set, g.binding) else {
+                return Err(format!(
+                    "{who}: resource `{}` has no descriptor set or binding decoration",
+                    program.display_name(g.id)
+                ));
+            };
+            match bindings.get_mut(&(set, binding)) {
+                Some((b, first)) => {
+                    if b.kind != kind || b.count != count {
+                        return Err(format!(
+                            "set {set}, binding {binding} is {:?} ×{:?} in {first} but {kind:?} ×{count:?} in {who}: no pipeline layout serves both",
+                            b.kind, b.count
+                        ));
+                    }
+                    b.stages.insert(s.stage);
+                }
+                None => {
+                    bindings.insert(
+                        (set, binding),
+                        (
+                            LayoutBinding {
+                                set,
+                                binding,
+                                kind,
+                                count,
+                                stages: BTreeSet::from([s.stage]),
+                            },
+                            who,
+                        ),
+                    );
+                }
+            }
+        }
+    }
+    out.bindings = bindings.into_values().map(|(b, _)| b).collect();
+    Ok(out)
+}
+
+/// The globals an entry point uses: referenced from a function it reaches,
+/// or listed in its interface.
+fn used_globals(program: &Program, s: &ShaderRef) -> HashSet<Id> {
+    let globals: HashSet<Id> = program.globals.iter().map(|g| g.id).collect();
+    let mut used = HashSet::new();
+    if let Some(e) = program
+        .entry_points
+        .iter()
+        .find(|e| e.name == s.entry && e.stage == s.stage)
+    {
+        used.extend(e.interface.iter().copied().filter(|i| globals.contains(i)));
+    }
+    for f in program.reachable_functions(s.function) {
+        let Some(f) = program.function(f) else {
+            continue;
+        };
+        for inst in &program.insts[f.start..=f.end] {
+            for op in &inst.operands {
+                if let rspirv::dr::Operand::IdRef(id) = op {
+                    if globals.contains(id) {
+                        used.insert(*id);
+                    }
+                }
+            }
+        }
+    }
+    used
+}
+
+/// The descriptor type and count of a resource variable of type `ty`;
+/// `None` for variables that are no descriptor.
+fn descriptor(
+    program: &Program,
+    storage: C,
+    ty: Id,
+) -> Result<Option<(DescriptorKind, DescriptorCount)>, String> {
+    let (elem, count) = match program.ty(ty) {
+        Some(Type::Array { elem, len }) => {
+            let n = len
+                .value()
+                .and_then(|n| u32::try_from(n).ok())
+                .filter(|&n| n > 0)
+                .ok_or_else(|| format!("a descriptor array of type %{ty} has no usable length"))?;
+            (*elem, DescriptorCount::Fixed(n))
+        }
+        Some(Type::RuntimeArray { elem }) => (*elem, DescriptorCount::Runtime),
+        _ => (ty, DescriptorCount::Fixed(1)),
+    };
+    let kind = match (storage, program.ty(elem)) {
+        (C::UniformConstant, Some(Type::AccelerationStructure)) => {
+            DescriptorKind::AccelerationStructure
+        }
+        (C::UniformConstant, Some(Type::Sampler)) => DescriptorKind::Sampler,
+        (C::UniformConstant, Some(Type::SampledImage)) => {
+            // glslang declares `samplerBuffer` as a sampled image of a
+            // buffer image: Vulkan binds that as a uniform texel buffer.
+            let image = program.def(elem).and_then(|i| match i.operands.first() {
+                Some(rspirv::dr::Operand::IdRef(id)) => Some(*id),
+                _ => None,
+            });
+            match image.map(|i| image_kind(program, i)).transpose()? {
+                Some(DescriptorKind::UniformTexelBuffer) => DescriptorKind::UniformTexelBuffer,
+                _ => DescriptorKind::CombinedImageSampler,
+            }
+        }
+        (C::UniformConstant, Some(Type::Image)) => image_kind(program, elem)?,
+        (C::UniformConstant, _) => return Ok(None),
+        (C::StorageBuffer, _) => DescriptorKind::StorageBuffer,
+        (C::Uniform, _) => {
+            if program
+                .decoration(elem, spirv::Decoration::BufferBlock)
+                .is_some()
+            {
+                DescriptorKind::StorageBuffer
+            } else {
+                DescriptorKind::UniformBuffer
+            }
+        }
+        _ => return Ok(None),
+    };
+    Ok(Some((kind, count)))
+}
+
+/// Sampled or storage image, uniform or storage texel buffer, from the
+/// `OpTypeImage` operands (Dim, Sampled).
+fn image_kind(program: &Program, ty: Id) -> Result<DescriptorKind, String> {
+    use rspirv::dr::Operand as O;
+    let inst = program
+        .def(ty)
+        .ok_or_else(|| format!("image type %{ty} has no definition"))?;
+    let dim = inst.operands.iter().find_map(|o| match o {
+        O::Dim(d) => Some(*d),
+        _ => None,
+    });
+    // Operands: sampled type, Dim, Depth, Arrayed, MS, Sampled, format.
+    let sampled = match inst.operands.get(5) {
+        Some(O::LiteralBit32(v)) => *v,
+        _ => 0,
+    };
+    Ok(match (dim, sampled) {
+        (Some(spirv::Dim::DimBuffer), 2) => DescriptorKind::StorageTexelBuffer,
+        (Some(spirv::Dim::DimBuffer), _) => DescriptorKind::UniformTexelBuffer,
+        (Some(spirv::Dim::DimSubpassData), _) => {
+            return Err("a subpass input has no place in a ray-tracing pipeline".into())
+        }
+        (_, 2) => DescriptorKind::StorageImage,
+        _ => DescriptorKind::SampledImage,
+    })
+}
+
+/// The bytes a block (push constants, shader record) spans: the end of its
+/// last member by its `Offset` decoration, else its scalar size.
+fn block_extent(program: &Program, ty: Id) -> Option<u32> {
+    let size = match program.ty(ty)? {
+        Type::Struct { members } => {
+            let mut end = 0u64;
+            for (i, &m) in members.iter().enumerate() {
+                let offset = program
+                    .member_decoration(ty, i as u32, spirv::Decoration::Offset)
+                    .and_then(|v| v.first().copied())
+                    .map(u64::from);
+                let offset = match offset {
+                    Some(o) => o,
+                    None => {
+                        return crate::program::scalar::scalar_size(program, ty)
+                            .and_then(|s| u32::try_from(s).ok())
+                    }
+                };
+                end = end.max(offset + member_size(program, ty, i as u32, m)?);
+            }
+            end
+        }
+        _ => crate::program::scalar::scalar_size(program, ty)?,
+    };
+    u32::try_from(size).ok()
+}
+
+/// A member's size, honouring matrix and array strides.
+fn member_size(program: &Program, parent: Id, index: u32, ty: Id) -> Option<u64> {
+    let scalar = crate::program::scalar::scalar_size;
+    match program.ty(ty)? {
+        Type::Matrix { columns, column } => {
+            match program
+                .member_decoration(parent, index, spirv::Decoration::MatrixStride)
+                .and_then(|v| v.first().copied())
+            {
+                Some(stride) => {
+                    let col = scalar(program, *column)?;
+                    let row_major = program
+                        .member_decoration(parent, index, spirv::Decoration::RowMajor)
+                        .is_some();
+                    if row_major {
+                        // Rows of `columns` elements, one per column component.
+                        let rows = match program.ty(*column)? {
+                            Type::Vector { count, .. } => u64::from(*count),
+                            _ => 1,
+                        };
+                        let elem = col / rows.max(1);
+                        Some((rows - 1) * u64::from(stride) + u64::from(*columns) * elem)
+                    } else {
+                        Some(u64::from(*columns - 1) * u64::from(stride) + col)
+                    }
+                }
+                None => scalar(program, ty),
+            }
+        }
+        Type::Array { elem, len } => match program
+            .decoration(ty, spirv::Decoration::ArrayStride)
+            .and_then(|v| v.first().copied())
+        {
+            Some(stride) => {
+                let n = len.value()?;
+                Some(n.saturating_sub(1) * u64::from(stride) + scalar(program, *elem)?)
+            }
+            None => scalar(program, ty),
+        },
+        _ => scalar(program, ty),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::path::Path;
+
+    fn load(rel: &str) -> Pipeline {
+        crate::pipeline::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join(rel)).unwrap()
+    }
+
+    #[test]
+    fn hlsl_texture_in_space1_and_bindless_array_in_space2() {
+        let i = reflect(&load("fixtures/pipelines/textured_hlsl.pipeline.toml")).unwrap();
+        let got: Vec<(u32, u32, DescriptorKind, DescriptorCount, Vec<Stage>)> = i
+            .bindings
+            .iter()
+            .map(|b| {
+                (
+                    b.set,
+                    b.binding,
+                    b.kind,
+                    b.count,
+                    b.stages.iter().copied().collect(),
+                )
+            })
+            .collect();
+        use DescriptorCount::*;
+        use DescriptorKind::*;
+        assert_eq!(
+            got,
+            [
+                (
+                    0,
+                    0,
+                    AccelerationStructure,
+                    Fixed(1),
+                    vec![Stage::RayGeneration]
+                ),
+                (0, 1, StorageImage, Fixed(1), vec![Stage::RayGeneration]),
+                (0, 2, UniformBuffer, Fixed(1), vec![Stage::RayGeneration]),
+                (1, 0, SampledImage, Fixed(1), vec![Stage::ClosestHit]),
+                (1, 1, Sampler, Fixed(1), vec![Stage::ClosestHit]),
+                (2, 0, StorageBuffer, Runtime, vec![Stage::ClosestHit]),
+            ]
+        );
+        assert_eq!(i.set_count(), 3);
+        assert!(i.has_runtime_array());
+        assert_eq!(i.push_constant_size, 0);
+    }
+
+    #[test]
+    fn glsl_bindless_arrays_in_four_sets() {
+        let i = reflect(&load("fixtures/pipelines/bindless.pipeline.toml")).unwrap();
+        use DescriptorCount::*;
+        use DescriptorKind::*;
+        let got: Vec<(u32, u32, DescriptorKind, DescriptorCount)> = i
+            .bindings
+            .iter()
+            .map(|b| (b.set, b.binding, b.kind, b.count))
+            .collect();
+        assert_eq!(
+            got,
+            [
+                (0, 0, AccelerationStructure, Fixed(1)),
+                (0, 1, StorageImage, Fixed(1)),
+                (0, 2, UniformBuffer, Fixed(1)),
+                (1, 0, SampledImage, Runtime),
+                (1, 1, Sampler, Fixed(1)),
+                (2, 0, StorageBuffer, Runtime),
+                (2, 1, UniformTexelBuffer, Fixed(1)),
+                (2, 2, StorageTexelBuffer, Fixed(1)),
+                (2, 3, CombinedImageSampler, Fixed(4)),
+                (3, 0, CombinedImageSampler, Fixed(1)),
+            ]
+        );
+        // Push constants in ray generation and closest hit, 8 bytes; the
+        // shader record (two uints) read by the closest hit.
+        assert_eq!(i.push_constant_size, 8);
+        assert_eq!(
+            i.push_constant_stages.iter().copied().collect::<Vec<_>>(),
+            [Stage::RayGeneration, Stage::ClosestHit]
+        );
+        assert_eq!(i.shader_record_size, 8);
+        let env = &i.bindings.last().unwrap().stages;
+        assert_eq!(env.iter().copied().collect::<Vec<_>>(), [Stage::Miss]);
+    }
+
+    #[test]
+    fn conflicting_declarations_are_an_error() {
+        // The same set and binding as a storage image in one shader and a
+        // uniform buffer in another: no layout serves both.
+        let mut p = load("fixtures/pipelines/bindless.pipeline.toml");
+        let rgen = p.raygen[0].program;
+        let g = p.programs[rgen]
+            .globals
+            .iter_mut()
+            .find(|g| g.binding == Some(1) && g.set == Some(0))
+            .unwrap();
+        g.set = Some(3);
+        g.binding = Some(0);
+        let e = reflect(&p).unwrap_err();
+        assert!(e.contains("set 3, binding 0"), "{e}");
+        assert!(e.contains("no pipeline layout serves both"), "{e}");
+    }
+}
