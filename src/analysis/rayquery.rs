@@ -413,10 +413,20 @@ pub fn in_loop(p: &Program, i: usize, resets: &[usize]) -> bool {
             continue;
         };
         let Some(b) = f.block_of(i) else { continue };
-        let reset_blocks: Vec<usize> = resets
-            .iter()
-            .filter(|&&r| f.start <= r && r <= f.end)
-            .filter_map(|&r| f.block_of(r))
+        // Blocks that reset: holding one of `resets`, or a call that reaches one.
+        let reset_blocks: Vec<usize> = (f.start..=f.end)
+            .filter(|&k| {
+                resets.contains(&k)
+                    || (p.insts[k].class.opcode == Op::FunctionCall
+                        && matches!(p.insts[k].operands.first(), Some(Operand::IdRef(c)) if {
+                            let funcs = p.reachable_functions(*c);
+                            resets.iter().any(|r| {
+                                p.function_of(*r)
+                                    .is_some_and(|g| funcs.contains(&p.functions[g].id))
+                            })
+                        }))
+            })
+            .filter_map(|k| f.block_of(k))
             .collect();
         if cfg::natural_loops(f)
             .iter()

@@ -473,6 +473,7 @@ mod tests {
                 "RT040 non-uniform-resource-index",
                 "RT041 register-binding-collision",
                 "RT050 normalize-of-zero",
+                "RT051 unguarded-pdf-division",
                 "RT060 ray-query-never-commits",
                 "RT061 ray-query-ignores-procedural",
                 "RT062 ray-query-single-proceed",
