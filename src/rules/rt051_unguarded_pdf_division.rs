@@ -75,6 +75,8 @@ fn dots(p: &Program, id: Id, depth: u32, out: &mut Vec<Id>) -> bool {
     }
     let Some(inst) = p.def(id) else { return false };
     match (inst.class.opcode, inst.operands.as_slice()) {
+        // `dot(v, v)` is a squared length (a ray-sphere test's `a`), not a cosine.
+        (Op::Dot, [Operand::IdRef(a), Operand::IdRef(b)]) if same_value(p, *a, *b) => false,
         (Op::Dot, _) => {
             out.push(id);
             true
@@ -107,6 +109,34 @@ fn dots(p: &Program, id: Id, depth: u32, out: &mut Vec<Id>) -> bool {
         }
         _ => false,
     }
+}
+
+/// Whether two ids are one value: the same id, or loads of one pointer.
+fn same_value(p: &Program, a: Id, b: Id) -> bool {
+    let ptr = |x: Id| {
+        p.def(x)
+            .filter(|i| i.class.opcode == Op::Load)
+            .and_then(|i| i.operands.first().cloned())
+    };
+    // One pointer, or two access chains with the same base and indices.
+    let same_ptr = |x: Id, y: Id| {
+        x == y
+            || matches!((p.def(x), p.def(y)), (Some(i), Some(j))
+                if i.class.opcode == Op::AccessChain
+                    && j.class.opcode == Op::AccessChain
+                    && i.operands == j.operands)
+    };
+    let extract = |x: Id| {
+        p.def(x)
+            .filter(|i| i.class.opcode == Op::CompositeExtract)
+            .map(|i| i.operands.clone())
+    };
+    a == b
+        || matches!((ptr(a), ptr(b)), (Some(Operand::IdRef(x)), Some(Operand::IdRef(y))) if same_ptr(x, y))
+        || matches!((extract(a), extract(b)), (Some(ea), Some(eb))
+            if ea[1..] == eb[1..]
+                && matches!((&ea[0], &eb[0]), (Operand::IdRef(x), Operand::IdRef(y))
+                    if x == y || matches!((ptr(*x), ptr(*y)), (Some(Operand::IdRef(u)), Some(Operand::IdRef(v))) if same_ptr(u, v))))
 }
 
 /// The one value stored to a function-local variable, when it is written
