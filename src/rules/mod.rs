@@ -215,8 +215,9 @@ impl<'a> Context<'a> {
     }
 
     /// Where a resource is declared: its debug-info position, else (glslang
-    /// `-g` has none for variables) the one line of the embedded source that
-    /// gives a binding and names it, else its first use.
+    /// `-g` has none for variables) the one line of the source (embedded, else
+    /// the file the debug info names) that
+    /// gives a binding (`binding`, `register(`) and names it, else its first use.
     pub fn resource_location(&self, var: Id) -> Option<Location> {
         let p = self.program;
         if let Some(l) = p.decl_location(Decl::Var(var)) {
@@ -235,9 +236,21 @@ impl<'a> Context<'a> {
             };
             let mut found = None;
             for (fi, f) in p.files.iter().enumerate() {
-                let Some(text) = &f.text else { continue };
+                // The embedded text, else the file debug info names (rtlint's
+                // own HLSL output embeds none).
+                let read;
+                let text = match &f.text {
+                    Some(t) => t,
+                    None => match std::fs::read_to_string(&f.path) {
+                        Ok(t) => {
+                            read = t;
+                            &read
+                        }
+                        Err(_) => continue,
+                    },
+                };
                 for (li, line) in text.lines().enumerate() {
-                    if line.contains("binding") && word(line) {
+                    if (line.contains("binding") || line.contains("register(")) && word(line) {
                         if found.is_some() {
                             return p.var_location(var);
                         }

@@ -145,10 +145,11 @@ fn check(ctx: &Context) -> Vec<Diagnostic> {
         if decorated {
             continue;
         }
-        let loc = p.site_location(i);
-        if !seen.insert((g.id, loc.as_ref().map(|l| (l.path.clone(), l.line)))) {
+        // One finding per array and index value, whatever the debug info.
+        if !seen.insert((g.id, *index)) {
             continue;
         }
+        let loc = p.site_location(i);
         let name = p.display_name(g.id);
         let marker = match p.language {
             Language::Hlsl => "`NonUniformResourceIndex(...)`",

@@ -158,7 +158,9 @@ fn check(ctx: &Context) -> Vec<Diagnostic> {
         }
     }
     let mut out = Vec::new();
-    for ((set, binding), vars) in by_slot {
+    for ((set, binding), mut vars) in by_slot {
+        // By name: compilers order their globals differently.
+        vars.sort_by_key(|(g, _)| (p.display_name(g.id), g.id));
         let Some(&(first, k0)) = vars.first() else {
             continue;
         };
