@@ -1,18 +1,24 @@
 // Mirror reflections with inline ray queries in a compute shader: no shader
-// binding table and no ray stack. Same scene, camera and shading as
-// reflect_iterative.wgsl.
+// binding table and no ray stack. Same scene, camera, shading, shadow rays
+// and ray origins as reflect_iterative.wgsl; the image must be the same.
 enable wgpu_ray_query;
 
 struct Params {
     width: u32,
     height: u32,
     max_bounces: u32,
-    _pad: u32,
+    // FLAG_LIGHT | FLAG_ROBUST
+    flags: u32,
+    camera: vec4<f32>,
+    // xyz: unit direction towards the light, w: ambient
+    light: vec4<f32>,
+    // t_min, t_max, throughput cut-off, fixed origin epsilon
+    ray: vec4<f32>,
 }
 
 struct Surface {
     normal_reflectivity: vec4<f32>,
-    albedo: vec4<f32>,
+    albedo_roughness: vec4<f32>,
 }
 
 @group(0) @binding(0) var tlas: acceleration_structure;
@@ -20,14 +26,37 @@ struct Surface {
 @group(0) @binding(2) var<storage, read> surfaces: array<Surface>;
 @group(0) @binding(3) var<uniform> params: Params;
 
+const FLAG_LIGHT: u32 = 1u;
+const FLAG_ROBUST: u32 = 2u;
+const RAY_FLAG_OPAQUE: u32 = 0x01u;
+// OPAQUE | ACCEPT_FIRST_HIT_AND_END_SEARCH
+const SHADOW_FLAGS: u32 = 0x05u;
+
 fn sky(dir: vec3<f32>) -> vec3<f32> {
     let k = 0.5 * (dir.y + 1.0);
     return mix(vec3<f32>(1.0, 1.0, 1.0), vec3<f32>(0.5, 0.7, 1.0), k);
 }
 
+// RGBA8 with alpha 255; a colour with an infinite or NaN channel is written
+// as 0 (alpha 0), so the image counts them. The exponent bits are tested:
+// a compiler may assume no NaN in `c != c`.
 fn pack_rgba8(c: vec3<f32>) -> u32 {
+    if any((bitcast<vec3<u32>>(c) & vec3<u32>(0x7F800000u)) == vec3<u32>(0x7F800000u)) {
+        return 0u;
+    }
     let v = vec3<u32>(clamp(c, vec3<f32>(0.0), vec3<f32>(1.0)) * 255.0 + 0.5);
     return v.x | (v.y << 8u) | (v.z << 16u) | (255u << 24u);
+}
+
+// Wächter & Binder, Ray Tracing Gems ch. 6: move the origin a few ulps
+// along the normal; a fixed epsilon when FLAG_ROBUST is off.
+fn offset_ray(p: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
+    if (params.flags & FLAG_ROBUST) == 0u {
+        return p + n * params.ray.w;
+    }
+    let of_i = vec3<i32>(256.0 * n);
+    let p_i = bitcast<vec3<f32>>(bitcast<vec3<i32>>(p) + select(of_i, -of_i, p < vec3<f32>(0.0)));
+    return select(p_i, p + (1.0 / 65536.0) * n, abs(p) < vec3<f32>(1.0 / 32.0));
 }
 
 @compute @workgroup_size(8, 8)
@@ -37,32 +66,50 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     }
     let size = vec2<f32>(f32(params.width), f32(params.height));
     let uv = (vec2<f32>(id.xy) + 0.5) / size * 2.0 - 1.0;
-    var origin = vec3<f32>(0.0, 1.0, 4.0);
+    var origin = params.camera.xyz;
     var dir = normalize(vec3<f32>(uv.x, -uv.y, -1.5));
     var color = vec3<f32>(0.0);
-    var throughput = vec3<f32>(1.0);
+    var throughput = 1.0;
     // Declared once, outside the loop: naga 30 emits invalid SPIR-V for a
     // ray query declared inside a loop body (rule RT005).
     var rq: ray_query;
     for (var bounce = 0u; bounce <= params.max_bounces; bounce++) {
-        rayQueryInitialize(&rq, tlas, RayDesc(0x01u, 0xFFu, 0.001, 100.0, origin, dir));
-        rayQueryProceed(&rq);
+        rayQueryInitialize(&rq, tlas, RayDesc(RAY_FLAG_OPAQUE, 0xFFu, params.ray.x, params.ray.y, origin, dir));
+        // Every candidate is opaque here (the flag forces it), so Proceed
+        // commits the closest triangle by itself.
+        while rayQueryProceed(&rq) {
+        }
         let hit = rayQueryGetCommittedIntersection(&rq);
         if hit.kind == RAY_QUERY_INTERSECTION_NONE {
             color += throughput * sky(dir);
             break;
         }
-        let s = surfaces[hit.primitive_index];
+        let s = surfaces[hit.instance_custom_data + hit.primitive_index];
         let normal = s.normal_reflectivity.xyz;
         let reflectivity = s.normal_reflectivity.w;
-        let shade = max(dot(normal, -dir), 0.0);
-        color += throughput * s.albedo.xyz * shade * (1.0 - reflectivity);
+        let n = select(-normal, normal, dot(normal, dir) < 0.0);
+        let base = throughput * (1.0 - reflectivity) * s.albedo_roughness.xyz;
         throughput *= reflectivity;
-        if reflectivity <= 0.0 {
+        origin = offset_ray(origin + dir * hit.t, n);
+        let ndl = dot(n, params.light.xyz);
+        let headlight = max(dot(n, -dir), 0.0);
+        dir = reflect(dir, n);
+        if (params.flags & FLAG_LIGHT) != 0u {
+            color += base * params.light.w;
+            if ndl > 0.0 {
+                rayQueryInitialize(&rq, tlas, RayDesc(SHADOW_FLAGS, 0xFFu, params.ray.x, params.ray.y, origin, params.light.xyz));
+                while rayQueryProceed(&rq) {
+                }
+                if rayQueryGetCommittedIntersection(&rq).kind == RAY_QUERY_INTERSECTION_NONE {
+                    color += base * ndl;
+                }
+            }
+        } else {
+            color += base * headlight;
+        }
+        if !(throughput > params.ray.z) {
             break;
         }
-        origin = origin + dir * hit.t + normal * 0.001;
-        dir = reflect(dir, normal);
     }
     image[id.y * params.width + id.x] = pack_rgba8(color);
 }

@@ -206,6 +206,7 @@ impl Builder {
             front: front::FrontOptions {
                 include_dirs: self.include_dirs.clone(),
                 defines: self.defines.clone(),
+                ..front::FrontOptions::default()
             },
             ..lint::Options::default()
         }
@@ -275,6 +276,7 @@ impl Builder {
                         .chain(self.defines.iter().cloned())
                         .collect(),
                     entry: None,
+                    stage: None,
                 };
                 if let Err(e) = emit_spirv(input, &program, &hlsl_options, dir, &mut spirv_names) {
                     run.diagnostics.push(*e.0);

@@ -19,4 +19,6 @@ pub mod rules;
 pub mod shader;
 pub mod suppress;
 #[cfg(feature = "vulkan")]
+pub mod verify;
+#[cfg(feature = "vulkan")]
 pub mod vk;

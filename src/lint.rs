@@ -244,6 +244,8 @@ fn front_options(config: &Config, options: &Options) -> FrontOptions {
             .iter()
             .map(|(k, v)| (k.clone(), v.clone()))
             .collect(),
+        entry: options.front.entry.clone(),
+        stage: options.front.stage,
     };
     front_options
         .include_dirs

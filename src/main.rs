@@ -41,6 +41,18 @@ struct Common {
     /// Define a macro for HLSL and GLSL sources: NAME or NAME=VALUE.
     #[arg(short = 'D', value_name = "NAME[=VALUE]")]
     define: Vec<String>,
+    /// HLSL: only this entry point.
+    #[arg(short = 'E', long = "entry", value_name = "NAME")]
+    entry: Option<String>,
+    /// HLSL: the entry point's stage when it has no `[shader(...)]`: a DXC
+    /// profile (`ps_6_5`, `cs_6_5`, `lib_6_3`) or a stage name.
+    #[arg(
+        short = 'T',
+        long = "stage",
+        value_name = "PROFILE",
+        requires = "entry"
+    )]
+    stage: Option<String>,
     /// The name standard input (`-`) is linted under; its extension picks the language.
     #[arg(long, value_name = "PATH")]
     stdin_filename: Option<PathBuf>,
@@ -144,6 +156,30 @@ struct CheckArgs {
     pipeline: Vec<PathBuf>,
 }
 
+/// `rtlint verify`.
+#[derive(clap::Args, Clone)]
+struct VerifyArgs {
+    /// The folder holding `verify.toml`, the shaders and `scenes/`.
+    #[arg(long, default_value = "shaders")]
+    shaders: PathBuf,
+    /// Where the tables (CSV, Markdown) and the images of failed cases go.
+    #[arg(long, default_value = "target/verify")]
+    out: PathBuf,
+    /// Use the first ray-tracing device whose name contains this text.
+    #[arg(long, value_name = "NAME")]
+    device: Option<String>,
+    /// Run only the cases whose name (`shader/scene`) contains this text.
+    #[arg(long, value_name = "NAME")]
+    filter: Option<String>,
+    /// Also run the numerical-extremes matrix.
+    #[arg(long)]
+    extremes: bool,
+    /// Internal: run one case on the device and write its image (the child
+    /// process `verify` starts for every GPU run).
+    #[arg(long, hide = true, value_names = ["CASE", "IMAGE"], num_args = 2)]
+    child: Option<Vec<String>>,
+}
+
 #[derive(Subcommand)]
 enum Command {
     /// Lint shaders and report best-practice violations.
@@ -187,6 +223,15 @@ enum Command {
         /// Compile only this entry point.
         #[arg(short = 'E', long = "entry")]
         entry: Option<String>,
+        /// The entry point's stage when it has no `[shader(...)]`: a DXC
+        /// profile (`ps_6_5`, `cs_6_5`, `lib_6_3`) or a stage name (`pixel`).
+        #[arg(
+            short = 'T',
+            long = "stage",
+            value_name = "PROFILE",
+            requires = "entry"
+        )]
+        stage: Option<String>,
         /// Include directory (searched after the including file's folder).
         #[arg(short = 'I', value_name = "DIR")]
         include: Vec<PathBuf>,
@@ -201,6 +246,9 @@ enum Command {
         #[arg(long)]
         whole: bool,
     },
+    /// Run the reference reflection shaders on the Vulkan device and
+    /// compare each image with the CPU reference renderer.
+    Verify(VerifyArgs),
     /// List every rule.
     Rules,
     /// (Internal) `stack --driver` runs this in a child process per
@@ -257,11 +305,13 @@ fn run(cli: Cli) -> Result<u8, String> {
         Command::Compile {
             file,
             entry,
+            stage,
             include,
             define,
             output,
             whole,
-        } => compile(file, entry, include, define, output, whole),
+        } => compile(file, entry, stage, include, define, output, whole),
+        Command::Verify(args) => verify(args),
         Command::DriverStackSizes { pipeline, shader } => driver_stack_sizes(pipeline, shader),
         Command::Rules => {
             let mut out = std::io::stdout().lock();
@@ -314,6 +364,16 @@ fn options(common: &Common) -> Result<lint::Options, String> {
         front: rtlint::front::FrontOptions {
             include_dirs: common.include.clone(),
             defines: common.define.iter().map(|d| split_define(d)).collect(),
+            entry: common.entry.clone(),
+            stage: match common
+                .stage
+                .as_deref()
+                .map(rtlint::front::hlsl::parse_stage)
+            {
+                Some(Ok(s)) => s,
+                Some(Err(e)) => return Err(format!("-T: {e}")),
+                None => None,
+            },
         },
         respect_gitignore: !common.no_gitignore,
         stdin,
@@ -670,13 +730,22 @@ fn print_report(
 fn compile(
     file: PathBuf,
     entry: Option<String>,
+    stage: Option<String>,
     include: Vec<PathBuf>,
     define: Vec<String>,
     output: PathBuf,
     whole: bool,
 ) -> Result<u8, String> {
     use rtlint::front::hlsl;
+    let stage = match stage.as_deref().map(hlsl::parse_stage).transpose() {
+        Ok(s) => s.flatten(),
+        Err(e) => {
+            eprintln!("error: -T: {e}");
+            return Ok(2);
+        }
+    };
     let options = hlsl::HlslOptions {
+        stage,
         include_dirs: include,
         defines: define.iter().map(|d| split_define(d)).collect(),
         entry,
@@ -694,6 +763,9 @@ fn compile(
     if whole {
         return match hlsl::compile_file(&file, &options) {
             Ok(m) => {
+                for w in &m.warnings {
+                    eprintln!("{w}");
+                }
                 write(&output, &m.words)?;
                 eprintln!("{}: {} entry points", output.display(), m.entries.len());
                 Ok(0)
@@ -707,6 +779,9 @@ fn compile(
     };
     if entries.is_empty() {
         return Err(format!("{}: no entry point to compile", file.display()));
+    }
+    for w in &entries[0].warnings {
+        eprintln!("{w}");
     }
     if output.is_dir() {
         for e in &entries {
@@ -726,6 +801,101 @@ fn compile(
         ));
     }
     Ok(0)
+}
+
+#[cfg(not(feature = "vulkan"))]
+fn verify(_: VerifyArgs) -> Result<u8, String> {
+    Err("verify needs rtlint built with the `vulkan` feature".into())
+}
+
+/// `rtlint verify`: every GPU run in a child process (this executable with
+/// `verify --child CASE IMAGE`), a progress bar, the table, exit 1 on a
+/// failed case.
+#[cfg(feature = "vulkan")]
+fn verify(args: VerifyArgs) -> Result<u8, String> {
+    use rtlint::verify;
+    if let Some(child) = &args.child {
+        let [case, image] = child.as_slice() else {
+            return Err("--child takes a case and an image path".into());
+        };
+        return match verify::child_main(
+            &args.shaders,
+            case,
+            std::path::Path::new(image),
+            args.device.as_deref(),
+        ) {
+            Ok(()) => Ok(0),
+            Err(e) if e == verify::SKIP => Ok(verify::SKIP_CODE as u8),
+            Err(e) => Err(e),
+        };
+    }
+    let exe = std::env::current_exe().map_err(|e| format!("cannot find rtlint itself: {e}"))?;
+    let make_child = |case: &str, image: &std::path::Path| {
+        let mut c = std::process::Command::new(&exe);
+        c.arg("verify")
+            .arg("--shaders")
+            .arg(&args.shaders)
+            .arg("--child")
+            .arg(case)
+            .arg(image);
+        if let Some(d) = &args.device {
+            c.arg("--device").arg(d);
+        }
+        c
+    };
+    let options = verify::Options {
+        shaders: args.shaders.clone(),
+        out: args.out.clone(),
+        filter: args.filter.clone(),
+        extremes: args.extremes,
+        child: &make_child,
+    };
+    let bar = indicatif::ProgressBar::new(0);
+    bar.set_style(
+        indicatif::ProgressStyle::with_template("{bar:30} {pos}/{len} {msg}")
+            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+    );
+    let report = verify::run(&options, |done, total, name| {
+        bar.set_length(total as u64);
+        bar.set_position(done as u64);
+        bar.set_message(name.to_string());
+    });
+    bar.finish_and_clear();
+    let report = report?;
+    let mut out = std::io::stdout().lock();
+    let device = report.device.as_deref().unwrap_or("no device answered");
+    let _ = writeln!(out, "device: {device}");
+    let _ = write!(out, "{}", report.text());
+    let mut files = vec![
+        ("verify.csv", report.csv()),
+        ("verify.md", report.markdown()),
+    ];
+    if args.extremes {
+        let matrix = verify::Report {
+            device: report.device.clone(),
+            rows: report
+                .rows
+                .iter()
+                .filter(|r| r.case.name.starts_with("extremes/"))
+                .cloned()
+                .collect(),
+        };
+        files.push(("extremes.csv", matrix.csv()));
+        files.push(("extremes.md", matrix.markdown()));
+    }
+    for (name, text) in files {
+        let path = args.out.join(name);
+        std::fs::write(&path, text).map_err(|e| format!("cannot write {}: {e}", path.display()))?;
+    }
+    let failed = report.rows.iter().filter(|r| !r.passed()).count();
+    let _ = writeln!(
+        out,
+        "{} cases, {} failed; tables in {}",
+        report.rows.len(),
+        failed,
+        args.out.display()
+    );
+    Ok(if failed == 0 { 0 } else { 1 })
 }
 
 /// What the child process of `stack --driver` reports for one pipeline.

@@ -232,7 +232,9 @@ fn json_check_contract() {
         "check",
         "--format",
         "json",
-        "fixtures/glsl/payloads.rgen.gV.spv",
+        // HLSL: RT002 and RT003 (whose fix is checked below) judge HLSL
+        // payloads only.
+        "fixtures/hlsl/payloads.hlsl",
     ]);
     let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     let diags = v["diagnostics"].as_array().unwrap();
@@ -254,8 +256,8 @@ fn json_check_contract() {
     ] {
         assert!(d.get(key).is_some(), "missing key {key}");
     }
-    assert_eq!(d["path"], "fixtures/glsl/payloads.rgen");
-    assert_eq!(d["line"], 6);
+    assert_eq!(d["path"], "fixtures/hlsl/payloads.hlsl");
+    assert_eq!(d["line"], 2);
     assert_eq!(d["severity"], "warning");
     assert_eq!(
         diags[1]["fix"]
@@ -265,7 +267,7 @@ fn json_check_contract() {
             .nth(1)
             .unwrap()
             .trim(),
-        "vec3 color;"
+        "float3 color;"
     );
     assert_eq!(v["summary"]["warnings"], 3);
     assert_eq!(v["summary"]["files"], 1);
@@ -319,23 +321,23 @@ fn github_and_sarif_formats() {
         "check",
         "--format",
         "github",
-        "fixtures/wgsl/RT002_bad.wgsl",
+        "fixtures/wgsl/RT001_bad.wgsl",
     ]);
     let text = stdout(&o);
     assert!(
         text.starts_with(
-            "::warning title=rtlint (RT002),file=fixtures/wgsl/RT002_bad.wgsl,line=3,"
+            "::warning title=rtlint (RT001),file=fixtures/wgsl/RT001_bad.wgsl,line=4,"
         ),
         "{text}"
     );
-    let o = run(&["check", "--format", "sarif", "fixtures/wgsl/RT002_bad.wgsl"]);
+    let o = run(&["check", "--format", "sarif", "fixtures/wgsl/RT001_bad.wgsl"]);
     let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     assert_eq!(v["version"], "2.1.0");
     let results = v["runs"][0]["results"].as_array().unwrap();
-    assert_eq!(results.len(), 2);
-    assert_eq!(results[0]["ruleId"], "RT002");
+    assert_eq!(results.len(), 1);
+    assert_eq!(results[0]["ruleId"], "RT001");
     assert_eq!(
         results[0]["locations"][0]["physicalLocation"]["region"]["startLine"],
-        3
+        4
     );
 }

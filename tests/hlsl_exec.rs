@@ -197,6 +197,42 @@ fn compute_semantics_on_the_driver() {
     assert_eq!(got[expected.len()], 0, "more results than expected");
 }
 
+/// Front-end constructs of the DXR corpus (default arguments, templates,
+/// classes, inheritance, static members, operator[], sizeof, functional casts,
+/// buffers passed to functions, namespaces, local constants, `return` of a
+/// void call, a ConstantBuffer passed as its struct) compute what HLSL says
+/// on the driver.
+#[test]
+fn front_end_constructs_on_the_driver() {
+    let Some(ctx) = common::device() else {
+        return;
+    };
+    let path = hlsl_path("exec_frontend.hlsl");
+    let entries = hlsl::compile(&path, &HlslOptions::default()).unwrap_or_else(|e| panic!("{e}"));
+    let expected = [
+        6.5f32, 2.5, 2.5, 8.0, 10.0, 3.5, 16.0, 7.0, 12.0, 56.0, 3.0, 4.0, 7.5, 7.0, 3.0, 4.5, 3.0,
+        9.0,
+    ];
+    let out = storage(&ctx, (expected.len() as u64 + 4) * 4);
+    // `sky`: color (1, 2, 3), intensity 0.5.
+    let sky: Vec<u8> = [1.0f32, 2.0, 3.0, 0.5]
+        .iter()
+        .flat_map(|f| f.to_le_bytes())
+        .collect();
+    let ubo = Buffer::from_data(&ctx, raw::BufferUsageFlags::UNIFORM_BUFFER, &sky).unwrap();
+    dispatch(
+        &ctx,
+        &entries[0].words,
+        "Main",
+        &[
+            (BindingKind::StorageBuffer, Resource::Buffer(&out)),
+            (BindingKind::UniformBuffer, Resource::Buffer(&ubo)),
+        ],
+    );
+    let got: Vec<f32> = out.read_u32().iter().map(|w| f32::from_bits(*w)).collect();
+    assert_eq!(&got[..expected.len()], &expected[..]);
+}
+
 /// Geometry of the one-instance test scenes.
 #[derive(Clone, Copy, Debug)]
 enum Geom {

@@ -418,7 +418,11 @@ fn analyses_do_not_depend_on_debug_info() {
     files_under(&root().join("fixtures"), &mut others);
     files_under(&root().join("shaders"), &mut others);
     files_under(&root().join("tests/hlsl"), &mut others);
-    others.retain(|p| matches!(ext(p), "hlsl" | "wgsl"));
+    // Classic entry points (tests/hlsl/classic) need their stage named on the
+    // command line; they have no ray-tracing stage to compare.
+    others.retain(|p| {
+        matches!(ext(p), "hlsl" | "wgsl") && !p.components().any(|c| c.as_os_str() == "classic")
+    });
     assert!(others.len() >= 10, "{others:?}");
     for path in &others {
         let language = Language::from_path(path).unwrap();
@@ -578,7 +582,7 @@ fn hlsl_compilers_agree() {
     let mut files = Vec::new();
     files_under(&root().join("fixtures"), &mut files);
     files_under(&root().join("tests/hlsl"), &mut files);
-    files.retain(|p| ext(p) == "hlsl");
+    files.retain(|p| ext(p) == "hlsl" && !p.components().any(|c| c.as_os_str() == "classic"));
     assert!(files.len() >= 3, "{files:?}");
     let config = Config::default();
     let mut differences: Vec<(String, String, String)> = Vec::new();
@@ -593,9 +597,17 @@ fn hlsl_compilers_agree() {
         let mut ours = Vec::new();
         let mut theirs = Vec::new();
         for e in entries.iter().filter(|e| e.stage.is_ray_tracing()) {
-            let words = slang
-                .compile_hlsl(file, &e.name, e.stage.hlsl_name(), &["-g".to_string()])
-                .unwrap_or_else(|err| panic!("{rel} {}: Slang: {err}", e.name));
+            let words =
+                match slang.compile_hlsl(file, &e.name, e.stage.hlsl_name(), &["-g".to_string()]) {
+                    Ok(w) => w,
+                    // The HLSL tests exercise constructs Slang lacks (vk::ext_*
+                    // attributes, SER, subobjects): nothing to compare there.
+                    Err(err) if !all_facts => {
+                        eprintln!("{rel} {}: not compared, Slang refuses it: {err}", e.name);
+                        continue;
+                    }
+                    Err(err) => panic!("{rel} {}: Slang: {err}", e.name),
+                };
             let a = parse(&e.words, file, Language::Hlsl);
             let b = parse(&words, file, Language::Hlsl);
             let mut note = |what: &str, x: String, y: String| {

@@ -63,6 +63,13 @@ const FORBIDDEN: &[(&str, &[&str])] = &[
             "analysis", "explain", "rules", "report", "config", "lint", "front",
         ],
     ),
+    (
+        "reference",
+        &[
+            "program", "front", "analysis", "explain", "rules", "report", "config", "pipeline",
+            "lint", "vk", "verify",
+        ],
+    ),
 ];
 
 fn src() -> PathBuf {

@@ -11,6 +11,14 @@
 mod common;
 
 use rtlint::reference::{self, Params, Scene};
+
+/// The mirror scene as one mesh: `primitive_index` is the triangle's index.
+fn mirror_scene() -> (Scene, Vec<[f32; 3]>, Vec<u32>) {
+    let scene = Scene::load(&common::root().join("shaders/scenes/mirror.toml")).unwrap();
+    let (positions, indices) = scene.world_mesh();
+    (scene, positions, indices)
+}
+
 use rtlint::vk::{
     raw, run_in_child, run_in_child_with_timeout, Aabb, AccelerationStructure, Binding,
     BindingKind, Buffer, ComputePipeline, Context, ContextOptions, Error, Geometry, Group,
@@ -128,12 +136,12 @@ fn teardown_leaves_no_objects_behind() {
     let log = ctx
         .validation_log()
         .expect("a validating context has a log");
-    let scene = Scene::reflection();
+    let (_, positions, indices) = mirror_scene();
     let blas = AccelerationStructure::bottom_level(
         &ctx,
         &[Geometry::Triangles {
-            positions: &scene.positions,
-            indices: &scene.indices,
+            positions: &positions,
+            indices: &indices,
             opaque: true,
         }],
     )
@@ -179,8 +187,8 @@ impl Ray {
         Ray {
             origin,
             dir,
-            t_min: reference::T_MIN,
-            t_max: reference::T_MAX,
+            t_min: 0.001,
+            t_max: 100.0,
             mask: 0xFF,
         }
     }
@@ -286,12 +294,12 @@ fn ray_queries_see_triangles_aabbs_transforms_and_masks() {
     if !common::has_ray_query(&ctx) {
         return;
     }
-    let scene = Scene::reflection();
+    let (scene, positions, indices) = mirror_scene();
     let triangles = AccelerationStructure::bottom_level(
         &ctx,
         &[Geometry::Triangles {
-            positions: &scene.positions,
-            indices: &scene.indices,
+            positions: &positions,
+            indices: &indices,
             opaque: true,
         }],
     )
@@ -327,17 +335,13 @@ fn ray_queries_see_triangles_aabbs_transforms_and_masks() {
     drop((triangles, procedural));
 
     // 1. Camera rays against the CPU intersection of the same scene.
-    let params = Params {
-        width: 32,
-        height: 32,
-        max_bounces: 0,
-    };
+    let params = Params::for_scene(&scene, 32, 32, 0);
     let mut rays = Vec::new();
     for y in 0..params.height {
         for x in 0..params.width {
             rays.push(Ray::new(
-                reference::CAMERA_ORIGIN,
-                reference::camera_dir(params, x, y),
+                scene.camera.to_array(),
+                reference::camera_dir(&params, x, y).to_array(),
             ));
         }
     }
@@ -369,7 +373,13 @@ fn ray_queries_see_triangles_aabbs_transforms_and_masks() {
 
     let mut compared = 0;
     for (ray, hit) in rays[..camera_rays].iter().zip(&hits) {
-        let (cpu, margin) = reference::intersect(&scene, ray.origin, ray.dir, ray.t_min, ray.t_max);
+        let (cpu, margin) = reference::intersect(
+            &scene,
+            ray.origin.into(),
+            ray.dir.into(),
+            ray.t_min,
+            ray.t_max,
+        );
         assert_eq!(hit.aabb_candidates, 0, "camera rays pass far from the box");
         if margin < 1e-4 {
             continue; // see EDGE_EPSILON in vulkan_smoke.rs
@@ -379,7 +389,7 @@ fn ray_queries_see_triangles_aabbs_transforms_and_masks() {
             None => assert_eq!(hit.kind, NONE, "{ray:?}: {hit:?}"),
             Some(cpu) => {
                 assert_eq!(hit.kind, TRIANGLE, "{ray:?}: {hit:?}");
-                assert_eq!(hit.primitive, cpu.primitive, "{ray:?}");
+                assert_eq!(hit.primitive, cpu.triangle, "{ray:?}");
                 assert!(
                     (hit.t - cpu.t).abs() <= 1e-5 * cpu.t,
                     "{ray:?}: {} vs {}",
@@ -749,12 +759,12 @@ fn child_process_runs_gpu_work() {
     let Some(ctx) = common::device() else {
         return;
     };
-    let scene = Scene::reflection();
+    let (_, positions, indices) = mirror_scene();
     let blas = AccelerationStructure::bottom_level(
         &ctx,
         &[Geometry::Triangles {
-            positions: &scene.positions,
-            indices: &scene.indices,
+            positions: &positions,
+            indices: &indices,
             opaque: true,
         }],
     )

@@ -9,20 +9,39 @@
 
 mod common;
 
-use rtlint::reference::{self, Params, Scene};
+use rtlint::reference::{self, Params, Scene, Vec3};
+use rtlint::verify::gpu::GpuScene;
 use rtlint::vk::{
-    raw, AccelerationStructure, Binding, BindingKind, Buffer, Context, Geometry, Group, Instance,
-    RayTracingPipeline, RayTracingPipelineDesc, Resource, ShaderStage, Stage,
+    raw, Binding, BindingKind, Buffer, Context, Group, RayTracingPipeline, RayTracingPipelineDesc,
+    Resource, ShaderStage, Stage,
 };
 use std::path::Path;
 use std::time::{Duration, Instant};
 
 const SHADER: &str = "shaders/reflect_iterative.wgsl";
-const PARAMS: Params = Params {
-    width: 64,
-    height: 64,
-    max_bounces: 3,
-};
+const WIDTH: u32 = 64;
+const HEIGHT: u32 = 64;
+
+/// The mirror scene (no light, identity instances).
+fn mirror_scene() -> Scene {
+    Scene::load(&common::root().join("shaders/scenes/mirror.toml")).expect("the mirror scene loads")
+}
+
+/// The shader's original settings: fixed-epsilon origins, `t` in
+/// [0.001, 100], no throughput cut-off.
+fn params(scene: &Scene) -> Params {
+    Params {
+        robust: false,
+        t_min: 0.001,
+        t_max: 100.0,
+        cutoff: 0.0,
+        epsilon: 0.001,
+        ..Params::for_scene(scene, WIDTH, HEIGHT, 3)
+    }
+}
+
+/// The mirror material's loud albedo.
+const MIRROR_ALBEDO: Vec3 = Vec3::new(1.0, 0.0, 1.0);
 
 /// Tolerance per 8-bit channel: the GPU and the CPU evaluate the same f32
 /// expressions, but the driver may fuse multiply-adds and use its own
@@ -138,17 +157,7 @@ fn render_on_gpu(
         timings.push((what, last.elapsed()));
         last = Instant::now();
     };
-    let blas = AccelerationStructure::bottom_level(
-        ctx,
-        &[Geometry::Triangles {
-            positions: &scene.positions,
-            indices: &scene.indices,
-            opaque: true,
-        }],
-    )
-    .expect("bottom-level build");
-    let tlas = AccelerationStructure::top_level(ctx, &[Instance::identity(&blas)])
-        .expect("top-level build");
+    let gpu_scene = GpuScene::new(ctx, scene).expect("acceleration structures");
     lap("acceleration structures", &mut timings);
 
     let pipeline = create_pipeline(ctx, spirv, stack_size);
@@ -157,12 +166,6 @@ fn render_on_gpu(
 
     let pixels = u64::from(params.width * params.height);
     let image = Buffer::new(ctx, pixels * 4, raw::BufferUsageFlags::STORAGE_BUFFER, 1).unwrap();
-    let surfaces = Buffer::from_data(
-        ctx,
-        raw::BufferUsageFlags::STORAGE_BUFFER,
-        &scene.surface_data(),
-    )
-    .unwrap();
     let uniform = Buffer::from_data(
         ctx,
         raw::BufferUsageFlags::UNIFORM_BUFFER,
@@ -170,9 +173,9 @@ fn render_on_gpu(
     )
     .unwrap();
     let resources = [
-        (0, Resource::AccelerationStructure(&tlas)),
+        (0, Resource::AccelerationStructure(&gpu_scene.tlas)),
         (1, Resource::Buffer(&image)),
-        (2, Resource::Buffer(&surfaces)),
+        (2, Resource::Buffer(&gpu_scene.surfaces)),
         (3, Resource::Buffer(&uniform)),
     ];
     let gpu = pipeline
@@ -204,22 +207,18 @@ struct Comparison {
 }
 
 fn compare(scene: &Scene, gpu: &[u32], cpu: &[u32]) -> Comparison {
-    let w = PARAMS.width;
+    let p = params(scene);
+    let w = WIDTH;
     let mut c = Comparison {
         max_diff: 0,
         differing: 0,
         near_edge: 0,
     };
-    for y in 0..PARAMS.height {
+    for y in 0..HEIGHT {
         for x in 0..w {
             let i = (y * w + x) as usize;
             let d = channel_diff(gpu[i], cpu[i]);
-            let path = reference::trace_pixel(scene, PARAMS, x, y);
-            let margin = path
-                .segments
-                .iter()
-                .map(|s| s.edge_margin)
-                .fold(f32::INFINITY, f32::min);
+            let margin = reference::trace_iterative(scene, &p, x, y).edge_margin();
             if margin < EDGE_EPSILON {
                 eprintln!(
                     "  pixel ({x}, {y}) passes {margin:e} from an edge: gpu {:08x} cpu {:08x}",
@@ -262,10 +261,10 @@ fn reflection_pipeline_matches_cpu_reference() {
     };
     let device_time = start.elapsed();
     let spirv = compile_shader(&ctx);
-    let scene = Scene::reflection();
-    let gpu = render_on_gpu(&ctx, &spirv, &scene, PARAMS, None);
+    let scene = mirror_scene();
+    let gpu = render_on_gpu(&ctx, &spirv, &scene, params(&scene), None);
     let start = Instant::now();
-    let cpu = reference::render(&scene, PARAMS);
+    let (cpu, _) = reference::render(&scene, &params(&scene), reference::Method::Iterative);
     let cpu_time = start.elapsed();
 
     eprintln!(
@@ -286,14 +285,14 @@ fn reflection_pipeline_matches_cpu_reference() {
     let c = compare(&scene, &gpu.image, &cpu);
     eprintln!(
         "  {} pixels compared: max channel difference {}, {} differ; {} near an edge, not compared",
-        PARAMS.width * PARAMS.height - c.near_edge as u32,
+        WIDTH * HEIGHT - c.near_edge as u32,
         c.max_diff,
         c.differing,
         c.near_edge
     );
     assert_matches(&c);
     if let Some(path) = std::env::var_os("RTLINT_SMOKE_PPM") {
-        write_ppm(Path::new(&path), &gpu.image, PARAMS.width, PARAMS.height);
+        write_ppm(Path::new(&path), &gpu.image, WIDTH, HEIGHT);
     }
     check_semantics(&scene, &gpu.image);
     assert_valid(&ctx);
@@ -308,9 +307,10 @@ fn explicit_stack_size_renders_the_same() {
         return;
     };
     let spirv = compile_shader(&ctx);
-    let scene = Scene::reflection();
-    let gpu = render_on_gpu(&ctx, &spirv, &scene, PARAMS, Some(1024));
-    let c = compare(&scene, &gpu.image, &reference::render(&scene, PARAMS));
+    let scene = mirror_scene();
+    let gpu = render_on_gpu(&ctx, &spirv, &scene, params(&scene), Some(1024));
+    let (cpu, _) = reference::render(&scene, &params(&scene), reference::Method::Iterative);
+    let c = compare(&scene, &gpu.image, &cpu);
     assert_matches(&c);
     assert_valid(&ctx);
 }
@@ -348,13 +348,14 @@ fn check_sbt(ctx: &Context, pipeline: &RayTracingPipeline) {
 /// Facts about the picture that hold whatever the renderer: sky where nothing
 /// is hit, and a mirror that shows what it reflects, not its own colour.
 fn check_semantics(scene: &Scene, image: &[u32]) {
-    let w = PARAMS.width;
+    let p = params(scene);
+    let w = WIDTH;
     let mut sky_checked = 0;
     let mut mirror_checked = 0;
-    for y in 0..PARAMS.height {
+    for y in 0..HEIGHT {
         for x in 0..w {
             let pixel = image[(y * w + x) as usize];
-            let path = reference::trace_pixel(scene, PARAMS, x, y);
+            let path = reference::trace_iterative(scene, &p, x, y);
             let first = &path.segments[0];
             if first.edge_margin < EDGE_EPSILON {
                 continue;
@@ -368,7 +369,7 @@ fn check_semantics(scene: &Scene, image: &[u32]) {
                     );
                     sky_checked += 1;
                 }
-                Some(hit) if scene.surfaces[hit.primitive as usize].reflectivity == 1.0 => {
+                Some(hit) if scene.surfaces[hit.triangle as usize].reflectivity == 1.0 => {
                     // The perfect mirror adds nothing of its own: the pixel is
                     // the floor it reflects, shaded from the reflected direction.
                     let Some(second) = path.segments.get(1) else {
@@ -377,18 +378,18 @@ fn check_semantics(scene: &Scene, image: &[u32]) {
                     let Some(floor_hit) = second.hit else {
                         continue;
                     };
-                    let floor = scene.surfaces[floor_hit.primitive as usize];
+                    let floor = scene.surfaces[floor_hit.triangle as usize];
                     if floor.reflectivity != 0.0 || second.edge_margin < EDGE_EPSILON {
                         continue;
                     }
-                    let shade = reference::dot(floor.normal, second.dir).abs();
-                    let expected = reference::pack_rgba8(floor.albedo.map(|a| a * shade));
+                    let shade = floor.normal.dot(second.dir).abs();
+                    let expected = reference::pack_rgba8(floor.albedo * shade);
                     assert!(
                         channel_diff(pixel, expected) <= MAX_CHANNEL_DIFF,
                         "pixel ({x}, {y}) sees the mirror reflecting the floor: \
                          {pixel:08x}, floor {expected:08x}"
                     );
-                    let own = reference::pack_rgba8(reference::scene::MIRROR_ALBEDO);
+                    let own = reference::pack_rgba8(MIRROR_ALBEDO);
                     assert!(
                         channel_diff(pixel, own) > 64,
                         "pixel ({x}, {y}) shows the mirror's albedo"

@@ -4,9 +4,11 @@
 pub mod callgraph;
 pub mod layout;
 pub mod liveness;
+pub mod payload_use;
 pub mod rayquery;
 pub mod recursion;
 pub mod stack;
+pub mod trace_sites;
 pub mod uniformity;
 
 pub use liveness::{live_report, LiveReport};

@@ -942,7 +942,7 @@ mod tests {
         let rg = &r.shaders[0];
         assert_eq!(
             (rg.breakdown.live_state, rg.breakdown.live_state_total),
-            (60, 80)
+            (64, 84)
         );
         assert!(r.assumptions.is_empty(), "{:?}", r.assumptions);
     }

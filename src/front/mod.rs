@@ -36,6 +36,10 @@ pub struct FrontOptions {
     pub include_dirs: Vec<PathBuf>,
     /// `-D NAME=VALUE` (HLSL and GLSL).
     pub defines: Vec<(String, String)>,
+    /// HLSL: compile only this entry point (`-E`).
+    pub entry: Option<String>,
+    /// HLSL: the stage of `entry` when it has no `[shader(...)]` (`-T`).
+    pub stage: Option<crate::shader::Stage>,
 }
 
 /// Reads and compiles one file to SPIR-V.
@@ -89,7 +93,8 @@ pub fn compile_input(
             let hlsl_options = hlsl::HlslOptions {
                 include_dirs: options.include_dirs.clone(),
                 defines: options.defines.clone(),
-                ..hlsl::HlslOptions::default()
+                entry: options.entry.clone(),
+                stage: options.stage,
             };
             let m =
                 hlsl::compile_source_whole(path, &text, &mut hlsl::pp::FsLoader, &hlsl_options)?;

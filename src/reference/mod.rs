@@ -1,36 +1,107 @@
-//! CPU reference renderer for `shaders/reflect_iterative.wgsl`, and the scene
-//! both it and the GPU test render.
+//! CPU reference renderer for the reflection reference shaders
+//! (`shaders/reflect_iterative.*`, `shaders/reflect_recursive.*`), over
+//! scenes described in data ([`scene`]).
 //!
-//! Everything is `f32` and follows the shader operation by operation (camera,
-//! bounce loop, sky, shading, packing) so that the GPU image should match to
-//! within one 8-bit step; ray/triangle tests use the shader's `t` range and
-//! treat every triangle as opaque, as `RAY_FLAG_OPAQUE` does.
+//! Everything is `f32` and follows the shaders operation by operation
+//! (camera, bounce loop or recursion, shadow rays, sky, shading, robust ray
+//! origins, packing) so that a GPU image should match to within one 8-bit
+//! step; ray/triangle tests use the shaders' `t` range and treat every
+//! triangle as opaque, as `RAY_FLAG_OPAQUE` does. Triangles are found
+//! through a BVH ([`bvh`]).
 
+pub mod bvh;
 pub mod math;
 pub mod scene;
 
-pub use math::{cross, dot, normalize, reflect, Vec3};
-pub use scene::{Scene, Surface};
+pub use glam::Vec3;
+pub use math::{mix, offset_ray, reflect};
+pub use scene::{Light, Scene, Surface};
 
-/// The ray interval the shader traces with.
-pub const T_MIN: f32 = 0.001;
-pub const T_MAX: f32 = 100.0;
-/// The shader offsets each bounce origin along the normal by this much.
-pub const NORMAL_OFFSET: f32 = 0.001;
-pub const CAMERA_ORIGIN: Vec3 = [0.0, 1.0, 4.0];
+/// `Params.flags`: the scene has a light (shadow rays are traced).
+pub const FLAG_LIGHT: u32 = 1;
+/// `Params.flags`: ray origins use the robust offset, not the fixed epsilon.
+pub const FLAG_ROBUST: u32 = 2;
 
-/// The shader's uniform block (`Params`).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+/// The shaders' uniform block (`Params`, 64 bytes).
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Params {
     pub width: u32,
     pub height: u32,
     pub max_bounces: u32,
+    /// Robust origins (Wächter & Binder) instead of `p + n · epsilon`.
+    pub robust: bool,
+    pub camera: Vec3,
+    pub light: Option<Light>,
+    pub t_min: f32,
+    pub t_max: f32,
+    /// A path goes on while its throughput is above this.
+    pub cutoff: f32,
+    /// The fixed offset along the normal when `robust` is off.
+    pub epsilon: f32,
+    /// Rays per pixel of the glossy shader (1–16).
+    pub samples: u32,
 }
 
 impl Params {
-    /// The uniform buffer contents: width, height, max_bounces, padding.
-    pub fn to_words(self) -> [u32; 4] {
-        [self.width, self.height, self.max_bounces, 0]
+    /// The defaults the reference shaders are verified with: robust origins
+    /// with `t_min` 0, `t_max` 1e4, cut-off 1/256.
+    pub fn for_scene(scene: &Scene, width: u32, height: u32, max_bounces: u32) -> Params {
+        Params {
+            width,
+            height,
+            max_bounces,
+            robust: true,
+            camera: scene.camera,
+            light: scene.light,
+            t_min: 0.0,
+            t_max: 1e4,
+            cutoff: 1.0 / 256.0,
+            epsilon: 1e-3,
+            samples: 4,
+        }
+    }
+
+    /// The uniform buffer contents:
+    /// `width, height, max_bounces, flags; camera.xyz, 0; light.xyz, ambient;
+    /// t_min, t_max, cutoff, epsilon`.
+    pub fn to_words(&self) -> [u32; 16] {
+        let f = |x: f32| x.to_bits();
+        let flags = if self.light.is_some() { FLAG_LIGHT } else { 0 }
+            | if self.robust { FLAG_ROBUST } else { 0 }
+            | (self.samples.min(255) << 8);
+        let (l, ambient) = self
+            .light
+            .map(|l| (l.direction, l.ambient))
+            .unwrap_or((Vec3::ZERO, 0.0));
+        let c = self.camera;
+        [
+            self.width,
+            self.height,
+            self.max_bounces,
+            flags,
+            f(c.x),
+            f(c.y),
+            f(c.z),
+            0,
+            f(l.x),
+            f(l.y),
+            f(l.z),
+            f(ambient),
+            f(self.t_min),
+            f(self.t_max),
+            f(self.cutoff),
+            f(self.epsilon),
+        ]
+    }
+
+    /// Where the next ray starts from the surface point `p` with normal `n`
+    /// (facing the side the ray leaves from).
+    pub fn next_origin(&self, p: Vec3, n: Vec3) -> Vec3 {
+        if self.robust {
+            offset_ray(p, n)
+        } else {
+            p + n * self.epsilon
+        }
     }
 }
 
@@ -38,42 +109,79 @@ impl Params {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Hit {
     pub t: f32,
-    /// `primitive_index`: the triangle's index in the scene.
-    pub primitive: u32,
+    /// The triangle's index in the scene: `instance_custom_index + primitive_index`.
+    pub triangle: u32,
 }
 
-/// One traced segment of a pixel's path.
+/// One traced ray of a pixel's path.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Segment {
     pub origin: Vec3,
     pub dir: Vec3,
     pub hit: Option<Hit>,
+    /// A shadow ray (any hit ends it) rather than a primary or reflection ray.
+    pub shadow: bool,
     /// World-space distance from where the ray crosses a triangle's plane
-    /// (within the `t` range) to that triangle's nearest open edge (see
-    /// [`Scene::open_edges`]), minimised over all triangles: how close this
-    /// segment came to a different hit/miss decision. Infinite when it
-    /// crossed no triangle's plane near an open edge.
+    /// (within the `t` range) to that triangle's nearest open edge, minimised
+    /// over all triangles near the ray: how close this ray came to a
+    /// different decision. Infinite when it crossed no triangle's plane near
+    /// an open edge.
     pub edge_margin: f32,
 }
 
-/// A pixel's colour and the path that produced it.
+/// A pixel's colour and the rays that produced it.
 #[derive(Clone, Debug, PartialEq)]
 pub struct PixelPath {
     pub color: Vec3,
     pub segments: Vec<Segment>,
 }
 
-/// The sky the miss path adds: white at the horizon blending to blue upwards.
-pub fn sky(dir: Vec3) -> Vec3 {
-    let k = 0.5 * (dir[1] + 1.0);
-    math::mix([1.0, 1.0, 1.0], [0.5, 0.7, 1.0], k)
+impl PixelPath {
+    /// Rays that left a triangle and hit that same (planar) triangle again:
+    /// self-intersections. Returns (such rays, rays that left a surface).
+    pub fn self_hits(&self) -> (usize, usize) {
+        let (mut own, mut secondary) = (0, 0);
+        let camera = self.segments.first().map(|s| s.origin);
+        let mut from: Option<u32> = None;
+        for s in &self.segments {
+            if !s.shadow && Some(s.origin) == camera {
+                // A primary ray (each sample of the glossy shader has one).
+                from = s.hit.map(|h| h.triangle);
+                continue;
+            }
+            secondary += 1;
+            own += usize::from(from.is_some() && s.hit.map(|h| h.triangle) == from);
+            if !s.shadow {
+                from = s.hit.map(|h| h.triangle);
+            }
+        }
+        (own, secondary)
+    }
+
+    /// The smallest edge margin of any of its rays.
+    pub fn edge_margin(&self) -> f32 {
+        self.segments
+            .iter()
+            .map(|s| s.edge_margin)
+            .fold(f32::INFINITY, f32::min)
+    }
 }
 
-/// Packs a colour as the shader does: clamp, scale to 255, round half up,
-/// RGBA8 with alpha 255 in the top byte.
+/// The sky the miss shader returns: white at the horizon blending to blue upwards.
+pub fn sky(dir: Vec3) -> Vec3 {
+    let k = 0.5 * (dir.y + 1.0);
+    mix(Vec3::new(1.0, 1.0, 1.0), Vec3::new(0.5, 0.7, 1.0), k)
+}
+
+/// Packs a colour as the shaders do: clamp, scale to 255, round half up,
+/// RGBA8 with alpha 255 in the top byte; 0 for a non-finite colour.
 pub fn pack_rgba8(c: Vec3) -> u32 {
+    // An infinite or NaN channel is written as 0 (alpha 0).
+    if !c.is_finite() {
+        return 0;
+    }
     let ch = |x: f32| (x.clamp(0.0, 1.0) * 255.0 + 0.5) as u32;
-    ch(c[0]) | (ch(c[1]) << 8) | (ch(c[2]) << 16) | (255 << 24)
+    ch(c.x) | (ch(c.y) << 8) | (ch(c.z) << 16) | (255 << 24)
 }
 
 /// The four channels of a packed pixel, red first.
@@ -82,17 +190,18 @@ pub fn unpack_rgba8(p: u32) -> [u8; 4] {
 }
 
 /// The primary ray direction through pixel `(x, y)`.
-pub fn camera_dir(params: Params, x: u32, y: u32) -> Vec3 {
+pub fn camera_dir(params: &Params, x: u32, y: u32) -> Vec3 {
     let size = [params.width as f32, params.height as f32];
     let uv = [
         (x as f32 + 0.5) / size[0] * 2.0 - 1.0,
         (y as f32 + 0.5) / size[1] * 2.0 - 1.0,
     ];
-    normalize([uv[0], -uv[1], -1.5])
+    Vec3::new(uv[0], -uv[1], -1.5).normalize()
 }
 
-/// The closest opaque triangle hit with `t` in `[t_min, t_max]`, and the
-/// segment's edge margin (see [`Segment::edge_margin`]).
+/// The closest opaque triangle hit with `t` in `[t_min, t_max]` (with
+/// `any`, the first found, as `ACCEPT_FIRST_HIT_AND_END_SEARCH` allows: only
+/// hit-or-miss matters then), and the ray's edge margin.
 pub fn intersect(
     scene: &Scene,
     origin: Vec3,
@@ -102,172 +211,479 @@ pub fn intersect(
 ) -> (Option<Hit>, f32) {
     let mut best: Option<Hit> = None;
     let mut margin = f32::INFINITY;
-    for prim in 0..scene.triangle_count() {
-        let [a, b, c] = scene.triangle(prim);
-        let Some((t, bary)) = math::ray_triangle(origin, dir, a, b, c) else {
-            continue;
+    scene.bvh.candidates(origin, dir, t_min, t_max, |tri| {
+        let t = &scene.triangles[tri];
+        let [a, b, c] = t.corners;
+        let Some((th, bary)) = math::ray_triangle(origin, dir, a, b, c) else {
+            return;
         };
-        if !(t_min..=t_max).contains(&t) {
-            continue;
+        if !(t_min..=t_max).contains(&th) {
+            return;
         }
-        margin = margin.min(math::edge_distance([a, b, c], bary, scene.open_edges(prim)));
-        if bary.iter().all(|&w| w >= 0.0) && best.is_none_or(|h| t < h.t) {
+        margin = margin.min(math::edge_distance(t.corners, bary, t.open));
+        let better = match best {
+            None => true,
+            Some(h) => th < h.t || (th == h.t && (tri as u32) < h.triangle),
+        };
+        if bary.iter().all(|&w| w >= 0.0) && better {
             best = Some(Hit {
-                t,
-                primitive: prim as u32,
+                t: th,
+                triangle: tri as u32,
             });
         }
-    }
+    });
     (best, margin)
 }
 
-/// Follows the shader's bounce loop for one pixel.
-pub fn trace_pixel(scene: &Scene, params: Params, x: u32, y: u32) -> PixelPath {
-    let mut origin = CAMERA_ORIGIN;
+/// What a hit adds, as both shaders compute it: the normal facing the
+/// incoming ray, where the next rays start (`from`), and the surface's own
+/// colour per unit of `weight` (the iterative shader's throughput; 1 in the
+/// recursive one), tracing the shadow ray when there is a light.
+struct Shading {
+    normal: Vec3,
+    from: Vec3,
+    local: Vec3,
+    reflectivity: f32,
+}
+
+fn shade(
+    scene: &Scene,
+    params: &Params,
+    origin: Vec3,
+    dir: Vec3,
+    hit: Hit,
+    weight: Option<f32>,
+    segments: &mut Vec<Segment>,
+) -> Shading {
+    let surface = scene.surfaces[hit.triangle as usize];
+    let n = if surface.normal.dot(dir) < 0.0 {
+        surface.normal
+    } else {
+        -surface.normal
+    };
+    let r = surface.reflectivity;
+    // Iterative: `throughput * (1 - r) * albedo`; recursive: `(1 - r) * albedo`.
+    let base = match weight {
+        Some(w) => w * (1.0 - r) * surface.albedo,
+        None => (1.0 - r) * surface.albedo,
+    };
+    let from = params.next_origin(origin + dir * hit.t, n);
+    let local = match params.light {
+        Some(light) => {
+            let ndl = n.dot(light.direction);
+            let mut c = base * light.ambient;
+            if ndl > 0.0 {
+                let (blocker, edge_margin) =
+                    intersect(scene, from, light.direction, params.t_min, params.t_max);
+                segments.push(Segment {
+                    origin: from,
+                    dir: light.direction,
+                    hit: blocker,
+                    shadow: true,
+                    edge_margin,
+                });
+                if blocker.is_none() {
+                    c += base * ndl;
+                }
+            }
+            c
+        }
+        None => base * n.dot(-dir).max(0.0),
+    };
+    Shading {
+        normal: n,
+        from,
+        local,
+        reflectivity: r,
+    }
+}
+
+/// Follows `reflect_iterative`'s bounce loop for one pixel.
+pub fn trace_iterative(scene: &Scene, params: &Params, x: u32, y: u32) -> PixelPath {
+    let mut origin = params.camera;
     let mut dir = camera_dir(params, x, y);
-    let mut color = [0.0f32; 3];
-    let mut throughput = [1.0f32; 3];
+    let mut color = Vec3::ZERO;
+    let mut throughput = 1.0f32;
     let mut segments = Vec::new();
     for _bounce in 0..=params.max_bounces {
-        let (hit, edge_margin) = intersect(scene, origin, dir, T_MIN, T_MAX);
+        let (hit, edge_margin) = intersect(scene, origin, dir, params.t_min, params.t_max);
         segments.push(Segment {
             origin,
             dir,
             hit,
+            shadow: false,
             edge_margin,
         });
         let Some(hit) = hit else {
-            let s = sky(dir);
-            for i in 0..3 {
-                color[i] += throughput[i] * s[i];
-            }
+            color += throughput * sky(dir);
             break;
         };
-        let surface = scene.surfaces[hit.primitive as usize];
-        let n = surface.normal;
-        let shade = dot(n, [-dir[0], -dir[1], -dir[2]]).max(0.0);
-        let r = surface.reflectivity;
-        for i in 0..3 {
-            color[i] += throughput[i] * surface.albedo[i] * shade * (1.0 - r);
-            throughput[i] *= r;
-        }
-        if r <= 0.0 {
+        let s = shade(
+            scene,
+            params,
+            origin,
+            dir,
+            hit,
+            Some(throughput),
+            &mut segments,
+        );
+        color += s.local;
+        throughput *= s.reflectivity;
+        origin = s.from;
+        // The shaders' `!(throughput > cutoff)`: a NaN throughput stops too.
+        if throughput.partial_cmp(&params.cutoff) != Some(std::cmp::Ordering::Greater) {
             break;
         }
-        for i in 0..3 {
-            origin[i] = origin[i] + dir[i] * hit.t + n[i] * NORMAL_OFFSET;
-        }
-        dir = reflect(dir, n);
+        dir = reflect(dir, s.normal);
     }
     PixelPath { color, segments }
 }
 
-/// The image the shader writes: `width × height` packed RGBA8, row by row.
-pub fn render(scene: &Scene, params: Params) -> Vec<u32> {
-    let mut image = Vec::with_capacity((params.width * params.height) as usize);
-    for y in 0..params.height {
-        for x in 0..params.width {
-            image.push(pack_rgba8(trace_pixel(scene, params, x, y).color));
+/// Follows `reflect_recursive`: the closest-hit shader shades, then traces
+/// the reflection itself and adds `reflectivity ×` what it returns.
+pub fn trace_recursive(scene: &Scene, params: &Params, x: u32, y: u32) -> PixelPath {
+    let mut segments = Vec::new();
+    let color = radiance(
+        scene,
+        params,
+        params.camera,
+        camera_dir(params, x, y),
+        0,
+        1.0,
+        &mut segments,
+    );
+    PixelPath { color, segments }
+}
+
+fn radiance(
+    scene: &Scene,
+    params: &Params,
+    origin: Vec3,
+    dir: Vec3,
+    depth: u32,
+    throughput: f32,
+    segments: &mut Vec<Segment>,
+) -> Vec3 {
+    let (hit, edge_margin) = intersect(scene, origin, dir, params.t_min, params.t_max);
+    segments.push(Segment {
+        origin,
+        dir,
+        hit,
+        shadow: false,
+        edge_margin,
+    });
+    let Some(hit) = hit else {
+        return sky(dir);
+    };
+    let s = shade(scene, params, origin, dir, hit, None, segments);
+    let r = s.reflectivity;
+    let mut color = s.local;
+    let next = throughput * r;
+    if next > params.cutoff && depth < params.max_bounces {
+        let child = radiance(
+            scene,
+            params,
+            s.from,
+            reflect(dir, s.normal),
+            depth + 1,
+            next,
+            segments,
+        );
+        color += r * child;
+    }
+    color
+}
+
+/// The PCG hash the glossy shader draws its numbers from (Jarzynski & Olano 2020).
+pub fn pcg(v: u32) -> u32 {
+    let state = v.wrapping_mul(747_796_405).wrapping_add(2_891_336_453);
+    let word = ((state >> ((state >> 28) + 4)) ^ state).wrapping_mul(277_803_737);
+    (word >> 22) ^ word
+}
+
+/// A uniform number in [0, 1) with 24 bits, advancing the seed.
+pub fn rand(seed: &mut u32) -> f32 {
+    *seed = pcg(*seed);
+    (*seed >> 8) as f32 * (1.0 / 16_777_216.0)
+}
+
+/// The glossy shader's `sample_vndf`: a GGX visible normal (Heitz 2018) for
+/// the tangent-space view `ve` and roughness `alpha`.
+pub fn sample_vndf(ve: Vec3, alpha: f32, u1: f32, u2: f32) -> Vec3 {
+    // A grazing view (ve.z = 0) with alpha = 0 would normalise zero.
+    let vh = Vec3::new(alpha * ve.x, alpha * ve.y, ve.z.max(1e-7)).normalize();
+    let lensq = vh.x * vh.x + vh.y * vh.y;
+    let t1 = if lensq > 0.0 {
+        Vec3::new(-vh.y, vh.x, 0.0) * (1.0 / lensq.sqrt())
+    } else {
+        Vec3::X
+    };
+    let t2 = vh.cross(t1);
+    let r = u1.sqrt();
+    let phi = 6.283_185_5 * u2;
+    let p1 = r * phi.cos();
+    let s = 0.5 * (1.0 + vh.z);
+    let p2 = (1.0 - s) * (1.0 - p1 * p1).sqrt() + s * (r * phi.sin());
+    let nh = p1 * t1 + p2 * t2 + (0.0f32).max(1.0 - p1 * p1 - p2 * p2).sqrt() * vh;
+    Vec3::new(alpha * nh.x, alpha * nh.y, nh.z.max(0.0)).normalize()
+}
+
+/// Follows `reflect_glossy`: the iterative loop with GGX-sampled reflections
+/// off rough surfaces, `params.samples` paths per pixel averaged.
+pub fn trace_glossy(scene: &Scene, params: &Params, x: u32, y: u32) -> PixelPath {
+    let samples = params.samples.clamp(1, 16);
+    let mut sum = Vec3::ZERO;
+    let mut segments = Vec::new();
+    for sample in 0..samples {
+        let mut seed = pcg(y * params.width + x) ^ pcg(sample.wrapping_add(0x9E37_79B9));
+        let mut origin = params.camera;
+        let mut dir = camera_dir(params, x, y);
+        let mut t_max = params.t_max;
+        let mut throughput = 1.0f32;
+        for _bounce in 0..=params.max_bounces {
+            let (hit, edge_margin) = intersect(scene, origin, dir, params.t_min, t_max);
+            segments.push(Segment {
+                origin,
+                dir,
+                hit,
+                shadow: false,
+                edge_margin,
+            });
+            let Some(hit) = hit else {
+                sum += throughput * sky(dir);
+                break;
+            };
+            let surface = scene.surfaces[hit.triangle as usize];
+            let n = if surface.normal.dot(dir) < 0.0 {
+                surface.normal
+            } else {
+                -surface.normal
+            };
+            let base = throughput * (1.0 - surface.reflectivity) * surface.albedo;
+            throughput *= surface.reflectivity;
+            let roughness = surface.roughness;
+            origin = params.next_origin(origin + dir * hit.t, n);
+            let light = params.light.unwrap_or(Light {
+                direction: Vec3::ZERO,
+                ambient: 0.0,
+            });
+            let ndl = n.dot(light.direction);
+            let headlight = n.dot(-dir).max(0.0);
+            if roughness > 0.0 {
+                let sgn = if n.z >= 0.0 { 1.0f32 } else { -1.0 };
+                let a = -1.0 / (sgn + n.z);
+                let b = n.x * n.y * a;
+                let tx = Vec3::new(1.0 + sgn * n.x * n.x * a, sgn * b, -sgn * n.x);
+                let ty = Vec3::new(b, sgn + n.y * n.y * a, -n.y);
+                let alpha = roughness * roughness;
+                let ve = Vec3::new((-dir).dot(tx), (-dir).dot(ty), (-dir).dot(n));
+                let u1 = rand(&mut seed);
+                let u2 = rand(&mut seed);
+                let m = sample_vndf(ve, alpha, u1, u2);
+                dir = reflect(dir, tx * m.x + ty * m.y + n * m.z);
+                let nl = n.dot(dir);
+                if nl > 0.0 {
+                    let a2 = alpha * alpha;
+                    throughput *= 2.0 * nl / (nl + (a2 + (1.0 - a2) * nl * nl).sqrt());
+                } else {
+                    throughput = 0.0;
+                }
+                t_max = params.t_max / (1.0 + 64.0 * roughness);
+            } else {
+                dir = reflect(dir, n);
+                t_max = params.t_max;
+            }
+            if params.light.is_some() {
+                sum += base * light.ambient;
+                if ndl > 0.0 {
+                    let lit = base * ndl;
+                    let (blocker, edge_margin) =
+                        intersect(scene, origin, light.direction, params.t_min, params.t_max);
+                    segments.push(Segment {
+                        origin,
+                        dir: light.direction,
+                        hit: blocker,
+                        shadow: true,
+                        edge_margin,
+                    });
+                    if blocker.is_none() {
+                        sum += lit;
+                    }
+                }
+            } else {
+                sum += base * headlight;
+            }
+            if throughput.partial_cmp(&params.cutoff) != Some(std::cmp::Ordering::Greater) {
+                break;
+            }
         }
     }
-    image
+    PixelPath {
+        color: sum / samples as f32,
+        segments,
+    }
+}
+
+/// Which shader's math to follow.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Method {
+    Iterative,
+    Recursive,
+    Glossy,
+}
+
+/// One pixel's path by `method`.
+pub fn trace_pixel(scene: &Scene, params: &Params, method: Method, x: u32, y: u32) -> PixelPath {
+    match method {
+        Method::Iterative => trace_iterative(scene, params, x, y),
+        Method::Recursive => trace_recursive(scene, params, x, y),
+        Method::Glossy => trace_glossy(scene, params, x, y),
+    }
+}
+
+/// The image a shader writes: `width × height` packed RGBA8, row by row,
+/// with each pixel's edge margin (see [`Segment::edge_margin`]).
+pub fn render(scene: &Scene, params: &Params, method: Method) -> (Vec<u32>, Vec<f32>) {
+    let n = (params.width * params.height) as usize;
+    let (mut image, mut margins) = (Vec::with_capacity(n), Vec::with_capacity(n));
+    for y in 0..params.height {
+        for x in 0..params.width {
+            let path = trace_pixel(scene, params, method, x, y);
+            image.push(pack_rgba8(path.color));
+            margins.push(path.edge_margin());
+        }
+    }
+    (image, margins)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
 
-    const PARAMS: Params = Params {
-        width: 64,
-        height: 64,
-        max_bounces: 3,
-    };
+    fn mirror() -> Scene {
+        let path =
+            std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("shaders/scenes/mirror.toml");
+        Scene::load(&path).unwrap()
+    }
+
+    fn showcase() -> Scene {
+        let path =
+            std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("shaders/scenes/showcase.toml");
+        Scene::load(&path).unwrap()
+    }
 
     #[test]
     fn packing_rounds_and_clamps() {
-        assert_eq!(pack_rgba8([0.0, 1.0, 2.0]), 0xFFFF_FF00);
+        assert_eq!(pack_rgba8(Vec3::new(0.0, 1.0, 2.0)), 0xFFFF_FF00);
+        assert_eq!(pack_rgba8(Vec3::new(0.0, f32::NAN, 0.0)), 0);
+        assert_eq!(pack_rgba8(Vec3::new(f32::INFINITY, 0.0, 0.0)), 0);
         // 0.5 * 255 + 0.5 = 128.0 → 128; just below rounds down.
         assert_eq!(
-            unpack_rgba8(pack_rgba8([0.5, 0.498, -1.0])),
+            unpack_rgba8(pack_rgba8(Vec3::new(0.5, 0.498, -1.0))),
             [128, 127, 0, 255]
         );
     }
 
     #[test]
     fn sky_is_white_at_horizon_and_blue_straight_up() {
-        assert_eq!(sky([0.0, -1.0, 0.0]), [1.0, 1.0, 1.0]);
-        assert_eq!(sky([0.0, 1.0, 0.0]), [0.5, 0.7, 1.0]);
+        assert_eq!(sky(Vec3::new(0.0, -1.0, 0.0)), Vec3::ONE);
+        assert_eq!(sky(Vec3::Y), Vec3::new(0.5, 0.7, 1.0));
+    }
+
+    #[test]
+    fn params_words_are_the_uniform_layout() {
+        let s = showcase();
+        let p = Params::for_scene(&s, 64, 32, 3);
+        let w = p.to_words();
+        assert_eq!(&w[..4], &[64, 32, 3, FLAG_LIGHT | FLAG_ROBUST | 4 << 8]);
+        assert_eq!(f32::from_bits(w[4]), s.camera.x);
+        assert_eq!(f32::from_bits(w[13]), 1e4);
     }
 
     #[test]
     fn t_range_excludes_hits_behind_the_minimum() {
-        let scene = Scene::reflection();
-        // Straight down onto the floor from just above it.
-        let (hit, _) = intersect(&scene, [0.5, 0.0005, 0.5], [0.0, -1.0, 0.0], T_MIN, T_MAX);
+        let scene = mirror();
+        let down = Vec3::new(0.0, -1.0, 0.0);
+        let (hit, _) = intersect(&scene, Vec3::new(0.5, 0.0005, 0.5), down, 0.001, 100.0);
         assert_eq!(hit, None, "a hit at t = 0.0005 is below t_min");
-        let (hit, _) = intersect(&scene, [0.5, 0.5, 0.5], [0.0, -1.0, 0.0], T_MIN, T_MAX);
+        let (hit, _) = intersect(&scene, Vec3::new(0.5, 0.5, 0.5), down, 0.001, 100.0);
         let hit = hit.expect("the floor is below");
         assert!((hit.t - 0.5).abs() < 1e-6);
-        assert_eq!(scene.surfaces[hit.primitive as usize].reflectivity, 0.0);
-        let (hit, _) = intersect(&scene, [0.5, 0.5, 0.5], [0.0, -1.0, 0.0], T_MIN, 0.4);
+        assert_eq!(scene.surfaces[hit.triangle as usize].reflectivity, 0.0);
+        let (hit, _) = intersect(&scene, Vec3::new(0.5, 0.5, 0.5), down, 0.001, 0.4);
         assert_eq!(hit, None, "the floor is beyond t_max");
     }
 
     #[test]
-    fn image_shows_sky_floor_and_mirror_reflections() {
-        let scene = Scene::reflection();
-        let mut kinds = [0usize; 3];
-        for y in 0..PARAMS.height {
-            for x in 0..PARAMS.width {
-                let path = trace_pixel(&scene, PARAMS, x, y);
-                let first = path.segments[0]
-                    .hit
-                    .map(|h| scene.surfaces[h.primitive as usize]);
-                match first {
-                    None => kinds[0] += 1,
-                    Some(s) if s.reflectivity == 0.0 => kinds[1] += 1,
-                    Some(_) => {
-                        kinds[2] += 1;
-                        assert!(path.segments.len() >= 2);
+    fn iterative_and_recursive_agree_and_show_every_path_kind() {
+        for scene in [mirror(), showcase()] {
+            let p = Params::for_scene(&scene, 48, 48, 3);
+            let mut kinds = [0usize; 3];
+            for y in 0..p.height {
+                for x in 0..p.width {
+                    let a = trace_iterative(&scene, &p, x, y);
+                    let b = trace_recursive(&scene, &p, x, y);
+                    assert_eq!(pack_rgba8(a.color), pack_rgba8(b.color), "({x}, {y})");
+                    let first = a.segments[0]
+                        .hit
+                        .map(|h| scene.surfaces[h.triangle as usize]);
+                    match first {
+                        None => kinds[0] += 1,
+                        Some(s) if s.reflectivity == 0.0 => kinds[1] += 1,
+                        Some(_) => kinds[2] += 1,
                     }
                 }
             }
+            assert!(kinds.iter().all(|&k| k > 100), "{}: {kinds:?}", scene.name);
         }
-        // The scene is meant to exercise every path kind with many pixels.
-        assert!(
-            kinds.iter().all(|&k| k > 200),
-            "sky/floor/mirror pixels: {kinds:?}"
-        );
     }
 
     #[test]
-    fn quad_diagonals_are_closed_edges() {
-        let scene = Scene::reflection();
-        // Each quad is (0, 1, 2), (0, 2, 3): the diagonal 0–2 is opposite
-        // corner 1 in the first triangle and corner 2 in the second.
-        assert_eq!(scene.open_edges(0), [true, false, true]);
-        assert_eq!(scene.open_edges(1), [true, true, false]);
-        // A point on the diagonal is far from any open edge of a 3 × 4 tile.
-        let [a, b, c] = scene.triangle(0);
-        let d = math::edge_distance([a, b, c], [0.5, 0.0, 0.5], scene.open_edges(0));
-        assert!(d > 1.0, "{d}");
-        // Just across the diagonal, inside the neighbour: the neighbour answers.
-        let d = math::edge_distance([a, b, c], [0.5, -0.01, 0.51], scene.open_edges(0));
-        assert_eq!(d, f32::INFINITY);
+    fn vndf_samples_are_finite_at_the_extremes() {
+        // alpha = 0 gives the normal; grazing and head-on views stay finite.
+        let n = sample_vndf(Vec3::new(0.6, 0.0, 0.8), 0.0, 0.3, 0.7);
+        assert_eq!(n, Vec3::Z);
+        for ve in [
+            Vec3::Z,
+            Vec3::new(1.0, 0.0, 0.0),
+            Vec3::new(0.0, 0.999_999, 0.001),
+        ] {
+            for alpha in [0.0, 1e-8, 0.25, 1.0] {
+                for (u1, u2) in [(0.0, 0.0), (0.999_999_9, 0.999_999_9), (0.5, 0.25)] {
+                    let m = sample_vndf(ve, alpha, u1, u2);
+                    assert!(m.is_finite() && m.z >= 0.0, "{ve} {alpha} {u1} {u2}: {m}");
+                }
+            }
+        }
+        // The hash and the numbers drawn from it are reproducible.
+        let mut seed = 7;
+        let (a, b) = (rand(&mut seed), rand(&mut seed));
+        assert!(a != b && (0.0..1.0).contains(&a) && (0.0..1.0).contains(&b));
+        assert_eq!(pcg(0), 129708002);
     }
 
     #[test]
-    fn stored_normals_face_the_camera() {
-        let scene = Scene::reflection();
-        for prim in 0..scene.triangle_count() {
-            let [a, b, c] = scene.triangle(prim);
-            let geometric = normalize(cross(math::sub(b, a), math::sub(c, a)));
-            let stored = scene.surfaces[prim].normal;
-            assert!(dot(geometric, stored).abs() > 0.9999, "triangle {prim}");
-            assert!(
-                dot(stored, math::sub(CAMERA_ORIGIN, a)) > 0.0,
-                "triangle {prim}"
+    fn glossy_without_roughness_is_the_mirror_image() {
+        let scene = mirror();
+        let p = Params::for_scene(&scene, 32, 32, 3);
+        for i in 0..32 * 32 {
+            let (x, y) = (i % 32, i / 32);
+            assert_eq!(
+                pack_rgba8(trace_glossy(&scene, &p, x, y).color),
+                pack_rgba8(trace_iterative(&scene, &p, x, y).color),
+                "({x}, {y})"
             );
         }
+    }
+
+    #[test]
+    fn the_light_casts_shadows() {
+        let scene = showcase();
+        let p = Params::for_scene(&scene, 48, 48, 3);
+        let shadowed = (0..48 * 48)
+            .map(|i| trace_iterative(&scene, &p, i % 48, i / 48))
+            .filter(|path| path.segments.iter().any(|s| s.shadow && s.hit.is_some()))
+            .count();
+        assert!(shadowed > 20, "{shadowed}");
     }
 }

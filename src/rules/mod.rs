@@ -193,6 +193,23 @@ impl<'a> Context<'a> {
         }
     }
 
+    /// Whether the module's source is HLSL (DXR): its language says so, or,
+    /// for SPIR-V from a compiler that names its own language (Slang), its
+    /// debug info names an `.hlsl` file. HLSL's 16-byte packing rules apply
+    /// only there.
+    pub fn source_is_hlsl(&self) -> bool {
+        self.program.language == crate::shader::Language::Hlsl
+            || (self.program.language == crate::shader::Language::Spirv
+                && self.program.files.iter().any(|f| {
+                    f.path
+                        .extension()
+                        .and_then(|e| e.to_str())
+                        .is_some_and(|e| {
+                            e.eq_ignore_ascii_case("hlsl") || e.eq_ignore_ascii_case("hlsli")
+                        })
+                }))
+    }
+
     /// Trace (or callable) sites that pass one of these variables.
     pub fn sites_using(&self, vars: &[Id]) -> Vec<Location> {
         self.program
@@ -476,6 +493,8 @@ mod tests {
                 "RT003 member-straddles-row",
                 "RT004 hit-attributes-over-limit",
                 "RT005 ray-query-null-constant",
+                "RT006 payload-member-unused",
+                "RT008 attributes-larger-than-written",
                 "RT010 live-state-over-budget",
                 "RT020 recursive-trace",
                 "RT021 depth-exceeds-declared",
@@ -492,6 +511,11 @@ mod tests {
                 "RT062 ray-query-single-proceed",
                 "RT063 ray-query-not-initialised",
                 "RT064 committed-read-before-proceed",
+                "RT070 full-instance-mask-on-secondary-ray",
+                "RT071 alpha-test-only-any-hit",
+                "RT072 incoherent-rays-without-reorder",
+                "RT073 ray-query-mega-shader",
+                "RT074 trace-ray-for-visibility",
             ]
         );
     }

@@ -5,14 +5,21 @@ use crate::diag::Diagnostic;
 super::declare_rule! {
     /// ## What it does
     ///
-    /// Lays out each ray payload and callable-data struct under HLSL's 16-byte
-    /// packing (no scalar or vector crosses a 16-byte row; structs, arrays and
+    /// Lays out each ray payload and callable-data struct of an HLSL (DXR) shader
+    /// under HLSL's 16-byte packing (no scalar or vector crosses a 16-byte row; structs, arrays and
     /// matrices start a new row; the last member is not padded) and compares the
     /// declared member order with the best possible order. When another order needs
     /// fewer bytes, it reports both sizes and offers the reordered struct. Among
     /// equally small orders it picks the one that moves members least (the
     /// lexicographically smallest list of declared positions). The search is exact
     /// for structs of up to 16 members.
+    ///
+    /// Only HLSL shaders are checked: the module's language is HLSL, or its
+    /// SPIR-V debug info names an `.hlsl` source. Vulkan sizes GLSL and WGSL
+    /// payloads with its scalar payload rule (every scalar aligned to the largest
+    /// scalar alignment in the block), which has no 16-byte rows, so no member
+    /// order of a GLSL or WGSL payload wastes rows; those modules are not
+    /// reported.
     ///
     /// ## Why is this bad?
     ///
@@ -21,6 +28,9 @@ super::declare_rule! {
     /// payload as a register quadruple. Padding inside those rows is stored, copied
     /// and spilled like data, so a badly ordered payload costs the same as a larger
     /// one.
+    ///
+    /// Fixtures: `fixtures/RT002/` (HLSL bad and good; GLSL and WGSL payloads that
+    /// are not reported).
     ///
     /// ## Example
     ///
@@ -54,6 +64,8 @@ super::declare_rule! {
     /// ## References
     ///
     /// - Microsoft, "Packing rules for constant variables" (HLSL).
+    /// - Vulkan specification, the payload size rule for
+    ///   `maxPipelineRayPayloadSize`.
     "RT002" "payload-packing-waste" {
         group: Perf,
         summary: "payload member order wastes 16-byte rows",
@@ -62,6 +74,9 @@ super::declare_rule! {
 }
 
 fn check(ctx: &Context) -> Vec<Diagnostic> {
+    if !ctx.source_is_hlsl() {
+        return Vec::new();
+    }
     let mut out = Vec::new();
     let packed_roles = |r: &Role| {
         matches!(

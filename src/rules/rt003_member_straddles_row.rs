@@ -5,42 +5,52 @@ use crate::diag::Diagnostic;
 super::declare_rule! {
     /// ## What it does
     ///
-    /// Reports a scalar or vector member of a payload, callable-data or hit-attribute
-    /// struct that, placed where its declared order puts it, crosses a 16-byte row.
-    /// Under HLSL 16-byte packing such a member is moved to the next row and the bytes
-    /// before it become padding; in the tight layout drivers use for payloads it is
-    /// split across two registers quadruples.
+    /// Reports a scalar or vector member of an HLSL (DXR) payload, callable-data or
+    /// hit-attribute struct that, placed where its declared order puts it in the
+    /// tight (scalar) layout, crosses a 16-byte row. Under HLSL 16-byte packing
+    /// such a member is moved to the next row and the bytes before it become
+    /// padding.
+    ///
+    /// Only HLSL shaders are checked: the module's language is HLSL, or its
+    /// SPIR-V debug info names an `.hlsl` source. Vulkan sizes GLSL and WGSL
+    /// payloads with its scalar rule, which has no rows to cross; no reordering
+    /// of such a payload changes what the driver stores (`rtlint layout` shows
+    /// the same), so those modules are not reported.
     ///
     /// ## Why is this bad?
     ///
-    /// A member split across rows needs two register quadruples to read or write, and
-    /// the padding that 16-byte packing inserts before it is stored and copied with
-    /// the payload on every trace.
+    /// The padding that 16-byte packing inserts before the member is stored and
+    /// copied with the payload on every trace, and the member needs a register
+    /// quadruple of its own.
     ///
     /// ## Example
     ///
-    /// ```glsl
+    /// ```hlsl
     /// struct Payload {
-    ///     vec3 color;   // bytes 0..12
-    ///     vec2 uv;      // bytes 12..20: crosses the row at 16
+    ///     float3 color;   // bytes 0..12
+    ///     float2 uv;      // bytes 12..20: crosses the row at 16
     /// };
     /// ```
     ///
     /// Use instead:
     ///
-    /// ```glsl
+    /// ```hlsl
     /// struct Payload {
-    ///     vec2 uv;
-    ///     vec3 color;   // bytes 8..20 still crosses: pair it with a scalar instead
+    ///     float3 color;
+    ///     float hitT;     // fills row 0
+    ///     float2 uv;      // row 1
     /// };
     /// ```
     ///
-    /// or better, put a scalar after `color` (see RT002, which computes the best order).
+    /// RT002 computes the best order.
     ///
     /// ## How to fix
     ///
     /// Place the member where its row has room, usually by moving a scalar next to a
     /// three-component vector, or apply the order RT002 suggests.
+    ///
+    /// Fixtures: `fixtures/RT003/` (HLSL bad and good; GLSL and WGSL payloads that
+    /// are not reported).
     ///
     /// ## Options
     ///
@@ -57,6 +67,9 @@ super::declare_rule! {
 }
 
 fn check(ctx: &Context) -> Vec<Diagnostic> {
+    if !ctx.source_is_hlsl() {
+        return Vec::new();
+    }
     let mut out = Vec::new();
     for t in ctx.layouts.iter().filter(|t| {
         t.roles

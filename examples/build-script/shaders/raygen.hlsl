@@ -23,5 +23,6 @@ void RayGen()
     p.depth = 0;
     TraceRay(scene, RAY_FLAG_NONE, 0xFF, 0, 1, 0, ray, p);
     float w = weights[0] + weights[1] + weights[2] + tail;
-    image[pixel] = float4(p.color * exposure * w, 1.0) * push.tint;
+    float coverage = p.hitT > 0.0 ? 1.0 : 0.0;
+    image[pixel] = float4(p.color * exposure * w, coverage) * push.tint;
 }

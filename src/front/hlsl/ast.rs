@@ -16,6 +16,16 @@ pub enum TArg {
     Expr(Expr),
 }
 
+/// A template parameter: `typename T` / `class T`, or a value `uint N`.
+#[derive(Clone, Debug)]
+pub struct TParam {
+    pub name: String,
+    /// `None` for a type parameter; the value's type otherwise.
+    pub value_ty: Option<TypeRef>,
+    pub default: Option<TArg>,
+    pub pos: Pos,
+}
+
 #[derive(Clone, Debug)]
 pub struct Attr {
     /// `shader`, `numthreads`, `vk::binding`, ...
@@ -40,8 +50,10 @@ pub struct Mods {
 
 #[derive(Clone, Debug)]
 pub struct Register {
+    /// `t`, `u`, `b`, `s`; `?` for a space alone (`register(space1)`).
     pub class: char,
-    pub index: u32,
+    /// `None` for a space alone: the binding is the next free one in it.
+    pub index: Option<u32>,
     pub space: u32,
     pub pos: Pos,
 }
@@ -58,6 +70,8 @@ pub struct VarDecl {
     pub semantic: Option<(String, Pos)>,
     pub register: Option<Register>,
     pub init: Option<Expr>,
+    /// `uint x : 24;`: a bit field of that many bits.
+    pub bits: Option<(u32, Pos)>,
 }
 
 #[derive(Clone, Debug)]
@@ -71,12 +85,20 @@ pub struct Function {
     pub params: Vec<VarDecl>,
     pub semantic: Option<(String, Pos)>,
     pub body: Option<Vec<Stmt>>,
+    /// A `static` struct method: no `this`.
+    pub is_static: bool,
+    /// Template parameters: a template, instantiated where it is used.
+    pub tparams: Vec<TParam>,
 }
 
 #[derive(Clone, Debug)]
 pub struct StructDecl {
     pub name: String,
     pub pos: Pos,
+    /// `struct B : A`: A's members come first.
+    pub bases: Vec<TypeRef>,
+    /// Template parameters: a template, instantiated where it is used.
+    pub tparams: Vec<TParam>,
     pub fields: Vec<VarDecl>,
     /// Methods: functions with an implicit `inout` `this`.
     pub methods: Vec<Function>,
@@ -107,6 +129,8 @@ pub enum Item {
         members: Vec<VarDecl>,
     },
     Function(Function),
+    /// `using namespace a::b;`: unqualified names also look in `a::b::`.
+    Using(String),
 }
 
 #[derive(Clone, Debug)]
@@ -178,6 +202,8 @@ impl BinOp {
 #[derive(Clone, Debug)]
 pub enum ExprKind {
     Int(u64, bool),
+    /// A 64-bit literal (`1ull`, `0x1ffffffffl`, or too large for 32 bits).
+    Int64(u64, bool),
     Float(f64),
     Bool(bool),
     /// Only in attributes (`[shader("miss")]`).
@@ -189,6 +215,10 @@ pub enum ExprKind {
     Ternary(Box<Expr>, Box<Expr>, Box<Expr>),
     /// A call of a function or intrinsic by name.
     Call(String, Vec<Expr>),
+    /// `f<T, 3>(args)`: a call with explicit template arguments.
+    CallT(String, Vec<TArg>, Vec<Expr>),
+    /// `obj.f<T>(args)`.
+    MethodT(Box<Expr>, String, Vec<TArg>, Vec<Expr>),
     /// `float3(...)`, `RayDesc(...)`: a constructor.
     Construct(TypeRef, Vec<Expr>),
     Method(Box<Expr>, String, Vec<Expr>),
@@ -196,6 +226,11 @@ pub enum ExprKind {
     Index(Box<Expr>, Box<Expr>),
     Cast(TypeRef, Box<Expr>),
     InitList(Vec<Expr>),
+    /// `sizeof(T)` or `sizeof(T[N])`: bytes, scalars packed (as DXC's HLSL 2021).
+    SizeOf(TypeRef, Vec<Option<Expr>>),
+    /// `sizeof(expression)`: the size of the expression's type (names,
+    /// members and elements only; it is not evaluated).
+    SizeOfExpr(Box<Expr>),
     Comma(Box<Expr>, Box<Expr>),
 }
 

@@ -12,8 +12,20 @@ pub struct Pos {
     pub col: u32,
 }
 
+/// What an error says about the input.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Kind {
+    /// The input is wrong: a syntax, name or type error.
+    Invalid,
+    /// Valid HLSL this compiler does not handle (`not supported: ...`).
+    Unsupported,
+    /// A bug of the compiler (a builder error).
+    Internal,
+}
+
 #[derive(Clone, Debug)]
 pub struct Error {
+    pub kind: Kind,
     pub pos: Pos,
     /// Columns the primary label covers (at least 1).
     pub len: u32,
@@ -26,6 +38,7 @@ pub struct Error {
 impl Error {
     pub fn new(pos: Pos, message: impl Into<String>) -> Self {
         Error {
+            kind: Kind::Invalid,
             pos,
             len: 1,
             message: message.into(),
@@ -33,6 +46,28 @@ impl Error {
             secondary: Vec::new(),
             notes: Vec::new(),
         }
+    }
+
+    /// `not supported: <what>`: valid HLSL this compiler refuses.
+    pub fn unsupported(pos: Pos, what: impl std::fmt::Display) -> Self {
+        Error {
+            kind: Kind::Unsupported,
+            ..Error::new(pos, format!("not supported: {what}"))
+        }
+    }
+
+    pub fn internal(message: impl std::fmt::Display) -> Self {
+        Error {
+            kind: Kind::Internal,
+            ..Error::new(
+                Pos::default(),
+                format!("internal compiler error: {message}"),
+            )
+        }
+    }
+
+    pub fn is_unsupported(&self) -> bool {
+        self.kind == Kind::Unsupported
     }
 
     pub fn len(mut self, len: u32) -> Self {
@@ -63,7 +98,7 @@ impl Error {
                 .cloned()
                 .unwrap_or_else(|| main.to_path_buf())
         };
-        let name = if self.message.starts_with("not supported") {
+        let name = if self.kind == Kind::Unsupported {
             InputErrorKind::HlslUnsupported
         } else {
             InputErrorKind::HlslError

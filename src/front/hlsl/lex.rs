@@ -12,6 +12,8 @@ pub enum Tok {
     Ident(Rc<str>),
     /// Integer literal: value and whether it had a `u`/`U` suffix.
     Int(u64, bool),
+    /// An integer literal with an `l`/`ll` suffix: 64-bit (`1ull`).
+    Long(u64, bool),
     /// Float literal: value (suffixes `f`, `h`, `l` are accepted and dropped).
     Float(f64),
     Str(Rc<str>),
@@ -46,6 +48,7 @@ impl Token {
         match &self.tok {
             Tok::Ident(s) => s.to_string(),
             Tok::Int(v, u) => format!("{v}{}", if *u { "u" } else { "" }),
+            Tok::Long(v, u) => format!("{v}{}ll", if *u { "u" } else { "" }),
             Tok::Float(f) => {
                 let s = format!("{f:?}");
                 s
@@ -164,12 +167,10 @@ pub fn lex(src: &str, file: u32) -> Result<Vec<Token>, Error> {
                         i += 1;
                         break;
                     }
-                    Some(b'\\') if i + 1 < b.len() => {
-                        s.push(match b[i + 1] {
-                            b'n' => '\n',
-                            b't' => '\t',
-                            other => other as char,
-                        });
+                    // `\"` and `\\` are escapes; any other backslash is kept, as
+                    // in Windows include paths (`"util\Compat.h"`).
+                    Some(b'\\') if matches!(b.get(i + 1), Some(b'"' | b'\\')) => {
+                        s.push(b[i + 1] as char);
                         i += 2;
                     }
                     Some(_) => {
@@ -186,7 +187,7 @@ pub fn lex(src: &str, file: u32) -> Result<Vec<Token>, Error> {
                 i += 3;
                 Tok::Int(b[start + 1] as u64, false)
             } else {
-                return Err(Error::new(pos, "not supported: character literal"));
+                return Err(Error::unsupported(pos, "character literal"));
             }
         } else {
             let rest = &src[i..];
@@ -227,9 +228,50 @@ fn lex_number(b: &[u8]) -> Option<(Tok, usize)> {
         while i < b.len() && b[i].is_ascii_hexdigit() {
             i += 1;
         }
+        let int_end = i;
+        // A hexadecimal float (C99): `0x1.8p-3`, mantissa in hex, exponent of 2.
+        let mut frac_digits = 0;
+        if i < b.len() && b[i] == b'.' {
+            let mut j = i + 1;
+            while j < b.len() && b[j].is_ascii_hexdigit() {
+                j += 1;
+            }
+            if j < b.len() && matches!(b[j], b'p' | b'P') {
+                frac_digits = j - i - 1;
+                i = j;
+            }
+        }
+        if i < b.len() && matches!(b[i], b'p' | b'P') {
+            let mut j = i + 1;
+            let neg = j < b.len() && b[j] == b'-';
+            if j < b.len() && matches!(b[j], b'+' | b'-') {
+                j += 1;
+            }
+            let es = j;
+            while j < b.len() && b[j].is_ascii_digit() {
+                j += 1;
+            }
+            if j > es {
+                let mut mantissa = 0f64;
+                for &d in b[s..int_end]
+                    .iter()
+                    .chain(&b[int_end + 1..int_end + 1 + frac_digits])
+                {
+                    mantissa = mantissa * 16.0 + (d as char).to_digit(16)? as f64;
+                }
+                let exp: i32 = std::str::from_utf8(&b[es..j]).ok()?.parse().ok()?;
+                let exp = if neg { -exp } else { exp } - 4 * frac_digits as i32;
+                let v = mantissa * 2f64.powi(exp);
+                if j < b.len() && matches!(b[j], b'f' | b'F' | b'h' | b'H' | b'l' | b'L') {
+                    j += 1;
+                }
+                return Some((Tok::Float(v), j));
+            }
+        }
+        let i = int_end;
         let v = u64::from_str_radix(std::str::from_utf8(&b[s..i]).ok()?, 16).ok()?;
-        let (u, n) = int_suffix(&b[i..]);
-        return Some((Tok::Int(v, u), i + n));
+        let (u, long, n) = int_suffix(&b[i..]);
+        return Some((int_token(v, u, long), i + n));
     }
     while i < b.len() && b[i].is_ascii_digit() {
         i += 1;
@@ -240,6 +282,20 @@ fn lex_number(b: &[u8]) -> Option<(Tok, usize)> {
         i += 1;
         while i < b.len() && b[i].is_ascii_digit() {
             i += 1;
+        }
+        // MSVC's spelling of special values, which DXC accepts: `1.#INF`.
+        for (spelling, v) in [
+            (&b"#INF"[..], f64::INFINITY),
+            (b"#IND", f64::NAN),
+            (b"#QNAN", f64::NAN),
+        ] {
+            if b[i..].starts_with(spelling) {
+                let mut j = i + spelling.len();
+                if j < b.len() && matches!(b[j], b'f' | b'F') {
+                    j += 1;
+                }
+                return Some((Tok::Float(v), j));
+            }
         }
     }
     if i < b.len() && (b[i] == b'e' || b[i] == b'E') {
@@ -269,21 +325,32 @@ fn lex_number(b: &[u8]) -> Option<(Tok, usize)> {
     } else {
         text.parse().ok()?
     };
-    let (u, n) = int_suffix(&b[i..]);
+    let (u, long, n) = int_suffix(&b[i..]);
     if i + n < b.len() && (b[i + n].is_ascii_alphanumeric() || b[i + n] == b'_') {
         return None;
     }
-    Some((Tok::Int(v, u), i + n))
+    Some((int_token(v, u, long), i + n))
 }
 
-fn int_suffix(b: &[u8]) -> (bool, usize) {
+/// `u`, `l`, `ul`, `ull`, ...: (unsigned, 64-bit, length).
+fn int_suffix(b: &[u8]) -> (bool, bool, usize) {
     let mut u = false;
+    let mut long = false;
     let mut n = 0;
     while n < b.len() && n < 3 && matches!(b[n], b'u' | b'U' | b'l' | b'L') {
         u |= matches!(b[n], b'u' | b'U');
+        long |= matches!(b[n], b'l' | b'L');
         n += 1;
     }
-    (u, n)
+    (u, long, n)
+}
+
+fn int_token(v: u64, u: bool, long: bool) -> Tok {
+    if long {
+        Tok::Long(v, u)
+    } else {
+        Tok::Int(v, u)
+    }
 }
 
 #[cfg(test)]
@@ -292,6 +359,17 @@ mod tests {
 
     fn kinds(s: &str) -> Vec<Tok> {
         lex(s, 0).unwrap().into_iter().map(|t| t.tok).collect()
+    }
+
+    #[test]
+    fn hexadecimal_floats_and_msvc_infinity() {
+        let toks =
+            |s: &str| -> Vec<Tok> { lex(s, 0).unwrap().into_iter().map(|t| t.tok).collect() };
+        assert!(matches!(toks("0x1.0p-24f")[..], [Tok::Float(v)] if v == 2f64.powi(-24)));
+        assert!(matches!(toks("0x1.8p1")[..], [Tok::Float(v)] if v == 3.0));
+        assert!(matches!(toks("0xAp0")[..], [Tok::Float(v)] if v == 10.0));
+        assert!(matches!(toks("0x10")[..], [Tok::Int(16, false)]));
+        assert!(matches!(toks("1.#INF")[..], [Tok::Float(v)] if v.is_infinite()));
     }
 
     #[test]

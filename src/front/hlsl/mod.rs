@@ -5,11 +5,14 @@
 //! place at this module's boundary. See `docs/hlsl.md` for what is supported.
 
 pub mod ast;
+pub mod attrs;
 pub mod error;
 pub mod lex;
 mod lower;
 pub mod parse;
 pub mod pp;
+pub mod subobject;
+pub mod template;
 pub mod types;
 
 pub use crate::shader::Stage;
@@ -28,6 +31,56 @@ pub struct HlslOptions {
     pub defines: Vec<(String, String)>,
     /// Compile only this entry point.
     pub entry: Option<String>,
+    /// The stage of `entry` when it has no `[shader(...)]` (DXC's `-T`).
+    pub stage: Option<Stage>,
+}
+
+/// Reads a DXC target profile (`ps_6_5`, `cs_6_0`, `lib_6_3`) or a stage name
+/// (`pixel`, `closesthit`, ...). `lib_*` gives `None`: stages come from the
+/// `[shader(...)]` attributes.
+pub fn parse_stage(s: &str) -> Result<Option<Stage>, String> {
+    if let Some(stage) = Stage::from_hlsl_name(s) {
+        return Ok(Some(stage));
+    }
+    let (kind, version) = s
+        .split_once('_')
+        .ok_or_else(|| format!("unknown profile or stage `{s}`"))?;
+    let valid_version = version
+        .split('_')
+        .all(|p| !p.is_empty() && p.chars().all(|c| c.is_ascii_digit()));
+    if !valid_version {
+        return Err(format!("unknown profile `{s}`"));
+    }
+    match kind {
+        "ps" => Ok(Some(Stage::Fragment)),
+        "cs" => Ok(Some(Stage::Compute)),
+        "lib" => Ok(None),
+        "vs" | "gs" | "hs" | "ds" | "ms" | "as" => Err(format!(
+            "not supported: {} shaders (`{s}`)",
+            match kind {
+                "vs" => "vertex",
+                "gs" => "geometry",
+                "hs" => "hull",
+                "ds" => "domain",
+                "ms" => "mesh",
+                _ => "amplification",
+            }
+        )),
+        _ => Err(format!("unknown profile `{s}`")),
+    }
+}
+
+/// The lowerer for `items`, told about a command-line entry point's stage.
+fn lowerer<'a>(
+    items: &'a [ast::Item],
+    files: &'a [PathBuf],
+    options: &HlslOptions,
+) -> lower::Lowerer<'a> {
+    let mut l = lower::Lowerer::new(items, files);
+    if let (Some(e), Some(s)) = (&options.entry, options.stage) {
+        l.forced_entry = Some((e.clone(), s));
+    }
+    l
 }
 
 /// One entry point compiled to its own SPIR-V module.
@@ -36,6 +89,8 @@ pub struct CompiledEntry {
     pub name: String,
     pub stage: Stage,
     pub words: Vec<u32>,
+    /// `file:line:col: warning: message` (e.g. an include matched ignoring case).
+    pub warnings: Vec<String>,
 }
 
 /// A whole file compiled to one module holding every entry point.
@@ -45,6 +100,10 @@ pub struct CompiledModule {
     pub entries: Vec<(String, Stage)>,
     /// Source positions of structs, members, globals and functions.
     pub decls: Vec<(NamedDecl, Location)>,
+    /// DXR subobjects (shader and pipeline configs, hit groups, associations).
+    pub subobjects: subobject::Subobjects,
+    /// `file:line:col: warning: message` (e.g. an include matched ignoring case).
+    pub warnings: Vec<String>,
 }
 
 /// Compiles each entry point of `path` into its own module.
@@ -77,10 +136,39 @@ fn parse_source_inner(
     loader: &mut dyn pp::FileLoader,
     options: &HlslOptions,
 ) -> Result<(Vec<ast::Item>, Vec<PathBuf>), InputError> {
+    parse_with_warnings(path, text, loader, options).map(|(items, files, _)| (items, files))
+}
+
+/// Items, the file table, and warnings.
+type Parsed = (Vec<ast::Item>, Vec<PathBuf>, Vec<String>);
+
+/// Preprocesses and parses; also gives the warnings, rendered
+/// `file:line:col: warning: message`.
+fn parse_with_warnings(
+    path: &Path,
+    text: &str,
+    loader: &mut dyn pp::FileLoader,
+    options: &HlslOptions,
+) -> Result<Parsed, InputError> {
     let out = pp::preprocess(path, text, loader, &options.include_dirs, &options.defines)
         .map_err(|f| f.error.into_input_error(&f.files, path))?;
     let items = parse::parse(&out.tokens).map_err(|e| e.into_input_error(&out.files, path))?;
-    Ok((items, out.files))
+    let warnings = out
+        .warnings
+        .iter()
+        .map(|w| {
+            let file = out
+                .files
+                .get(w.pos.file as usize)
+                .map(|f| f.display().to_string())
+                .unwrap_or_default();
+            format!(
+                "{file}:{}:{}: warning: {}",
+                w.pos.line, w.pos.col, w.message
+            )
+        })
+        .collect();
+    Ok((items, out.files, warnings))
 }
 
 fn entry_indices(
@@ -105,7 +193,7 @@ fn entry_indices(
         let msg = match &options.entry {
             Some(name) => format!("no entry point named `{name}`"),
             None => {
-                "no entry points: mark one with [shader(\"...\")] or [numthreads(...)]".to_string()
+                "no entry points: mark one with [shader(\"...\")] or [numthreads(...)], or name it with its stage (-E main -T ps_6_5)".to_string()
             }
         };
         return Err(InputError::new(InputErrorKind::HlslError, path, msg));
@@ -142,19 +230,66 @@ pub fn compile_source(
     with_stack(|| compile_source_inner(path, text, loader, options))
 }
 
+/// Template instances: lowering finds the ones missing, they are added to
+/// the syntax tree, and lowering runs again until none is missing.
+fn instantiate_templates(items: &mut Vec<ast::Item>, files: &[PathBuf], options: &HlslOptions) {
+    const MAX_ROUNDS: usize = 64;
+    const MAX_INSTANCES: usize = 512;
+    let has_templates = items.iter().any(|i| match i {
+        ast::Item::Function(f) => !f.tparams.is_empty(),
+        ast::Item::Struct(s) => {
+            !s.tparams.is_empty() || s.methods.iter().any(|m| !m.tparams.is_empty())
+        }
+        _ => false,
+    });
+    if !has_templates {
+        return;
+    }
+    let mut made = std::collections::HashSet::new();
+    for _ in 0..MAX_ROUNDS {
+        let needed = {
+            let mut l = lowerer(items, files, options);
+            let entries = l.declare().map(|e| {
+                e.iter()
+                    .filter(|e| options.entry.as_ref().is_none_or(|n| *n == e.name))
+                    .filter_map(|e| l.entry_function(&e.name))
+                    .collect::<Vec<_>>()
+            });
+            if let Ok(ks) = entries {
+                let _ = l.lower_reached(&ks);
+            }
+            std::mem::take(&mut l.needed)
+        };
+        if needed.is_empty() {
+            return;
+        }
+        for inst in &needed {
+            // A failure here (or an instance asked for twice) leaves the
+            // instance missing: the compile then reports the use that needed it.
+            if !made.insert(inst.name.clone())
+                || made.len() > MAX_INSTANCES
+                || template::instantiate(items, inst).is_err()
+            {
+                return;
+            }
+        }
+    }
+}
+
 fn compile_source_inner(
     path: &Path,
     text: &str,
     loader: &mut dyn pp::FileLoader,
     options: &HlslOptions,
 ) -> Result<Vec<CompiledEntry>, InputError> {
-    let (items, files) = parse_source_inner(path, text, loader, options)?;
-    let mut probe = lower::Lowerer::new(&items, &files);
+    let (mut items, files, warnings) = parse_with_warnings(path, text, loader, options)?;
+    instantiate_templates(&mut items, &files, options);
+    let mut probe = lowerer(&items, &files, options);
     let picked = entry_indices(&mut probe, path, &files, options)?;
     let mut out = Vec::new();
     for (_, name, stage) in picked {
         // A fresh module per entry point, holding only what it reaches.
-        let mut l = lower::Lowerer::new(&items, &files);
+        let mut l = lowerer(&items, &files, options);
         l.declare().map_err(|e| e.into_input_error(&files, path))?;
         let k = l.entry_function(&name).ok_or_else(|| {
             InputError::new(InputErrorKind::HlslError, path, "entry point vanished")
@@ -162,7 +297,12 @@ fn compile_source_inner(
         let (words, _) = l
             .finish(&[k])
             .map_err(|e| e.into_input_error(&files, path))?;
-        out.push(CompiledEntry { name, stage, words });
+        out.push(CompiledEntry {
+            name,
+            stage,
+            words,
+            warnings: warnings.clone(),
+        });
     }
     Ok(out)
 }
@@ -182,13 +322,15 @@ fn compile_source_whole_inner(
     loader: &mut dyn pp::FileLoader,
     options: &HlslOptions,
 ) -> Result<CompiledModule, InputError> {
-    let (items, files) = parse_source_inner(path, text, loader, options)?;
-    let mut l = lower::Lowerer::new(&items, &files);
+    let (mut items, files, warnings) = parse_with_warnings(path, text, loader, options)?;
+    instantiate_templates(&mut items, &files, options);
+    let mut l = lowerer(&items, &files, options);
     let picked = entry_indices(&mut l, path, &files, options)?;
     let ks: Vec<usize> = picked
         .iter()
         .filter_map(|(_, name, _)| l.entry_function(name))
         .collect();
+    let subobjects = std::mem::take(&mut l.subobjects);
     let (words, decls) = l
         .finish(&ks)
         .map_err(|e| e.into_input_error(&files, path))?;
@@ -196,5 +338,7 @@ fn compile_source_whole_inner(
         words,
         entries: picked.into_iter().map(|(_, n, s)| (n, s)).collect(),
         decls,
+        subobjects,
+        warnings,
     })
 }

@@ -5,8 +5,10 @@
 //! meets them.
 
 use super::ast::*;
+use super::attrs::{check, check_site, Site};
 use super::error::{Error, Pos, Result};
 use super::lex::{Tok, Token};
+use super::pp::{PACK_COLUMN_MAJOR, PACK_ROW_MAJOR};
 use std::collections::HashSet;
 
 pub struct Parser<'t> {
@@ -14,12 +16,44 @@ pub struct Parser<'t> {
     i: usize,
     types: HashSet<String>,
     ns: Vec<String>,
+    /// Namespaces named by `using namespace`.
+    using: Vec<String>,
+    /// `#pragma pack_matrix` changes: (token index from which it holds, row major).
+    pack: Vec<(usize, bool)>,
+    /// Structs declared inside function bodies, added before the function.
+    hoisted: Vec<Item>,
+    /// Names of function and struct templates (bare and qualified).
+    template_fns: HashSet<String>,
+    template_structs: HashSet<String>,
     depth: usize,
 }
 
 /// Nesting limit: deep enough for any real shader, shallow enough that a
 /// fuzzer's `((((...` cannot overflow the stack.
 const MAX_DEPTH: usize = 96;
+
+/// Keywords `mods` reads.
+const MODIFIERS: &[&str] = &[
+    "static",
+    "const",
+    "groupshared",
+    "uniform",
+    "in",
+    "out",
+    "inout",
+    "row_major",
+    "column_major",
+    "precise",
+    "nointerpolation",
+    "inline",
+    "export",
+    "extern",
+    "volatile",
+    "linear",
+    "snorm",
+    "unorm",
+    "globallycoherent",
+];
 
 /// What may follow a declarator: a semantic and a register binding.
 type PostDecl = (Option<(String, Pos)>, Option<Register>);
@@ -60,6 +94,9 @@ pub const TEMPLATE_TYPES: &[&str] = &[
     "Texture3D",
     "TextureCube",
     "Texture2DArray",
+    "Texture1DArray",
+    "TextureCubeArray",
+    "RWTexture1DArray",
     "RWTexture1D",
     "RWTexture2D",
     "RWTexture3D",
@@ -82,7 +119,7 @@ const PLAIN_TYPES: &[&str] = &[
     "RWByteAddressBuffer",
     "string",
     "HitObject",
-    // DXR state-object subobjects: recognised so they can be refused by name.
+    // DXR state-object subobjects (see `subobject`).
     "TriangleHitGroup",
     "ProceduralPrimitiveHitGroup",
     "RaytracingShaderConfig",
@@ -116,11 +153,26 @@ pub fn is_builtin_type(name: &str) -> bool {
 }
 
 pub fn parse(tokens: &[Token]) -> Result<Vec<Item>> {
+    // `#pragma pack_matrix` markers: (index of the next token, row major).
+    let mut pack = Vec::new();
+    let mut kept = Vec::with_capacity(tokens.len());
+    for t in tokens {
+        match t.tok {
+            Tok::Punct(PACK_ROW_MAJOR) => pack.push((kept.len(), true)),
+            Tok::Punct(PACK_COLUMN_MAJOR) => pack.push((kept.len(), false)),
+            _ => kept.push(t.clone()),
+        }
+    }
     let mut p = Parser {
-        t: tokens,
+        t: &kept,
+        pack,
+        hoisted: Vec::new(),
+        template_fns: HashSet::new(),
+        template_structs: HashSet::new(),
         i: 0,
         types: HashSet::new(),
         ns: Vec::new(),
+        using: Vec::new(),
         depth: 0,
     };
     let mut items = Vec::new();
@@ -188,6 +240,11 @@ impl<'t> Parser<'t> {
                     name.push_str(self.peek_at(1).and_then(Token::ident).unwrap_or_default());
                     self.i += 2;
                 }
+                // DXC's `dx` namespace holds built-ins (`dx::HitObject`,
+                // `dx::MaybeReorderThread`): they are known by their bare names.
+                if let Some(bare) = name.strip_prefix("dx::") {
+                    name = bare.to_string();
+                }
                 Ok((name, t.pos))
             }
             _ => Err(self.unexpected("a name")),
@@ -206,7 +263,10 @@ impl<'t> Parser<'t> {
         let Some(name) = self.peek_at(k).and_then(Token::ident) else {
             return false;
         };
-        if is_builtin_type(name) || self.types.contains(name) {
+        if name == "unsigned" {
+            return true;
+        }
+        if (is_builtin_type(name) || self.types.contains(name)) && !self.is_at(k + 1, "::") {
             return true;
         }
         // A qualified name whose last part is a known type.
@@ -220,14 +280,19 @@ impl<'t> Parser<'t> {
             full.push_str(n);
             j += 2;
         }
-        self.types.contains(&full) || self.ns_qualified(&full).is_some()
+        let full = full.strip_prefix("dx::").unwrap_or(&full);
+        is_builtin_type(full) || self.types.contains(full) || self.ns_qualified(full).is_some()
     }
 
     fn ns_qualified(&self, name: &str) -> Option<String> {
         let mut prefix = self.ns.join("::");
         loop {
             if prefix.is_empty() {
-                return None;
+                return self
+                    .using
+                    .iter()
+                    .map(|u| format!("{u}::{name}"))
+                    .find(|q| self.types.contains(q));
             }
             let q = format!("{prefix}::{name}");
             if self.types.contains(&q) {
@@ -255,13 +320,25 @@ impl<'t> Parser<'t> {
 
     fn type_ref(&mut self) -> Result<TypeRef> {
         let (mut name, pos) = self.ident()?;
+        if name == "unsigned" {
+            // `unsigned int2`, `unsigned int`, `unsigned`: the `uint` types.
+            name = match self.peek().and_then(Token::ident) {
+                Some(n) if n.starts_with("int") && split_numeric(n).is_some() => {
+                    self.i += 1;
+                    format!("u{n}")
+                }
+                _ => "uint".to_string(),
+            };
+        }
         if !is_builtin_type(&name) && !self.types.contains(&name) {
             if let Some(q) = self.ns_qualified(&name) {
                 name = q;
             }
         }
         let mut args = Vec::new();
-        if TEMPLATE_TYPES.contains(&name.as_str()) && self.is("<") {
+        if self.is("<") && self.is_template_struct(&name) {
+            args = self.template_args()?;
+        } else if TEMPLATE_TYPES.contains(&name.as_str()) && self.is("<") {
             self.i += 1;
             loop {
                 if self.type_at(0) {
@@ -299,7 +376,13 @@ impl<'t> Parser<'t> {
                     }
                     self.expect(")")?;
                 }
-                out.push(Attr { name, args, pos });
+                let name = match super::attrs::lookup(&name) {
+                    Some(info) => info.name.to_string(),
+                    None => name,
+                };
+                let attr = Attr { name, args, pos };
+                check(&attr)?;
+                out.push(attr);
                 if !self.eat(",") {
                     break;
                 }
@@ -312,8 +395,21 @@ impl<'t> Parser<'t> {
         Ok(out)
     }
 
+    /// Whether `#pragma pack_matrix(row_major)` holds at the current token.
+    fn row_major_default(&self) -> bool {
+        self.pack
+            .iter()
+            .rev()
+            .find(|(at, _)| *at <= self.i)
+            .is_some_and(|(_, row)| *row)
+    }
+
     fn mods(&mut self) -> Mods {
         let mut m = Mods::default();
+        if self.row_major_default() {
+            // Explicit `column_major` below turns it off again.
+            m.row_major = true;
+        }
         loop {
             match self.peek().and_then(Token::ident) {
                 Some("static") => m.is_static = true,
@@ -327,7 +423,10 @@ impl<'t> Parser<'t> {
                     m.output = true
                 }
                 Some("row_major") => m.row_major = true,
-                Some("column_major") => m.column_major = true,
+                Some("column_major") => {
+                    m.column_major = true;
+                    m.row_major = false;
+                }
                 Some("precise") => m.precise = true,
                 Some("nointerpolation") => m.nointerp = true,
                 Some(
@@ -340,11 +439,170 @@ impl<'t> Parser<'t> {
         }
     }
 
+    /// `template<...>` and the function, struct or alias it introduces.
+    fn template_item(&mut self, items: &mut Vec<Item>) -> Result<()> {
+        let tpos = self.pos();
+        let tparams = self.template_params()?;
+        let added: Vec<String> = tparams
+            .iter()
+            .filter(|p| p.value_ty.is_none() && self.types.insert(p.name.clone()))
+            .map(|p| p.name.clone())
+            .collect();
+        let mut one = Vec::new();
+        let r = self.item(&mut one);
+        for a in &added {
+            self.types.remove(a);
+        }
+        r?;
+        // Nested declarations (static members of a templated struct) are not templates.
+        let Some(last) = one.pop() else {
+            return Err(Error::new(
+                tpos,
+                "expected a declaration after `template<...>`",
+            ));
+        };
+        match last {
+            Item::Function(mut f) => {
+                self.template_fns.insert(f.name.clone());
+                if let Some((_, bare)) = f.name.rsplit_once("::") {
+                    self.template_fns.insert(bare.to_string());
+                }
+                f.tparams = tparams;
+                items.extend(one);
+                items.push(Item::Function(f));
+            }
+            Item::Struct(mut sd) => {
+                self.template_structs.insert(sd.name.clone());
+                if let Some((_, bare)) = sd.name.rsplit_once("::") {
+                    self.template_structs.insert(bare.to_string());
+                }
+                sd.tparams = tparams;
+                if !one.is_empty() {
+                    return Err(Error::unsupported(
+                        sd.pos,
+                        "static members or nested types in a struct template",
+                    ));
+                }
+                items.push(Item::Struct(sd));
+            }
+            _ => {
+                return Err(
+                    Error::unsupported(tpos, "templates other than functions and structs").len(8),
+                )
+            }
+        }
+        Ok(())
+    }
+
+    /// `template<typename T, uint N = 4>`.
+    fn template_params(&mut self) -> Result<Vec<TParam>> {
+        self.expect("template")?;
+        self.expect("<")?;
+        let mut out = Vec::new();
+        while !self.is(">") {
+            let pos = self.pos();
+            let value_ty = if self.eat("typename") || self.eat("class") {
+                None
+            } else {
+                Some(self.type_ref()?)
+            };
+            let (name, _) = self.ident()?;
+            let default = if self.eat("=") {
+                Some(if value_ty.is_none() {
+                    TArg::Type(self.type_ref()?)
+                } else {
+                    TArg::Expr(self.binary(0, true)?)
+                })
+            } else {
+                None
+            };
+            out.push(TParam {
+                name,
+                value_ty,
+                default,
+                pos,
+            });
+            if !self.eat(",") {
+                break;
+            }
+        }
+        self.expect(">")?;
+        Ok(out)
+    }
+
+    /// `<float3, 4>` after a template's name.
+    fn template_args(&mut self) -> Result<Vec<TArg>> {
+        self.expect("<")?;
+        let mut args = Vec::new();
+        while !self.is(">") {
+            if self.type_at(0) {
+                args.push(TArg::Type(self.type_ref()?));
+            } else {
+                args.push(TArg::Expr(self.binary(0, true)?));
+            }
+            if !self.eat(",") {
+                break;
+            }
+        }
+        self.expect(">")?;
+        Ok(args)
+    }
+
+    /// Whether `<` at `k` opens template arguments: `<` then a type or a
+    /// number and a closing `>` before anything that cannot be in a list.
+    fn template_args_at(&self, k: usize) -> bool {
+        if !self.is_at(k, "<") {
+            return false;
+        }
+        let mut j = k + 1;
+        let mut depth = 1;
+        while let Some(t) = self.peek_at(j) {
+            if t.is("<") {
+                depth += 1;
+            } else if t.is(">") {
+                depth -= 1;
+                if depth == 0 {
+                    return self.is_at(j + 1, "(");
+                }
+            } else if t.is(";") || t.is("{") || t.is("}") || t.is("&&") || t.is("||") {
+                return false;
+            }
+            j += 1;
+        }
+        false
+    }
+
+    fn is_template_struct(&self, name: &str) -> bool {
+        self.template_structs.contains(name)
+            || name
+                .rsplit_once("::")
+                .is_some_and(|(_, bare)| self.template_structs.contains(bare))
+    }
+
+    /// How many modifier keywords start at the current token.
+    fn mods_len(&self) -> usize {
+        let mut k = 0;
+        while let Some(w) = self.peek_at(k).and_then(Token::ident) {
+            if !MODIFIERS.contains(&w) {
+                break;
+            }
+            k += 1;
+        }
+        k
+    }
+
     fn item(&mut self, items: &mut Vec<Item>) -> Result<()> {
         if self.eat(";") {
             return Ok(());
         }
         let attrs = self.attrs()?;
+        let declares_code = self.is_kw("cbuffer") || self.is_kw("tbuffer") || {
+            let k = self.mods_len();
+            self.type_at(k)
+        };
+        if !declares_code {
+            check_site(&attrs, Site::Struct)?;
+        }
         if self.is_kw("namespace") {
             self.i += 1;
             let (name, _) = self.ident()?;
@@ -360,12 +618,48 @@ impl<'t> Parser<'t> {
             self.ns.pop();
             return Ok(());
         }
-        if self.is_kw("struct")
-            && (self.peek_at(2).is_some_and(|t| t.is("{")) || self.is_at(1, "["))
-        {
-            let s = self.struct_decl()?;
+        let record = self.is_kw("struct") || self.is_kw("class");
+        if record && self.is_at(2, ";") {
+            // A forward declaration: `struct X;`, `class Foo;`.
+            self.i += 1;
+            let (name, _) = self.ident()?;
+            self.declare_type(&name);
             self.expect(";")?;
+            return Ok(());
+        }
+        if record && (self.peek_at(2).is_some_and(|t| t.is("{") || t.is(":")) || self.is_at(1, "["))
+        {
+            let s = self.struct_decl(items)?;
+            self.expect(";")?;
+            items.append(&mut self.hoisted);
             items.push(Item::Struct(s));
+            return Ok(());
+        }
+        if self.is_kw("using") {
+            self.i += 1;
+            if self.eat("namespace") {
+                let (name, _) = self.ident()?;
+                self.expect(";")?;
+                if name != "dx" {
+                    self.using.push(name.clone());
+                    items.push(Item::Using(name));
+                }
+                return Ok(());
+            }
+            // `using Name = Type;`: a typedef.
+            let (name, pos) = self.ident()?;
+            self.expect("=")?;
+            let _ = self.mods();
+            let ty = self.type_ref()?;
+            let dims = self.dims()?;
+            self.expect(";")?;
+            self.declare_type(&name);
+            items.push(Item::Typedef {
+                ty,
+                dims,
+                name: self.qualify(&name),
+                pos,
+            });
             return Ok(());
         }
         if self.is_kw("typedef") {
@@ -422,8 +716,9 @@ impl<'t> Parser<'t> {
         if self.is_kw("cbuffer") || self.is_kw("tbuffer") {
             let kw_pos = self.pos();
             if self.is_kw("tbuffer") {
-                return Err(Error::new(kw_pos, "not supported: tbuffer").len(7));
+                return Err(Error::unsupported(kw_pos, "tbuffer").len(7));
             }
+            check_site(&attrs, Site::Global)?;
             self.i += 1;
             let (name, pos) = self.ident()?;
             let (_, register) = self.post_decl()?;
@@ -434,6 +729,7 @@ impl<'t> Parser<'t> {
                     return Err(self.unexpected("`}`"));
                 }
                 let mattrs = self.attrs()?;
+                check_site(&mattrs, Site::Member)?;
                 let mods = self.mods();
                 let ty = self.type_ref()?;
                 self.declarators(mattrs, mods, ty, &mut members)?;
@@ -452,14 +748,12 @@ impl<'t> Parser<'t> {
         let mods = self.mods();
         if self.is_kw("struct") {
             // `struct S { ... } s;` or `struct S s;`: not worth supporting.
-            return Err(Error::new(
-                self.pos(),
-                "not supported: struct declared inside a declaration",
-            )
-            .len(6));
+            return Err(
+                Error::unsupported(self.pos(), "struct declared inside a declaration").len(6),
+            );
         }
         if self.is_kw("template") {
-            return Err(Error::new(self.pos(), "not supported: templates").len(8));
+            return self.template_item(items);
         }
         if !self.type_at(0) {
             return Err(self.unexpected("a declaration"));
@@ -474,16 +768,47 @@ impl<'t> Parser<'t> {
             self.is_at(k, "(")
         } {
             let (name, pos) = self.ident()?;
-            if name.contains("::") {
-                return Err(Error::new(
-                    pos,
-                    "not supported: out-of-line member definition",
-                ));
+            if let Some((owner, method)) = name.rsplit_once("::") {
+                // `T S::m(...) { ... }`: the definition of a method declared in `S`.
+                let owner = self
+                    .ns_qualified(owner)
+                    .unwrap_or_else(|| owner.to_string());
+                if let Some(sd) = items.iter_mut().rev().find_map(|it| match it {
+                    Item::Struct(sd) if sd.name == owner => Some(sd),
+                    _ => None,
+                }) {
+                    check_site(&attrs, Site::Function)?;
+                    let mut f = self.function(attrs, ty, method.to_string(), pos)?;
+                    f.name = method.to_string();
+                    let Some(decl) = sd.methods.iter_mut().find(|m| {
+                        m.name == method && m.body.is_none() && m.params.len() == f.params.len()
+                    }) else {
+                        return Err(Error::new(
+                            pos,
+                            format!(
+                                "`{owner}` declares no method `{method}` with {} parameter(s)",
+                                f.params.len()
+                            ),
+                        ));
+                    };
+                    f.is_static = decl.is_static;
+                    for (d, p) in decl.params.iter().zip(f.params.iter_mut()) {
+                        if p.init.is_none() {
+                            p.init = d.init.clone();
+                        }
+                    }
+                    *decl = f;
+                    items.append(&mut self.hoisted);
+                    return Ok(());
+                }
             }
+            check_site(&attrs, Site::Function)?;
             let f = self.function(attrs, ty, name, pos)?;
+            items.append(&mut self.hoisted);
             items.push(Item::Function(f));
             return Ok(());
         }
+        check_site(&attrs, Site::Global)?;
         let mut vars = Vec::new();
         self.declarators(attrs, mods, ty, &mut vars)?;
         items.extend(vars.into_iter().map(|mut v| {
@@ -493,55 +818,159 @@ impl<'t> Parser<'t> {
         Ok(())
     }
 
-    fn struct_decl(&mut self) -> Result<StructDecl> {
-        self.expect("struct")?;
-        let _ = self.attrs()?; // `[raypayload]`
+    /// A struct or class. Nested declarations (structs, enums, typedefs,
+    /// `static` members) go to `items`, qualified by the struct's name, before it.
+    fn struct_decl(&mut self, items: &mut Vec<Item>) -> Result<StructDecl> {
+        if !self.eat("class") {
+            self.expect("struct")?;
+        }
+        check_site(&self.attrs()?, Site::Struct)?; // `[raypayload]`
         let (name, pos) = self.ident()?;
         self.declare_type(&name);
+        let qualified = self.qualify(&name);
+        let mut bases = Vec::new();
         if self.eat(":") {
-            return Err(Error::new(self.pos(), "not supported: struct inheritance"));
+            loop {
+                let _ = self.eat("public") || self.eat("private") || self.eat("protected");
+                bases.push(self.type_ref()?);
+                if !self.eat(",") {
+                    break;
+                }
+            }
         }
         self.expect("{")?;
+        self.ns.push(name);
+        let body = self.struct_body(items, &qualified);
+        self.ns.pop();
+        let (fields, methods) = body?;
+        Ok(StructDecl {
+            name: qualified,
+            pos,
+            bases,
+            tparams: Vec::new(),
+            fields,
+            methods,
+        })
+    }
+
+    fn struct_body(
+        &mut self,
+        items: &mut Vec<Item>,
+        qualified: &str,
+    ) -> Result<(Vec<VarDecl>, Vec<Function>)> {
         let mut fields = Vec::new();
         let mut methods = Vec::new();
         while !self.is("}") {
             if self.peek().is_none() {
                 return Err(self.unexpected("`}`"));
             }
-            let fattrs = self.attrs()?;
-            let mods = self.mods();
-            if self.is_kw("struct") {
-                return Err(Error::new(self.pos(), "not supported: nested struct").len(6));
-            }
-            let ty = self.type_ref()?;
-            if self.peek().and_then(Token::ident).is_some() && self.is_at(1, "(") {
-                if mods.is_static {
-                    return Err(Error::new(
-                        self.pos(),
-                        "not supported: static struct methods",
-                    ));
-                }
-                let (mname, mpos) = self.ident()?;
-                let mut f = self.function(fattrs, ty, mname.clone(), mpos)?;
-                if f.body.is_none() {
-                    return Err(Error::new(
-                        mpos,
-                        "not supported: struct method declared without a body",
-                    ));
-                }
-                f.name = mname;
-                methods.push(f);
+            // `public:` / `private:` / `protected:` sections: access is not checked.
+            if ["public", "private", "protected"]
+                .iter()
+                .any(|k| self.is_kw(k))
+                && self.is_at(1, ":")
+            {
+                self.i += 2;
                 continue;
             }
-            self.declarators(fattrs, mods, ty, &mut fields)?;
+            if ["struct", "class", "enum", "typedef", "using"]
+                .iter()
+                .any(|k| self.is_kw(k))
+            {
+                // A nested declaration: a declaration of its own, named `Outer::Inner`.
+                self.item(items)?;
+                continue;
+            }
+            let tparams = if self.is_kw("template") {
+                self.template_params()?
+            } else {
+                Vec::new()
+            };
+            let added: Vec<String> = tparams
+                .iter()
+                .filter(|p| p.value_ty.is_none() && self.types.insert(p.name.clone()))
+                .map(|p| p.name.clone())
+                .collect();
+            let member = self.struct_member(items, qualified, &mut fields, tparams);
+            for a in &added {
+                self.types.remove(a);
+            }
+            if let Some(f) = member? {
+                methods.push(f);
+            }
         }
         self.i += 1;
-        Ok(StructDecl {
-            name: self.qualify(&name),
-            pos,
-            fields,
-            methods,
-        })
+        Ok((fields, methods))
+    }
+
+    /// One member of a struct body: a method (returned), a field or a static.
+    fn struct_member(
+        &mut self,
+        items: &mut Vec<Item>,
+        qualified: &str,
+        fields: &mut Vec<VarDecl>,
+        tparams: Vec<TParam>,
+    ) -> Result<Option<Function>> {
+        {
+            let fattrs = self.attrs()?;
+            let mods = self.mods();
+            let ty = self.type_ref()?;
+            if self.is_kw("operator") {
+                // `T operator[](...)`, `T operator+(...)`: a method named `operator[]`.
+                let mpos = self.pos();
+                self.i += 1;
+                let mut mname = String::from("operator");
+                while !self.is("(")
+                    || mname == "operator" && self.is_at(1, ")") && self.is_at(2, "(")
+                {
+                    let t = self.peek().ok_or_else(|| self.unexpected("an operator"))?;
+                    mname.push_str(&t.spelling());
+                    self.i += 1;
+                    if mname.len() > 12 {
+                        return Err(Error::new(mpos, "expected an operator after `operator`"));
+                    }
+                }
+                check_site(&fattrs, Site::Function)?;
+                let mut f = self.function(fattrs, ty, mname.clone(), mpos)?;
+                f.name = mname;
+                f.is_static = mods.is_static;
+                f.tparams = tparams;
+                return Ok(Some(f));
+            }
+            if self.peek().and_then(Token::ident).is_some() && self.is_at(1, "(") {
+                let (mname, mpos) = self.ident()?;
+                check_site(&fattrs, Site::Function)?;
+                // Without a body, the definition follows outside (`T S::m(...) {}`).
+                let mut f = self.function(fattrs, ty, mname.clone(), mpos)?;
+                f.name = mname;
+                f.is_static = mods.is_static;
+                if !tparams.is_empty() {
+                    self.template_fns.insert(f.name.clone());
+                }
+                f.tparams = tparams;
+                return Ok(Some(f));
+            }
+            if !tparams.is_empty() {
+                return Err(Error::unsupported(
+                    ty.pos,
+                    "member templates other than methods",
+                ));
+            }
+            if mods.is_static {
+                // A static member is a global named `S::name`.
+                check_site(&fattrs, Site::Global)?;
+                let mut vars = Vec::new();
+                self.declarators(fattrs, mods, ty, &mut vars)?;
+                items.extend(vars.into_iter().map(|mut v| {
+                    v.name = format!("{qualified}::{}", v.name);
+                    Item::Var(v)
+                }));
+                return Ok(None);
+            }
+            check_site(&fattrs, Site::Member)?;
+            self.declarators(fattrs, mods, ty, fields)?;
+            Ok(None)
+        }
     }
 
     fn dims(&mut self) -> Result<Vec<Option<Expr>>> {
@@ -567,14 +996,24 @@ impl<'t> Parser<'t> {
                 "register" => {
                     self.expect("(")?;
                     let (r, rpos) = self.ident()?;
-                    let mut chars = r.chars();
-                    let class = chars.next().unwrap_or('?').to_ascii_lowercase();
-                    let index = chars
-                        .as_str()
-                        .parse::<u32>()
-                        .map_err(|_| Error::new(rpos, format!("malformed register `{r}`")))?;
+                    let space_of = |s: &str| s.strip_prefix("space").and_then(|n| n.parse().ok());
                     let mut space = 0;
-                    if self.eat(",") {
+                    let (class, index) = match space_of(&r) {
+                        // `register(space99)`: a space, the binding left to the compiler.
+                        Some(sp) => {
+                            space = sp;
+                            ('?', None)
+                        }
+                        None => {
+                            let mut chars = r.chars();
+                            let class = chars.next().unwrap_or('?').to_ascii_lowercase();
+                            let index = chars.as_str().parse::<u32>().map_err(|_| {
+                                Error::new(rpos, format!("malformed register `{r}`"))
+                            })?;
+                            (class, Some(index))
+                        }
+                    };
+                    if index.is_some() && self.eat(",") {
                         let (s, spos) = self.ident()?;
                         space = s
                             .strip_prefix("space")
@@ -592,7 +1031,7 @@ impl<'t> Parser<'t> {
                     });
                 }
                 "packoffset" => {
-                    return Err(Error::new(pos, "not supported: packoffset").len(10));
+                    return Err(Error::unsupported(pos, "packoffset").len(10));
                 }
                 "read" | "write" => {
                     // Payload access qualifiers: checked by DXC, no effect on SPIR-V.
@@ -620,6 +1059,17 @@ impl<'t> Parser<'t> {
         loop {
             let (name, pos) = self.ident()?;
             let dims = self.dims()?;
+            let bits = match self.peek_at(1) {
+                Some(Token {
+                    tok: Tok::Int(n, _),
+                    pos,
+                    ..
+                }) if self.is(":") => {
+                    self.i += 2;
+                    Some((*n as u32, *pos))
+                }
+                _ => None,
+            };
             let (semantic, register) = self.post_decl()?;
             let init = if self.eat("=") {
                 Some(self.initializer()?)
@@ -636,6 +1086,7 @@ impl<'t> Parser<'t> {
                 semantic,
                 register,
                 init,
+                bits,
             });
             if !self.eat(",") {
                 break;
@@ -679,6 +1130,7 @@ impl<'t> Parser<'t> {
         if !(self.is(")") || self.is_kw("void") && self.is_at(1, ")")) {
             loop {
                 let pattrs = self.attrs()?;
+                check_site(&pattrs, Site::Param)?;
                 let mods = self.mods();
                 if !self.type_at(0) {
                     return Err(self.unexpected("a parameter type"));
@@ -687,11 +1139,9 @@ impl<'t> Parser<'t> {
                 let (pname, ppos) = self.ident()?;
                 let dims = self.dims()?;
                 let (semantic, register) = self.post_decl()?;
+                // A default value: used for trailing arguments a call leaves out.
                 let init = if self.eat("=") {
-                    return Err(Error::new(
-                        self.pos(),
-                        "not supported: default parameter values",
-                    ));
+                    Some(self.ternary()?)
                 } else {
                     None
                 };
@@ -705,6 +1155,7 @@ impl<'t> Parser<'t> {
                     semantic,
                     register,
                     init,
+                    bits: None,
                 });
                 if !self.eat(",") {
                     break;
@@ -733,6 +1184,8 @@ impl<'t> Parser<'t> {
             params,
             semantic,
             body,
+            is_static: false,
+            tparams: Vec::new(),
         })
     }
 
@@ -757,7 +1210,8 @@ impl<'t> Parser<'t> {
     }
 
     fn stmt_inner(&mut self) -> Result<Stmt> {
-        let _ = self.attrs()?; // [unroll], [loop], [branch], [flatten]: hints only
+        // [unroll], [loop], [branch], [flatten]: hints only.
+        check_site(&self.attrs()?, Site::Statement)?;
         let pos = self.pos();
         let kind = match self.peek().map(|t| &t.tok) {
             None => return Err(self.unexpected("a statement")),
@@ -765,6 +1219,26 @@ impl<'t> Parser<'t> {
             Some(Tok::Punct(";")) => {
                 self.i += 1;
                 StmtKind::Empty
+            }
+            Some(Tok::Ident(k)) if (&**k == "struct" || &**k == "class") && self.is_at(2, "{") => {
+                // A struct declared in a function: declared before the function
+                // (named as written), then the declarators if any.
+                let mut nested = Vec::new();
+                let sd = self.struct_decl(&mut nested)?;
+                let ty = TypeRef {
+                    name: sd.name.clone(),
+                    args: Vec::new(),
+                    pos: sd.pos,
+                };
+                self.hoisted.extend(nested);
+                self.hoisted.push(Item::Struct(sd));
+                if self.eat(";") {
+                    StmtKind::Empty
+                } else {
+                    let mut vars = Vec::new();
+                    self.declarators(Vec::new(), Mods::default(), ty, &mut vars)?;
+                    StmtKind::Decl(vars)
+                }
             }
             Some(Tok::Ident(k)) => match &**k {
                 "if" => {
@@ -914,7 +1388,7 @@ impl<'t> Parser<'t> {
             });
         if starts_decl {
             if self.is_kw("struct") {
-                return Err(Error::new(pos, "not supported: local struct declaration"));
+                return Err(Error::unsupported(pos, "local struct declaration"));
             }
             let mods = self.mods();
             let ty = self.type_ref()?;
@@ -1063,6 +1537,14 @@ impl<'t> Parser<'t> {
         }
         // Skip the type (with a template list) and look for `)`.
         let mut k = 2;
+        if self.peek_at(1).and_then(Token::ident) == Some("unsigned")
+            && self
+                .peek_at(2)
+                .and_then(Token::ident)
+                .is_some_and(|n| n.starts_with("int"))
+        {
+            k = 3;
+        }
         while self.is_at(k, "::") {
             k += 2;
         }
@@ -1143,12 +1625,14 @@ impl<'t> Parser<'t> {
             if self.eat(".") {
                 // Member and method expressions point at the name after the dot.
                 let (name, pos) = self.ident()?;
-                if self.is("<") && self.type_at(1) {
-                    return Err(Error::new(
+                if self.template_args_at(0) {
+                    let targs = self.template_args()?;
+                    let args = self.args()?;
+                    e = Expr {
+                        kind: ExprKind::MethodT(Box::new(e), name, targs, args),
                         pos,
-                        format!("not supported: templated method `{name}<...>`"),
-                    )
-                    .len(name.len() as u32));
+                    };
+                    continue;
                 }
                 if self.is("(") {
                     let args = self.args()?;
@@ -1192,9 +1676,17 @@ impl<'t> Parser<'t> {
             return Err(self.unexpected("an expression"));
         };
         let kind = match &t.tok {
+            Tok::Int(v, u) if *v > u32::MAX as u64 => {
+                self.i += 1;
+                ExprKind::Int64(*v, *u)
+            }
             Tok::Int(v, u) => {
                 self.i += 1;
                 ExprKind::Int(*v, *u)
+            }
+            Tok::Long(v, u) => {
+                self.i += 1;
+                ExprKind::Int64(*v, *u)
             }
             Tok::Float(f) => {
                 self.i += 1;
@@ -1202,7 +1694,13 @@ impl<'t> Parser<'t> {
             }
             Tok::Str(s) => {
                 self.i += 1;
-                ExprKind::Str(s.to_string())
+                // Adjacent literals join, as in C: `"SRV(t0), " "UAV(u0)"`.
+                let mut s = s.to_string();
+                while let Some(Tok::Str(more)) = self.peek().map(|t| &t.tok) {
+                    s.push_str(more);
+                    self.i += 1;
+                }
+                ExprKind::Str(s)
             }
             Tok::Punct("(") => {
                 self.i += 1;
@@ -1213,6 +1711,21 @@ impl<'t> Parser<'t> {
             Tok::Ident(k) if &**k == "true" || &**k == "false" => {
                 self.i += 1;
                 ExprKind::Bool(&**k == "true")
+            }
+            Tok::Ident(k) if &**k == "sizeof" && self.is_at(1, "(") => {
+                self.i += 2;
+                if !self.type_at(0) {
+                    let e = self.expr()?;
+                    self.expect(")")?;
+                    return Ok(Expr {
+                        kind: ExprKind::SizeOfExpr(Box::new(e)),
+                        pos,
+                    });
+                }
+                let ty = self.type_ref()?;
+                let dims = self.dims()?;
+                self.expect(")")?;
+                ExprKind::SizeOf(ty, dims)
             }
             // `Enum::Value` names a value even though `Enum` is a type.
             Tok::Ident(_) if self.type_at(0) && !self.enum_value_ahead() => {
@@ -1225,6 +1738,21 @@ impl<'t> Parser<'t> {
             }
             Tok::Ident(_) => {
                 let (name, _) = self.ident()?;
+                let bare = name.rsplit("::").next().unwrap_or(&name);
+                let builtin_template = matches!(
+                    name.as_str(),
+                    "vk::RawBufferLoad" | "vk::RawBufferStore" | "vk::ReadClock"
+                );
+                if (self.template_fns.contains(bare) || builtin_template)
+                    && self.template_args_at(0)
+                {
+                    let targs = self.template_args()?;
+                    let args = self.args()?;
+                    return Ok(Expr {
+                        kind: ExprKind::CallT(name, targs, args),
+                        pos,
+                    });
+                }
                 if self.is("(") {
                     let args = self.args()?;
                     ExprKind::Call(name, args)
@@ -1281,7 +1809,7 @@ mod tests {
                 members,
                 ..
             } => {
-                assert_eq!((r.class, r.index, r.space), ('b', 1, 2));
+                assert_eq!((r.class, r.index, r.space), ('b', Some(1), 2));
                 assert_eq!(members.len(), 2);
             }
             other => panic!("{other:?}"),
@@ -1344,9 +1872,9 @@ mod tests {
             err("struct S { float a }"),
             (1, 20, "expected `;`, found `}`".into())
         );
-        assert!(err("template<typename T> void f() {}")
+        assert!(err("template<typename T> typedef T X;")
             .2
-            .starts_with("not supported: templates"));
+            .starts_with("not supported: templates other than functions and structs"));
         assert!(err("cbuffer C { float a : packoffset(c0); }")
             .2
             .starts_with("not supported: packoffset"));

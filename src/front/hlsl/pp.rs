@@ -13,6 +13,11 @@ use std::rc::Rc;
 /// Where `#include` looks for files; tests and fuzzers read from memory.
 pub trait FileLoader: Send {
     fn read(&mut self, path: &Path) -> Option<String>;
+    /// The names in a folder (files and folders), for matching an include
+    /// whose case differs from the file's.
+    fn list(&mut self, _dir: &Path) -> Vec<String> {
+        Vec::new()
+    }
 }
 
 pub struct FsLoader;
@@ -20,6 +25,20 @@ pub struct FsLoader;
 impl FileLoader for FsLoader {
     fn read(&mut self, path: &Path) -> Option<String> {
         std::fs::read_to_string(path).ok()
+    }
+
+    fn list(&mut self, dir: &Path) -> Vec<String> {
+        let dir = if dir.as_os_str().is_empty() {
+            Path::new(".")
+        } else {
+            dir
+        };
+        std::fs::read_dir(dir)
+            .map(|r| {
+                r.filter_map(|e| e.ok()?.file_name().into_string().ok())
+                    .collect()
+            })
+            .unwrap_or_default()
     }
 }
 
@@ -31,6 +50,43 @@ impl FileLoader for MemLoader {
     fn read(&mut self, path: &Path) -> Option<String> {
         self.0.get(path).cloned()
     }
+
+    fn list(&mut self, dir: &Path) -> Vec<String> {
+        let mut names: Vec<String> = self
+            .0
+            .keys()
+            .filter_map(|p| p.strip_prefix(dir).ok()?.components().next())
+            .filter_map(|c| c.as_os_str().to_str().map(String::from))
+            .collect();
+        names.sort();
+        names.dedup();
+        names
+    }
+}
+
+/// `path` with each component matched without regard to case where the exact
+/// name is missing (Windows file systems ignore case; DXR code relies on it).
+fn case_insensitive_match(loader: &mut dyn FileLoader, path: &Path) -> Option<PathBuf> {
+    use std::path::Component;
+    let mut out = PathBuf::new();
+    let mut changed = false;
+    for c in path.components() {
+        match c {
+            Component::Normal(name) => {
+                let name = name.to_str()?;
+                let names = loader.list(&out);
+                if names.iter().any(|n| n == name) {
+                    out.push(name);
+                } else {
+                    let m = names.iter().find(|n| n.eq_ignore_ascii_case(name))?;
+                    out.push(m);
+                    changed = true;
+                }
+            }
+            other => out.push(other.as_os_str()),
+        }
+    }
+    changed.then_some(out)
 }
 
 #[derive(Clone, Debug)]
@@ -44,6 +100,7 @@ struct Macro {
 pub struct Output {
     pub tokens: Vec<Token>,
     pub files: Vec<PathBuf>,
+    pub warnings: Vec<Error>,
 }
 
 struct Cond {
@@ -68,9 +125,15 @@ pub struct Preprocessor<'a> {
     out: Vec<Token>,
     /// Expansion work done so far; bounds runaway macros.
     budget: usize,
+    /// Warnings (positions and messages), rendered by the caller.
+    pub warnings: Vec<Error>,
 }
 
 const MAX_INCLUDE_DEPTH: usize = 64;
+
+/// Marker tokens for `#pragma pack_matrix(...)`, read by the parser.
+pub const PACK_ROW_MAJOR: &str = "#pragma pack_matrix(row_major)";
+pub const PACK_COLUMN_MAJOR: &str = "#pragma pack_matrix(column_major)";
 const EXPANSION_BUDGET: usize = 2_000_000;
 
 impl<'a> Preprocessor<'a> {
@@ -88,12 +151,48 @@ impl<'a> Preprocessor<'a> {
             stack: Vec::new(),
             out: Vec::new(),
             budget: 0,
+            warnings: Vec::new(),
         };
+        // What DXC defines when it compiles for Vulkan (`-spirv`), before the
+        // user's `-D`s (which may replace them). Shader model 6.5: what this
+        // compiler implements.
+        let predefined = [
+            ("__spirv__", "1"),
+            ("__hlsl_dx_compiler", "1"),
+            ("__HLSL_VERSION", "2021"),
+            ("__SHADER_TARGET_MAJOR", "6"),
+            ("__SHADER_TARGET_MINOR", "5"),
+        ];
+        for (name, value) in predefined {
+            // Plain numbers: no file of their own (nothing in them can fail).
+            let body = lex(value, 0)?
+                .into_iter()
+                .map(|mut t| {
+                    t.bol = false;
+                    t
+                })
+                .collect();
+            pp.macros.insert(
+                Rc::from(name),
+                Macro {
+                    params: None,
+                    variadic: false,
+                    body,
+                },
+            );
+        }
         // `-D` values are lexed as a file of their own, so errors point somewhere.
         for (name, value) in defines {
             let file = pp.files.len() as u32;
             pp.files
                 .push(PathBuf::from(format!("<command line -D{name}>")));
+            if name.contains('(') {
+                // `-D NAME(x)=body`: a function-like macro, read as `#define` reads it.
+                let line = lex(&format!("{name} {value}"), file)?;
+                let pos = line.first().map(|t| t.pos).unwrap_or_default();
+                pp.define(pos, &line)?;
+                continue;
+            }
             let body = lex(value, file)?
                 .into_iter()
                 .map(|mut t| {
@@ -119,6 +218,7 @@ impl<'a> Preprocessor<'a> {
         Ok(Output {
             tokens: self.out,
             files: self.files,
+            warnings: self.warnings,
         })
     }
 
@@ -258,15 +358,25 @@ impl<'a> Preprocessor<'a> {
             "include" => self.include(pos, rest),
             "pragma" => {
                 if rest.first().and_then(Token::ident) == Some("pack_matrix") {
-                    // Changing the default matrix packing would change every layout.
+                    // The default packing of the matrices declared after it: a
+                    // marker token the parser reads (and removes).
                     let arg = rest.get(2).and_then(Token::ident).unwrap_or("");
-                    if arg != "column_major" {
-                        return Err(Error::new(
-                            pos,
-                            format!("not supported: #pragma pack_matrix({arg})"),
-                        )
-                        .note("declare matrices `row_major` one by one instead"));
-                    }
+                    let marker = match arg {
+                        "row_major" => PACK_ROW_MAJOR,
+                        "column_major" => PACK_COLUMN_MAJOR,
+                        _ => {
+                            return Err(Error::new(
+                                pos,
+                                format!(
+                                "#pragma pack_matrix needs row_major or column_major, not `{arg}`"
+                            ),
+                            ))
+                        }
+                    };
+                    let mut t = rest[0].clone();
+                    t.tok = Tok::Punct(marker);
+                    t.bol = false;
+                    self.out.push(t);
                 }
                 if rest.first().and_then(Token::ident) == Some("once") {
                     let file = self.stack.last().map(|s| s.0).unwrap_or(0);
@@ -452,6 +562,8 @@ impl<'a> Preprocessor<'a> {
             }
             _ => return Err(Error::new(pos, "#include needs \"file\" or <file>")),
         };
+        // Windows separators: `#include "util\Compat.h"`.
+        let name = name.replace('\\', "/");
         let current = self.stack.last().map(|s| s.0).unwrap_or(0);
         let mut candidates = Vec::new();
         if quoted {
@@ -465,10 +577,29 @@ impl<'a> Preprocessor<'a> {
             candidates.push(d.join(&name));
         }
         let mut found = None;
-        for c in candidates {
-            if let Some(text) = self.loader.read(&c) {
-                found = Some((c, text));
+        for c in &candidates {
+            if let Some(text) = self.loader.read(c) {
+                found = Some((c.clone(), text));
                 break;
+            }
+        }
+        if found.is_none() {
+            // Windows ignores case: take a file whose name differs only in case, and say so.
+            for c in &candidates {
+                let Some(m) = case_insensitive_match(self.loader, c) else {
+                    continue;
+                };
+                if let Some(text) = self.loader.read(&m) {
+                    self.warnings.push(Error::new(
+                        pos,
+                        format!(
+                            "include `{name}` matched `{}` only when ignoring case",
+                            m.display()
+                        ),
+                    ));
+                    found = Some((m, text));
+                    break;
+                }
             }
         }
         let Some((path, text)) = found else {
@@ -944,7 +1075,7 @@ impl CondExpr<'_> {
         };
         self.i += 1;
         match &t.tok {
-            Tok::Int(v, _) => Ok(*v as i64),
+            Tok::Int(v, _) | Tok::Long(v, _) => Ok(*v as i64),
             // Identifiers left after expansion are 0, as in C.
             Tok::Ident(_) => Ok(0),
             Tok::Punct("!") => Ok((self.unary()? == 0) as i64),
@@ -996,6 +1127,7 @@ pub fn preprocess(
         Ok(()) => Ok(Output {
             tokens: pp.out,
             files: pp.files,
+            warnings: pp.warnings,
         }),
         Err(error) => Err(Box::new(Failure {
             error,

@@ -11,6 +11,9 @@ pub enum Sc {
     Bool,
     Int,
     Uint,
+    /// `int64_t` and `uint64_t` (ordered so that mixed arithmetic widens).
+    Int64,
+    Uint64,
     Float,
 }
 
@@ -20,8 +23,26 @@ impl Sc {
             Sc::Bool => "bool",
             Sc::Int => "int",
             Sc::Uint => "uint",
+            Sc::Int64 => "int64_t",
+            Sc::Uint64 => "uint64_t",
             Sc::Float => "float",
         }
+    }
+
+    /// Bytes of one value in memory.
+    pub fn size(self) -> u32 {
+        match self {
+            Sc::Int64 | Sc::Uint64 => 8,
+            _ => 4,
+        }
+    }
+
+    pub fn is_signed(self) -> bool {
+        matches!(self, Sc::Int | Sc::Int64)
+    }
+
+    pub fn is_64(self) -> bool {
+        matches!(self, Sc::Int64 | Sc::Uint64)
     }
 }
 
@@ -32,6 +53,10 @@ pub enum Dim {
     D3,
     Cube,
     D2Array,
+    D1Array,
+    CubeArray,
+    /// `Buffer<T>` / `RWBuffer<T>`: texel buffers.
+    Buffer,
 }
 
 #[derive(Clone, Debug, PartialEq, Eq, Hash)]
@@ -48,11 +73,17 @@ pub enum Ty {
     Accel,
     RayQuery(u32),
     Sampler,
+    /// `dx::HitObject` (shader execution reordering): opaque, like a ray query.
+    HitObject,
+    /// `SamplerComparisonState` (the same SPIR-V sampler; used with `SampleCmp*`).
+    SamplerCmp,
     Texture {
         dim: Dim,
         sc: Sc,
         n: u8,
         rw: bool,
+        /// `[[vk::image_format("...")]]`; else derived from the element type.
+        fmt: Option<spirv::ImageFormat>,
     },
     StructuredBuffer(Box<Ty>, bool),
     ByteAddress(bool),
@@ -60,6 +91,10 @@ pub enum Ty {
 }
 
 impl Ty {
+    /// Ray queries and hit objects: variables only, never copied or stored.
+    pub fn is_opaque(&self) -> bool {
+        matches!(self, Ty::RayQuery(_) | Ty::HitObject)
+    }
     pub fn scalar(&self) -> Option<Sc> {
         match self {
             Ty::Sc(s) | Ty::Vec(s, _) | Ty::Mat(s, _, _) => Some(*s),
@@ -88,6 +123,7 @@ impl Ty {
         match self {
             Ty::Accel
             | Ty::Sampler
+            | Ty::SamplerCmp
             | Ty::Texture { .. }
             | Ty::StructuredBuffer(..)
             | Ty::ByteAddress(_)
@@ -133,9 +169,9 @@ fn round_up(x: u32, a: u32) -> u32 {
 /// Size and alignment of `ty` under `layout` (scalars are 32-bit).
 pub fn size_align(ty: &Ty, layout: Layout, structs: &[StructDef]) -> (u32, u32) {
     match (ty, layout) {
-        (Ty::Sc(_), _) => (4, 4),
-        (Ty::Vec(_, n), Layout::CBuffer) => (4 * *n as u32, 4),
-        (Ty::Vec(_, n), _) => (4 * *n as u32, if *n == 2 { 8 } else { 16 }),
+        (Ty::Sc(s), _) => (s.size(), s.size()),
+        (Ty::Vec(s, n), Layout::CBuffer) => (s.size() * *n as u32, s.size()),
+        (Ty::Vec(s, n), _) => (s.size() * *n as u32, s.size() * if *n == 2 { 2 } else { 4 }),
         (Ty::Mat(..), _) => {
             let (count, stride, n) = matrix_layout(ty, false, layout);
             matrix_size_align(count, stride, n, layout)
@@ -228,8 +264,8 @@ pub fn struct_offsets(k: u32, layout: Layout, structs: &[StructDef]) -> Vec<u32>
         off = match (layout, &f.ty) {
             // Vectors may sit at scalar alignment unless they would cross a
             // 16-byte row (HLSL packing, and DXC's relaxed std430).
-            (_, Ty::Vec(..)) | (Layout::CBuffer, Ty::Sc(_)) => {
-                let o = round_up(off, 4);
+            (_, Ty::Vec(s, _)) | (Layout::CBuffer, Ty::Sc(s)) => {
+                let o = round_up(off, s.size());
                 if o % 16 + size > 16 {
                     round_up(o, 16)
                 } else {
@@ -242,6 +278,26 @@ pub fn struct_offsets(k: u32, layout: Layout, structs: &[StructDef]) -> Vec<u32>
         off += size;
     }
     out
+}
+
+/// `sizeof(T)` as DXC computes it: 32-bit scalars packed without padding
+/// (`float3` is 12 bytes, `struct { float a; float3 b; }` 16); `None` for
+/// types with no size in memory (resources, ray queries).
+pub fn packed_size(ty: &Ty, structs: &[StructDef]) -> Option<u32> {
+    Some(match ty {
+        Ty::Sc(s) => s.size(),
+        Ty::Vec(s, n) => s.size() * *n as u32,
+        Ty::Mat(_, r, c) => 4 * *r as u32 * *c as u32,
+        Ty::Array(e, n) => packed_size(e, structs)? * n,
+        Ty::Struct(k) => {
+            let mut total = 0;
+            for f in &structs.get(*k as usize)?.fields {
+                total += packed_size(&f.ty, structs)?;
+            }
+            total
+        }
+        _ => return None,
+    })
 }
 
 #[cfg(test)]

@@ -2,76 +2,21 @@
 //! ray-tracing operations and methods of resources and ray queries.
 
 use super::*;
-
-/// GLSL.std.450 instruction numbers used here.
-mod g {
-    pub const ROUND_EVEN: u32 = 2;
-    pub const TRUNC: u32 = 3;
-    pub const FABS: u32 = 4;
-    pub const SABS: u32 = 5;
-    pub const FSIGN: u32 = 6;
-    pub const SSIGN: u32 = 7;
-    pub const FLOOR: u32 = 8;
-    pub const CEIL: u32 = 9;
-    pub const FRACT: u32 = 10;
-    pub const RADIANS: u32 = 11;
-    pub const DEGREES: u32 = 12;
-    pub const SIN: u32 = 13;
-    pub const COS: u32 = 14;
-    pub const TAN: u32 = 15;
-    pub const ASIN: u32 = 16;
-    pub const ACOS: u32 = 17;
-    pub const ATAN: u32 = 18;
-    pub const SINH: u32 = 19;
-    pub const COSH: u32 = 20;
-    pub const TANH: u32 = 21;
-    pub const ATAN2: u32 = 25;
-    pub const POW: u32 = 26;
-    pub const EXP: u32 = 27;
-    pub const LOG: u32 = 28;
-    pub const EXP2: u32 = 29;
-    pub const LOG2: u32 = 30;
-    pub const SQRT: u32 = 31;
-    pub const INVERSE_SQRT: u32 = 32;
-    pub const DETERMINANT: u32 = 33;
-    pub const FMIN: u32 = 37;
-    pub const UMIN: u32 = 38;
-    pub const SMIN: u32 = 39;
-    pub const FMAX: u32 = 40;
-    pub const UMAX: u32 = 41;
-    pub const SMAX: u32 = 42;
-    pub const FCLAMP: u32 = 43;
-    pub const UCLAMP: u32 = 44;
-    pub const SCLAMP: u32 = 45;
-    pub const FMIX: u32 = 46;
-    pub const STEP: u32 = 48;
-    pub const SMOOTH_STEP: u32 = 49;
-    pub const FMA: u32 = 50;
-    pub const PACK_HALF_2X16: u32 = 58;
-    pub const UNPACK_HALF_2X16: u32 = 62;
-    pub const LENGTH: u32 = 66;
-    pub const DISTANCE: u32 = 67;
-    pub const CROSS: u32 = 68;
-    pub const NORMALIZE: u32 = 69;
-    pub const FACE_FORWARD: u32 = 70;
-    pub const REFLECT: u32 = 71;
-    pub const REFRACT: u32 = 72;
-    pub const FIND_ILSB: u32 = 73;
-    pub const FIND_SMSB: u32 = 74;
-    pub const FIND_UMSB: u32 = 75;
-}
+use spirv::GlslStd450Op as G;
 
 /// A call argument: an expression, or a place already evaluated (`this`).
 pub(super) enum Arg<'a> {
     Expr(&'a Expr),
     Place(Place, Pos),
+    /// An argument already evaluated (for an `in` parameter).
+    Value(Val, Pos),
 }
 
 impl Arg<'_> {
     fn pos(&self) -> Pos {
         match self {
             Arg::Expr(e) => e.pos,
-            Arg::Place(_, p) => *p,
+            Arg::Place(_, p) | Arg::Value(_, p) => *p,
         }
     }
 }
@@ -83,20 +28,31 @@ impl<'a> Lowerer<'a> {
         self.line(e.pos);
         match &e.kind {
             ExprKind::Call(name, args) => self.call(name, args, e.pos),
+            ExprKind::CallT(name, targs, args) => self.call_with_targs(name, targs, args, e.pos),
+            ExprKind::MethodT(obj, name, targs, args) => {
+                self.method_with_targs(obj, name, targs, args, e.pos)
+            }
             ExprKind::Method(obj, name, args) => self.method(obj, name, args, e.pos),
             _ => Ok(Some(self.expr(e)?)),
         }
     }
 
-    fn stage_check(&self, name: &str, allowed: &[Stage], pos: Pos) -> Result<()> {
-        if let Some(s) = self.cur_stage {
-            if !allowed.contains(&s) {
+    pub(super) fn stage_check(&mut self, name: &str, allowed: &[Stage], pos: Pos) -> Result<()> {
+        match self.f.cur_stage {
+            Some(s) if !allowed.contains(&s) => {
                 return Err(Error::new(
                     pos,
                     format!("`{name}` is not available in {} shaders", s.hlsl_name()),
                 )
                 .len(name.len() as u32));
             }
+            Some(_) => {}
+            // In a helper: checked against every entry point that reaches it.
+            None => self.fn_stage_uses.entry(self.f.cur_fn).or_default().push((
+                name.to_string(),
+                allowed.to_vec(),
+                pos,
+            )),
         }
         Ok(())
     }
@@ -114,7 +70,7 @@ impl<'a> Lowerer<'a> {
             _ => (Op::Fwidth, "fwidth"),
         };
         let len = name.len() as u32;
-        match self.cur_stage {
+        match self.f.cur_stage {
             Some(Stage::Fragment) => {}
             Some(s) => {
                 return Err(Error::new(
@@ -129,7 +85,7 @@ impl<'a> Lowerer<'a> {
             // In a helper: checked against the entry points that reach it.
             None => {
                 self.fn_derivs
-                    .entry(self.cur_fn)
+                    .entry(self.f.cur_fn)
                     .or_insert((static_name, pos));
             }
         }
@@ -157,11 +113,11 @@ impl<'a> Lowerer<'a> {
         Ok(Val { id, ty })
     }
 
-    fn glsl(&mut self, inst: u32, ty: &Ty, args: &[Id]) -> Result<Val> {
+    fn glsl(&mut self, inst: G, ty: &Ty, args: &[Id]) -> Result<Val> {
         let tid = self.ty_id(ty)?;
         let mut ops = vec![
             Operand::IdRef(self.glsl),
-            Operand::LiteralExtInstInteger(inst),
+            Operand::LiteralExtInstInteger(inst as u32),
         ];
         ops.extend(args.iter().map(|a| Operand::IdRef(*a)));
         let id = self.inst(Op::ExtInst, Some(tid), ops)?;
@@ -221,31 +177,77 @@ impl<'a> Lowerer<'a> {
     }
 
     fn find_user(&self, name: &str) -> Option<Vec<usize>> {
-        if !self.cur_ns.is_empty() {
-            if let Some(v) = self.fn_by_name.get(&format!("{}{name}", self.cur_ns)) {
-                return Some(v.clone());
-            }
-        }
-        self.fn_by_name.get(name).cloned()
+        self.scoped_names(name)
+            .iter()
+            .find_map(|n| self.fn_by_name.get(n))
+            .cloned()
     }
 
     fn call(&mut self, name: &str, args: &'a [Expr], pos: Pos) -> Result<Option<Val>> {
-        if let Some(this) = self.this_place.clone() {
+        if let Some(this) = self.f.this_place.clone() {
             if let Ty::Struct(k) = this.ty() {
                 let qualified = format!("{}::{name}", self.structs[*k as usize].name);
                 if let Some(c) = self.fn_by_name.get(&qualified).cloned() {
+                    if c.iter().all(|k| self.funcs[*k].this.is_none()) {
+                        let args = args.iter().map(Arg::Expr).collect();
+                        return self.call_user(name, c, args, pos);
+                    }
                     let mut all = vec![Arg::Place(this, pos)];
                     all.extend(args.iter().map(Arg::Expr));
                     return self.call_user(name, c, all, pos);
                 }
             }
         }
+        if let Some(this) = self.f.this_place.clone() {
+            if let Ty::Struct(k) = this.ty() {
+                let key = format!("{}::{name}", self.structs[*k as usize].name);
+                if let Some(ts) = self.method_templates.get(&key).cloned() {
+                    return self.template_call(name, ts, &[], args, Some(this), pos);
+                }
+            }
+        }
+        if let Some(r) = self.ser_call(name, args, pos)? {
+            return Ok(r);
+        }
+        let user_fits = self.find_user(name).is_some_and(|c| {
+            c.iter().any(|k| {
+                let f = &self.funcs[*k];
+                (f.params.len() - f.defaults.len()..=f.params.len()).contains(&args.len())
+            })
+        });
+        if !user_fits {
+            // A template takes the call when one fits the arguments (a user
+            // template may share an intrinsic's or an overload's name).
+            if let Some(ts) = self.find_fn_template(name) {
+                let fits = ts.iter().any(|f| {
+                    let required = f.params.iter().take_while(|p| p.init.is_none()).count();
+                    (required..=f.params.len()).contains(&args.len())
+                });
+                if fits {
+                    return self.template_call(name, ts, &[], args, None, pos);
+                }
+            }
+            let ns = self.f.cur_ns.clone();
+            let refused = self
+                .unusable
+                .get(&format!("{ns}{name}"))
+                .or_else(|| self.unusable.get(name));
+            if let Some(e) = refused {
+                let mut e = e.clone();
+                e.secondary.push((pos, format!("`{name}` is called here")));
+                return Err(e);
+            }
+        }
+        if self.returns_resource(name) {
+            let p = self.resource_call(name, args, pos)?;
+            return self.read(&p).map(Some);
+        }
         if let Some(c) = self.find_user(name) {
             return self.call_user(name, c, args.iter().map(Arg::Expr).collect(), pos);
         }
         if let Some((bi, ty, stages)) = system_value(name) {
             self.arity(name, args, 0, pos)?;
-            if self.cur_stage == Some(Stage::Compute) {
+            if self.f.cur_stage == Some(Stage::Compute) {
                 return Err(Error::new(
                     pos,
                     format!("`{name}` is not available in compute shaders"),
@@ -264,36 +266,36 @@ impl<'a> Lowerer<'a> {
             return Ok(Some(v));
         }
         let f = Ty::Sc(Sc::Float);
-        let one_float = |this: &mut Self, inst: u32| -> Result<Option<Val>> {
+        let one_float = |this: &mut Self, inst: G| -> Result<Option<Val>> {
             this.arity(name, args, 1, pos)?;
             let vals = this.args(args)?;
             let (t, ids) = this.unify(vals, true, pos)?;
             Ok(Some(this.glsl(inst, &t, &ids)?))
         };
         let unary_glsl = match name {
-            "sin" => Some(g::SIN),
-            "cos" => Some(g::COS),
-            "tan" => Some(g::TAN),
-            "asin" => Some(g::ASIN),
-            "acos" => Some(g::ACOS),
-            "atan" => Some(g::ATAN),
-            "sinh" => Some(g::SINH),
-            "cosh" => Some(g::COSH),
-            "tanh" => Some(g::TANH),
-            "exp" => Some(g::EXP),
-            "log" => Some(g::LOG),
-            "exp2" => Some(g::EXP2),
-            "log2" => Some(g::LOG2),
-            "sqrt" => Some(g::SQRT),
-            "rsqrt" => Some(g::INVERSE_SQRT),
-            "floor" => Some(g::FLOOR),
-            "ceil" => Some(g::CEIL),
-            "frac" => Some(g::FRACT),
-            "trunc" => Some(g::TRUNC),
-            "round" => Some(g::ROUND_EVEN),
-            "radians" => Some(g::RADIANS),
-            "degrees" => Some(g::DEGREES),
-            "normalize" => Some(g::NORMALIZE),
+            "sin" => Some(G::Sin),
+            "cos" => Some(G::Cos),
+            "tan" => Some(G::Tan),
+            "asin" => Some(G::Asin),
+            "acos" => Some(G::Acos),
+            "atan" => Some(G::Atan),
+            "sinh" => Some(G::Sinh),
+            "cosh" => Some(G::Cosh),
+            "tanh" => Some(G::Tanh),
+            "exp" => Some(G::Exp),
+            "log" => Some(G::Log),
+            "exp2" => Some(G::Exp2),
+            "log2" => Some(G::Log2),
+            "sqrt" => Some(G::Sqrt),
+            "rsqrt" => Some(G::InverseSqrt),
+            "floor" => Some(G::Floor),
+            "ceil" => Some(G::Ceil),
+            "frac" => Some(G::Fract),
+            "trunc" => Some(G::Trunc),
+            "round" => Some(G::RoundEven),
+            "radians" => Some(G::Radians),
+            "degrees" => Some(G::Degrees),
+            "normalize" => Some(G::Normalize),
             _ => None,
         };
         if let Some(inst) = unary_glsl {
@@ -357,7 +359,7 @@ impl<'a> Lowerer<'a> {
                 self.arity(name, args, 0, pos)?;
                 self.stage_check(name, &[Stage::AnyHit], pos)?;
                 self.ray_tracing_caps();
-                if self.term {
+                if self.f.term {
                     self.start_block(None)?;
                 }
                 if name == "IgnoreHit" {
@@ -365,7 +367,7 @@ impl<'a> Lowerer<'a> {
                 } else {
                     self.b.terminate_ray_khr()?;
                 }
-                self.term = true;
+                self.f.term = true;
                 return Ok(None);
             }
             "NonUniformResourceIndex" => {
@@ -457,8 +459,8 @@ impl<'a> Lowerer<'a> {
                 self.arity(name, args, 3, pos)?;
                 let x = self.expr(&args[0])?;
                 let (t, ids) = self.unify(vec![x], true, pos)?;
-                let sn = self.glsl(g::SIN, &t, &ids)?;
-                let cs = self.glsl(g::COS, &t, &ids)?;
+                let sn = self.glsl(G::Sin, &t, &ids)?;
+                let cs = self.glsl(G::Cos, &t, &ids)?;
                 self.store_out(&args[1], sn)?;
                 self.store_out(&args[2], cs)?;
                 return Ok(None);
@@ -468,7 +470,7 @@ impl<'a> Lowerer<'a> {
                 self.arity(name, args, 2, pos)?;
                 let x = self.expr(&args[0])?;
                 let (t, ids) = self.unify(vec![x], true, pos)?;
-                let ip = self.glsl(g::TRUNC, &t, &ids)?;
+                let ip = self.glsl(G::Trunc, &t, &ids)?;
                 let frac = self.binary(
                     BinOp::Sub,
                     Val {
@@ -485,7 +487,7 @@ impl<'a> Lowerer<'a> {
                 self.arity(name, args, 2, pos)?;
                 let vals = self.args(args)?;
                 let (t, ids) = self.unify(vals, true, pos)?;
-                let p = self.glsl(g::EXP2, &t, &ids[1..])?;
+                let p = self.glsl(G::Exp2, &t, &ids[1..])?;
                 return self
                     .binary(BinOp::Mul, Val { id: ids[0], ty: t }, p, pos)
                     .map(Some);
@@ -506,7 +508,15 @@ impl<'a> Lowerer<'a> {
                 return Err(unsupported(pos, format!("`{name}` (pixel shaders only)"))
                     .len(name.len() as u32));
             }
-            _ if name.starts_with("Wave") || name.starts_with("Quad") => {
+            _ if name.starts_with("Wave") => {
+                if let Some(v) = self.wave(name, args, pos)? {
+                    return Ok(Some(v));
+                }
+                return Err(
+                    unsupported(pos, format!("wave intrinsic `{name}`")).len(name.len() as u32)
+                );
+            }
+            _ if name.starts_with("Quad") => {
                 return Err(
                     unsupported(pos, format!("wave intrinsic `{name}`")).len(name.len() as u32)
                 );
@@ -531,6 +541,14 @@ impl<'a> Lowerer<'a> {
 
     fn intrinsic(&mut self, name: &str, vals: Vec<Val>, pos: Pos) -> Result<Val> {
         let f = Ty::Sc(Sc::Float);
+        // 64-bit integers: the min/max/clamp/abs family only.
+        if vals.iter().any(|v| v.ty.scalar().is_some_and(Sc::is_64))
+            && !matches!(name, "min" | "max" | "clamp" | "abs")
+        {
+            return Err(
+                unsupported(pos, format!("`{name}` of 64-bit integers")).len(name.len() as u32)
+            );
+        }
         match name {
             "dot" => {
                 let (t, ids) = self.unify(vals, false, pos)?;
@@ -578,23 +596,23 @@ impl<'a> Lowerer<'a> {
                 if t != Ty::Vec(Sc::Float, 3) {
                     return Err(Error::new(pos, "`cross` needs float3 arguments"));
                 }
-                self.glsl(g::CROSS, &t, &ids)
+                self.glsl(G::Cross, &t, &ids)
             }
             "length" => {
                 let (_, ids) = self.unify(vals, true, pos)?;
-                self.glsl(g::LENGTH, &f, &ids)
+                self.glsl(G::Length, &f, &ids)
             }
             "distance" => {
                 let (_, ids) = self.unify(vals, true, pos)?;
-                self.glsl(g::DISTANCE, &f, &ids)
+                self.glsl(G::Distance, &f, &ids)
             }
             "reflect" => {
                 let (t, ids) = self.unify(vals, true, pos)?;
-                self.glsl(g::REFLECT, &t, &ids)
+                self.glsl(G::Reflect, &t, &ids)
             }
             "faceforward" => {
                 let (t, ids) = self.unify(vals, true, pos)?;
-                self.glsl(g::FACE_FORWARD, &t, &ids)
+                self.glsl(G::FaceForward, &t, &ids)
             }
             "refract" => {
                 let mut vals = vals;
@@ -602,14 +620,14 @@ impl<'a> Lowerer<'a> {
                 let eta = self.convert(eta, &f, pos, false)?;
                 let (t, mut ids) = self.unify(vals, true, pos)?;
                 ids.push(eta.id);
-                self.glsl(g::REFRACT, &t, &ids)
+                self.glsl(G::Refract, &t, &ids)
             }
             "lerp" | "smoothstep" | "fma" => {
                 let (t, ids) = self.unify(vals, true, pos)?;
                 let inst = match name {
-                    "lerp" => g::FMIX,
-                    "fma" => g::FMA,
-                    _ => g::SMOOTH_STEP,
+                    "lerp" => G::FMix,
+                    "fma" => G::Fma,
+                    _ => G::SmoothStep,
                 };
                 self.glsl(inst, &t, &ids)
             }
@@ -627,29 +645,29 @@ impl<'a> Lowerer<'a> {
                 let (t, ids) = self.unify(vals, true, pos)?;
                 let zero = self.const_splat(&t, 0.0)?;
                 let one = self.const_splat(&t, 1.0)?;
-                self.glsl(g::FCLAMP, &t, &[ids[0], zero, one])
+                self.glsl(G::FClamp, &t, &[ids[0], zero, one])
             }
             "clamp" | "min" | "max" => {
                 let (t, ids) = self.unify(vals, false, pos)?;
                 let s = t.scalar().unwrap_or(Sc::Float);
                 let inst = match (name, s) {
-                    ("clamp", Sc::Float) => g::FCLAMP,
-                    ("clamp", Sc::Int) => g::SCLAMP,
-                    ("clamp", _) => g::UCLAMP,
-                    ("min", Sc::Float) => g::FMIN,
-                    ("min", Sc::Int) => g::SMIN,
-                    ("min", _) => g::UMIN,
-                    (_, Sc::Float) => g::FMAX,
-                    (_, Sc::Int) => g::SMAX,
-                    _ => g::UMAX,
+                    ("clamp", Sc::Float) => G::FClamp,
+                    ("clamp", s) if s.is_signed() => G::SClamp,
+                    ("clamp", _) => G::UClamp,
+                    ("min", Sc::Float) => G::FMin,
+                    ("min", s) if s.is_signed() => G::SMin,
+                    ("min", _) => G::UMin,
+                    (_, Sc::Float) => G::FMax,
+                    (_, s) if s.is_signed() => G::SMax,
+                    _ => G::UMax,
                 };
                 self.glsl(inst, &t, &ids)
             }
             "abs" => {
                 let (t, ids) = self.unify(vals, false, pos)?;
                 match t.scalar() {
-                    Some(Sc::Float) => self.glsl(g::FABS, &t, &ids),
-                    Some(Sc::Int) => self.glsl(g::SABS, &t, &ids),
+                    Some(Sc::Float) => self.glsl(G::FAbs, &t, &ids),
+                    Some(s) if s.is_signed() => self.glsl(G::SAbs, &t, &ids),
                     _ => Ok(Val { id: ids[0], ty: t }),
                 }
             }
@@ -659,10 +677,10 @@ impl<'a> Lowerer<'a> {
                 let it = t.with_scalar(Sc::Int);
                 match t.scalar() {
                     Some(Sc::Float) => {
-                        let v = self.glsl(g::FSIGN, &t, &ids)?;
+                        let v = self.glsl(G::FSign, &t, &ids)?;
                         self.convert(v, &it, pos, true)
                     }
-                    Some(Sc::Int) => self.glsl(g::SSIGN, &t, &ids),
+                    Some(Sc::Int) => self.glsl(G::SSign, &t, &ids),
                     _ => {
                         let v = Val {
                             id: ids[0],
@@ -676,9 +694,9 @@ impl<'a> Lowerer<'a> {
             "pow" | "atan2" | "step" => {
                 let (t, ids) = self.unify(vals, true, pos)?;
                 let inst = match name {
-                    "pow" => g::POW,
-                    "atan2" => g::ATAN2,
-                    _ => g::STEP,
+                    "pow" => G::Pow,
+                    "atan2" => G::Atan2,
+                    _ => G::Step,
                 };
                 self.glsl(inst, &t, &ids)
             }
@@ -704,7 +722,7 @@ impl<'a> Lowerer<'a> {
             }
             "log10" => {
                 let (t, ids) = self.unify(vals, true, pos)?;
-                let l = self.glsl(g::LOG2, &t, &ids)?;
+                let l = self.glsl(G::Log2, &t, &ids)?;
                 let k = Val {
                     id: self.const_splat(&t, std::f64::consts::LOG10_2)?,
                     ty: t,
@@ -725,7 +743,7 @@ impl<'a> Lowerer<'a> {
             "determinant" => {
                 let v = vals.into_iter().next().unwrap_or_else(|| unreachable!());
                 match v.ty {
-                    Ty::Mat(_, r, c) if r == c => self.glsl(g::DETERMINANT, &f, &[v.id]),
+                    Ty::Mat(_, r, c) if r == c => self.glsl(G::Determinant, &f, &[v.id]),
                     _ => Err(Error::new(pos, "`determinant` needs a square matrix")),
                 }
             }
@@ -784,10 +802,9 @@ impl<'a> Lowerer<'a> {
                         let zero = self.const_f32(0.0);
                         let v2 = self.ty_id(&Ty::Vec(Sc::Float, 2))?;
                         let pair = self.op(Op::CompositeConstruct, v2, &[c.id, zero])?;
-                        out.push(self.glsl(g::PACK_HALF_2X16, &Ty::Sc(Sc::Uint), &[pair])?);
+                        out.push(self.glsl(G::PackHalf2x16, &Ty::Sc(Sc::Uint), &[pair])?);
                     } else {
-                        let pair =
-                            self.glsl(g::UNPACK_HALF_2X16, &Ty::Vec(Sc::Float, 2), &[c.id])?;
+                        let pair = self.glsl(G::UnpackHalf2x16, &Ty::Vec(Sc::Float, 2), &[c.id])?;
                         let ft = self.ty_id(&f)?;
                         let id = self.inst(
                             Op::CompositeExtract,
@@ -831,14 +848,14 @@ impl<'a> Lowerer<'a> {
                     }
                     "firstbithigh" => self.glsl(
                         if s == Some(Sc::Int) {
-                            g::FIND_SMSB
+                            G::FindSMsb
                         } else {
-                            g::FIND_UMSB
+                            G::FindUMsb
                         },
                         &t,
                         &[v.id],
                     )?,
-                    _ => self.glsl(g::FIND_ILSB, &t, &[v.id])?,
+                    _ => self.glsl(G::FindILsb, &t, &[v.id])?,
                 };
                 // HLSL returns uint components for all four.
                 self.convert(r, &t.with_scalar(Sc::Uint), pos, true)
@@ -1079,9 +1096,13 @@ impl<'a> Lowerer<'a> {
         args: Vec<Arg<'a>>,
         pos: Pos,
     ) -> Result<Option<Val>> {
+        // Trailing parameters with default values may be left out.
         let cands: Vec<usize> = cands
             .into_iter()
-            .filter(|k| self.funcs[*k].params.len() == args.len())
+            .filter(|k| {
+                let f = &self.funcs[*k];
+                (f.params.len() - f.defaults.len()..=f.params.len()).contains(&args.len())
+            })
             .collect();
         if cands.is_empty() {
             return Err(Error::new(
@@ -1102,6 +1123,10 @@ impl<'a> Lowerer<'a> {
                 argv.push((Some(p.clone()), v));
                 continue;
             }
+            if let Arg::Value(v, _) = a {
+                argv.push((None, v.clone()));
+                continue;
+            }
             let Arg::Expr(a) = *a else { unreachable!() };
             if is_out {
                 let p = self.place(a)?;
@@ -1114,7 +1139,17 @@ impl<'a> Lowerer<'a> {
                 };
                 argv.push((Some(p), v));
             } else {
-                let v = self.expr(a)?;
+                let mut v = self.expr(a)?;
+                if let Ty::ConstantBuffer(k) = v.ty {
+                    // A `ConstantBuffer<S>` passed for an `S`: its contents.
+                    let wants_buffer = cands
+                        .iter()
+                        .any(|c| matches!(self.funcs[*c].params[i].ty, Ty::ConstantBuffer(_)));
+                    if !wants_buffer {
+                        let p = self.place(a)?;
+                        v = self.struct_of(p, k, a.pos)?;
+                    }
+                }
                 argv.push((None, v));
             }
         }
@@ -1157,16 +1192,46 @@ impl<'a> Lowerer<'a> {
         if sig.stage.is_some() {
             return Err(unsupported(pos, "calling an entry point function"));
         }
+        let mut args = args;
+        let first_default = sig.params.len() - sig.defaults.len();
+        for i in args.len()..sig.params.len() {
+            // Evaluated at the call, as C++ and DXC do.
+            let e = sig.defaults[i - first_default];
+            argv.push((None, self.expr(e)?));
+            args.push(Arg::Expr(e));
+        }
         let mut temps = Vec::new();
-        for ((p, (place, v)), a) in sig.params.iter().zip(&argv).zip(&args) {
+        // Buffers (storage-buffer pointers) cannot be function arguments
+        // without variable pointers: the function is specialized on them.
+        let mut bound = Vec::new();
+        for (i, ((p, (place, v)), a)) in sig.params.iter().zip(&argv).zip(&args).enumerate() {
+            if let Ty::RayQuery(_) = p.ty {
+                // A ray query is passed as its variable (it cannot be copied).
+                if p.out || v.ty != p.ty {
+                    return Err(Error::new(
+                        a.pos(),
+                        format!(
+                            "expected a `{}` variable (passed `in`)",
+                            self.ty_name(&p.ty)
+                        ),
+                    ));
+                }
+                temps.push(v.id);
+                continue;
+            }
             if p.ty.is_resource() {
                 // Passed as the resource variable itself, which SPIR-V's
-                // logical addressing allows only for whole variables.
-                if !self.resource_vars.contains(&v.id) {
+                // logical addressing allows for whole variables and, for
+                // images and samplers, for elements of arrays of them.
+                let element_ok = matches!(p.ty, Ty::Texture { .. } | Ty::Sampler | Ty::SamplerCmp);
+                if !element_ok && !self.resource_vars.contains(&v.id) {
                     return Err(unsupported(
                         a.pos(),
                         "passing an element of a resource array to a function",
                     ));
+                }
+                if self.param_class(&p.ty).0 != StorageClass::UniformConstant {
+                    bound.push((i, v.id));
                 }
                 temps.push(v.id);
                 continue;
@@ -1182,12 +1247,39 @@ impl<'a> Lowerer<'a> {
             }
             temps.push(tmp);
         }
+        let (k, sig) = if bound.is_empty() {
+            (k, sig)
+        } else {
+            let k = self.specialize(k, &bound);
+            (k, self.funcs[k].clone())
+        };
+        let mut passed: Vec<Id> = temps
+            .iter()
+            .enumerate()
+            .filter(|(i, _)| !sig.bound.iter().any(|(b, _)| b == i))
+            .map(|(_, t)| *t)
+            .collect();
+        if let Some((t, _)) = &sig.ret_slot {
+            match self.f.ret_dest.take() {
+                Some((var, dt)) if dt == *t => passed.push(var),
+                _ => {
+                    return Err(unsupported(
+                        pos,
+                        format!(
+                        "`{name}` returns a {}: call it only to initialize a variable of that type",
+                        self.ty_name(t)
+                    ),
+                    )
+                    .len(name.len() as u32))
+                }
+            }
+        }
         let rt = self.ty_id(&sig.ret)?;
-        if self.term {
+        if self.f.term {
             self.start_block(None)?;
         }
-        let id = self.b.function_call(rt, None, sig.id, temps.clone())?;
-        self.fn_calls.entry(self.cur_fn).or_default().insert(k);
+        let id = self.b.function_call(rt, None, sig.id, passed)?;
+        self.fn_calls.entry(self.f.cur_fn).or_default().insert(k);
         if !self.lowered.contains(&k) && !self.pending.contains(&k) {
             self.pending.push(k);
         }
@@ -1215,5 +1307,140 @@ impl<'a> Lowerer<'a> {
         } else {
             Some(Val { id, ty: sig.ret })
         })
+    }
+
+    /// Function `k` with the buffer parameters `bound` (parameter index,
+    /// variable) replaced by those variables: one copy per combination.
+    fn specialize(&mut self, k: usize, bound: &[(usize, Id)]) -> usize {
+        let key = (k, bound.to_vec());
+        if let Some(&s) = self.specialized.get(&key) {
+            return s;
+        }
+        let mut sig = self.funcs[k].clone();
+        sig.id = self.b.id();
+        sig.bound = bound
+            .iter()
+            .map(|&(i, var)| {
+                let ty = sig.params[i].ty.clone();
+                let (class, layout) = self.param_class(&ty);
+                (
+                    i,
+                    Place::Ptr {
+                        ptr: var,
+                        ty,
+                        layout,
+                        class,
+                    },
+                )
+            })
+            .collect();
+        let s = self.funcs.len();
+        self.funcs.push(sig);
+        self.specialized.insert(key, s);
+        s
+    }
+
+    /// Whether `name` is a user function returning a resource.
+    pub(super) fn returns_resource(&self, name: &str) -> bool {
+        self.find_user(name)
+            .is_some_and(|c| c.iter().any(|k| self.funcs[*k].ret.is_resource()))
+    }
+
+    /// A call of a helper that returns a resource: SPIR-V's logical
+    /// addressing cannot return one, so (as DXC's legalization does) the
+    /// helper is inlined. Its body must be `return <resource expression>;`,
+    /// evaluated with the parameters bound to the arguments.
+    pub(super) fn resource_call(
+        &mut self,
+        name: &str,
+        args: &'a [Expr],
+        pos: Pos,
+    ) -> Result<Place> {
+        let cands = self.find_user(name).unwrap_or_default();
+        let Some(k) = cands.into_iter().find(|k| {
+            let f = &self.funcs[*k];
+            f.this.is_none()
+                && (f.params.len() - f.defaults.len()..=f.params.len()).contains(&args.len())
+        }) else {
+            return Err(Error::new(
+                pos,
+                format!("no overload of `{name}` takes {} argument(s)", args.len()),
+            )
+            .len(name.len() as u32));
+        };
+        let sig = self.funcs[k].clone();
+        let body = sig.func.body.as_deref().unwrap_or_default();
+        let [Stmt {
+            kind: StmtKind::Return(Some(ret)),
+            ..
+        }] = body
+        else {
+            return Err(unsupported(
+                sig.func.pos,
+                "a function returning a resource whose body is more than `return <resource>;`",
+            )
+            .len(sig.name.len() as u32));
+        };
+        if self.f.inline_depth >= 16 {
+            return Err(Error::new(
+                pos,
+                format!("`{name}` is recursive; HLSL does not allow recursion"),
+            ));
+        }
+        let first_default = sig.params.len() - sig.defaults.len();
+        let mut scope = HashMap::new();
+        for (i, (p, decl)) in sig.params.iter().zip(&sig.func.params).enumerate() {
+            let a = match args.get(i) {
+                Some(a) => a,
+                None => sig.defaults[i - first_default],
+            };
+            if p.out {
+                return Err(unsupported(
+                    decl.pos,
+                    "`out` parameters of a function returning a resource",
+                ));
+            }
+            let place = if p.ty.is_resource() {
+                self.place(a)?
+            } else {
+                let v = self.expr(a)?;
+                Place::Value(self.convert(v, &p.ty, a.pos, false)?)
+            };
+            scope.insert(decl.name.clone(), place);
+        }
+        // The helper's body sees its parameters and the globals, not the caller's locals.
+        let scopes = std::mem::replace(&mut self.f.scopes, vec![scope]);
+        let this = self.f.this_place.take();
+        let ns = std::mem::replace(&mut self.f.cur_ns, sig.func.ns.clone());
+        self.f.inline_depth += 1;
+        let r = self.place(ret);
+        self.f.inline_depth -= 1;
+        self.f.scopes = scopes;
+        self.f.this_place = this;
+        self.f.cur_ns = ns;
+        let r = r?;
+        if !r.ty().is_resource() {
+            return Err(Error::new(ret.pos, "expected a resource"));
+        }
+        Ok(r)
+    }
+
+    /// The value of a struct place read member by member (a constant buffer's
+    /// contents as an `S`).
+    pub(super) fn struct_of(&mut self, p: Place, k: u32, pos: Pos) -> Result<Val> {
+        let names: Vec<String> = self.structs[k as usize]
+            .fields
+            .iter()
+            .map(|f| f.name.clone())
+            .collect();
+        let mut ids = Vec::new();
+        for n in &names {
+            let m = self.member(p.clone(), n, pos)?;
+            ids.push(self.read(&m)?.id);
+        }
+        let t = Ty::Struct(k);
+        let tid = self.ty_id(&t)?;
+        let id = self.op(Op::CompositeConstruct, tid, &ids)?;
+        Ok(Val { id, ty: t })
     }
 }

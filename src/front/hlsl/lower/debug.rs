@@ -3,25 +3,7 @@
 //! to disk (`rtlint compile`) still leads back to declarations when checked.
 
 use super::*;
-
-mod op {
-    pub const INFO_NONE: u32 = 0;
-    pub const COMPILATION_UNIT: u32 = 1;
-    pub const TYPE_BASIC: u32 = 2;
-    pub const TYPE_ARRAY: u32 = 5;
-    pub const TYPE_VECTOR: u32 = 6;
-    pub const TYPE_FUNCTION: u32 = 8;
-    pub const TYPE_COMPOSITE: u32 = 10;
-    pub const TYPE_MEMBER: u32 = 11;
-    pub const GLOBAL_VARIABLE: u32 = 18;
-    pub const FUNCTION: u32 = 20;
-    pub const LOCAL_VARIABLE: u32 = 26;
-    pub const DECLARE: u32 = 28;
-    pub const EXPRESSION: u32 = 31;
-    pub const SOURCE: u32 = 35;
-    pub const FUNCTION_DEFINITION: u32 = 101;
-    pub const TYPE_MATRIX: u32 = 108;
-}
+use spirv::NonsemanticShaderDebuginfo100Op as D;
 
 pub(super) struct DebugInfo {
     set: Id,
@@ -38,9 +20,12 @@ pub(super) struct DebugInfo {
 }
 
 impl<'a> Lowerer<'a> {
-    fn dbg_inst(&mut self, d: &DebugInfo, which: u32, args: &[Id]) -> Id {
+    fn dbg_inst(&mut self, d: &DebugInfo, which: D, args: &[Id]) -> Id {
         let id = self.b.id();
-        let mut ops = vec![Operand::IdRef(d.set), Operand::LiteralExtInstInteger(which)];
+        let mut ops = vec![
+            Operand::IdRef(d.set),
+            Operand::LiteralExtInstInteger(which as u32),
+        ];
         ops.extend(args.iter().map(|a| Operand::IdRef(*a)));
         self.b.insert_types_global_values(
             InsertPoint::End,
@@ -56,27 +41,27 @@ impl<'a> Lowerer<'a> {
         let id = match t {
             Ty::Sc(s) => {
                 let name = self.b.string(s.name());
-                let size = self.const_u32(32);
+                let size = self.const_u32(8 * s.size());
                 // DWARF-style encodings: Boolean 2, Float 3, Signed 4, Unsigned 6.
                 let enc = self.const_u32(match s {
                     Sc::Bool => 2,
                     Sc::Float => 3,
-                    Sc::Int => 4,
-                    Sc::Uint => 6,
+                    Sc::Int | Sc::Int64 => 4,
+                    Sc::Uint | Sc::Uint64 => 6,
                 });
                 let flags = self.const_u32(0);
-                self.dbg_inst(d, op::TYPE_BASIC, &[name, size, enc, flags])
+                self.dbg_inst(d, D::DebugTypeBasic, &[name, size, enc, flags])
             }
             Ty::Vec(s, n) => {
                 let base = self.dbg_type(d, &Ty::Sc(*s));
                 let count = self.const_u32(*n as u32);
-                self.dbg_inst(d, op::TYPE_VECTOR, &[base, count])
+                self.dbg_inst(d, D::DebugTypeVector, &[base, count])
             }
             Ty::Mat(s, r, c) => {
                 let col = self.dbg_type(d, &Ty::Vec(*s, *c));
                 let count = self.const_u32(*r as u32);
                 let column_major = self.const_bool(true);
-                self.dbg_inst(d, op::TYPE_MATRIX, &[col, count, column_major])
+                self.dbg_inst(d, D::DebugTypeMatrix, &[col, count, column_major])
             }
             Ty::Array(e, n) => {
                 let base = self.dbg_type(d, e);
@@ -84,7 +69,7 @@ impl<'a> Lowerer<'a> {
                     return d.none; // arrays of resources
                 }
                 let count = self.const_u32(*n);
-                self.dbg_inst(d, op::TYPE_ARRAY, &[base, count])
+                self.dbg_inst(d, D::DebugTypeArray, &[base, count])
             }
             Ty::Struct(k) => self.dbg_struct(d, *k),
             _ => d.none,
@@ -118,7 +103,7 @@ impl<'a> Lowerer<'a> {
             let flags = self.const_u32(3); // FlagIsPublic
             members.push(self.dbg_inst(
                 d,
-                op::TYPE_MEMBER,
+                D::DebugTypeMember,
                 &[name, ty, source, line, col, offset, bits, flags],
             ));
         }
@@ -131,7 +116,7 @@ impl<'a> Lowerer<'a> {
         let flags = self.const_u32(3);
         let mut args = vec![name, tag, source, line, col, d.unit, name, bits, flags];
         args.extend(members);
-        self.dbg_inst(d, op::TYPE_COMPOSITE, &args)
+        self.dbg_inst(d, D::DebugTypeComposite, &args)
     }
 
     /// Emits the debug info; returns what `finish` needs to place the
@@ -154,9 +139,9 @@ impl<'a> Lowerer<'a> {
             declares: Vec::new(),
             expression: 0,
         };
-        d.none = self.dbg_inst(&d, op::INFO_NONE, &[]);
+        d.none = self.dbg_inst(&d, D::DebugInfoNone, &[]);
         for f in self.file_ids.clone() {
-            let s = self.dbg_inst(&d, op::SOURCE, &[f]);
+            let s = self.dbg_inst(&d, D::DebugSource, &[f]);
             d.sources.push(s);
         }
         let version = self.const_u32(100);
@@ -164,7 +149,7 @@ impl<'a> Lowerer<'a> {
         let lang = self.const_u32(5); // HLSL
         d.unit = self.dbg_inst(
             &d,
-            op::COMPILATION_UNIT,
+            D::DebugCompilationUnit,
             &[version, dwarf, d.sources[0], lang],
         );
         // User structs (the built-in RayDesc and attributes have no source).
@@ -189,7 +174,7 @@ impl<'a> Lowerer<'a> {
             let flags = self.const_u32(3);
             self.dbg_inst(
                 &d,
-                op::GLOBAL_VARIABLE,
+                D::DebugGlobalVariable,
                 &[n, t, source, line, col, d.unit, n, var, flags],
             );
         }
@@ -211,7 +196,7 @@ impl<'a> Lowerer<'a> {
             if targs[1..].contains(&d.none) {
                 continue; // resource parameters have no debug type to give
             }
-            let fty = self.dbg_inst(&d, op::TYPE_FUNCTION, &targs);
+            let fty = self.dbg_inst(&d, D::DebugTypeFunction, &targs);
             let n = self.b.string(sig.name.clone());
             let pos = sig.func.pos;
             let source = d
@@ -223,14 +208,14 @@ impl<'a> Lowerer<'a> {
             let col = self.const_u32(pos.col.max(1));
             let f = self.dbg_inst(
                 &d,
-                op::FUNCTION,
+                D::DebugFunction,
                 &[n, fty, source, line, col, d.unit, n, flags, line],
             );
             let result = self.b.id();
             d.definitions.push((f, sig.id, result));
             dbg_fns.insert(k, f);
         }
-        d.expression = self.dbg_inst(&d, op::EXPRESSION, &[]);
+        d.expression = self.dbg_inst(&d, D::DebugExpression, &[]);
         let local_flags = self.const_u32(4); // FlagIsLocal
         for (k, var, name, ty, pos) in self.local_decls.clone() {
             let Some(&scope) = dbg_fns.get(&k) else {
@@ -250,7 +235,7 @@ impl<'a> Lowerer<'a> {
             let col = self.const_u32(pos.col.max(1));
             let local = self.dbg_inst(
                 &d,
-                op::LOCAL_VARIABLE,
+                D::DebugLocalVariable,
                 &[n, t, source, line, col, scope, local_flags],
             );
             let result = self.b.id();
@@ -286,7 +271,7 @@ impl<'a> Lowerer<'a> {
                         Some(*result),
                         vec![
                             Operand::IdRef(d.set),
-                            Operand::LiteralExtInstInteger(op::DECLARE),
+                            Operand::LiteralExtInstInteger(D::DebugDeclare as u32),
                             Operand::IdRef(*local),
                             Operand::IdRef(*var),
                             Operand::IdRef(d.expression),
@@ -302,7 +287,7 @@ impl<'a> Lowerer<'a> {
                     Some(*result),
                     vec![
                         Operand::IdRef(d.set),
-                        Operand::LiteralExtInstInteger(op::FUNCTION_DEFINITION),
+                        Operand::LiteralExtInstInteger(D::DebugFunctionDefinition as u32),
                         Operand::IdRef(*dbg_fn),
                         Operand::IdRef(*fn_id),
                     ],

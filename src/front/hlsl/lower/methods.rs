@@ -40,6 +40,12 @@ impl<'a> Lowerer<'a> {
                 all.extend(args.iter().map(super::calls::Arg::Expr));
                 self.call_user(name, c, all, pos)
             }
+            Ty::HitObject => {
+                let Place::Ptr { ptr, .. } = p else {
+                    return Err(Error::new(obj.pos, "a HitObject must be a local variable"));
+                };
+                self.hit_object_method(ptr, name, args, pos)
+            }
             Ty::RayQuery(flags) => {
                 let Place::Ptr { ptr, .. } = p else {
                     return Err(Error::new(obj.pos, "a RayQuery must be a local variable"));
@@ -48,13 +54,13 @@ impl<'a> Lowerer<'a> {
             }
             Ty::Texture { .. } => {
                 let Place::Ptr { ptr, .. } = p else {
-                    unreachable!("textures are variables")
+                    return Err(not_a_variable(pos));
                 };
                 self.texture(ptr, &t, name, args, pos)
             }
             Ty::StructuredBuffer(e, _) => {
                 let Place::Ptr { ptr, .. } = p.clone() else {
-                    unreachable!("buffers are variables")
+                    return Err(not_a_variable(pos));
                 };
                 match name {
                     "Load" => {
@@ -97,7 +103,7 @@ impl<'a> Lowerer<'a> {
             }
             Ty::ByteAddress(rw) => {
                 let Place::Ptr { ptr, .. } = p else {
-                    unreachable!("buffers are variables")
+                    return Err(not_a_variable(pos));
                 };
                 self.byte_address(ptr, *rw, name, args, pos)
             }
@@ -116,7 +122,7 @@ impl<'a> Lowerer<'a> {
         self.write(&p, v, a.pos)
     }
 
-    fn byte_address(
+    pub(super) fn byte_address(
         &mut self,
         var: Id,
         rw: bool,
@@ -282,20 +288,23 @@ impl<'a> Lowerer<'a> {
         let im = self.image(ptr, t)?;
         let v4 = Ty::Vec(*sc, 4);
         let vt = self.ty_id(&v4)?;
-        let lod = match lod {
-            Some(l) => l,
-            None => self.const_i32(0),
-        };
-        let id = self.inst(
-            Op::ImageFetch,
-            Some(vt),
-            vec![
-                Operand::IdRef(im),
-                Operand::IdRef(coord),
-                Operand::ImageOperands(spirv::ImageOperands::LOD),
-                Operand::IdRef(lod),
-            ],
-        )?;
+        let mut ops = vec![Operand::IdRef(im), Operand::IdRef(coord)];
+        // Texel buffers have no mip levels.
+        if !matches!(
+            t,
+            Ty::Texture {
+                dim: Dim::Buffer,
+                ..
+            }
+        ) {
+            let lod = match lod {
+                Some(l) => l,
+                None => self.const_i32(0),
+            };
+            ops.push(Operand::ImageOperands(spirv::ImageOperands::LOD));
+            ops.push(Operand::IdRef(lod));
+        }
+        let id = self.inst(Op::ImageFetch, Some(vt), ops)?;
         let texel = if *n == 1 {
             Ty::Sc(*sc)
         } else {
@@ -312,7 +321,7 @@ impl<'a> Lowerer<'a> {
         args: &'a [Expr],
         pos: Pos,
     ) -> Result<Option<Val>> {
-        let Ty::Texture { dim, sc, n, rw } = t.clone() else {
+        let Ty::Texture { dim, sc, n, rw, .. } = t.clone() else {
             unreachable!("texture method")
         };
         let texel = if n == 1 { Ty::Sc(sc) } else { Ty::Vec(sc, n) };
@@ -323,18 +332,27 @@ impl<'a> Lowerer<'a> {
             Ty::Vec(Sc::Float, cn)
         };
         match name {
-            "Sample" if self.cur_stage.is_some_and(|s| s != Stage::Fragment) => Err(unsupported(
+            _ if dim == Dim::Buffer && name.starts_with("Sample") => Err(Error::new(
+                pos,
+                format!("a Buffer has no `{name}`; use Load or []"),
+            )),
+            "Sample" if self.f.cur_stage.is_some_and(|s| s != Stage::Fragment) => Err(unsupported(
                 pos,
                 "`Sample` (implicit level of detail) outside pixel shaders; use `SampleLevel`",
             )
             .len(6)),
+            "SampleCmp" | "SampleCmpLevelZero" | "SampleCmpLevel" => self
+                .sample_cmp(ptr, t, float_coord, name, args, pos)
+                .map(Some),
             "Sample" | "SampleLevel" | "SampleGrad" => {
                 if rw {
                     return Err(Error::new(pos, format!("RWTexture has no method `{name}`")));
                 }
-                if name == "Sample" && self.cur_stage.is_none() {
+                if name == "Sample" && self.f.cur_stage.is_none() {
                     // Implicit LOD takes derivatives: checked against the reaching entry points.
-                    self.fn_derivs.entry(self.cur_fn).or_insert(("Sample", pos));
+                    self.fn_derivs
+                        .entry(self.f.cur_fn)
+                        .or_insert(("Sample", pos));
                 }
                 let want = match name {
                     "Sample" => 2,
@@ -366,9 +384,9 @@ impl<'a> Lowerer<'a> {
                     ops.push(Operand::ImageOperands(spirv::ImageOperands::LOD));
                     ops.push(Operand::IdRef(lod.id));
                 } else {
-                    let gt = if dim == Dim::Cube || dim == Dim::D3 {
+                    let gt = if matches!(dim, Dim::Cube | Dim::CubeArray | Dim::D3) {
                         Ty::Vec(Sc::Float, 3)
-                    } else if dim == Dim::D1 {
+                    } else if matches!(dim, Dim::D1 | Dim::D1Array) {
                         Ty::Sc(Sc::Float)
                     } else {
                         Ty::Vec(Sc::Float, 2)
@@ -384,7 +402,12 @@ impl<'a> Lowerer<'a> {
                 let id = self.inst(Op::ImageSampleExplicitLod, Some(vt), ops)?;
                 Ok(Some(self.shrink(Val { id, ty: v4 }, &texel)?))
             }
-            "Load" if dim == Dim::Cube => Err(Error::new(
+            "Load" if dim == Dim::Buffer && !rw => {
+                self.arity(name, args, 1, pos)?;
+                let c = self.expr_as(&args[0], &Ty::Sc(Sc::Int))?;
+                Ok(Some(self.fetch(ptr, t, c.id, None)?))
+            }
+            "Load" if matches!(dim, Dim::Cube | Dim::CubeArray) => Err(Error::new(
                 pos,
                 "a TextureCube has no `Load`; use SampleLevel",
             )),
@@ -450,7 +473,7 @@ impl<'a> Lowerer<'a> {
                 };
                 let qtid = self.ty_id(&qt)?;
                 let im = self.image(ptr, t)?;
-                let size = if rw {
+                let size = if rw || dim == Dim::Buffer {
                     self.op(Op::ImageQuerySize, qtid, &[im])?
                 } else {
                     let lod = match mip {
@@ -680,5 +703,205 @@ impl<'a> Lowerer<'a> {
             return Ok(Some(Val { id, ty: t34 }));
         }
         Ok(Some(Val { id, ty: t }))
+    }
+
+    /// `buffer.Load<T>(address)` for 32-bit scalars and vectors: the words
+    /// `LoadN` reads, reinterpreted as `T`.
+    pub(super) fn typed_load(
+        &mut self,
+        p: Place,
+        name: &str,
+        targs: &'a [TArg],
+        args: &'a [Expr],
+        pos: Pos,
+    ) -> Result<Option<Val>> {
+        let (Place::Ptr { ptr, .. }, Ty::ByteAddress(rw)) = (&p, p.ty()) else {
+            return Err(not_a_variable(pos));
+        };
+        let ns = self.f.cur_ns.clone();
+        let t = match (name, targs) {
+            ("Load", [TArg::Type(t)]) => self.resolve_ty(t, &ns)?,
+            _ => {
+                return Err(unsupported(pos, format!("templated method `{name}<...>`"))
+                    .len(name.len() as u32))
+            }
+        };
+        let (sc, n) = match t {
+            Ty::Sc(s) if s != Sc::Bool && !s.is_64() => (s, 1),
+            Ty::Vec(s, n) if s != Sc::Bool && !s.is_64() => (s, n),
+            Ty::Struct(_) | Ty::Array(..) => {
+                return self.load_packed(*ptr, &t, args, pos).map(Some);
+            }
+            _ => {
+                return Err(unsupported(
+                    pos,
+                    format!(
+                        "`Load<{}>` (only 32-bit scalars, vectors, and structs and arrays of them)",
+                        self.ty_name(&t)
+                    ),
+                ))
+            }
+        };
+        let method = match n {
+            1 => "Load",
+            2 => "Load2",
+            3 => "Load3",
+            _ => "Load4",
+        };
+        let Some(words) = self.byte_address(*ptr, *rw, method, args, pos)? else {
+            return Err(Error::new(pos, "`Load` gave no value"));
+        };
+        if sc == Sc::Uint {
+            return Ok(Some(words));
+        }
+        let tid = self.ty_id(&t)?;
+        let id = self.op(Op::Bitcast, tid, &[words.id])?;
+        Ok(Some(Val { id, ty: t }))
+    }
+
+    /// `SampleCmp`, `SampleCmpLevelZero`, `SampleCmpLevel`: depth-comparison
+    /// sampling with a `SamplerComparisonState` (`OpImageSampleDref*`).
+    fn sample_cmp(
+        &mut self,
+        ptr: Id,
+        t: &Ty,
+        coord: Ty,
+        name: &str,
+        args: &'a [Expr],
+        pos: Pos,
+    ) -> Result<Val> {
+        let Ty::Texture { rw: false, sc, .. } = t else {
+            return Err(Error::new(pos, format!("RWTexture has no method `{name}`")));
+        };
+        let implicit = name == "SampleCmp";
+        if implicit {
+            if self.f.cur_stage.is_some_and(|s| s != Stage::Fragment) {
+                return Err(unsupported(
+                    pos,
+                    "`SampleCmp` (implicit level of detail) outside pixel shaders; use `SampleCmpLevelZero`",
+                ));
+            }
+            if self.f.cur_stage.is_none() {
+                self.fn_derivs
+                    .entry(self.f.cur_fn)
+                    .or_insert(("SampleCmp", pos));
+            }
+        }
+        let want = if name == "SampleCmpLevel" { 4 } else { 3 };
+        self.arity(name, args, want, pos)?;
+        let s = self.expr(&args[0])?;
+        if s.ty != Ty::SamplerCmp {
+            return Err(Error::new(args[0].pos, "expected a SamplerComparisonState"));
+        }
+        let uv = self.expr(&args[1])?;
+        let uv = self.convert(uv, &coord, args[1].pos, false)?;
+        let reference = self.expr(&args[2])?;
+        let reference = self.convert(reference, &Ty::Sc(Sc::Float), args[2].pos, false)?;
+        let im = self.image(ptr, t)?;
+        let st = self.ty_id(&Ty::SamplerCmp)?;
+        let sm = self.b.load(st, None, s.id, None, [])?;
+        let it = self.ty_id(t)?;
+        let sit = self.b.type_sampled_image(it);
+        let si = self.op(Op::SampledImage, sit, &[im, sm])?;
+        let rt = Ty::Sc(*sc);
+        let rid = self.ty_id(&rt)?;
+        let mut ops = vec![
+            Operand::IdRef(si),
+            Operand::IdRef(uv.id),
+            Operand::IdRef(reference.id),
+        ];
+        let op = if implicit {
+            Op::ImageSampleDrefImplicitLod
+        } else {
+            let lod = if name == "SampleCmpLevel" {
+                let l = self.expr(&args[3])?;
+                self.convert(l, &Ty::Sc(Sc::Float), args[3].pos, false)?.id
+            } else {
+                self.const_f32(0.0)
+            };
+            ops.push(Operand::ImageOperands(spirv::ImageOperands::LOD));
+            ops.push(Operand::IdRef(lod));
+            Op::ImageSampleDrefExplicitLod
+        };
+        let id = self.inst(op, Some(rid), ops)?;
+        Ok(Val { id, ty: rt })
+    }
+
+    /// `Load<S>` of a struct or array: its 32-bit leaves packed one word each,
+    /// in declaration order (the layout `sizeof` gives), then put together.
+    fn load_packed(&mut self, var: Id, t: &Ty, args: &'a [Expr], pos: Pos) -> Result<Val> {
+        fn leaves(t: &Ty, structs: &[StructDef], out: &mut Vec<Sc>) -> bool {
+            match t {
+                Ty::Sc(s) if *s != Sc::Bool && !s.is_64() => out.push(*s),
+                Ty::Vec(s, n) if *s != Sc::Bool && !s.is_64() => {
+                    out.extend(std::iter::repeat_n(*s, *n as usize))
+                }
+                Ty::Array(e, n) => {
+                    for _ in 0..*n {
+                        if !leaves(e, structs, out) {
+                            return false;
+                        }
+                    }
+                }
+                Ty::Struct(k) => {
+                    for f in &structs[*k as usize].fields {
+                        if !leaves(&f.ty, structs, out) {
+                            return false;
+                        }
+                    }
+                }
+                _ => return false,
+            }
+            true
+        }
+        let mut scalars = Vec::new();
+        if !leaves(t, &self.structs, &mut scalars) {
+            return Err(unsupported(
+                pos,
+                format!(
+                    "`Load<{}>`: members other than 32-bit scalars, vectors, structs and arrays",
+                    self.ty_name(t)
+                ),
+            ));
+        }
+        self.arity("Load", args, 1, pos)?;
+        let u = Ty::Sc(Sc::Uint);
+        let ut = self.ty_id(&u)?;
+        let pty = self.b.type_pointer(None, StorageClass::StorageBuffer, ut);
+        let addr = self.expr_as(&args[0], &u)?;
+        let two = Val {
+            id: self.const_u32(2),
+            ty: u.clone(),
+        };
+        let word = self.binary(BinOp::Shr, addr, two, pos)?;
+        let zero = self.const_u32(0);
+        let mut vals = Vec::new();
+        for (i, s) in scalars.iter().enumerate() {
+            let off = Val {
+                id: self.const_u32(i as u32),
+                ty: u.clone(),
+            };
+            let w = self.binary(BinOp::Add, word.clone(), off, pos)?;
+            let ptr = self.inst(
+                Op::AccessChain,
+                Some(pty),
+                vec![
+                    Operand::IdRef(var),
+                    Operand::IdRef(zero),
+                    Operand::IdRef(w.id),
+                ],
+            )?;
+            let id = self.b.load(ut, None, ptr, None, [])?;
+            let st = Ty::Sc(*s);
+            let id = if *s == Sc::Uint {
+                id
+            } else {
+                let sid = self.ty_id(&st)?;
+                self.op(Op::Bitcast, sid, &[id])?
+            };
+            vals.push(Val { id, ty: st });
+        }
+        let mut it = vals.into_iter();
+        self.build(t, &mut it, pos)
     }
 }

@@ -26,13 +26,7 @@ impl<'a> Lowerer<'a> {
     pub(super) fn pixel_wrapper(&mut self, k: usize) -> Result<(Id, Vec<Id>)> {
         let sig = self.funcs[k].clone();
         let f = sig.func;
-        self.cur_fn = k;
-        self.cur_ns = f.ns.clone();
-        self.cur_stage = Some(Stage::Fragment);
-        self.scopes = vec![HashMap::new()];
-        self.flow.clear();
-        self.term = false;
-        self.this_place = None;
+        self.f = FnCtx::new(k, &f.ns, Some(Stage::Fragment), Ty::Void);
         let void = self.b.type_void();
         let fty = self.b.type_function(void, []);
         let id = self.b.id();
@@ -41,20 +35,12 @@ impl<'a> Lowerer<'a> {
         self.b.name(id, sig.name.clone());
         self.start_block(None)?;
         self.line(f.pos);
-        for (var, t, e) in self.deferred_inits.clone() {
-            self.line(e.pos);
-            let v = self.expr_as(e, &t)?;
-            self.use_global(var);
-            if self.term {
-                self.start_block(None)?;
-            }
-            self.b.store(var, v.id, None, [])?;
-        }
+        self.run_deferred_inits()?;
         let mut io = Io::default();
         let mut args = Vec::new();
         let mut outs = Vec::new();
         for (p, decl) in sig.params.iter().zip(&f.params) {
-            if p.ty.is_resource() || matches!(p.ty, Ty::RayQuery(_)) {
+            if p.ty.is_resource() || p.ty.is_opaque() {
                 return Err(
                     unsupported(decl.pos, "resource parameters on a pixel entry point")
                         .len(decl.name.len() as u32),
@@ -305,6 +291,36 @@ impl<'a> Lowerer<'a> {
 
     /// Derivatives, implicit-LOD `Sample` and `discard` exist only in pixel shaders: a function that
     /// uses them must not be reached from another stage's entry point.
+    /// Stage-restricted operations in helpers (`TraceRay`, system values, ...)
+    /// against an entry point that reaches them.
+    pub(super) fn check_stage_uses(&self, reached: &HashSet<usize>, entry: &FnSig) -> Result<()> {
+        let Some(stage) = entry.stage else {
+            return Ok(());
+        };
+        let mut fs: Vec<&usize> = reached.iter().collect();
+        fs.sort();
+        for f in fs {
+            for (name, allowed, pos) in self.fn_stage_uses.get(f).into_iter().flatten() {
+                if !allowed.contains(&stage) {
+                    return Err(Error::new(
+                        *pos,
+                        format!("`{name}` is not available in {} shaders", stage.hlsl_name()),
+                    )
+                    .len(name.len() as u32)
+                    .secondary(
+                        entry.func.pos,
+                        format!(
+                            "reached from {} entry point `{}`",
+                            stage.hlsl_name(),
+                            entry.name
+                        ),
+                    ));
+                }
+            }
+        }
+        Ok(())
+    }
+
     pub(super) fn check_derivatives(&self, reached: &HashSet<usize>, entry: &FnSig) -> Result<()> {
         let mut uses: Vec<(usize, &(&str, Pos))> = self
             .fn_derivs

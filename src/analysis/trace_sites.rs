@@ -1,0 +1,212 @@
+//! Every trace an entry point reaches, per call chain: its operands folded
+//! for that chain, and whether it runs inside a loop (a bounce loop).
+
+use crate::program::cfg::{call_chains, natural_loops};
+use crate::program::{Program, SiteKind, TraceOperands};
+use crate::shader::Stage;
+
+/// How many call chains are followed per entry point and site.
+const MAX_CHAINS: usize = 16;
+
+/// One trace as one entry point reaches it.
+#[derive(Clone, Debug)]
+pub struct ReachedTrace {
+    /// Index into [`Program::entry_points`].
+    pub entry: usize,
+    pub stage: Stage,
+    /// Index into [`Program::sites`].
+    pub site: usize,
+    /// `OpFunctionCall` indices from the entry point, outermost first.
+    pub chain: Vec<usize>,
+    pub operands: TraceOperands,
+    /// The trace, or a call on its chain, sits in a loop.
+    pub in_loop: bool,
+}
+
+/// Whether instruction `inst` sits in a natural loop of its function.
+pub fn inst_in_loop(program: &Program, inst: usize) -> bool {
+    let Some(f) = program
+        .function_of(inst)
+        .and_then(|i| program.functions.get(i))
+    else {
+        return false;
+    };
+    let Some(b) = f.block_of(inst) else {
+        return false;
+    };
+    natural_loops(f).iter().any(|(_, body)| body.contains(&b))
+}
+
+/// The traces (`OpTraceRayKHR`) each ray-tracing entry point reaches.
+pub fn reached_traces(program: &Program) -> Vec<ReachedTrace> {
+    let mut out = Vec::new();
+    for (e, entry) in program.entry_points.iter().enumerate() {
+        if !entry.stage.is_ray_tracing() {
+            continue;
+        }
+        for (s, site) in program.sites.iter().enumerate() {
+            if site.kind != SiteKind::TraceRay {
+                continue;
+            }
+            let Some(f) = program.functions.get(site.function) else {
+                continue;
+            };
+            for chain in call_chains(program, entry.function, f.id, MAX_CHAINS) {
+                let Some(operands) = program.trace_operands_in(site, &chain) else {
+                    continue;
+                };
+                let in_loop = inst_in_loop(program, site.inst)
+                    || chain.iter().any(|&c| inst_in_loop(program, c));
+                out.push(ReachedTrace {
+                    entry: e,
+                    stage: entry.stage,
+                    site: s,
+                    chain,
+                    operands,
+                    in_loop,
+                });
+            }
+        }
+    }
+    out
+}
+
+/// Whether value `id` (in the context of `chain`) is computed from a load of
+/// a ray payload: followed through operands, locals (every value stored into
+/// a function-local variable the value is loaded from) and parameters.
+/// What a bounce loop's next ray looks like: its origin or direction comes
+/// from the previous trace's payload.
+pub fn depends_on_payload(program: &Program, id: crate::program::Id, chain: &[usize]) -> bool {
+    use rspirv::dr::Operand;
+    use spirv::{Op, StorageClass};
+    /// How many values the search visits at most.
+    const LIMIT: usize = 2000;
+    let storage_of = |ptr: crate::program::Id| -> Option<StorageClass> {
+        let d = program.def(ptr)?;
+        match program.ty(d.result_type?) {
+            Some(crate::program::Type::Pointer { storage, .. }) => Some(*storage),
+            _ => None,
+        }
+    };
+    // The variable an access chain starts from.
+    let root = |mut ptr: crate::program::Id| -> crate::program::Id {
+        for _ in 0..32 {
+            match program.def(ptr) {
+                Some(d)
+                    if matches!(
+                        d.class.opcode,
+                        Op::AccessChain | Op::InBoundsAccessChain | Op::CopyObject
+                    ) =>
+                {
+                    match d.operands.first() {
+                        Some(Operand::IdRef(b)) => ptr = *b,
+                        _ => break,
+                    }
+                }
+                _ => break,
+            }
+        }
+        ptr
+    };
+    let mut seen: Vec<(crate::program::Id, usize)> = Vec::new();
+    let mut work: Vec<(crate::program::Id, usize)> = vec![(id, chain.len())];
+    while let Some((v, depth)) = work.pop() {
+        if seen.contains(&(v, depth)) || seen.len() > LIMIT {
+            continue;
+        }
+        seen.push((v, depth));
+        let Some(inst) = program.def(v) else { continue };
+        match inst.class.opcode {
+            Op::Load => {
+                let Some(Operand::IdRef(ptr)) = inst.operands.first() else {
+                    continue;
+                };
+                if matches!(
+                    storage_of(*ptr),
+                    Some(StorageClass::RayPayloadKHR | StorageClass::IncomingRayPayloadKHR)
+                ) {
+                    return true;
+                }
+                let var = root(*ptr);
+                if matches!(
+                    storage_of(var),
+                    Some(StorageClass::Function | StorageClass::Private)
+                ) {
+                    // Every value stored into the local.
+                    for s in program.insts.iter() {
+                        if s.class.opcode != Op::Store {
+                            continue;
+                        }
+                        if let (Some(Operand::IdRef(p)), Some(Operand::IdRef(val))) =
+                            (s.operands.first(), s.operands.get(1))
+                        {
+                            if root(*p) == var {
+                                work.push((*val, depth));
+                            }
+                        }
+                    }
+                }
+            }
+            Op::FunctionParameter => {
+                // The argument the chain's call passes.
+                let Some(f) = program
+                    .function_of(*program.defs.get(&v).unwrap_or(&0))
+                    .and_then(|i| program.functions.get(i))
+                else {
+                    continue;
+                };
+                let Some(k) = f.params.iter().position(|&p| p == v) else {
+                    continue;
+                };
+                let Some(at) = chain[..depth.min(chain.len())].iter().rposition(|&c| {
+                    matches!(program.insts[c].operands.first(), Some(Operand::IdRef(x)) if *x == f.id)
+                }) else {
+                    continue;
+                };
+                if let Some(Operand::IdRef(arg)) = program.insts[chain[at]].operands.get(1 + k) {
+                    work.push((*arg, at));
+                }
+            }
+            Op::Variable | Op::Constant | Op::ConstantComposite | Op::FunctionCall => {}
+            _ => {
+                for o in &inst.operands {
+                    if let Operand::IdRef(x) = o {
+                        work.push((*x, depth));
+                    }
+                }
+            }
+        }
+    }
+    false
+}
+
+/// Whether trace instruction `inst`, reached from entry function `entry`
+/// through `chain`, is a bounce: it runs in a loop, and its origin or
+/// direction comes from a ray payload (not a loop over samples).
+pub fn is_bounce(program: &Program, inst: usize, chain: &[usize], in_loop: bool) -> bool {
+    use rspirv::dr::Operand;
+    in_loop
+        && [6, 8].iter().any(
+            |&k| match program.insts.get(inst).and_then(|i| i.operands.get(k)) {
+                Some(Operand::IdRef(x)) => depends_on_payload(program, *x, chain),
+                _ => false,
+            },
+        )
+}
+
+/// [`is_bounce`] over every call chain from entry function `entry`.
+pub fn is_bounce_from(program: &Program, entry: crate::program::Id, inst: usize) -> bool {
+    let Some(f) = program
+        .function_of(inst)
+        .and_then(|i| program.functions.get(i))
+    else {
+        return false;
+    };
+    call_chains(program, entry, f.id, MAX_CHAINS)
+        .iter()
+        .any(|chain| {
+            let in_loop =
+                inst_in_loop(program, inst) || chain.iter().any(|&c| inst_in_loop(program, c));
+            is_bounce(program, inst, chain, in_loop)
+        })
+}

@@ -1,0 +1,257 @@
+//! Wave intrinsics (SM 6.0) → SPIR-V group non-uniform instructions at
+//! subgroup scope, as DXC maps them. One table: name, arity, lowering.
+
+use super::*;
+
+/// How a wave intrinsic is lowered.
+#[derive(Clone, Copy)]
+enum Wave {
+    /// A built-in input: `WaveGetLaneIndex`, `WaveGetLaneCount`.
+    Lane(BuiltIn),
+    /// `WaveIsFirstLane`: `OpGroupNonUniformElect`.
+    Elect,
+    /// `WaveActiveAnyTrue` / `AllTrue` on a `bool`.
+    Vote(Op),
+    /// `WaveActiveAllEqual` on a scalar.
+    AllEqual,
+    /// `WaveActiveBallot`: `uint4`.
+    Ballot,
+    /// `WaveReadLaneFirst`.
+    First,
+    /// `WaveReadLaneAt(value, lane)`.
+    ReadAt,
+    /// Reductions and prefix scans: (float op, signed op, unsigned op), group operation.
+    Arith(Op, Op, Op, spirv::GroupOperation),
+    /// Bitwise reductions on integers.
+    Bits(Op),
+    /// `WaveActiveCountBits` / `WavePrefixCountBits` of a `bool`.
+    CountBits(spirv::GroupOperation),
+}
+
+/// The wave family of the intrinsic table: name, arity, lowering.
+const WAVE: &[(&str, usize, Wave)] = {
+    use spirv::GroupOperation::{ExclusiveScan, Reduce};
+    use Op::*;
+    &[
+        (
+            "WaveGetLaneIndex",
+            0,
+            Wave::Lane(BuiltIn::SubgroupLocalInvocationId),
+        ),
+        ("WaveGetLaneCount", 0, Wave::Lane(BuiltIn::SubgroupSize)),
+        ("WaveIsFirstLane", 0, Wave::Elect),
+        ("WaveActiveAnyTrue", 1, Wave::Vote(GroupNonUniformAny)),
+        ("WaveActiveAllTrue", 1, Wave::Vote(GroupNonUniformAll)),
+        ("WaveActiveAllEqual", 1, Wave::AllEqual),
+        ("WaveActiveBallot", 1, Wave::Ballot),
+        ("WaveReadLaneFirst", 1, Wave::First),
+        ("WaveReadLaneAt", 2, Wave::ReadAt),
+        (
+            "WaveActiveSum",
+            1,
+            Wave::Arith(
+                GroupNonUniformFAdd,
+                GroupNonUniformIAdd,
+                GroupNonUniformIAdd,
+                Reduce,
+            ),
+        ),
+        (
+            "WaveActiveProduct",
+            1,
+            Wave::Arith(
+                GroupNonUniformFMul,
+                GroupNonUniformIMul,
+                GroupNonUniformIMul,
+                Reduce,
+            ),
+        ),
+        (
+            "WaveActiveMin",
+            1,
+            Wave::Arith(
+                GroupNonUniformFMin,
+                GroupNonUniformSMin,
+                GroupNonUniformUMin,
+                Reduce,
+            ),
+        ),
+        (
+            "WaveActiveMax",
+            1,
+            Wave::Arith(
+                GroupNonUniformFMax,
+                GroupNonUniformSMax,
+                GroupNonUniformUMax,
+                Reduce,
+            ),
+        ),
+        (
+            "WavePrefixSum",
+            1,
+            Wave::Arith(
+                GroupNonUniformFAdd,
+                GroupNonUniformIAdd,
+                GroupNonUniformIAdd,
+                ExclusiveScan,
+            ),
+        ),
+        (
+            "WavePrefixProduct",
+            1,
+            Wave::Arith(
+                GroupNonUniformFMul,
+                GroupNonUniformIMul,
+                GroupNonUniformIMul,
+                ExclusiveScan,
+            ),
+        ),
+        ("WaveActiveBitAnd", 1, Wave::Bits(GroupNonUniformBitwiseAnd)),
+        ("WaveActiveBitOr", 1, Wave::Bits(GroupNonUniformBitwiseOr)),
+        ("WaveActiveBitXor", 1, Wave::Bits(GroupNonUniformBitwiseXor)),
+        ("WaveActiveCountBits", 1, Wave::CountBits(Reduce)),
+        ("WavePrefixCountBits", 1, Wave::CountBits(ExclusiveScan)),
+    ]
+};
+
+impl<'a> Lowerer<'a> {
+    /// A wave intrinsic, or `None` when `name` is not one.
+    pub(super) fn wave(&mut self, name: &str, args: &'a [Expr], pos: Pos) -> Result<Option<Val>> {
+        let Some(&(_, arity, kind)) = WAVE.iter().find(|(n, ..)| *n == name) else {
+            return Ok(None);
+        };
+        self.arity(name, args, arity, pos)?;
+        self.cap(Capability::GroupNonUniform);
+        let u = Ty::Sc(Sc::Uint);
+        let b = Ty::Sc(Sc::Bool);
+        let scope = self.const_u32(spirv::Scope::Subgroup as u32);
+        let group_op = |this: &mut Self, op: Op, ty: &Ty, rest: Vec<Operand>| -> Result<Val> {
+            let tid = this.ty_id(ty)?;
+            let mut ops = vec![Operand::IdRef(scope)];
+            ops.extend(rest);
+            let id = this.inst(op, Some(tid), ops)?;
+            Ok(Val { id, ty: ty.clone() })
+        };
+        let v = match kind {
+            Wave::Lane(bi) => self.read_builtin(bi, &u)?,
+            Wave::Elect => group_op(self, Op::GroupNonUniformElect, &b, vec![])?,
+            Wave::Vote(op) => {
+                self.cap(Capability::GroupNonUniformVote);
+                let c = self.expr_as(&args[0], &b)?;
+                group_op(self, op, &b, vec![Operand::IdRef(c.id)])?
+            }
+            Wave::AllEqual => {
+                self.cap(Capability::GroupNonUniformVote);
+                let x = self.expr(&args[0])?;
+                if !matches!(x.ty, Ty::Sc(_)) {
+                    return Err(unsupported(
+                        args[0].pos,
+                        format!("`{name}` of a `{}` (scalars only)", self.ty_name(&x.ty)),
+                    ));
+                }
+                group_op(
+                    self,
+                    Op::GroupNonUniformAllEqual,
+                    &b,
+                    vec![Operand::IdRef(x.id)],
+                )?
+            }
+            Wave::Ballot => {
+                self.cap(Capability::GroupNonUniformBallot);
+                let c = self.expr_as(&args[0], &b)?;
+                let u4 = Ty::Vec(Sc::Uint, 4);
+                group_op(
+                    self,
+                    Op::GroupNonUniformBallot,
+                    &u4,
+                    vec![Operand::IdRef(c.id)],
+                )?
+            }
+            Wave::First | Wave::ReadAt => {
+                let x = self.wave_value(name, &args[0])?;
+                if let Wave::First = kind {
+                    self.cap(Capability::GroupNonUniformBallot);
+                    group_op(
+                        self,
+                        Op::GroupNonUniformBroadcastFirst,
+                        &x.ty.clone(),
+                        vec![Operand::IdRef(x.id)],
+                    )?
+                } else {
+                    self.cap(Capability::GroupNonUniformShuffle);
+                    let lane = self.expr_as(&args[1], &u)?;
+                    group_op(
+                        self,
+                        Op::GroupNonUniformShuffle,
+                        &x.ty.clone(),
+                        vec![Operand::IdRef(x.id), Operand::IdRef(lane.id)],
+                    )?
+                }
+            }
+            Wave::Arith(fop, sop, uop, gop) => {
+                self.cap(Capability::GroupNonUniformArithmetic);
+                let x = self.wave_value(name, &args[0])?;
+                let op = match x.ty.scalar() {
+                    Some(Sc::Float) => fop,
+                    Some(Sc::Int) => sop,
+                    _ => uop,
+                };
+                group_op(
+                    self,
+                    op,
+                    &x.ty.clone(),
+                    vec![Operand::GroupOperation(gop), Operand::IdRef(x.id)],
+                )?
+            }
+            Wave::Bits(op) => {
+                self.cap(Capability::GroupNonUniformArithmetic);
+                let x = self.wave_value(name, &args[0])?;
+                if !matches!(x.ty.scalar(), Some(Sc::Int | Sc::Uint)) {
+                    return Err(Error::new(
+                        args[0].pos,
+                        format!("`{name}` needs an integer, not a `{}`", self.ty_name(&x.ty)),
+                    ));
+                }
+                group_op(
+                    self,
+                    op,
+                    &x.ty.clone(),
+                    vec![
+                        Operand::GroupOperation(spirv::GroupOperation::Reduce),
+                        Operand::IdRef(x.id),
+                    ],
+                )?
+            }
+            Wave::CountBits(gop) => {
+                self.cap(Capability::GroupNonUniformBallot);
+                let c = self.expr_as(&args[0], &b)?;
+                let u4 = Ty::Vec(Sc::Uint, 4);
+                let ballot = group_op(
+                    self,
+                    Op::GroupNonUniformBallot,
+                    &u4,
+                    vec![Operand::IdRef(c.id)],
+                )?;
+                group_op(
+                    self,
+                    Op::GroupNonUniformBallotBitCount,
+                    &u,
+                    vec![Operand::GroupOperation(gop), Operand::IdRef(ballot.id)],
+                )?
+            }
+        };
+        Ok(Some(v))
+    }
+
+    /// A numeric scalar or vector argument of a wave intrinsic.
+    fn wave_value(&mut self, name: &str, e: &'a Expr) -> Result<Val> {
+        let x = self.expr(e)?;
+        match x.ty {
+            Ty::Sc(s) | Ty::Vec(s, _) if s != Sc::Bool && !s.is_64() => Ok(x),
+            _ => Err(unsupported(
+                e.pos,
+                format!("`{name}` of a `{}`", self.ty_name(&x.ty)),
+            )),
+        }
+    }
+}
