@@ -4,8 +4,14 @@
 use std::path::Path;
 
 fn main() {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("src/rules");
+    // The manifest directory at run time, not when the script was compiled:
+    // worktrees sharing one target directory share this script's binary.
+    let manifest = std::env::var("CARGO_MANIFEST_DIR").expect("CARGO_MANIFEST_DIR");
+    let dir = Path::new(&manifest).join("src/rules");
     println!("cargo:rerun-if-changed={}", dir.display());
+    // Cargo keeps one output of this script per target directory, whatever
+    // checkout it came from: run again when cargo runs in another directory.
+    println!("cargo:rerun-if-env-changed=PWD");
     let mut files: Vec<String> = std::fs::read_dir(&dir)
         .expect("src/rules")
         .filter_map(|e| {

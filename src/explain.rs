@@ -241,3 +241,87 @@ pub fn float(v: f64) -> String {
         format!("{v}")
     }
 }
+
+/// Ray flags as the source language spells them (`gl_RayFlagsOpaqueEXT |
+/// gl_RayFlagsTerminateOnFirstHitEXT`, `RAY_FLAG_FORCE_OPAQUE`), `none` for 0.
+pub fn ray_flags(flags: u64, language: Language) -> String {
+    const NAMES: [(&str, &str, &str); 10] = [
+        (
+            "gl_RayFlagsOpaqueEXT",
+            "RAY_FLAG_FORCE_OPAQUE",
+            "RAY_FLAG_FORCE_OPAQUE",
+        ),
+        (
+            "gl_RayFlagsNoOpaqueEXT",
+            "RAY_FLAG_FORCE_NON_OPAQUE",
+            "RAY_FLAG_FORCE_NO_OPAQUE",
+        ),
+        (
+            "gl_RayFlagsTerminateOnFirstHitEXT",
+            "RAY_FLAG_ACCEPT_FIRST_HIT_AND_END_SEARCH",
+            "RAY_FLAG_TERMINATE_ON_FIRST_HIT",
+        ),
+        (
+            "gl_RayFlagsSkipClosestHitShaderEXT",
+            "RAY_FLAG_SKIP_CLOSEST_HIT_SHADER",
+            "RAY_FLAG_SKIP_CLOSEST_HIT_SHADER",
+        ),
+        (
+            "gl_RayFlagsCullBackFacingTrianglesEXT",
+            "RAY_FLAG_CULL_BACK_FACING_TRIANGLES",
+            "RAY_FLAG_CULL_BACK_FACING",
+        ),
+        (
+            "gl_RayFlagsCullFrontFacingTrianglesEXT",
+            "RAY_FLAG_CULL_FRONT_FACING_TRIANGLES",
+            "RAY_FLAG_CULL_FRONT_FACING",
+        ),
+        (
+            "gl_RayFlagsCullOpaqueEXT",
+            "RAY_FLAG_CULL_OPAQUE",
+            "RAY_FLAG_CULL_OPAQUE",
+        ),
+        (
+            "gl_RayFlagsCullNoOpaqueEXT",
+            "RAY_FLAG_CULL_NON_OPAQUE",
+            "RAY_FLAG_CULL_NO_OPAQUE",
+        ),
+        (
+            "gl_RayFlagsSkipTrianglesEXT",
+            "RAY_FLAG_SKIP_TRIANGLES",
+            "RAY_FLAG_SKIP_TRIANGLES",
+        ),
+        (
+            "gl_RayFlagsSkipAABBEXT",
+            "RAY_FLAG_SKIP_PROCEDURAL_PRIMITIVES",
+            "RAY_FLAG_SKIP_AABBS",
+        ),
+    ];
+    let mut parts = Vec::new();
+    for (bit, (glsl, hlsl, wgsl)) in NAMES.iter().enumerate() {
+        if flags & (1 << bit) != 0 {
+            parts.push(match language {
+                Language::Hlsl => *hlsl,
+                Language::Wgsl => *wgsl,
+                _ => *glsl,
+            });
+        }
+    }
+    let rest = flags & !0x3ff;
+    let mut s = if parts.is_empty() && rest == 0 {
+        "none".to_string()
+    } else {
+        parts
+            .iter()
+            .map(|p| format!("`{p}`"))
+            .collect::<Vec<_>>()
+            .join(" | ")
+    };
+    if rest != 0 {
+        if !parts.is_empty() {
+            s.push_str(" | ");
+        }
+        s.push_str(&format!("{rest:#x}"));
+    }
+    s
+}

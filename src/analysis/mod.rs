@@ -5,10 +5,12 @@ pub mod callgraph;
 pub mod layout;
 pub mod liveness;
 pub mod payload_use;
+pub mod rayquery;
 pub mod rays;
 pub mod recursion;
 pub mod stack;
 pub mod trace_sites;
+pub mod uniformity;
 
 pub use liveness::{live_report, LiveReport};
 pub use recursion::{recursion_report, RecursionReport};

@@ -231,6 +231,63 @@ impl<'a> Context<'a> {
         }
     }
 
+    /// Where a resource is declared: its debug-info position, else (glslang
+    /// `-g` has none for variables) the one line of the source (embedded, else
+    /// the file the debug info names) that
+    /// gives a binding (`binding`, `register(`) and names it, else its first use.
+    pub fn resource_location(&self, var: Id) -> Option<Location> {
+        let p = self.program;
+        if let Some(l) = p.decl_location(Decl::Var(var)) {
+            return Some(l);
+        }
+        let name = p.name(var).filter(|n| !n.is_empty());
+        if let Some(name) = name {
+            let word = |line: &str| {
+                line.match_indices(name).any(|(i, _)| {
+                    let before = line[..i].chars().next_back();
+                    let after = line[i + name.len()..].chars().next();
+                    let ident =
+                        |c: Option<char>| c.is_some_and(|c| c.is_alphanumeric() || c == '_');
+                    !ident(before) && !ident(after)
+                })
+            };
+            let mut found = None;
+            for (fi, f) in p.files.iter().enumerate() {
+                // The embedded text, else the file debug info names (rtlint's
+                // own HLSL output embeds none).
+                let read;
+                let text = match &f.text {
+                    Some(t) => t,
+                    None => match std::fs::read_to_string(&f.path) {
+                        Ok(t) => {
+                            read = t;
+                            &read
+                        }
+                        Err(_) => continue,
+                    },
+                };
+                for (li, line) in text.lines().enumerate() {
+                    if (line.contains("binding") || line.contains("register(")) && word(line) {
+                        if found.is_some() {
+                            return p.var_location(var);
+                        }
+                        found = Some((fi, li));
+                    }
+                }
+            }
+            if let Some((fi, li)) = found {
+                return Some(Location {
+                    path: p.files[fi].path.clone(),
+                    line: li as u32 + 1,
+                    column: 0,
+                    end_line: li as u32 + 1,
+                    end_column: 0,
+                });
+            }
+        }
+        p.var_location(var)
+    }
+
     pub fn diagnostic(&self, rule: &'static Rule, message: impl Into<String>) -> Diagnostic {
         Diagnostic::new(rule.level, rule.name, &self.program.path, message).with_code(rule.code)
     }
@@ -455,6 +512,15 @@ mod tests {
                 "RT037 any-hit-with-opaque-geometry",
                 "RT038 opaque-flag-missing",
                 "RT039 cull-flags-on-procedural",
+                "RT040 non-uniform-resource-index",
+                "RT041 register-binding-collision",
+                "RT050 normalize-of-zero",
+                "RT051 unguarded-pdf-division",
+                "RT060 ray-query-never-commits",
+                "RT061 ray-query-ignores-procedural",
+                "RT062 ray-query-single-proceed",
+                "RT063 ray-query-not-initialised",
+                "RT064 committed-read-before-proceed",
                 "RT070 full-instance-mask-on-secondary-ray",
                 "RT071 alpha-test-only-any-hit",
                 "RT072 incoherent-rays-without-reorder",

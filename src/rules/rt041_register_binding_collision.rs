@@ -1,0 +1,189 @@
+use super::Context;
+use crate::diag::Diagnostic;
+use crate::program::{Global, Program, Type};
+use crate::shader::Language;
+use rspirv::dr::Operand;
+use spirv::{Decoration, Op, StorageClass};
+use std::collections::BTreeMap;
+
+super::declare_rule! {
+    /// ## What it does
+    ///
+    /// Finds two resources of different descriptor types bound to the same
+    /// Vulkan descriptor set and binding: a texture and a UAV, a constant buffer
+    /// and a structured buffer, an acceleration structure and anything else. A
+    /// sampled image and a sampler may share a binding (a combined image
+    /// sampler), and resources of one type may alias each other; neither is
+    /// reported.
+    ///
+    /// ## Why is this bad?
+    ///
+    /// A binding of a descriptor set layout has one descriptor type. HLSL keeps a
+    /// separate register space per class (`t0`, `u0`, `b0`, `s0` are four
+    /// registers), but DXC, Slang and rtlint map `register(xN, spaceM)` to
+    /// binding `N` of set `M` whatever the class unless told otherwise, so a
+    /// shader ported from DXR puts its TLAS (`t0`) and its output UAV (`u0`) on
+    /// the same binding. `spirv-val` accepts the module; pipeline creation fails
+    /// validation, and without validation layers one of the two resources reads
+    /// the other's descriptor.
+    ///
+    /// ## Example
+    ///
+    /// ```hlsl
+    /// RaytracingAccelerationStructure scene : register(t0);
+    /// RWTexture2D<float4> output : register(u0);      // binding 0 of set 0 as well
+    /// ```
+    ///
+    /// Use instead:
+    ///
+    /// ```hlsl
+    /// RaytracingAccelerationStructure scene : register(t0);
+    /// [[vk::binding(1, 0)]] RWTexture2D<float4> output : register(u0);
+    /// ```
+    ///
+    /// ## How to fix
+    ///
+    /// Give one of the resources its own binding: `[[vk::binding(N, S)]]`,
+    /// another register number, or a shift option of the compiler
+    /// (`-fvk-u-shift`, `-fvk-t-shift`, …).
+    ///
+    /// ## Options
+    ///
+    /// None.
+    ///
+    /// ## References
+    ///
+    /// - DXC, "SPIR-V codegen": HLSL register and Vulkan binding mapping,
+    ///   `[[vk::binding]]`, `-fvk-*-shift`.
+    /// - Vulkan specification, "Descriptor Set Layout" (one type per binding).
+    "RT041" "register-binding-collision" {
+        group: Suspicious,
+        summary: "resources of different descriptor types share one set and binding",
+        kind: super::Kind::Module(check),
+    }
+}
+
+/// A descriptor type, as far as a binding's compatibility goes.
+#[derive(Clone, Copy, PartialEq, Eq, Debug)]
+enum Kind {
+    Sampler,
+    SampledImage,
+    CombinedImageSampler,
+    StorageImage,
+    UniformTexelBuffer,
+    StorageTexelBuffer,
+    UniformBuffer,
+    StorageBuffer,
+    AccelerationStructure,
+}
+
+impl Kind {
+    fn as_str(self) -> &'static str {
+        match self {
+            Kind::Sampler => "sampler",
+            Kind::SampledImage => "sampled image",
+            Kind::CombinedImageSampler => "combined image sampler",
+            Kind::StorageImage => "storage image",
+            Kind::UniformTexelBuffer => "uniform texel buffer",
+            Kind::StorageTexelBuffer => "storage texel buffer",
+            Kind::UniformBuffer => "uniform buffer",
+            Kind::StorageBuffer => "storage buffer",
+            Kind::AccelerationStructure => "acceleration structure",
+        }
+    }
+
+    /// Whether two kinds can live on one binding.
+    fn compatible(self, other: Kind) -> bool {
+        use Kind::*;
+        self == other
+            || matches!(
+                (self, other),
+                (Sampler, SampledImage)
+                    | (SampledImage, Sampler)
+                    | (Sampler, CombinedImageSampler)
+                    | (CombinedImageSampler, Sampler)
+                    | (SampledImage, CombinedImageSampler)
+                    | (CombinedImageSampler, SampledImage)
+            )
+    }
+}
+
+fn kind(p: &Program, g: &Global) -> Option<Kind> {
+    let mut ty = g.ty;
+    for _ in 0..4 {
+        match p.ty(ty)? {
+            Type::Array { elem, .. } | Type::RuntimeArray { elem } => ty = *elem,
+            _ => break,
+        }
+    }
+    match (g.storage, p.ty(ty)?) {
+        (StorageClass::StorageBuffer, _) => Some(Kind::StorageBuffer),
+        (StorageClass::Uniform, _) if p.decoration(ty, Decoration::BufferBlock).is_some() => {
+            Some(Kind::StorageBuffer)
+        }
+        (StorageClass::Uniform, _) => Some(Kind::UniformBuffer),
+        (StorageClass::UniformConstant, Type::AccelerationStructure) => {
+            Some(Kind::AccelerationStructure)
+        }
+        (StorageClass::UniformConstant, Type::Sampler) => Some(Kind::Sampler),
+        (StorageClass::UniformConstant, Type::SampledImage) => Some(Kind::CombinedImageSampler),
+        (StorageClass::UniformConstant, Type::Image) => {
+            let inst = p.def(ty)?;
+            if inst.class.opcode != Op::TypeImage {
+                return None;
+            }
+            // Sampled Type, Dim, Depth, Arrayed, MS, Sampled, Format.
+            let buffer = matches!(inst.operands.get(1), Some(Operand::Dim(spirv::Dim::DimBuffer)));
+            let storage = matches!(inst.operands.get(5), Some(Operand::LiteralBit32(2)));
+            Some(match (buffer, storage) {
+                (true, true) => Kind::StorageTexelBuffer,
+                (true, false) => Kind::UniformTexelBuffer,
+                (false, true) => Kind::StorageImage,
+                (false, false) => Kind::SampledImage,
+            })
+        }
+        _ => None,
+    }
+}
+
+fn check(ctx: &Context) -> Vec<Diagnostic> {
+    let p = ctx.program;
+    let mut by_slot: BTreeMap<(u32, u32), Vec<(&Global, Kind)>> = BTreeMap::new();
+    for g in &p.globals {
+        let (Some(set), Some(binding)) = (g.set, g.binding) else {
+            continue;
+        };
+        if let Some(k) = kind(p, g) {
+            by_slot.entry((set, binding)).or_default().push((g, k));
+        }
+    }
+    let mut out = Vec::new();
+    for ((set, binding), mut vars) in by_slot {
+        // By name: compilers order their globals differently.
+        vars.sort_by_key(|(g, _)| (p.display_name(g.id), g.id));
+        let Some(&(first, k0)) = vars.first() else {
+            continue;
+        };
+        let Some(&(other, k1)) = vars.iter().skip(1).find(|(_, k)| !k.compatible(k0)) else {
+            continue;
+        };
+        let (a, b) = (p.display_name(first.id), p.display_name(other.id));
+        let mut d = ctx
+            .diagnostic(
+                &RULE,
+                format!(
+                    "`{b}` ({}) and `{a}` ({}) share descriptor set {set} binding {binding}",
+                    k1.as_str(),
+                    k0.as_str()
+                ),
+            )
+            .with_primary(ctx.resource_location(other.id), "bound here")
+            .with_secondary(ctx.resource_location(first.id), "same set and binding as this")
+            .with_subject(format!("`{a}` and `{b}`"));
+        if p.language == Language::Hlsl {
+            d = d.with_note("HLSL register classes (`t`, `u`, `b`, `s`) map to the same Vulkan binding number without `[[vk::binding]]` or a shift option");
+        }
+        out.push(d.with_help("give one of them its own binding"));
+    }
+    out
+}
