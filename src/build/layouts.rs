@@ -77,7 +77,7 @@ impl Kind {
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-enum Sc {
+enum ScalarKind {
     F16,
     F32,
     F64,
@@ -93,22 +93,22 @@ enum Sc {
     Bool,
 }
 
-impl Sc {
-    fn of(program: &Program, id: Id) -> Option<Sc> {
+impl ScalarKind {
+    fn of(program: &Program, id: Id) -> Option<ScalarKind> {
         Some(match program.ty(id)? {
-            Type::Bool => Sc::Bool,
-            Type::Float { width: 16 } => Sc::F16,
-            Type::Float { width: 32 } => Sc::F32,
-            Type::Float { width: 64 } => Sc::F64,
+            Type::Bool => ScalarKind::Bool,
+            Type::Float { width: 16 } => ScalarKind::F16,
+            Type::Float { width: 32 } => ScalarKind::F32,
+            Type::Float { width: 64 } => ScalarKind::F64,
             Type::Int { width, signed } => match (width, signed) {
-                (8, true) => Sc::I8,
-                (8, false) => Sc::U8,
-                (16, true) => Sc::I16,
-                (16, false) => Sc::U16,
-                (32, true) => Sc::I32,
-                (32, false) => Sc::U32,
-                (64, true) => Sc::I64,
-                (64, false) => Sc::U64,
+                (8, true) => ScalarKind::I8,
+                (8, false) => ScalarKind::U8,
+                (16, true) => ScalarKind::I16,
+                (16, false) => ScalarKind::U16,
+                (32, true) => ScalarKind::I32,
+                (32, false) => ScalarKind::U32,
+                (64, true) => ScalarKind::I64,
+                (64, false) => ScalarKind::U64,
                 _ => return None,
             },
             _ => return None,
@@ -117,36 +117,36 @@ impl Sc {
 
     fn bytes(self) -> u64 {
         match self {
-            Sc::I8 | Sc::U8 => 1,
-            Sc::F16 | Sc::I16 | Sc::U16 => 2,
-            Sc::F32 | Sc::I32 | Sc::U32 | Sc::Bool => 4,
-            Sc::F64 | Sc::I64 | Sc::U64 => 8,
+            ScalarKind::I8 | ScalarKind::U8 => 1,
+            ScalarKind::F16 | ScalarKind::I16 | ScalarKind::U16 => 2,
+            ScalarKind::F32 | ScalarKind::I32 | ScalarKind::U32 | ScalarKind::Bool => 4,
+            ScalarKind::F64 | ScalarKind::I64 | ScalarKind::U64 => 8,
         }
     }
 
     /// The Rust scalar (a half float is kept as its bits).
     fn rust(self) -> &'static str {
         match self {
-            Sc::F16 | Sc::U16 => "u16",
-            Sc::F32 => "f32",
-            Sc::F64 => "f64",
-            Sc::I8 => "i8",
-            Sc::U8 => "u8",
-            Sc::I16 => "i16",
-            Sc::I32 => "i32",
-            Sc::U32 | Sc::Bool => "u32",
-            Sc::I64 => "i64",
-            Sc::U64 => "u64",
+            ScalarKind::F16 | ScalarKind::U16 => "u16",
+            ScalarKind::F32 => "f32",
+            ScalarKind::F64 => "f64",
+            ScalarKind::I8 => "i8",
+            ScalarKind::U8 => "u8",
+            ScalarKind::I16 => "i16",
+            ScalarKind::I32 => "i32",
+            ScalarKind::U32 | ScalarKind::Bool => "u32",
+            ScalarKind::I64 => "i64",
+            ScalarKind::U64 => "u64",
         }
     }
 
     /// glam's vector family for this scalar, with its element alignment.
     fn glam_vector(self) -> Option<&'static str> {
         match self {
-            Sc::F32 => Some("Vec"),
-            Sc::I32 => Some("IVec"),
-            Sc::U32 => Some("UVec"),
-            Sc::F64 => Some("DVec"),
+            ScalarKind::F32 => Some("Vec"),
+            ScalarKind::I32 => Some("IVec"),
+            ScalarKind::U32 => Some("UVec"),
+            ScalarKind::F64 => Some("DVec"),
             _ => None,
         }
     }
@@ -155,13 +155,13 @@ impl Sc {
 /// A type as laid out in memory.
 #[derive(Clone, Debug, PartialEq, Eq, Hash)]
 enum Lay {
-    Scalar(Sc),
+    Scalar(ScalarKind),
     /// `n` contiguous scalars.
-    Vector(Sc, u64),
+    Vector(ScalarKind, u64),
     /// `vectors` groups of `comps` scalars, `stride` bytes apart.
     /// `glam_order`: the groups are the columns of the source-language matrix.
     Matrix {
-        sc: Sc,
+        sc: ScalarKind,
         vectors: u64,
         comps: u64,
         stride: u64,
@@ -223,17 +223,17 @@ fn explicit(p: &Program, ty: Id, member: Option<(Id, u32)>, depth: u32) -> Resul
         return Err("types nest too deeply".into());
     }
     match p.ty(ty) {
-        Some(Type::Bool | Type::Int { .. } | Type::Float { .. }) => Sc::of(p, ty)
+        Some(Type::Bool | Type::Int { .. } | Type::Float { .. }) => ScalarKind::of(p, ty)
             .map(Lay::Scalar)
             .ok_or_else(|| format!("`{}` has no Rust equivalent", p.type_name(ty))),
-        Some(Type::Vector { elem, count }) => Sc::of(p, *elem)
+        Some(Type::Vector { elem, count }) => ScalarKind::of(p, *elem)
             .map(|s| Lay::Vector(s, u64::from(*count)))
             .ok_or_else(|| format!("`{}` has no Rust equivalent", p.type_name(ty))),
         Some(Type::Matrix { column, columns }) => {
             let Some(Type::Vector { elem, count }) = p.ty(*column) else {
                 return Err(format!("`{}` is a malformed matrix", p.type_name(ty)));
             };
-            let sc = Sc::of(p, *elem)
+            let sc = ScalarKind::of(p, *elem)
                 .ok_or_else(|| format!("`{}` has no Rust equivalent", p.type_name(ty)))?;
             let (s, k) = member.ok_or("a matrix outside a struct member has no stride")?;
             let stride = p
@@ -345,7 +345,7 @@ fn scalar(p: &Program, ty: Id, align: u64, depth: u32) -> Result<Lay, String> {
     }
     let no_rust = || format!("`{}` has no Rust equivalent", p.type_name(ty));
     // A scalar narrower than the block's alignment takes `align` bytes.
-    let spaced = |sc: Sc, n: u64| {
+    let spaced = |sc: ScalarKind, n: u64| {
         if sc.bytes() == align {
             Lay::Vector(sc, n)
         } else {
@@ -358,17 +358,17 @@ fn scalar(p: &Program, ty: Id, align: u64, depth: u32) -> Result<Lay, String> {
     };
     match p.ty(ty) {
         Some(Type::Bool | Type::Int { .. } | Type::Float { .. }) => {
-            Sc::of(p, ty).map(Lay::Scalar).ok_or_else(no_rust)
+            ScalarKind::of(p, ty).map(Lay::Scalar).ok_or_else(no_rust)
         }
         Some(Type::Vector { elem, count }) => {
-            let sc = Sc::of(p, *elem).ok_or_else(no_rust)?;
+            let sc = ScalarKind::of(p, *elem).ok_or_else(no_rust)?;
             Ok(spaced(sc, u64::from(*count)))
         }
         Some(Type::Matrix { column, columns }) => {
             let Some(Type::Vector { elem, count }) = p.ty(*column) else {
                 return Err(no_rust());
             };
-            let sc = Sc::of(p, *elem).ok_or_else(no_rust)?;
+            let sc = ScalarKind::of(p, *elem).ok_or_else(no_rust)?;
             let (columns, count) = (u64::from(*columns), u64::from(*count));
             if sc.bytes() == align {
                 Ok(Lay::Matrix {
@@ -508,7 +508,7 @@ impl Gen<'_> {
         }
     }
 
-    fn scalar(sc: Sc) -> RustTy {
+    fn scalar(sc: ScalarKind) -> RustTy {
         RustTy {
             text: sc.rust().to_string(),
             size: sc.bytes(),
@@ -529,7 +529,11 @@ impl Gen<'_> {
                     let size = b * n;
                     // glam's Vec4 is 16-byte aligned; the integer and f64
                     // vectors keep their scalar's alignment.
-                    let align = if *sc == Sc::F32 && *n == 4 { 16 } else { b };
+                    let align = if *sc == ScalarKind::F32 && *n == 4 {
+                        16
+                    } else {
+                        b
+                    };
                     if align < 16 || wide {
                         return Ok(self.glam(&format!("{family}{n}"), size, align));
                     }
@@ -544,7 +548,7 @@ impl Gen<'_> {
                 glam_order,
             } => {
                 let b = sc.bytes();
-                if self.options.glam && *sc == Sc::F32 && *glam_order && vectors == comps {
+                if self.options.glam && *sc == ScalarKind::F32 && *glam_order && vectors == comps {
                     let pick = match (*vectors, *stride) {
                         (2, 8) if wide => Some(("Mat2", 16, 16)),
                         (3, 12) => Some(("Mat3", 36, 4)),

@@ -228,7 +228,7 @@ pub struct Lowerer<'a> {
     /// cbuffer member name → (variable, type, index, layout, storage class).
     cbuffer_members: HashMap<String, (Id, Ty, u32, Layout, StorageClass)>,
     /// Scalar constants known at compile time (enums, `static const`), for array sizes.
-    const_items: HashMap<String, CVal>,
+    const_items: HashMap<String, ConstValue>,
     /// Scalar constant id → its bits.
     const_ids: HashMap<Id, u32>,
     /// Static globals whose initializers run at the start of each entry point.
@@ -326,12 +326,12 @@ fn system_value(name: &str) -> Option<(BuiltIn, Ty, &'static [Stage])> {
     ];
     const RAY: &[Stage] = &[ClosestHit, AnyHit, Miss, Intersection];
     const HIT: &[Stage] = &[ClosestHit, AnyHit, Intersection];
-    let f3 = Ty::Vec(Sc::Float, 3);
-    let u = Ty::Sc(Sc::Uint);
-    let f = Ty::Sc(Sc::Float);
+    let f3 = Ty::Vec(ScalarKind::Float, 3);
+    let u = Ty::ScalarKind(ScalarKind::Uint);
+    let f = Ty::ScalarKind(ScalarKind::Float);
     Some(match name {
-        "DispatchRaysIndex" => (BuiltIn::LaunchIdKHR, Ty::Vec(Sc::Uint, 3), ALL),
-        "DispatchRaysDimensions" => (BuiltIn::LaunchSizeKHR, Ty::Vec(Sc::Uint, 3), ALL),
+        "DispatchRaysIndex" => (BuiltIn::LaunchIdKHR, Ty::Vec(ScalarKind::Uint, 3), ALL),
+        "DispatchRaysDimensions" => (BuiltIn::LaunchSizeKHR, Ty::Vec(ScalarKind::Uint, 3), ALL),
         "WorldRayOrigin" => (BuiltIn::WorldRayOriginKHR, f3, RAY),
         "WorldRayDirection" => (BuiltIn::WorldRayDirectionKHR, f3, RAY),
         "ObjectRayOrigin" => (BuiltIn::ObjectRayOriginKHR, f3, HIT),
@@ -345,12 +345,16 @@ fn system_value(name: &str) -> Option<(BuiltIn, Ty, &'static [Stage])> {
         "PrimitiveIndex" => (BuiltIn::PrimitiveId, u, HIT),
         "HitKind" => (BuiltIn::HitKindKHR, u, &[ClosestHit, AnyHit]),
         // SPIR-V holds these as 4 columns of float3, which is HLSL's float4x3.
-        "ObjectToWorld4x3" | "ObjectToWorld3x4" | "ObjectToWorld" => {
-            (BuiltIn::ObjectToWorldKHR, Ty::Mat(Sc::Float, 4, 3), HIT)
-        }
-        "WorldToObject4x3" | "WorldToObject3x4" | "WorldToObject" => {
-            (BuiltIn::WorldToObjectKHR, Ty::Mat(Sc::Float, 4, 3), HIT)
-        }
+        "ObjectToWorld4x3" | "ObjectToWorld3x4" | "ObjectToWorld" => (
+            BuiltIn::ObjectToWorldKHR,
+            Ty::Mat(ScalarKind::Float, 4, 3),
+            HIT,
+        ),
+        "WorldToObject4x3" | "WorldToObject3x4" | "WorldToObject" => (
+            BuiltIn::WorldToObjectKHR,
+            Ty::Mat(ScalarKind::Float, 4, 3),
+            HIT,
+        ),
         _ => return None,
     })
 }
@@ -422,8 +426,8 @@ impl<'a> Lowerer<'a> {
                 None::<String>,
             );
         }
-        let f = Ty::Sc(Sc::Float);
-        let f3 = Ty::Vec(Sc::Float, 3);
+        let f = Ty::ScalarKind(ScalarKind::Float);
+        let f3 = Ty::Vec(ScalarKind::Float, 3);
         let field = |name: &str, ty: &Ty| Field {
             name: name.into(),
             ty: ty.clone(),
@@ -443,7 +447,7 @@ impl<'a> Lowerer<'a> {
             },
             StructDef {
                 name: "BuiltInTriangleIntersectionAttributes".into(),
-                fields: vec![field("barycentrics", &Ty::Vec(Sc::Float, 2))],
+                fields: vec![field("barycentrics", &Ty::Vec(ScalarKind::Float, 2))],
                 pos: Pos::default(),
             },
         ];
@@ -708,17 +712,18 @@ impl<'a> Lowerer<'a> {
     }
 }
 
+/// A value the lowerer computed at compile time (constant folding).
 #[derive(Clone, Debug, PartialEq)]
-pub enum CVal {
+pub enum ConstValue {
     I(i64),
     F(f64),
 }
 
-impl CVal {
+impl ConstValue {
     fn as_f64(&self) -> f64 {
         match self {
-            CVal::I(i) => *i as f64,
-            CVal::F(f) => *f,
+            ConstValue::I(i) => *i as f64,
+            ConstValue::F(f) => *f,
         }
     }
 }
@@ -859,7 +864,10 @@ mod tests {
     #[test]
     fn system_values_follow_dxc() {
         let (b, t, stages) = system_value("RayTCurrent").unwrap();
-        assert_eq!((b, t), (BuiltIn::RayTmaxKHR, Ty::Sc(Sc::Float)));
+        assert_eq!(
+            (b, t),
+            (BuiltIn::RayTmaxKHR, Ty::ScalarKind(ScalarKind::Float))
+        );
         assert!(!stages.contains(&Stage::RayGeneration));
         assert_eq!(
             system_value("InstanceIndex").unwrap().0,
@@ -871,7 +879,7 @@ mod tests {
         );
         assert_eq!(
             system_value("ObjectToWorld4x3").unwrap().1,
-            Ty::Mat(Sc::Float, 4, 3)
+            Ty::Mat(ScalarKind::Float, 4, 3)
         );
         assert_eq!(
             builtin_constant("RAY_FLAG_SKIP_PROCEDURAL_PRIMITIVES"),
@@ -894,18 +902,18 @@ mod tests {
         let mut l = Lowerer::new(&items, &files);
         let a = Val {
             id: l.const_i32(6),
-            ty: Ty::Sc(Sc::Int),
+            ty: Ty::ScalarKind(ScalarKind::Int),
         };
         let b = Val {
             id: l.const_u32(1),
-            ty: Ty::Sc(Sc::Uint),
+            ty: Ty::ScalarKind(ScalarKind::Uint),
         };
         let v = l.binary(BinOp::BitOr, a, b, Pos::default()).unwrap();
-        assert_eq!(v.ty, Ty::Sc(Sc::Uint));
-        assert_eq!(l.known(&v), Some((Sc::Uint, 7)));
+        assert_eq!(v.ty, Ty::ScalarKind(ScalarKind::Uint));
+        assert_eq!(l.known(&v), Some((ScalarKind::Uint, 7)));
         let f = l
-            .convert(v, &Ty::Sc(Sc::Float), Pos::default(), false)
+            .convert(v, &Ty::ScalarKind(ScalarKind::Float), Pos::default(), false)
             .unwrap();
-        assert_eq!(l.known(&f), Some((Sc::Float, 7.0f32.to_bits())));
+        assert_eq!(l.known(&f), Some((ScalarKind::Float, 7.0f32.to_bits())));
     }
 }

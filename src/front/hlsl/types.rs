@@ -7,7 +7,7 @@
 use super::error::Pos;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
-pub enum Sc {
+pub enum ScalarKind {
     Bool,
     Int,
     Uint,
@@ -17,32 +17,32 @@ pub enum Sc {
     Float,
 }
 
-impl Sc {
+impl ScalarKind {
     pub fn name(self) -> &'static str {
         match self {
-            Sc::Bool => "bool",
-            Sc::Int => "int",
-            Sc::Uint => "uint",
-            Sc::Int64 => "int64_t",
-            Sc::Uint64 => "uint64_t",
-            Sc::Float => "float",
+            ScalarKind::Bool => "bool",
+            ScalarKind::Int => "int",
+            ScalarKind::Uint => "uint",
+            ScalarKind::Int64 => "int64_t",
+            ScalarKind::Uint64 => "uint64_t",
+            ScalarKind::Float => "float",
         }
     }
 
     /// Bytes of one value in memory.
     pub fn size(self) -> u32 {
         match self {
-            Sc::Int64 | Sc::Uint64 => 8,
+            ScalarKind::Int64 | ScalarKind::Uint64 => 8,
             _ => 4,
         }
     }
 
     pub fn is_signed(self) -> bool {
-        matches!(self, Sc::Int | Sc::Int64)
+        matches!(self, ScalarKind::Int | ScalarKind::Int64)
     }
 
     pub fn is_64(self) -> bool {
-        matches!(self, Sc::Int64 | Sc::Uint64)
+        matches!(self, ScalarKind::Int64 | ScalarKind::Uint64)
     }
 }
 
@@ -62,10 +62,10 @@ pub enum Dim {
 #[derive(Clone, Debug, PartialEq, Eq, Hash)]
 pub enum Ty {
     Void,
-    Sc(Sc),
-    Vec(Sc, u8),
+    ScalarKind(ScalarKind),
+    Vec(ScalarKind, u8),
     /// HLSL rows, columns.
-    Mat(Sc, u8, u8),
+    Mat(ScalarKind, u8, u8),
     Array(Box<Ty>, u32),
     /// Unbounded arrays: resources only.
     RtArray(Box<Ty>),
@@ -79,7 +79,7 @@ pub enum Ty {
     SamplerCmp,
     Texture {
         dim: Dim,
-        sc: Sc,
+        sc: ScalarKind,
         n: u8,
         rw: bool,
         /// `[[vk::image_format("...")]]`; else derived from the element type.
@@ -95,14 +95,14 @@ impl Ty {
     pub fn is_opaque(&self) -> bool {
         matches!(self, Ty::RayQuery(_) | Ty::HitObject)
     }
-    pub fn scalar(&self) -> Option<Sc> {
+    pub fn scalar(&self) -> Option<ScalarKind> {
         match self {
-            Ty::Sc(s) | Ty::Vec(s, _) | Ty::Mat(s, _, _) => Some(*s),
+            Ty::ScalarKind(s) | Ty::Vec(s, _) | Ty::Mat(s, _, _) => Some(*s),
             _ => None,
         }
     }
     pub fn is_numeric(&self) -> bool {
-        matches!(self, Ty::Sc(_) | Ty::Vec(..) | Ty::Mat(..))
+        matches!(self, Ty::ScalarKind(_) | Ty::Vec(..) | Ty::Mat(..))
     }
     /// Components of a scalar or vector.
     pub fn width(&self) -> u8 {
@@ -111,9 +111,9 @@ impl Ty {
             _ => 1,
         }
     }
-    pub fn with_scalar(&self, s: Sc) -> Ty {
+    pub fn with_scalar(&self, s: ScalarKind) -> Ty {
         match self {
-            Ty::Sc(_) => Ty::Sc(s),
+            Ty::ScalarKind(_) => Ty::ScalarKind(s),
             Ty::Vec(_, n) => Ty::Vec(s, *n),
             Ty::Mat(_, r, c) => Ty::Mat(s, *r, *c),
             other => other.clone(),
@@ -169,7 +169,7 @@ fn round_up(x: u32, a: u32) -> u32 {
 /// Size and alignment of `ty` under `layout` (scalars are 32-bit).
 pub fn size_align(ty: &Ty, layout: Layout, structs: &[StructDef]) -> (u32, u32) {
     match (ty, layout) {
-        (Ty::Sc(s), _) => (s.size(), s.size()),
+        (Ty::ScalarKind(s), _) => (s.size(), s.size()),
         (Ty::Vec(s, n), Layout::CBuffer) => (s.size() * *n as u32, s.size()),
         (Ty::Vec(s, n), _) => (s.size() * *n as u32, s.size() * if *n == 2 { 2 } else { 4 }),
         (Ty::Mat(..), _) => {
@@ -264,7 +264,7 @@ pub fn struct_offsets(k: u32, layout: Layout, structs: &[StructDef]) -> Vec<u32>
         off = match (layout, &f.ty) {
             // Vectors may sit at scalar alignment unless they would cross a
             // 16-byte row (HLSL packing, and DXC's relaxed std430).
-            (_, Ty::Vec(s, _)) | (Layout::CBuffer, Ty::Sc(s)) => {
+            (_, Ty::Vec(s, _)) | (Layout::CBuffer, Ty::ScalarKind(s)) => {
                 let o = round_up(off, s.size());
                 if o % 16 + size > 16 {
                     round_up(o, 16)
@@ -285,7 +285,7 @@ pub fn struct_offsets(k: u32, layout: Layout, structs: &[StructDef]) -> Vec<u32>
 /// types with no size in memory (resources, ray queries).
 pub fn packed_size(ty: &Ty, structs: &[StructDef]) -> Option<u32> {
     Some(match ty {
-        Ty::Sc(s) => s.size(),
+        Ty::ScalarKind(s) => s.size(),
         Ty::Vec(s, n) => s.size() * *n as u32,
         Ty::Mat(_, r, c) => 4 * *r as u32 * *c as u32,
         Ty::Array(e, n) => packed_size(e, structs)? * n,
@@ -323,9 +323,9 @@ mod tests {
 
     #[test]
     fn cbuffer_packing() {
-        let f = Ty::Sc(Sc::Float);
-        let f3 = Ty::Vec(Sc::Float, 3);
-        let f2 = Ty::Vec(Sc::Float, 2);
+        let f = Ty::ScalarKind(ScalarKind::Float);
+        let f3 = Ty::Vec(ScalarKind::Float, 3);
+        let f2 = Ty::Vec(ScalarKind::Float, 2);
         // float3 then float shares a row; float2 after float3 starts a new row.
         let s = st(vec![f3.clone(), f.clone(), f2.clone(), f3.clone()]);
         assert_eq!(struct_offsets(0, Layout::CBuffer, &s), vec![0, 12, 16, 32]);
@@ -338,7 +338,7 @@ mod tests {
         assert_eq!(struct_offsets(0, Layout::CBuffer, &s), vec![0, 16, 52]);
         assert_eq!(
             size_align(
-                &Ty::Array(Box::new(Ty::Sc(Sc::Uint)), 256),
+                &Ty::Array(Box::new(Ty::ScalarKind(ScalarKind::Uint)), 256),
                 Layout::CBuffer,
                 &s
             )
@@ -346,14 +346,14 @@ mod tests {
             4084
         );
         // float4x4 and float3x4 (HLSL columns are 3 long, 4 of them).
-        let s = st(vec![f.clone(), Ty::Mat(Sc::Float, 3, 4), f.clone()]);
+        let s = st(vec![f.clone(), Ty::Mat(ScalarKind::Float, 3, 4), f.clone()]);
         assert_eq!(struct_offsets(0, Layout::CBuffer, &s), vec![0, 16, 76]);
     }
 
     #[test]
     fn std430_relaxed() {
-        let f = Ty::Sc(Sc::Float);
-        let f3 = Ty::Vec(Sc::Float, 3);
+        let f = Ty::ScalarKind(ScalarKind::Float);
+        let f3 = Ty::Vec(ScalarKind::Float, 3);
         let s = st(vec![f.clone(), f3.clone(), f.clone()]);
         assert_eq!(struct_offsets(0, Layout::Std430, &s), vec![0, 4, 16]);
         assert_eq!(size_align(&Ty::Struct(0), Layout::Std430, &s), (32, 16));

@@ -92,8 +92,8 @@ impl<'a> Lowerer<'a> {
         self.arity(name, args, 1, pos)?;
         let v = self.expr(&args[0])?;
         let ty = match v.ty {
-            Ty::Sc(_) => Ty::Sc(Sc::Float),
-            Ty::Vec(_, n) => Ty::Vec(Sc::Float, n),
+            Ty::ScalarKind(_) => Ty::ScalarKind(ScalarKind::Float),
+            Ty::Vec(_, n) => Ty::Vec(ScalarKind::Float, n),
             _ => {
                 return Err(Error::new(
                     args[0].pos,
@@ -148,8 +148,12 @@ impl<'a> Lowerer<'a> {
         for v in &vals[1..] {
             t = self.common(&t, &v.ty, pos)?;
         }
-        if float_only || t.scalar() == Some(Sc::Bool) {
-            t = t.with_scalar(if float_only { Sc::Float } else { Sc::Int });
+        if float_only || t.scalar() == Some(ScalarKind::Bool) {
+            t = t.with_scalar(if float_only {
+                ScalarKind::Float
+            } else {
+                ScalarKind::Int
+            });
         }
         if !t.is_numeric() {
             return Err(Error::new(
@@ -258,14 +262,14 @@ impl<'a> Lowerer<'a> {
             self.ray_tracing_caps();
             let v = self.read_builtin(bi, &ty)?;
             if name.ends_with("3x4") || name == "ObjectToWorld" || name == "WorldToObject" {
-                let t = Ty::Mat(Sc::Float, 3, 4);
+                let t = Ty::Mat(ScalarKind::Float, 3, 4);
                 let tid = self.ty_id(&t)?;
                 let id = self.op(Op::Transpose, tid, &[v.id])?;
                 return Ok(Some(Val { id, ty: t }));
             }
             return Ok(Some(v));
         }
-        let f = Ty::Sc(Sc::Float);
+        let f = Ty::ScalarKind(ScalarKind::Float);
         let one_float = |this: &mut Self, inst: G| -> Result<Option<Val>> {
             this.arity(name, args, 1, pos)?;
             let vals = this.args(args)?;
@@ -316,7 +320,8 @@ impl<'a> Lowerer<'a> {
                     pos,
                 )?;
                 let idx = self.expr(&args[0])?;
-                let idx = self.convert(idx, &Ty::Sc(Sc::Uint), args[0].pos, false)?;
+                let idx =
+                    self.convert(idx, &Ty::ScalarKind(ScalarKind::Uint), args[0].pos, false)?;
                 let p = self.place(&args[1])?;
                 let t = p.ty().clone();
                 if !matches!(t, Ty::Struct(_)) {
@@ -341,18 +346,18 @@ impl<'a> Lowerer<'a> {
                 let t = self.expr(&args[0])?;
                 let t = self.convert(t, &f, args[0].pos, false)?;
                 let k = self.expr(&args[1])?;
-                let k = self.convert(k, &Ty::Sc(Sc::Uint), args[1].pos, false)?;
+                let k = self.convert(k, &Ty::ScalarKind(ScalarKind::Uint), args[1].pos, false)?;
                 let a = self.expr(&args[2])?;
                 if !matches!(a.ty, Ty::Struct(_)) {
                     return Err(Error::new(args[2].pos, "hit attributes must be a struct"));
                 }
                 let var = self.rt_var(StorageClass::HitAttributeKHR, &a.ty)?;
                 self.b.store(var, a.id, None, [])?;
-                let bt = self.ty_id(&Ty::Sc(Sc::Bool))?;
+                let bt = self.ty_id(&Ty::ScalarKind(ScalarKind::Bool))?;
                 let id = self.op(Op::ReportIntersectionKHR, bt, &[t.id, k.id])?;
                 return Ok(Some(Val {
                     id,
-                    ty: Ty::Sc(Sc::Bool),
+                    ty: Ty::ScalarKind(ScalarKind::Bool),
                 }));
             }
             "IgnoreHit" | "AcceptHitAndEndSearch" => {
@@ -420,7 +425,9 @@ impl<'a> Lowerer<'a> {
                 self.arity(name, args, 2, pos)?;
                 let a = self.expr(&args[0])?;
                 let b = self.expr(&args[1])?;
-                let t = self.common(&a.ty, &b.ty, pos)?.with_scalar(Sc::Bool);
+                let t = self
+                    .common(&a.ty, &b.ty, pos)?
+                    .with_scalar(ScalarKind::Bool);
                 if let Ty::Mat(..) = t {
                     return Err(unsupported(pos, format!("matrix arguments to `{name}`")));
                 }
@@ -441,13 +448,13 @@ impl<'a> Lowerer<'a> {
                 let a = self.expr(&args[1])?;
                 let b = self.expr(&args[2])?;
                 let mut t = self.common(&a.ty, &b.ty, pos)?;
-                if let (Ty::Vec(_, n), Ty::Sc(s)) = (&c.ty, &t) {
+                if let (Ty::Vec(_, n), Ty::ScalarKind(s)) = (&c.ty, &t) {
                     t = Ty::Vec(*s, *n);
                 }
                 if let Ty::Mat(..) = t {
                     return Err(unsupported(pos, "matrix arguments to `select`"));
                 }
-                let ct = t.with_scalar(Sc::Bool);
+                let ct = t.with_scalar(ScalarKind::Bool);
                 let cb = self.convert(c, &ct, args[0].pos, false)?;
                 let x = self.convert(a, &t, args[1].pos, false)?;
                 let y = self.convert(b, &t, args[2].pos, false)?;
@@ -540,9 +547,11 @@ impl<'a> Lowerer<'a> {
     }
 
     fn intrinsic(&mut self, name: &str, vals: Vec<Val>, pos: Pos) -> Result<Val> {
-        let f = Ty::Sc(Sc::Float);
+        let f = Ty::ScalarKind(ScalarKind::Float);
         // 64-bit integers: the min/max/clamp/abs family only.
-        if vals.iter().any(|v| v.ty.scalar().is_some_and(Sc::is_64))
+        if vals
+            .iter()
+            .any(|v| v.ty.scalar().is_some_and(ScalarKind::is_64))
             && !matches!(name, "min" | "max" | "clamp" | "abs")
         {
             return Err(
@@ -552,9 +561,9 @@ impl<'a> Lowerer<'a> {
         match name {
             "dot" => {
                 let (t, ids) = self.unify(vals, false, pos)?;
-                let s = t.scalar().unwrap_or(Sc::Float);
-                let st = Ty::Sc(s);
-                if let Ty::Sc(_) = t {
+                let s = t.scalar().unwrap_or(ScalarKind::Float);
+                let st = Ty::ScalarKind(s);
+                if let Ty::ScalarKind(_) = t {
                     return self.binary(
                         BinOp::Mul,
                         Val {
@@ -565,7 +574,7 @@ impl<'a> Lowerer<'a> {
                         pos,
                     );
                 }
-                if s == Sc::Float {
+                if s == ScalarKind::Float {
                     let tid = self.ty_id(&st)?;
                     let id = self.op(Op::Dot, tid, &ids)?;
                     return Ok(Val { id, ty: st });
@@ -593,7 +602,7 @@ impl<'a> Lowerer<'a> {
             }
             "cross" => {
                 let (t, ids) = self.unify(vals, true, pos)?;
-                if t != Ty::Vec(Sc::Float, 3) {
+                if t != Ty::Vec(ScalarKind::Float, 3) {
                     return Err(Error::new(pos, "`cross` needs float3 arguments"));
                 }
                 self.glsl(G::Cross, &t, &ids)
@@ -649,15 +658,15 @@ impl<'a> Lowerer<'a> {
             }
             "clamp" | "min" | "max" => {
                 let (t, ids) = self.unify(vals, false, pos)?;
-                let s = t.scalar().unwrap_or(Sc::Float);
+                let s = t.scalar().unwrap_or(ScalarKind::Float);
                 let inst = match (name, s) {
-                    ("clamp", Sc::Float) => G::FClamp,
+                    ("clamp", ScalarKind::Float) => G::FClamp,
                     ("clamp", s) if s.is_signed() => G::SClamp,
                     ("clamp", _) => G::UClamp,
-                    ("min", Sc::Float) => G::FMin,
+                    ("min", ScalarKind::Float) => G::FMin,
                     ("min", s) if s.is_signed() => G::SMin,
                     ("min", _) => G::UMin,
-                    (_, Sc::Float) => G::FMax,
+                    (_, ScalarKind::Float) => G::FMax,
                     (_, s) if s.is_signed() => G::SMax,
                     _ => G::UMax,
                 };
@@ -666,7 +675,7 @@ impl<'a> Lowerer<'a> {
             "abs" => {
                 let (t, ids) = self.unify(vals, false, pos)?;
                 match t.scalar() {
-                    Some(Sc::Float) => self.glsl(G::FAbs, &t, &ids),
+                    Some(ScalarKind::Float) => self.glsl(G::FAbs, &t, &ids),
                     Some(s) if s.is_signed() => self.glsl(G::SAbs, &t, &ids),
                     _ => Ok(Val { id: ids[0], ty: t }),
                 }
@@ -674,19 +683,19 @@ impl<'a> Lowerer<'a> {
             "sign" => {
                 // HLSL's sign returns int components.
                 let (t, ids) = self.unify(vals, false, pos)?;
-                let it = t.with_scalar(Sc::Int);
+                let it = t.with_scalar(ScalarKind::Int);
                 match t.scalar() {
-                    Some(Sc::Float) => {
+                    Some(ScalarKind::Float) => {
                         let v = self.glsl(G::FSign, &t, &ids)?;
                         self.convert(v, &it, pos, true)
                     }
-                    Some(Sc::Int) => self.glsl(G::SSign, &t, &ids),
+                    Some(ScalarKind::Int) => self.glsl(G::SSign, &t, &ids),
                     _ => {
                         let v = Val {
                             id: ids[0],
                             ty: t.clone(),
                         };
-                        let b = self.convert(v, &t.with_scalar(Sc::Bool), pos, true)?;
+                        let b = self.convert(v, &t.with_scalar(ScalarKind::Bool), pos, true)?;
                         self.convert(b, &it, pos, true)
                     }
                 }
@@ -749,11 +758,11 @@ impl<'a> Lowerer<'a> {
             }
             "any" | "all" => {
                 let v = vals.into_iter().next().unwrap_or_else(|| unreachable!());
-                let bt = Ty::Sc(Sc::Bool);
+                let bt = Ty::ScalarKind(ScalarKind::Bool);
                 match v.ty.clone() {
-                    Ty::Sc(_) => self.convert(v, &bt, pos, false),
+                    Ty::ScalarKind(_) => self.convert(v, &bt, pos, false),
                     Ty::Vec(_, n) => {
-                        let b = self.convert(v, &Ty::Vec(Sc::Bool, n), pos, false)?;
+                        let b = self.convert(v, &Ty::Vec(ScalarKind::Bool, n), pos, false)?;
                         let tid = self.ty_id(&bt)?;
                         let id =
                             self.op(if name == "any" { Op::Any } else { Op::All }, tid, &[b.id])?;
@@ -771,11 +780,13 @@ impl<'a> Lowerer<'a> {
             "asuint" | "asint" | "asfloat" => {
                 let v = vals.into_iter().next().unwrap_or_else(|| unreachable!());
                 let s = match name {
-                    "asuint" => Sc::Uint,
-                    "asint" => Sc::Int,
-                    _ => Sc::Float,
+                    "asuint" => ScalarKind::Uint,
+                    "asint" => ScalarKind::Int,
+                    _ => ScalarKind::Float,
                 };
-                if !matches!(v.ty, Ty::Sc(_) | Ty::Vec(..)) || v.ty.scalar() == Some(Sc::Bool) {
+                if !matches!(v.ty, Ty::ScalarKind(_) | Ty::Vec(..))
+                    || v.ty.scalar() == Some(ScalarKind::Bool)
+                {
                     return Err(Error::new(
                         pos,
                         format!("`{name}` needs a 32-bit scalar or vector"),
@@ -792,7 +803,11 @@ impl<'a> Lowerer<'a> {
             "f32tof16" | "f16tof32" => {
                 let v = vals.into_iter().next().unwrap_or_else(|| unreachable!());
                 let to_half = name == "f32tof16";
-                let src = v.ty.with_scalar(if to_half { Sc::Float } else { Sc::Uint });
+                let src = v.ty.with_scalar(if to_half {
+                    ScalarKind::Float
+                } else {
+                    ScalarKind::Uint
+                });
                 let v = self.convert(v, &src, pos, false)?;
                 let mut comps = Vec::new();
                 self.flatten(v, &mut comps)?;
@@ -800,11 +815,16 @@ impl<'a> Lowerer<'a> {
                 for c in comps {
                     if to_half {
                         let zero = self.const_f32(0.0);
-                        let v2 = self.ty_id(&Ty::Vec(Sc::Float, 2))?;
+                        let v2 = self.ty_id(&Ty::Vec(ScalarKind::Float, 2))?;
                         let pair = self.op(Op::CompositeConstruct, v2, &[c.id, zero])?;
-                        out.push(self.glsl(G::PackHalf2x16, &Ty::Sc(Sc::Uint), &[pair])?);
+                        out.push(self.glsl(
+                            G::PackHalf2x16,
+                            &Ty::ScalarKind(ScalarKind::Uint),
+                            &[pair],
+                        )?);
                     } else {
-                        let pair = self.glsl(G::UnpackHalf2x16, &Ty::Vec(Sc::Float, 2), &[c.id])?;
+                        let pair =
+                            self.glsl(G::UnpackHalf2x16, &Ty::Vec(ScalarKind::Float, 2), &[c.id])?;
                         let ft = self.ty_id(&f)?;
                         let id = self.inst(
                             Op::CompositeExtract,
@@ -814,7 +834,11 @@ impl<'a> Lowerer<'a> {
                         out.push(Val { id, ty: f.clone() });
                     }
                 }
-                let t = src.with_scalar(if to_half { Sc::Uint } else { Sc::Float });
+                let t = src.with_scalar(if to_half {
+                    ScalarKind::Uint
+                } else {
+                    ScalarKind::Float
+                });
                 if out.len() == 1 {
                     return Ok(out.pop().unwrap_or_else(|| unreachable!()));
                 }
@@ -824,7 +848,9 @@ impl<'a> Lowerer<'a> {
             "countbits" | "reversebits" | "firstbithigh" | "firstbitlow" => {
                 let v = vals.into_iter().next().unwrap_or_else(|| unreachable!());
                 let s = v.ty.scalar();
-                if !matches!(s, Some(Sc::Int | Sc::Uint)) || matches!(v.ty, Ty::Mat(..)) {
+                if !matches!(s, Some(ScalarKind::Int | ScalarKind::Uint))
+                    || matches!(v.ty, Ty::Mat(..))
+                {
                     return Err(Error::new(
                         pos,
                         format!("`{name}` needs an integer scalar or vector"),
@@ -847,7 +873,7 @@ impl<'a> Lowerer<'a> {
                         }
                     }
                     "firstbithigh" => self.glsl(
-                        if s == Some(Sc::Int) {
+                        if s == Some(ScalarKind::Int) {
                             G::FindSMsb
                         } else {
                             G::FindUMsb
@@ -858,11 +884,11 @@ impl<'a> Lowerer<'a> {
                     _ => self.glsl(G::FindILsb, &t, &[v.id])?,
                 };
                 // HLSL returns uint components for all four.
-                self.convert(r, &t.with_scalar(Sc::Uint), pos, true)
+                self.convert(r, &t.with_scalar(ScalarKind::Uint), pos, true)
             }
             "isnan" | "isinf" | "isfinite" => {
                 let (t, ids) = self.unify(vals, true, pos)?;
-                let bt = t.with_scalar(Sc::Bool);
+                let bt = t.with_scalar(ScalarKind::Bool);
                 let tid = self.ty_id(&bt)?;
                 if name == "isfinite" {
                     let a = self.op(Op::IsNan, tid, &ids)?;
@@ -895,7 +921,7 @@ impl<'a> Lowerer<'a> {
         );
         let (at, bt) = (a.ty.clone(), b.ty.clone());
         match (&at, &bt) {
-            (Ty::Sc(_), _) | (_, Ty::Sc(_)) => self.binary(BinOp::Mul, a, b, pos),
+            (Ty::ScalarKind(_), _) | (_, Ty::ScalarKind(_)) => self.binary(BinOp::Mul, a, b, pos),
             (Ty::Vec(..), Ty::Vec(..)) => self.intrinsic("dot", vec![a, b], pos),
             (Ty::Mat(_, r, c), Ty::Vec(_, n)) => {
                 if n != c {
@@ -905,8 +931,8 @@ impl<'a> Lowerer<'a> {
                     ));
                 }
                 let (r, c) = (*r, *c);
-                let v = self.convert(b, &Ty::Vec(Sc::Float, c), pos, false)?;
-                let t = Ty::Vec(Sc::Float, r);
+                let v = self.convert(b, &Ty::Vec(ScalarKind::Float, c), pos, false)?;
+                let t = Ty::Vec(ScalarKind::Float, r);
                 let tid = self.ty_id(&t)?;
                 let id = self.op(Op::VectorTimesMatrix, tid, &[v.id, a.id])?;
                 Ok(Val { id, ty: t })
@@ -921,8 +947,8 @@ impl<'a> Lowerer<'a> {
                     ));
                 }
                 let c = *c;
-                let v = self.convert(a, &Ty::Vec(Sc::Float, *n), pos, false)?;
-                let t = Ty::Vec(Sc::Float, c);
+                let v = self.convert(a, &Ty::Vec(ScalarKind::Float, *n), pos, false)?;
+                let t = Ty::Vec(ScalarKind::Float, c);
                 let tid = self.ty_id(&t)?;
                 let id = self.op(Op::MatrixTimesVector, tid, &[b.id, v.id])?;
                 Ok(Val { id, ty: t })
@@ -934,7 +960,7 @@ impl<'a> Lowerer<'a> {
                         format!("`mul` of {r}x{k} and {k2}x{c} matrices"),
                     ));
                 }
-                let t = Ty::Mat(Sc::Float, *r, *c);
+                let t = Ty::Mat(ScalarKind::Float, *r, *c);
                 let tid = self.ty_id(&t)?;
                 let id = self.op(Op::MatrixTimesMatrix, tid, &[b.id, a.id])?;
                 Ok(Val { id, ty: t })
@@ -976,7 +1002,7 @@ impl<'a> Lowerer<'a> {
         };
         let Place::Ptr {
             ptr,
-            ty: Ty::Sc(s @ (Sc::Int | Sc::Uint)),
+            ty: Ty::ScalarKind(s @ (ScalarKind::Int | ScalarKind::Uint)),
             class: class @ (StorageClass::StorageBuffer | StorageClass::Workgroup),
             ..
         } = dest
@@ -989,9 +1015,9 @@ impl<'a> Lowerer<'a> {
             ("Or", _) => Op::AtomicOr,
             ("Xor", _) => Op::AtomicXor,
             ("Exchange", _) => Op::AtomicExchange,
-            ("Min", Sc::Int) => Op::AtomicSMin,
+            ("Min", ScalarKind::Int) => Op::AtomicSMin,
             ("Min", _) => Op::AtomicUMin,
-            ("Max", Sc::Int) => Op::AtomicSMax,
+            ("Max", ScalarKind::Int) => Op::AtomicSMax,
             ("Max", _) => Op::AtomicUMax,
             ("CompareExchange" | "CompareStore", _) => Op::AtomicCompareExchange,
             _ => return Err(unsupported(pos, format!("`{name}`")).len(name.len() as u32)),
@@ -1008,7 +1034,7 @@ impl<'a> Lowerer<'a> {
                 format!("`{name}` takes {} to {} arguments", min + 1, max + 1),
             ));
         }
-        let t = Ty::Sc(s);
+        let t = Ty::ScalarKind(s);
         let mut vals = Vec::new();
         for e in &rest[..if cmp { 2 } else { 1 }] {
             let v = self.expr(e)?;
@@ -1051,15 +1077,18 @@ impl<'a> Lowerer<'a> {
         let mut ids = Vec::new();
         for a in &args[1..6] {
             let v = self.expr(a)?;
-            ids.push(self.convert(v, &Ty::Sc(Sc::Uint), a.pos, false)?.id);
+            ids.push(
+                self.convert(v, &Ty::ScalarKind(ScalarKind::Uint), a.pos, false)?
+                    .id,
+            );
         }
         let ray = self.expr_as(&args[6], &Ty::Struct(RAY_DESC))?;
         let mut parts = Vec::new();
         for (i, t) in [
-            Ty::Vec(Sc::Float, 3),
-            Ty::Sc(Sc::Float),
-            Ty::Vec(Sc::Float, 3),
-            Ty::Sc(Sc::Float),
+            Ty::Vec(ScalarKind::Float, 3),
+            Ty::ScalarKind(ScalarKind::Float),
+            Ty::Vec(ScalarKind::Float, 3),
+            Ty::ScalarKind(ScalarKind::Float),
         ]
         .iter()
         .enumerate()
@@ -1158,11 +1187,11 @@ impl<'a> Lowerer<'a> {
                 return Some(0);
             }
             match (from, to) {
-                (Ty::Sc(_), Ty::Sc(_)) => Some(1),
+                (Ty::ScalarKind(_), Ty::ScalarKind(_)) => Some(1),
                 (Ty::Vec(_, n), Ty::Vec(_, m)) if n == m => Some(1),
-                (Ty::Sc(_), Ty::Vec(..) | Ty::Mat(..)) => Some(2),
+                (Ty::ScalarKind(_), Ty::Vec(..) | Ty::Mat(..)) => Some(2),
                 (Ty::Vec(_, n), Ty::Vec(_, m)) if m < n => Some(3),
-                (Ty::Vec(..), Ty::Sc(_)) => Some(3),
+                (Ty::Vec(..), Ty::ScalarKind(_)) => Some(3),
                 _ => None,
             }
         };

@@ -4,20 +4,20 @@
 use super::*;
 
 impl<'a> Lowerer<'a> {
-    pub(super) fn sc_id(&mut self, s: Sc) -> Id {
+    pub(super) fn sc_id(&mut self, s: ScalarKind) -> Id {
         match s {
-            Sc::Bool => self.b.type_bool(),
-            Sc::Int => self.b.type_int(32, 1),
-            Sc::Uint => self.b.type_int(32, 0),
-            Sc::Int64 => {
+            ScalarKind::Bool => self.b.type_bool(),
+            ScalarKind::Int => self.b.type_int(32, 1),
+            ScalarKind::Uint => self.b.type_int(32, 0),
+            ScalarKind::Int64 => {
                 self.cap(Capability::Int64);
                 self.b.type_int(64, 1)
             }
-            Sc::Uint64 => {
+            ScalarKind::Uint64 => {
                 self.cap(Capability::Int64);
                 self.b.type_int(64, 0)
             }
-            Sc::Float => self.b.type_float(32, None),
+            ScalarKind::Float => self.b.type_float(32, None),
         }
     }
 
@@ -30,8 +30,10 @@ impl<'a> Lowerer<'a> {
         let layout = match t {
             Ty::Struct(_) | Ty::Array(..) => layout,
             // Buffers hold no bools (Vulkan forbids them there); DXC stores uints.
-            Ty::Sc(Sc::Bool) | Ty::Vec(Sc::Bool, _) if layout != Layout::None => {
-                return self.spv(&t.with_scalar(Sc::Uint), Layout::None);
+            Ty::ScalarKind(ScalarKind::Bool) | Ty::Vec(ScalarKind::Bool, _)
+                if layout != Layout::None =>
+            {
+                return self.spv(&t.with_scalar(ScalarKind::Uint), Layout::None);
             }
             _ => Layout::None,
         };
@@ -41,7 +43,7 @@ impl<'a> Lowerer<'a> {
         }
         let id = match t {
             Ty::Void => self.b.type_void(),
-            Ty::Sc(s) => self.sc_id(*s),
+            Ty::ScalarKind(s) => self.sc_id(*s),
             Ty::Vec(s, n) => {
                 let e = self.sc_id(*s);
                 self.b.type_vector(e, *n as u32)
@@ -89,7 +91,11 @@ impl<'a> Lowerer<'a> {
                 rw,
                 fmt,
             } => {
-                let st = self.sc_id(if *sc == Sc::Bool { Sc::Uint } else { *sc });
+                let st = self.sc_id(if *sc == ScalarKind::Bool {
+                    ScalarKind::Uint
+                } else {
+                    *sc
+                });
                 let (d, arrayed) = match dim {
                     Dim::D1 => (spirv::Dim::Dim1D, 0),
                     Dim::D2 => (spirv::Dim::Dim2D, 0),
@@ -144,18 +150,18 @@ impl<'a> Lowerer<'a> {
         Ok(id)
     }
 
-    pub(super) fn image_format(&self, sc: Sc, n: u8) -> spirv::ImageFormat {
+    pub(super) fn image_format(&self, sc: ScalarKind, n: u8) -> spirv::ImageFormat {
         use spirv::ImageFormat as F;
         match (sc, n) {
-            (Sc::Float, 1) => F::R32f,
-            (Sc::Float, 2) => F::Rg32f,
-            (Sc::Float, 4) => F::Rgba32f,
-            (Sc::Uint, 1) => F::R32ui,
-            (Sc::Uint, 2) => F::Rg32ui,
-            (Sc::Uint, 4) => F::Rgba32ui,
-            (Sc::Int, 1) => F::R32i,
-            (Sc::Int, 2) => F::Rg32i,
-            (Sc::Int, 4) => F::Rgba32i,
+            (ScalarKind::Float, 1) => F::R32f,
+            (ScalarKind::Float, 2) => F::Rg32f,
+            (ScalarKind::Float, 4) => F::Rgba32f,
+            (ScalarKind::Uint, 1) => F::R32ui,
+            (ScalarKind::Uint, 2) => F::Rg32ui,
+            (ScalarKind::Uint, 4) => F::Rgba32ui,
+            (ScalarKind::Int, 1) => F::R32i,
+            (ScalarKind::Int, 2) => F::Rg32i,
+            (ScalarKind::Int, 4) => F::Rgba32i,
             _ => F::Unknown,
         }
     }
@@ -227,9 +233,9 @@ impl<'a> Lowerer<'a> {
     }
 
     /// The value of a scalar constant made by this lowerer, as (scalar, bits).
-    pub(super) fn known(&self, v: &Val) -> Option<(Sc, u32)> {
+    pub(super) fn known(&self, v: &Val) -> Option<(ScalarKind, u32)> {
         match v.ty {
-            Ty::Sc(s @ (Sc::Int | Sc::Uint | Sc::Float)) => {
+            Ty::ScalarKind(s @ (ScalarKind::Int | ScalarKind::Uint | ScalarKind::Float)) => {
                 self.const_ids.get(&v.id).map(|b| (s, *b))
             }
             _ => None,
@@ -238,14 +244,19 @@ impl<'a> Lowerer<'a> {
 
     /// Folds an operator on two scalar constants, so trace operands, flags and
     /// SBT indices written as expressions stay constants in the module.
-    pub(super) fn fold(&mut self, op: BinOp, a: (Sc, u32), b: (Sc, u32)) -> Option<Val> {
+    pub(super) fn fold(
+        &mut self,
+        op: BinOp,
+        a: (ScalarKind, u32),
+        b: (ScalarKind, u32),
+    ) -> Option<Val> {
         use BinOp::*;
         let (s, x, y) = (a.0, a.1, b.1);
         if s != b.0 {
             return None;
         }
         let v = match s {
-            Sc::Float => {
+            ScalarKind::Float => {
                 let (x, y) = (f32::from_bits(x), f32::from_bits(y));
                 let r = match op {
                     Add => x + y,
@@ -256,7 +267,7 @@ impl<'a> Lowerer<'a> {
                 };
                 return Some(Val {
                     id: self.const_f32(r),
-                    ty: Ty::Sc(Sc::Float),
+                    ty: Ty::ScalarKind(ScalarKind::Float),
                 });
             }
             _ => match op {
@@ -267,7 +278,7 @@ impl<'a> Lowerer<'a> {
                 BitOr => x | y,
                 BitXor => x ^ y,
                 Shl if y < 32 => x << y,
-                Shr if y < 32 && s == Sc::Uint => x >> y,
+                Shr if y < 32 && s == ScalarKind::Uint => x >> y,
                 Shr if y < 32 => ((x as i32) >> y) as u32,
                 _ => return None,
             },
@@ -275,27 +286,27 @@ impl<'a> Lowerer<'a> {
         let t = self.sc_id(s);
         Some(Val {
             id: self.const_bits(t, v),
-            ty: Ty::Sc(s),
+            ty: Ty::ScalarKind(s),
         })
     }
 
     pub(super) fn const_u32(&mut self, v: u32) -> Id {
-        let t = self.sc_id(Sc::Uint);
+        let t = self.sc_id(ScalarKind::Uint);
         self.const_bits(t, v)
     }
 
     pub(super) fn const_i32(&mut self, v: i32) -> Id {
-        let t = self.sc_id(Sc::Int);
+        let t = self.sc_id(ScalarKind::Int);
         self.const_bits(t, v as u32)
     }
 
     pub(super) fn const_f32(&mut self, v: f32) -> Id {
-        let t = self.sc_id(Sc::Float);
+        let t = self.sc_id(ScalarKind::Float);
         self.const_bits(t, v.to_bits())
     }
 
     pub(super) fn const_bool(&mut self, v: bool) -> Id {
-        let t = self.sc_id(Sc::Bool);
+        let t = self.sc_id(ScalarKind::Bool);
         let key = (t, v as u32);
         if let Some(id) = self.consts.get(&key) {
             return *id;
@@ -309,25 +320,25 @@ impl<'a> Lowerer<'a> {
         id
     }
 
-    pub(super) fn const_scalar(&mut self, s: Sc, f: f64, i: i64) -> Id {
+    pub(super) fn const_scalar(&mut self, s: ScalarKind, f: f64, i: i64) -> Id {
         match s {
-            Sc::Bool => self.const_bool(i != 0 || f != 0.0),
-            Sc::Int => self.const_i32(i as i32),
-            Sc::Uint => self.const_u32(i as u32),
-            Sc::Int64 | Sc::Uint64 => {
+            ScalarKind::Bool => self.const_bool(i != 0 || f != 0.0),
+            ScalarKind::Int => self.const_i32(i as i32),
+            ScalarKind::Uint => self.const_u32(i as u32),
+            ScalarKind::Int64 | ScalarKind::Uint64 => {
                 let t = self.sc_id(s);
                 self.b.constant_bit64(t, i as u64)
             }
-            Sc::Float => self.const_f32(f as f32),
+            ScalarKind::Float => self.const_f32(f as f32),
         }
     }
 
     /// A constant of numeric type `t` with every component `v`.
     pub(super) fn const_splat(&mut self, t: &Ty, v: f64) -> Result<Id> {
-        let s = t.scalar().unwrap_or(Sc::Float);
+        let s = t.scalar().unwrap_or(ScalarKind::Float);
         let c = self.const_scalar(s, v, v as i64);
         Ok(match t {
-            Ty::Sc(_) => c,
+            Ty::ScalarKind(_) => c,
             Ty::Vec(_, n) => {
                 let tid = self.ty_id(t)?;
                 self.b.constant_composite(tid, vec![c; *n as usize])
@@ -345,18 +356,18 @@ impl<'a> Lowerer<'a> {
     /// Evaluates an integer constant expression (array sizes, attributes, enums).
     pub(super) fn const_int(&mut self, e: &Expr) -> Result<i64> {
         match self.const_eval(e)? {
-            Some(CVal::I(v)) => Ok(v),
-            Some(CVal::F(f)) => Ok(f as i64),
+            Some(ConstValue::I(v)) => Ok(v),
+            Some(ConstValue::F(f)) => Ok(f as i64),
             _ => Err(Error::new(e.pos, "expected an integer constant")),
         }
     }
 
-    pub(super) fn const_eval(&mut self, e: &Expr) -> Result<Option<CVal>> {
+    pub(super) fn const_eval(&mut self, e: &Expr) -> Result<Option<ConstValue>> {
         Ok(match &e.kind {
-            ExprKind::Int(v, _) | ExprKind::Int64(v, _) => Some(CVal::I(*v as i64)),
-            ExprKind::Float(f) => Some(CVal::F(*f)),
-            ExprKind::Bool(b) => Some(CVal::I(*b as i64)),
-            ExprKind::SizeOf(t, dims) => Some(CVal::I(self.size_of(t, dims, e.pos)? as i64)),
+            ExprKind::Int(v, _) | ExprKind::Int64(v, _) => Some(ConstValue::I(*v as i64)),
+            ExprKind::Float(f) => Some(ConstValue::F(*f)),
+            ExprKind::Bool(b) => Some(ConstValue::I(*b as i64)),
+            ExprKind::SizeOf(t, dims) => Some(ConstValue::I(self.size_of(t, dims, e.pos)? as i64)),
             ExprKind::SizeOfExpr(x) => {
                 let t = self.type_of_name(x)?;
                 let n = packed_size(&t, &self.structs).ok_or_else(|| {
@@ -365,23 +376,25 @@ impl<'a> Lowerer<'a> {
                         format!("`{}` has no size in memory", self.ty_name(&t)),
                     )
                 })?;
-                Some(CVal::I(n as i64))
+                Some(ConstValue::I(n as i64))
             }
             ExprKind::Ident(n) => {
                 // A local shadows every global: constant only when it is one.
                 if let Some(p) = self.f.scopes.iter().rev().find_map(|s| s.get(n.as_str())) {
                     return Ok(match p {
                         Place::Value(v) => match self.known(v) {
-                            Some((Sc::Float, b)) => Some(CVal::F(f32::from_bits(b) as f64)),
-                            Some((Sc::Int, b)) => Some(CVal::I(b as i32 as i64)),
-                            Some((_, b)) => Some(CVal::I(b as i64)),
+                            Some((ScalarKind::Float, b)) => {
+                                Some(ConstValue::F(f32::from_bits(b) as f64))
+                            }
+                            Some((ScalarKind::Int, b)) => Some(ConstValue::I(b as i32 as i64)),
+                            Some((_, b)) => Some(ConstValue::I(b as i64)),
                             None => None,
                         },
                         _ => None,
                     });
                 }
                 if let Some(v) = builtin_constant(n) {
-                    return Ok(Some(CVal::I(v as i64)));
+                    return Ok(Some(ConstValue::I(v as i64)));
                 }
                 self.enum_value(n)
             }
@@ -390,11 +403,11 @@ impl<'a> Lowerer<'a> {
                     return Ok(None);
                 };
                 match (op, a) {
-                    (UnOp::Neg, CVal::I(v)) => Some(CVal::I(v.wrapping_neg())),
-                    (UnOp::Neg, CVal::F(v)) => Some(CVal::F(-v)),
+                    (UnOp::Neg, ConstValue::I(v)) => Some(ConstValue::I(v.wrapping_neg())),
+                    (UnOp::Neg, ConstValue::F(v)) => Some(ConstValue::F(-v)),
                     (UnOp::Plus, v) => Some(v),
-                    (UnOp::BitNot, CVal::I(v)) => Some(CVal::I(!v & 0xffff_ffff)),
-                    (UnOp::Not, CVal::I(v)) => Some(CVal::I((v == 0) as i64)),
+                    (UnOp::BitNot, ConstValue::I(v)) => Some(ConstValue::I(!v & 0xffff_ffff)),
+                    (UnOp::Not, ConstValue::I(v)) => Some(ConstValue::I((v == 0) as i64)),
                     _ => None,
                 }
             }
@@ -403,7 +416,7 @@ impl<'a> Lowerer<'a> {
                     return Ok(None);
                 };
                 match (a, b) {
-                    (CVal::I(a), CVal::I(b)) => {
+                    (ConstValue::I(a), ConstValue::I(b)) => {
                         let v = match op {
                             BinOp::Add => a.wrapping_add(b),
                             BinOp::Sub => a.wrapping_sub(b),
@@ -427,15 +440,15 @@ impl<'a> Lowerer<'a> {
                             BinOp::Gt => (a > b) as i64,
                             BinOp::Ge => (a >= b) as i64,
                         };
-                        Some(CVal::I(v))
+                        Some(ConstValue::I(v))
                     }
                     (a, b) => {
                         let (a, b) = (a.as_f64(), b.as_f64());
                         match op {
-                            BinOp::Add => Some(CVal::F(a + b)),
-                            BinOp::Sub => Some(CVal::F(a - b)),
-                            BinOp::Mul => Some(CVal::F(a * b)),
-                            BinOp::Div => Some(CVal::F(a / b)),
+                            BinOp::Add => Some(ConstValue::F(a + b)),
+                            BinOp::Sub => Some(ConstValue::F(a - b)),
+                            BinOp::Mul => Some(ConstValue::F(a * b)),
+                            BinOp::Div => Some(ConstValue::F(a / b)),
                             _ => None,
                         }
                     }
@@ -446,13 +459,15 @@ impl<'a> Lowerer<'a> {
                     return Ok(None);
                 };
                 match split_numeric(&t.name) {
-                    Some(("float" | "half", 0, 0)) => Some(CVal::F(v.as_f64())),
-                    Some(("int" | "uint" | "dword", 0, 0)) => Some(CVal::I(v.as_f64() as i64)),
+                    Some(("float" | "half", 0, 0)) => Some(ConstValue::F(v.as_f64())),
+                    Some(("int" | "uint" | "dword", 0, 0)) => {
+                        Some(ConstValue::I(v.as_f64() as i64))
+                    }
                     _ => None,
                 }
             }
             ExprKind::Ternary(c, a, b) => match self.const_eval(c)? {
-                Some(CVal::I(c)) => {
+                Some(ConstValue::I(c)) => {
                     if c != 0 {
                         self.const_eval(a)?
                     } else {
@@ -467,7 +482,7 @@ impl<'a> Lowerer<'a> {
 
     /// A named constant: looked up in the current namespace (or struct),
     /// then each enclosing one, then the `using` namespaces.
-    pub(super) fn enum_value(&self, n: &str) -> Option<CVal> {
+    pub(super) fn enum_value(&self, n: &str) -> Option<ConstValue> {
         let mut prefix = self.f.cur_ns.as_str();
         loop {
             if let Some(c) = self.const_items.get(&format!("{prefix}{n}")) {
@@ -506,7 +521,7 @@ impl<'a> Lowerer<'a> {
         Ok(Some(id))
     }
 
-    pub(super) fn const_flatten(&mut self, e: &Expr, out: &mut Vec<CVal>) -> Result<bool> {
+    pub(super) fn const_flatten(&mut self, e: &Expr, out: &mut Vec<ConstValue>) -> Result<bool> {
         match &e.kind {
             ExprKind::InitList(items) | ExprKind::Construct(_, items) => {
                 for i in items {
@@ -529,22 +544,22 @@ impl<'a> Lowerer<'a> {
     pub(super) fn const_build(
         &mut self,
         t: &Ty,
-        it: &mut std::vec::IntoIter<CVal>,
+        it: &mut std::vec::IntoIter<ConstValue>,
         pos: Pos,
     ) -> Result<Id> {
-        let mut next = |this: &mut Self, s: Sc| -> Result<Id> {
+        let mut next = |this: &mut Self, s: ScalarKind| -> Result<Id> {
             let v = it
                 .next()
                 .ok_or_else(|| Error::new(pos, "too few initializers"))?;
             let f = v.as_f64();
             let i = match v {
-                CVal::I(i) => i,
-                CVal::F(f) => f as i64,
+                ConstValue::I(i) => i,
+                ConstValue::F(f) => f as i64,
             };
             Ok(this.const_scalar(s, f, i))
         };
         match t {
-            Ty::Sc(s) => next(self, *s),
+            Ty::ScalarKind(s) => next(self, *s),
             Ty::Vec(s, n) => {
                 let mut c = Vec::new();
                 for _ in 0..*n {
@@ -656,7 +671,7 @@ impl Lowerer<'_> {
             }
             ExprKind::Index(b, _) => match self.type_of_name(b)? {
                 Ty::Array(t, _) | Ty::RtArray(t) => Ok(*t),
-                Ty::Vec(s, _) => Ok(Ty::Sc(s)),
+                Ty::Vec(s, _) => Ok(Ty::ScalarKind(s)),
                 Ty::Mat(s, _, c) => Ok(Ty::Vec(s, c)),
                 _ => Err(refuse()),
             },

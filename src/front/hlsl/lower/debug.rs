@@ -39,21 +39,21 @@ impl<'a> Lowerer<'a> {
             return *id;
         }
         let id = match t {
-            Ty::Sc(s) => {
+            Ty::ScalarKind(s) => {
                 let name = self.b.string(s.name());
                 let size = self.const_u32(8 * s.size());
                 // DWARF-style encodings: Boolean 2, Float 3, Signed 4, Unsigned 6.
                 let enc = self.const_u32(match s {
-                    Sc::Bool => 2,
-                    Sc::Float => 3,
-                    Sc::Int | Sc::Int64 => 4,
-                    Sc::Uint | Sc::Uint64 => 6,
+                    ScalarKind::Bool => 2,
+                    ScalarKind::Float => 3,
+                    ScalarKind::Int | ScalarKind::Int64 => 4,
+                    ScalarKind::Uint | ScalarKind::Uint64 => 6,
                 });
                 let flags = self.const_u32(0);
                 self.dbg_inst(d, D::DebugTypeBasic, &[name, size, enc, flags])
             }
             Ty::Vec(s, n) => {
-                let base = self.dbg_type(d, &Ty::Sc(*s));
+                let base = self.dbg_type(d, &Ty::ScalarKind(*s));
                 let count = self.const_u32(*n as u32);
                 self.dbg_inst(d, D::DebugTypeVector, &[base, count])
             }

@@ -12,7 +12,8 @@ impl<'a> Lowerer<'a> {
                 // Scalar `static const`s are known in source order, so array
                 // sizes in later structs and typedefs can use them.
                 Item::Var(v) if v.mods.is_static && v.mods.is_const && v.dims.is_empty() => {
-                    if let (Some(e), Ok(Ty::Sc(s))) = (&v.init, self.resolve_ty(&v.ty, "")) {
+                    if let (Some(e), Ok(Ty::ScalarKind(s))) = (&v.init, self.resolve_ty(&v.ty, ""))
+                    {
                         // Not constant (or not yet resolvable): declared later as usual.
                         let scope = v.name.rsplit_once("::").map(|(n, _)| format!("{n}::"));
                         let saved =
@@ -21,8 +22,8 @@ impl<'a> Lowerer<'a> {
                         self.f.cur_ns = saved;
                         if let Ok(Some(c)) = c {
                             let c = match (s, c) {
-                                (Sc::Float, c) => CVal::F(c.as_f64()),
-                                (_, CVal::F(f)) => CVal::I(f as i64),
+                                (ScalarKind::Float, c) => ConstValue::F(c.as_f64()),
+                                (_, ConstValue::F(f)) => ConstValue::I(f as i64),
                                 (_, c) => c,
                             };
                             self.const_items.insert(v.name.clone(), c);
@@ -62,12 +63,12 @@ impl<'a> Lowerer<'a> {
                 } => {
                     let sc = match underlying {
                         Some(t) => match self.resolve_ty(t, "")? {
-                            Ty::Sc(s @ (Sc::Int | Sc::Uint)) => s,
+                            Ty::ScalarKind(s @ (ScalarKind::Int | ScalarKind::Uint)) => s,
                             _ => return Err(Error::new(t.pos, "enum type must be int or uint")),
                         },
-                        None => Sc::Int,
+                        None => ScalarKind::Int,
                     };
-                    self.typedefs.insert(name.clone(), Ty::Sc(sc));
+                    self.typedefs.insert(name.clone(), Ty::ScalarKind(sc));
                     let mut next = 0i64;
                     let ns = name
                         .rsplit_once("::")
@@ -82,13 +83,17 @@ impl<'a> Lowerer<'a> {
                             next = r?;
                         }
                         let id = self.const_scalar(sc, next as f64, next);
-                        let c = Global::Const(Val { id, ty: Ty::Sc(sc) });
+                        let c = Global::Const(Val {
+                            id,
+                            ty: Ty::ScalarKind(sc),
+                        });
                         self.globals.insert(format!("{name}::{v}"), c.clone());
                         self.const_items
-                            .insert(format!("{name}::{v}"), CVal::I(next));
+                            .insert(format!("{name}::{v}"), ConstValue::I(next));
                         if !scoped {
                             self.globals.insert(format!("{ns}{v}"), c);
-                            self.const_items.insert(format!("{ns}{v}"), CVal::I(next));
+                            self.const_items
+                                .insert(format!("{ns}{v}"), ConstValue::I(next));
                         }
                         next += 1;
                     }
@@ -463,13 +468,13 @@ impl<'a> Lowerer<'a> {
         };
         if let Some((base, a, b)) = split_numeric(name) {
             let sc = match base {
-                "bool" => Sc::Bool,
-                "int" | "min16int" | "min12int" | "int32_t" => Sc::Int,
-                "uint" | "dword" | "min16uint" | "uint32_t" => Sc::Uint,
-                "int64_t" => Sc::Int64,
-                "uint64_t" => Sc::Uint64,
+                "bool" => ScalarKind::Bool,
+                "int" | "min16int" | "min12int" | "int32_t" => ScalarKind::Int,
+                "uint" | "dword" | "min16uint" | "uint32_t" => ScalarKind::Uint,
+                "int64_t" => ScalarKind::Int64,
+                "uint64_t" => ScalarKind::Uint64,
                 // Without 16-bit types enabled, DXC treats half as float.
-                "float" | "half" | "min16float" | "min10float" | "float32_t" => Sc::Float,
+                "float" | "half" | "min16float" | "min10float" | "float32_t" => ScalarKind::Float,
                 other => {
                     return Err(unsupported(
                         t.pos,
@@ -483,8 +488,8 @@ impl<'a> Lowerer<'a> {
         Ok(match name {
             "void" => Ty::Void,
             "vector" | "matrix" => {
-                let sc = match targ_ty(self, 0, Ty::Sc(Sc::Float))? {
-                    Ty::Sc(s) => s,
+                let sc = match targ_ty(self, 0, Ty::ScalarKind(ScalarKind::Float))? {
+                    Ty::ScalarKind(s) => s,
                     _ => {
                         return Err(Error::new(
                             t.pos,
@@ -550,9 +555,9 @@ impl<'a> Lowerer<'a> {
                     "Buffer" => Dim::Buffer,
                     _ => Dim::D2Array,
                 };
-                let (sc, n) = match targ_ty(self, 0, Ty::Vec(Sc::Float, 4))? {
-                    Ty::Sc(s) if s != Sc::Bool && !s.is_64() => (s, 1),
-                    Ty::Vec(s, n) if s != Sc::Bool && !s.is_64() => (s, n),
+                let (sc, n) = match targ_ty(self, 0, Ty::Vec(ScalarKind::Float, 4))? {
+                    Ty::ScalarKind(s) if s != ScalarKind::Bool && !s.is_64() => (s, 1),
+                    Ty::Vec(s, n) if s != ScalarKind::Bool && !s.is_64() => (s, n),
                     _ => {
                         return Err(Error::new(
                             t.pos,
@@ -616,12 +621,12 @@ impl<'a> Lowerer<'a> {
         })
     }
 
-    pub(super) fn numeric(&mut self, sc: Sc, a: u8, b: u8, pos: Pos) -> Result<Ty> {
+    pub(super) fn numeric(&mut self, sc: ScalarKind, a: u8, b: u8, pos: Pos) -> Result<Ty> {
         Ok(match (a, b) {
-            (0, _) | (1, 0) => Ty::Sc(sc),
+            (0, _) | (1, 0) => Ty::ScalarKind(sc),
             (n, 0) => Ty::Vec(sc, n),
             (r, c) => {
-                if sc != Sc::Float {
+                if sc != ScalarKind::Float {
                     return Err(unsupported(pos, "non-float matrices"));
                 }
                 if r < 2 || c < 2 {
@@ -1056,7 +1061,7 @@ impl<'a> Lowerer<'a> {
                 },
             ),
             Ty::ByteAddress(rw) => (
-                self.spv(&Ty::Sc(Sc::Uint), Layout::None)?,
+                self.spv(&Ty::ScalarKind(ScalarKind::Uint), Layout::None)?,
                 4,
                 *rw,
                 if *rw {
@@ -1274,12 +1279,12 @@ impl<'a> Lowerer<'a> {
             None => None,
         };
         // Scalars and vectors that never change are used as constants directly.
-        if v.mods.is_const && matches!(t, Ty::Sc(_) | Ty::Vec(..)) {
-            if let (Ty::Sc(s), Some(e)) = (&t, &v.init) {
+        if v.mods.is_const && matches!(t, Ty::ScalarKind(_) | Ty::Vec(..)) {
+            if let (Ty::ScalarKind(s), Some(e)) = (&t, &v.init) {
                 if let Some(c) = self.const_eval(e)? {
                     let c = match (s, c) {
-                        (Sc::Float, c) => CVal::F(c.as_f64()),
-                        (_, CVal::F(f)) => CVal::I(f as i64),
+                        (ScalarKind::Float, c) => ConstValue::F(c.as_f64()),
+                        (_, ConstValue::F(f)) => ConstValue::I(f as i64),
                         (_, c) => c,
                     };
                     self.const_items.insert(v.name.clone(), c);
@@ -1325,7 +1330,7 @@ impl<'a> Lowerer<'a> {
             .first()
             .ok_or_else(|| Error::new(a.pos, "vk::constant_id needs an id"))?;
         let spec_id = self.const_int(id_expr)? as u32;
-        let Ty::Sc(s) = t else {
+        let Ty::ScalarKind(s) = t else {
             return Err(unsupported(
                 v.pos,
                 "specialization constants that are not scalars",
@@ -1344,7 +1349,7 @@ impl<'a> Lowerer<'a> {
         };
         let tid = self.sc_id(*s);
         let id = match s {
-            Sc::Bool => {
+            ScalarKind::Bool => {
                 let on = default.as_f64() != 0.0;
                 let id = self.b.id();
                 let op = if on {
@@ -1358,13 +1363,13 @@ impl<'a> Lowerer<'a> {
                 );
                 id
             }
-            Sc::Float => self
+            ScalarKind::Float => self
                 .b
                 .spec_constant_bit32(tid, (default.as_f64() as f32).to_bits()),
             _ => {
                 let i = match default {
-                    CVal::I(i) => i,
-                    CVal::F(f) => f as i64,
+                    ConstValue::I(i) => i,
+                    ConstValue::F(f) => f as i64,
                 };
                 if s.is_64() {
                     self.b.spec_constant_bit64(tid, i as u64)

@@ -58,7 +58,7 @@ impl<'a> Lowerer<'a> {
     pub fn ty_name(&self, t: &Ty) -> String {
         match t {
             Ty::Void => "void".into(),
-            Ty::Sc(s) => s.name().into(),
+            Ty::ScalarKind(s) => s.name().into(),
             Ty::Vec(s, n) => format!("{}{n}", s.name()),
             Ty::Mat(s, r, c) => format!("{}{r}x{c}", s.name()),
             Ty::Array(e, n) => format!("{}[{n}]", self.ty_name(e)),
@@ -128,53 +128,53 @@ impl<'a> Lowerer<'a> {
             // `sizeof` is a `uint` constant, as in DXC.
             ExprKind::SizeOfExpr(_) => {
                 let n = match self.const_eval(e)? {
-                    Some(CVal::I(n)) => n as u32,
+                    Some(ConstValue::I(n)) => n as u32,
                     _ => return Err(Error::new(e.pos, "`sizeof` needs a name")),
                 };
                 Val {
                     id: self.const_u32(n),
-                    ty: Ty::Sc(Sc::Uint),
+                    ty: Ty::ScalarKind(ScalarKind::Uint),
                 }
             }
             ExprKind::SizeOf(t, dims) => {
                 let n = self.size_of(t, dims, e.pos)?;
                 Val {
                     id: self.const_u32(n),
-                    ty: Ty::Sc(Sc::Uint),
+                    ty: Ty::ScalarKind(ScalarKind::Uint),
                 }
             }
             ExprKind::Int64(v, u) => {
                 // `uint64_t` with a `u` suffix or above `int64_t`'s range, as in C.
                 let s = if *u || *v > i64::MAX as u64 {
-                    Sc::Uint64
+                    ScalarKind::Uint64
                 } else {
-                    Sc::Int64
+                    ScalarKind::Int64
                 };
                 Val {
                     id: self.const_scalar(s, *v as f64, *v as i64),
-                    ty: Ty::Sc(s),
+                    ty: Ty::ScalarKind(s),
                 }
             }
             ExprKind::Int(v, u) => {
                 if *u || *v > i32::MAX as u64 {
                     Val {
                         id: self.const_u32(*v as u32),
-                        ty: Ty::Sc(Sc::Uint),
+                        ty: Ty::ScalarKind(ScalarKind::Uint),
                     }
                 } else {
                     Val {
                         id: self.const_i32(*v as i32),
-                        ty: Ty::Sc(Sc::Int),
+                        ty: Ty::ScalarKind(ScalarKind::Int),
                     }
                 }
             }
             ExprKind::Float(f) => Val {
                 id: self.const_f32(*f as f32),
-                ty: Ty::Sc(Sc::Float),
+                ty: Ty::ScalarKind(ScalarKind::Float),
             },
             ExprKind::Bool(b) => Val {
                 id: self.const_bool(*b),
-                ty: Ty::Sc(Sc::Bool),
+                ty: Ty::ScalarKind(ScalarKind::Bool),
             },
             ExprKind::Str(_) => {
                 return Err(unsupported(e.pos, "string literals outside attributes"))
@@ -233,7 +233,7 @@ impl<'a> Lowerer<'a> {
                 let ty = self.resolve_ty(t, &ns)?;
                 if let Ty::Struct(_) = ty {
                     // `(S)0` zero-initializes; a same-typed value passes through.
-                    if let Some(CVal::I(0)) = self.const_eval(a)? {
+                    if let Some(ConstValue::I(0)) = self.const_eval(a)? {
                         let tid = self.ty_id(&ty)?;
                         let id = self.b.constant_null(tid);
                         return Ok(Val { id, ty });
@@ -297,11 +297,11 @@ impl<'a> Lowerer<'a> {
     /// Splits a value into its scalar components, in memory order.
     pub(super) fn flatten(&mut self, v: Val, out: &mut Vec<Val>) -> Result<()> {
         let parts: Vec<Ty> = match &v.ty {
-            Ty::Sc(_) => {
+            Ty::ScalarKind(_) => {
                 out.push(v);
                 return Ok(());
             }
-            Ty::Vec(s, n) => vec![Ty::Sc(*s); *n as usize],
+            Ty::Vec(s, n) => vec![Ty::ScalarKind(*s); *n as usize],
             Ty::Mat(s, r, c) => vec![Ty::Vec(*s, *c); *r as usize],
             Ty::Array(e, n) => vec![(**e).clone(); *n as usize],
             Ty::Struct(k) => self.structs[*k as usize]
@@ -336,7 +336,7 @@ impl<'a> Lowerer<'a> {
         pos: Pos,
     ) -> Result<Val> {
         let parts: Vec<Ty> = match t {
-            Ty::Sc(_) => {
+            Ty::ScalarKind(_) => {
                 let v = it.next().ok_or_else(|| {
                     Error::new(
                         pos,
@@ -345,7 +345,7 @@ impl<'a> Lowerer<'a> {
                 })?;
                 return self.convert(v, t, pos, false);
             }
-            Ty::Vec(s, n) => vec![Ty::Sc(*s); *n as usize],
+            Ty::Vec(s, n) => vec![Ty::ScalarKind(*s); *n as usize],
             Ty::Mat(s, r, c) => vec![Ty::Vec(*s, *c); *r as usize],
             Ty::Array(e, n) => vec![(**e).clone(); *n as usize],
             Ty::Struct(k) => self.structs[*k as usize]
@@ -404,7 +404,7 @@ impl<'a> Lowerer<'a> {
         for a in args {
             vals.push(self.expr(a)?);
         }
-        if vals.len() == 1 && matches!(vals[0].ty, Ty::Sc(_)) {
+        if vals.len() == 1 && matches!(vals[0].ty, Ty::ScalarKind(_)) {
             let v = vals.pop().unwrap_or_else(|| unreachable!());
             return self.convert(v, ty, pos, false);
         }
@@ -459,14 +459,14 @@ impl<'a> Lowerer<'a> {
             .label(format!("this is a `{}`", this.ty_name(&v.ty)))
         };
         match (&v.ty, to) {
-            (Ty::Sc(a), Ty::Sc(b)) => self.convert_scalar(v.id, *a, *b, to),
-            (Ty::Sc(_), Ty::Vec(s, n)) => {
-                let c = self.convert(v, &Ty::Sc(*s), pos, explicit)?;
+            (Ty::ScalarKind(a), Ty::ScalarKind(b)) => self.convert_scalar(v.id, *a, *b, to),
+            (Ty::ScalarKind(_), Ty::Vec(s, n)) => {
+                let c = self.convert(v, &Ty::ScalarKind(*s), pos, explicit)?;
                 let tid = self.ty_id(to)?;
                 let id = self.op(Op::CompositeConstruct, tid, &vec![c.id; *n as usize])?;
                 Ok(Val { id, ty: to.clone() })
             }
-            (Ty::Sc(_), Ty::Mat(s, r, c)) => {
+            (Ty::ScalarKind(_), Ty::Mat(s, r, c)) => {
                 let row = self.convert(v, &Ty::Vec(*s, *c), pos, explicit)?;
                 let tid = self.ty_id(to)?;
                 let id = self.op(Op::CompositeConstruct, tid, &vec![row.id; *r as usize])?;
@@ -480,9 +480,9 @@ impl<'a> Lowerer<'a> {
                 };
                 self.convert_scalar(v.id, *a, *b, to)
             }
-            (Ty::Vec(a, _), Ty::Sc(b)) => {
+            (Ty::Vec(a, _), Ty::ScalarKind(b)) => {
                 // Truncation to the first component (DXC warns; so would we).
-                let s = self.shrink(v.clone(), &Ty::Sc(*a))?;
+                let s = self.shrink(v.clone(), &Ty::ScalarKind(*a))?;
                 self.convert_scalar(s.id, *a, *b, to)
             }
             (Ty::Mat(a, r, c), Ty::Mat(b, r2, c2)) if a == b && r2 <= r && c2 <= c && explicit => {
@@ -507,17 +507,23 @@ impl<'a> Lowerer<'a> {
         }
     }
 
-    pub(super) fn convert_scalar(&mut self, id: Id, from: Sc, to: Sc, to_ty: &Ty) -> Result<Val> {
-        if let (Ty::Sc(_), Some(bits)) = (to_ty, self.const_ids.get(&id).copied()) {
-            if from != Sc::Bool && to != Sc::Bool && from != to {
+    pub(super) fn convert_scalar(
+        &mut self,
+        id: Id,
+        from: ScalarKind,
+        to: ScalarKind,
+        to_ty: &Ty,
+    ) -> Result<Val> {
+        if let (Ty::ScalarKind(_), Some(bits)) = (to_ty, self.const_ids.get(&id).copied()) {
+            if from != ScalarKind::Bool && to != ScalarKind::Bool && from != to {
                 let (f, i) = match from {
-                    Sc::Float => (f32::from_bits(bits) as f64, f32::from_bits(bits) as i64),
-                    Sc::Int => (bits as i32 as f64, bits as i32 as i64),
+                    ScalarKind::Float => (f32::from_bits(bits) as f64, f32::from_bits(bits) as i64),
+                    ScalarKind::Int => (bits as i32 as f64, bits as i32 as i64),
                     _ => (bits as f64, bits as i64),
                 };
                 // Between integers the value is sign- or zero-extended from its
                 // own type (then wraps to the target); float conversions convert.
-                let i = if from != Sc::Float && to != Sc::Float {
+                let i = if from != ScalarKind::Float && to != ScalarKind::Float {
                     if from.is_signed() {
                         bits as i32 as i64
                     } else {
@@ -536,24 +542,24 @@ impl<'a> Lowerer<'a> {
         let from_ty = to_ty.with_scalar(from);
         let id = match (from, to) {
             _ if from == to => id,
-            (Sc::Bool, _) => {
+            (ScalarKind::Bool, _) => {
                 let one = self.const_splat(to_ty, 1.0)?;
                 let zero = self.const_splat(to_ty, 0.0)?;
                 self.op(Op::Select, tid, &[id, one, zero])?
             }
-            (_, Sc::Bool) => {
+            (_, ScalarKind::Bool) => {
                 let zero = self.const_splat(&from_ty, 0.0)?;
-                let op = if from == Sc::Float {
+                let op = if from == ScalarKind::Float {
                     Op::FUnordNotEqual
                 } else {
                     Op::INotEqual
                 };
                 self.op(op, tid, &[id, zero])?
             }
-            (s, Sc::Float) if s.is_signed() => self.op(Op::ConvertSToF, tid, &[id])?,
-            (_, Sc::Float) => self.op(Op::ConvertUToF, tid, &[id])?,
-            (Sc::Float, s) if s.is_signed() => self.op(Op::ConvertFToS, tid, &[id])?,
-            (Sc::Float, _) => self.op(Op::ConvertFToU, tid, &[id])?,
+            (s, ScalarKind::Float) if s.is_signed() => self.op(Op::ConvertSToF, tid, &[id])?,
+            (_, ScalarKind::Float) => self.op(Op::ConvertUToF, tid, &[id])?,
+            (ScalarKind::Float, s) if s.is_signed() => self.op(Op::ConvertFToS, tid, &[id])?,
+            (ScalarKind::Float, _) => self.op(Op::ConvertFToU, tid, &[id])?,
             // Integers of another width: extended by the source's signedness,
             // or truncated (the result type's signedness is its own).
             (s, t) if s.size() != t.size() => {
@@ -586,7 +592,7 @@ impl<'a> Lowerer<'a> {
         };
         let s = sa.max(sb);
         Ok(match (a, b) {
-            (Ty::Sc(_), x) | (x, Ty::Sc(_)) => x.with_scalar(s),
+            (Ty::ScalarKind(_), x) | (x, Ty::ScalarKind(_)) => x.with_scalar(s),
             (Ty::Vec(_, n), Ty::Vec(_, m)) => Ty::Vec(s, (*n).min(*m)),
             (Ty::Mat(_, r, c), Ty::Mat(_, r2, c2)) => Ty::Mat(s, (*r).min(*r2), (*c).min(*c2)),
             _ => {
@@ -607,18 +613,18 @@ impl<'a> Lowerer<'a> {
         let mut ct = self.common(&a.ty, &b.ty, pos)?;
         let cmp = matches!(op, Eq | Ne | Lt | Le | Gt | Ge);
         let bits = matches!(op, Shl | Shr | BitAnd | BitOr | BitXor);
-        if ct.scalar() == Some(Sc::Bool) && !(cmp && matches!(op, Eq | Ne)) {
-            ct = ct.with_scalar(Sc::Int);
+        if ct.scalar() == Some(ScalarKind::Bool) && !(cmp && matches!(op, Eq | Ne)) {
+            ct = ct.with_scalar(ScalarKind::Int);
         }
         if matches!(op, Shl | Shr) {
             // A shift has its left operand's type (HLSL, like C).
             let ls = match a.ty.scalar() {
-                Some(Sc::Bool) | None => Sc::Int,
+                Some(ScalarKind::Bool) | None => ScalarKind::Int,
                 Some(s) => s,
             };
             ct = ct.with_scalar(ls);
         }
-        if bits && ct.scalar() == Some(Sc::Float) {
+        if bits && ct.scalar() == Some(ScalarKind::Float) {
             return Err(Error::new(
                 pos,
                 format!("`{}` needs integer operands", op.as_str()),
@@ -669,14 +675,14 @@ impl<'a> Lowerer<'a> {
             let id = self.op(Op::CompositeConstruct, tid, &ids)?;
             return Ok(Val { id, ty: mt });
         }
-        let s = ct.scalar().unwrap_or(Sc::Float);
-        let f = s == Sc::Float;
+        let s = ct.scalar().unwrap_or(ScalarKind::Float);
+        let f = s == ScalarKind::Float;
         let signed = s.is_signed();
         let class = if f {
             0
         } else if signed {
             1
-        } else if s == Sc::Bool {
+        } else if s == ScalarKind::Bool {
             3
         } else {
             2
@@ -691,7 +697,11 @@ impl<'a> Lowerer<'a> {
                 format!("`{}` is not an arithmetic operator", op.as_str()),
             ));
         };
-        let rt = if cmp { ct.with_scalar(Sc::Bool) } else { ct };
+        let rt = if cmp {
+            ct.with_scalar(ScalarKind::Bool)
+        } else {
+            ct
+        };
         let tid = self.ty_id(&rt)?;
         let id = self.op(opcode, tid, &[a.id, b.id])?;
         Ok(Val { id, ty: rt })
@@ -703,12 +713,12 @@ impl<'a> Lowerer<'a> {
         if let Ty::Vec(_, n) = av.ty {
             let bv = self.expr(b)?;
             let t = Ty::Vec(
-                Sc::Bool,
-                n.min(
-                    bv.ty
-                        .width()
-                        .max(if matches!(bv.ty, Ty::Sc(_)) { n } else { 0 }),
-                ),
+                ScalarKind::Bool,
+                n.min(bv.ty.width().max(if matches!(bv.ty, Ty::ScalarKind(_)) {
+                    n
+                } else {
+                    0
+                })),
             );
             let x = self.convert(av, &t, pos, false)?;
             let y = self.convert(bv, &t, pos, false)?;
@@ -724,7 +734,7 @@ impl<'a> Lowerer<'a> {
             )?;
             return Ok(Val { id, ty: t });
         }
-        let bool_t = Ty::Sc(Sc::Bool);
+        let bool_t = Ty::ScalarKind(ScalarKind::Bool);
         let x = self.convert(av, &bool_t, a.pos, false)?;
         let from = self.f.cur_label;
         let (rhs_l, merge) = (self.b.id(), self.b.id());
@@ -769,17 +779,17 @@ impl<'a> Lowerer<'a> {
             let bv = self.expr(b)?;
             let t = self.common(&av.ty, &bv.ty, pos)?;
             let t = match t {
-                Ty::Sc(s) => Ty::Vec(s, n),
+                Ty::ScalarKind(s) => Ty::Vec(s, n),
                 other => other,
             };
             let x = self.convert(av, &t, pos, false)?;
             let y = self.convert(bv, &t, pos, false)?;
-            let cb = self.convert(cv, &Ty::Vec(Sc::Bool, t.width()), c.pos, false)?;
+            let cb = self.convert(cv, &Ty::Vec(ScalarKind::Bool, t.width()), c.pos, false)?;
             let tid = self.ty_id(&t)?;
             let id = self.op(Op::Select, tid, &[cb.id, x.id, y.id])?;
             return Ok(Val { id, ty: t });
         }
-        let cb = self.convert(cv, &Ty::Sc(Sc::Bool), c.pos, false)?;
+        let cb = self.convert(cv, &Ty::ScalarKind(ScalarKind::Bool), c.pos, false)?;
         // Only the chosen side runs. Each side leaves its value in a temporary
         // of its own type; the result, in the common type of both, is selected
         // after the merge (the unchosen temporary is never observed).
@@ -827,8 +837,8 @@ impl<'a> Lowerer<'a> {
             UnOp::Plus => self.expr(a),
             UnOp::Neg => {
                 let v = self.expr(a)?;
-                let v = if v.ty.scalar() == Some(Sc::Bool) {
-                    self.convert(v.clone(), &v.ty.with_scalar(Sc::Int), pos, false)?
+                let v = if v.ty.scalar() == Some(ScalarKind::Bool) {
+                    self.convert(v.clone(), &v.ty.with_scalar(ScalarKind::Int), pos, false)?
                 } else {
                     v
                 };
@@ -849,7 +859,7 @@ impl<'a> Lowerer<'a> {
                 if let Ty::Mat(..) = v.ty {
                     return Err(unsupported(pos, "`!` on a matrix"));
                 }
-                let t = v.ty.with_scalar(Sc::Bool);
+                let t = v.ty.with_scalar(ScalarKind::Bool);
                 let b = self.convert(v, &t, pos, false)?;
                 let tid = self.ty_id(&t)?;
                 let id = self.op(Op::LogicalNot, tid, &[b.id])?;
@@ -857,7 +867,7 @@ impl<'a> Lowerer<'a> {
             }
             UnOp::BitNot => {
                 let v = self.expr(a)?;
-                if !matches!(v.ty.scalar(), Some(Sc::Int | Sc::Uint)) {
+                if !matches!(v.ty.scalar(), Some(ScalarKind::Int | ScalarKind::Uint)) {
                     return Err(Error::new(pos, "`~` needs an integer"));
                 }
                 let tid = self.ty_id(&v.ty)?;

@@ -264,10 +264,17 @@ impl<'a> Lowerer<'a> {
                     ));
                 };
                 let (bi, bty) = match sem.to_ascii_uppercase().as_str() {
-                    "SV_DISPATCHTHREADID" => (BuiltIn::GlobalInvocationId, Ty::Vec(Sc::Uint, 3)),
-                    "SV_GROUPTHREADID" => (BuiltIn::LocalInvocationId, Ty::Vec(Sc::Uint, 3)),
-                    "SV_GROUPID" => (BuiltIn::WorkgroupId, Ty::Vec(Sc::Uint, 3)),
-                    "SV_GROUPINDEX" => (BuiltIn::LocalInvocationIndex, Ty::Sc(Sc::Uint)),
+                    "SV_DISPATCHTHREADID" => {
+                        (BuiltIn::GlobalInvocationId, Ty::Vec(ScalarKind::Uint, 3))
+                    }
+                    "SV_GROUPTHREADID" => {
+                        (BuiltIn::LocalInvocationId, Ty::Vec(ScalarKind::Uint, 3))
+                    }
+                    "SV_GROUPID" => (BuiltIn::WorkgroupId, Ty::Vec(ScalarKind::Uint, 3)),
+                    "SV_GROUPINDEX" => (
+                        BuiltIn::LocalInvocationIndex,
+                        Ty::ScalarKind(ScalarKind::Uint),
+                    ),
                     _ => {
                         return Err(unsupported(
                             *spos,

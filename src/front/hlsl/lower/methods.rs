@@ -71,7 +71,7 @@ impl<'a> Lowerer<'a> {
                     }
                     "GetDimensions" => {
                         self.arity(name, args, 2, pos)?;
-                        let ut = self.ty_id(&Ty::Sc(Sc::Uint))?;
+                        let ut = self.ty_id(&Ty::ScalarKind(ScalarKind::Uint))?;
                         let n = self.inst(
                             Op::ArrayLength,
                             Some(ut),
@@ -83,14 +83,14 @@ impl<'a> Lowerer<'a> {
                             &args[0],
                             Val {
                                 id: n,
-                                ty: Ty::Sc(Sc::Uint),
+                                ty: Ty::ScalarKind(ScalarKind::Uint),
                             },
                         )?;
                         self.out_arg(
                             &args[1],
                             Val {
                                 id: s,
-                                ty: Ty::Sc(Sc::Uint),
+                                ty: Ty::ScalarKind(ScalarKind::Uint),
                             },
                         )?;
                         Ok(None)
@@ -130,7 +130,7 @@ impl<'a> Lowerer<'a> {
         args: &'a [Expr],
         pos: Pos,
     ) -> Result<Option<Val>> {
-        let u = Ty::Sc(Sc::Uint);
+        let u = Ty::ScalarKind(ScalarKind::Uint);
         let ut = self.ty_id(&u)?;
         let pty = self.b.type_pointer(None, StorageClass::StorageBuffer, ut);
         if let Some(op) = name.strip_prefix("Interlocked") {
@@ -222,7 +222,7 @@ impl<'a> Lowerer<'a> {
         let vt = if n == 1 {
             u.clone()
         } else {
-            Ty::Vec(Sc::Uint, n)
+            Ty::Vec(ScalarKind::Uint, n)
         };
         let value = if store {
             let v = self.expr(&args[1])?;
@@ -306,7 +306,7 @@ impl<'a> Lowerer<'a> {
         }
         let id = self.inst(Op::ImageFetch, Some(vt), ops)?;
         let texel = if *n == 1 {
-            Ty::Sc(*sc)
+            Ty::ScalarKind(*sc)
         } else {
             Ty::Vec(*sc, *n)
         };
@@ -324,12 +324,16 @@ impl<'a> Lowerer<'a> {
         let Ty::Texture { dim, sc, n, rw, .. } = t.clone() else {
             unreachable!("texture method")
         };
-        let texel = if n == 1 { Ty::Sc(sc) } else { Ty::Vec(sc, n) };
+        let texel = if n == 1 {
+            Ty::ScalarKind(sc)
+        } else {
+            Ty::Vec(sc, n)
+        };
         let cn = self.coord_size(dim, true);
         let float_coord = if cn == 1 {
-            Ty::Sc(Sc::Float)
+            Ty::ScalarKind(ScalarKind::Float)
         } else {
-            Ty::Vec(Sc::Float, cn)
+            Ty::Vec(ScalarKind::Float, cn)
         };
         match name {
             _ if dim == Dim::Buffer && name.starts_with("Sample") => Err(Error::new(
@@ -380,16 +384,17 @@ impl<'a> Lowerer<'a> {
                     return Ok(Some(self.shrink(Val { id, ty: v4 }, &texel)?));
                 } else if name == "SampleLevel" {
                     let lod = self.expr(&args[2])?;
-                    let lod = self.convert(lod, &Ty::Sc(Sc::Float), args[2].pos, false)?;
+                    let lod =
+                        self.convert(lod, &Ty::ScalarKind(ScalarKind::Float), args[2].pos, false)?;
                     ops.push(Operand::ImageOperands(spirv::ImageOperands::LOD));
                     ops.push(Operand::IdRef(lod.id));
                 } else {
                     let gt = if matches!(dim, Dim::Cube | Dim::CubeArray | Dim::D3) {
-                        Ty::Vec(Sc::Float, 3)
+                        Ty::Vec(ScalarKind::Float, 3)
                     } else if matches!(dim, Dim::D1 | Dim::D1Array) {
-                        Ty::Sc(Sc::Float)
+                        Ty::ScalarKind(ScalarKind::Float)
                     } else {
-                        Ty::Vec(Sc::Float, 2)
+                        Ty::Vec(ScalarKind::Float, 2)
                     };
                     let dx = self.expr(&args[2])?;
                     let dx = self.convert(dx, &gt, args[2].pos, false)?;
@@ -404,7 +409,7 @@ impl<'a> Lowerer<'a> {
             }
             "Load" if dim == Dim::Buffer && !rw => {
                 self.arity(name, args, 1, pos)?;
-                let c = self.expr_as(&args[0], &Ty::Sc(Sc::Int))?;
+                let c = self.expr_as(&args[0], &Ty::ScalarKind(ScalarKind::Int))?;
                 Ok(Some(self.fetch(ptr, t, c.id, None)?))
             }
             "Load" if matches!(dim, Dim::Cube | Dim::CubeArray) => Err(Error::new(
@@ -417,9 +422,9 @@ impl<'a> Lowerer<'a> {
                 let icn = self.coord_size(dim, false);
                 if rw {
                     let ct = if icn == 1 {
-                        Ty::Sc(Sc::Int)
+                        Ty::ScalarKind(ScalarKind::Int)
                     } else {
-                        Ty::Vec(Sc::Int, icn)
+                        Ty::Vec(ScalarKind::Int, icn)
                     };
                     let coord = self.convert(c, &ct, args[0].pos, false)?;
                     let pl = Place::Texel {
@@ -431,12 +436,12 @@ impl<'a> Lowerer<'a> {
                     return Ok(Some(self.read(&pl)?));
                 }
                 // Sampled textures: the last component is the mip level.
-                let full = Ty::Vec(Sc::Int, icn + 1);
+                let full = Ty::Vec(ScalarKind::Int, icn + 1);
                 let c = self.convert(c, &full, args[0].pos, false)?;
                 let ct = if icn == 1 {
-                    Ty::Sc(Sc::Int)
+                    Ty::ScalarKind(ScalarKind::Int)
                 } else {
-                    Ty::Vec(Sc::Int, icn)
+                    Ty::Vec(ScalarKind::Int, icn)
                 };
                 let ctid = self.ty_id(&ct)?;
                 let coord = if icn == 1 {
@@ -450,7 +455,7 @@ impl<'a> Lowerer<'a> {
                     ops.extend((0..icn as u32).map(Operand::LiteralBit32));
                     self.inst(Op::VectorShuffle, Some(ctid), ops)?
                 };
-                let it = self.ty_id(&Ty::Sc(Sc::Int))?;
+                let it = self.ty_id(&Ty::ScalarKind(ScalarKind::Int))?;
                 let lod = self.inst(
                     Op::CompositeExtract,
                     Some(it),
@@ -467,9 +472,9 @@ impl<'a> Lowerer<'a> {
                     _ => return Err(Error::new(pos, format!("`GetDimensions` takes {icn} out arguments (or a mip level, {icn} sizes and a level count)"))),
                 };
                 let qt = if icn == 1 {
-                    Ty::Sc(Sc::Uint)
+                    Ty::ScalarKind(ScalarKind::Uint)
                 } else {
-                    Ty::Vec(Sc::Uint, icn)
+                    Ty::Vec(ScalarKind::Uint, icn)
                 };
                 let qtid = self.ty_id(&qt)?;
                 let im = self.image(ptr, t)?;
@@ -479,7 +484,8 @@ impl<'a> Lowerer<'a> {
                     let lod = match mip {
                         Some(m) => {
                             let v = self.expr(m)?;
-                            self.convert(v, &Ty::Sc(Sc::Uint), m.pos, false)?.id
+                            self.convert(v, &Ty::ScalarKind(ScalarKind::Uint), m.pos, false)?
+                                .id
                         }
                         None => self.const_u32(0),
                     };
@@ -491,13 +497,13 @@ impl<'a> Lowerer<'a> {
                     self.out_arg(a, c)?;
                 }
                 if mip.is_some() {
-                    let ut = self.ty_id(&Ty::Sc(Sc::Uint))?;
+                    let ut = self.ty_id(&Ty::ScalarKind(ScalarKind::Uint))?;
                     let levels = self.op(Op::ImageQueryLevels, ut, &[im])?;
                     self.out_arg(
                         &outs[icn as usize],
                         Val {
                             id: levels,
-                            ty: Ty::Sc(Sc::Uint),
+                            ty: Ty::ScalarKind(ScalarKind::Uint),
                         },
                     )?;
                 }
@@ -518,10 +524,10 @@ impl<'a> Lowerer<'a> {
         args: &'a [Expr],
         pos: Pos,
     ) -> Result<Option<Val>> {
-        let u = Ty::Sc(Sc::Uint);
-        let f = Ty::Sc(Sc::Float);
-        let b = Ty::Sc(Sc::Bool);
-        let f3 = Ty::Vec(Sc::Float, 3);
+        let u = Ty::ScalarKind(ScalarKind::Uint);
+        let f = Ty::ScalarKind(ScalarKind::Float);
+        let b = Ty::ScalarKind(ScalarKind::Bool);
+        let f3 = Ty::Vec(ScalarKind::Float, 3);
         match name {
             "TraceRayInline" => {
                 self.arity(name, args, 4, pos)?;
@@ -619,7 +625,7 @@ impl<'a> Lowerer<'a> {
             );
         };
         let k = self.const_u32(which);
-        let m43 = Ty::Mat(Sc::Float, 4, 3);
+        let m43 = Ty::Mat(ScalarKind::Float, 4, 3);
         let (op, t, transpose) = match (which, rest) {
             (0, "Type") | (1, "Status") => (Op::RayQueryGetIntersectionTypeKHR, u.clone(), false),
             (0, "TriangleRayT") | (1, "RayT") => {
@@ -648,7 +654,7 @@ impl<'a> Lowerer<'a> {
             ),
             (_, "TriangleBarycentrics") => (
                 Op::RayQueryGetIntersectionBarycentricsKHR,
-                Ty::Vec(Sc::Float, 2),
+                Ty::Vec(ScalarKind::Float, 2),
                 false,
             ),
             (_, "TriangleFrontFace") => (Op::RayQueryGetIntersectionFrontFaceKHR, b.clone(), false),
@@ -697,7 +703,7 @@ impl<'a> Lowerer<'a> {
         let tid = self.ty_id(&t)?;
         let id = self.op(op, tid, &[q, k])?;
         if transpose {
-            let t34 = Ty::Mat(Sc::Float, 3, 4);
+            let t34 = Ty::Mat(ScalarKind::Float, 3, 4);
             let tid = self.ty_id(&t34)?;
             let id = self.op(Op::Transpose, tid, &[id])?;
             return Ok(Some(Val { id, ty: t34 }));
@@ -727,8 +733,8 @@ impl<'a> Lowerer<'a> {
             }
         };
         let (sc, n) = match t {
-            Ty::Sc(s) if s != Sc::Bool && !s.is_64() => (s, 1),
-            Ty::Vec(s, n) if s != Sc::Bool && !s.is_64() => (s, n),
+            Ty::ScalarKind(s) if s != ScalarKind::Bool && !s.is_64() => (s, 1),
+            Ty::Vec(s, n) if s != ScalarKind::Bool && !s.is_64() => (s, n),
             Ty::Struct(_) | Ty::Array(..) => {
                 return self.load_packed(*ptr, &t, args, pos).map(Some);
             }
@@ -751,7 +757,7 @@ impl<'a> Lowerer<'a> {
         let Some(words) = self.byte_address(*ptr, *rw, method, args, pos)? else {
             return Err(Error::new(pos, "`Load` gave no value"));
         };
-        if sc == Sc::Uint {
+        if sc == ScalarKind::Uint {
             return Ok(Some(words));
         }
         let tid = self.ty_id(&t)?;
@@ -796,14 +802,19 @@ impl<'a> Lowerer<'a> {
         let uv = self.expr(&args[1])?;
         let uv = self.convert(uv, &coord, args[1].pos, false)?;
         let reference = self.expr(&args[2])?;
-        let reference = self.convert(reference, &Ty::Sc(Sc::Float), args[2].pos, false)?;
+        let reference = self.convert(
+            reference,
+            &Ty::ScalarKind(ScalarKind::Float),
+            args[2].pos,
+            false,
+        )?;
         let im = self.image(ptr, t)?;
         let st = self.ty_id(&Ty::SamplerCmp)?;
         let sm = self.b.load(st, None, s.id, None, [])?;
         let it = self.ty_id(t)?;
         let sit = self.b.type_sampled_image(it);
         let si = self.op(Op::SampledImage, sit, &[im, sm])?;
-        let rt = Ty::Sc(*sc);
+        let rt = Ty::ScalarKind(*sc);
         let rid = self.ty_id(&rt)?;
         let mut ops = vec![
             Operand::IdRef(si),
@@ -815,7 +826,8 @@ impl<'a> Lowerer<'a> {
         } else {
             let lod = if name == "SampleCmpLevel" {
                 let l = self.expr(&args[3])?;
-                self.convert(l, &Ty::Sc(Sc::Float), args[3].pos, false)?.id
+                self.convert(l, &Ty::ScalarKind(ScalarKind::Float), args[3].pos, false)?
+                    .id
             } else {
                 self.const_f32(0.0)
             };
@@ -830,10 +842,10 @@ impl<'a> Lowerer<'a> {
     /// `Load<S>` of a struct or array: its 32-bit leaves packed one word each,
     /// in declaration order (the layout `sizeof` gives), then put together.
     fn load_packed(&mut self, var: Id, t: &Ty, args: &'a [Expr], pos: Pos) -> Result<Val> {
-        fn leaves(t: &Ty, structs: &[StructDef], out: &mut Vec<Sc>) -> bool {
+        fn leaves(t: &Ty, structs: &[StructDef], out: &mut Vec<ScalarKind>) -> bool {
             match t {
-                Ty::Sc(s) if *s != Sc::Bool && !s.is_64() => out.push(*s),
-                Ty::Vec(s, n) if *s != Sc::Bool && !s.is_64() => {
+                Ty::ScalarKind(s) if *s != ScalarKind::Bool && !s.is_64() => out.push(*s),
+                Ty::Vec(s, n) if *s != ScalarKind::Bool && !s.is_64() => {
                     out.extend(std::iter::repeat_n(*s, *n as usize))
                 }
                 Ty::Array(e, n) => {
@@ -865,7 +877,7 @@ impl<'a> Lowerer<'a> {
             ));
         }
         self.arity("Load", args, 1, pos)?;
-        let u = Ty::Sc(Sc::Uint);
+        let u = Ty::ScalarKind(ScalarKind::Uint);
         let ut = self.ty_id(&u)?;
         let pty = self.b.type_pointer(None, StorageClass::StorageBuffer, ut);
         let addr = self.expr_as(&args[0], &u)?;
@@ -892,8 +904,8 @@ impl<'a> Lowerer<'a> {
                 ],
             )?;
             let id = self.b.load(ut, None, ptr, None, [])?;
-            let st = Ty::Sc(*s);
-            let id = if *s == Sc::Uint {
+            let st = Ty::ScalarKind(*s);
+            let id = if *s == ScalarKind::Uint {
                 id
             } else {
                 let sid = self.ty_id(&st)?;

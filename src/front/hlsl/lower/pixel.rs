@@ -149,15 +149,16 @@ impl<'a> Lowerer<'a> {
                 _ => Err(Error::new(a.pos, "[[vk::location]] needs one location")),
             })
             .transpose()?;
-        let plain = matches!(ty, Ty::Sc(s) | Ty::Vec(s, _) if *s != Sc::Bool);
+        let plain = matches!(ty, Ty::ScalarKind(s) | Ty::Vec(s, _) if *s != ScalarKind::Bool);
         // (built-in, its SPIR-V type) or a location.
         let (builtin, location) = match (dir, upper.as_str()) {
-            (Dir::In, "SV_POSITION") if *ty == Ty::Vec(Sc::Float, 4) => {
+            (Dir::In, "SV_POSITION") if *ty == Ty::Vec(ScalarKind::Float, 4) => {
                 (Some((BuiltIn::FragCoord, ty.clone())), None)
             }
-            (Dir::In, "SV_ISFRONTFACE") if *ty == Ty::Sc(Sc::Bool) => {
-                (Some((BuiltIn::FrontFacing, Ty::Sc(Sc::Bool))), None)
-            }
+            (Dir::In, "SV_ISFRONTFACE") if *ty == Ty::ScalarKind(ScalarKind::Bool) => (
+                Some((BuiltIn::FrontFacing, Ty::ScalarKind(ScalarKind::Bool))),
+                None,
+            ),
             (Dir::In, "SV_POSITION" | "SV_ISFRONTFACE") => {
                 return Err(Error::new(
                     pos,
@@ -264,7 +265,8 @@ impl<'a> Lowerer<'a> {
                     .decorate(var, Decoration::Location, [Operand::LiteralBit32(n)]);
                 self.b.name(var, format!("{prefix}{sem}"));
                 // Vulkan: integer fragment inputs are not interpolated.
-                if dir == Dir::In && matches!(ty.scalar(), Some(Sc::Int | Sc::Uint)) {
+                if dir == Dir::In && matches!(ty.scalar(), Some(ScalarKind::Int | ScalarKind::Uint))
+                {
                     self.b.decorate(var, Decoration::Flat, []);
                 }
             }

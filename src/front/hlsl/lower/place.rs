@@ -63,7 +63,7 @@ impl<'a> Lowerer<'a> {
             let id = self.const_u32(v);
             return Ok(Place::Value(Val {
                 id,
-                ty: Ty::Sc(Sc::Uint),
+                ty: Ty::ScalarKind(ScalarKind::Uint),
             }));
         }
         if self.fn_by_name.contains_key(name) || system_value(name).is_some() {
@@ -130,7 +130,10 @@ impl<'a> Lowerer<'a> {
                 }),
                 _ => {
                     let v = self.read(&Place::Swizzle {
-                        ty: Ty::Vec(elem.scalar().unwrap_or(Sc::Float), comps.len() as u8),
+                        ty: Ty::Vec(
+                            elem.scalar().unwrap_or(ScalarKind::Float),
+                            comps.len() as u8,
+                        ),
                         base,
                         comps,
                     })?;
@@ -198,7 +201,7 @@ impl<'a> Lowerer<'a> {
             ExprKind::Index(base, idx) => {
                 let bp = self.place(base)?;
                 let iv = self.expr(idx)?;
-                if !matches!(iv.ty, Ty::Sc(_) | Ty::Vec(..)) {
+                if !matches!(iv.ty, Ty::ScalarKind(_) | Ty::Vec(..)) {
                     return Err(Error::new(idx.pos, "index must be an integer"));
                 }
                 self.index(bp, iv, idx, e.pos)
@@ -234,7 +237,7 @@ impl<'a> Lowerer<'a> {
                 let c = self.const_u32(i as u32);
                 self.sub_place(bp, c, Some(i as u32), ft, pos)
             }
-            Ty::Sc(s) | Ty::Vec(s, _) => {
+            Ty::ScalarKind(s) | Ty::Vec(s, _) => {
                 let Some(comps) = swizzle_comps(name) else {
                     return Err(Error::new(
                         pos,
@@ -248,7 +251,7 @@ impl<'a> Lowerer<'a> {
                         format!("swizzle `{name}` reaches past a {}", self.ty_name(&t)),
                     ));
                 }
-                if let Ty::Sc(_) = t {
+                if let Ty::ScalarKind(_) = t {
                     // `x.xxx` on a scalar: a splat, read-only.
                     let v = self.read(&bp)?;
                     if comps.len() == 1 {
@@ -259,7 +262,7 @@ impl<'a> Lowerer<'a> {
                 }
                 if comps.len() == 1 {
                     let c = self.const_u32(comps[0]);
-                    return self.sub_place(bp, c, Some(comps[0]), Ty::Sc(*s), pos);
+                    return self.sub_place(bp, c, Some(comps[0]), Ty::ScalarKind(*s), pos);
                 }
                 // Swizzles of swizzles compose.
                 let (base, comps) = match bp {
@@ -292,7 +295,7 @@ impl<'a> Lowerer<'a> {
                     let ci = self.const_u32(i);
                     let row = self.sub_place(bp, ci, Some(i), Ty::Vec(*s, *c), pos)?;
                     let cj = self.const_u32(j);
-                    return self.sub_place(row, cj, Some(j), Ty::Sc(*s), pos);
+                    return self.sub_place(row, cj, Some(j), Ty::ScalarKind(*s), pos);
                 }
                 let m = self.read(&bp)?;
                 let st = self.sc_id(*s);
@@ -338,14 +341,14 @@ impl<'a> Lowerer<'a> {
             }
         }
         let const_index = match self.const_eval(idx)? {
-            Some(CVal::I(v)) if v >= 0 => Some(v as u32),
+            Some(ConstValue::I(v)) if v >= 0 => Some(v as u32),
             _ => None,
         };
         let scalar_index = |this: &mut Self, iv: Val| -> Result<Id> {
             let nu = this.nonuniform.contains(&iv.id);
             let v = match iv.ty {
-                Ty::Sc(Sc::Int) | Ty::Sc(Sc::Uint) => iv,
-                _ => this.convert(iv, &Ty::Sc(Sc::Uint), idx.pos, false)?,
+                Ty::ScalarKind(ScalarKind::Int) | Ty::ScalarKind(ScalarKind::Uint) => iv,
+                _ => this.convert(iv, &Ty::ScalarKind(ScalarKind::Uint), idx.pos, false)?,
             };
             if nu {
                 this.nonuniform.insert(v.id);
@@ -371,7 +374,7 @@ impl<'a> Lowerer<'a> {
             }
             Ty::Vec(s, _) => {
                 let i = scalar_index(self, iv)?;
-                self.sub_place(bp, i, const_index, Ty::Sc(*s), pos)
+                self.sub_place(bp, i, const_index, Ty::ScalarKind(*s), pos)
             }
             Ty::Mat(s, _, c) => {
                 let i = scalar_index(self, iv)?;
@@ -410,13 +413,13 @@ impl<'a> Lowerer<'a> {
                 };
                 let cn = self.coord_size(*dim, false);
                 let ct = if cn == 1 {
-                    Ty::Sc(Sc::Int)
+                    Ty::ScalarKind(ScalarKind::Int)
                 } else {
-                    Ty::Vec(Sc::Int, cn)
+                    Ty::Vec(ScalarKind::Int, cn)
                 };
                 let coord = self.convert(iv, &ct, idx.pos, false)?;
                 let texel = if *n == 1 {
-                    Ty::Sc(*sc)
+                    Ty::ScalarKind(*sc)
                 } else {
                     Ty::Vec(*sc, *n)
                 };
@@ -516,7 +519,7 @@ impl<'a> Lowerer<'a> {
             } => {
                 let it = self.ty_id(img)?;
                 let im = self.b.load(it, None, *image, None, [])?;
-                let s = ty.scalar().unwrap_or(Sc::Float);
+                let s = ty.scalar().unwrap_or(ScalarKind::Float);
                 let v4 = self.ty_id(&Ty::Vec(s, 4))?;
                 let id = self.op(Op::ImageRead, v4, &[im, *coord])?;
                 self.shrink(
@@ -533,7 +536,7 @@ impl<'a> Lowerer<'a> {
 
     pub(super) fn has_bool(&self, t: &Ty) -> bool {
         match t {
-            Ty::Sc(Sc::Bool) | Ty::Vec(Sc::Bool, _) => true,
+            Ty::ScalarKind(ScalarKind::Bool) | Ty::Vec(ScalarKind::Bool, _) => true,
             Ty::Array(e, _) | Ty::RtArray(e) => self.has_bool(e),
             Ty::Struct(k) => self.structs[*k as usize]
                 .fields
@@ -565,10 +568,10 @@ impl<'a> Lowerer<'a> {
         layout: Layout,
         class: StorageClass,
     ) -> Result<Val> {
-        if let Ty::Sc(_) | Ty::Vec(..) = t {
+        if let Ty::ScalarKind(_) | Ty::Vec(..) = t {
             let ut = self.spv(t, layout)?;
             let raw = self.b.load(ut, None, ptr, None, [])?;
-            return self.convert_scalar(raw, Sc::Uint, Sc::Bool, t);
+            return self.convert_scalar(raw, ScalarKind::Uint, ScalarKind::Bool, t);
         }
         let mut ids = Vec::new();
         for (i, pt) in self.parts(t) {
@@ -604,9 +607,9 @@ impl<'a> Lowerer<'a> {
         layout: Layout,
         class: StorageClass,
     ) -> Result<()> {
-        if let Ty::Sc(_) | Ty::Vec(..) = v.ty {
-            let ut = v.ty.with_scalar(Sc::Uint);
-            let raw = self.convert_scalar(v.id, Sc::Bool, Sc::Uint, &ut)?;
+        if let Ty::ScalarKind(_) | Ty::Vec(..) = v.ty {
+            let ut = v.ty.with_scalar(ScalarKind::Uint);
+            let raw = self.convert_scalar(v.id, ScalarKind::Bool, ScalarKind::Uint, &ut)?;
             self.b.store(ptr, raw.id, None, [])?;
             return Ok(());
         }
@@ -650,7 +653,7 @@ impl<'a> Lowerer<'a> {
         }
         let tid = self.ty_id(to)?;
         let id = match to {
-            Ty::Sc(_) => self.inst(
+            Ty::ScalarKind(_) => self.inst(
                 Op::CompositeExtract,
                 Some(tid),
                 vec![Operand::IdRef(v.id), Operand::LiteralBit32(0)],
@@ -754,7 +757,7 @@ impl<'a> Lowerer<'a> {
                 let Ty::Texture { rw: true, .. } = img else {
                     return Err(Error::new(pos, "cannot write to a read-only texture"));
                 };
-                let s = ty.scalar().unwrap_or(Sc::Float);
+                let s = ty.scalar().unwrap_or(ScalarKind::Float);
                 let v4 = self.widen4(v, s)?;
                 let it = self.ty_id(img)?;
                 let im = self.b.load(it, None, *image, None, [])?;
@@ -766,7 +769,7 @@ impl<'a> Lowerer<'a> {
     }
 
     /// Pads a scalar or vector to 4 components with zeros (image writes).
-    pub(super) fn widen4(&mut self, v: Val, s: Sc) -> Result<Id> {
+    pub(super) fn widen4(&mut self, v: Val, s: ScalarKind) -> Result<Id> {
         let n = v.ty.width() as u32;
         if n == 4 {
             return Ok(v.id);

@@ -41,14 +41,14 @@ impl<'a> Lowerer<'a> {
             "HitObject::MakeMiss" => {
                 // SPV_NV_shader_invocation_reorder records a miss without ray flags.
                 self.arity(name, args, 3, e.pos)?;
-                let flags = self.expr_as(&args[0], &Ty::Sc(Sc::Uint))?;
-                if self.known(&flags) != Some((Sc::Uint, 0)) {
+                let flags = self.expr_as(&args[0], &Ty::ScalarKind(ScalarKind::Uint))?;
+                if self.known(&flags) != Some((ScalarKind::Uint, 0)) {
                     return Err(unsupported(
                         args[0].pos,
                         "ray flags other than 0 in HitObject::MakeMiss (SPV_NV_shader_invocation_reorder has none)",
                     ));
                 }
-                let miss = self.expr_as(&args[1], &Ty::Sc(Sc::Uint))?;
+                let miss = self.expr_as(&args[1], &Ty::ScalarKind(ScalarKind::Uint))?;
                 let ray = self.ray_parts(&args[2])?;
                 self.inst(
                     Op::HitObjectRecordMissNV,
@@ -76,7 +76,7 @@ impl<'a> Lowerer<'a> {
                 let at = self.ty_id(&Ty::Accel)?;
                 let mut ids = Vec::new();
                 for a in &args[1..6] {
-                    ids.push(self.expr_as(a, &Ty::Sc(Sc::Uint))?.id);
+                    ids.push(self.expr_as(a, &Ty::ScalarKind(ScalarKind::Uint))?.id);
                 }
                 let ray = self.ray_parts(&args[6])?;
                 let (var, p, t) = self.payload_in(&args[7])?;
@@ -104,10 +104,10 @@ impl<'a> Lowerer<'a> {
         let ray = self.expr_as(e, &Ty::Struct(RAY_DESC))?;
         let mut parts = [0; 4];
         let tys = [
-            Ty::Vec(Sc::Float, 3),
-            Ty::Sc(Sc::Float),
-            Ty::Vec(Sc::Float, 3),
-            Ty::Sc(Sc::Float),
+            Ty::Vec(ScalarKind::Float, 3),
+            Ty::ScalarKind(ScalarKind::Float),
+            Ty::Vec(ScalarKind::Float, 3),
+            Ty::ScalarKind(ScalarKind::Float),
         ];
         for (i, t) in tys.iter().enumerate() {
             let tid = self.ty_id(t)?;
@@ -177,7 +177,7 @@ impl<'a> Lowerer<'a> {
             "MaybeReorderThread" => {
                 self.ser_caps();
                 self.stage_check(name, &[Stage::RayGeneration], pos)?;
-                let u = Ty::Sc(Sc::Uint);
+                let u = Ty::ScalarKind(ScalarKind::Uint);
                 match args.len() {
                     1 | 3 => {
                         let h = self.hit_object_ptr(&args[0])?;
@@ -224,10 +224,10 @@ impl<'a> Lowerer<'a> {
         pos: Pos,
     ) -> Result<Option<Val>> {
         self.ser_caps();
-        let f = Ty::Sc(Sc::Float);
-        let f3 = Ty::Vec(Sc::Float, 3);
-        let u = Ty::Sc(Sc::Uint);
-        let b = Ty::Sc(Sc::Bool);
+        let f = Ty::ScalarKind(ScalarKind::Float);
+        let f3 = Ty::Vec(ScalarKind::Float, 3);
+        let u = Ty::ScalarKind(ScalarKind::Uint);
+        let b = Ty::ScalarKind(ScalarKind::Bool);
         let (op, ty) = match name {
             "IsMiss" => (Op::HitObjectIsMissNV, b),
             "IsHit" => (Op::HitObjectIsHitNV, b),
@@ -244,12 +244,14 @@ impl<'a> Lowerer<'a> {
             "GetPrimitiveIndex" => (Op::HitObjectGetPrimitiveIndexNV, u),
             "GetHitKind" => (Op::HitObjectGetHitKindNV, u),
             "GetShaderTableIndex" => (Op::HitObjectGetShaderBindingTableRecordIndexNV, u),
-            "GetObjectToWorld3x4" | "GetObjectToWorld4x3" => {
-                (Op::HitObjectGetObjectToWorldNV, Ty::Mat(Sc::Float, 4, 3))
-            }
-            "GetWorldToObject3x4" | "GetWorldToObject4x3" => {
-                (Op::HitObjectGetWorldToObjectNV, Ty::Mat(Sc::Float, 4, 3))
-            }
+            "GetObjectToWorld3x4" | "GetObjectToWorld4x3" => (
+                Op::HitObjectGetObjectToWorldNV,
+                Ty::Mat(ScalarKind::Float, 4, 3),
+            ),
+            "GetWorldToObject3x4" | "GetWorldToObject4x3" => (
+                Op::HitObjectGetWorldToObjectNV,
+                Ty::Mat(ScalarKind::Float, 4, 3),
+            ),
             _ => {
                 return Err(
                     unsupported(pos, format!("HitObject method `{name}`")).len(name.len() as u32)
@@ -260,7 +262,7 @@ impl<'a> Lowerer<'a> {
         let tid = self.ty_id(&ty)?;
         let id = self.inst(op, Some(tid), vec![Operand::IdRef(h)])?;
         if name.ends_with("3x4") {
-            let t = Ty::Mat(Sc::Float, 3, 4);
+            let t = Ty::Mat(ScalarKind::Float, 3, 4);
             let tt = self.ty_id(&t)?;
             let id = self.op(Op::Transpose, tt, &[id])?;
             return Ok(Some(Val { id, ty: t }));

@@ -17,7 +17,7 @@ impl<'a> Lowerer<'a> {
 
     pub(super) fn cond(&mut self, e: &'a Expr) -> Result<Id> {
         let v = self.expr(e)?;
-        if !matches!(v.ty, Ty::Sc(_)) {
+        if !matches!(v.ty, Ty::ScalarKind(_)) {
             return Err(Error::new(
                 e.pos,
                 format!(
@@ -26,7 +26,9 @@ impl<'a> Lowerer<'a> {
                 ),
             ));
         }
-        Ok(self.convert(v, &Ty::Sc(Sc::Bool), e.pos, false)?.id)
+        Ok(self
+            .convert(v, &Ty::ScalarKind(ScalarKind::Bool), e.pos, false)?
+            .id)
     }
 
     pub(super) fn branch(&mut self, to: Id) -> Result<()> {
@@ -237,8 +239,10 @@ impl<'a> Lowerer<'a> {
     pub(super) fn lower_switch(&mut self, sel: &'a Expr, cases: &'a [Case]) -> Result<()> {
         let v = self.expr(sel)?;
         let v = match v.ty {
-            Ty::Sc(Sc::Int) | Ty::Sc(Sc::Uint) => v,
-            Ty::Sc(Sc::Bool) => self.convert(v, &Ty::Sc(Sc::Int), sel.pos, false)?,
+            Ty::ScalarKind(ScalarKind::Int) | Ty::ScalarKind(ScalarKind::Uint) => v,
+            Ty::ScalarKind(ScalarKind::Bool) => {
+                self.convert(v, &Ty::ScalarKind(ScalarKind::Int), sel.pos, false)?
+            }
             _ => return Err(Error::new(sel.pos, "switch needs an integer scalar")),
         };
         let merge = self.b.id();
@@ -383,7 +387,7 @@ impl<'a> Lowerer<'a> {
         }
         if v.mods.is_const && !v.mods.is_static {
             // `const int N = 3;`: a name for the constant (usable as an array size).
-            if let (Ty::Sc(_), Some(init)) = (&t, &v.init) {
+            if let (Ty::ScalarKind(_), Some(init)) = (&t, &v.init) {
                 let val = self.expr_as(init, &t)?;
                 if self.known(&val).is_some() {
                     self.bind(&v.name, Place::Value(val));

@@ -89,7 +89,7 @@ impl<'a> Lowerer<'a> {
                 kind: ExprKind::Int(*i as u64, *i > i32::MAX as i64),
                 pos,
             }),
-            TVal::Type(t @ (Ty::Sc(_) | Ty::Vec(..) | Ty::Mat(..))) => {
+            TVal::Type(t @ (Ty::ScalarKind(_) | Ty::Vec(..) | Ty::Mat(..))) => {
                 TArg::Type(tref(self.ty_name(t), Vec::new()))
             }
             TVal::Type(Ty::Struct(k)) => {
@@ -201,7 +201,7 @@ impl<'a> Lowerer<'a> {
         match (pattern.name.as_str(), ty) {
             ("vector", Ty::Vec(s, n)) => {
                 if let Some(a) = pattern.args.first() {
-                    bind(a, TVal::Type(Ty::Sc(*s)), out);
+                    bind(a, TVal::Type(Ty::ScalarKind(*s)), out);
                 }
                 if let Some(a) = pattern.args.get(1) {
                     bind(a, TVal::Int(*n as i64), out);
@@ -209,7 +209,7 @@ impl<'a> Lowerer<'a> {
             }
             ("matrix", Ty::Mat(s, r, c)) => {
                 let vals = [
-                    TVal::Type(Ty::Sc(*s)),
+                    TVal::Type(Ty::ScalarKind(*s)),
                     TVal::Int(*r as i64),
                     TVal::Int(*c as i64),
                 ];

@@ -122,8 +122,8 @@ impl<'a> Lowerer<'a> {
         };
         self.arity(name, args, arity, pos)?;
         self.cap(Capability::GroupNonUniform);
-        let u = Ty::Sc(Sc::Uint);
-        let b = Ty::Sc(Sc::Bool);
+        let u = Ty::ScalarKind(ScalarKind::Uint);
+        let b = Ty::ScalarKind(ScalarKind::Bool);
         let scope = self.const_u32(spirv::Scope::Subgroup as u32);
         let group_op = |this: &mut Self, op: Op, ty: &Ty, rest: Vec<Operand>| -> Result<Val> {
             let tid = this.ty_id(ty)?;
@@ -143,7 +143,7 @@ impl<'a> Lowerer<'a> {
             Wave::AllEqual => {
                 self.cap(Capability::GroupNonUniformVote);
                 let x = self.expr(&args[0])?;
-                if !matches!(x.ty, Ty::Sc(_)) {
+                if !matches!(x.ty, Ty::ScalarKind(_)) {
                     return Err(unsupported(
                         args[0].pos,
                         format!("`{name}` of a `{}` (scalars only)", self.ty_name(&x.ty)),
@@ -159,7 +159,7 @@ impl<'a> Lowerer<'a> {
             Wave::Ballot => {
                 self.cap(Capability::GroupNonUniformBallot);
                 let c = self.expr_as(&args[0], &b)?;
-                let u4 = Ty::Vec(Sc::Uint, 4);
+                let u4 = Ty::Vec(ScalarKind::Uint, 4);
                 group_op(
                     self,
                     Op::GroupNonUniformBallot,
@@ -192,8 +192,8 @@ impl<'a> Lowerer<'a> {
                 self.cap(Capability::GroupNonUniformArithmetic);
                 let x = self.wave_value(name, &args[0])?;
                 let op = match x.ty.scalar() {
-                    Some(Sc::Float) => fop,
-                    Some(Sc::Int) => sop,
+                    Some(ScalarKind::Float) => fop,
+                    Some(ScalarKind::Int) => sop,
                     _ => uop,
                 };
                 group_op(
@@ -206,7 +206,7 @@ impl<'a> Lowerer<'a> {
             Wave::Bits(op) => {
                 self.cap(Capability::GroupNonUniformArithmetic);
                 let x = self.wave_value(name, &args[0])?;
-                if !matches!(x.ty.scalar(), Some(Sc::Int | Sc::Uint)) {
+                if !matches!(x.ty.scalar(), Some(ScalarKind::Int | ScalarKind::Uint)) {
                     return Err(Error::new(
                         args[0].pos,
                         format!("`{name}` needs an integer, not a `{}`", self.ty_name(&x.ty)),
@@ -225,7 +225,7 @@ impl<'a> Lowerer<'a> {
             Wave::CountBits(gop) => {
                 self.cap(Capability::GroupNonUniformBallot);
                 let c = self.expr_as(&args[0], &b)?;
-                let u4 = Ty::Vec(Sc::Uint, 4);
+                let u4 = Ty::Vec(ScalarKind::Uint, 4);
                 let ballot = group_op(
                     self,
                     Op::GroupNonUniformBallot,
@@ -247,7 +247,7 @@ impl<'a> Lowerer<'a> {
     fn wave_value(&mut self, name: &str, e: &'a Expr) -> Result<Val> {
         let x = self.expr(e)?;
         match x.ty {
-            Ty::Sc(s) | Ty::Vec(s, _) if s != Sc::Bool && !s.is_64() => Ok(x),
+            Ty::ScalarKind(s) | Ty::Vec(s, _) if s != ScalarKind::Bool && !s.is_64() => Ok(x),
             _ => Err(unsupported(
                 e.pos,
                 format!("`{name}` of a `{}`", self.ty_name(&x.ty)),
