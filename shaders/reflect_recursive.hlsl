@@ -73,6 +73,7 @@ void closest_hit(inout Radiance r, in BuiltInTriangleIntersectionAttributes attr
             reflected.color = float3(0.0, 0.0, 0.0);
             reflected.depth = r.depth + 1;
             reflected.throughput = next;
+            // rtlint: allow(recursive-trace, reason = "the recursive reference: bounded by maxBounces; reflect_iterative.hlsl is the loop form")
             TraceRay(tlas, RAY_FLAG_FORCE_OPAQUE, 0xFF, 0, 1, 0, ray, reflected);
             color += reflectivity * reflected.color;
         }

@@ -132,6 +132,7 @@ fn closest_hit(
     if next > params.ray.z && incoming.depth < params.max_bounces {
         ray.depth = incoming.depth + 1u;
         ray.throughput = next;
+        // rtlint: allow(recursive-trace, reason = "the recursive reference: bounded by max_bounces; reflect_iterative.wgsl is the loop form")
         traceRay(tlas, RayDesc(RAY_FLAG_OPAQUE, 0xFFu, params.ray.x, params.ray.y, start, reflect(dir, n)), &ray);
         color += reflectivity * ray.color;
     }

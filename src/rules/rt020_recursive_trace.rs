@@ -150,6 +150,6 @@ mod tests {
         let d = run("shaders/reflect_recursive.pipeline.toml");
         assert_eq!(d.len(), 1, "{d:?}");
         let l = &d[0].primary.as_ref().unwrap().location;
-        assert_eq!((l.line, l.column), (135, 9));
+        assert_eq!((l.line, l.column), (136, 9));
     }
 }
