@@ -15,11 +15,11 @@ pub mod compare;
 pub mod gpu;
 
 use crate::reference::{self, Method, Params, Scene};
+use crate::vk::{spawn_command, ChildOutcome, RunningChild};
 use compare::Comparison;
 use serde::Deserialize;
-use std::io::Read;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Stdio};
+use std::process::Command;
 use std::time::{Duration, Instant};
 
 /// Tolerance per 8-bit channel: the GPU and the CPU evaluate the same f32
@@ -482,31 +482,20 @@ impl Report {
     }
 }
 
-/// How a child ended.
-#[derive(Debug)]
-struct ChildEnd {
-    code: Option<i32>,
-    signal: Option<i32>,
-    timed_out: bool,
-    stdout: String,
-    stderr: String,
-}
-
-impl ChildEnd {
-    fn describe(&self) -> String {
-        let last = self.stderr.lines().rev().find(|l| !l.trim().is_empty());
-        match (self.timed_out, self.signal, self.code) {
-            (true, _, _) => format!(
-                "the child ran past {} s and was killed",
-                CHILD_TIMEOUT.as_secs()
-            ),
-            (_, Some(s), _) => format!("the child was killed by signal {s} ({})", signal_name(s)),
-            (_, _, Some(c)) => match last {
-                Some(l) => format!("the child exited with {c}: {}", l.trim()),
-                None => format!("the child exited with {c}"),
-            },
-            _ => "the child ended without a status".into(),
-        }
+/// How a child ended, in words.
+fn describe(end: &ChildOutcome) -> String {
+    let last = end.stderr.lines().rev().find(|l| !l.trim().is_empty());
+    match (end.timed_out, end.signal, end.code) {
+        (true, _, _) => format!(
+            "the child ran past {} s and was killed",
+            CHILD_TIMEOUT.as_secs()
+        ),
+        (_, Some(s), _) => format!("the child was killed by signal {s} ({})", signal_name(s)),
+        (_, _, Some(c)) => match last {
+            Some(l) => format!("the child exited with {c}: {}", l.trim()),
+            None => format!("the child exited with {c}"),
+        },
+        _ => "the child ended without a status".into(),
     }
 }
 
@@ -521,63 +510,12 @@ fn signal_name(s: i32) -> &'static str {
     }
 }
 
-struct Running {
-    child: std::process::Child,
-    out: std::thread::JoinHandle<String>,
-    err: std::thread::JoinHandle<String>,
-    start: Instant,
+fn spawn(cmd: Command) -> Result<RunningChild, String> {
+    spawn_command(cmd).map_err(|e| format!("cannot start the child process: {e}"))
 }
 
-fn spawn(mut cmd: Command) -> Result<Running, String> {
-    let mut child = cmd
-        .stdin(Stdio::null())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .map_err(|e| format!("cannot start the child process: {e}"))?;
-    let drain = |pipe: Option<Box<dyn Read + Send>>| {
-        std::thread::spawn(move || {
-            let mut text = Vec::new();
-            if let Some(mut p) = pipe {
-                let _ = p.read_to_end(&mut text);
-            }
-            String::from_utf8_lossy(&text).into_owned()
-        })
-    };
-    let out = drain(child.stdout.take().map(|p| Box::new(p) as _));
-    let err = drain(child.stderr.take().map(|p| Box::new(p) as _));
-    Ok(Running {
-        child,
-        out,
-        err,
-        start: Instant::now(),
-    })
-}
-
-fn wait(mut r: Running) -> Result<ChildEnd, String> {
-    let mut timed_out = false;
-    let status = loop {
-        if let Some(s) = r.child.try_wait().map_err(|e| e.to_string())? {
-            break s;
-        }
-        if r.start.elapsed() > CHILD_TIMEOUT {
-            timed_out = true;
-            let _ = r.child.kill();
-            break r.child.wait().map_err(|e| e.to_string())?;
-        }
-        std::thread::sleep(Duration::from_millis(5));
-    };
-    #[cfg(unix)]
-    let signal = std::os::unix::process::ExitStatusExt::signal(&status);
-    #[cfg(not(unix))]
-    let signal = None;
-    Ok(ChildEnd {
-        code: status.code(),
-        signal,
-        timed_out,
-        stdout: r.out.join().unwrap_or_default(),
-        stderr: r.err.join().unwrap_or_default(),
-    })
+fn wait(r: RunningChild) -> Result<ChildOutcome, String> {
+    r.wait(CHILD_TIMEOUT).map_err(|e| e.to_string())
 }
 
 fn file_name(case: &str) -> String {
@@ -680,14 +618,14 @@ pub fn run(
                 let _ = std::fs::remove_file(&image);
                 note_device(&mut report, &end);
                 let o = if end.signal.is_some() && !end.timed_out {
-                    Outcome::ExpectedFailure(format!("caught: {}; {needs}", end.describe()))
+                    Outcome::ExpectedFailure(format!("caught: {}; {needs}", describe(&end)))
                 } else if end.code == Some(0) {
                     Outcome::Fail(format!(
                         "the pipeline declared with depth {depth} ran clean ({}×{}); {needs}",
                         params.width, params.height
                     ))
                 } else {
-                    Outcome::Fail(format!("expected a crash, but {}", end.describe()))
+                    Outcome::Fail(format!("expected a crash, but {}", describe(&end)))
                 };
                 (None, o)
             }
@@ -709,7 +647,7 @@ pub fn run(
     Ok(report)
 }
 
-fn note_device(report: &mut Report, end: &ChildEnd) {
+fn note_device(report: &mut Report, end: &ChildOutcome) {
     if report.device.is_none() {
         report.device = end
             .stdout
@@ -758,7 +696,7 @@ fn render_case(
         return Ok((None, Outcome::Skipped(why.to_string()), None));
     }
     if end.code != Some(0) {
-        return Ok((None, Outcome::Fail(end.describe()), None));
+        return Ok((None, Outcome::Fail(describe(&end)), None));
     }
     let bytes = std::fs::read(&image_path)
         .map_err(|e| format!("cannot read {}: {e}", image_path.display()))?;

@@ -69,13 +69,27 @@ pub fn run_in_child_with_timeout(test_name: &str, timeout: Duration) -> Option<C
 /// Runs `command` with piped output, killing it after `timeout`, and says
 /// how it ended: a crash (a signal) or a hang is an outcome, not an error.
 /// Only a failure to start or wait for it is an error.
-pub fn run_command(mut command: Command, timeout: Duration) -> std::io::Result<ChildOutcome> {
+pub fn run_command(command: Command, timeout: Duration) -> std::io::Result<ChildOutcome> {
+    spawn_command(command)?.wait(timeout)
+}
+
+/// A child started by [`spawn_command`], its output being drained.
+pub struct RunningChild {
+    child: std::process::Child,
+    out: std::thread::JoinHandle<String>,
+    err: std::thread::JoinHandle<String>,
+    start: Instant,
+}
+
+/// Starts `command` with piped output, so the caller can work while it runs
+/// and [`RunningChild::wait`] for it afterwards.
+pub fn spawn_command(mut command: Command) -> std::io::Result<RunningChild> {
     let mut child = command
         .stdin(Stdio::null())
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())
         .spawn()?;
-    // Drain both pipes while waiting, so a chatty child cannot block on a
+    // Drain both pipes while it runs, so a chatty child cannot block on a
     // full pipe.
     let drain = |pipe: Option<Box<dyn Read + Send>>| {
         std::thread::spawn(move || {
@@ -88,28 +102,40 @@ pub fn run_command(mut command: Command, timeout: Duration) -> std::io::Result<C
     };
     let out = drain(child.stdout.take().map(|p| Box::new(p) as _));
     let err = drain(child.stderr.take().map(|p| Box::new(p) as _));
-    let start = Instant::now();
-    let mut timed_out = false;
-    let status = loop {
-        if let Some(status) = child.try_wait()? {
-            break status;
-        }
-        if start.elapsed() > timeout {
-            timed_out = true;
-            let _ = child.kill();
-            break child.wait()?;
-        }
-        std::thread::sleep(Duration::from_millis(5));
-    };
-    #[cfg(unix)]
-    let signal = std::os::unix::process::ExitStatusExt::signal(&status);
-    #[cfg(not(unix))]
-    let signal = None;
-    Ok(ChildOutcome {
-        code: status.code(),
-        signal,
-        timed_out,
-        stdout: out.join().unwrap_or_default(),
-        stderr: err.join().unwrap_or_default(),
+    Ok(RunningChild {
+        child,
+        out,
+        err,
+        start: Instant::now(),
     })
+}
+
+impl RunningChild {
+    /// Waits for the child, killing it once `timeout` has passed since it
+    /// started.
+    pub fn wait(mut self, timeout: Duration) -> std::io::Result<ChildOutcome> {
+        let mut timed_out = false;
+        let status = loop {
+            if let Some(status) = self.child.try_wait()? {
+                break status;
+            }
+            if self.start.elapsed() > timeout {
+                timed_out = true;
+                let _ = self.child.kill();
+                break self.child.wait()?;
+            }
+            std::thread::sleep(Duration::from_millis(5));
+        };
+        #[cfg(unix)]
+        let signal = std::os::unix::process::ExitStatusExt::signal(&status);
+        #[cfg(not(unix))]
+        let signal = None;
+        Ok(ChildOutcome {
+            code: status.code(),
+            signal,
+            timed_out,
+            stdout: self.out.join().unwrap_or_default(),
+            stderr: self.err.join().unwrap_or_default(),
+        })
+    }
 }

@@ -35,8 +35,8 @@ mod validation;
 pub use accel::{Aabb, AccelerationStructure, Geometry, Instance, IDENTITY};
 pub use buffer::{bytes_of, Buffer, Pod};
 pub use child::{
-    run_command, run_in_child, run_in_child_with_timeout, ChildOutcome, CHILD_ENV,
-    DEFAULT_CHILD_TIMEOUT,
+    run_command, run_in_child, run_in_child_with_timeout, spawn_command, ChildOutcome,
+    RunningChild, CHILD_ENV, DEFAULT_CHILD_TIMEOUT,
 };
 pub use context::{Context, ContextOptions, DeviceInfo, RayTracingLimits};
 pub use descriptors::{Binding, BindingKind, Resource};
