@@ -27,6 +27,10 @@ struct ParamsData
     float4 light;
     // t_min, t_max, throughput cut-off, fixed origin epsilon
     float4 ray;
+    // x: reflection rays' t_max (before the roughness shortening);
+    // y: roughness above which the environment replaces the reflection ray
+    // (read by the glossy shader only)
+    float4 knobs;
 };
 ConstantBuffer<ParamsData> params : register(b3);
 

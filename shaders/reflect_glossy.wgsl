@@ -18,6 +18,9 @@ struct Params {
     light: vec4<f32>,
     // t_min, t_max, throughput cut-off, fixed origin epsilon
     ray: vec4<f32>,
+    // x: reflection rays' t_max (before the roughness shortening);
+    // y: roughness above which the environment replaces the reflection ray
+    knobs: vec4<f32>,
 }
 
 // One entry per triangle (instance custom index + primitive index):
@@ -168,10 +171,10 @@ fn raygen(@builtin(ray_invocation_id) id: vec3<u32>) {
                 } else {
                     throughput = 0.0;
                 }
-                t_max = params.ray.y / (1.0 + 64.0 * roughness);
+                t_max = params.knobs.x / (1.0 + 64.0 * roughness);
             } else {
                 dir = reflect(dir, n);
-                t_max = params.ray.y;
+                t_max = params.knobs.x;
             }
             if (params.flags & FLAG_LIGHT) != 0u {
                 sum += base * params.light.w;
@@ -185,6 +188,12 @@ fn raygen(@builtin(ray_invocation_id) id: vec3<u32>) {
                 }
             } else {
                 sum += base * headlight;
+            }
+            // Too rough to be worth a ray: the environment answers instead
+            // of the reflection ray the next bounce would trace.
+            if roughness > params.knobs.y && bounce < params.max_bounces {
+                sum += throughput * sky(dir);
+                break;
             }
             if !(throughput > params.ray.z) {
                 break;

@@ -22,7 +22,7 @@ pub const FLAG_LIGHT: u32 = 1;
 /// `Params.flags`: ray origins use the robust offset, not the fixed epsilon.
 pub const FLAG_ROBUST: u32 = 2;
 
-/// The shaders' uniform block (`Params`, 64 bytes).
+/// The shaders' uniform block (`Params`, 80 bytes).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Params {
     pub width: u32,
@@ -40,6 +40,12 @@ pub struct Params {
     pub epsilon: f32,
     /// Rays per pixel of the glossy shader (1–16).
     pub samples: u32,
+    /// `t_max` of the glossy shader's reflection rays (before its
+    /// shortening with roughness); primary and shadow rays keep `t_max`.
+    pub reflect_t_max: f32,
+    /// The glossy shader replaces the reflection ray off a surface rougher
+    /// than this with the environment in the sampled direction.
+    pub rough_cutoff: f32,
 }
 
 impl Params {
@@ -58,13 +64,15 @@ impl Params {
             cutoff: 1.0 / 256.0,
             epsilon: 1e-3,
             samples: 4,
+            reflect_t_max: 1e4,
+            rough_cutoff: f32::INFINITY,
         }
     }
 
     /// The uniform buffer contents:
     /// `width, height, max_bounces, flags; camera.xyz, 0; light.xyz, ambient;
-    /// t_min, t_max, cutoff, epsilon`.
-    pub fn to_words(&self) -> [u32; 16] {
+    /// t_min, t_max, cutoff, epsilon; reflect_t_max, rough_cutoff, 0, 0`.
+    pub fn to_words(&self) -> [u32; 20] {
         let f = |x: f32| x.to_bits();
         let flags = if self.light.is_some() { FLAG_LIGHT } else { 0 }
             | if self.robust { FLAG_ROBUST } else { 0 }
@@ -91,6 +99,10 @@ impl Params {
             f(self.t_max),
             f(self.cutoff),
             f(self.epsilon),
+            f(self.reflect_t_max),
+            f(self.rough_cutoff),
+            0,
+            0,
         ]
     }
 
@@ -435,93 +447,126 @@ pub fn trace_glossy(scene: &Scene, params: &Params, x: u32, y: u32) -> PixelPath
     let mut sum = Vec3::ZERO;
     let mut segments = Vec::new();
     for sample in 0..samples {
-        let mut seed = pcg(y * params.width + x) ^ pcg(sample.wrapping_add(0x9E37_79B9));
-        let mut origin = params.camera;
-        let mut dir = camera_dir(params, x, y);
-        let mut t_max = params.t_max;
-        let mut throughput = 1.0f32;
-        for _bounce in 0..=params.max_bounces {
-            let (hit, edge_margin) = intersect(scene, origin, dir, params.t_min, t_max);
-            segments.push(Segment {
-                origin,
-                dir,
-                hit,
-                shadow: false,
-                edge_margin,
-            });
-            let Some(hit) = hit else {
-                sum += throughput * sky(dir);
-                break;
-            };
-            let surface = scene.surfaces[hit.triangle as usize];
-            let n = if surface.normal.dot(dir) < 0.0 {
-                surface.normal
-            } else {
-                -surface.normal
-            };
-            let base = throughput * (1.0 - surface.reflectivity) * surface.albedo;
-            throughput *= surface.reflectivity;
-            let roughness = surface.roughness;
-            origin = params.next_origin(origin + dir * hit.t, n);
-            let light = params.light.unwrap_or(Light {
-                direction: Vec3::ZERO,
-                ambient: 0.0,
-            });
-            let ndl = n.dot(light.direction);
-            let headlight = n.dot(-dir).max(0.0);
-            if roughness > 0.0 {
-                let sgn = if n.z >= 0.0 { 1.0f32 } else { -1.0 };
-                let a = -1.0 / (sgn + n.z);
-                let b = n.x * n.y * a;
-                let tx = Vec3::new(1.0 + sgn * n.x * n.x * a, sgn * b, -sgn * n.x);
-                let ty = Vec3::new(b, sgn + n.y * n.y * a, -n.y);
-                let alpha = roughness * roughness;
-                let ve = Vec3::new((-dir).dot(tx), (-dir).dot(ty), (-dir).dot(n));
-                let u1 = rand(&mut seed);
-                let u2 = rand(&mut seed);
-                let m = sample_vndf(ve, alpha, u1, u2);
-                dir = reflect(dir, tx * m.x + ty * m.y + n * m.z);
-                let nl = n.dot(dir);
-                if nl > 0.0 {
-                    let a2 = alpha * alpha;
-                    throughput *= 2.0 * nl / (nl + (a2 + (1.0 - a2) * nl * nl).sqrt());
-                } else {
-                    throughput = 0.0;
-                }
-                t_max = params.t_max / (1.0 + 64.0 * roughness);
-            } else {
-                dir = reflect(dir, n);
-                t_max = params.t_max;
-            }
-            if params.light.is_some() {
-                sum += base * light.ambient;
-                if ndl > 0.0 {
-                    let lit = base * ndl;
-                    let (blocker, edge_margin) =
-                        intersect(scene, origin, light.direction, params.t_min, params.t_max);
-                    segments.push(Segment {
-                        origin,
-                        dir: light.direction,
-                        hit: blocker,
-                        shadow: true,
-                        edge_margin,
-                    });
-                    if blocker.is_none() {
-                        sum += lit;
-                    }
-                }
-            } else {
-                sum += base * headlight;
-            }
-            if throughput.partial_cmp(&params.cutoff) != Some(std::cmp::Ordering::Greater) {
-                break;
-            }
-        }
+        sum += glossy_sample(scene, params, x, y, sample, &mut segments);
     }
     PixelPath {
         color: sum / samples as f32,
         segments,
     }
+}
+
+/// The mean of the glossy shader's paths `0..samples` of pixel `(x, y)`,
+/// for any number of them (the shader stops at 16): the converged image
+/// the tradeoff sweep measures against. Not clamped or packed.
+pub fn glossy_mean(scene: &Scene, params: &Params, x: u32, y: u32, samples: u32) -> Vec3 {
+    let mut sum = Vec3::ZERO;
+    let mut segments = Vec::new();
+    for sample in 0..samples.max(1) {
+        segments.clear();
+        sum += glossy_sample(scene, params, x, y, sample, &mut segments);
+    }
+    sum / samples.max(1) as f32
+}
+
+/// One path of the glossy shader: what it adds to the pixel's sum.
+fn glossy_sample(
+    scene: &Scene,
+    params: &Params,
+    x: u32,
+    y: u32,
+    sample: u32,
+    segments: &mut Vec<Segment>,
+) -> Vec3 {
+    let mut sum = Vec3::ZERO;
+    let mut seed = pcg(y * params.width + x) ^ pcg(sample.wrapping_add(0x9E37_79B9));
+    let mut origin = params.camera;
+    let mut dir = camera_dir(params, x, y);
+    let mut t_max = params.t_max;
+    let mut throughput = 1.0f32;
+    for bounce in 0..=params.max_bounces {
+        let (hit, edge_margin) = intersect(scene, origin, dir, params.t_min, t_max);
+        segments.push(Segment {
+            origin,
+            dir,
+            hit,
+            shadow: false,
+            edge_margin,
+        });
+        let Some(hit) = hit else {
+            sum += throughput * sky(dir);
+            break;
+        };
+        let surface = scene.surfaces[hit.triangle as usize];
+        let n = if surface.normal.dot(dir) < 0.0 {
+            surface.normal
+        } else {
+            -surface.normal
+        };
+        let base = throughput * (1.0 - surface.reflectivity) * surface.albedo;
+        throughput *= surface.reflectivity;
+        let roughness = surface.roughness;
+        origin = params.next_origin(origin + dir * hit.t, n);
+        let light = params.light.unwrap_or(Light {
+            direction: Vec3::ZERO,
+            ambient: 0.0,
+        });
+        let ndl = n.dot(light.direction);
+        let headlight = n.dot(-dir).max(0.0);
+        if roughness > 0.0 {
+            let sgn = if n.z >= 0.0 { 1.0f32 } else { -1.0 };
+            let a = -1.0 / (sgn + n.z);
+            let b = n.x * n.y * a;
+            let tx = Vec3::new(1.0 + sgn * n.x * n.x * a, sgn * b, -sgn * n.x);
+            let ty = Vec3::new(b, sgn + n.y * n.y * a, -n.y);
+            let alpha = roughness * roughness;
+            let ve = Vec3::new((-dir).dot(tx), (-dir).dot(ty), (-dir).dot(n));
+            let u1 = rand(&mut seed);
+            let u2 = rand(&mut seed);
+            let m = sample_vndf(ve, alpha, u1, u2);
+            dir = reflect(dir, tx * m.x + ty * m.y + n * m.z);
+            let nl = n.dot(dir);
+            if nl > 0.0 {
+                let a2 = alpha * alpha;
+                throughput *= 2.0 * nl / (nl + (a2 + (1.0 - a2) * nl * nl).sqrt());
+            } else {
+                throughput = 0.0;
+            }
+            t_max = params.reflect_t_max / (1.0 + 64.0 * roughness);
+        } else {
+            dir = reflect(dir, n);
+            t_max = params.reflect_t_max;
+        }
+        if params.light.is_some() {
+            sum += base * light.ambient;
+            if ndl > 0.0 {
+                let lit = base * ndl;
+                let (blocker, edge_margin) =
+                    intersect(scene, origin, light.direction, params.t_min, params.t_max);
+                segments.push(Segment {
+                    origin,
+                    dir: light.direction,
+                    hit: blocker,
+                    shadow: true,
+                    edge_margin,
+                });
+                if blocker.is_none() {
+                    sum += lit;
+                }
+            }
+        } else {
+            sum += base * headlight;
+        }
+        // Too rough to be worth a ray: the environment answers instead of
+        // the reflection ray the next bounce would trace.
+        if roughness > params.rough_cutoff && bounce < params.max_bounces {
+            sum += throughput * sky(dir);
+            break;
+        }
+        if throughput.partial_cmp(&params.cutoff) != Some(std::cmp::Ordering::Greater) {
+            break;
+        }
+    }
+    sum
 }
 
 /// Which shader's math to follow.

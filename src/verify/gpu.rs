@@ -70,9 +70,9 @@ pub struct Rendered {
 
 /// Creates the described pipeline (with `depth` instead of its declared
 /// recursion depth when given) and traces `params`' image of `scene`.
-pub fn render<'p>(
+pub fn render(
     ctx: &Context,
-    pipeline: &'p Pipeline,
+    pipeline: &Pipeline,
     depth: Option<u32>,
     scene: &Scene,
     params: &Params,
@@ -80,6 +80,41 @@ pub fn render<'p>(
     let start = Instant::now();
     let vk = |e: crate::vk::Error| e.to_string();
     let gpu_scene = GpuScene::new(ctx, scene).map_err(vk)?;
+    let rt = ray_tracing_pipeline(ctx, pipeline, depth, scene)?;
+    let pixels = u64::from(params.width) * u64::from(params.height);
+    let image =
+        Buffer::new(ctx, pixels * 4, raw::BufferUsageFlags::STORAGE_BUFFER, 1).map_err(vk)?;
+    let uniform = Buffer::from_data(
+        ctx,
+        raw::BufferUsageFlags::UNIFORM_BUFFER,
+        &params.to_words(),
+    )
+    .map_err(vk)?;
+    let resources = [
+        (0, Resource::AccelerationStructure(&gpu_scene.tlas)),
+        (1, Resource::Buffer(&image)),
+        (2, Resource::Buffer(&gpu_scene.surfaces)),
+        (3, Resource::Buffer(&uniform)),
+    ];
+    let trace = rt
+        .trace_rays(&resources, params.width, params.height, 1)
+        .map_err(vk)?;
+    Ok(Rendered {
+        image: image.read_u32(),
+        trace,
+        total: start.elapsed(),
+    })
+}
+
+/// The described pipeline on the device (with `depth` instead of its
+/// declared recursion depth when given), with only the groups `scene` needs.
+pub fn ray_tracing_pipeline<'p>(
+    ctx: &Context,
+    pipeline: &'p Pipeline,
+    depth: Option<u32>,
+    scene: &Scene,
+) -> Result<RayTracingPipeline, String> {
+    let vk = |e: crate::vk::Error| e.to_string();
     let mut stages: Vec<ShaderStage<'p>> = Vec::new();
     let mut groups = Vec::new();
     let mut add = |s: &'p crate::pipeline::ShaderRef| -> Result<u32, String> {
@@ -114,7 +149,7 @@ pub fn render<'p>(
             any_hit,
         });
     }
-    let rt = RayTracingPipeline::new(
+    RayTracingPipeline::new(
         ctx,
         &RayTracingPipelineDesc {
             stages: &stages,
@@ -125,30 +160,7 @@ pub fn render<'p>(
             stack_size: None,
         },
     )
-    .map_err(vk)?;
-    let pixels = u64::from(params.width) * u64::from(params.height);
-    let image =
-        Buffer::new(ctx, pixels * 4, raw::BufferUsageFlags::STORAGE_BUFFER, 1).map_err(vk)?;
-    let uniform = Buffer::from_data(
-        ctx,
-        raw::BufferUsageFlags::UNIFORM_BUFFER,
-        &params.to_words(),
-    )
-    .map_err(vk)?;
-    let resources = [
-        (0, Resource::AccelerationStructure(&gpu_scene.tlas)),
-        (1, Resource::Buffer(&image)),
-        (2, Resource::Buffer(&gpu_scene.surfaces)),
-        (3, Resource::Buffer(&uniform)),
-    ];
-    let trace = rt
-        .trace_rays(&resources, params.width, params.height, 1)
-        .map_err(vk)?;
-    Ok(Rendered {
-        image: image.read_u32(),
-        trace,
-        total: start.elapsed(),
-    })
+    .map_err(vk)
 }
 
 /// Dispatches the compute shader `entry` (8 × 8 workgroups, one invocation

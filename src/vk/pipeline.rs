@@ -504,6 +504,69 @@ impl RayTracingPipeline {
     }
 }
 
+impl RayTracingPipeline {
+    /// Device time of `repeats` traces of `width × height` rays from the
+    /// first ray generation group, from timestamp queries, after `warmup`
+    /// untimed traces (lavapipe compiles the pipeline at its first
+    /// dispatch). Nanoseconds per trace, in order.
+    pub fn time_trace_rays(
+        &self,
+        resources: &[(u32, Resource<'_>)],
+        width: u32,
+        height: u32,
+        warmup: u32,
+        repeats: u32,
+    ) -> Result<Vec<f64>> {
+        for _ in 0..warmup {
+            self.trace_rays(resources, width, height, 1)?;
+        }
+        let Some(rg) = self.sbt.raygen.first() else {
+            return Err(Error::Invalid(
+                "the pipeline has no ray generation group".into(),
+            ));
+        };
+        self.descriptors.write(resources)?;
+        let d = &self.shared.device;
+        super::timing::timed_dispatches(
+            &self.shared,
+            repeats,
+            vk::PipelineStageFlags::RAY_TRACING_SHADER_KHR,
+            |cmd| {
+                // SAFETY: cmd is recording; pipeline and set are live.
+                unsafe {
+                    d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::RAY_TRACING_KHR, self.pipeline);
+                    bind_set(
+                        d,
+                        cmd,
+                        vk::PipelineBindPoint::RAY_TRACING_KHR,
+                        &self.descriptors,
+                    );
+                    if let Some(bytes) = self.stack_size {
+                        self.shared
+                            .rt
+                            .cmd_set_ray_tracing_pipeline_stack_size(cmd, bytes);
+                    }
+                }
+            },
+            |cmd| {
+                // SAFETY: bound above; the SBT outlives the submission.
+                unsafe {
+                    self.shared.rt.cmd_trace_rays(
+                        cmd,
+                        &rg.raw(),
+                        &self.sbt.miss.raw(),
+                        &self.sbt.hit.raw(),
+                        &self.sbt.callable.raw(),
+                        width,
+                        height,
+                        1,
+                    )
+                }
+            },
+        )
+    }
+}
+
 impl Drop for RayTracingPipeline {
     fn drop(&mut self) {
         if self.shared.hung() {
@@ -754,6 +817,39 @@ impl ComputePipeline {
                 d.cmd_dispatch(cmd, x, y, z);
             }
         })
+    }
+}
+
+impl ComputePipeline {
+    /// As [`RayTracingPipeline::time_trace_rays`] for `x × y × z`
+    /// workgroups: nanoseconds per timed dispatch.
+    pub fn time_dispatch(
+        &self,
+        resources: &[(u32, Resource<'_>)],
+        groups: [u32; 3],
+        warmup: u32,
+        repeats: u32,
+    ) -> Result<Vec<f64>> {
+        let [x, y, z] = groups;
+        for _ in 0..warmup {
+            self.dispatch(resources, x, y, z)?;
+        }
+        self.descriptors.write(resources)?;
+        let d = &self.shared.device;
+        super::timing::timed_dispatches(
+            &self.shared,
+            repeats,
+            vk::PipelineStageFlags::COMPUTE_SHADER,
+            |cmd| {
+                // SAFETY: cmd is recording; pipeline and set are live.
+                unsafe {
+                    d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, self.pipeline);
+                    bind_set(d, cmd, vk::PipelineBindPoint::COMPUTE, &self.descriptors);
+                }
+            },
+            // SAFETY: bound above.
+            |cmd| unsafe { d.cmd_dispatch(cmd, x, y, z) },
+        )
     }
 }
 
