@@ -70,10 +70,7 @@ const FORBIDDEN: &[(&str, &[&str])] = &[
             "lint", "vk", "verify", "tradeoff",
         ],
     ),
-    (
-        "verify",
-        &["rules", "report", "lint", "build", "tradeoff"],
-    ),
+    ("verify", &["rules", "report", "lint", "build", "tradeoff"]),
     (
         "tradeoff",
         &["rules", "report", "lint", "build", "explain", "config"],

@@ -52,10 +52,7 @@ fn check_xml(text: &str) -> Result<(), String> {
     let mut roots = 0;
     while let Some(at) = rest.find('<') {
         check_text(&rest[..at])?;
-        let end = rest[at..]
-            .find('>')
-            .ok_or("a tag is not closed")?
-            + at;
+        let end = rest[at..].find('>').ok_or("a tag is not closed")? + at;
         let tag = &rest[at + 1..end];
         if let Some(name) = tag.strip_prefix('/') {
             match stack.pop() {
@@ -65,17 +62,16 @@ fn check_xml(text: &str) -> Result<(), String> {
         } else {
             let self_closing = tag.ends_with('/');
             let body = tag.trim_end_matches('/');
-            let name: String = body
-                .chars()
-                .take_while(|c| !c.is_whitespace())
-                .collect();
+            let name: String = body.chars().take_while(|c| !c.is_whitespace()).collect();
             if name.is_empty() || !name.chars().all(|c| c.is_ascii_alphanumeric()) {
                 return Err(format!("bad element name in <{tag}>"));
             }
             // Attributes: name="value" pairs.
             let mut attrs = body[name.len()..].trim();
             while !attrs.is_empty() {
-                let eq = attrs.find("=\"").ok_or(format!("attribute without =\" in <{tag}>"))?;
+                let eq = attrs
+                    .find("=\"")
+                    .ok_or(format!("attribute without =\" in <{tag}>"))?;
                 let key = attrs[..eq].trim();
                 if key.is_empty() || key.contains(char::is_whitespace) {
                     return Err(format!("bad attribute `{key}` in <{tag}>"));
@@ -167,7 +163,10 @@ fn quick_sweep_writes_a_true_front_and_error_falls_with_rays_per_pixel() {
         let rmse = number(r, "rmse");
         assert!((0.0..1.0).contains(&rmse), "{r:?}");
         assert!(number(r, "max_error") >= rmse);
-        assert!(number(r, "rays") >= 32.0 * 32.0, "a primary ray per pixel at least");
+        assert!(
+            number(r, "rays") >= 32.0 * 32.0,
+            "a primary ray per pixel at least"
+        );
         // The GPU follows the CPU reference of the same setting.
         assert!(number(r, "cpu_diff") <= 1.0, "{r:?}");
     }

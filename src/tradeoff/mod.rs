@@ -96,7 +96,7 @@ pub const KNOBS: &[Knob] = &[
         quick_values: &["0.1"],
         apply: |p, scene, v| {
             let f: f32 = number("tmax", v)?;
-            if !(f > 0.0) {
+            if f.is_nan() || f <= 0.0 {
                 return Err("tmax must be above 0".into());
             }
             p.reflect_t_max = f * diagonal(scene);
@@ -113,6 +113,24 @@ pub const KNOBS: &[Knob] = &[
         quick_values: &["0.25"],
         apply: |p, _, v| {
             p.rough_cutoff = number("rough_cutoff", v)?;
+            Ok(())
+        },
+    },
+    Knob {
+        name: "half_res",
+        doc: "half-resolution reflections: a pixel whose first hit is rougher than this takes \
+              the reflection its 2×2 block's top-left pixel traced in a quarter-size pass \
+              before (`Params.knobs.z`; WGSL only)",
+        shaders: &["glossy"],
+        values: &["0.1", "0.5"],
+        quick_shaders: &["glossy"],
+        quick_values: &["0.1"],
+        apply: |p, _, v| {
+            let r: f32 = number("half_res", v)?;
+            if !(0.0..=1.0).contains(&r) {
+                return Err("half_res must be 0–1".into());
+            }
+            p.half_res = r;
             Ok(())
         },
     },
@@ -165,11 +183,11 @@ pub struct Sweep {
 }
 
 pub const FULL: Sweep = Sweep {
-    width: 96,
-    height: 96,
+    width: 128,
+    height: 128,
     warmup: 2,
     repeats: 15,
-    reference_samples: 1024,
+    reference_samples: 512,
     reference_bounces: 8,
 };
 
@@ -394,7 +412,10 @@ pub fn child_main(
     let ts = ctx.timestamps();
     println!("timestamps: {} {}", ts.valid_bits, ts.period_ns);
     if ts.valid_bits == 0 {
-        println!("skip: the queue of {} writes no timestamps", ctx.info().name);
+        println!(
+            "skip: the queue of {} writes no timestamps",
+            ctx.info().name
+        );
         return Err(verify::SKIP.into());
     }
     let vk = |e: crate::vk::Error| e.to_string();
@@ -414,23 +435,29 @@ pub fn child_main(
         &params.to_words(),
     )
     .map_err(vk)?;
+    let half = verify::gpu::half_res_buffer(&ctx, params).map_err(vk)?;
     let resources = [
-        (0, crate::vk::Resource::AccelerationStructure(&gpu_scene.tlas)),
+        (
+            0,
+            crate::vk::Resource::AccelerationStructure(&gpu_scene.tlas),
+        ),
         (1, crate::vk::Resource::Buffer(&out)),
         (2, crate::vk::Resource::Buffer(&gpu_scene.surfaces)),
         (3, crate::vk::Resource::Buffer(&uniform)),
+        (6, crate::vk::Resource::Buffer(&half)),
     ];
     let times = match &p.loaded {
         Loaded::Pipeline(pipeline) => {
             let rt = verify::gpu::ray_tracing_pipeline(&ctx, pipeline, p.depth, &p.scene)?;
-            rt.time_trace_rays(
-                &resources,
-                params.width,
-                params.height,
-                sweep.warmup,
-                sweep.repeats,
-            )
-            .map_err(vk)?
+            let (w, h) = (params.width, params.height);
+            // Half-resolution mode: the block pass, then the image.
+            let passes: &[[u32; 2]] = if params.half_res <= 1.0 {
+                &[[w.div_ceil(2), h.div_ceil(2)], [w, h]]
+            } else {
+                &[[w, h]]
+            };
+            rt.time_trace_rays(&resources, passes, sweep.warmup, sweep.repeats)
+                .map_err(vk)?
         }
         Loaded::Compute { words, entry } => {
             if !ctx.info().ray_query {
@@ -450,7 +477,11 @@ pub fn child_main(
     };
     let line: Vec<String> = times.iter().map(|t| format!("{t:.0}")).collect();
     println!("gpu-ns: {}", line.join(" "));
-    let bytes: Vec<u8> = out.read_u32().iter().flat_map(|p| p.to_le_bytes()).collect();
+    let bytes: Vec<u8> = out
+        .read_u32()
+        .iter()
+        .flat_map(|p| p.to_le_bytes())
+        .collect();
     std::fs::write(image, bytes).map_err(|e| format!("cannot write {}: {e}", image.display()))
 }
 
@@ -565,12 +596,7 @@ pub struct Report {
 /// origins, full `t_max`, no roughness cut-off; rendered by the CPU
 /// reference in `f32`.
 pub fn converged(scene: &Scene, sweep: &Sweep) -> Vec<Vec3> {
-    let params = Params::for_scene(
-        scene,
-        sweep.width,
-        sweep.height,
-        sweep.reference_bounces,
-    );
+    let params = Params::for_scene(scene, sweep.width, sweep.height, sweep.reference_bounces);
     (0..sweep.width * sweep.height)
         .into_par_iter()
         .map(|i| {
@@ -1030,7 +1056,11 @@ mod tests {
         let base = Params::for_scene(&scene, 24, 24, 3);
         let rays = |p: &Params| -> usize {
             (0..24 * 24)
-                .map(|i| reference::trace_glossy(&scene, p, i % 24, i / 24).segments.len())
+                .map(|i| {
+                    reference::trace_glossy(&scene, p, i % 24, i / 24)
+                        .segments
+                        .len()
+                })
                 .sum()
         };
         // Cutting every rough reflection, or shortening reflection rays,
@@ -1047,5 +1077,19 @@ mod tests {
             ..base
         };
         assert_ne!(image(&short), image(&base));
+        // Half resolution: rough first hits share their block's reflection
+        // (fewer rays); pixels off rough surfaces keep their own.
+        let half = Params {
+            half_res: 0.1,
+            ..base
+        };
+        assert!(rays(&half) < rays(&base));
+        let (a, b) = (image(&half), image(&base));
+        let same = a.iter().zip(&b).filter(|(x, y)| x == y).count();
+        assert!(
+            same > a.len() / 2 && same < a.len(),
+            "{same} of {}",
+            a.len()
+        );
     }
 }

@@ -35,10 +35,7 @@ mod tests {
             Some((2.0, 2.0)), // equal to a front point: on the front too
             Some((0.5, f64::NAN)),
         ];
-        assert_eq!(
-            front(&pts),
-            [true, true, false, true, false, true, false]
-        );
+        assert_eq!(front(&pts), [true, true, false, true, false, true, false]);
         assert!(!dominates((1.0, 1.0), (1.0, 1.0)));
     }
 }

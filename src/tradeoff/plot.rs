@@ -42,7 +42,10 @@ impl Axis {
         if !lo.is_finite() {
             (lo, hi) = (1.0, 10.0);
         }
-        let (lo, hi) = (lo.log10().floor(), hi.log10().ceil().max(lo.log10().floor() + 1.0));
+        let (lo, hi) = (
+            lo.log10().floor(),
+            hi.log10().ceil().max(lo.log10().floor() + 1.0),
+        );
         Axis { lo, hi, from, to }
     }
 
@@ -179,10 +182,7 @@ pub fn svg(report: &Report) -> String {
     for &(i, t, e) in &points {
         let r = &report.rows[i];
         let (px, py) = (x.map(t), y.map(e));
-        let title = escape(&format!(
-            "{}: {t:.4} ms, RMSE {e:.5}",
-            r.setting.name()
-        ));
+        let title = escape(&format!("{}: {t:.4} ms, RMSE {e:.5}", r.setting.name()));
         if r.front {
             let _ = writeln!(
                 s,
@@ -201,7 +201,11 @@ pub fn svg(report: &Report) -> String {
     let mut last_y = f64::NEG_INFINITY;
     for p in &front {
         let (px, py) = (x.map(p.1), y.map(p.2));
-        let ly = if py - last_y < 12.0 { last_y + 12.0 } else { py };
+        let ly = if py - last_y < 12.0 {
+            last_y + 12.0
+        } else {
+            py
+        };
         last_y = ly;
         let _ = writeln!(
             s,

@@ -10,13 +10,23 @@ use crate::vk::{
 };
 use std::time::{Duration, Instant};
 
-/// The interface every reflection reference shader declares (set 0).
-pub const BINDINGS: [Binding; 4] = [
+/// The interface every reflection reference shader declares (set 0), and
+/// the glossy shader's half-resolution buffer (binding 6; the others leave
+/// it unused).
+pub const BINDINGS: [Binding; 5] = [
     Binding::new(0, BindingKind::AccelerationStructure),
     Binding::new(1, BindingKind::StorageBuffer),
     Binding::new(2, BindingKind::StorageBuffer),
     Binding::new(3, BindingKind::UniformBuffer),
+    Binding::new(6, BindingKind::StorageBuffer),
 ];
+
+/// The glossy shader's half-resolution buffer for `params`' image: one
+/// `vec4<f32>` per 2×2 block.
+pub fn half_res_buffer(ctx: &Context, params: &Params) -> crate::vk::Result<Buffer> {
+    let blocks = u64::from(params.width.div_ceil(2)) * u64::from(params.height.div_ceil(2));
+    Buffer::new(ctx, blocks * 16, raw::BufferUsageFlags::STORAGE_BUFFER, 1)
+}
 
 /// A scene on the device: one bottom-level structure per mesh, one instance
 /// per scene instance with its transform and, as custom index, the index of
@@ -90,11 +100,13 @@ pub fn render(
         &params.to_words(),
     )
     .map_err(vk)?;
+    let half = half_res_buffer(ctx, params).map_err(vk)?;
     let resources = [
         (0, Resource::AccelerationStructure(&gpu_scene.tlas)),
         (1, Resource::Buffer(&image)),
         (2, Resource::Buffer(&gpu_scene.surfaces)),
         (3, Resource::Buffer(&uniform)),
+        (6, Resource::Buffer(&half)),
     ];
     let trace = rt
         .trace_rays(&resources, params.width, params.height, 1)
@@ -185,11 +197,13 @@ pub fn render_compute(
         &params.to_words(),
     )
     .map_err(vk)?;
+    let half = half_res_buffer(ctx, params).map_err(vk)?;
     let resources = [
         (0, Resource::AccelerationStructure(&gpu_scene.tlas)),
         (1, Resource::Buffer(&image)),
         (2, Resource::Buffer(&gpu_scene.surfaces)),
         (3, Resource::Buffer(&uniform)),
+        (6, Resource::Buffer(&half)),
     ];
     let trace = pipeline
         .dispatch(

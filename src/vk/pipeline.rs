@@ -505,20 +505,22 @@ impl RayTracingPipeline {
 }
 
 impl RayTracingPipeline {
-    /// Device time of `repeats` traces of `width × height` rays from the
-    /// first ray generation group, from timestamp queries, after `warmup`
-    /// untimed traces (lavapipe compiles the pipeline at its first
-    /// dispatch). Nanoseconds per trace, in order.
+    /// Device time of `repeats` runs of `passes` (traces of `width ×
+    /// height` rays from the first ray generation group, in order, each
+    /// seeing the writes of the one before), from timestamp queries, after
+    /// `warmup` untimed runs (lavapipe compiles the pipeline at its first
+    /// dispatch). Nanoseconds per run, in order.
     pub fn time_trace_rays(
         &self,
         resources: &[(u32, Resource<'_>)],
-        width: u32,
-        height: u32,
+        passes: &[[u32; 2]],
         warmup: u32,
         repeats: u32,
     ) -> Result<Vec<f64>> {
         for _ in 0..warmup {
-            self.trace_rays(resources, width, height, 1)?;
+            for &[width, height] in passes {
+                self.trace_rays(resources, width, height, 1)?;
+            }
         }
         let Some(rg) = self.sbt.raygen.first() else {
             return Err(Error::Invalid(
@@ -549,18 +551,35 @@ impl RayTracingPipeline {
                 }
             },
             |cmd| {
-                // SAFETY: bound above; the SBT outlives the submission.
-                unsafe {
-                    self.shared.rt.cmd_trace_rays(
-                        cmd,
-                        &rg.raw(),
-                        &self.sbt.miss.raw(),
-                        &self.sbt.hit.raw(),
-                        &self.sbt.callable.raw(),
-                        width,
-                        height,
-                        1,
-                    )
+                let stage = vk::PipelineStageFlags::RAY_TRACING_SHADER_KHR;
+                let barrier = vk::MemoryBarrier::default()
+                    .src_access_mask(vk::AccessFlags::SHADER_WRITE)
+                    .dst_access_mask(vk::AccessFlags::SHADER_READ | vk::AccessFlags::SHADER_WRITE);
+                for (k, &[width, height]) in passes.iter().enumerate() {
+                    // SAFETY: bound above; the SBT outlives the submission.
+                    unsafe {
+                        if k > 0 {
+                            d.cmd_pipeline_barrier(
+                                cmd,
+                                stage,
+                                stage,
+                                vk::DependencyFlags::empty(),
+                                &[barrier],
+                                &[],
+                                &[],
+                            );
+                        }
+                        self.shared.rt.cmd_trace_rays(
+                            cmd,
+                            &rg.raw(),
+                            &self.sbt.miss.raw(),
+                            &self.sbt.hit.raw(),
+                            &self.sbt.callable.raw(),
+                            width,
+                            height,
+                            1,
+                        )
+                    }
                 }
             },
         )
