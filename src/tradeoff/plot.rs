@@ -24,12 +24,18 @@ pub fn escape(s: &str) -> String {
         .replace('"', "&quot;")
 }
 
-/// A log10 axis over `[lo, hi]` (padded to whole decades' 1-2-5 steps).
+/// A log10 axis from the 1-2-5 step at or below the smallest value to the
+/// one at or above the largest (`lo`, `hi` are their logarithms).
 struct Axis {
     lo: f64,
     hi: f64,
     from: f64,
     to: f64,
+}
+
+/// 1, 2 and 5 times each power of ten from 10^`a` to 10^`b`.
+fn steps(a: i32, b: i32) -> impl Iterator<Item = f64> {
+    (a..=b).flat_map(|e| [1.0, 2.0, 5.0].map(|m| m * 10f64.powi(e)))
 }
 
 impl Axis {
@@ -42,11 +48,20 @@ impl Axis {
         if !lo.is_finite() {
             (lo, hi) = (1.0, 10.0);
         }
-        let (lo, hi) = (
-            lo.log10().floor(),
-            hi.log10().ceil().max(lo.log10().floor() + 1.0),
-        );
-        Axis { lo, hi, from, to }
+        let (a, b) = (lo.log10().floor() as i32 - 1, hi.log10().ceil() as i32);
+        // A hair of slack, so a value on a step is not pushed past it.
+        let low = steps(a, b)
+            .filter(|&v| v <= lo * (1.0 + 1e-9))
+            .last()
+            .unwrap_or(lo);
+        let high = steps(a, b).find(|&v| v >= hi * (1.0 - 1e-9)).unwrap_or(hi);
+        let high = if high > low { high } else { low * 2.0 };
+        Axis {
+            lo: low.log10(),
+            hi: high.log10(),
+            from,
+            to,
+        }
     }
 
     fn map(&self, v: f64) -> f64 {
@@ -54,19 +69,38 @@ impl Axis {
         self.from + (l - self.lo) / (self.hi - self.lo) * (self.to - self.from)
     }
 
-    /// Tick values: 1, 2 and 5 times each power of ten in range.
+    /// Tick values: the 1-2-5 steps in range.
     fn ticks(&self) -> Vec<f64> {
-        let mut t = Vec::new();
-        for e in self.lo as i32..=self.hi as i32 {
-            for m in [1.0, 2.0, 5.0] {
-                let v = m * 10f64.powi(e);
-                if v.log10() <= self.hi + 1e-9 {
-                    t.push(v);
-                }
-            }
-        }
-        t
+        steps(self.lo.floor() as i32, self.hi.ceil() as i32)
+            .filter(|v| (self.lo - 1e-9..=self.hi + 1e-9).contains(&v.log10()))
+            .collect()
     }
+}
+
+/// Label heights near `wanted`, at least `gap` apart, within `[top,
+/// bottom]` as far as they fit.
+fn spread(wanted: &[f64], gap: f64, top: f64, bottom: f64) -> Vec<f64> {
+    let mut order: Vec<usize> = (0..wanted.len()).collect();
+    order.sort_by(|&a, &b| wanted[a].total_cmp(&wanted[b]));
+    let mut y: Vec<f64> = order.iter().map(|&i| wanted[i]).collect();
+    for k in 1..y.len() {
+        y[k] = y[k].max(y[k - 1] + gap);
+    }
+    // Pushed past the bottom: move up from there.
+    if let Some(last) = y.last_mut() {
+        *last = last.min(bottom);
+    }
+    for k in (0..y.len().saturating_sub(1)).rev() {
+        y[k] = y[k].min(y[k + 1] - gap);
+    }
+    if let Some(first) = y.first_mut() {
+        *first = first.max(top);
+    }
+    let mut out = vec![0.0; wanted.len()];
+    for (k, &i) in order.iter().enumerate() {
+        out[i] = y[k];
+    }
+    out
 }
 
 fn label(v: f64) -> String {
@@ -197,20 +231,31 @@ pub fn svg(report: &Report) -> String {
             );
         }
     }
-    // Labels of the front, nudged apart vertically.
-    let mut last_y = f64::NEG_INFINITY;
-    for p in &front {
+    // Labels of the front, spread apart vertically inside the plot, with a
+    // leader line where a label had to move.
+    let wanted: Vec<f64> = front.iter().map(|p| y.map(p.2)).collect();
+    let placed = spread(&wanted, 12.0, TOP + 8.0, HEIGHT - BOTTOM - 4.0);
+    for (p, ly) in front.iter().zip(placed) {
         let (px, py) = (x.map(p.1), y.map(p.2));
-        let ly = if py - last_y < 12.0 {
-            last_y + 12.0
+        let right_third = px > LEFT + (WIDTH - RIGHT - LEFT) * 2.0 / 3.0;
+        let dx = if right_third { -7.0 } else { 7.0 };
+        if (ly - py).abs() > 2.0 {
+            let _ = writeln!(
+                s,
+                r##"<line x1="{px:.1}" y1="{py:.1}" x2="{:.1}" y2="{ly:.1}" stroke="#808080" stroke-width="0.7"/>"##,
+                px + dx
+            );
+        }
+        // Right of the point, or left of it in the plot's right third, so
+        // the text stays off the legend.
+        let (tx, anchor) = if right_third {
+            (px - 8.0, "end")
         } else {
-            py
+            (px + 8.0, "start")
         };
-        last_y = ly;
         let _ = writeln!(
             s,
-            r#"<text x="{:.1}" y="{:.1}">{}</text>"#,
-            px + 8.0,
+            r#"<text x="{tx:.1}" y="{:.1}" text-anchor="{anchor}">{}</text>"#,
             ly + 4.0,
             escape(&report.rows[p.0].setting.name())
         );
@@ -254,11 +299,33 @@ mod tests {
     #[test]
     fn axes_cover_the_values_and_text_is_escaped() {
         let a = Axis::new([0.03, 4.0].into_iter(), 0.0, 100.0);
-        assert_eq!((a.lo, a.hi), (-2.0, 1.0));
+        // From the step 0.02 to the step 5.
+        assert!((a.lo - 0.02f64.log10()).abs() < 1e-12, "{}", a.lo);
+        assert!((a.hi - 5f64.log10()).abs() < 1e-12, "{}", a.hi);
         assert!(a.map(0.03) > 0.0 && a.map(4.0) < 100.0);
         assert_eq!(a.map(0.01), 0.0);
+        let ticks: Vec<String> = a.ticks().into_iter().map(label).collect();
+        assert_eq!(ticks, ["0.02", "0.05", "0.1", "0.2", "0.5", "1", "2", "5"]);
+        // Values on a step stay on it.
+        let b = Axis::new([1.0, 10.0].into_iter(), 0.0, 1.0);
+        assert!(b.map(1.0).abs() < 1e-9 && (b.map(10.0) - 1.0).abs() < 1e-9);
         assert_eq!(escape("a<b & \"c\""), "a&lt;b &amp; &quot;c&quot;");
         assert_eq!(label(0.02), "0.02");
         assert_eq!(label(50.0), "50");
+    }
+
+    #[test]
+    fn labels_spread_apart_and_stay_inside() {
+        let y = spread(&[100.0, 101.0, 99.0, 300.0], 12.0, 0.0, 400.0);
+        let mut sorted = y.clone();
+        sorted.sort_by(f64::total_cmp);
+        assert!(
+            sorted.windows(2).all(|w| w[1] - w[0] >= 12.0 - 1e-9),
+            "{y:?}"
+        );
+        assert_eq!(y[3], 300.0, "a label with room keeps its place");
+        // Crowded at the bottom: pushed up, not out.
+        let y = spread(&[395.0, 396.0, 397.0], 12.0, 0.0, 400.0);
+        assert!(y.iter().all(|&v| v <= 400.0), "{y:?}");
     }
 }
