@@ -175,8 +175,10 @@ pub struct Sweep {
     /// Untimed dispatches before the timed ones (lavapipe compiles the
     /// pipeline at its first).
     pub warmup: u32,
-    /// Timed dispatches; the median is reported.
+    /// Timed dispatches per child; the median over all rounds is reported.
     pub repeats: u32,
+    /// Children per setting, one per pass over the whole sweep.
+    pub rounds: u32,
     /// The converged reference: glossy paths per pixel and bounces.
     pub reference_samples: u32,
     pub reference_bounces: u32,
@@ -186,7 +188,8 @@ pub const FULL: Sweep = Sweep {
     width: 128,
     height: 128,
     warmup: 2,
-    repeats: 15,
+    repeats: 11,
+    rounds: 3,
     reference_samples: 512,
     reference_bounces: 8,
 };
@@ -196,6 +199,7 @@ pub const QUICK: Sweep = Sweep {
     height: 32,
     warmup: 1,
     repeats: 5,
+    rounds: 1,
     reference_samples: 128,
     reference_bounces: 8,
 };
@@ -648,6 +652,9 @@ fn median(v: &[f64]) -> f64 {
     }
 }
 
+/// A setting's timed dispatches (ms) over every round, and its image.
+type Timed = (Vec<f64>, Vec<u32>);
+
 /// Runs the sweep; `progress` is told before each setting starts. An `Err`
 /// is a usage or input problem (exit 2); a failed setting is a row.
 pub fn run(
@@ -668,36 +675,45 @@ pub fn run(
         .collect::<Result<Vec<_>, _>>()?;
     std::fs::create_dir_all(&options.out)
         .map_err(|e| format!("cannot create {}: {e}", options.out.display()))?;
-    let total = settings.len() + 1;
+    let total = settings.len() * sweep.rounds as usize + 1;
     // The GPU runs come first and alone: on lavapipe the "GPU" is these
     // CPU cores, and CPU work beside a child would slow its timings.
-    let mut runs = Vec::new();
+    // Rounds over the whole sweep, so that a stretch of load from other
+    // work slows one round of a setting rather than all its dispatches.
+    let mut runs: Vec<Result<Timed, Outcome>> = vec![Ok((Vec::new(), Vec::new())); settings.len()];
     let (mut device, mut timestamps) = (None, None);
-    for (i, s) in settings.iter().enumerate() {
-        let name = s.name();
-        progress(i, total, &name);
-        let image = options.out.join(format!("{}.rgba", file_name(&name)));
-        let _ = std::fs::remove_file(&image);
-        let end = spawn_command((options.child)(&name, &image))
-            .map_err(|e| format!("cannot start the child process: {e}"))?
-            .wait(CHILD_TIMEOUT)
-            .map_err(|e| e.to_string())?;
-        let field = |key: &str| {
-            end.stdout
-                .lines()
-                .find_map(|l| l.strip_prefix(key))
-                .map(str::to_string)
-        };
-        device = device.or_else(|| field("device: "));
-        timestamps = timestamps.or_else(|| field("timestamps: "));
-        let outcome = if end.code == Some(verify::SKIP_CODE) {
-            Err(Outcome::Skipped(
-                field("skip: ").unwrap_or_else(|| "the device cannot run it".into()),
-            ))
-        } else if end.code != Some(0) {
-            Err(Outcome::Failed(describe(&end)))
-        } else {
-            let times: Vec<f64> = field("gpu-ns: ")
+    for round in 0..sweep.rounds {
+        for (i, s) in settings.iter().enumerate() {
+            let Ok((times, pixels)) = &mut runs[i] else {
+                continue;
+            };
+            let name = s.name();
+            progress(round as usize * settings.len() + i, total, &name);
+            let image = options.out.join(format!("{}.rgba", file_name(&name)));
+            let _ = std::fs::remove_file(&image);
+            let end = spawn_command((options.child)(&name, &image))
+                .map_err(|e| format!("cannot start the child process: {e}"))?
+                .wait(CHILD_TIMEOUT)
+                .map_err(|e| e.to_string())?;
+            let field = |key: &str| {
+                end.stdout
+                    .lines()
+                    .find_map(|l| l.strip_prefix(key))
+                    .map(str::to_string)
+            };
+            device = device.or_else(|| field("device: "));
+            timestamps = timestamps.or_else(|| field("timestamps: "));
+            if end.code == Some(verify::SKIP_CODE) {
+                runs[i] = Err(Outcome::Skipped(
+                    field("skip: ").unwrap_or_else(|| "the device cannot run it".into()),
+                ));
+                continue;
+            }
+            if end.code != Some(0) {
+                runs[i] = Err(Outcome::Failed(describe(&end)));
+                continue;
+            }
+            let new: Vec<f64> = field("gpu-ns: ")
                 .unwrap_or_default()
                 .split_whitespace()
                 .filter_map(|t| t.parse::<f64>().ok())
@@ -705,23 +721,30 @@ pub fn run(
                 .collect();
             let bytes = std::fs::read(&image).unwrap_or_default();
             let _ = std::fs::remove_file(&image);
-            let pixels: Vec<u32> = bytes
+            let image: Vec<u32> = bytes
                 .chunks_exact(4)
                 .map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]))
                 .collect();
-            if times.is_empty() || pixels.len() != (sweep.width * sweep.height) as usize {
-                Err(Outcome::Failed(format!(
+            if new.is_empty() || image.len() != (sweep.width * sweep.height) as usize {
+                runs[i] = Err(Outcome::Failed(format!(
                     "the child reported {} times and {} pixels",
-                    times.len(),
-                    pixels.len()
-                )))
-            } else {
-                Ok((times, pixels))
+                    new.len(),
+                    image.len()
+                )));
+                continue;
             }
-        };
-        runs.push(outcome);
+            if !pixels.is_empty() && *pixels != image {
+                runs[i] = Err(Outcome::Failed(format!(
+                    "round {} rendered a different image",
+                    round + 1
+                )));
+                continue;
+            }
+            times.extend(new);
+            *pixels = image;
+        }
     }
-    progress(settings.len(), total, "converged reference (CPU)");
+    progress(total - 1, total, "converged reference (CPU)");
     let reference = converged(&scene, &sweep);
     let mut rows = Vec::new();
     for ((setting, p), run) in settings.into_iter().zip(&prepared).zip(runs) {
@@ -884,14 +907,15 @@ impl Report {
     fn header(&self) -> String {
         format!(
             "device: {}; timestamps (valid bits, ns per tick): {}; scene `{}` at {}×{}; \
-             GPU time: median of {} timed dispatches after {} warm-up; error against the CPU \
-             reference of the glossy shader's math at {} bounces and {} rays per pixel (f32, \
-             before packing)",
+             GPU time: median of {} rounds × {} timed dispatches, each child after {} \
+             warm-up; error against the CPU reference of the glossy shader's math at {} \
+             bounces and {} rays per pixel (f32, before packing)",
             self.device.as_deref().unwrap_or("none answered"),
             self.timestamps.as_deref().unwrap_or("-"),
             self.scene,
             self.sweep.width,
             self.sweep.height,
+            self.sweep.rounds,
             self.sweep.repeats,
             self.sweep.warmup,
             self.sweep.reference_bounces,
