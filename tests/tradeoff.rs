@@ -125,6 +125,19 @@ fn the_xml_checker_rejects_broken_documents() {
     }
 }
 
+#[test]
+fn bad_input_exits_2_naming_the_file() {
+    let o = common::rtlint()
+        .current_dir(common::root())
+        .args(["tradeoff", "--quick", "--scene", "no-such-scene", "--out"])
+        .arg(std::env::temp_dir().join(format!("rtlint-tradeoff-bad-{}", std::process::id())))
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{stderr}");
+    assert!(stderr.contains("no-such-scene.toml"), "{stderr}");
+}
+
 fn number(row: &HashMap<String, String>, key: &str) -> f64 {
     row[key]
         .parse()
