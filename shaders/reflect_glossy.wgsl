@@ -46,7 +46,7 @@ struct HitInfo {
 // Half-resolution reflections, one per 2×2 block: xyz = the block's
 // top-left pixel's light beyond its first hit (mean over its rays), w = the
 // roughness of that first hit (-1: not rough enough to share).
-@group(0) @binding(6) var<storage, read_write> half_res: array<vec4<f32>>;
+@group(0) @binding(8) var<storage, read_write> half_res: array<vec4<f32>>;
 
 var<ray_payload> hit: HitInfo;
 // Shadow rays get a payload of their own (only `t` is used).

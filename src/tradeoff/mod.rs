@@ -14,6 +14,7 @@ pub mod pareto;
 pub mod plot;
 
 use crate::reference::{self, Method, Params, Scene, Vec3};
+use crate::verify::gpu::HALF_RES_BINDING;
 use crate::verify::{self, CaseKind, Loaded, Manifest, Source};
 use crate::vk::{spawn_command, ChildOutcome};
 use rayon::prelude::*;
@@ -448,17 +449,17 @@ pub fn child_main(
         (1, crate::vk::Resource::Buffer(&out)),
         (2, crate::vk::Resource::Buffer(&gpu_scene.surfaces)),
         (3, crate::vk::Resource::Buffer(&uniform)),
-        (6, crate::vk::Resource::Buffer(&half)),
+        (HALF_RES_BINDING, crate::vk::Resource::Buffer(&half)),
     ];
     let times = match &p.loaded {
         Loaded::Pipeline(pipeline) => {
             let rt = verify::gpu::ray_tracing_pipeline(&ctx, pipeline, p.depth, &p.scene)?;
             let (w, h) = (params.width, params.height);
             // Half-resolution mode: the block pass, then the image.
-            let passes: &[[u32; 2]] = if params.half_res <= 1.0 {
-                &[[w.div_ceil(2), h.div_ceil(2)], [w, h]]
+            let passes: &[(usize, [u32; 2])] = if params.half_res <= 1.0 {
+                &[(0, [w.div_ceil(2), h.div_ceil(2)]), (0, [w, h])]
             } else {
-                &[[w, h]]
+                &[(0, [w, h])]
             };
             rt.time_trace_rays(&resources, passes, sweep.warmup, sweep.repeats)
                 .map_err(vk)?

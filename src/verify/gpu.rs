@@ -11,15 +11,18 @@ use crate::vk::{
 use std::time::{Duration, Instant};
 
 /// The interface every reflection reference shader declares (set 0), and
-/// the glossy shader's half-resolution buffer (binding 6; the others leave
+/// the glossy shader's half-resolution buffer (binding 8; the others leave
 /// it unused).
 pub const BINDINGS: [Binding; 5] = [
     Binding::new(0, BindingKind::AccelerationStructure),
     Binding::new(1, BindingKind::StorageBuffer),
     Binding::new(2, BindingKind::StorageBuffer),
     Binding::new(3, BindingKind::UniformBuffer),
-    Binding::new(6, BindingKind::StorageBuffer),
+    Binding::new(HALF_RES_BINDING, BindingKind::StorageBuffer),
 ];
+
+/// The binding of the glossy shader's half-resolution buffer.
+pub const HALF_RES_BINDING: u32 = 8;
 
 /// The glossy shader's half-resolution buffer for `params`' image: one
 /// `vec4<f32>` per 2×2 block.
@@ -106,7 +109,7 @@ pub fn render(
         (1, Resource::Buffer(&image)),
         (2, Resource::Buffer(&gpu_scene.surfaces)),
         (3, Resource::Buffer(&uniform)),
-        (6, Resource::Buffer(&half)),
+        (HALF_RES_BINDING, Resource::Buffer(&half)),
     ];
     let trace = rt
         .trace_rays(&resources, params.width, params.height, 1)
@@ -203,7 +206,7 @@ pub fn render_compute(
         (1, Resource::Buffer(&image)),
         (2, Resource::Buffer(&gpu_scene.surfaces)),
         (3, Resource::Buffer(&uniform)),
-        (6, Resource::Buffer(&half)),
+        (HALF_RES_BINDING, Resource::Buffer(&half)),
     ];
     let trace = pipeline
         .dispatch(

@@ -505,28 +505,30 @@ impl RayTracingPipeline {
 }
 
 impl RayTracingPipeline {
-    /// Device time of `repeats` runs of `passes` (traces of `width ×
-    /// height` rays from the first ray generation group, in order, each
+    /// Device time of `repeats` runs of `passes` (each a trace of `[width,
+    /// height]` rays from the given ray generation group, in order, each
     /// seeing the writes of the one before), from timestamp queries, after
     /// `warmup` untimed runs (lavapipe compiles the pipeline at its first
     /// dispatch). Nanoseconds per run, in order.
     pub fn time_trace_rays(
         &self,
         resources: &[(u32, Resource<'_>)],
-        passes: &[[u32; 2]],
+        passes: &[(usize, [u32; 2])],
         warmup: u32,
         repeats: u32,
     ) -> Result<Vec<f64>> {
         for _ in 0..warmup {
-            for &[width, height] in passes {
-                self.trace_rays(resources, width, height, 1)?;
+            for &(raygen, [width, height]) in passes {
+                self.trace_rays_from(raygen, resources, width, height, 1)?;
             }
         }
-        let Some(rg) = self.sbt.raygen.first() else {
-            return Err(Error::Invalid(
-                "the pipeline has no ray generation group".into(),
-            ));
-        };
+        if let Some(&(raygen, _)) = passes.iter().find(|p| p.0 >= self.sbt.raygen.len()) {
+            return Err(Error::Invalid(format!(
+                "the pipeline has {} ray generation groups, not {}",
+                self.sbt.raygen.len(),
+                raygen + 1
+            )));
+        }
         self.descriptors.write(resources)?;
         let d = &self.shared.device;
         super::timing::timed_dispatches(
@@ -555,7 +557,7 @@ impl RayTracingPipeline {
                 let barrier = vk::MemoryBarrier::default()
                     .src_access_mask(vk::AccessFlags::SHADER_WRITE)
                     .dst_access_mask(vk::AccessFlags::SHADER_READ | vk::AccessFlags::SHADER_WRITE);
-                for (k, &[width, height]) in passes.iter().enumerate() {
+                for (k, &(raygen, [width, height])) in passes.iter().enumerate() {
                     // SAFETY: bound above; the SBT outlives the submission.
                     unsafe {
                         if k > 0 {
@@ -571,7 +573,7 @@ impl RayTracingPipeline {
                         }
                         self.shared.rt.cmd_trace_rays(
                             cmd,
-                            &rg.raw(),
+                            &self.sbt.raygen[raygen].raw(),
                             &self.sbt.miss.raw(),
                             &self.sbt.hit.raw(),
                             &self.sbt.callable.raw(),
