@@ -274,7 +274,8 @@ enum Command {
     /// compare each image with the CPU reference renderer.
     Verify(VerifyArgs),
     /// Sweep the reference shaders' knobs (bounces, rays per pixel, t_max,
-    /// roughness cut-off, ray origins) and measure GPU time against error.
+    /// roughness cut-off, half resolution, ray origins) and measure GPU time
+    /// against error.
     Tradeoff(TradeoffArgs),
     /// List every rule.
     Rules,
