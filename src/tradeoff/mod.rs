@@ -461,7 +461,7 @@ pub fn child_main(
             } else {
                 &[(0, [w, h])]
             };
-            rt.time_trace_rays(&resources, passes, sweep.warmup, sweep.repeats)
+            rt.time_trace_rays(&resources, passes, &[], sweep.warmup, sweep.repeats)
                 .map_err(vk)?
         }
         Loaded::Compute { words, entry } => {

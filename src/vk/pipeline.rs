@@ -509,11 +509,14 @@ impl RayTracingPipeline {
     /// height]` rays from the given ray generation group, in order, each
     /// seeing the writes of the one before), from timestamp queries, after
     /// `warmup` untimed runs (lavapipe compiles the pipeline at its first
-    /// dispatch). Nanoseconds per run, in order.
+    /// dispatch). The `clear` buffers (made with `TRANSFER_DST` usage) are
+    /// zeroed before each timed run, outside its timestamps: state that
+    /// passes accumulate starts afresh. Nanoseconds per run, in order.
     pub fn time_trace_rays(
         &self,
         resources: &[(u32, Resource<'_>)],
         passes: &[(usize, [u32; 2])],
+        clear: &[&Buffer],
         warmup: u32,
         repeats: u32,
     ) -> Result<Vec<f64>> {
@@ -550,6 +553,43 @@ impl RayTracingPipeline {
                             .rt
                             .cmd_set_ray_tracing_pipeline_stack_size(cmd, bytes);
                     }
+                }
+            },
+            |cmd| {
+                if clear.is_empty() {
+                    return;
+                }
+                let rt = vk::PipelineStageFlags::RAY_TRACING_SHADER_KHR;
+                let transfer = vk::PipelineStageFlags::TRANSFER;
+                let to_fill = vk::MemoryBarrier::default()
+                    .src_access_mask(vk::AccessFlags::SHADER_READ | vk::AccessFlags::SHADER_WRITE)
+                    .dst_access_mask(vk::AccessFlags::TRANSFER_WRITE);
+                let to_shader = vk::MemoryBarrier::default()
+                    .src_access_mask(vk::AccessFlags::TRANSFER_WRITE)
+                    .dst_access_mask(vk::AccessFlags::SHADER_READ | vk::AccessFlags::SHADER_WRITE);
+                // SAFETY: cmd is recording; the buffers outlive the submission.
+                unsafe {
+                    d.cmd_pipeline_barrier(
+                        cmd,
+                        rt,
+                        transfer,
+                        vk::DependencyFlags::empty(),
+                        &[to_fill],
+                        &[],
+                        &[],
+                    );
+                    for b in clear {
+                        d.cmd_fill_buffer(cmd, b.raw(), b.offset(), b.size(), 0);
+                    }
+                    d.cmd_pipeline_barrier(
+                        cmd,
+                        transfer,
+                        rt,
+                        vk::DependencyFlags::empty(),
+                        &[to_shader],
+                        &[],
+                        &[],
+                    );
                 }
             },
             |cmd| {
@@ -868,6 +908,7 @@ impl ComputePipeline {
                     bind_set(d, cmd, vk::PipelineBindPoint::COMPUTE, &self.descriptors);
                 }
             },
+            |_| {},
             // SAFETY: bound above.
             |cmd| unsafe { d.cmd_dispatch(cmd, x, y, z) },
         )

@@ -8,13 +8,15 @@ use super::error::{vk_err, Error, Result};
 use ash::vk;
 
 /// Records `repeats` dispatches (`dispatch` records one; `bind` runs once
-/// first) and returns each one's device time in nanoseconds. `stage` is the
-/// shader stage the dispatches run in, for the barrier between them.
+/// first; `before` before each one, outside its timestamps) and returns
+/// each one's device time in nanoseconds. `stage` is the shader stage the
+/// dispatches run in, for the barrier between them.
 pub(crate) fn timed_dispatches(
     shared: &Shared,
     repeats: u32,
     stage: vk::PipelineStageFlags,
     bind: impl Fn(vk::CommandBuffer),
+    before: impl Fn(vk::CommandBuffer),
     dispatch: impl Fn(vk::CommandBuffer),
 ) -> Result<Vec<f64>> {
     let ts = shared.timestamps;
@@ -56,6 +58,7 @@ pub(crate) fn timed_dispatches(
                         &[],
                     );
                 }
+                before(cmd);
                 d.cmd_write_timestamp(cmd, vk::PipelineStageFlags::TOP_OF_PIPE, pool, 2 * i);
                 dispatch(cmd);
                 d.cmd_write_timestamp(cmd, vk::PipelineStageFlags::BOTTOM_OF_PIPE, pool, 2 * i + 1);
