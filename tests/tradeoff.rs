@@ -211,6 +211,16 @@ fn quick_sweep_writes_a_true_front_and_error_falls_with_rays_per_pixel() {
             assert!(png.is_file(), "{}", png.display());
         }
     }
+    // A thumbnail for each front setting and for nothing else.
+    let thumbnails = std::fs::read_dir(&out)
+        .unwrap()
+        .filter(|e| {
+            let name = e.as_ref().unwrap().file_name();
+            let name = name.to_string_lossy();
+            name.starts_with("front-") && name.ends_with(".png")
+        })
+        .count();
+    assert_eq!(thumbnails, front.len());
     // Rays per pixel 1, 4 (the default), 16: each more rays, less error.
     let glossy = |spp: &str| {
         let name = if spp == "4" {

@@ -1009,6 +1009,15 @@ impl Report {
             .map(|&c| reference::pack_rgba8(c))
             .collect();
         verify::compare::write_png(&out.join("reference.png"), &reference, w, h)?;
+        // Thumbnails of an earlier sweep's front would read as this one's.
+        if let Ok(entries) = std::fs::read_dir(out) {
+            for e in entries.flatten() {
+                let name = e.file_name().to_string_lossy().into_owned();
+                if name.starts_with("front-") && name.ends_with(".png") {
+                    let _ = std::fs::remove_file(e.path());
+                }
+            }
+        }
         for r in self.front() {
             if let Some(m) = r.measured() {
                 let name = format!("front-{}.png", file_name(&r.setting.name()));
