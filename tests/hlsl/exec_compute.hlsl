@@ -240,4 +240,12 @@ void Main()
     put(tc);
     float tw = b1 < 0 ? 1 : (bump(tc) ? 2.5 : 0.5);
     put(tw + tc);
+    // 82..83: cheap sides are selected whole: vectors and structs on a
+    // scalar condition
+    put((b1 > 0 ? float3(1, 2, 3) : float3(4, 5, 6)).y);
+    Counter other;
+    other.count = 9;
+    other.scale = 2.0;
+    Counter picked = b1 < 0 ? ctr : other;
+    put(picked.count + picked.scale);
 }

@@ -780,7 +780,11 @@ impl<'a> Lowerer<'a> {
             // observed running, which leaves no temporary behind.
             let av = self.expr(a)?;
             let bv = self.expr(b)?;
-            let t = self.common(&av.ty, &bv.ty, pos)?;
+            let t = if av.ty == bv.ty {
+                av.ty.clone()
+            } else {
+                self.common(&av.ty, &bv.ty, pos)?
+            };
             let t = match (t, &cv.ty) {
                 (Ty::ScalarKind(s), Ty::Vec(_, n)) => Ty::Vec(s, *n),
                 (other, _) => other,
