@@ -75,7 +75,7 @@ void raygen()
             ray.TMin = params.ray.x;
             ray.TMax = t_max;
             HitInfo hit = (HitInfo)0;
-            TraceRay(tlas, RAY_FLAG_FORCE_OPAQUE, 0xFF, 0, 1, 0, ray, hit);
+            TraceRay(tlas, RAY_FLAG_NONE, 0xFF, 0, 1, 0, ray, hit);
             if (hit.t < 0.0)
             {
                 sum += throughput * sky(dir);
@@ -135,7 +135,7 @@ void raygen()
                     ShadowInfo shadow;
                     shadow.visible = 0.0;
                     // rtlint: allow(RT010, reason = "the sample loop's sum, seed and counters beside the bounce state; one sample per launch index would fit")
-                    TraceRay(tlas, SHADOW_FLAGS, 0xFF, 0, 1, 1, shadow_ray, shadow);
+                    TraceRay(tlas, SHADOW_FLAGS, 0xFF, 1, 1, 1, shadow_ray, shadow);
                     if (shadow.visible > 0.0)
                         sum += lit;
                 }
@@ -162,4 +162,11 @@ void closest_hit(inout HitInfo hit, in BuiltInTriangleIntersectionAttributes att
 {
     hit.t = RayTCurrent();
     hit.surface = InstanceID() + PrimitiveIndex();
+}
+
+[shader("anyhit")]
+void any_hit(inout HitInfo hit, in BuiltInTriangleIntersectionAttributes attr)
+{
+    if (!alpha_keeps(InstanceID() + PrimitiveIndex(), attr.barycentrics))
+        IgnoreHit();
 }

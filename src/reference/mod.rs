@@ -5,8 +5,9 @@
 //! Everything is `f32` and follows the shaders operation by operation
 //! (camera, bounce loop or recursion, shadow rays, sky, shading, robust ray
 //! origins, packing) so that a GPU image should match to within one 8-bit
-//! step; ray/triangle tests use the shaders' `t` range and treat every
-//! triangle as opaque, as `RAY_FLAG_OPAQUE` does. Triangles are found
+//! step; ray/triangle tests use the shaders' `t` range, and a cut-out
+//! material's triangle counts only where its alpha texel keeps it (what the
+//! any-hit shaders and the ray queries' candidate loops do). Triangles are found
 //! through a BVH ([`bvh`]).
 
 pub mod bvh;
@@ -199,7 +200,8 @@ pub fn camera_dir(params: &Params, x: u32, y: u32) -> Vec3 {
     Vec3::new(uv[0], -uv[1], -1.5).normalize()
 }
 
-/// The closest opaque triangle hit with `t` in `[t_min, t_max]` (with
+/// The closest triangle hit with `t` in `[t_min, t_max]` that is opaque or
+/// whose alpha texel keeps it (with
 /// `any`, the first found, as `ACCEPT_FIRST_HIT_AND_END_SEARCH` allows: only
 /// hit-or-miss matters then), and the ray's edge margin.
 pub fn intersect(
@@ -225,7 +227,10 @@ pub fn intersect(
             None => true,
             Some(h) => th < h.t || (th == h.t && (tri as u32) < h.triangle),
         };
-        if bary.iter().all(|&w| w >= 0.0) && better {
+        // A cut-out's candidate counts only where its texel keeps the
+        // surface: the any-hit shaders' `IgnoreHit` and the ray queries'
+        // alpha test before committing.
+        if bary.iter().all(|&w| w >= 0.0) && better && scene.keeps(tri, bary) {
             best = Some(Hit {
                 t: th,
                 triangle: tri as u32,
@@ -674,6 +679,35 @@ mod tests {
                 "({x}, {y})"
             );
         }
+    }
+
+    #[test]
+    fn cutouts_let_primary_reflection_and_shadow_rays_through() {
+        let path =
+            std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("shaders/scenes/cutout.toml");
+        let scene = Scene::load(&path).unwrap();
+        assert!(scene.has_cutouts());
+        let mut solid = scene.clone();
+        for s in &mut solid.surfaces {
+            s.cutout = false;
+        }
+        let p = Params::for_scene(&scene, 48, 48, 3);
+        // Per ray kind: rays whose hit changes when the holes are filled.
+        let mut through = [0usize; 3];
+        for y in 0..p.height {
+            for x in 0..p.width {
+                let a = trace_iterative(&scene, &p, x, y);
+                let b = trace_iterative(&solid, &p, x, y);
+                for (k, (sa, sb)) in a.segments.iter().zip(&b.segments).enumerate() {
+                    if sa.hit.map(|h| h.triangle) != sb.hit.map(|h| h.triangle) {
+                        let kind = if sa.shadow { 2 } else { usize::from(k > 0) };
+                        through[kind] += 1;
+                        break;
+                    }
+                }
+            }
+        }
+        assert!(through.iter().all(|&n| n > 5), "{through:?}");
     }
 
     #[test]

@@ -7,6 +7,7 @@ use crate::reference::{Params, Scene};
 use crate::vk::{
     raw, AccelerationStructure, Binding, BindingKind, Buffer, ComputePipeline, Context, Geometry,
     Group, Instance, RayTracingPipeline, RayTracingPipelineDesc, Resource, ShaderStage,
+    StorageImage,
 };
 use std::time::{Duration, Instant};
 
@@ -18,12 +19,33 @@ pub const BINDINGS: [Binding; 4] = [
     Binding::new(3, BindingKind::UniformBuffer),
 ];
 
+/// What a scene with alpha-tested cut-outs adds: the alpha texture (t4,
+/// read with `Load`, one texel per test) and the per-triangle texture
+/// coordinates (t5).
+pub const CUTOUT_BINDINGS: [Binding; 2] = [
+    Binding::new(4, BindingKind::SampledImage),
+    Binding::new(5, BindingKind::StorageBuffer),
+];
+
+/// The bindings a scene needs: [`BINDINGS`], and [`CUTOUT_BINDINGS`] only
+/// when it has cut-outs.
+pub fn bindings(scene: &Scene) -> Vec<Binding> {
+    let mut b = BINDINGS.to_vec();
+    if scene.has_cutouts() {
+        b.extend(CUTOUT_BINDINGS);
+    }
+    b
+}
+
 /// A scene on the device: one bottom-level structure per mesh, one instance
 /// per scene instance with its transform and, as custom index, the index of
 /// its first triangle in the `surfaces` buffer.
 pub struct GpuScene {
     pub tlas: AccelerationStructure,
     pub surfaces: Buffer,
+    /// The alpha texture and the `cutouts` buffer, when the scene has
+    /// alpha-tested geometry.
+    pub cutout: Option<(StorageImage, Buffer)>,
 }
 
 impl GpuScene {
@@ -46,6 +68,14 @@ impl GpuScene {
             .map(|i| Instance {
                 transform: i.rows(),
                 custom_index: i.first_triangle,
+                // Geometry is built opaque; a cut-out's instances are not,
+                // so its candidates reach the any-hit shader or the ray
+                // query's candidate loop.
+                flags: if scene.materials[i.material].cutout {
+                    raw::GeometryInstanceFlagsKHR::FORCE_NO_OPAQUE
+                } else {
+                    raw::GeometryInstanceFlagsKHR::empty()
+                },
                 ..Instance::identity(&blases[i.mesh])
             })
             .collect();
@@ -55,7 +85,40 @@ impl GpuScene {
             raw::BufferUsageFlags::STORAGE_BUFFER,
             &scene.surface_data(),
         )?;
-        Ok(GpuScene { tlas, surfaces })
+        let cutout = match &scene.cutout {
+            Some(c) if scene.has_cutouts() => {
+                let texture = StorageImage::new(ctx, c.width, c.height)?;
+                texture.write(ctx, &c.texels())?;
+                let records = Buffer::from_data(
+                    ctx,
+                    raw::BufferUsageFlags::STORAGE_BUFFER,
+                    &scene.cutout_data(),
+                )?;
+                Some((texture, records))
+            }
+            _ => None,
+        };
+        Ok(GpuScene {
+            tlas,
+            surfaces,
+            cutout,
+        })
+    }
+
+    /// The scene's resources at their bindings (see [`bindings`]), with the
+    /// image and the parameters.
+    pub fn resources<'a>(&'a self, image: &'a Buffer, uniform: &'a Buffer) -> Vec<(u32, Resource<'a>)> {
+        let mut r = vec![
+            (0, Resource::AccelerationStructure(&self.tlas)),
+            (1, Resource::Buffer(image)),
+            (2, Resource::Buffer(&self.surfaces)),
+            (3, Resource::Buffer(uniform)),
+        ];
+        if let Some((texture, records)) = &self.cutout {
+            r.push((4, Resource::SampledImage(texture.view())));
+            r.push((5, Resource::Buffer(records)));
+        }
+        r
     }
 }
 
@@ -103,12 +166,19 @@ pub fn render<'p>(
     for s in pipeline.raygen.iter().chain(misses) {
         groups.push(Group::General(add(s)?));
     }
+    // Any-hit shaders only for alpha-tested geometry: without it every
+    // instance is opaque and they would never run. A group left with no
+    // shader keeps its place, so SBT offsets stay as the shaders trace them.
+    let cutouts = scene.has_cutouts();
     for g in &pipeline.hit_groups {
         if g.kind != HitGroupKind::Triangles {
             return Err("verify builds triangle hit groups only".into());
         }
         let closest_hit = g.closest_hit.as_ref().map(&mut add).transpose()?;
-        let any_hit = g.any_hit.as_ref().map(&mut add).transpose()?;
+        let any_hit = match &g.any_hit {
+            Some(s) if cutouts => Some(add(s)?),
+            _ => None,
+        };
         groups.push(Group::Triangles {
             closest_hit,
             any_hit,
@@ -120,7 +190,7 @@ pub fn render<'p>(
             stages: &stages,
             groups: &groups,
             max_recursion_depth: depth.or(pipeline.max_recursion_depth).unwrap_or(1),
-            bindings: &BINDINGS,
+            bindings: &bindings(scene),
             push_constant_size: 0,
             stack_size: None,
         },
@@ -135,12 +205,7 @@ pub fn render<'p>(
         &params.to_words(),
     )
     .map_err(vk)?;
-    let resources = [
-        (0, Resource::AccelerationStructure(&gpu_scene.tlas)),
-        (1, Resource::Buffer(&image)),
-        (2, Resource::Buffer(&gpu_scene.surfaces)),
-        (3, Resource::Buffer(&uniform)),
-    ];
+    let resources = gpu_scene.resources(&image, &uniform);
     let trace = rt
         .trace_rays(&resources, params.width, params.height, 1)
         .map_err(vk)?;
@@ -163,7 +228,7 @@ pub fn render_compute(
     let start = Instant::now();
     let vk = |e: crate::vk::Error| e.to_string();
     let gpu_scene = GpuScene::new(ctx, scene).map_err(vk)?;
-    let pipeline = ComputePipeline::new(ctx, words, entry, &BINDINGS).map_err(vk)?;
+    let pipeline = ComputePipeline::new(ctx, words, entry, &bindings(scene)).map_err(vk)?;
     let pixels = u64::from(params.width) * u64::from(params.height);
     let image =
         Buffer::new(ctx, pixels * 4, raw::BufferUsageFlags::STORAGE_BUFFER, 1).map_err(vk)?;
@@ -173,12 +238,7 @@ pub fn render_compute(
         &params.to_words(),
     )
     .map_err(vk)?;
-    let resources = [
-        (0, Resource::AccelerationStructure(&gpu_scene.tlas)),
-        (1, Resource::Buffer(&image)),
-        (2, Resource::Buffer(&gpu_scene.surfaces)),
-        (3, Resource::Buffer(&uniform)),
-    ];
+    let resources = gpu_scene.resources(&image, &uniform);
     let trace = pipeline
         .dispatch(
             &resources,

@@ -58,6 +58,9 @@ struct RawShader {
     /// a compute shader (ray queries) with its entry point and bounces.
     compute: Option<PathBuf>,
     entry: Option<String>,
+    /// The compute entry point for scenes with alpha-tested cut-outs (it
+    /// binds the alpha texture; `entry` does not).
+    cutout_entry: Option<String>,
     max_bounces: Option<u32>,
     reference: String,
     scenes: Vec<String>,
@@ -84,6 +87,8 @@ pub enum Source {
     Compute {
         file: PathBuf,
         entry: String,
+        /// The entry point for scenes with cut-outs.
+        cutout_entry: Option<String>,
         max_bounces: u32,
     },
 }
@@ -239,6 +244,7 @@ impl Manifest {
                 (None, Some(c)) => Source::Compute {
                     file: dir.join(c),
                     entry: s.entry.clone().unwrap_or_else(|| "main".into()),
+                    cutout_entry: s.cutout_entry.clone(),
                     max_bounces: s.max_bounces.unwrap_or(3),
                 },
                 _ => {
@@ -274,7 +280,10 @@ impl Manifest {
                     s.name
                 ));
             }
-            for sc in &s.scenes {
+            let theirs = &raw.shader.iter().find(|o| &o.name == other).unwrap().scenes;
+            // Only the scenes both render (the WGSL pipelines cannot render
+            // cut-outs).
+            for sc in s.scenes.iter().filter(|sc| theirs.contains(sc)) {
                 cases.push(Case {
                     name: format!("{}={other}/{sc}", s.name),
                     shader: format!("{} = {other}", s.name),
@@ -389,6 +398,7 @@ pub fn setup(
     scene_path: &Path,
     depth: Option<u32>,
 ) -> Result<(Loaded, Scene, Params), String> {
+    let scene = Scene::load(scene_path)?;
     let (loaded, bounces) = match source {
         Source::Pipeline(path) => {
             let mut pipeline = crate::pipeline::load(path)
@@ -407,8 +417,20 @@ pub fn setup(
         Source::Compute {
             file,
             entry,
+            cutout_entry,
             max_bounces,
         } => {
+            let entry = match cutout_entry {
+                Some(e) if scene.has_cutouts() => e,
+                _ if scene.has_cutouts() => {
+                    return Err(format!(
+                        "{}: scene {} has cut-outs, and the shader names no `cutout_entry`",
+                        file.display(),
+                        scene_path.display()
+                    ))
+                }
+                _ => entry,
+            };
             let language = crate::shader::Language::from_path(file)
                 .ok_or_else(|| format!("{}: not a shader file", file.display()))?;
             let compiled = crate::front::compile_path(file, language)
@@ -422,7 +444,6 @@ pub fn setup(
             )
         }
     };
-    let scene = Scene::load(scene_path)?;
     let params = Params::for_scene(&scene, manifest.width, manifest.height, bounces);
     Ok((loaded, scene, params))
 }
