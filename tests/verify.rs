@@ -74,6 +74,8 @@ fn reference_shaders_pass_and_the_shallow_pipeline_fails_as_expected() {
         ("rayquery-hlsl", query, true),
         ("glossy", "pass", false),
         ("glossy-hlsl", "pass", true),
+        ("hybrid-hlsl", "pass", true),
+        ("adaptive-hlsl", "pass", false),
     ] {
         for scene in ["mirror", "showcase", "cutout"] {
             if scene != "cutout" || cutout {
@@ -104,6 +106,22 @@ fn reference_shaders_pass_and_the_shallow_pipeline_fails_as_expected() {
         stdout.contains(
             "expected failure recursive-depth-1/showcase: caught: the child was killed by signal"
         ),
+        "{stdout}"
+    );
+    // The multi-pass shaders say what they measured, and the hybrid one
+    // draws the path each pixel took.
+    for scene in ["mirror", "showcase", "cutout"] {
+        let note = format!("hybrid-hlsl/{scene}: ");
+        let line = stdout.lines().find(|l| l.starts_with(&note));
+        assert!(
+            line.is_some_and(|l| l.contains("reflecting pixels traced a ray")
+                && l.ends_with("paths differ from the CPU's on 0")),
+            "{stdout}"
+        );
+        assert!(out.join(format!("hybrid-hlsl_{scene}-paths.png")).is_file());
+    }
+    assert!(
+        stdout.contains("adaptive-hlsl/mirror: 16384 paths instead of 65536 for 16 fixed passes"),
         "{stdout}"
     );
     let csv = std::fs::read_to_string(out.join("verify.csv")).unwrap();

@@ -27,6 +27,18 @@ pub const CUTOUT_BINDINGS: [Binding; 2] = [
     Binding::new(5, BindingKind::StorageBuffer),
 ];
 
+/// What multi-pass shaders (hybrid, adaptive) add: a count per pixel (u6:
+/// the path each pixel's reflection took, or the paths it traced) and 64
+/// bytes of state per pixel kept between passes (u7: the G-buffer, the
+/// accumulator).
+pub const SCRATCH_BINDINGS: [Binding; 2] = [
+    Binding::new(6, BindingKind::StorageBuffer),
+    Binding::new(7, BindingKind::StorageBuffer),
+];
+
+/// Bytes of [`SCRATCH_BINDINGS`]' state per pixel.
+pub const SCRATCH_BYTES: u64 = 64;
+
 /// The bindings a scene needs: [`BINDINGS`], and [`CUTOUT_BINDINGS`] only
 /// when it has cut-outs.
 pub fn bindings(scene: &Scene) -> Vec<Binding> {
@@ -35,6 +47,29 @@ pub fn bindings(scene: &Scene) -> Vec<Binding> {
         b.extend(CUTOUT_BINDINGS);
     }
     b
+}
+
+/// How a pipeline runs: its ray generation shaders each in turn, `repeat`
+/// times, with [`SCRATCH_BINDINGS`] when `scratch`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Passes {
+    pub repeat: u32,
+    pub scratch: bool,
+}
+
+impl Passes {
+    /// One trace from the first ray generation shader.
+    pub const SINGLE: Passes = Passes {
+        repeat: 1,
+        scratch: false,
+    };
+
+    pub fn for_method(method: crate::reference::Method) -> Passes {
+        Passes {
+            repeat: method.passes(),
+            scratch: method.scratch(),
+        }
+    }
 }
 
 /// A scene on the device: one bottom-level structure per mesh, one instance
@@ -125,6 +160,8 @@ impl GpuScene {
 /// What one run measured.
 pub struct Rendered {
     pub image: Vec<u32>,
+    /// The per-pixel counts of multi-pass shaders ([`SCRATCH_BINDINGS`]).
+    pub counts: Option<Vec<u32>>,
     /// Submission to fence of the trace (includes lavapipe's shader compile).
     pub trace: Duration,
     /// Everything on the device: structures, pipeline, trace, readback.
@@ -133,12 +170,24 @@ pub struct Rendered {
 
 /// Creates the described pipeline (with `depth` instead of its declared
 /// recursion depth when given) and traces `params`' image of `scene`.
-pub fn render<'p>(
+pub fn render(
+    ctx: &Context,
+    pipeline: &Pipeline,
+    depth: Option<u32>,
+    scene: &Scene,
+    params: &Params,
+) -> Result<Rendered, String> {
+    render_passes(ctx, pipeline, depth, scene, params, Passes::SINGLE)
+}
+
+/// As [`render`], running the pipeline's ray generation shaders as `passes` says.
+pub fn render_passes<'p>(
     ctx: &Context,
     pipeline: &'p Pipeline,
     depth: Option<u32>,
     scene: &Scene,
     params: &Params,
+    passes: Passes,
 ) -> Result<Rendered, String> {
     let start = Instant::now();
     let vk = |e: crate::vk::Error| e.to_string();
@@ -163,7 +212,13 @@ pub fn render<'p>(
     } else {
         &pipeline.miss[..pipeline.miss.len().min(1)]
     };
-    for s in pipeline.raygen.iter().chain(misses) {
+    // Every ray generation shader when they run in turn; else the first.
+    let raygens = if passes.repeat > 1 || passes.scratch {
+        &pipeline.raygen[..]
+    } else {
+        &pipeline.raygen[..pipeline.raygen.len().min(1)]
+    };
+    for s in raygens.iter().chain(misses) {
         groups.push(Group::General(add(s)?));
     }
     // Any-hit shaders only for alpha-tested geometry: without it every
@@ -184,13 +239,17 @@ pub fn render<'p>(
             any_hit,
         });
     }
+    let mut all_bindings = bindings(scene);
+    if passes.scratch {
+        all_bindings.extend(SCRATCH_BINDINGS);
+    }
     let rt = RayTracingPipeline::new(
         ctx,
         &RayTracingPipelineDesc {
             stages: &stages,
             groups: &groups,
             max_recursion_depth: depth.or(pipeline.max_recursion_depth).unwrap_or(1),
-            bindings: &bindings(scene),
+            bindings: &all_bindings,
             push_constant_size: 0,
             stack_size: None,
         },
@@ -205,12 +264,37 @@ pub fn render<'p>(
         &params.to_words(),
     )
     .map_err(vk)?;
-    let resources = gpu_scene.resources(&image, &uniform);
-    let trace = rt
-        .trace_rays(&resources, params.width, params.height, 1)
+    let mut resources = gpu_scene.resources(&image, &uniform);
+    let scratch = if passes.scratch {
+        let counts =
+            Buffer::new(ctx, pixels * 4, raw::BufferUsageFlags::STORAGE_BUFFER, 1).map_err(vk)?;
+        let state = Buffer::new(
+            ctx,
+            pixels * SCRATCH_BYTES,
+            raw::BufferUsageFlags::STORAGE_BUFFER,
+            1,
+        )
         .map_err(vk)?;
+        Some((counts, state))
+    } else {
+        None
+    };
+    if let Some((counts, state)) = &scratch {
+        resources.push((6, Resource::Buffer(counts)));
+        resources.push((7, Resource::Buffer(state)));
+    }
+    // Each trace waits for the one before: a pass reads what the last wrote.
+    let mut trace = Duration::ZERO;
+    for _ in 0..passes.repeat {
+        for r in 0..raygens.len() {
+            trace += rt
+                .trace_rays_from(r, &resources, params.width, params.height, 1)
+                .map_err(vk)?;
+        }
+    }
     Ok(Rendered {
         image: image.read_u32(),
+        counts: scratch.map(|(c, _)| c.read_u32()),
         trace,
         total: start.elapsed(),
     })
@@ -249,6 +333,7 @@ pub fn render_compute(
         .map_err(vk)?;
     Ok(Rendered {
         image: image.read_u32(),
+        counts: None,
         trace,
         total: start.elapsed(),
     })

@@ -13,6 +13,7 @@
 
 pub mod compare;
 pub mod gpu;
+pub mod measure;
 
 use crate::reference::{self, Method, Params, Scene};
 use crate::vk::{spawn_command, ChildOutcome, RunningChild};
@@ -215,8 +216,10 @@ fn method(name: &str, what: &str) -> Result<Method, String> {
         "iterative" => Ok(Method::Iterative),
         "recursive" => Ok(Method::Recursive),
         "glossy" => Ok(Method::Glossy),
+        "hybrid" => Ok(Method::Hybrid),
+        "adaptive" => Ok(Method::Adaptive),
         other => Err(format!(
-            "{what}: unknown reference `{other}` (expected `iterative`, `recursive` or `glossy`)"
+            "{what}: unknown reference `{other}` (expected `iterative`, `recursive`, `glossy`, `hybrid` or `adaptive`)"
         )),
     }
 }
@@ -482,6 +485,8 @@ pub struct Row {
     pub self_hit: Option<f64>,
     pub time: Duration,
     pub outcome: Outcome,
+    /// What a multi-pass shader measured (paths taken, paths saved).
+    pub note: Option<String>,
 }
 
 impl Row {
@@ -578,12 +583,14 @@ pub fn run(
     for (i, case) in cases.iter().enumerate() {
         progress(i, cases.len(), &case.name);
         let start = Instant::now();
+        let mut note = None;
         let (comparison, outcome) = match &case.kind {
             CaseKind::Render { .. } => {
-                let (c, o, image) = render_case(options, &manifest, case, &mut report)?;
+                let (c, o, image, n) = render_case(options, &manifest, case, &mut report)?;
                 if let Some(image) = image {
                     images.push((case.name.clone(), image));
                 }
+                note = n;
                 (c, o)
             }
             CaseKind::Identical { a, b } => {
@@ -662,6 +669,7 @@ pub fn run(
             self_hit,
             time: start.elapsed(),
             outcome,
+            note,
         });
     }
     progress(cases.len(), cases.len(), "");
@@ -679,7 +687,7 @@ fn note_device(report: &mut Report, end: &ChildOutcome) {
 }
 
 type Measured = (Comparison, Option<usize>, Option<f64>);
-type CaseResult = (Option<Measured>, Outcome, Option<Vec<u32>>);
+type CaseResult = (Option<Measured>, Outcome, Option<Vec<u32>>, Option<String>);
 
 fn render_case(
     options: &Options<'_>,
@@ -705,7 +713,7 @@ fn render_case(
     let _ = std::fs::remove_file(&image_path);
     // The CPU reference renders while the child runs.
     let running = spawn((options.child)(&case.name, &image_path))?;
-    let (cpu, margins) = reference::render(&scene, &params, method);
+    let (cpu, margins, cpu_counts) = measure::cpu_render(&scene, &params, method);
     let end = wait(running)?;
     note_device(report, &end);
     if end.code == Some(SKIP_CODE) {
@@ -714,18 +722,17 @@ fn render_case(
             .lines()
             .find_map(|l| l.strip_prefix("skip: "))
             .unwrap_or("the device cannot run it");
-        return Ok((None, Outcome::Skipped(why.to_string()), None));
+        return Ok((None, Outcome::Skipped(why.to_string()), None, None));
     }
     if end.code != Some(0) {
-        return Ok((None, Outcome::Fail(describe(&end)), None));
+        return Ok((None, Outcome::Fail(describe(&end)), None, None));
     }
-    let bytes = std::fs::read(&image_path)
-        .map_err(|e| format!("cannot read {}: {e}", image_path.display()))?;
-    let _ = std::fs::remove_file(&image_path);
-    let gpu: Vec<u32> = bytes
-        .chunks_exact(4)
-        .map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]))
-        .collect();
+    let gpu = read_words(&image_path)?;
+    let gpu_counts = if method.scratch() {
+        Some(read_words(&counts_path(&image_path))?)
+    } else {
+        None
+    };
     if gpu.len() != cpu.len() {
         return Ok((
             None,
@@ -734,6 +741,7 @@ fn render_case(
                 gpu.len(),
                 cpu.len()
             )),
+            None,
             None,
         ));
     }
@@ -773,10 +781,34 @@ fn render_case(
         } else {
             Outcome::Pass
         };
-        return Ok((Some((c, Some(nan), Some(rate))), outcome, Some(gpu)));
+        return Ok((Some((c, Some(nan), Some(rate))), outcome, Some(gpu), None));
     }
-    let outcome = if c.passes() && nan == 0 {
+    // Multi-pass shaders: their per-pixel counts against the CPU's, and
+    // what they measured.
+    let mut counts_ok = true;
+    let note = match (&gpu_counts, &cpu_counts) {
+        (Some(g), Some(k)) if g.len() == k.len() => {
+            let differ = g.iter().zip(k).filter(|(a, b)| a != b).count();
+            counts_ok = differ * 1000 <= g.len();
+            let m = measure::measure(method, &scene, &params, g, differ);
+            if let Some(picture) = &m.picture {
+                png("paths", picture)?;
+            }
+            Some(m.note)
+        }
+        (Some(_), _) => {
+            counts_ok = false;
+            Some("the child's counts do not cover the image".into())
+        }
+        _ => None,
+    };
+    let outcome = if c.passes() && nan == 0 && counts_ok {
         Outcome::Pass
+    } else if !counts_ok {
+        Outcome::Fail(format!(
+            "more than 0.1 % of the per-pixel counts differ from the CPU's: {}",
+            note.as_deref().unwrap_or("")
+        ))
     } else {
         png("cpu", &cpu)?;
         png("diff", &compare::difference(&gpu, &cpu))?;
@@ -787,7 +819,7 @@ fn render_case(
             options.out.display()
         ))
     };
-    Ok((Some((c, Some(nan), None)), outcome, Some(gpu)))
+    Ok((Some((c, Some(nan), None)), outcome, Some(gpu), note))
 }
 
 /// The child's side: renders case `name` on the device and writes the
@@ -822,8 +854,19 @@ pub fn child_main(
     })
     .map_err(|e| e.to_string())?;
     println!("device: {}", ctx.info().name);
+    let method = match &case.kind {
+        CaseKind::Render { method, .. } | CaseKind::ExpectedCrash { method, .. } => *method,
+        CaseKind::Identical { .. } => Method::Iterative,
+    };
     let rendered = match &loaded {
-        Loaded::Pipeline(p) => gpu::render(&ctx, p, None, &scene, &params)?,
+        Loaded::Pipeline(p) => gpu::render_passes(
+            &ctx,
+            p,
+            None,
+            &scene,
+            &params,
+            gpu::Passes::for_method(method),
+        )?,
         Loaded::Compute { words, entry } => {
             if !ctx.info().ray_query {
                 println!("skip: {} has no VK_KHR_ray_query", ctx.info().name);
@@ -834,12 +877,29 @@ pub fn child_main(
     };
     println!("trace: {:.3}", rendered.trace.as_secs_f64() * 1000.0);
     println!("total: {:.3}", rendered.total.as_secs_f64() * 1000.0);
-    let bytes: Vec<u8> = rendered
-        .image
-        .iter()
-        .flat_map(|p| p.to_le_bytes())
-        .collect();
-    std::fs::write(image, bytes).map_err(|e| format!("cannot write {}: {e}", image.display()))
+    let write = |path: &Path, words: &[u32]| {
+        let bytes: Vec<u8> = words.iter().flat_map(|p| p.to_le_bytes()).collect();
+        std::fs::write(path, bytes).map_err(|e| format!("cannot write {}: {e}", path.display()))
+    };
+    if let Some(counts) = &rendered.counts {
+        write(&counts_path(image), counts)?;
+    }
+    write(image, &rendered.image)
+}
+
+/// Where the child writes the per-pixel counts of a multi-pass shader.
+fn counts_path(image: &Path) -> PathBuf {
+    image.with_extension("counts")
+}
+
+fn read_words(path: &Path) -> Result<Vec<u32>, String> {
+    let bytes =
+        std::fs::read(path).map_err(|e| format!("cannot read {}: {e}", path.display()))?;
+    let _ = std::fs::remove_file(path);
+    Ok(bytes
+        .chunks_exact(4)
+        .map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+        .collect())
 }
 
 /// The table's columns, in order.
@@ -919,6 +979,11 @@ impl Report {
                 }
                 Outcome::Skipped(why) => out.push_str(&format!("skipped {}: {why}\n", r.case.name)),
                 Outcome::Pass => {}
+            }
+        }
+        for r in &self.rows {
+            if let Some(note) = &r.note {
+                out.push_str(&format!("{}: {note}\n", r.case.name));
             }
         }
         out
