@@ -579,6 +579,7 @@ pub fn run(
         }
     }
     let mut report = Report::default();
+    let mut cache = CpuCache::new();
     let mut images: Vec<(String, Vec<u32>)> = Vec::new();
     for (i, case) in cases.iter().enumerate() {
         progress(i, cases.len(), &case.name);
@@ -586,7 +587,8 @@ pub fn run(
         let mut note = None;
         let (comparison, outcome) = match &case.kind {
             CaseKind::Render { .. } => {
-                let (c, o, image, n) = render_case(options, &manifest, case, &mut report)?;
+                let (c, o, image, n) =
+                    render_case(options, &manifest, case, &mut report, &mut cache)?;
                 if let Some(image) = image {
                     images.push((case.name.clone(), image));
                 }
@@ -689,11 +691,15 @@ fn note_device(report: &mut Report, end: &ChildOutcome) {
 type Measured = (Comparison, Option<usize>, Option<f64>);
 type CaseResult = (Option<Measured>, Outcome, Option<Vec<u32>>, Option<String>);
 
+/// CPU renders by reference method and scene.
+type CpuCache = std::collections::HashMap<String, std::rc::Rc<measure::CpuRender>>;
+
 fn render_case(
     options: &Options<'_>,
     manifest: &Manifest,
     case: &Case,
     report: &mut Report,
+    cache: &mut CpuCache,
 ) -> Result<CaseResult, String> {
     let CaseKind::Render {
         source,
@@ -713,7 +719,20 @@ fn render_case(
     let _ = std::fs::remove_file(&image_path);
     // The CPU reference renders while the child runs.
     let running = spawn((options.child)(&case.name, &image_path))?;
-    let (cpu, margins, cpu_counts) = measure::cpu_render(&scene, &params, method);
+    // The CPU render of a case that is not an extreme is shared by every
+    // shader with the same reference and scene.
+    let key = format!("{method:?} {}", scene_path.display());
+    let cpu_render = match cache.get(&key) {
+        Some(r) if extreme.is_none() => r.clone(),
+        _ => {
+            let r = std::rc::Rc::new(measure::cpu_render(&scene, &params, method));
+            if extreme.is_none() {
+                cache.insert(key, r.clone());
+            }
+            r
+        }
+    };
+    let (cpu, margins) = (&cpu_render.image, &cpu_render.margins);
     let end = wait(running)?;
     note_device(report, &end);
     if end.code == Some(SKIP_CODE) {
@@ -745,7 +764,7 @@ fn render_case(
             None,
         ));
     }
-    let c = compare::compare(&gpu, &cpu, &margins, TOLERANCE);
+    let c = compare::compare(&gpu, cpu, margins, TOLERANCE);
     let base = options.out.join(file_name(&case.name));
     let png = |suffix: &str, image: &[u32]| {
         compare::write_png(
@@ -786,11 +805,11 @@ fn render_case(
     // Multi-pass shaders: their per-pixel counts against the CPU's, and
     // what they measured.
     let mut counts_ok = true;
-    let note = match (&gpu_counts, &cpu_counts) {
+    let note = match (&gpu_counts, &cpu_render.counts) {
         (Some(g), Some(k)) if g.len() == k.len() => {
             let differ = g.iter().zip(k).filter(|(a, b)| a != b).count();
             counts_ok = differ * 1000 <= g.len();
-            let m = measure::measure(method, &scene, &params, g, differ);
+            let m = measure::measure(&cpu_render, g, differ);
             if let Some(picture) = &m.picture {
                 png("paths", picture)?;
             }
@@ -810,8 +829,8 @@ fn render_case(
             note.as_deref().unwrap_or("")
         ))
     } else {
-        png("cpu", &cpu)?;
-        png("diff", &compare::difference(&gpu, &cpu))?;
+        png("cpu", cpu)?;
+        png("diff", &compare::difference(&gpu, cpu))?;
         Outcome::Fail(format!(
             "{} pixels above {TOLERANCE}/255 ({} near an edge); images in {}",
             c.above,
