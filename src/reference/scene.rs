@@ -454,6 +454,20 @@ impl Scene {
         s
     }
 
+    /// The same scene with every triangle wound the other way: every
+    /// geometric normal the shaders read points to the other side, away
+    /// from whoever sees the surface first.
+    pub fn with_flipped_normals(&self) -> Scene {
+        let mut s = self.clone();
+        for m in &mut s.meshes {
+            for t in m.indices.chunks_exact_mut(3) {
+                t.swap(1, 2);
+            }
+        }
+        s.flatten();
+        s
+    }
+
     /// Rebuilds the world-space triangles, surfaces and BVH from the instances.
     fn flatten(&mut self) {
         self.triangles.clear();
@@ -801,6 +815,15 @@ mod tests {
         assert_eq!(t.uv([1.0, 0.0, 0.0]), Vec2::ZERO);
         assert_eq!(t.uv([0.0, 0.0, 1.0]), Vec2::ONE);
         assert_eq!(t.uv([0.5, 0.5, 0.0]), Vec2::new(0.5, 0.0));
+    }
+
+    #[test]
+    fn flipping_turns_every_normal_around() {
+        let s = Scene::parse("t", SCENE).unwrap();
+        let f = s.with_flipped_normals();
+        for (a, b) in s.surfaces.iter().zip(&f.surfaces) {
+            assert!((a.normal + b.normal).length() < 1e-5, "{} {}", a.normal, b.normal);
+        }
     }
 
     #[test]

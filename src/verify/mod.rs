@@ -98,13 +98,14 @@ pub enum Source {
 /// ray parameters, rendered with robust origins or the fixed epsilon.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Extreme {
-    /// `translate=1e3`, `tmax=inf`, `tmin=1e-3`, `roughness=0.5`, `grazing`.
+    /// `translate=1e3`, `tmax=inf`, `tmin=1e-3`, `roughness=0.5`, `grazing`,
+    /// `backfacing`.
     pub variant: String,
     pub robust: bool,
 }
 
 /// The variants of the matrix, each rendered both ways.
-pub const EXTREMES: [&str; 14] = [
+pub const EXTREMES: [&str; 15] = [
     "translate=0",
     "translate=1e3",
     "translate=1e4",
@@ -119,6 +120,7 @@ pub const EXTREMES: [&str; 14] = [
     "roughness=0.5",
     "roughness=1",
     "grazing",
+    "backfacing",
 ];
 
 impl Extreme {
@@ -146,6 +148,9 @@ impl Extreme {
                 scene.camera.y = 1e-3;
                 params.camera = scene.camera;
             }
+            // Every normal in the surfaces buffer faces away from the viewer:
+            // the shaders must turn it towards the ray before shading.
+            None if self.variant == "backfacing" => *scene = scene.with_flipped_normals(),
             _ => return Err(format!("unknown extreme `{}`", self.variant)),
         }
         Ok(())
@@ -782,17 +787,22 @@ fn render_case(
         // than 0.1 % of the rays leaving a surface hit it again. The
         // difference to the CPU is reported, not judged (far from the
         // origin both sides round differently by design).
-        let (mut own, mut secondary) = (0usize, 0usize);
+        // The CPU's colours are checked in f32 too, before any packing.
+        let (mut own, mut secondary, mut cpu_nan) = (0usize, 0usize, 0usize);
         for y in 0..params.height {
             for x in 0..params.width {
-                let (o, n) = reference::trace_pixel(&scene, &params, method, x, y).self_hits();
+                let path = reference::trace_pixel(&scene, &params, method, x, y);
+                let (o, n) = path.self_hits();
                 own += o;
                 secondary += n;
+                cpu_nan += usize::from(!path.color.is_finite());
             }
         }
         let rate = 100.0 * own as f64 / secondary.max(1) as f64;
-        let outcome = if nan > 0 {
-            Outcome::Fail(format!("{nan} pixels are NaN or infinite"))
+        let outcome = if nan > 0 || cpu_nan > 0 {
+            Outcome::Fail(format!(
+                "{nan} GPU and {cpu_nan} CPU pixels are NaN or infinite"
+            ))
         } else if e.robust && rate >= 0.1 {
             Outcome::Fail(format!(
                 "{own} of {secondary} rays ({rate:.3} %) hit the triangle they left"
