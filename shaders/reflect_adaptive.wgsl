@@ -144,12 +144,22 @@ fn glossy_sample(id: vec2<u32>, sample: u32, sum: ptr<function, vec3<f32>>) {
             *sum += throughput * sky(dir);
             break;
         }
+        // The shadow ray first, from the next origin: across it only the
+        // path's own state stays live; the surface is read again after it.
+        let normal = surfaces[hit.surface].normal_reflectivity.xyz;
+        var n = select(-normal, normal, dot(normal, dir) < 0.0);
+        origin = offset_ray(origin + dir * hit.t, n);
+        var visible = false;
+        if (params.flags & FLAG_LIGHT) != 0u && dot(n, params.light.xyz) > 0.0 {
+            shadow.t = 0.0;
+            traceRay(tlas, RayDesc(SHADOW_FLAGS, 0xFFu, params.ray.x, params.ray.y, origin, params.light.xyz), &shadow);
+            visible = shadow.t < 0.0;
+        }
         let s = surfaces[hit.surface];
-        let n = select(-s.normal_reflectivity.xyz, s.normal_reflectivity.xyz, dot(s.normal_reflectivity.xyz, dir) < 0.0);
+        n = select(-s.normal_reflectivity.xyz, s.normal_reflectivity.xyz, dot(s.normal_reflectivity.xyz, dir) < 0.0);
         let base = throughput * (1.0 - s.normal_reflectivity.w) * s.albedo_roughness.xyz;
         throughput *= s.normal_reflectivity.w;
         let roughness = s.albedo_roughness.w;
-        origin = offset_ray(origin + dir * hit.t, n);
         let ndl = dot(n, params.light.xyz);
         let headlight = max(dot(n, -dir), 0.0);
         if roughness > 0.0 {
@@ -179,13 +189,8 @@ fn glossy_sample(id: vec2<u32>, sample: u32, sum: ptr<function, vec3<f32>>) {
         }
         if (params.flags & FLAG_LIGHT) != 0u {
             *sum += base * params.light.w;
-            if ndl > 0.0 {
-                let lit = base * ndl;
-                shadow.t = 0.0;
-                traceRay(tlas, RayDesc(SHADOW_FLAGS, 0xFFu, params.ray.x, params.ray.y, origin, params.light.xyz), &shadow);
-                if shadow.t < 0.0 {
-                    *sum += lit;
-                }
+            if ndl > 0.0 && visible {
+                *sum += base * ndl;
             }
         } else {
             *sum += base * headlight;

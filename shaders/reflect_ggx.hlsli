@@ -76,12 +76,18 @@ void glossy_sample(uint2 id, uint sample, inout float3 sum)
             sum += throughput * sky(dir);
             break;
         }
+        // The shadow ray first, from the next origin: across it only the
+        // path's own state stays live; the surface is read again after it.
+        float3 n = facing(surfaces[hit.surface].normal_reflectivity.xyz, dir);
+        origin = offset_ray(origin + dir * hit.t, n);
+        float visible = 0.0;
+        if ((params.flags & FLAG_LIGHT) != 0 && dot(n, params.light.xyz) > 0.0)
+            visible = shadow_ray(origin);
         Surface s = surfaces[hit.surface];
-        float3 n = select(dot(s.normal_reflectivity.xyz, dir) < 0.0, s.normal_reflectivity.xyz, -s.normal_reflectivity.xyz);
+        n = facing(s.normal_reflectivity.xyz, dir);
         float3 base = throughput * (1.0 - s.normal_reflectivity.w) * s.albedo_roughness.xyz;
         throughput *= s.normal_reflectivity.w;
         float roughness = s.albedo_roughness.w;
-        origin = offset_ray(origin + dir * hit.t, n);
         float ndl = dot(n, params.light.xyz);
         float headlight = max(dot(n, -dir), 0.0);
         if (roughness > 0.0)
@@ -119,21 +125,8 @@ void glossy_sample(uint2 id, uint sample, inout float3 sum)
         if ((params.flags & FLAG_LIGHT) != 0)
         {
             sum += base * params.light.w;
-            if (ndl > 0.0)
-            {
-                float3 lit = base * ndl;
-                RayDesc shadow_ray;
-                shadow_ray.Origin = origin;
-                shadow_ray.Direction = params.light.xyz;
-                shadow_ray.TMin = params.ray.x;
-                shadow_ray.TMax = params.ray.y;
-                ShadowInfo shadow;
-                shadow.visible = 0.0;
-                // rtlint: allow(RT010, reason = "the sample loop's sum, seed and counters beside the bounce state; one sample per launch index would fit")
-                TraceRay(tlas, SHADOW_FLAGS, 0xFF, 1, 1, 1, shadow_ray, shadow);
-                if (shadow.visible > 0.0)
-                    sum += lit;
-            }
+            if (ndl > 0.0 && visible > 0.0)
+                sum += base * ndl;
         }
         else
         {

@@ -65,11 +65,6 @@ float3 local_light(Surface s, float3 n, float3 dir, float3 from)
     return c;
 }
 
-float3 facing(float3 normal, float3 dir)
-{
-    return select(dot(normal, dir) < 0.0, normal, -normal);
-}
-
 [shader("raygeneration")]
 void gbuffer_pass()
 {
