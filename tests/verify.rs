@@ -284,7 +284,11 @@ fn extremes_matrix() {
         for mode in ["robust", "epsilon"] {
             let row = cells(mode, variant);
             // shader, case, pixels, max, mean, above, PSNR, NaN, self-hit %, time, result
-            assert_eq!((row[7].as_str(), row.last().unwrap().as_str()), ("0", "pass"), "{row:?}");
+            assert_eq!(
+                (row[7].as_str(), row.last().unwrap().as_str()),
+                ("0", "pass"),
+                "{row:?}"
+            );
             if mode == "robust" {
                 assert_eq!(row[8], "0.000", "{row:?}");
             }
@@ -293,6 +297,10 @@ fn extremes_matrix() {
     let self_hit: f64 = cells("epsilon", "translate=1e5")[8].parse().unwrap();
     assert!(self_hit > 50.0, "{stdout}");
     let md = std::fs::read_to_string(out.join("extremes.md")).unwrap();
-    assert_eq!(md.lines().count(), 2 + 2 * rtlint::verify::EXTREMES.len(), "{md}");
+    assert_eq!(
+        md.lines().count(),
+        2 + 2 * rtlint::verify::EXTREMES.len(),
+        "{md}"
+    );
     std::fs::remove_dir_all(&out).unwrap();
 }

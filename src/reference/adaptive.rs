@@ -73,7 +73,14 @@ pub fn trace_adaptive(scene: &Scene, params: &Params, x: u32, y: u32) -> (PixelP
 
 /// The mean of `count` glossy paths starting at sample number `first`, and
 /// how many rays they traced: the fixed-count render and the converged one.
-pub fn fixed(scene: &Scene, params: &Params, x: u32, y: u32, first: u32, count: u32) -> (Vec3, usize) {
+pub fn fixed(
+    scene: &Scene,
+    params: &Params,
+    x: u32,
+    y: u32,
+    first: u32,
+    count: u32,
+) -> (Vec3, usize) {
     let mut sum = Vec3::ZERO;
     let mut segments = Vec::new();
     for s in first..first + count {
@@ -113,6 +120,8 @@ mod tests {
         let max = counts.iter().filter(|&&n| n == ADAPTIVE_MAX).count();
         eprintln!("more {more} max {max}");
         assert!(more > 20 && max > 0 && more < 32 * 32 / 2, "{more} {max}");
-        assert!(counts.iter().all(|&n| (ADAPTIVE_MIN..=ADAPTIVE_MAX).contains(&n)));
+        assert!(counts
+            .iter()
+            .all(|&n| (ADAPTIVE_MIN..=ADAPTIVE_MAX).contains(&n)));
     }
 }

@@ -3,6 +3,8 @@
 //! with a thickness test and a confidence value; pixels whose march misses,
 //! leaves the screen or has low confidence trace one reflection ray.
 
+use std::cmp::Ordering;
+
 use super::{camera_dir, intersect, reflect, shade, sky, Params, PixelPath, Scene, Segment, Vec3};
 
 /// March steps, each this far along the reflection (world units).
@@ -105,7 +107,7 @@ pub fn march(params: &Params, gbuf: &[GTexel], g: &GTexel, r: Vec3) -> Option<Ve
         let rel = q - params.camera;
         let z = -rel.z;
         // Behind the camera: off the screen.
-        if !(z > 1e-3) {
+        if z.partial_cmp(&1e-3) != Some(Ordering::Greater) {
             return None;
         }
         // The camera's projection: direction (u, -v, -1.5) through pixel
@@ -144,7 +146,8 @@ pub fn resolve(
     segments: &mut Vec<Segment>,
 ) -> (Vec3, ReflectionPath) {
     let g = &gbuf[(y * params.width + x) as usize];
-    if g.depth < 0.0 || !(g.reflectivity > params.cutoff) {
+    // The shader's `!(reflectivity > cutoff)`: NaN does not reflect either.
+    if g.depth < 0.0 || g.reflectivity.partial_cmp(&params.cutoff) != Some(Ordering::Greater) {
         return (g.local, ReflectionPath::None);
     }
     let r = reflect(camera_dir(params, x, y), g.normal);
@@ -227,7 +230,10 @@ mod tests {
             count(ReflectionPath::Ray),
         );
         eprintln!("none {none} screen {screen} ray {ray}");
-        assert!(none > 200 && screen > 100 && ray > 100, "{none} {screen} {ray}");
+        assert!(
+            none > 200 && screen > 100 && ray > 100,
+            "{none} {screen} {ray}"
+        );
         // Where the march found a texel, the ray it saved mostly sees the
         // same surface's light: the colours stay close.
         let gbuf = gbuffer(&s, &p);

@@ -822,7 +822,12 @@ mod tests {
         let s = Scene::parse("t", SCENE).unwrap();
         let f = s.with_flipped_normals();
         for (a, b) in s.surfaces.iter().zip(&f.surfaces) {
-            assert!((a.normal + b.normal).length() < 1e-5, "{} {}", a.normal, b.normal);
+            assert!(
+                (a.normal + b.normal).length() < 1e-5,
+                "{} {}",
+                a.normal,
+                b.normal
+            );
         }
     }
 

@@ -142,7 +142,11 @@ impl GpuScene {
 
     /// The scene's resources at their bindings (see [`bindings`]), with the
     /// image and the parameters.
-    pub fn resources<'a>(&'a self, image: &'a Buffer, uniform: &'a Buffer) -> Vec<(u32, Resource<'a>)> {
+    pub fn resources<'a>(
+        &'a self,
+        image: &'a Buffer,
+        uniform: &'a Buffer,
+    ) -> Vec<(u32, Resource<'a>)> {
         let mut r = vec![
             (0, Resource::AccelerationStructure(&self.tlas)),
             (1, Resource::Buffer(image)),

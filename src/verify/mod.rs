@@ -922,8 +922,7 @@ fn counts_path(image: &Path) -> PathBuf {
 }
 
 fn read_words(path: &Path) -> Result<Vec<u32>, String> {
-    let bytes =
-        std::fs::read(path).map_err(|e| format!("cannot read {}: {e}", path.display()))?;
+    let bytes = std::fs::read(path).map_err(|e| format!("cannot read {}: {e}", path.display()))?;
     let _ = std::fs::remove_file(path);
     Ok(bytes
         .chunks_exact(4)
