@@ -2,7 +2,7 @@
 //! acceleration structures, the pipeline from its description, one trace,
 //! the image read back.
 
-use crate::pipeline::{HitGroupKind, Pipeline};
+use crate::pipeline::{HitGroupKind, Pipeline, ShaderRef};
 use crate::reference::{Params, Scene};
 use crate::vk::{
     raw, AccelerationStructure, Binding, BindingKind, Buffer, ComputePipeline, Context, Geometry,
@@ -172,6 +172,69 @@ pub struct Rendered {
     pub total: Duration,
 }
 
+/// What the harness builds for a pipeline on a scene: the shader stages,
+/// the groups over them, the bindings, and how many ray generation groups
+/// run in turn.
+pub struct Plan<'p> {
+    pub stages: Vec<&'p ShaderRef>,
+    pub groups: Vec<Group>,
+    pub bindings: Vec<Binding>,
+    pub raygens: usize,
+}
+
+/// Only what the scene needs: no shadow miss shader without a light, no
+/// any-hit shader and no texture binding without cut-outs, the scratch
+/// bindings only for multi-pass shaders.
+pub fn plan<'p>(pipeline: &'p Pipeline, scene: &Scene, passes: Passes) -> Result<Plan<'p>, String> {
+    let mut stages: Vec<&'p ShaderRef> = Vec::new();
+    let mut groups = Vec::new();
+    let mut add = |s: &'p ShaderRef| {
+        stages.push(s);
+        stages.len() as u32 - 1
+    };
+    // Without a light no shadow ray is traced: the shadow miss shaders
+    // (every miss after the first) are left out.
+    let misses = if scene.light.is_some() {
+        &pipeline.miss[..]
+    } else {
+        &pipeline.miss[..pipeline.miss.len().min(1)]
+    };
+    // Every ray generation shader when they run in turn; else the first.
+    let raygens = if passes.repeat > 1 || passes.scratch {
+        &pipeline.raygen[..]
+    } else {
+        &pipeline.raygen[..pipeline.raygen.len().min(1)]
+    };
+    for s in raygens.iter().chain(misses) {
+        groups.push(Group::General(add(s)));
+    }
+    // Any-hit shaders only for alpha-tested geometry: without it every
+    // instance is opaque and they would never run. A group left with no
+    // shader keeps its place, so SBT offsets stay as the shaders trace them.
+    let cutouts = scene.has_cutouts();
+    for g in &pipeline.hit_groups {
+        if g.kind != HitGroupKind::Triangles {
+            return Err("verify builds triangle hit groups only".into());
+        }
+        let closest_hit = g.closest_hit.as_ref().map(&mut add);
+        let any_hit = g.any_hit.as_ref().filter(|_| cutouts).map(&mut add);
+        groups.push(Group::Triangles {
+            closest_hit,
+            any_hit,
+        });
+    }
+    let mut bindings = bindings(scene);
+    if passes.scratch {
+        bindings.extend(SCRATCH_BINDINGS);
+    }
+    Ok(Plan {
+        stages,
+        groups,
+        bindings,
+        raygens: raygens.len(),
+    })
+}
+
 /// Creates the described pipeline (with `depth` instead of its declared
 /// recursion depth when given) and traces `params`' image of `scene`.
 pub fn render(
@@ -196,9 +259,9 @@ pub fn render_passes<'p>(
     let start = Instant::now();
     let vk = |e: crate::vk::Error| e.to_string();
     let gpu_scene = GpuScene::new(ctx, scene).map_err(vk)?;
+    let plan = plan(pipeline, scene, passes)?;
     let mut stages: Vec<ShaderStage<'p>> = Vec::new();
-    let mut groups = Vec::new();
-    let mut add = |s: &'p crate::pipeline::ShaderRef| -> Result<u32, String> {
+    for s in &plan.stages {
         let program = pipeline
             .program(s)
             .ok_or_else(|| format!("{}: no program for `{}`", s.file.display(), s.entry))?;
@@ -207,46 +270,8 @@ pub fn render_passes<'p>(
             entry_point: &s.entry,
             stage: s.stage,
         });
-        Ok(stages.len() as u32 - 1)
-    };
-    // Only what the scene needs: without a light no shadow ray is traced, so
-    // the shadow miss shaders (every miss after the first) are left out.
-    let misses = if scene.light.is_some() {
-        &pipeline.miss[..]
-    } else {
-        &pipeline.miss[..pipeline.miss.len().min(1)]
-    };
-    // Every ray generation shader when they run in turn; else the first.
-    let raygens = if passes.repeat > 1 || passes.scratch {
-        &pipeline.raygen[..]
-    } else {
-        &pipeline.raygen[..pipeline.raygen.len().min(1)]
-    };
-    for s in raygens.iter().chain(misses) {
-        groups.push(Group::General(add(s)?));
     }
-    // Any-hit shaders only for alpha-tested geometry: without it every
-    // instance is opaque and they would never run. A group left with no
-    // shader keeps its place, so SBT offsets stay as the shaders trace them.
-    let cutouts = scene.has_cutouts();
-    for g in &pipeline.hit_groups {
-        if g.kind != HitGroupKind::Triangles {
-            return Err("verify builds triangle hit groups only".into());
-        }
-        let closest_hit = g.closest_hit.as_ref().map(&mut add).transpose()?;
-        let any_hit = match &g.any_hit {
-            Some(s) if cutouts => Some(add(s)?),
-            _ => None,
-        };
-        groups.push(Group::Triangles {
-            closest_hit,
-            any_hit,
-        });
-    }
-    let mut all_bindings = bindings(scene);
-    if passes.scratch {
-        all_bindings.extend(SCRATCH_BINDINGS);
-    }
+    let (groups, all_bindings, raygens) = (plan.groups, plan.bindings, plan.raygens);
     let rt = RayTracingPipeline::new(
         ctx,
         &RayTracingPipelineDesc {
@@ -290,7 +315,7 @@ pub fn render_passes<'p>(
     // Each trace waits for the one before: a pass reads what the last wrote.
     let mut trace = Duration::ZERO;
     for _ in 0..passes.repeat {
-        for r in 0..raygens.len() {
+        for r in 0..raygens {
             trace += rt
                 .trace_rays_from(r, &resources, params.width, params.height, 1)
                 .map_err(vk)?;
@@ -341,4 +366,58 @@ pub fn render_compute(
         trace,
         total: start.elapsed(),
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::reference::Method;
+    use std::path::Path;
+
+    fn load(pipeline: &str, scene: &str) -> (Pipeline, Scene) {
+        let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("shaders");
+        (
+            crate::pipeline::load(&dir.join(pipeline)).unwrap(),
+            Scene::load(&dir.join("scenes").join(format!("{scene}.toml"))).unwrap(),
+        )
+    }
+
+    fn any_hits(plan: &Plan) -> usize {
+        plan.stages
+            .iter()
+            .filter(|s| s.stage == crate::shader::Stage::AnyHit)
+            .count()
+    }
+
+    #[test]
+    fn only_what_the_scene_needs_is_built() {
+        // Showcase: a light (shadow miss), no cut-outs (no any-hit, no texture).
+        let (p, s) = load("reflect_iterative_hlsl.pipeline.toml", "showcase");
+        let built = plan(&p, &s, Passes::SINGLE).unwrap();
+        assert_eq!(any_hits(&built), 0);
+        assert_eq!(built.bindings, BINDINGS);
+        // raygen, miss, shadow miss, the primary and the shadow hit group.
+        assert_eq!(built.groups.len(), 5);
+        assert!(matches!(
+            built.groups[4],
+            Group::Triangles {
+                closest_hit: None,
+                any_hit: None
+            }
+        ));
+        // Mirror: no light, so no shadow miss either.
+        let (p, s) = load("reflect_iterative_hlsl.pipeline.toml", "mirror");
+        let built = plan(&p, &s, Passes::SINGLE).unwrap();
+        assert_eq!(built.groups.len(), 4);
+        // Cut-outs: both any-hit shaders, the texture and the coordinates.
+        let (p, s) = load("reflect_iterative_hlsl.pipeline.toml", "cutout");
+        let built = plan(&p, &s, Passes::SINGLE).unwrap();
+        assert_eq!(any_hits(&built), 2);
+        assert_eq!(built.bindings[4..], CUTOUT_BINDINGS);
+        // The hybrid shader's two passes, with their scratch buffers.
+        let (p, s) = load("reflect_hybrid_hlsl.pipeline.toml", "showcase");
+        let built = plan(&p, &s, Passes::for_method(Method::Hybrid)).unwrap();
+        assert_eq!(built.raygens, 2);
+        assert_eq!(built.bindings[4..], SCRATCH_BINDINGS);
+    }
 }

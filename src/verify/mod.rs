@@ -1060,6 +1060,19 @@ mod tests {
                 setup(&m, source, scene, depth).unwrap();
             }
         }
+        // Ray-query shaders run their cut-out entry point only on scenes
+        // with cut-outs.
+        for (case, want) in [
+            ("rayquery/mirror", "main"),
+            ("rayquery-hlsl/cutout", "main_alpha"),
+        ] {
+            let c = m.cases.iter().find(|c| c.name == case).unwrap();
+            let (source, scene, depth) = c.kind.runs().unwrap();
+            match setup(&m, source, scene, depth).unwrap().0 {
+                Loaded::Compute { entry, .. } => assert_eq!(entry, want),
+                Loaded::Pipeline(_) => panic!("{case} is a compute case"),
+            }
+        }
         // Selecting an identity case brings the renders it compares.
         let sel = m.select(Some("recursive=iterative/mirror"));
         let names: Vec<&str> = sel.iter().map(|c| c.name.as_str()).collect();
