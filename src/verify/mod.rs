@@ -65,7 +65,29 @@ struct RawShader {
     max_bounces: Option<u32>,
     reference: String,
     scenes: Vec<String>,
-    identical_to: Option<String>,
+    /// Shaders whose images this one's must equal, on the scenes both render.
+    #[serde(default)]
+    identical_to: OneOrMany,
+}
+
+/// A name, or a list of them.
+#[derive(Deserialize, Default)]
+#[serde(untagged)]
+enum OneOrMany {
+    #[default]
+    None,
+    One(String),
+    Many(Vec<String>),
+}
+
+impl OneOrMany {
+    fn names(&self) -> &[String] {
+        match self {
+            OneOrMany::None => &[],
+            OneOrMany::One(n) => std::slice::from_ref(n),
+            OneOrMany::Many(v) => v,
+        }
+    }
 }
 
 #[derive(Deserialize)]
@@ -278,29 +300,27 @@ impl Manifest {
             }
         }
         for s in &raw.shader {
-            let Some(other) = &s.identical_to else {
-                continue;
-            };
-            if !raw.shader.iter().any(|o| &o.name == other) {
-                return Err(format!(
-                    "{}: `{}` is to be identical to unknown shader `{other}`",
-                    path.display(),
-                    s.name
-                ));
-            }
-            let theirs = &raw.shader.iter().find(|o| &o.name == other).unwrap().scenes;
-            // Only the scenes both render (the WGSL pipelines cannot render
-            // cut-outs).
-            for sc in s.scenes.iter().filter(|sc| theirs.contains(sc)) {
-                cases.push(Case {
-                    name: format!("{}={other}/{sc}", s.name),
-                    shader: format!("{} = {other}", s.name),
-                    scene: sc.clone(),
-                    kind: CaseKind::Identical {
-                        a: format!("{}/{sc}", s.name),
-                        b: format!("{other}/{sc}"),
-                    },
-                });
+            for other in s.identical_to.names() {
+                let Some(theirs) = raw.shader.iter().find(|o| &o.name == other) else {
+                    return Err(format!(
+                        "{}: `{}` is to be identical to unknown shader `{other}`",
+                        path.display(),
+                        s.name
+                    ));
+                };
+                // Only the scenes both render (the WGSL pipelines cannot
+                // render cut-outs).
+                for sc in s.scenes.iter().filter(|sc| theirs.scenes.contains(sc)) {
+                    cases.push(Case {
+                        name: format!("{}={other}/{sc}", s.name),
+                        shader: format!("{} = {other}", s.name),
+                        scene: sc.clone(),
+                        kind: CaseKind::Identical {
+                            a: format!("{}/{sc}", s.name),
+                            b: format!("{other}/{sc}"),
+                        },
+                    });
+                }
             }
         }
         for f in &raw.expected_failure {
