@@ -247,20 +247,28 @@ pub fn render(
     render_passes(ctx, pipeline, depth, scene, params, Passes::SINGLE)
 }
 
-/// As [`render`], running the pipeline's ray generation shaders as `passes` says.
-pub fn render_passes<'p>(
+/// The described pipeline on the device (with `depth` instead of its
+/// declared recursion depth when given), with only what `scene` needs
+/// ([`plan`]) for one trace from the first ray generation shader.
+pub fn ray_tracing_pipeline(
     ctx: &Context,
-    pipeline: &'p Pipeline,
+    pipeline: &Pipeline,
     depth: Option<u32>,
     scene: &Scene,
-    params: &Params,
+) -> Result<RayTracingPipeline, String> {
+    ray_tracing_pipeline_for(ctx, pipeline, depth, scene, Passes::SINGLE)
+}
+
+/// As [`ray_tracing_pipeline`], built to run as `passes` says.
+pub fn ray_tracing_pipeline_for(
+    ctx: &Context,
+    pipeline: &Pipeline,
+    depth: Option<u32>,
+    scene: &Scene,
     passes: Passes,
-) -> Result<Rendered, String> {
-    let start = Instant::now();
-    let vk = |e: crate::vk::Error| e.to_string();
-    let gpu_scene = GpuScene::new(ctx, scene).map_err(vk)?;
+) -> Result<RayTracingPipeline, String> {
     let plan = plan(pipeline, scene, passes)?;
-    let mut stages: Vec<ShaderStage<'p>> = Vec::new();
+    let mut stages = Vec::new();
     for s in &plan.stages {
         let program = pipeline
             .program(s)
@@ -271,19 +279,34 @@ pub fn render_passes<'p>(
             stage: s.stage,
         });
     }
-    let (groups, all_bindings, raygens) = (plan.groups, plan.bindings, plan.raygens);
-    let rt = RayTracingPipeline::new(
+    RayTracingPipeline::new(
         ctx,
         &RayTracingPipelineDesc {
             stages: &stages,
-            groups: &groups,
+            groups: &plan.groups,
             max_recursion_depth: depth.or(pipeline.max_recursion_depth).unwrap_or(1),
-            bindings: &all_bindings,
+            bindings: &plan.bindings,
             push_constant_size: 0,
             stack_size: None,
         },
     )
-    .map_err(vk)?;
+    .map_err(|e| e.to_string())
+}
+
+/// As [`render`], running the pipeline's ray generation shaders as `passes` says.
+pub fn render_passes(
+    ctx: &Context,
+    pipeline: &Pipeline,
+    depth: Option<u32>,
+    scene: &Scene,
+    params: &Params,
+    passes: Passes,
+) -> Result<Rendered, String> {
+    let start = Instant::now();
+    let vk = |e: crate::vk::Error| e.to_string();
+    let gpu_scene = GpuScene::new(ctx, scene).map_err(vk)?;
+    let rt = ray_tracing_pipeline_for(ctx, pipeline, depth, scene, passes)?;
+    let raygens = plan(pipeline, scene, passes)?.raygens;
     let pixels = u64::from(params.width) * u64::from(params.height);
     let image =
         Buffer::new(ctx, pixels * 4, raw::BufferUsageFlags::STORAGE_BUFFER, 1).map_err(vk)?;
