@@ -36,6 +36,8 @@ ConstantBuffer<ParamsData> params : register(b3);
 
 static const uint FLAG_LIGHT = 1;
 static const uint FLAG_ROBUST = 2;
+// The hybrid shader traces every reflection, marching none (rtlint tradeoff).
+static const uint FLAG_RAY_ONLY = 4;
 
 float3 sky(float3 dir)
 {
@@ -63,6 +65,12 @@ float3 offset_ray(float3 p, float3 n)
     int3 of_i = int3(256.0 * n);
     float3 p_i = asfloat(asint(p) + select(p < 0.0, -of_i, of_i));
     return select(abs(p) < 0.03125, p + 0.0000152587890625 * n, p_i);
+}
+
+// The geometric normal turned towards the side the ray comes from.
+float3 facing(float3 normal, float3 dir)
+{
+    return select(dot(normal, dir) < 0.0, normal, -normal);
 }
 
 float3 camera_dir(uint2 id)

@@ -5,14 +5,18 @@
 //! Everything is `f32` and follows the shaders operation by operation
 //! (camera, bounce loop or recursion, shadow rays, sky, shading, robust ray
 //! origins, packing) so that a GPU image should match to within one 8-bit
-//! step; ray/triangle tests use the shaders' `t` range and treat every
-//! triangle as opaque, as `RAY_FLAG_OPAQUE` does. Triangles are found
+//! step; ray/triangle tests use the shaders' `t` range, and a cut-out
+//! material's triangle counts only where its alpha texel keeps it (what the
+//! any-hit shaders and the ray queries' candidate loops do). Triangles are found
 //! through a BVH ([`bvh`]).
 
+pub mod adaptive;
 pub mod bvh;
+pub mod hybrid;
 pub mod math;
 pub mod scene;
 
+pub use adaptive::ADAPTIVE_TOLERANCE;
 pub use glam::Vec3;
 pub use math::{mix, offset_ray, reflect};
 pub use scene::{Light, Scene, Surface};
@@ -21,6 +25,8 @@ pub use scene::{Light, Scene, Surface};
 pub const FLAG_LIGHT: u32 = 1;
 /// `Params.flags`: ray origins use the robust offset, not the fixed epsilon.
 pub const FLAG_ROBUST: u32 = 2;
+/// `Params.flags`: the hybrid shader traces every reflection, marching none.
+pub const FLAG_RAY_ONLY: u32 = 4;
 
 /// The shaders' uniform block (`Params`, 80 bytes).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -40,6 +46,8 @@ pub struct Params {
     pub epsilon: f32,
     /// Rays per pixel of the glossy shader (1–16).
     pub samples: u32,
+    /// The adaptive shader's variance tolerance (`camera.w`).
+    pub tolerance: f32,
     /// `t_max` of the glossy shader's reflection rays (before its
     /// shortening with roughness); primary and shadow rays keep `t_max`.
     pub reflect_t_max: f32,
@@ -50,6 +58,9 @@ pub struct Params {
     /// this (and as rough as its 2×2 block's top-left pixel's) takes that
     /// pixel's light beyond the first hit instead of tracing on. Off above 1.
     pub half_res: f32,
+    /// The hybrid shader traces every reflection instead of marching the
+    /// screen first.
+    pub ray_only: bool,
 }
 
 impl Params {
@@ -68,19 +79,22 @@ impl Params {
             cutoff: 1.0 / 256.0,
             epsilon: 1e-3,
             samples: 4,
+            tolerance: ADAPTIVE_TOLERANCE,
             reflect_t_max: 1e4,
             rough_cutoff: f32::INFINITY,
             half_res: f32::INFINITY,
+            ray_only: false,
         }
     }
 
     /// The uniform buffer contents:
-    /// `width, height, max_bounces, flags; camera.xyz, 0; light.xyz, ambient;
+    /// `width, height, max_bounces, flags; camera.xyz, tolerance; light.xyz, ambient;
     /// t_min, t_max, cutoff, epsilon; reflect_t_max, rough_cutoff, half_res, 0`.
     pub fn to_words(&self) -> [u32; 20] {
         let f = |x: f32| x.to_bits();
         let flags = if self.light.is_some() { FLAG_LIGHT } else { 0 }
             | if self.robust { FLAG_ROBUST } else { 0 }
+            | if self.ray_only { FLAG_RAY_ONLY } else { 0 }
             | (self.samples.min(255) << 8);
         let (l, ambient) = self
             .light
@@ -95,7 +109,7 @@ impl Params {
             f(c.x),
             f(c.y),
             f(c.z),
-            0,
+            f(self.tolerance),
             f(l.x),
             f(l.y),
             f(l.z),
@@ -216,7 +230,8 @@ pub fn camera_dir(params: &Params, x: u32, y: u32) -> Vec3 {
     Vec3::new(uv[0], -uv[1], -1.5).normalize()
 }
 
-/// The closest opaque triangle hit with `t` in `[t_min, t_max]` (with
+/// The closest triangle hit with `t` in `[t_min, t_max]` that is opaque or
+/// whose alpha texel keeps it (with
 /// `any`, the first found, as `ACCEPT_FIRST_HIT_AND_END_SEARCH` allows: only
 /// hit-or-miss matters then), and the ray's edge margin.
 pub fn intersect(
@@ -242,7 +257,10 @@ pub fn intersect(
             None => true,
             Some(h) => th < h.t || (th == h.t && (tri as u32) < h.triangle),
         };
-        if bary.iter().all(|&w| w >= 0.0) && better {
+        // A cut-out's candidate counts only where its texel keeps the
+        // surface: the any-hit shaders' `IgnoreHit` and the ray queries'
+        // alpha test before committing.
+        if bary.iter().all(|&w| w >= 0.0) && better && scene.keeps(tri, bary) {
             best = Some(Hit {
                 t: th,
                 triangle: tri as u32,
@@ -256,14 +274,14 @@ pub fn intersect(
 /// incoming ray, where the next rays start (`from`), and the surface's own
 /// colour per unit of `weight` (the iterative shader's throughput; 1 in the
 /// recursive one), tracing the shadow ray when there is a light.
-struct Shading {
-    normal: Vec3,
-    from: Vec3,
-    local: Vec3,
-    reflectivity: f32,
+pub(crate) struct Shading {
+    pub normal: Vec3,
+    pub from: Vec3,
+    pub local: Vec3,
+    pub reflectivity: f32,
 }
 
-fn shade(
+pub(crate) fn shade(
     scene: &Scene,
     params: &Params,
     origin: Vec3,
@@ -516,9 +534,10 @@ pub fn glossy_mean(scene: &Scene, params: &Params, x: u32, y: u32, samples: u32)
     sum / samples.max(1) as f32
 }
 
-/// One path of the glossy shader: sample number `sample` of pixel `(x, y)`,
-/// its light added into `sum` term by term (as the shader does: the
-/// rounding depends on it), its rays appended to `segments`.
+/// One path of the glossy shaders (and of the adaptive one): sample number
+/// `sample` of pixel `(x, y)`, its light added into `sum` term by term (as
+/// the shaders do: the rounding depends on it), its rays appended to
+/// `segments`.
 pub fn glossy_sample(
     scene: &Scene,
     params: &Params,
@@ -682,6 +701,27 @@ pub enum Method {
     Iterative,
     Recursive,
     Glossy,
+    /// G-buffer, screen-space march, ray fallback ([`hybrid`]).
+    Hybrid,
+    /// Glossy paths accumulated until the variance is low ([`adaptive`]).
+    Adaptive,
+}
+
+impl Method {
+    /// How many times the GPU runs the pipeline's ray generation shaders
+    /// (each in turn) over the image.
+    pub fn passes(self) -> u32 {
+        match self {
+            Method::Adaptive => adaptive::ADAPTIVE_MAX,
+            _ => 1,
+        }
+    }
+
+    /// Whether the shaders keep per-pixel state between passes (the
+    /// `scratch` buffer) and write a per-pixel count (`counts`).
+    pub fn scratch(self) -> bool {
+        matches!(self, Method::Hybrid | Method::Adaptive)
+    }
 }
 
 /// One pixel's path by `method`.
@@ -690,6 +730,8 @@ pub fn trace_pixel(scene: &Scene, params: &Params, method: Method, x: u32, y: u3
         Method::Iterative => trace_iterative(scene, params, x, y),
         Method::Recursive => trace_recursive(scene, params, x, y),
         Method::Glossy => trace_glossy(scene, params, x, y),
+        Method::Hybrid => hybrid::trace_hybrid(scene, params, x, y),
+        Method::Adaptive => adaptive::trace_adaptive(scene, params, x, y).0,
     }
 }
 
@@ -697,6 +739,13 @@ pub fn trace_pixel(scene: &Scene, params: &Params, method: Method, x: u32, y: u3
 /// with each pixel's edge margin (see [`Segment::edge_margin`]).
 pub fn render(scene: &Scene, params: &Params, method: Method) -> (Vec<u32>, Vec<f32>) {
     let n = (params.width * params.height) as usize;
+    if method == Method::Hybrid {
+        let (paths, _) = hybrid::render(scene, params);
+        return (
+            paths.iter().map(|p| pack_rgba8(p.color)).collect(),
+            paths.iter().map(PixelPath::edge_margin).collect(),
+        );
+    }
     let (mut image, mut margins) = (Vec::with_capacity(n), Vec::with_capacity(n));
     for y in 0..params.height {
         for x in 0..params.width {
@@ -826,6 +875,35 @@ mod tests {
                 "({x}, {y})"
             );
         }
+    }
+
+    #[test]
+    fn cutouts_let_primary_reflection_and_shadow_rays_through() {
+        let path =
+            std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("shaders/scenes/cutout.toml");
+        let scene = Scene::load(&path).unwrap();
+        assert!(scene.has_cutouts());
+        let mut solid = scene.clone();
+        for s in &mut solid.surfaces {
+            s.cutout = false;
+        }
+        let p = Params::for_scene(&scene, 48, 48, 3);
+        // Per ray kind: rays whose hit changes when the holes are filled.
+        let mut through = [0usize; 3];
+        for y in 0..p.height {
+            for x in 0..p.width {
+                let a = trace_iterative(&scene, &p, x, y);
+                let b = trace_iterative(&solid, &p, x, y);
+                for (k, (sa, sb)) in a.segments.iter().zip(&b.segments).enumerate() {
+                    if sa.hit.map(|h| h.triangle) != sb.hit.map(|h| h.triangle) {
+                        let kind = if sa.shadow { 2 } else { usize::from(k > 0) };
+                        through[kind] += 1;
+                        break;
+                    }
+                }
+            }
+        }
+        assert!(through.iter().all(|&n| n > 5), "{through:?}");
     }
 
     #[test]

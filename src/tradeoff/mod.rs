@@ -136,9 +136,43 @@ pub const KNOBS: &[Knob] = &[
         },
     },
     Knob {
+        name: "ssr",
+        doc: "the hybrid shader marches the screen first (`on`) or traces every reflection \
+              (`off`: ray only; `Params.flags` bit 2)",
+        shaders: &["hybrid", "hybrid-hlsl"],
+        values: &["on", "off"],
+        quick_shaders: &["hybrid"],
+        quick_values: &["off"],
+        apply: |p, _, v| {
+            p.ray_only = match v {
+                "on" => false,
+                "off" => true,
+                _ => return Err(format!("bad value `{v}` for knob `ssr`")),
+            };
+            Ok(())
+        },
+    },
+    Knob {
+        name: "tolerance",
+        doc: "the adaptive shader's variance tolerance (`Params.camera.w`); it traces 4 to 16 \
+              paths per pixel over 16 passes",
+        shaders: &["adaptive", "adaptive-hlsl"],
+        values: &["1e-2", "1e-3", "1e-4", "1e-5"],
+        quick_shaders: &["adaptive"],
+        quick_values: &["1e-2"],
+        apply: |p, _, v| {
+            let t: f32 = number("tolerance", v)?;
+            if t.is_nan() || t < 0.0 {
+                return Err("tolerance must be 0 or above".into());
+            }
+            p.tolerance = t;
+            Ok(())
+        },
+    },
+    Knob {
         name: "origin",
         doc: "ray origins: `robust` (Wächter & Binder) or `epsilon` (p + 1e-3 n; `Params.flags` bit 1)",
-        shaders: &["iterative", "glossy"],
+        shaders: &["iterative", "glossy", "hybrid"],
         values: &["robust", "epsilon"],
         quick_shaders: &["glossy"],
         quick_values: &["epsilon"],
@@ -441,27 +475,50 @@ pub fn child_main(
     )
     .map_err(vk)?;
     let half = verify::gpu::half_res_buffer(&ctx, params).map_err(vk)?;
-    let resources = [
-        (
-            0,
-            crate::vk::Resource::AccelerationStructure(&gpu_scene.tlas),
-        ),
-        (1, crate::vk::Resource::Buffer(&out)),
-        (2, crate::vk::Resource::Buffer(&gpu_scene.surfaces)),
-        (3, crate::vk::Resource::Buffer(&uniform)),
-        (HALF_RES_BINDING, crate::vk::Resource::Buffer(&half)),
-    ];
+    let mut resources = gpu_scene.resources(&out, &uniform);
+    for r in &mut resources {
+        if r.0 == HALF_RES_BINDING {
+            r.1 = crate::vk::Resource::Buffer(&half);
+        }
+    }
+    // Multi-pass shaders (hybrid, adaptive) keep per-pixel state between
+    // passes: zeroed before each timed run, as for a fresh frame.
+    let passes = verify::gpu::Passes::for_method(p.method);
+    let usage = crate::vk::raw::BufferUsageFlags::STORAGE_BUFFER
+        | crate::vk::raw::BufferUsageFlags::TRANSFER_DST;
+    let scratch = if passes.scratch {
+        Some((
+            crate::vk::Buffer::new(&ctx, pixels * 4, usage, 1).map_err(vk)?,
+            crate::vk::Buffer::new(&ctx, pixels * verify::gpu::SCRATCH_BYTES, usage, 1)
+                .map_err(vk)?,
+        ))
+    } else {
+        None
+    };
+    if let Some((counts, state)) = &scratch {
+        resources.push((6, crate::vk::Resource::Buffer(counts)));
+        resources.push((7, crate::vk::Resource::Buffer(state)));
+    }
     let times = match &p.loaded {
         Loaded::Pipeline(pipeline) => {
-            let rt = verify::gpu::ray_tracing_pipeline(&ctx, pipeline, p.depth, &p.scene)?;
+            let rt =
+                verify::gpu::ray_tracing_pipeline_for(&ctx, pipeline, p.depth, &p.scene, passes)?;
             let (w, h) = (params.width, params.height);
-            // Half-resolution mode: the block pass, then the image.
-            let passes: &[(usize, [u32; 2])] = if params.half_res <= 1.0 {
-                &[(0, [w.div_ceil(2), h.div_ceil(2)]), (0, [w, h])]
+            let raygens = if passes.repeat > 1 || passes.scratch {
+                pipeline.raygen.len()
             } else {
-                &[(0, [w, h])]
+                1
             };
-            rt.time_trace_rays(&resources, passes, &[], sweep.warmup, sweep.repeats)
+            let mut run: Vec<(usize, [u32; 2])> = Vec::new();
+            // Half-resolution mode: the block pass first.
+            if params.half_res <= 1.0 {
+                run.push((0, [w.div_ceil(2), h.div_ceil(2)]));
+            }
+            for _ in 0..passes.repeat {
+                run.extend((0..raygens).map(|r| (r, [w, h])));
+            }
+            let clear: Vec<&crate::vk::Buffer> = scratch.iter().flat_map(|(c, s)| [c, s]).collect();
+            rt.time_trace_rays(&resources, &run, &clear, sweep.warmup, sweep.repeats)
                 .map_err(vk)?
         }
         Loaded::Compute { words, entry } => {
@@ -469,8 +526,13 @@ pub fn child_main(
                 println!("skip: {} has no VK_KHR_ray_query", ctx.info().name);
                 return Err(verify::SKIP.into());
             }
-            let cp = crate::vk::ComputePipeline::new(&ctx, words, entry, &verify::gpu::BINDINGS)
-                .map_err(vk)?;
+            let cp = crate::vk::ComputePipeline::new(
+                &ctx,
+                words,
+                entry,
+                &verify::gpu::bindings(&p.scene),
+            )
+            .map_err(vk)?;
             cp.time_dispatch(
                 &resources,
                 [params.width.div_ceil(8), params.height.div_ceil(8), 1],
@@ -614,6 +676,18 @@ pub fn converged(scene: &Scene, sweep: &Sweep) -> Vec<Vec3> {
 
 /// The CPU reference of one setting: its image and the rays it traces.
 fn cpu_render(p: &Prepared) -> (Vec<u32>, u64) {
+    if p.method == Method::Hybrid {
+        // Its pixels read one G-buffer of the whole image.
+        let (paths, _) = reference::hybrid::render(&p.scene, &p.params);
+        let rays = paths.iter().map(|q| q.segments.len() as u64).sum();
+        return (
+            paths
+                .iter()
+                .map(|q| reference::pack_rgba8(q.color))
+                .collect(),
+            rays,
+        );
+    }
     let w = p.params.width;
     let pixels: Vec<(u32, u64)> = (0..w * p.params.height)
         .into_par_iter()
