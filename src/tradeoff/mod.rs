@@ -312,35 +312,51 @@ fn shader_source(manifest: &Manifest, shader: &str) -> Option<(Source, Method)> 
     })
 }
 
-/// The settings of a sweep: each shader's defaults, then every knob's values
-/// on each of its shaders, the others at their defaults. Shaders the
-/// manifest lacks are left out; a knob value that equals the defaults is
-/// the defaults' row.
-pub fn settings(manifest: &Manifest, scene: &Scene, quick: bool) -> Vec<Setting> {
-    let mut shaders: Vec<&str> = Vec::new();
+/// The settings of a sweep over `scene_name` in the `shaders` folder: each
+/// shader's defaults, then every knob's values on each of its shaders, the
+/// others at their defaults. Shaders the manifest lacks are left out; a
+/// knob value that equals the defaults is the defaults' row.
+pub fn settings(
+    manifest: &Manifest,
+    shaders: &Path,
+    scene_name: &str,
+    quick: bool,
+) -> Result<Vec<Setting>, String> {
+    let mut names: Vec<&str> = Vec::new();
     for k in KNOBS {
         let list = if quick { k.quick_shaders } else { k.shaders };
         for s in list {
-            if !shaders.contains(s) && shader_source(manifest, s).is_some() {
-                shaders.push(s);
+            if !names.contains(s) && shader_source(manifest, s).is_some() {
+                names.push(s);
             }
         }
     }
+    // Each shader's defaults as verify sets them up (the bounce count from
+    // its pipeline description).
+    let path = scene_path(shaders, scene_name);
+    let scene = Scene::load(&path)?;
+    let mut defaults = Vec::new();
+    for name in &names {
+        let (source, _) = shader_source(manifest, name)
+            .ok_or_else(|| format!("no shader `{name}` in the manifest"))?;
+        defaults.push(verify::setup(manifest, &source, &path, None)?.2);
+    }
     let mut out: Vec<(Setting, Vec<u32>)> = Vec::new();
-    let mut push = |s: Setting| {
-        let Ok(p) = effective_params(manifest, scene, &s, (1, 1)) else {
-            return;
-        };
-        let words = p.to_words().to_vec();
+    let mut push = |s: Setting| -> Result<(), String> {
+        let k = names.iter().position(|n| *n == s.shader).unwrap_or(0);
+        let mut params = defaults[k];
+        s.apply(&mut params, &scene)?;
+        let words = params.to_words().to_vec();
         if !out.iter().any(|(o, w)| o.shader == s.shader && *w == words) {
             out.push((s, words));
         }
+        Ok(())
     };
-    for s in &shaders {
+    for s in &names {
         push(Setting {
             shader: s.to_string(),
             knobs: Vec::new(),
-        });
+        })?;
     }
     for k in KNOBS {
         let (list, values) = if quick {
@@ -348,35 +364,16 @@ pub fn settings(manifest: &Manifest, scene: &Scene, quick: bool) -> Vec<Setting>
         } else {
             (k.shaders, k.values)
         };
-        for s in list.iter().filter(|s| shaders.contains(s)) {
+        for s in list.iter().filter(|s| names.contains(s)) {
             for v in values {
                 push(Setting {
                     shader: s.to_string(),
                     knobs: vec![(k.name.to_string(), v.to_string())],
-                });
+                })?;
             }
         }
     }
-    out.into_iter().map(|(s, _)| s).collect()
-}
-
-/// The uniform parameters of `setting` at `size`: the shader's defaults
-/// (its description's bounce count) with the knobs set.
-fn effective_params(
-    manifest: &Manifest,
-    scene: &Scene,
-    setting: &Setting,
-    size: (u32, u32),
-) -> Result<Params, String> {
-    let (source, _) = shader_source(manifest, &setting.shader)
-        .ok_or_else(|| format!("no shader `{}` in the manifest", setting.shader))?;
-    let bounces = match &source {
-        Source::Compute { max_bounces, .. } => *max_bounces,
-        Source::Pipeline(_) => 3,
-    };
-    let mut p = Params::for_scene(scene, size.0, size.1, bounces);
-    setting.apply(&mut p, scene)?;
-    Ok(p)
+    Ok(out.into_iter().map(|(s, _)| s).collect())
 }
 
 /// A setting ready to run: its shaders loaded, the scene, the parameters,
@@ -739,7 +736,7 @@ pub fn run(
     let sweep = if options.quick { QUICK } else { FULL };
     let manifest = Manifest::load(&options.shaders)?;
     let scene = Scene::load(&scene_path(&options.shaders, &options.scene))?;
-    let settings = settings(&manifest, &scene, options.quick);
+    let settings = settings(&manifest, &options.shaders, &options.scene, options.quick)?;
     if settings.is_empty() {
         return Err("the manifest names none of the shaders the knobs apply to".into());
     }
@@ -1113,8 +1110,7 @@ mod tests {
     #[test]
     fn settings_names_round_trip_and_knobs_reach_the_parameters() {
         let manifest = Manifest::load(&shaders()).unwrap();
-        let scene = Scene::load(&scene_path(&shaders(), "showcase")).unwrap();
-        let all = settings(&manifest, &scene, false);
+        let all = settings(&manifest, &shaders(), "showcase", false).unwrap();
         for s in &all {
             assert_eq!(&Setting::parse(&s.name()).unwrap(), s);
         }
@@ -1141,11 +1137,11 @@ mod tests {
         assert_eq!(p.params.reflect_t_max, 0.5 * diagonal(&p.scene));
         assert_eq!((p.params.rough_cutoff, p.params.robust), (0.2, false));
         assert!(Setting::parse("glossy warp=9").is_err());
-        assert!(effective_params(
-            &manifest,
-            &scene,
-            &Setting::parse("glossy spp=99").unwrap(),
-            (1, 1)
+        assert!(prepare(
+            &shaders(),
+            "showcase",
+            &QUICK,
+            &Setting::parse("glossy spp=99").unwrap()
         )
         .is_err());
     }
