@@ -12,8 +12,10 @@ const LEFT: f64 = 80.0;
 const RIGHT: f64 = 230.0;
 const TOP: f64 = 40.0;
 const BOTTOM: f64 = 60.0;
-const PALETTE: [&str; 8] = [
+// Twelve colours that stay apart: one per reference shader.
+const PALETTE: [&str; 12] = [
     "#1f77b4", "#d62728", "#2ca02c", "#9467bd", "#ff7f0e", "#8c564b", "#e377c2", "#17becf",
+    "#bcbd22", "#7f7f7f", "#000080", "#00a000",
 ];
 
 /// Text safe inside an XML element or attribute.
