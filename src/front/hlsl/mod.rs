@@ -266,7 +266,7 @@ fn instantiate_templates(items: &mut Vec<ast::Item>, files: &[PathBuf], options:
         for inst in &needed {
             // A failure here (or an instance asked for twice) leaves the
             // instance missing: the compile then reports the use that needed it.
-            if !made.insert(inst.name.clone())
+            if !made.insert((inst.name.clone(), inst.template))
                 || made.len() > MAX_INSTANCES
                 || template::instantiate(items, inst).is_err()
             {

@@ -190,6 +190,10 @@ impl<'a> Lowerer<'a> {
     fn call(&mut self, name: &str, args: &'a [Expr], pos: Pos) -> Result<Option<Val>> {
         if let Some(this) = self.f.this_place.clone() {
             if let Ty::Struct(k) = this.ty() {
+                // `S::m(...)` inside a method of `S` is `m(...)` (on `this`
+                // when `m` is not static), as in C++.
+                let own = format!("{}::", self.structs[*k as usize].name);
+                let name = name.strip_prefix(own.as_str()).unwrap_or(name);
                 let qualified = format!("{}::{name}", self.structs[*k as usize].name);
                 if let Some(c) = self.fn_by_name.get(&qualified).cloned() {
                     if c.iter().all(|k| self.funcs[*k].this.is_none()) {
@@ -212,6 +216,9 @@ impl<'a> Lowerer<'a> {
         }
         if let Some(r) = self.ser_call(name, args, pos)? {
             return Ok(r);
+        }
+        if name == "vk::RawBufferLoad" {
+            return self.raw_buffer_load(None, args, pos).map(Some);
         }
         let user_fits = self.find_user(name).is_some_and(|c| {
             c.iter().any(|k| {
@@ -1386,10 +1393,43 @@ impl<'a> Lowerer<'a> {
         pos: Pos,
     ) -> Result<Place> {
         let cands = self.find_user(name).unwrap_or_default();
+        // Found as `S::m` from a method of `S`: a method of `this`.
+        let this = self
+            .f
+            .this_place
+            .clone()
+            .filter(|_| cands.iter().any(|k| self.funcs[*k].this.is_some()));
+        self.inline_resource_call(name, cands, this, args, pos)
+    }
+
+    /// `m(...)` inside a method, or `obj.m(...)`, of a struct whose method
+    /// `m` returns a resource: the struct's qualified name and candidates.
+    pub(super) fn resource_method(&self, this: &Place, name: &str) -> Option<Vec<usize>> {
+        let Ty::Struct(k) = this.ty() else {
+            return None;
+        };
+        let own = format!("{}::", self.structs[*k as usize].name);
+        let name = name.strip_prefix(own.as_str()).unwrap_or(name);
+        let c = self.fn_by_name.get(&format!("{own}{name}"))?;
+        c.iter()
+            .any(|k| self.funcs[*k].ret.is_resource())
+            .then(|| c.clone())
+    }
+
+    /// Inlines a helper (or, with `this`, a method) returning a resource.
+    pub(super) fn inline_resource_call(
+        &mut self,
+        name: &str,
+        cands: Vec<usize>,
+        this: Option<Place>,
+        args: &'a [Expr],
+        pos: Pos,
+    ) -> Result<Place> {
+        let first = this.is_some() as usize;
         let Some(k) = cands.into_iter().find(|k| {
             let f = &self.funcs[*k];
-            f.this.is_none()
-                && (f.params.len() - f.defaults.len()..=f.params.len()).contains(&args.len())
+            let n = f.params.len() - first;
+            f.this.is_some() == this.is_some() && (n - f.defaults.len()..=n).contains(&args.len())
         }) else {
             return Err(Error::new(
                 pos,
@@ -1416,9 +1456,12 @@ impl<'a> Lowerer<'a> {
                 format!("`{name}` is recursive; HLSL does not allow recursion"),
             ));
         }
-        let first_default = sig.params.len() - sig.defaults.len();
+        let first_default = sig.params.len() - first - sig.defaults.len();
         let mut scope = HashMap::new();
-        for (i, (p, decl)) in sig.params.iter().zip(&sig.func.params).enumerate() {
+        if let Some(t) = &this {
+            scope.insert("this".to_string(), t.clone());
+        }
+        for (i, (p, decl)) in sig.params[first..].iter().zip(&sig.func.params).enumerate() {
             let a = match args.get(i) {
                 Some(a) => a,
                 None => sig.defaults[i - first_default],
@@ -1439,7 +1482,7 @@ impl<'a> Lowerer<'a> {
         }
         // The helper's body sees its parameters and the globals, not the caller's locals.
         let scopes = std::mem::replace(&mut self.f.scopes, vec![scope]);
-        let this = self.f.this_place.take();
+        let this = std::mem::replace(&mut self.f.this_place, this);
         let ns = std::mem::replace(&mut self.f.cur_ns, sig.func.ns.clone());
         self.f.inline_depth += 1;
         let r = self.place(ret);

@@ -242,11 +242,12 @@ impl<'a> Lowerer<'a> {
         let mut params = Vec::new();
         for p in &f.params {
             let t = self.resolve_ty(&p.ty, &f.ns)?;
-            let t = self.apply_dims(t, &p.dims, p.pos, false)?;
-            if t.is_resource() && (matches!(t, Ty::Array(..) | Ty::RtArray(_)) || p.mods.output) {
+            let unsized_ok = t.is_resource(); // `Texture2D ts[]`, passed as its variable
+            let t = self.apply_dims(t, &p.dims, p.pos, unsized_ok)?;
+            if t.is_resource() && (bad_resource_array(&t) || p.mods.output) {
                 return Err(unsupported(
                     p.pos,
-                    "arrays of resources, or `out` resources, as function parameters",
+                    "arrays of buffers, or `out` resources, as function parameters",
                 ));
             }
             params.push(Param {
@@ -315,12 +316,12 @@ impl<'a> Lowerer<'a> {
             }
             for p in &f.params {
                 let t = self.resolve_ty(&p.ty, &f.ns)?;
-                let t = self.apply_dims(t, &p.dims, p.pos, false)?;
-                if t.is_resource() && (matches!(t, Ty::Array(..) | Ty::RtArray(_)) || p.mods.output)
-                {
+                let unsized_ok = t.is_resource(); // `Texture2D ts[]`, passed as its variable
+                let t = self.apply_dims(t, &p.dims, p.pos, unsized_ok)?;
+                if t.is_resource() && (bad_resource_array(&t) || p.mods.output) {
                     return Err(unsupported(
                         p.pos,
-                        "arrays of resources, or `out` resources, as function parameters",
+                        "arrays of buffers, or `out` resources, as function parameters",
                     ));
                 }
                 params.push(Param {
@@ -371,16 +372,27 @@ impl<'a> Lowerer<'a> {
 
     fn declare_struct_in(&mut self, s: &StructDecl, scope: &str) -> Result<()> {
         let mut fields = Vec::new();
+        let mut decorations = Vec::new();
         for b in &s.bases {
             // A base's members come first, as C++ lays them out.
             match self.resolve_ty(b, scope)? {
-                Ty::Struct(k) => fields.extend(self.structs[k as usize].fields.iter().cloned()),
+                Ty::Struct(k) => {
+                    let at = fields.len() as u32;
+                    for (i, d, ops) in self.member_decorations.get(&k).into_iter().flatten() {
+                        decorations.push((at + i, *d, ops.clone()));
+                    }
+                    fields.extend(self.structs[k as usize].fields.iter().cloned())
+                }
                 _ => return Err(Error::new(b.pos, "a base must be a struct")),
             }
         }
         for f in &s.fields {
             if let Some((_, pos)) = f.bits {
                 return Err(unsupported(pos, "bit fields"));
+            }
+            for a in f.attrs.iter().filter(|a| a.name == "vk::ext_decorate") {
+                let (d, ops) = self.ext_decoration(a)?;
+                decorations.push((fields.len() as u32, d, ops));
             }
             let t = self.resolve_ty(&f.ty, scope)?;
             let t = self.apply_dims(t, &f.dims, f.pos, false)?;
@@ -419,11 +431,14 @@ impl<'a> Lowerer<'a> {
             fields,
             pos: s.pos,
         });
+        if !decorations.is_empty() {
+            self.member_decorations.insert(k, decorations);
+        }
         self.struct_io.insert(
             k,
             s.fields
                 .iter()
-                .map(|f| (f.semantic.clone(), f.attrs.clone()))
+                .map(|f| (f.semantic.clone(), f.attrs.clone(), f.mods))
                 .collect(),
         );
         self.struct_names.insert(s.name.clone(), k);
@@ -977,6 +992,32 @@ impl<'a> Lowerer<'a> {
         binding: Option<(u32, u32)>,
         name: &str,
     ) -> Result<Id> {
+        let (tid, class) = self.descriptor_array_type(ty, attrs)?;
+        let pty = self.b.type_pointer(None, class, tid);
+        let var = self.global_var(pty, class, None);
+        self.b.name(var, name);
+        self.resource_vars.insert(var);
+        if let Some((set, binding)) = binding {
+            if matches!(
+                class,
+                StorageClass::Uniform | StorageClass::StorageBuffer | StorageClass::UniformConstant
+            ) {
+                self.b
+                    .decorate(var, Decoration::DescriptorSet, [Operand::LiteralBit32(set)]);
+                self.b
+                    .decorate(var, Decoration::Binding, [Operand::LiteralBit32(binding)]);
+            }
+        }
+        Ok(var)
+    }
+
+    /// The SPIR-V type of a descriptor variable of `ty` (a resource or an
+    /// array of them, sized or not) and its storage class.
+    pub(super) fn descriptor_array_type(
+        &mut self,
+        ty: &Ty,
+        attrs: &[Attr],
+    ) -> Result<(Id, StorageClass)> {
         let (inner, arrays) = {
             let mut t = ty;
             let mut arrays = Vec::new();
@@ -1009,22 +1050,7 @@ impl<'a> Lowerer<'a> {
                 }
             };
         }
-        let pty = self.b.type_pointer(None, class, tid);
-        let var = self.global_var(pty, class, None);
-        self.b.name(var, name);
-        self.resource_vars.insert(var);
-        if let Some((set, binding)) = binding {
-            if matches!(
-                class,
-                StorageClass::Uniform | StorageClass::StorageBuffer | StorageClass::UniformConstant
-            ) {
-                self.b
-                    .decorate(var, Decoration::DescriptorSet, [Operand::LiteralBit32(set)]);
-                self.b
-                    .decorate(var, Decoration::Binding, [Operand::LiteralBit32(binding)]);
-            }
-        }
-        Ok(var)
+        Ok((tid, class))
     }
 
     /// The SPIR-V type of one descriptor (or push-constant / shader-record
@@ -1444,4 +1470,43 @@ fn defaults_of(f: &Function) -> Result<Vec<&Expr>> {
             })
         })
         .collect()
+}
+
+impl<'a> Lowerer<'a> {
+    /// `[[vk::ext_decorate(decoration, literals...)]]`: the decoration and
+    /// its literal operands, as constant integers.
+    fn ext_decoration(&mut self, a: &Attr) -> Result<(Decoration, Vec<u32>)> {
+        let Some((first, rest)) = a.args.split_first() else {
+            return Err(Error::new(
+                a.pos,
+                "expected [[vk::ext_decorate(decoration, ...)]]",
+            ));
+        };
+        let n = self.const_int(first)?;
+        let d = u32::try_from(n)
+            .ok()
+            .and_then(Decoration::from_u32)
+            .ok_or_else(|| Error::new(first.pos, format!("unknown SPIR-V decoration {n}")))?;
+        let mut ops = Vec::new();
+        for e in rest {
+            let v = self.const_int(e)?;
+            ops.push(u32::try_from(v).map_err(|_| {
+                Error::new(e.pos, format!("{v} is not a 32-bit decoration literal"))
+            })?);
+        }
+        Ok((d, ops))
+    }
+}
+
+/// Arrays of buffers cannot be function parameters (a function is copied per
+/// buffer passed); arrays of textures, samplers and acceleration structures
+/// are passed as their variable.
+fn bad_resource_array(t: &Ty) -> bool {
+    match t {
+        Ty::Array(e, _) | Ty::RtArray(e) => !matches!(
+            **e,
+            Ty::Accel | Ty::Sampler | Ty::SamplerCmp | Ty::Texture { .. }
+        ),
+        _ => false,
+    }
 }
