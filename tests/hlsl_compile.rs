@@ -1236,3 +1236,72 @@ fn a_returned_ray_query_is_the_callers_variable() {
         .collect();
     assert_eq!(params.len(), 2);
 }
+
+/// The constructs public shaders failed on (tests/hlsl/corpus_constructs.hlsl).
+#[test]
+fn constructs_from_the_public_corpus() {
+    let entries = compile_all("corpus_constructs.hlsl");
+    assert_eq!(
+        entries,
+        [
+            ("Main".to_string(), Stage::Compute),
+            ("Shade".to_string(), Stage::Fragment)
+        ]
+    );
+    let m = hlsl::compile(&shader("corpus_constructs.hlsl"), &HlslOptions::default()).unwrap();
+    let (main, shade) = (&m[0].words, &m[1].words);
+    let insts = instructions(main);
+    // Texture arrays are passed as their variables: `pick(gTextures, ...)`
+    // and `pickAny(gBindless, ...)` take the descriptor variables themselves,
+    // and `occluded` hands its acceleration-structure parameter on.
+    let textures = named(main, "gTextures")[0];
+    let bindless = named(main, "gBindless")[0];
+    let all_calls = calls(main);
+    assert!(all_calls.iter().any(|c| c[3..].contains(&textures)));
+    assert!(all_calls.iter().any(|c| c[3..].contains(&bindless)));
+    let scene_param = named(main, "scene");
+    assert!(all_calls
+        .iter()
+        .any(|c| c[3..].iter().any(|a| scene_param.contains(a))));
+    // Atomics on texels: OpImageTexelPointer (60) then OpAtomicOr (241) and
+    // OpAtomicUMin (237) on it.
+    let texel_ptrs: Vec<u32> = insts
+        .iter()
+        .filter(|(op, _)| *op == 60)
+        .map(|(_, ops)| ops[1])
+        .collect();
+    assert_eq!(texel_ptrs.len(), 2);
+    assert!(insts
+        .iter()
+        .any(|(op, ops)| *op == 241 && texel_ptrs.contains(&ops[2])));
+    assert!(insts
+        .iter()
+        .any(|(op, ops)| *op == 237 && texel_ptrs.contains(&ops[2])));
+    // vk::RawBufferLoad: OpConvertUToPtr (120) and an Aligned (2) load of 4,
+    // then of 16; the addressing model is PhysicalStorageBuffer64 (5348).
+    assert_eq!(insts.iter().filter(|(op, _)| *op == 120).count(), 2);
+    let aligned: Vec<u32> = insts
+        .iter()
+        .filter(|(op, ops)| *op == 61 && ops.len() == 5 && ops[3] == 2)
+        .map(|(_, ops)| ops[4])
+        .collect();
+    assert_eq!(aligned, [4, 16]);
+    assert!(insts.iter().any(|(op, ops)| *op == 14 && ops[0] == 5348));
+    // [[vk::ext_decorate(0)]]: member 0 of `Material` is RelaxedPrecision (0).
+    assert!(member_decorations(main, "Material").contains(&(0, 0)));
+    // The pixel shader: EarlyFragmentTests (9), and each input's interpolation.
+    let pixel = instructions(shade);
+    assert!(pixel.iter().any(|(op, ops)| *op == 16 && ops[1] == 9));
+    let decorated = |name: &str, decoration: u32| {
+        let var = named(shade, name)[0];
+        pixel
+            .iter()
+            .any(|(op, ops)| *op == 71 && ops[0] == var && ops[1] == decoration)
+    };
+    // Centroid (16), Flat (14), NoPerspective (13), Sample (17).
+    assert!(decorated("in.var.TEXCOORD0", 16));
+    assert!(decorated("in.var.TEXCOORD1", 14));
+    assert!(decorated("in.var.TEXCOORD2", 13));
+    assert!(decorated("in.var.TEXCOORD3", 17));
+    assert!(!decorated("in.var.TEXCOORD0", 14));
+}

@@ -160,7 +160,8 @@ pub const ATTRIBUTES: &[AttrInfo] = &[
         ANY,
     ),
     // Other stages and their attributes.
-    a("earlydepthstencil", Refused("`[earlydepthstencil]`"), ANY),
+    // Pixel entry points: `EarlyFragmentTests`.
+    a("earlydepthstencil", Implemented, FUNCTION),
     a("wavesize", Refused("`[WaveSize]`"), ANY),
     a("maxvertexcount", Refused("geometry shaders"), ANY),
     a("domain", Refused("tessellation shaders"), ANY),

@@ -23,6 +23,7 @@ mod templates;
 mod wave;
 
 use super::ast::*;
+use super::attrs;
 use super::error::{Error, Pos, Result};
 use super::parse::split_numeric;
 use super::subobject;
@@ -711,6 +712,18 @@ impl<'a> Lowerer<'a> {
                 sig.name.clone(),
                 vars,
             );
+            let early = sig
+                .func
+                .attrs
+                .iter()
+                .find(|a| attrs::normalize(&a.name) == "earlydepthstencil");
+            if let (Some(a), false) = (early, stage == Stage::Fragment) {
+                return Err(Error::new(
+                    a.pos,
+                    "`[earlydepthstencil]` applies to pixel shaders only",
+                )
+                .len(a.name.len() as u32));
+            }
             if stage == Stage::Compute {
                 self.b
                     .execution_mode(sig.id, spirv::ExecutionMode::LocalSize, sig.numthreads);
@@ -718,6 +731,10 @@ impl<'a> Lowerer<'a> {
                 // Vulkan requires it; HLSL's SV_Position has its origin at the top left.
                 self.b
                     .execution_mode(entry_id, spirv::ExecutionMode::OriginUpperLeft, []);
+                if early.is_some() {
+                    self.b
+                        .execution_mode(entry_id, spirv::ExecutionMode::EarlyFragmentTests, []);
+                }
             } else {
                 self.ray_tracing_caps();
             }

@@ -1004,17 +1004,30 @@ impl<'a> Lowerer<'a> {
         let bad = || {
             Error::new(
                 dest_pos,
-                format!("`{name}` needs an int or uint in a buffer or groupshared memory"),
+                format!("`{name}` needs an int or uint in a buffer, a storage image or groupshared memory"),
             )
         };
-        let Place::Ptr {
-            ptr,
-            ty: Ty::ScalarKind(s @ (ScalarKind::Int | ScalarKind::Uint)),
-            class: class @ (StorageClass::StorageBuffer | StorageClass::Workgroup),
-            ..
-        } = dest
-        else {
-            return Err(bad());
+        let (ptr, s, class) = match dest {
+            Place::Ptr {
+                ptr,
+                ty: Ty::ScalarKind(s @ (ScalarKind::Int | ScalarKind::Uint)),
+                class: class @ (StorageClass::StorageBuffer | StorageClass::Workgroup),
+                ..
+            } => (ptr, s, class),
+            // `img[coord]` of a `RWTexture*<uint>` or `RWBuffer<uint>`: a texel pointer.
+            Place::Texel {
+                image,
+                coord,
+                ty: Ty::ScalarKind(s @ (ScalarKind::Int | ScalarKind::Uint)),
+                ..
+            } => {
+                let st = self.ty_id(&Ty::ScalarKind(s))?;
+                let pty = self.b.type_pointer(None, StorageClass::Image, st);
+                let sample = self.const_u32(0);
+                let ptr = self.op(Op::ImageTexelPointer, pty, &[image, coord, sample])?;
+                (ptr, s, StorageClass::Image)
+            }
+            _ => return Err(bad()),
         };
         let op = match (name.trim_start_matches("Interlocked"), s) {
             ("Add", _) => Op::AtomicIAdd,

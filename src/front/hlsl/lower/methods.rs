@@ -27,6 +27,11 @@ impl<'a> Lowerer<'a> {
             let r = self.inline_resource_call(name, c, Some(p), args, pos)?;
             return self.read(&r).map(Some);
         }
+        if let Ty::ConstantBuffer(k) = *p.ty() {
+            // `cb.m()` of a `ConstantBuffer<S>`: `S::m` on a copy of its contents.
+            let v = self.struct_of(p, k, obj.pos)?;
+            return self.method_at(Place::Value(v), obj, name, args, pos);
+        }
         let t = p.ty().clone();
         match &t {
             Ty::Struct(k) => {
