@@ -246,6 +246,7 @@ fn front_options(config: &Config, options: &Options) -> FrontOptions {
             .collect(),
         entry: options.front.entry.clone(),
         stage: options.front.stage,
+        enable_16bit_types: config.hlsl.enable_16bit_types || options.front.enable_16bit_types,
     };
     front_options
         .include_dirs

@@ -53,6 +53,9 @@ struct Common {
         requires = "entry"
     )]
     stage: Option<String>,
+    /// HLSL: DXC's `-enable-16bit-types` (`half` is then 16-bit).
+    #[arg(long = "enable-16bit-types")]
+    enable_16bit_types: bool,
     /// The name standard input (`-`) is linted under; its extension picks the language.
     #[arg(long, value_name = "PATH")]
     stdin_filename: Option<PathBuf>,
@@ -238,6 +241,9 @@ enum Command {
         /// Define a macro: NAME or NAME=VALUE.
         #[arg(short = 'D', value_name = "NAME[=VALUE]")]
         define: Vec<String>,
+        /// DXC's `-enable-16bit-types` (`half` is then 16-bit).
+        #[arg(long = "enable-16bit-types")]
+        enable_16bit_types: bool,
         /// Output: a `.spv` file (one entry point, or with --whole every entry
         /// point in one module), or a directory for one module per entry point.
         #[arg(short = 'o', long = "output")]
@@ -308,9 +314,15 @@ fn run(cli: Cli) -> Result<u8, String> {
             stage,
             include,
             define,
+            enable_16bit_types,
             output,
             whole,
-        } => compile(file, entry, stage, include, define, output, whole),
+        } => compile(
+            file,
+            hlsl_options(entry, stage, include, define, enable_16bit_types),
+            output,
+            whole,
+        ),
         Command::Verify(args) => verify(args),
         Command::DriverStackSizes { pipeline, shader } => driver_stack_sizes(pipeline, shader),
         Command::Rules => {
@@ -374,6 +386,7 @@ fn options(common: &Common) -> Result<lint::Options, String> {
                 Some(Err(e)) => return Err(format!("-T: {e}")),
                 None => None,
             },
+            enable_16bit_types: common.enable_16bit_types,
         },
         respect_gitignore: !common.no_gitignore,
         stdin,
@@ -727,28 +740,42 @@ fn print_report(
     Ok(if problems.is_empty() { 0 } else { 2 })
 }
 
-fn compile(
-    file: PathBuf,
+/// `rtlint compile`'s HLSL options; `Err` is a bad `-T`.
+fn hlsl_options(
     entry: Option<String>,
     stage: Option<String>,
     include: Vec<PathBuf>,
     define: Vec<String>,
-    output: PathBuf,
-    whole: bool,
-) -> Result<u8, String> {
+    enable_16bit_types: bool,
+) -> Result<rtlint::front::hlsl::HlslOptions, String> {
     use rtlint::front::hlsl;
-    let stage = match stage.as_deref().map(hlsl::parse_stage).transpose() {
-        Ok(s) => s.flatten(),
-        Err(e) => {
-            eprintln!("error: -T: {e}");
-            return Ok(2);
-        }
-    };
-    let options = hlsl::HlslOptions {
+    let stage = stage
+        .as_deref()
+        .map(hlsl::parse_stage)
+        .transpose()?
+        .flatten();
+    Ok(hlsl::HlslOptions {
         stage,
         include_dirs: include,
         defines: define.iter().map(|d| split_define(d)).collect(),
         entry,
+        enable_16bit_types,
+    })
+}
+
+fn compile(
+    file: PathBuf,
+    options: Result<rtlint::front::hlsl::HlslOptions, String>,
+    output: PathBuf,
+    whole: bool,
+) -> Result<u8, String> {
+    use rtlint::front::hlsl;
+    let options = match options {
+        Ok(o) => o,
+        Err(e) => {
+            eprintln!("error: -T: {e}");
+            return Ok(2);
+        }
     };
     let write = |path: &std::path::Path, words: &[u32]| -> Result<(), String> {
         let bytes: Vec<u8> = words.iter().flat_map(|w| w.to_le_bytes()).collect();

@@ -378,6 +378,15 @@ fn cases() -> Vec<Case> {
             dx_layout: false,
         },
         Case {
+            name: "compute-frontend",
+            file: "diff_frontend.hlsl",
+            entries: vec![("Main", Compute)],
+            shape: Shape::Compute { groups: [1, 1, 1] },
+            scene: SceneKind::None,
+            resources: vec![out(0, 64 * 4 * 16, Format::F32x4)],
+            dx_layout: false,
+        },
+        Case {
             name: "compute-memory",
             file: "exec_memory.hlsl",
             entries: vec![("Main", Compute)],

@@ -40,6 +40,8 @@ pub struct FrontOptions {
     pub entry: Option<String>,
     /// HLSL: the stage of `entry` when it has no `[shader(...)]` (`-T`).
     pub stage: Option<crate::shader::Stage>,
+    /// HLSL: DXC's `-enable-16bit-types`.
+    pub enable_16bit_types: bool,
 }
 
 /// Reads and compiles one file to SPIR-V.
@@ -95,6 +97,7 @@ pub fn compile_input(
                 defines: options.defines.clone(),
                 entry: options.entry.clone(),
                 stage: options.stage,
+                enable_16bit_types: options.enable_16bit_types,
             };
             let m =
                 hlsl::compile_source_whole(path, &text, &mut hlsl::pp::FsLoader, &hlsl_options)?;

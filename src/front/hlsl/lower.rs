@@ -199,6 +199,8 @@ pub struct Lowerer<'a> {
     /// An entry point named on the command line with its stage, for
     /// functions without `[shader(...)]`.
     pub forced_entry: Option<(String, Stage)>,
+    /// `-enable-16bit-types`: `half` and `min16*` are 16-bit (refused).
+    pub sixteen_bit_types: bool,
     /// DXR subobjects the file declares.
     pub subobjects: super::subobject::Subobjects,
     /// Function templates by qualified name (never lowered themselves).
@@ -537,6 +539,7 @@ impl<'a> Lowerer<'a> {
             struct_io: HashMap::new(),
             member_decorations: HashMap::new(),
             physical_addressing: false,
+            sixteen_bit_types: false,
             fn_derivs: HashMap::new(),
             nonuniform: HashSet::new(),
             cbuffer_members: HashMap::new(),

@@ -482,6 +482,32 @@ impl<'a> Lowerer<'a> {
             }
         };
         if let Some((base, a, b)) = split_numeric(name) {
+            let sixteen = matches!(
+                base,
+                "half" | "min16float" | "min10float" | "min16int" | "min12int" | "min16uint"
+            );
+            if sixteen && self.sixteen_bit_types {
+                // 16-bit with -enable-16bit-types: refused, never widened.
+                return Err(unsupported(
+                    t.pos,
+                    format!("16-bit type `{base}` (with -enable-16bit-types)"),
+                )
+                .len(base.len() as u32));
+            }
+            if matches!(base, "float16_t" | "int16_t" | "uint16_t") {
+                let e = if self.sixteen_bit_types {
+                    unsupported(
+                        t.pos,
+                        format!("16-bit type `{base}` (with -enable-16bit-types)"),
+                    )
+                } else {
+                    Error::new(
+                        t.pos,
+                        format!("type `{base}` needs -enable-16bit-types, as in DXC"),
+                    )
+                };
+                return Err(e.len(base.len() as u32));
+            }
             let sc = match base {
                 "bool" => ScalarKind::Bool,
                 "int" | "min16int" | "min12int" | "int32_t" => ScalarKind::Int,
