@@ -431,6 +431,11 @@ fn cases() -> Vec<Case> {
 /// file in tests/hlsl must be in a case or here.
 const NOT_RUN: &[(&str, &str)] = &[
     (
+        "corpus_constructs.hlsl",
+        "samples textures, uses device addresses and a pixel shader; tests/hlsl_compile.rs \
+         checks each construct's instructions",
+    ),
+    (
         "pixel.hlsl",
         "a pixel shader: rtlint::vk has no graphics pipeline; tests/hlsl_compile.rs \
          compares its interface (built-ins, locations, Flat, execution mode) with Slang's",
