@@ -660,7 +660,7 @@ fn sixteen_bit_types_are_refused_rather_than_widened() {
     let src = "[numthreads(1,1,1)]\nvoid m() { half h = 1; float16_t f = h; }";
     assert_eq!(
         err(src),
-        "main.hlsl:2:24: type `float16_t` needs -enable-16bit-types, as in DXC"
+        "main.hlsl:2:24: not supported: 16-bit type `float16_t` (DXC needs -enable-16bit-types for it)"
     );
     let with_flag = |text: &str| {
         let opts = HlslOptions {

@@ -495,18 +495,17 @@ impl<'a> Lowerer<'a> {
                 .len(base.len() as u32));
             }
             if matches!(base, "float16_t" | "int16_t" | "uint16_t") {
-                let e = if self.sixteen_bit_types {
-                    unsupported(
-                        t.pos,
-                        format!("16-bit type `{base}` (with -enable-16bit-types)"),
-                    )
+                // Unsupported either way (refused where used, like other
+                // unsupported types); without the flag DXC refuses it too.
+                let why = if self.sixteen_bit_types {
+                    "with -enable-16bit-types"
                 } else {
-                    Error::new(
-                        t.pos,
-                        format!("type `{base}` needs -enable-16bit-types, as in DXC"),
-                    )
+                    "DXC needs -enable-16bit-types for it"
                 };
-                return Err(e.len(base.len() as u32));
+                return Err(
+                    unsupported(t.pos, format!("16-bit type `{base}` ({why})"))
+                        .len(base.len() as u32),
+                );
             }
             let sc = match base {
                 "bool" => ScalarKind::Bool,
