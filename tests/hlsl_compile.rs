@@ -1073,6 +1073,12 @@ fn shader_execution_reordering_uses_nv_invocation_reorder() {
     assert_eq!(count(5279), 2);
     assert_eq!(count(5280), 1);
     assert!(count(5259) >= 1);
+    // `materialOf(hit)` is given the hit object's variable itself.
+    let hit = named(&gen.words, "hit")[0];
+    let helper = named(&gen.words, "materialOf")[0];
+    assert!(calls(&gen.words)
+        .iter()
+        .any(|c| c[2] == helper && c[3] == hit));
     // The hit shaders do not reorder.
     assert!(!instructions(&entries[1].words)
         .iter()

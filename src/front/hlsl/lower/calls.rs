@@ -1254,8 +1254,9 @@ impl<'a> Lowerer<'a> {
         // without variable pointers: the function is specialized on them.
         let mut bound = Vec::new();
         for (i, ((p, (place, v)), a)) in sig.params.iter().zip(&argv).zip(&args).enumerate() {
-            if let Ty::RayQuery(_) = p.ty {
-                // A ray query is passed as its variable (it cannot be copied).
+            if let Ty::RayQuery(_) | Ty::HitObject = p.ty {
+                // A ray query or hit object is passed as its variable (it
+                // cannot be copied).
                 if p.out || v.ty != p.ty {
                     return Err(Error::new(
                         a.pos(),

@@ -502,10 +502,8 @@ impl<'a> Lowerer<'a> {
                 } else {
                     "DXC needs -enable-16bit-types for it"
                 };
-                return Err(
-                    unsupported(t.pos, format!("16-bit type `{base}` ({why})"))
-                        .len(base.len() as u32),
-                );
+                return Err(unsupported(t.pos, format!("16-bit type `{base}` ({why})"))
+                    .len(base.len() as u32));
             }
             let sc = match base {
                 "bool" => ScalarKind::Bool,

@@ -101,9 +101,6 @@ impl<'a> Lowerer<'a> {
                 if is_bound(i) {
                     continue;
                 }
-                if p.ty == Ty::HitObject {
-                    return Err(unsupported(f.pos, "HitObject function parameters"));
-                }
                 let (class, _) = self.param_class(&p.ty);
                 let t = if p.ty.is_resource() {
                     self.descriptor_array_type(&p.ty, &[])?.0
