@@ -27,6 +27,10 @@ pub enum Assumption {
     /// No pipeline description: every trace may reach every hit group and
     /// miss shader.
     Undescribed,
+    /// The pipeline comes from an HLSL library's DXR subobjects, which do
+    /// not give the shader table's order: every trace may reach every hit
+    /// group and miss shader they declare.
+    FromSubobjects,
     /// A trace whose SBT offset or stride is not a compile-time constant may
     /// reach every hit group.
     DynamicSbtOffset { at: Option<Location> },
@@ -51,7 +55,7 @@ impl Assumption {
     /// traces by position.
     fn sort_key(&self) -> (u8, bool, String, u8) {
         match self {
-            Assumption::Undescribed => (0, false, String::new(), 0),
+            Assumption::Undescribed | Assumption::FromSubobjects => (0, false, String::new(), 0),
             Assumption::DynamicSbtOffset { at } => (
                 1,
                 at.is_none(),
@@ -148,7 +152,9 @@ pub fn trace_graph(pipeline: &Pipeline) -> TraceGraph {
             slot: Slot::Callable(i),
         });
     }
-    if !pipeline.described() {
+    if pipeline.subobject_library.is_some() {
+        g.assumptions.push(Assumption::FromSubobjects);
+    } else if !pipeline.described() {
         g.assumptions.push(Assumption::Undescribed);
     }
     let described = pipeline.described();
