@@ -863,6 +863,44 @@ struct Rel {
 }
 
 /// The relations that hold when `cond` has value `want`.
+/// The label of the block that defines `id`.
+fn inst_block_label(program: &Program, id: Id) -> Option<Id> {
+    let at = *program.defs.get(&id)?;
+    let f = program.functions.get(program.function_of(at)?)?;
+    let b = f.blocks.iter().find(|b| b.start <= at && at <= b.end)?;
+    program.insts[b.start].result_id
+}
+
+/// The value bool `v` must have on the edge from block `from` to block `to`:
+/// when `from` ends in a conditional branch on `v` (or on its negation)
+/// that reaches `to` on one side only (glslang's `a || b` passes `a` itself
+/// to the phi, from the block that found it true).
+fn edge_value(program: &Program, v: Id, from: Id, to: Option<Id>) -> Option<bool> {
+    let to = to?;
+    let f = program
+        .functions
+        .iter()
+        .find(|f| f.block_by_label(from).is_some())?;
+    let end = &program.insts[f.blocks[f.block_by_label(from)?].end];
+    if end.class.opcode != Op::BranchConditional {
+        return None;
+    }
+    let o: Vec<Id> = ids(end).collect();
+    let [c, t, e, ..] = o.as_slice() else {
+        return None;
+    };
+    let taken = match (*t == to, *e == to) {
+        (true, false) => true,
+        (false, true) => false,
+        _ => return None,
+    };
+    if *c == v {
+        return Some(taken);
+    }
+    let not = program.def(*c)?;
+    (not.class.opcode == Op::LogicalNot && ids(not).next() == Some(v)).then_some(!taken)
+}
+
 fn relations(program: &Program, cond: Id, want: bool, out: &mut Vec<Rel>, depth: u32) {
     if depth > 8 {
         return;
@@ -901,6 +939,35 @@ fn relations(program: &Program, cond: Id, want: bool, out: &mut Vec<Rel>, depth:
                 c != Some(&crate::program::Constant::Bool(!want))
                     && !(want && c == Some(&crate::program::Constant::Null))
             })
+            .collect();
+        if let [only] = possible.as_slice() {
+            relations(program, *only, want, out, depth + 1);
+        }
+        return;
+    }
+    if inst.class.opcode == Op::Phi {
+        // glslang's `a || b` and `a && b`: a phi of a constant (the operand
+        // that decided) and the second operand. Where exactly one incoming
+        // value can be the wanted one, the branch implies it.
+        let possible: Vec<Id> = inst
+            .operands
+            .chunks(2)
+            .filter_map(|pair| match pair {
+                [rspirv::dr::Operand::IdRef(v), rspirv::dr::Operand::IdRef(from)] => {
+                    Some((*v, *from))
+                }
+                _ => None,
+            })
+            .filter(|&(v, from)| {
+                let c = program.constants.get(&v);
+                let known = match c {
+                    Some(crate::program::Constant::Bool(b)) => Some(*b),
+                    Some(crate::program::Constant::Null) => Some(false),
+                    _ => edge_value(program, v, from, inst_block_label(program, cond)),
+                };
+                known != Some(!want)
+            })
+            .map(|(v, _)| v)
             .collect();
         if let [only] = possible.as_slice() {
             relations(program, *only, want, out, depth + 1);
@@ -1188,7 +1255,7 @@ pub fn trace_loops(
                             header: header_inst,
                             location,
                             site_location: program.site_location(site.inst),
-                            bound: loop_bound(program, f, &body, constants),
+                            bound: loop_bound(program, f, header, &body, constants),
                         });
                     }
                 }
@@ -1201,13 +1268,25 @@ pub fn trace_loops(
 fn loop_bound(
     program: &Program,
     f: &Function,
+    header: usize,
     body: &HashSet<usize>,
     constants: &BTreeMap<String, DescribedConstant>,
 ) -> Result<LoopBound, NoLoopBound> {
     let mut why: Option<NoLoopBound> = None;
     let mut blocks: Vec<usize> = body.iter().copied().collect();
     blocks.sort_unstable();
+    // An exit bounds the loop only when every iteration passes it: its
+    // block dominates every back edge.
+    let idom = dominators(f);
+    let latches: Vec<usize> = blocks
+        .iter()
+        .copied()
+        .filter(|&b| f.blocks[b].succs.contains(&header))
+        .collect();
     for b in blocks {
+        if !latches.iter().all(|&l| dominates(&idom, b, l)) {
+            continue;
+        }
         let term = &program.insts[f.blocks[b].end];
         if term.class.opcode != Op::BranchConditional {
             continue;
@@ -1219,9 +1298,22 @@ fn loop_bound(
         let (Some(tb), Some(eb)) = (f.block_by_label(*t), f.block_by_label(*e)) else {
             continue;
         };
-        let stay = match (body.contains(&tb), body.contains(&eb)) {
-            (true, false) => true,
-            (false, true) => false,
+        // A target outside the loop, or a block in it that only branches out
+        // (`if (…) break;`), leaves the loop.
+        let leaves = |blk: usize| {
+            if !body.contains(&blk) {
+                return true;
+            }
+            let end = &program.insts[f.blocks[blk].end];
+            end.class.opcode == Op::Branch
+                && ids(end)
+                    .next()
+                    .and_then(|l| f.block_by_label(l))
+                    .is_some_and(|to| !body.contains(&to))
+        };
+        let stay = match (leaves(tb), leaves(eb)) {
+            (false, true) => true,
+            (true, false) => false,
             _ => continue,
         };
         let mut rels = Vec::new();
