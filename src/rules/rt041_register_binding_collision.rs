@@ -98,15 +98,19 @@ fn meant_for_vulkan(ctx: &Context) -> bool {
     if option == Some(true) {
         return true;
     }
-    p.files.iter().any(|f| {
-        let text = match &f.text {
+    // The sources debug info names, and the input itself (a module without
+    // debug info names none).
+    let own = std::fs::read_to_string(&p.path).unwrap_or_default();
+    std::iter::once(own)
+        .chain(p.files.iter().map(|f| match &f.text {
             Some(t) => t.clone(),
             None => std::fs::read_to_string(&f.path).unwrap_or_default(),
-        };
-        // Code, not a comment that mentions Vulkan.
-        text.lines()
-            .any(|l| l.split("//").next().is_some_and(|code| code.contains("vk::")))
-    })
+        }))
+        .any(|text| {
+            // Code, not a comment that mentions Vulkan.
+            text.lines()
+                .any(|l| l.split("//").next().is_some_and(|code| code.contains("vk::")))
+        })
 }
 
 /// A descriptor type, as far as a binding's compatibility goes.
