@@ -817,7 +817,7 @@ pub fn check_loose(
                 run(&pipeline, Assumption::FromSubobjects.to_string());
                 continue;
             }
-            Err(p) => p,
+            Err(p) => *p,
         };
         let has_rt = p.entry_points.iter().any(|e| e.stage.is_ray_tracing());
         if !has_rt {

@@ -625,7 +625,7 @@ fn stack(
         }
         match rtlint::pipeline::Pipeline::from_subobjects(program, &s) {
             Ok(p) => pipelines.push(p),
-            Err(program) => loose_programs.push(program),
+            Err(program) => loose_programs.push(*program),
         }
     }
     let programs = loose_programs;

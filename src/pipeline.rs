@@ -232,7 +232,10 @@ impl Pipeline {
     /// generation shader) or a hit group names a shader the library does not
     /// define with that stage (it is linked from another library): then the
     /// program comes back.
-    pub fn from_subobjects(program: Program, subobjects: &Subobjects) -> Result<Pipeline, Program> {
+    pub fn from_subobjects(
+        program: Program,
+        subobjects: &Subobjects,
+    ) -> Result<Pipeline, Box<Program>> {
         let describes = !subobjects.pipeline_configs.is_empty()
             || !subobjects.shader_configs.is_empty()
             || !subobjects.hit_groups.is_empty();
@@ -241,7 +244,7 @@ impl Pipeline {
             .iter()
             .any(|e| e.stage == Stage::RayGeneration);
         if !describes || !has_raygen {
-            return Err(program);
+            return Err(Box::new(program));
         }
         let file = program.path.clone();
         let mut p = Pipeline::from_programs(vec![program]);
@@ -280,7 +283,7 @@ impl Pipeline {
             };
             match subobjects.hit_groups.iter().map(group).collect() {
                 Some(groups) => p.hit_groups = groups,
-                None => return Err(p.programs.remove(0)),
+                None => return Err(Box::new(p.programs.remove(0))),
             }
         }
         if let Some(c) = subobjects
@@ -771,7 +774,7 @@ mod tests {
         let program = Pipeline::from_subobjects(program, &subobjects).unwrap_err();
         assert_eq!(program.entry_points.len(), 3);
         // Without subobjects: no description either.
-        assert!(Pipeline::from_subobjects(program, &Subobjects::default()).is_err());
+        assert!(Pipeline::from_subobjects(*program, &Subobjects::default()).is_err());
     }
 
     #[test]
