@@ -653,10 +653,14 @@ fn counter_of(program: &Program, id: Id) -> Option<Counter> {
     if inst.class.opcode != Op::Load {
         return None;
     }
-    let (var, path) = pointer_path(program, ids(inst).next()?)?;
+    let ptr = ids(inst).next()?;
     let incoming = |v: Id| {
         global(program, v).is_some_and(|g| g.storage == StorageClass::IncomingRayPayloadKHR)
     };
+    if let Some(c) = parameter_counter(program, ptr, &[], &incoming) {
+        return Some(c);
+    }
+    let (var, path) = pointer_path(program, ptr)?;
     if incoming(var) {
         return Some(Counter::Payload { var, path });
     }
@@ -674,6 +678,72 @@ fn counter_of(program: &Program, id: Id) -> Option<Counter> {
         }
     }
     Some(Counter::Var { var, path })
+}
+
+/// A parameter passed by pointer (HLSL copies an `in` argument into a
+/// temporary and passes that): the incoming payload member every call from
+/// a hit or miss shader copies into it, when they all agree (`TraceRadianceRay(ray,
+/// payload.recursionDepth)` with the guard inside the helper).
+fn parameter_counter(
+    program: &Program,
+    param: Id,
+    path: &[u64],
+    incoming: &dyn Fn(Id) -> bool,
+) -> Option<Counter> {
+    if program.def(param)?.class.opcode != Op::FunctionParameter {
+        return None;
+    }
+    let f = program
+        .functions
+        .iter()
+        .find(|f| f.params.contains(&param))?;
+    let k = f.params.iter().position(|&p| p == param)?;
+    // Only calls from shaders that can close a recursion cycle (those with
+    // an incoming payload) matter to a depth guard: the ray generation
+    // shader's first call passes its own start value.
+    let mut in_cycle_stages: HashSet<Id> = HashSet::new();
+    for e in program.entry_points.iter().filter(|e| {
+        matches!(
+            e.stage,
+            Stage::ClosestHit | Stage::AnyHit | Stage::Miss | Stage::Intersection
+        )
+    }) {
+        in_cycle_stages.extend(program.reachable_functions(e.function));
+    }
+    let mut found: Option<Counter> = None;
+    for (_, call) in program.insts.iter().enumerate().filter(|(n, i)| {
+        i.class.opcode == Op::FunctionCall
+            && matches!(i.operands.first(), Some(Operand::IdRef(x)) if *x == f.id)
+            && program
+                .function_of(*n)
+                .and_then(|k| program.functions.get(k))
+                .is_some_and(|g| in_cycle_stages.contains(&g.id))
+    }) {
+        let Some(Operand::IdRef(arg)) = call.operands.get(1 + k) else {
+            return None;
+        };
+        let (var, mut arg_path) = pointer_path(program, *arg)?;
+        if !is_local(program, var) {
+            return None;
+        }
+        arg_path.extend_from_slice(path);
+        let sources = values_of(program, (var, arg_path));
+        let Some(Source::Read(v, p)) = sources.first() else {
+            return None;
+        };
+        if !incoming(*v) || sources.iter().any(|s| *s != sources[0]) {
+            return None;
+        }
+        let c = Counter::Payload {
+            var: *v,
+            path: p.clone(),
+        };
+        if found.as_ref().is_some_and(|f| *f != c) {
+            return None;
+        }
+        found = Some(c);
+    }
+    found
 }
 
 /// Whether `value` is `counter + c` with a constant `c > 0`; `c`.
@@ -1172,12 +1242,25 @@ fn initial_value(
         }
         let shader = &graph.nodes[e.from].shader;
         let program = pipeline.program(shader)?;
-        let payload = program.sites.iter().find(|s| s.inst == e.inst)?.payload?;
+        let site = program.sites.iter().find(|s| s.inst == e.inst)?;
+        let payload = site.payload?;
+        // A helper's parameter (the depth a ray generation shader passes to
+        // the function that traces) folds per call chain.
+        let mut chains = program
+            .functions
+            .get(site.function)
+            .map(|f| call_chains(program, shader.function, f.id, super::liveness::MAX_CHAINS))
+            .unwrap_or_default();
+        if chains.is_empty() {
+            chains.push(Vec::new());
+        }
         for source in values_of(program, (payload, path.to_vec())) {
             if let Source::Value(val) = source {
-                if let Some(c) = program.fold(val) {
-                    let c = signed(program, val, c);
-                    value = Some(value.map_or(c, |v: i64| v.min(c)));
+                for chain in &chains {
+                    if let Some(c) = program.fold_in(val, chain) {
+                        let c = signed(program, val, c);
+                        value = Some(value.map_or(c, |v: i64| v.min(c)));
+                    }
                 }
             }
         }

@@ -260,9 +260,37 @@ impl Program {
         Some(v & mask)
     }
 
+    /// Whether the function `call` calls never stores through, nor passes
+    /// on, its parameter for operand `k` (an `in` argument's copy).
+    fn reads_only(&self, call: &rspirv::dr::Instruction, k: usize) -> bool {
+        let Some(Operand::IdRef(callee)) = call.operands.first() else {
+            return false;
+        };
+        let Some(f) = self.functions.iter().find(|f| f.id == *callee) else {
+            return false;
+        };
+        let Some(&param) = f.params.get(k - 1) else {
+            return false;
+        };
+        self.insts[f.start..=f.end].iter().all(|i| {
+            self.is_debug_inst(i)
+                || !i
+                    .operands
+                    .iter()
+                    .any(|o| matches!(o, Operand::IdRef(x) if *x == param))
+                || i.class.opcode == Op::Load
+        })
+    }
+
     /// The one value every write to local variable `ptr` stores, folded.
     fn forwarded(&self, ptr: Id, chain: &[usize], depth: u32) -> Option<u64> {
         let var = self.def(ptr)?;
+        if var.class.opcode == Op::FunctionParameter && depth <= MAX_DEPTH {
+            // A pointer parameter (HLSL's copy of an `in` argument): the
+            // temporary the chain's call passes.
+            let (arg, outer) = self.argument(ptr, chain)?;
+            return self.forwarded(arg, outer, depth + 1);
+        }
         if var.class.opcode != Op::Variable
             || !matches!(
                 var.operands.first(),
@@ -290,6 +318,9 @@ impl Program {
             }
             match inst.class.opcode {
                 Op::Load => {}
+                // Passed to a function that only reads it (HLSL's copy of an
+                // `in` argument).
+                Op::FunctionCall if k > 0 && uses.next().is_none() && self.reads_only(inst, k) => {}
                 Op::Store if k == 0 && uses.next().is_none() => {
                     let Some(Operand::IdRef(stored)) = inst.operands.get(1) else {
                         return None;
