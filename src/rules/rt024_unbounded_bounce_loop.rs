@@ -99,9 +99,9 @@ super::declare_rule! {
     /// such bounds; `docs/rules-precision.md`).
     ///
     /// The rule is pedantic (off unless selected): of what remained on public
-    /// shaders, none was a loop that really ends only on a miss, and two were
-    /// recursions bounded in ways the analysis does not follow (a depth passed
-    /// to a helper as a parameter, a `SkipShading` flag in the payload).
+    /// shaders, none was a loop that really ends only on a miss, and one was a
+    /// recursion bounded in a way the analysis does not follow (a
+    /// `SkipShading` flag in the payload instead of a counter).
     ///
     /// ## Why is this bad?
     ///
