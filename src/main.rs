@@ -265,6 +265,9 @@ enum Command {
         /// A pipeline description.
         #[arg(long)]
         pipeline: Option<PathBuf>,
+        /// An HLSL library whose DXR subobjects describe the pipeline.
+        #[arg(long)]
+        library: Option<PathBuf>,
         /// Loose shaders, as `LANG:PATH`.
         #[arg(long)]
         shader: Vec<String>,
@@ -324,7 +327,11 @@ fn run(cli: Cli) -> Result<u8, String> {
             whole,
         ),
         Command::Verify(args) => verify(args),
-        Command::DriverStackSizes { pipeline, shader } => driver_stack_sizes(pipeline, shader),
+        Command::DriverStackSizes {
+            pipeline,
+            library,
+            shader,
+        } => driver_stack_sizes(pipeline, library, shader),
         Command::Rules => {
             let mut out = std::io::stdout().lock();
             for r in rtlint::rules::RULES {
@@ -534,6 +541,8 @@ fn color_choice(arg: ColorArg, to_file: bool) -> ColorChoice {
 /// descriptions found, and input errors.
 struct Loaded {
     programs: Vec<rtlint::program::Program>,
+    /// The DXR subobjects of each program (empty but for HLSL libraries).
+    subobjects: Vec<rtlint::front::hlsl::subobject::Subobjects>,
     pipelines: Vec<PathBuf>,
     problems: Vec<Diagnostic>,
 }
@@ -543,14 +552,19 @@ fn load(common: &Common) -> Result<Loaded, String> {
     let inputs = lint::inputs(&common.paths, &options);
     let mut problems: Vec<Diagnostic> = inputs.errors.iter().map(|e| (*e.0).clone()).collect();
     let mut programs = Vec::new();
+    let mut subobjects = Vec::new();
     for input in &inputs.files {
-        match lint::load(input, &options) {
-            Ok(p) => programs.push(p),
+        match lint::load_library(input, &options) {
+            Ok((p, s)) => {
+                programs.push(p);
+                subobjects.push(s);
+            }
             Err(InputError(d)) => problems.push(*d),
         }
     }
     Ok(Loaded {
         programs,
+        subobjects,
         pipelines: inputs.pipelines.into_iter().map(|(p, _)| p).collect(),
         problems,
     })
@@ -599,16 +613,35 @@ fn stack(
     };
     let Loaded {
         programs,
+        subobjects,
         pipelines: descriptions,
         mut problems,
     } = load(&common)?;
     let mut pipelines = Vec::new();
+    let mut described = Vec::new();
     for p in &descriptions {
         match rtlint::pipeline::load(p) {
-            Ok(p) => pipelines.push(p),
+            Ok(p) => {
+                described.extend(p.programs.iter().map(|q| canonical(&q.path)));
+                pipelines.push(p)
+            }
             Err(InputError(d)) => problems.push(*d),
         }
     }
+    // An HLSL library no description names, declaring DXR subobjects, is
+    // the pipeline they describe.
+    let mut loose_programs = Vec::new();
+    for (program, s) in programs.into_iter().zip(subobjects) {
+        if described.contains(&canonical(&program.path)) {
+            loose_programs.push(program);
+            continue;
+        }
+        match rtlint::pipeline::Pipeline::from_subobjects(program, &s) {
+            Ok(p) => pipelines.push(p),
+            Err(program) => loose_programs.push(*program),
+        }
+    }
+    let programs = loose_programs;
     // Loose shaders: one conservative pipeline over all of them.
     if !programs.is_empty() {
         pipelines.push(rtlint::pipeline::Pipeline::from_programs(programs));
@@ -621,7 +654,7 @@ fn stack(
     #[cfg_attr(not(feature = "vulkan"), allow(unused_variables))]
     let loose: Vec<String> = pipelines
         .last()
-        .filter(|p| p.path.is_none())
+        .filter(|p| p.path.is_none() && p.subobject_library.is_none())
         .map(|p| {
             p.programs
                 .iter()
@@ -954,11 +987,14 @@ fn driver_in_child(
     };
     let mut command = std::process::Command::new(exe);
     command.arg("driver-stack-sizes");
-    match &p.path {
-        Some(path) => {
+    match (&p.path, &p.subobject_library) {
+        (Some(path), _) => {
             command.arg("--pipeline").arg(path);
         }
-        None => {
+        (None, Some(library)) => {
+            command.arg("--library").arg(library);
+        }
+        (None, None) => {
             for s in loose {
                 command.arg("--shader").arg(s);
             }
@@ -1005,10 +1041,21 @@ fn driver_in_child(
 }
 
 /// The child's side of [`driver_in_child`].
-fn driver_stack_sizes(pipeline: Option<PathBuf>, shaders: Vec<String>) -> Result<u8, String> {
-    let p = match pipeline {
-        Some(path) => rtlint::pipeline::load(&path).map_err(|e| e.0.message.clone())?,
-        None => {
+fn driver_stack_sizes(
+    pipeline: Option<PathBuf>,
+    library: Option<PathBuf>,
+    shaders: Vec<String>,
+) -> Result<u8, String> {
+    let p = match (pipeline, library) {
+        (Some(path), _) => rtlint::pipeline::load(&path).map_err(|e| e.0.message.clone())?,
+        (None, Some(path)) => {
+            let (program, subobjects) =
+                rtlint::front::load_library(&path, None, Language::Hlsl, &Default::default())
+                    .map_err(|e| e.0.message.clone())?;
+            rtlint::pipeline::Pipeline::from_subobjects(program, &subobjects)
+                .map_err(|_| format!("`{}` declares no pipeline subobjects", path.display()))?
+        }
+        (None, None) => {
             let mut programs = Vec::new();
             for s in &shaders {
                 let (lang, path) = s
@@ -1111,4 +1158,8 @@ fn measured_for(
         .filter(|(key, ..)| path == *key || path.ends_with(&format!("/{key}")))
         .map(|(_, slot, stage, b)| ((*slot, *stage), *b))
         .collect()
+}
+
+fn canonical(p: &std::path::Path) -> PathBuf {
+    std::fs::canonicalize(p).unwrap_or_else(|_| p.to_path_buf())
 }

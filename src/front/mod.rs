@@ -27,6 +27,8 @@ pub struct Compiled {
     pub decls: Vec<(NamedDecl, Location)>,
     /// The scratch file an external compiler read instead of `path`.
     pub scratch_source: Option<PathBuf>,
+    /// DXR subobjects an HLSL file declares (empty for other languages).
+    pub subobjects: hlsl::subobject::Subobjects,
 }
 
 /// Options for front-ends that read more than one file.
@@ -70,6 +72,7 @@ pub fn compile_input(
         words,
         decls,
         scratch_source: None,
+        subobjects: Default::default(),
     };
     match language {
         Language::Wgsl => {
@@ -101,7 +104,9 @@ pub fn compile_input(
             };
             let m =
                 hlsl::compile_source_whole(path, &text, &mut hlsl::pp::FsLoader, &hlsl_options)?;
-            Ok(compiled(Language::Hlsl, m.words, m.decls))
+            let mut c = compiled(Language::Hlsl, m.words, m.decls);
+            c.subobjects = m.subobjects;
+            Ok(c)
         }
         Language::Glsl => {
             // glslang takes bytes: a Latin-1 comment is no reason to refuse.
@@ -130,6 +135,17 @@ pub fn load_input(
     language: Language,
     options: &FrontOptions,
 ) -> Result<crate::program::Program, InputError> {
+    load_library(path, contents, language, options).map(|(program, _)| program)
+}
+
+/// [`load_input`], also giving the DXR subobjects an HLSL library declares
+/// (a pipeline description when no `*.pipeline.toml` names the file).
+pub fn load_library(
+    path: &Path,
+    contents: Option<&[u8]>,
+    language: Language,
+    options: &FrontOptions,
+) -> Result<(crate::program::Program, hlsl::subobject::Subobjects), InputError> {
     let c = compile_input(path, contents, language, options)?;
     let mut program = crate::program::parse(&c.words, &c.path, c.language)?;
     program.attach_named_decls(&c.decls);
@@ -140,5 +156,5 @@ pub fn load_input(
             }
         }
     }
-    Ok(program)
+    Ok((program, c.subobjects))
 }
