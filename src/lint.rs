@@ -2,8 +2,10 @@
 //! find the inputs, pick each one's config, load each into a Program, run the
 //! rules, apply suppressions. [`check_paths`] is the one entry point.
 
+use crate::analysis::callgraph::Assumption;
 use crate::config::Config;
 use crate::diag::{Diagnostic, InputError, InputErrorKind, Severity};
+use crate::front::hlsl::subobject::Subobjects;
 use crate::front::{self, FrontOptions};
 use crate::program::Program;
 use crate::shader::Language;
@@ -128,7 +130,7 @@ pub fn check_paths(paths: &[PathBuf], options: &Options) -> Report {
         .map(|input| check_input_with(input, &input.config, options))
         .collect();
     let mut owned: Vec<PathBuf> = Vec::new();
-    let mut programs: Vec<Program> = Vec::new();
+    let mut programs: Vec<(Program, Subobjects)> = Vec::new();
     for c in checked {
         if let Some(p) = &c.program {
             for f in &p.files {
@@ -141,7 +143,7 @@ pub fn check_paths(paths: &[PathBuf], options: &Options) -> Report {
             owned.push(c.path.clone());
         }
         diagnostics.extend(c.diagnostics);
-        programs.extend(c.program);
+        programs.extend(c.program.map(|p| (p, c.subobjects)));
     }
     let pipelines: Vec<Checked> = inputs
         .pipelines
@@ -230,9 +232,14 @@ pub fn inputs(paths: &[PathBuf], options: &Options) -> Inputs {
 /// Loads one input into a Program, with the config's and the options'
 /// include directories and defines.
 pub fn load(input: &Input, options: &Options) -> Result<Program, InputError> {
+    load_library(input, options).map(|(program, _)| program)
+}
+
+/// [`load`], also giving the DXR subobjects an HLSL library declares.
+pub fn load_library(input: &Input, options: &Options) -> Result<(Program, Subobjects), InputError> {
     let front_options = front_options(&input.config, options);
     let contents = input.contents.as_deref().map(|v| v.as_slice());
-    front::load_input(&input.path, contents, input.language, &front_options)
+    front::load_library(&input.path, contents, input.language, &front_options)
 }
 
 fn front_options(config: &Config, options: &Options) -> FrontOptions {
@@ -246,6 +253,7 @@ fn front_options(config: &Config, options: &Options) -> FrontOptions {
             .collect(),
         entry: options.front.entry.clone(),
         stage: options.front.stage,
+        enable_16bit_types: config.hlsl.enable_16bit_types || options.front.enable_16bit_types,
     };
     front_options
         .include_dirs
@@ -599,6 +607,8 @@ fn is_shader_like(p: &Path) -> bool {
 pub struct Checked {
     pub path: PathBuf,
     pub program: Option<Program>,
+    /// DXR subobjects the input declares (HLSL).
+    pub subobjects: Subobjects,
     pub diagnostics: Vec<Diagnostic>,
 }
 
@@ -615,20 +625,22 @@ pub fn check_input(path: &Path, language: Language, config: &Config) -> Checked 
 }
 
 fn check_input_with(input: &Input, config: &Config, options: &Options) -> Checked {
-    match load(input, options) {
-        Ok(program) => {
+    match load_library(input, options) {
+        Ok((program, subobjects)) => {
             let ignored = config.ignored_for(&input.path);
             let mut diagnostics = crate::rules::check_program(&program, config);
             drop_ignored(&mut diagnostics, &ignored);
             Checked {
                 path: input.path.clone(),
                 program: Some(program),
+                subobjects,
                 diagnostics,
             }
         }
         Err(e) => Checked {
             path: input.path.clone(),
             program: None,
+            subobjects: Subobjects::default(),
             diagnostics: vec![*e.0],
         },
     }
@@ -657,12 +669,14 @@ pub fn check_pipeline(path: &Path, config: &Config) -> Checked {
             Checked {
                 path: path.to_path_buf(),
                 program: None,
+                subobjects: Subobjects::default(),
                 diagnostics,
             }
         }
         Err(e) => Checked {
             path: path.to_path_buf(),
             program: None,
+            subobjects: Subobjects::default(),
             diagnostics: vec![*e.0],
         },
     }
@@ -776,18 +790,36 @@ fn canonical(p: &Path) -> PathBuf {
 }
 
 /// Runs the pipeline rules (RT020–RT025) on shaders no description uses:
-/// the shaders of each folder form one pipeline in which every trace may
-/// reach every hit group and miss shader, and each finding says so.
+/// an HLSL library that declares DXR subobjects is the pipeline they
+/// describe; otherwise the shaders of each folder form one pipeline in which
+/// every trace may reach every hit group and miss shader. Each finding says
+/// what was assumed.
 pub fn check_loose(
-    programs: Vec<Program>,
+    programs: Vec<(Program, Subobjects)>,
     described: &[PathBuf],
     config: &Config,
 ) -> Vec<Diagnostic> {
+    let mut out = Vec::new();
+    let mut run = |pipeline: &crate::pipeline::Pipeline, note: String| {
+        let ctx = crate::rules::PipelineContext::new(pipeline, config);
+        out.extend(
+            crate::rules::check_pipeline(&ctx)
+                .into_iter()
+                .map(|d| d.with_note(note.clone())),
+        );
+    };
     let mut groups: Vec<(PathBuf, Vec<Program>)> = Vec::new();
-    for p in programs {
+    for (p, subobjects) in programs {
         if described.contains(&canonical(&p.path)) {
             continue;
         }
+        let p = match crate::pipeline::Pipeline::from_subobjects(p, &subobjects) {
+            Ok(pipeline) => {
+                run(&pipeline, Assumption::FromSubobjects.to_string());
+                continue;
+            }
+            Err(p) => *p,
+        };
         let has_rt = p.entry_points.iter().any(|e| e.stage.is_ray_tracing());
         if !has_rt {
             continue;
@@ -809,16 +841,9 @@ pub fn check_loose(
             None => groups.push((dir, vec![p])),
         }
     }
-    let mut out = Vec::new();
     for (_, programs) in groups {
         let pipeline = crate::pipeline::Pipeline::from_programs(programs);
-        let ctx = crate::rules::PipelineContext::new(&pipeline, config);
-        let note = crate::analysis::callgraph::Assumption::Undescribed.to_string();
-        out.extend(
-            crate::rules::check_pipeline(&ctx)
-                .into_iter()
-                .map(|d| d.with_note(note.clone())),
-        );
+        run(&pipeline, Assumption::Undescribed.to_string());
     }
     out
 }
@@ -833,7 +858,7 @@ mod tests {
     fn loose_shaders_get_pipeline_rules_with_the_assumption() {
         let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/guards/constructed.wgsl");
         let p = front::load(&path, Language::Wgsl).unwrap();
-        let d = check_loose(vec![p], &[], &Config::default());
+        let d = check_loose(vec![(p, Subobjects::default())], &[], &Config::default());
         let rt020: Vec<_> = d.iter().filter(|d| d.code == Some("RT020")).collect();
         assert_eq!(rt020.len(), 1, "{d:?}");
         assert_eq!(rt020[0].primary.as_ref().unwrap().location.line, 42);
@@ -843,6 +868,7 @@ mod tests {
             .any(|n| n.contains("every trace may reach every hit group and miss shader")));
         // A shader a description uses is checked with that description only.
         let p = front::load(&path, Language::Wgsl).unwrap();
-        assert!(check_loose(vec![p], &[canonical(&path)], &Config::default()).is_empty());
+        let p = vec![(p, Subobjects::default())];
+        assert!(check_loose(p, &[canonical(&path)], &Config::default()).is_empty());
     }
 }
