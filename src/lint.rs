@@ -32,6 +32,8 @@ pub struct Overrides {
     pub ignore: Vec<String>,
     pub payload_budget: Option<u64>,
     pub deny_warnings: bool,
+    /// `--analysis`: which rules run by what they need.
+    pub analysis: Option<crate::config::AnalysisLevel>,
 }
 
 /// How to lint.
@@ -51,6 +53,34 @@ pub struct Options {
     pub stdin: Option<Vec<u8>>,
     /// The name standard input is linted under (`--stdin-filename`).
     pub stdin_filename: Option<PathBuf>,
+    /// The result cache's folder; `None`: no cache.
+    pub cache: Option<PathBuf>,
+    /// Check only this part of the files (`--shard K/N`).
+    pub shard: Option<Shard>,
+}
+
+/// Part `index` (1-based) of `count`: folders are dealt out whole, so the
+/// shaders a loose pipeline groups together stay on one shard.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Shard {
+    pub index: u32,
+    pub count: u32,
+}
+
+impl std::str::FromStr for Shard {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        let bad = || format!("`{s}` is not a shard: write K/N with 1 ≤ K ≤ N, e.g. 2/4");
+        let (k, n) = s.split_once('/').ok_or_else(bad)?;
+        let (index, count) = (
+            k.trim().parse::<u32>().map_err(|_| bad())?,
+            n.trim().parse::<u32>().map_err(|_| bad())?,
+        );
+        if index == 0 || index > count {
+            return Err(bad());
+        }
+        Ok(Shard { index, count })
+    }
 }
 
 impl Default for Options {
@@ -64,6 +94,8 @@ impl Default for Options {
             respect_gitignore: true,
             stdin: None,
             stdin_filename: None,
+            cache: None,
+            shard: None,
         }
     }
 }
@@ -111,7 +143,19 @@ impl Report {
 /// Lints `paths` (files, folders, or `-` for standard input).
 pub fn check_paths(paths: &[PathBuf], options: &Options) -> Report {
     let mut configs = Configs::new(options);
-    let inputs = collect(paths, options, &mut configs);
+    let mut inputs = collect(paths, options, &mut configs);
+    // Shaders a description uses are checked with it (on the description's
+    // shard), never as loose shaders: on every shard.
+    let descriptions: Vec<Vec<PathBuf>> = inputs
+        .pipelines
+        .iter()
+        .map(|(p, _)| described_shaders(p))
+        .collect();
+    if let Some(shard) = options.shard {
+        keep_shard(&mut inputs, &descriptions, shard);
+    }
+    let described: Vec<PathBuf> = descriptions.into_iter().flatten().collect();
+    let cache = options.cache.as_deref().and_then(crate::cache::Cache::open);
     let mut report = Report {
         files: inputs.files.iter().map(|i| i.path.clone()).collect(),
         pipelines: inputs.pipelines.iter().map(|(p, _)| p.clone()).collect(),
@@ -122,26 +166,34 @@ pub fn check_paths(paths: &[PathBuf], options: &Options) -> Report {
     diagnostics.extend(inputs.errors.iter().map(|e| (*e.0).clone()));
     // Files in parallel; collected in input order, so output is the same
     // whatever the thread count.
-    let checked: Vec<Checked> = inputs
+    let checked: Vec<Outcome> = inputs
         .files
         .par_iter()
-        .map(|input| check_input_with(input, &input.config, options))
+        .map(|input| check_cached(input, options, cache.as_ref()))
         .collect();
     let mut owned: Vec<PathBuf> = Vec::new();
-    let mut programs: Vec<Program> = Vec::new();
-    for c in checked {
-        if let Some(p) = &c.program {
-            for f in &p.files {
-                if let Some(t) = &f.text {
-                    report.embedded.push((f.path.clone(), t.clone()));
+    // The loose pipelines: each group's members (input index, outcome).
+    let mut groups: Vec<(PathBuf, Vec<usize>)> = Vec::new();
+    let mut outcomes = Vec::with_capacity(checked.len());
+    for (i, mut c) in checked.into_iter().enumerate() {
+        if c.analysed {
+            for (path, text) in &c.files {
+                if let Some(t) = text {
+                    report.embedded.push((path.clone(), t.clone()));
                 }
-                owned.push(f.path.clone());
+                owned.push(path.clone());
             }
             // Suppressions are judged only in inputs that were analysed.
-            owned.push(c.path.clone());
+            owned.push(inputs.files[i].path.clone());
         }
-        diagnostics.extend(c.diagnostics);
-        programs.extend(c.program);
+        diagnostics.append(&mut c.diagnostics);
+        if let Some(g) = &c.group {
+            match groups.iter_mut().find(|(d, _)| d == g) {
+                Some((_, members)) => members.push(i),
+                None => groups.push((g.clone(), vec![i])),
+            }
+        }
+        outcomes.push(c);
     }
     let pipelines: Vec<Checked> = inputs
         .pipelines
@@ -153,13 +205,24 @@ pub fn check_paths(paths: &[PathBuf], options: &Options) -> Report {
     }
     // Shaders no description uses still get the pipeline rules, under the
     // assumption that every trace reaches every shader.
-    let described: Vec<PathBuf> = inputs
-        .pipelines
-        .iter()
-        .flat_map(|(p, _)| described_shaders(p))
-        .collect();
     if let Some(first) = inputs.files.first() {
-        diagnostics.extend(check_loose(programs, &described, &first.config));
+        for (_, members) in groups {
+            let members: Vec<usize> = members
+                .into_iter()
+                .filter(|&i| !described.contains(&canonical(&inputs.files[i].path)))
+                .collect();
+            if members.is_empty() {
+                continue;
+            }
+            diagnostics.extend(check_group_cached(
+                &members,
+                &inputs.files,
+                &mut outcomes,
+                &first.config,
+                options,
+                cache.as_ref(),
+            ));
+        }
     }
     report.deny_warnings = options.overrides.deny_warnings
         || inputs.files.iter().any(|i| i.config.deny_warnings)
@@ -325,6 +388,9 @@ impl Configs {
             config.set_option("RT001", "budget", toml::Value::Integer(b as i64));
         }
         config.deny_warnings |= o.deny_warnings;
+        if let Some(a) = o.analysis {
+            config.analysis = a;
+        }
         let c = Arc::new(config);
         self.by_file.insert(key, c.clone());
         c
@@ -788,21 +854,8 @@ pub fn check_loose(
         if described.contains(&canonical(&p.path)) {
             continue;
         }
-        let has_rt = p.entry_points.iter().any(|e| e.stage.is_ray_tracing());
-        if !has_rt {
+        let Some(dir) = loose_group(&p) else {
             continue;
-        }
-        // A file holding a ray generation shader and others (WGSL, HLSL) is
-        // a pipeline of its own; one-stage modules pipeline with their folder.
-        let whole = p
-            .entry_points
-            .iter()
-            .any(|e| e.stage == crate::shader::Stage::RayGeneration)
-            && p.entry_points.len() > 1;
-        let dir = if whole {
-            p.path.clone()
-        } else {
-            p.path.parent().map(Path::to_path_buf).unwrap_or_default()
         };
         match groups.iter_mut().find(|(d, _)| *d == dir) {
             Some((_, g)) => g.push(p),
@@ -811,16 +864,255 @@ pub fn check_loose(
     }
     let mut out = Vec::new();
     for (_, programs) in groups {
-        let pipeline = crate::pipeline::Pipeline::from_programs(programs);
-        let ctx = crate::rules::PipelineContext::new(&pipeline, config);
-        let note = crate::analysis::callgraph::Assumption::Undescribed.to_string();
-        out.extend(
-            crate::rules::check_pipeline(&ctx)
-                .into_iter()
-                .map(|d| d.with_note(note.clone())),
-        );
+        out.extend(check_group(programs, config));
     }
     out
+}
+
+/// The loose pipeline a module belongs to: a file holding a ray generation
+/// shader and others (WGSL, HLSL) is a pipeline of its own; one-stage
+/// modules pipeline with their folder. `None` without ray-tracing stages.
+fn loose_group(p: &Program) -> Option<PathBuf> {
+    if !p.entry_points.iter().any(|e| e.stage.is_ray_tracing()) {
+        return None;
+    }
+    let whole = p
+        .entry_points
+        .iter()
+        .any(|e| e.stage == crate::shader::Stage::RayGeneration)
+        && p.entry_points.len() > 1;
+    Some(if whole {
+        p.path.clone()
+    } else {
+        p.path.parent().map(Path::to_path_buf).unwrap_or_default()
+    })
+}
+
+/// The pipeline rules over one loose group, each finding noting the
+/// assumption.
+fn check_group(programs: Vec<Program>, config: &Config) -> Vec<Diagnostic> {
+    let pipeline = crate::pipeline::Pipeline::from_programs(programs);
+    let ctx = crate::rules::PipelineContext::new(&pipeline, config);
+    let note = crate::analysis::callgraph::Assumption::Undescribed.to_string();
+    crate::rules::check_pipeline(&ctx)
+        .into_iter()
+        .map(|d| d.with_note(note.clone()))
+        .collect()
+}
+
+/// One input's outcome in [`check_paths`]: computed, or read from the cache
+/// (then without a Program, which a loose pipeline group loads only when its
+/// own entry misses).
+struct Outcome {
+    /// Loaded and analysed (suppressions in its files are judged).
+    analysed: bool,
+    program: Option<Program>,
+    diagnostics: Vec<Diagnostic>,
+    /// The module's source files and the text it embeds.
+    files: Vec<(PathBuf, Option<String>)>,
+    /// Its loose pipeline group.
+    group: Option<PathBuf>,
+    /// Its cache key, when the cache is on and the input could be read.
+    key: Option<crate::cache::Key>,
+}
+
+/// The cache key of an input under its config and the options.
+fn input_key(input: &Input, options: &Options) -> Option<crate::cache::Key> {
+    let contents;
+    let bytes = match &input.contents {
+        Some(c) => c.as_slice(),
+        None => {
+            contents = std::fs::read(&input.path).ok()?;
+            contents.as_slice()
+        }
+    };
+    let front = front_options(&input.config, options);
+    let mut k = crate::cache::base_key();
+    k.add(&input.path)
+        .add(format!("{:?}", input.language))
+        .add(bytes)
+        .add(format!("{:?}", input.config))
+        .add(format!("{front:?}"));
+    Some(k.finish())
+}
+
+fn check_cached(input: &Input, options: &Options, cache: Option<&crate::cache::Cache>) -> Outcome {
+    let key = cache.and_then(|_| input_key(input, options));
+    if let (Some(cache), Some(key)) = (cache, key) {
+        if let Some(entry) = cache.get(key) {
+            if let Some(diagnostics) = crate::cache::load_all(entry.diagnostics) {
+                return Outcome {
+                    analysed: true,
+                    program: None,
+                    diagnostics,
+                    files: entry.files,
+                    group: entry.group,
+                    key: Some(key),
+                };
+            }
+        }
+    }
+    let c = check_input_with(input, &input.config, options);
+    let files: Vec<(PathBuf, Option<String>)> = c
+        .program
+        .iter()
+        .flat_map(|p| p.files.iter().map(|f| (f.path.clone(), f.text.clone())))
+        .collect();
+    let group = c.program.as_ref().and_then(loose_group);
+    if let (Some(cache), Some(key), Some(_)) = (cache, key, &c.program) {
+        if let Some(diagnostics) = crate::cache::store_all(&c.diagnostics) {
+            // Everything the module names besides the input itself: includes,
+            // and sources debug info points at (rules read their text).
+            let deps = files
+                .iter()
+                .map(|(p, _)| p)
+                .filter(|p| **p != input.path)
+                .map(|p| (p.clone(), crate::cache::dep_hash(p)))
+                .collect();
+            cache.put(
+                key,
+                &crate::cache::Entry {
+                    deps,
+                    files: files.clone(),
+                    diagnostics,
+                    group: group.clone(),
+                },
+            );
+        }
+    }
+    Outcome {
+        analysed: c.program.is_some(),
+        // Only modules with ray-tracing stages join a loose pipeline.
+        program: c.program.filter(|_| group.is_some()),
+        diagnostics: c.diagnostics,
+        files,
+        group,
+        key,
+    }
+}
+
+/// The pipeline rules over one loose group (`members`: indices into
+/// `inputs`), from the cache when every member and the group are cached.
+fn check_group_cached(
+    members: &[usize],
+    inputs: &[Input],
+    outcomes: &mut [Outcome],
+    config: &Config,
+    options: &Options,
+    cache: Option<&crate::cache::Cache>,
+) -> Vec<Diagnostic> {
+    let key = cache.and_then(|_| {
+        let mut k = crate::cache::base_key();
+        k.add(format!("{config:?}"));
+        for &i in members {
+            k.add(&inputs[i].path).add(outcomes[i].key?);
+        }
+        Some(k.finish())
+    });
+    if let (Some(cache), Some(key)) = (cache, key) {
+        if let Some(d) = cache
+            .get_group(key)
+            .and_then(|g| crate::cache::load_all(g.diagnostics))
+        {
+            return d;
+        }
+    }
+    let mut programs = Vec::with_capacity(members.len());
+    for &i in members {
+        match outcomes[i].program.take() {
+            Some(p) => programs.push(p),
+            // Read from the cache: load it again for the pipeline.
+            None => match load(&inputs[i], options) {
+                Ok(p) => programs.push(p),
+                Err(_) => continue,
+            },
+        }
+    }
+    let out = check_group(programs, config);
+    if let (Some(cache), Some(key), Some(diagnostics)) = (cache, key, crate::cache::store_all(&out))
+    {
+        cache.put_group(key, &crate::cache::GroupEntry { diagnostics });
+    }
+    out
+}
+
+/// Keeps the files (and pipeline descriptions) of one shard. Folders are
+/// dealt out whole, in path order, each to the shard with the fewest files
+/// so far; a description's folder and the folders of the shaders it uses
+/// count as one, so that each finding comes from one shard.
+fn keep_shard(inputs: &mut Inputs, descriptions: &[Vec<PathBuf>], shard: Shard) {
+    let folder = |p: &Path| {
+        canonical(p)
+            .parent()
+            .map(Path::to_path_buf)
+            .unwrap_or_default()
+    };
+    // Union-find over folders.
+    let mut index: BTreeMap<PathBuf, usize> = BTreeMap::new();
+    for p in inputs
+        .files
+        .iter()
+        .map(|i| &i.path)
+        .chain(inputs.pipelines.iter().map(|(p, _)| p))
+    {
+        let n = index.len();
+        index.entry(folder(p)).or_insert(n);
+    }
+    for shaders in descriptions {
+        for s in shaders {
+            let n = index.len();
+            index.entry(folder(s)).or_insert(n);
+        }
+    }
+    let mut parent: Vec<usize> = (0..index.len()).collect();
+    fn root(parent: &mut [usize], mut v: usize) -> usize {
+        while parent[v] != v {
+            parent[v] = parent[parent[v]];
+            v = parent[v];
+        }
+        v
+    }
+    for ((p, _), shaders) in inputs.pipelines.iter().zip(descriptions) {
+        let a = index[&folder(p)];
+        for s in shaders {
+            let (ra, rb) = (root(&mut parent, a), root(&mut parent, index[&folder(s)]));
+            // The smaller index stays the root: the result is independent of
+            // the order of the unions.
+            parent[ra.max(rb)] = ra.min(rb);
+        }
+    }
+    let mut sizes: BTreeMap<usize, usize> = BTreeMap::new();
+    for i in &inputs.files {
+        let r = root(&mut parent, index[&folder(&i.path)]);
+        *sizes.entry(r).or_default() += 1;
+    }
+    for (p, _) in &inputs.pipelines {
+        let r = root(&mut parent, index[&folder(p)]);
+        sizes.entry(r).or_default();
+    }
+    // Components in the order of their first folder by path.
+    let mut order: Vec<usize> = Vec::new();
+    let mut placed = HashSet::new();
+    for &i in index.values() {
+        let r = root(&mut parent, i);
+        if sizes.contains_key(&r) && placed.insert(r) {
+            order.push(r);
+        }
+    }
+    let mut load = vec![0usize; shard.count as usize];
+    let mut owner: HashMap<usize, usize> = HashMap::new();
+    for r in order {
+        let k = (0..load.len()).min_by_key(|&k| (load[k], k)).unwrap_or(0);
+        load[k] += sizes[&r];
+        owner.insert(r, k);
+    }
+    let me = shard.index as usize - 1;
+    let mut mine = |p: &Path| {
+        let r = root(&mut parent, index[&folder(p)]);
+        owner.get(&r) == Some(&me)
+    };
+    inputs.files.retain(|i| mine(&i.path));
+    inputs.pipelines.retain(|(p, _)| mine(p));
 }
 
 #[cfg(test)]

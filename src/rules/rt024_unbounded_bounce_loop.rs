@@ -131,6 +131,7 @@ super::declare_rule! {
         group: Perf,
         summary: "bounce loop or recursion with no bound known at compile time",
         kind: super::Kind::Pipeline(run),
+        analysis: Full,
     }
 }
 

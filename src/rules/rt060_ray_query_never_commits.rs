@@ -66,6 +66,7 @@ super::declare_rule! {
         group: Suspicious,
         summary: "ray-query loop never commits non-opaque triangles",
         kind: super::Kind::Module(check),
+        analysis: Full,
     }
 }
 

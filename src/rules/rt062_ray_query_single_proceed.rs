@@ -55,6 +55,7 @@ super::declare_rule! {
         group: Suspicious,
         summary: "single Proceed per initialisation on a query that can meet non-opaque triangles",
         kind: super::Kind::Module(check),
+        analysis: Full,
     }
 }
 

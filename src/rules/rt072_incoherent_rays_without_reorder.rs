@@ -67,6 +67,7 @@ super::declare_rule! {
         group: Pedantic,
         summary: "bounce loop over several closest-hit shaders without execution reordering",
         kind: super::Kind::Pipeline(run),
+        analysis: Full,
     }
 }
 
