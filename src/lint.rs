@@ -154,7 +154,7 @@ pub fn check_paths(paths: &[PathBuf], options: &Options) -> Report {
     if let Some(shard) = options.shard {
         keep_shard(&mut inputs, &descriptions, shard);
     }
-    let described: Vec<PathBuf> = descriptions.into_iter().flatten().collect();
+    let described: HashSet<PathBuf> = descriptions.into_iter().flatten().collect();
     let cache = options.cache.as_deref().and_then(crate::cache::Cache::open);
     let mut report = Report {
         files: inputs.files.iter().map(|i| i.path.clone()).collect(),
@@ -174,6 +174,7 @@ pub fn check_paths(paths: &[PathBuf], options: &Options) -> Report {
     let mut owned: Vec<PathBuf> = Vec::new();
     // The loose pipelines: each group's members (input index, outcome).
     let mut groups: Vec<(PathBuf, Vec<usize>)> = Vec::new();
+    let mut group_of: HashMap<PathBuf, usize> = HashMap::new();
     let mut outcomes = Vec::with_capacity(checked.len());
     for (i, mut c) in checked.into_iter().enumerate() {
         if c.analysed {
@@ -188,9 +189,12 @@ pub fn check_paths(paths: &[PathBuf], options: &Options) -> Report {
         }
         diagnostics.append(&mut c.diagnostics);
         if let Some(g) = &c.group {
-            match groups.iter_mut().find(|(d, _)| d == g) {
-                Some((_, members)) => members.push(i),
-                None => groups.push((g.clone(), vec![i])),
+            match group_of.get(g) {
+                Some(&k) => groups[k].1.push(i),
+                None => {
+                    group_of.insert(g.clone(), groups.len());
+                    groups.push((g.clone(), vec![i]));
+                }
             }
         }
         outcomes.push(c);
