@@ -107,23 +107,41 @@ impl Table {
     }
 }
 
-/// Runs a command to its end: wall time and the child's peak memory (KiB).
+/// Runs a command to its end: wall time and its peak memory (KiB), as GNU
+/// time reports it. (A child's own `wait4` rusage will not do: std starts it
+/// with `vfork`, so its maximum resident set starts at this process's.)
 fn run_child(cmd: &mut Command) -> (Duration, u64) {
-    cmd.stdout(std::process::Stdio::null())
+    let out = std::env::temp_dir().join(format!("rtlint-peers-rss-{}", std::process::id()));
+    let time = Path::new("/usr/bin/time");
+    let mut wrapped = if time.is_file() {
+        let mut w = Command::new(time);
+        w.args(["-f", "%M", "-o"]).arg(&out).arg(cmd.get_program());
+        w
+    } else {
+        Command::new(cmd.get_program())
+    };
+    wrapped.args(cmd.get_args());
+    for (k, v) in cmd.get_envs() {
+        match v {
+            Some(v) => wrapped.env(k, v),
+            None => wrapped.env_remove(k),
+        };
+    }
+    if let Some(d) = cmd.get_current_dir() {
+        wrapped.current_dir(d);
+    }
+    wrapped
+        .stdout(std::process::Stdio::null())
         .stderr(std::process::Stdio::null());
     let t = Instant::now();
-    let child = cmd.spawn().expect("start child");
-    let pid = child.id() as libc::pid_t;
-    let mut status = 0;
-    // SAFETY: an all-zero rusage is a valid value; wait4 writes it.
-    let mut usage: libc::rusage = unsafe { std::mem::zeroed() };
-    // SAFETY: the pid is our own child, not yet waited for (std's `Child`
-    // is not waited: `wait4` reaps it here and reports its own usage).
-    let r = unsafe { libc::wait4(pid, &mut status, 0, &mut usage) };
+    wrapped.status().expect("start child");
     let elapsed = t.elapsed();
-    assert_eq!(r, pid, "wait4");
-    std::mem::forget(child);
-    (elapsed, usage.ru_maxrss as u64)
+    let rss = std::fs::read_to_string(&out)
+        .ok()
+        .and_then(|s| s.lines().last().and_then(|l| l.trim().parse().ok()))
+        .unwrap_or(0);
+    let _ = std::fs::remove_file(&out);
+    (elapsed, rss)
 }
 
 fn rtlint_bin() -> Command {
