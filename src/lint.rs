@@ -164,40 +164,79 @@ pub fn check_paths(paths: &[PathBuf], options: &Options) -> Report {
     };
     let mut diagnostics: Vec<Diagnostic> = configs.errors.clone();
     diagnostics.extend(inputs.errors.iter().map(|e| (*e.0).clone()));
-    // Files in parallel; collected in input order, so output is the same
-    // whatever the thread count.
-    let checked: Vec<Outcome> = inputs
-        .files
-        .par_iter()
-        .map(|input| check_cached(input, options, cache.as_ref()))
-        .collect();
     let mut owned: Vec<PathBuf> = Vec::new();
-    // The loose pipelines: each group's members (input index, outcome).
-    let mut groups: Vec<(PathBuf, Vec<usize>)> = Vec::new();
+    // The loose pipelines: each group's members (input indices) and, once
+    // checked, its findings. A folder's group is checked as soon as its last
+    // input is, and its Programs dropped: memory follows the largest folder,
+    // not the tree.
+    let mut groups: Vec<(PathBuf, Vec<usize>, Option<Vec<Diagnostic>>)> = Vec::new();
     let mut group_of: HashMap<PathBuf, usize> = HashMap::new();
-    let mut outcomes = Vec::with_capacity(checked.len());
-    for (i, mut c) in checked.into_iter().enumerate() {
-        if c.analysed {
-            for (path, text) in &c.files {
-                if let Some(t) = text {
-                    report.embedded.push((path.clone(), t.clone()));
+    let folder = |p: &Path| p.parent().map(Path::to_path_buf).unwrap_or_default();
+    let mut last_in: HashMap<PathBuf, usize> = HashMap::new();
+    for (i, input) in inputs.files.iter().enumerate() {
+        last_in.insert(folder(&input.path), i);
+    }
+    let mut outcomes: Vec<Outcome> = Vec::with_capacity(inputs.files.len());
+    const CHUNK: usize = 512;
+    for (ci, chunk) in inputs.files.chunks(CHUNK).enumerate() {
+        // Files in parallel; collected in input order, so output is the
+        // same whatever the thread count.
+        let checked: Vec<Outcome> = chunk
+            .par_iter()
+            .map(|input| check_cached(input, options, cache.as_ref()))
+            .collect();
+        for (k, mut c) in checked.into_iter().enumerate() {
+            let i = ci * CHUNK + k;
+            if c.analysed {
+                for (path, text) in c.files.drain(..) {
+                    if let Some(t) = text {
+                        report.embedded.push((path.clone(), t));
+                    }
+                    owned.push(path);
                 }
-                owned.push(path.clone());
+                // Suppressions are judged only in inputs that were analysed.
+                owned.push(inputs.files[i].path.clone());
             }
-            // Suppressions are judged only in inputs that were analysed.
-            owned.push(inputs.files[i].path.clone());
-        }
-        diagnostics.append(&mut c.diagnostics);
-        if let Some(g) = &c.group {
-            match group_of.get(g) {
-                Some(&k) => groups[k].1.push(i),
-                None => {
-                    group_of.insert(g.clone(), groups.len());
-                    groups.push((g.clone(), vec![i]));
+            diagnostics.append(&mut c.diagnostics);
+            if let Some(g) = &c.group {
+                match group_of.get(g) {
+                    Some(&k) => groups[k].1.push(i),
+                    None => {
+                        group_of.insert(g.clone(), groups.len());
+                        groups.push((g.clone(), vec![i], None));
+                    }
                 }
             }
+            outcomes.push(c);
         }
-        outcomes.push(c);
+        let done = ci * CHUNK + chunk.len();
+        let Some(first) = inputs.files.first() else {
+            continue;
+        };
+        for (dir, members, found) in groups.iter_mut() {
+            // A group named by a file (a whole pipeline in one module) is
+            // complete at once; a folder's after its last input.
+            if found.is_some() || last_in.get(dir.as_path()).is_some_and(|&l| l >= done) {
+                continue;
+            }
+            let members: Vec<usize> = members
+                .iter()
+                .copied()
+                .filter(|&i| !described.contains(&canonical(&inputs.files[i].path)))
+                .collect();
+            *found = Some(if members.is_empty() {
+                Vec::new()
+            } else {
+                check_group_cached(
+                    &members,
+                    &inputs.files,
+                    &mut outcomes,
+                    &first.config,
+                    options,
+                    cache.as_ref(),
+                )
+            });
+        }
     }
     let pipelines: Vec<Checked> = inputs
         .pipelines
@@ -209,24 +248,8 @@ pub fn check_paths(paths: &[PathBuf], options: &Options) -> Report {
     }
     // Shaders no description uses still get the pipeline rules, under the
     // assumption that every trace reaches every shader.
-    if let Some(first) = inputs.files.first() {
-        for (_, members) in groups {
-            let members: Vec<usize> = members
-                .into_iter()
-                .filter(|&i| !described.contains(&canonical(&inputs.files[i].path)))
-                .collect();
-            if members.is_empty() {
-                continue;
-            }
-            diagnostics.extend(check_group_cached(
-                &members,
-                &inputs.files,
-                &mut outcomes,
-                &first.config,
-                options,
-                cache.as_ref(),
-            ));
-        }
+    for (_, _, found) in groups {
+        diagnostics.extend(found.into_iter().flatten());
     }
     report.deny_warnings = options.overrides.deny_warnings
         || inputs.files.iter().any(|i| i.config.deny_warnings)
