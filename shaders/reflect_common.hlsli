@@ -61,6 +61,12 @@ float3 offset_ray(float3 p, float3 n)
     return select(abs(p) < 0.03125, p + 0.0000152587890625 * n, p_i);
 }
 
+// The geometric normal turned towards the side the ray comes from.
+float3 facing(float3 normal, float3 dir)
+{
+    return select(dot(normal, dir) < 0.0, normal, -normal);
+}
+
 float3 camera_dir(uint2 id)
 {
     float2 size = float2(params.width, params.height);

@@ -114,9 +114,10 @@ fn sample_vndf(ve: vec3<f32>, alpha: f32, u1: f32, u2: f32) -> vec3<f32> {
     return normalize(vec3<f32>(alpha * nh.x, alpha * nh.y, max(0.0, nh.z)));
 }
 
-// Across the traces the sample loop keeps the running sum, seed, counters
-// and t_max beside the bounce state: above RT010's 64-byte budget, which
-// one sample per launch index (z) would meet at the cost of a second pass.
+// Across both traces the path keeps 52 bytes (origin, direction, sum,
+// throughput, seed and the two loop counters), within RT010's 64-byte
+// budget as in reflect_glossy.hlsl; naga's SPIR-V adds a 64-bit
+// `loop_bound` counter per loop (its infinite-loop guard), 16 bytes more.
 @diagnostic(off, rtlint.live_state_over_budget)
 @ray_generation
 fn raygen(@builtin(ray_invocation_id) id: vec3<u32>) {
@@ -140,12 +141,22 @@ fn raygen(@builtin(ray_invocation_id) id: vec3<u32>) {
                 sum += throughput * sky(dir);
                 break;
             }
+            // The shadow ray first, from the next origin: across it only the
+            // path's own state stays live; the surface is read again after it.
+            let normal = surfaces[hit.surface].normal_reflectivity.xyz;
+            var n = select(-normal, normal, dot(normal, dir) < 0.0);
+            origin = offset_ray(origin + dir * hit.t, n);
+            var visible = false;
+            if (params.flags & FLAG_LIGHT) != 0u && dot(n, params.light.xyz) > 0.0 {
+                shadow.t = 0.0;
+                traceRay(tlas, RayDesc(SHADOW_FLAGS, 0xFFu, params.ray.x, params.ray.y, origin, params.light.xyz), &shadow);
+                visible = shadow.t < 0.0;
+            }
             let s = surfaces[hit.surface];
-            let n = select(-s.normal_reflectivity.xyz, s.normal_reflectivity.xyz, dot(s.normal_reflectivity.xyz, dir) < 0.0);
+            n = select(-s.normal_reflectivity.xyz, s.normal_reflectivity.xyz, dot(s.normal_reflectivity.xyz, dir) < 0.0);
             let base = throughput * (1.0 - s.normal_reflectivity.w) * s.albedo_roughness.xyz;
             throughput *= s.normal_reflectivity.w;
             let roughness = s.albedo_roughness.w;
-            origin = offset_ray(origin + dir * hit.t, n);
             let ndl = dot(n, params.light.xyz);
             let headlight = max(dot(n, -dir), 0.0);
             if roughness > 0.0 {
@@ -175,13 +186,8 @@ fn raygen(@builtin(ray_invocation_id) id: vec3<u32>) {
             }
             if (params.flags & FLAG_LIGHT) != 0u {
                 sum += base * params.light.w;
-                if ndl > 0.0 {
-                    let lit = base * ndl;
-                    shadow.t = 0.0;
-                    traceRay(tlas, RayDesc(SHADOW_FLAGS, 0xFFu, params.ray.x, params.ray.y, origin, params.light.xyz), &shadow);
-                    if shadow.t < 0.0 {
-                        sum += lit;
-                    }
+                if ndl > 0.0 && visible {
+                    sum += base * ndl;
                 }
             } else {
                 sum += base * headlight;

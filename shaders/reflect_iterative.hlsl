@@ -2,7 +2,9 @@
 // the ray generation shader loops over bounces, the closest-hit shader only
 // reports the surface, so the pipeline needs recursion depth 1. Shadow rays
 // (when the scene has a light) are traced from raygen with their own payload
-// and miss shader (miss index 1). Same math as reflect_iterative.wgsl.
+// and miss shader (miss index 1). Cut-outs: the any-hit shaders ignore
+// candidates whose alpha texel is cut away. Same math as
+// reflect_iterative.wgsl, which cannot express the alpha test.
 #include "reflect_shadow.hlsli"
 
 struct HitInfo
@@ -32,7 +34,7 @@ void raygen()
         ray.TMax = params.ray.y;
         // Written whole, so nothing of the last bounce's payload stays live.
         HitInfo hit = (HitInfo)0;
-        TraceRay(tlas, RAY_FLAG_FORCE_OPAQUE, 0xFF, 0, 1, 0, ray, hit);
+        TraceRay(tlas, RAY_FLAG_NONE, 0xFF, 0, 1, 0, ray, hit);
         if (hit.t < 0.0)
         {
             color += throughput * sky(dir);
@@ -79,4 +81,11 @@ void closest_hit(inout HitInfo hit, in BuiltInTriangleIntersectionAttributes att
     hit.t = RayTCurrent();
     hit.normal = s.normal_reflectivity.xyz;
     hit.reflectivity = s.normal_reflectivity.w;
+}
+
+[shader("anyhit")]
+void any_hit(inout HitInfo hit, in BuiltInTriangleIntersectionAttributes attr)
+{
+    if (!alpha_keeps(InstanceID() + PrimitiveIndex(), attr.barycentrics))
+        IgnoreHit();
 }

@@ -2,7 +2,8 @@
 // the closest-hit shader traces the reflected ray itself, and a shadow ray
 // (miss index 1, its own payload) when the scene has a light, so the
 // pipeline needs recursion depth max_bounces + 2. Same math as
-// reflect_recursive.wgsl; the image must equal the iterative one.
+// reflect_recursive.wgsl; the image must equal the iterative one. Cut-outs:
+// the any-hit shaders ignore candidates whose alpha texel is cut away.
 #include "reflect_shadow.hlsli"
 
 // Radiance gathered along the ray, how many bounces led to it, and the
@@ -27,7 +28,7 @@ void raygen()
     r.color = float3(0.0, 0.0, 0.0);
     r.depth = 0;
     r.throughput = 1.0;
-    TraceRay(tlas, RAY_FLAG_FORCE_OPAQUE, 0xFF, 0, 1, 0, ray, r);
+    TraceRay(tlas, RAY_FLAG_NONE, 0xFF, 0, 1, 0, ray, r);
     image[id.y * params.width + id.x] = pack_rgba8(r.color);
 }
 
@@ -74,9 +75,16 @@ void closest_hit(inout Radiance r, in BuiltInTriangleIntersectionAttributes attr
             reflected.depth = r.depth + 1;
             reflected.throughput = next;
             // rtlint: allow(recursive-trace, reason = "the recursive reference: bounded by maxBounces; reflect_iterative.hlsl is the loop form")
-            TraceRay(tlas, RAY_FLAG_FORCE_OPAQUE, 0xFF, 0, 1, 0, ray, reflected);
+            TraceRay(tlas, RAY_FLAG_NONE, 0xFF, 0, 1, 0, ray, reflected);
             color += reflectivity * reflected.color;
         }
     }
     r.color = color;
+}
+
+[shader("anyhit")]
+void any_hit(inout Radiance r, in BuiltInTriangleIntersectionAttributes attr)
+{
+    if (!alpha_keeps(InstanceID() + PrimitiveIndex(), attr.barycentrics))
+        IgnoreHit();
 }

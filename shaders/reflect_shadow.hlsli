@@ -1,14 +1,16 @@
-// Shadow rays of the HLSL ray-tracing pipelines: a payload of their own and
-// a miss shader of their own (miss index 1) that marks the light visible.
+// Shadow rays of the HLSL ray-tracing pipelines: a payload of their own, a
+// miss shader of their own (miss index 1) that marks the light visible, and
+// a hit group of their own (SBT offset 1) whose any-hit shader lets them
+// through a cut-out's holes. Opaque geometry never runs it.
 #pragma once
-#include "reflect_common.hlsli"
+#include "reflect_cutout.hlsli"
 
 struct ShadowInfo
 {
     float visible;
 };
 
-static const uint SHADOW_FLAGS = RAY_FLAG_FORCE_OPAQUE | RAY_FLAG_ACCEPT_FIRST_HIT_AND_END_SEARCH | RAY_FLAG_SKIP_CLOSEST_HIT_SHADER;
+static const uint SHADOW_FLAGS = RAY_FLAG_ACCEPT_FIRST_HIT_AND_END_SEARCH | RAY_FLAG_SKIP_CLOSEST_HIT_SHADER;
 
 float shadow_ray(float3 origin)
 {
@@ -19,7 +21,7 @@ float shadow_ray(float3 origin)
     ray.TMax = params.ray.y;
     ShadowInfo shadow;
     shadow.visible = 0.0;
-    TraceRay(tlas, SHADOW_FLAGS, 0xFF, 0, 1, 1, ray, shadow);
+    TraceRay(tlas, SHADOW_FLAGS, 0xFF, 1, 1, 1, ray, shadow);
     return shadow.visible;
 }
 
@@ -27,4 +29,11 @@ float shadow_ray(float3 origin)
 void shadow_miss(inout ShadowInfo shadow)
 {
     shadow.visible = 1.0;
+}
+
+[shader("anyhit")]
+void shadow_any_hit(inout ShadowInfo shadow, in BuiltInTriangleIntersectionAttributes attr)
+{
+    if (!alpha_keeps(InstanceID() + PrimitiveIndex(), attr.barycentrics))
+        IgnoreHit();
 }

@@ -169,6 +169,11 @@ fn compute_semantics_on_the_driver() {
         I(3),
         I(1),
         I(8),
+        F(1.0),
+        I(0),
+        F(3.5),
+        F(2.0),
+        F(11.0),
     ];
     let out = storage(&ctx, (expected.len() as u64 + 4) * 4);
     let ubo = Buffer::from_data(&ctx, raw::BufferUsageFlags::UNIFORM_BUFFER, &inputs()).unwrap();

@@ -511,6 +511,21 @@ const KNOWN_ACROSS_COMPILERS: &[(&str, &str, &str, &str)] = &[
         "rtlint keeps `desc` (a `RayDesc`) and `r` in locals, Slang SSA values",
     ),
     (
+        "fixtures/live/out_early.hlsl",
+        "RayGen",
+        "live bytes",
+        "Slang carries the `out` values of `SampleLight`, unwritten when it returns early, \
+         around the loop: `light.position` (12 B kept), `light.color` and `weight` (16 B \
+         recomputable) are live across the trace; rtlint's `out` temporaries start undefined \
+         at each call",
+    ),
+    (
+        "fixtures/live/out_early.hlsl",
+        "RayGen",
+        "kept bytes",
+        "as above: Slang keeps the stale `light.position` (12 B) across the trace",
+    ),
+    (
         "fixtures/hlsl/payloads.hlsl",
         "RayGen",
         "live bytes",

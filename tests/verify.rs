@@ -64,30 +64,45 @@ fn reference_shaders_pass_and_the_shallow_pipeline_fails_as_expected() {
     assert_eq!(o.status.code(), Some(0), "{stdout}");
     let row = |s: &str, c: &str, r: &str| (s.to_string(), c.to_string(), r.to_string());
     let mut expected = Vec::new();
-    for (shader, result) in [
-        ("iterative", "pass"),
-        ("recursive", "pass"),
-        ("iterative-hlsl", "pass"),
-        ("recursive-hlsl", "pass"),
-        ("rayquery", query),
-        ("rayquery-hlsl", query),
-        ("glossy", "pass"),
-        ("glossy-hlsl", "pass"),
+    // The cut-out scene: HLSL pipelines (any-hit) and ray queries only.
+    for (shader, result, cutout) in [
+        ("iterative", "pass", false),
+        ("recursive", "pass", false),
+        ("iterative-hlsl", "pass", true),
+        ("recursive-hlsl", "pass", true),
+        ("rayquery", query, true),
+        ("rayquery-hlsl", query, true),
+        ("glossy", "pass", false),
+        ("glossy-hlsl", "pass", true),
+        ("hybrid", "pass", false),
+        ("hybrid-hlsl", "pass", true),
+        ("adaptive", "pass", false),
+        ("adaptive-hlsl", "pass", false),
     ] {
-        for scene in ["mirror", "showcase"] {
-            expected.push(row(shader, scene, result));
+        for scene in ["mirror", "showcase", "cutout"] {
+            if scene != "cutout" || cutout {
+                expected.push(row(shader, scene, result));
+            }
         }
     }
-    for (pair, result) in [
-        ("recursive = iterative", "pass"),
-        ("iterative-hlsl = iterative", "pass"),
-        ("recursive-hlsl = recursive", "pass"),
-        ("rayquery = iterative", query),
-        ("rayquery-hlsl = iterative", query),
-        ("glossy-hlsl = glossy", "pass"),
+    // Identity cases, on the scenes both shaders render.
+    for (pair, result, cutout) in [
+        ("recursive = iterative", "pass", false),
+        ("iterative-hlsl = iterative", "pass", false),
+        ("recursive-hlsl = recursive", "pass", false),
+        ("recursive-hlsl = iterative-hlsl", "pass", true),
+        ("rayquery = iterative", query, false),
+        ("rayquery = iterative-hlsl", query, true),
+        ("rayquery-hlsl = iterative", query, false),
+        ("rayquery-hlsl = rayquery", query, true),
+        ("glossy-hlsl = glossy", "pass", false),
+        ("hybrid-hlsl = hybrid", "pass", false),
+        ("adaptive-hlsl = adaptive", "pass", false),
     ] {
-        for scene in ["mirror", "showcase"] {
-            expected.push(row(pair, scene, result));
+        for scene in ["mirror", "showcase", "cutout"] {
+            if scene != "cutout" || cutout {
+                expected.push(row(pair, scene, result));
+            }
         }
     }
     expected.push(row(
@@ -101,6 +116,27 @@ fn reference_shaders_pass_and_the_shallow_pipeline_fails_as_expected() {
         stdout.contains(
             "expected failure recursive-depth-1/showcase: caught: the child was killed by signal"
         ),
+        "{stdout}"
+    );
+    // The multi-pass shaders say what they measured, and the hybrid one
+    // draws the path each pixel took.
+    for (shader, scene) in [
+        ("hybrid", "mirror"),
+        ("hybrid", "showcase"),
+        ("hybrid-hlsl", "cutout"),
+    ] {
+        let note = format!("{shader}/{scene}: ");
+        let line = stdout.lines().find(|l| l.starts_with(&note));
+        assert!(
+            line.is_some_and(|l| l.contains("reflecting pixels traced a ray")
+                && l.ends_with("paths differ from the CPU's on 0")),
+            "{stdout}"
+        );
+        assert!(out.join(format!("{shader}_{scene}-paths.png")).is_file());
+    }
+    assert!(
+        // Without rough surfaces every pixel stops at the minimum, 4 of 16.
+        stdout.contains("adaptive/mirror: 16384 paths instead of 65536 for 16 fixed passes"),
         "{stdout}"
     );
     let csv = std::fs::read_to_string(out.join("verify.csv")).unwrap();
@@ -222,45 +258,55 @@ fn usage_errors_exit_2() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
-/// The extremes matrix far from the origin: robust origins never hit the
-/// triangle they leave; the fixed epsilon, below the coordinates' ulp at
-/// 1e5, does for most rays. No case writes a NaN.
+/// The whole extremes matrix: every cell passes (no NaN or infinity on
+/// either side, robust origins below 0.1 % self-intersections); far from
+/// the origin the fixed epsilon, below the coordinates' ulp at 1e5, makes
+/// most rays hit the triangle they leave, the robust origin none.
 #[test]
-fn extremes_far_from_the_origin() {
+fn extremes_matrix() {
     if common::device().is_none() {
         return;
     }
     let out = out_dir("extremes");
     let o = common::rtlint()
-        .args(["verify", "--extremes", "--filter", "translate=1e5", "--out"])
+        .args(["verify", "--extremes", "--filter", "extremes/", "--out"])
         .arg(&out)
         .output()
         .unwrap();
     let stdout = String::from_utf8_lossy(&o.stdout);
     assert_eq!(o.status.code(), Some(0), "{stdout}");
-    let cells = |mode: &str| -> Vec<String> {
+    let cells = |mode: &str, variant: &str| -> Vec<String> {
         let line = stdout
             .lines()
-            .find(|l| l.starts_with(&format!("iterative {mode}")))
-            .unwrap_or_else(|| panic!("no {mode} row: {stdout}"));
+            .find(|l| l.contains(&format!(" {mode} ")) && l.contains(&format!(" {variant} ")))
+            .unwrap_or_else(|| panic!("no {mode} {variant} row: {stdout}"));
         line.split("  ")
             .map(str::trim)
             .filter(|c| !c.is_empty())
             .map(str::to_string)
             .collect()
     };
-    let (robust, epsilon) = (cells("robust"), cells("epsilon"));
-    // shader, case, pixels, max, mean, above, PSNR, NaN, self-hit %, time, result
-    assert_eq!(
-        (robust[7].as_str(), robust[8].as_str()),
-        ("0", "0.000"),
-        "{robust:?}"
-    );
-    assert_eq!(epsilon[7], "0", "{epsilon:?}");
-    let self_hit: f64 = epsilon[8].parse().unwrap();
-    assert!(self_hit > 50.0, "{epsilon:?}");
-    assert_eq!(robust.last().unwrap(), "pass");
+    for variant in rtlint::verify::EXTREMES {
+        for mode in ["robust", "epsilon"] {
+            let row = cells(mode, variant);
+            // shader, case, pixels, max, mean, above, PSNR, NaN, self-hit %, time, result
+            assert_eq!(
+                (row[7].as_str(), row.last().unwrap().as_str()),
+                ("0", "pass"),
+                "{row:?}"
+            );
+            if mode == "robust" {
+                assert_eq!(row[8], "0.000", "{row:?}");
+            }
+        }
+    }
+    let self_hit: f64 = cells("epsilon", "translate=1e5")[8].parse().unwrap();
+    assert!(self_hit > 50.0, "{stdout}");
     let md = std::fs::read_to_string(out.join("extremes.md")).unwrap();
-    assert_eq!(md.lines().count(), 4, "{md}");
+    assert_eq!(
+        md.lines().count(),
+        2 + 2 * rtlint::verify::EXTREMES.len(),
+        "{md}"
+    );
     std::fs::remove_dir_all(&out).unwrap();
 }

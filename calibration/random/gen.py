@@ -10,7 +10,7 @@ recursion, shadow rays, and one to three miss shaders. Even seeds are GLSL
 description; rtlint compiles it). Seeds below --split are the fitting set,
 the rest the held-out set.
 
-    calibration/random/gen.py [--seeds 480] [--split 320] [--out DIR]
+    calibration/random/gen.py [--seeds 640] [--split 320] [--first N] [--out DIR]
 
 writes DIR/sNNN/sNNN.pipeline.toml and its shaders, and DIR/manifest.csv with the
 knobs of every seed. DIR defaults to calibration/random/out (not committed:
@@ -34,9 +34,15 @@ def pick_bytes(rng, lo, hi):
     return max(lo, min(hi, int(round(v / 4)) * 4))
 
 
+# Seeds from here on form a second held-out set, generated after the model
+# was last changed (2026-12-01) and judged once: the first held-out set had
+# been seen by then, so only this one still tells how the model generalises.
+SECOND_HELDOUT = 480
+
+
 def knobs(seed, split):
     rng = random.Random(seed)
-    k = {"seed": seed, "set": "fit" if seed < split else "heldout"}
+    k = {"seed": seed, "set": "fit" if seed < split else "heldout" if seed < SECOND_HELDOUT else "heldout2"}
     k["lang"] = "glsl" if seed % 2 == 0 else "hlsl"
     k["payload"] = pick_bytes(rng, 4, 512)
     k["rg_mode"] = rng.choice(["single", "straight", "loop"])
@@ -524,15 +530,22 @@ def write_hlsl(k, d):
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--seeds", type=int, default=480)
+    ap.add_argument("--seeds", type=int, default=640)
     ap.add_argument("--split", type=int, default=320)
+    ap.add_argument("--first", type=int, default=0, help="keep the seeds below this one already in --out")
     ap.add_argument("--out", default=os.path.join(os.path.dirname(os.path.abspath(__file__)), "out"))
     args = ap.parse_args()
-    if os.path.isdir(args.out):
-        shutil.rmtree(args.out)
-    os.makedirs(args.out)
+    manifest = os.path.join(args.out, "manifest.csv")
     rows = []
-    for seed in range(args.seeds):
+    if args.first > 0:
+        rows = [r for r in csv.DictReader(open(manifest)) if int(r["seed"]) < args.first]
+        for seed in range(args.first, args.seeds):
+            shutil.rmtree(os.path.join(args.out, f"s{seed:03}"), ignore_errors=True)
+    else:
+        if os.path.isdir(args.out):
+            shutil.rmtree(args.out)
+        os.makedirs(args.out)
+    for seed in range(args.first, args.seeds):
         k = knobs(seed, args.split)
         d = os.path.join(args.out, f"s{seed:03}")
         os.makedirs(d)
@@ -540,7 +553,7 @@ def main():
         with open(os.path.join(d, f"s{seed:03}.pipeline.toml"), "w") as f:
             f.write(toml)
         rows.append(k)
-    with open(os.path.join(args.out, "manifest.csv"), "w", newline="") as f:
+    with open(manifest, "w", newline="") as f:
         w = csv.DictWriter(f, fieldnames=list(rows[0].keys()))
         w.writeheader()
         w.writerows(rows)

@@ -100,7 +100,7 @@ def main():
         d = rep.get("driver") or {}
         ref = d.get("exact_call_chain")
         chain[key(rep["pipeline"])] = ref if ref is not None else d.get("vulkan_default")
-    groups = {"fit": ([], []), "heldout": ([], []), "repository": ([], [])}
+    groups = {"fit": ([], []), "heldout": ([], []), "heldout2": ([], []), "repository": ([], [])}
     feats = []
     for rep in model_reports(args.rtlint, paths):
         k = key(rep["pipeline"])

@@ -1790,6 +1790,62 @@ mod tests {
         }
     }
 
+    /// rtlint's HLSL lowering keeps nothing live that the source does not:
+    /// `?:` leaves no temporary per side (was 40 B more), and the `out`
+    /// temporaries of a callee that returns early start undefined at each
+    /// call (was 16 B more). `tests/invariance.rs` checks the same without
+    /// debug info.
+    #[test]
+    fn hlsl_lowering_adds_no_live_state() {
+        let s = one_site("fixtures/live/ternary.hlsl");
+        assert_eq!(names(&s), [("acc", 12, false), ("i", 4, false)]);
+        assert_eq!((s.live_bytes, s.rematerializable_bytes), (16, 0));
+        let s = one_site("fixtures/live/out_early.hlsl");
+        assert_eq!(
+            names(&s),
+            [("acc", 12, false), ("i", 4, false), ("seed", 4, false)]
+        );
+        assert_eq!(s.live_bytes, 20);
+    }
+
+    /// An HLSL local declared after the trace is not live across it, its
+    /// `DebugDeclare` is where it is declared (after the trace; `acc`'s is
+    /// before), and a copy of `DispatchRaysIndex()` stays recomputable.
+    #[test]
+    fn hlsl_locals_declared_where_declared() {
+        let rel = "fixtures/live/declared_after.hlsl";
+        let p = program(rel);
+        let s = one_site(rel);
+        assert_eq!(
+            names(&s),
+            [("acc", 12, false), ("i", 4, false), ("id", 12, true)]
+        );
+        assert_eq!((s.live_bytes, s.rematerializable_bytes), (28, 12));
+        let trace = p.sites[0].inst;
+        let declared_at = |name: &str| -> usize {
+            let var = p
+                .names
+                .iter()
+                .find(|(_, n)| n.as_str() == name)
+                .map(|(id, _)| *id)
+                .unwrap();
+            p.insts
+                .iter()
+                .position(|inst| {
+                    p.is_debug_inst(inst)
+                        && matches!(
+                            inst.operands.get(1),
+                            Some(Operand::LiteralExtInstInteger(28)) // DebugDeclare
+                        )
+                        && matches!(inst.operands.get(3), Some(Operand::IdRef(v)) if *v == var)
+                })
+                .unwrap_or_else(|| panic!("no DebugDeclare of `{name}`"))
+        };
+        assert!(declared_at("acc") < trace);
+        assert!(declared_at("n") > trace);
+        assert!(declared_at("h") > trace);
+    }
+
     /// Parts behind a pointer parameter that the callee needs after its
     /// trace are live, counted at the caller's argument (glslang's and
     /// rtlint's temporaries for a struct passed by value).

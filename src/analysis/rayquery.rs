@@ -87,7 +87,7 @@ pub fn queries(p: &Program) -> Vec<Query> {
             match op {
                 Op::RayQueryInitializeKHR => {
                     q.inits.push(i);
-                    q.init_flags.push(init_flags(p, i));
+                    q.init_flags.push(init_flags(p, i, root));
                 }
                 Op::RayQueryProceedKHR => q.proceeds.push(i),
                 Op::RayQueryConfirmIntersectionKHR => q.confirms.push(i),
@@ -123,9 +123,12 @@ fn is_committed_read(p: &Program, i: usize) -> bool {
         && matches!(inst.operands.get(1), Some(Operand::IdRef(k)) if p.fold(*k) == Some(1))
 }
 
-/// The flags operand of initialisation `i`, folded along every call chain
-/// from an entry point (or as is, when none reaches it).
-fn init_flags(p: &Program, i: usize) -> Vec<Option<u64>> {
+/// The flags operand of initialisation `i` of the query variable `root`,
+/// folded along every call chain from an entry point that passes through
+/// the function declaring `root` (or as is, when none reaches it). naga
+/// initialises every query in one generated helper: the flags other queries
+/// pass to it are not this one's.
+fn init_flags(p: &Program, i: usize, root: Id) -> Vec<Option<u64>> {
     let Some(Operand::IdRef(flags)) = p.insts[i].operands.get(2) else {
         return vec![None];
     };
@@ -135,10 +138,23 @@ fn init_flags(p: &Program, i: usize) -> Vec<Option<u64>> {
     let Some(f) = p.function_of(i).and_then(|f| p.functions.get(f)) else {
         return vec![None];
     };
+    let home = p
+        .defs
+        .get(&root)
+        .and_then(|&d| p.function_of(d))
+        .map(|k| p.functions[k].id);
     let mut vals = Vec::new();
     for e in &p.entry_points {
         for chain in cfg::call_chains(p, e.function, f.id, MAX_CHAINS) {
-            vals.push(p.fold_in(*flags, &chain));
+            let through_home = home.is_none_or(|h| {
+                e.function == h
+                    || chain
+                        .iter()
+                        .any(|&c| p.function_of(c).map(|k| p.functions[k].id) == Some(h))
+            });
+            if through_home {
+                vals.push(p.fold_in(*flags, &chain));
+            }
         }
     }
     if vals.is_empty() {

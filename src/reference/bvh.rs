@@ -145,6 +145,7 @@ mod tests {
                 Vec3::new(x, 0.5, 0.0),
             ],
             open: [true; 3],
+            uvs: [glam::Vec2::ZERO; 3],
         }
     }
 

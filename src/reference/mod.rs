@@ -5,14 +5,18 @@
 //! Everything is `f32` and follows the shaders operation by operation
 //! (camera, bounce loop or recursion, shadow rays, sky, shading, robust ray
 //! origins, packing) so that a GPU image should match to within one 8-bit
-//! step; ray/triangle tests use the shaders' `t` range and treat every
-//! triangle as opaque, as `RAY_FLAG_OPAQUE` does. Triangles are found
+//! step; ray/triangle tests use the shaders' `t` range, and a cut-out
+//! material's triangle counts only where its alpha texel keeps it (what the
+//! any-hit shaders and the ray queries' candidate loops do). Triangles are found
 //! through a BVH ([`bvh`]).
 
+pub mod adaptive;
 pub mod bvh;
+pub mod hybrid;
 pub mod math;
 pub mod scene;
 
+pub use adaptive::ADAPTIVE_TOLERANCE;
 pub use glam::Vec3;
 pub use math::{mix, offset_ray, reflect};
 pub use scene::{Light, Scene, Surface};
@@ -40,6 +44,8 @@ pub struct Params {
     pub epsilon: f32,
     /// Rays per pixel of the glossy shader (1–16).
     pub samples: u32,
+    /// The adaptive shader's variance tolerance (`camera.w`).
+    pub tolerance: f32,
 }
 
 impl Params {
@@ -58,11 +64,12 @@ impl Params {
             cutoff: 1.0 / 256.0,
             epsilon: 1e-3,
             samples: 4,
+            tolerance: ADAPTIVE_TOLERANCE,
         }
     }
 
     /// The uniform buffer contents:
-    /// `width, height, max_bounces, flags; camera.xyz, 0; light.xyz, ambient;
+    /// `width, height, max_bounces, flags; camera.xyz, tolerance; light.xyz, ambient;
     /// t_min, t_max, cutoff, epsilon`.
     pub fn to_words(&self) -> [u32; 16] {
         let f = |x: f32| x.to_bits();
@@ -82,7 +89,7 @@ impl Params {
             f(c.x),
             f(c.y),
             f(c.z),
-            0,
+            f(self.tolerance),
             f(l.x),
             f(l.y),
             f(l.z),
@@ -199,7 +206,8 @@ pub fn camera_dir(params: &Params, x: u32, y: u32) -> Vec3 {
     Vec3::new(uv[0], -uv[1], -1.5).normalize()
 }
 
-/// The closest opaque triangle hit with `t` in `[t_min, t_max]` (with
+/// The closest triangle hit with `t` in `[t_min, t_max]` that is opaque or
+/// whose alpha texel keeps it (with
 /// `any`, the first found, as `ACCEPT_FIRST_HIT_AND_END_SEARCH` allows: only
 /// hit-or-miss matters then), and the ray's edge margin.
 pub fn intersect(
@@ -225,7 +233,10 @@ pub fn intersect(
             None => true,
             Some(h) => th < h.t || (th == h.t && (tri as u32) < h.triangle),
         };
-        if bary.iter().all(|&w| w >= 0.0) && better {
+        // A cut-out's candidate counts only where its texel keeps the
+        // surface: the any-hit shaders' `IgnoreHit` and the ray queries'
+        // alpha test before committing.
+        if bary.iter().all(|&w| w >= 0.0) && better && scene.keeps(tri, bary) {
             best = Some(Hit {
                 t: th,
                 triangle: tri as u32,
@@ -239,14 +250,14 @@ pub fn intersect(
 /// incoming ray, where the next rays start (`from`), and the surface's own
 /// colour per unit of `weight` (the iterative shader's throughput; 1 in the
 /// recursive one), tracing the shadow ray when there is a light.
-struct Shading {
-    normal: Vec3,
-    from: Vec3,
-    local: Vec3,
-    reflectivity: f32,
+pub(crate) struct Shading {
+    pub normal: Vec3,
+    pub from: Vec3,
+    pub local: Vec3,
+    pub reflectivity: f32,
 }
 
-fn shade(
+pub(crate) fn shade(
     scene: &Scene,
     params: &Params,
     origin: Vec3,
@@ -435,92 +446,108 @@ pub fn trace_glossy(scene: &Scene, params: &Params, x: u32, y: u32) -> PixelPath
     let mut sum = Vec3::ZERO;
     let mut segments = Vec::new();
     for sample in 0..samples {
-        let mut seed = pcg(y * params.width + x) ^ pcg(sample.wrapping_add(0x9E37_79B9));
-        let mut origin = params.camera;
-        let mut dir = camera_dir(params, x, y);
-        let mut t_max = params.t_max;
-        let mut throughput = 1.0f32;
-        for _bounce in 0..=params.max_bounces {
-            let (hit, edge_margin) = intersect(scene, origin, dir, params.t_min, t_max);
-            segments.push(Segment {
-                origin,
-                dir,
-                hit,
-                shadow: false,
-                edge_margin,
-            });
-            let Some(hit) = hit else {
-                sum += throughput * sky(dir);
-                break;
-            };
-            let surface = scene.surfaces[hit.triangle as usize];
-            let n = if surface.normal.dot(dir) < 0.0 {
-                surface.normal
-            } else {
-                -surface.normal
-            };
-            let base = throughput * (1.0 - surface.reflectivity) * surface.albedo;
-            throughput *= surface.reflectivity;
-            let roughness = surface.roughness;
-            origin = params.next_origin(origin + dir * hit.t, n);
-            let light = params.light.unwrap_or(Light {
-                direction: Vec3::ZERO,
-                ambient: 0.0,
-            });
-            let ndl = n.dot(light.direction);
-            let headlight = n.dot(-dir).max(0.0);
-            if roughness > 0.0 {
-                let sgn = if n.z >= 0.0 { 1.0f32 } else { -1.0 };
-                let a = -1.0 / (sgn + n.z);
-                let b = n.x * n.y * a;
-                let tx = Vec3::new(1.0 + sgn * n.x * n.x * a, sgn * b, -sgn * n.x);
-                let ty = Vec3::new(b, sgn + n.y * n.y * a, -n.y);
-                let alpha = roughness * roughness;
-                let ve = Vec3::new((-dir).dot(tx), (-dir).dot(ty), (-dir).dot(n));
-                let u1 = rand(&mut seed);
-                let u2 = rand(&mut seed);
-                let m = sample_vndf(ve, alpha, u1, u2);
-                dir = reflect(dir, tx * m.x + ty * m.y + n * m.z);
-                let nl = n.dot(dir);
-                if nl > 0.0 {
-                    let a2 = alpha * alpha;
-                    throughput *= 2.0 * nl / (nl + (a2 + (1.0 - a2) * nl * nl).sqrt());
-                } else {
-                    throughput = 0.0;
-                }
-                t_max = params.t_max / (1.0 + 64.0 * roughness);
-            } else {
-                dir = reflect(dir, n);
-                t_max = params.t_max;
-            }
-            if params.light.is_some() {
-                sum += base * light.ambient;
-                if ndl > 0.0 {
-                    let lit = base * ndl;
-                    let (blocker, edge_margin) =
-                        intersect(scene, origin, light.direction, params.t_min, params.t_max);
-                    segments.push(Segment {
-                        origin,
-                        dir: light.direction,
-                        hit: blocker,
-                        shadow: true,
-                        edge_margin,
-                    });
-                    if blocker.is_none() {
-                        sum += lit;
-                    }
-                }
-            } else {
-                sum += base * headlight;
-            }
-            if throughput.partial_cmp(&params.cutoff) != Some(std::cmp::Ordering::Greater) {
-                break;
-            }
-        }
+        glossy_sample(scene, params, x, y, sample, &mut sum, &mut segments);
     }
     PixelPath {
         color: sum / samples as f32,
         segments,
+    }
+}
+
+/// One path of the glossy shaders (and of the adaptive one): sample number
+/// `sample` of pixel `(x, y)`, its light added into `sum` term by term (as
+/// the shaders do: the rounding depends on it), its rays appended to
+/// `segments`.
+pub fn glossy_sample(
+    scene: &Scene,
+    params: &Params,
+    x: u32,
+    y: u32,
+    sample: u32,
+    sum: &mut Vec3,
+    segments: &mut Vec<Segment>,
+) {
+    let mut seed = pcg(y * params.width + x) ^ pcg(sample.wrapping_add(0x9E37_79B9));
+    let mut origin = params.camera;
+    let mut dir = camera_dir(params, x, y);
+    let mut t_max = params.t_max;
+    let mut throughput = 1.0f32;
+    for _bounce in 0..=params.max_bounces {
+        let (hit, edge_margin) = intersect(scene, origin, dir, params.t_min, t_max);
+        segments.push(Segment {
+            origin,
+            dir,
+            hit,
+            shadow: false,
+            edge_margin,
+        });
+        let Some(hit) = hit else {
+            *sum += throughput * sky(dir);
+            break;
+        };
+        let surface = scene.surfaces[hit.triangle as usize];
+        let n = if surface.normal.dot(dir) < 0.0 {
+            surface.normal
+        } else {
+            -surface.normal
+        };
+        let base = throughput * (1.0 - surface.reflectivity) * surface.albedo;
+        throughput *= surface.reflectivity;
+        let roughness = surface.roughness;
+        origin = params.next_origin(origin + dir * hit.t, n);
+        let light = params.light.unwrap_or(Light {
+            direction: Vec3::ZERO,
+            ambient: 0.0,
+        });
+        let ndl = n.dot(light.direction);
+        let headlight = n.dot(-dir).max(0.0);
+        if roughness > 0.0 {
+            let sgn = if n.z >= 0.0 { 1.0f32 } else { -1.0 };
+            let a = -1.0 / (sgn + n.z);
+            let b = n.x * n.y * a;
+            let tx = Vec3::new(1.0 + sgn * n.x * n.x * a, sgn * b, -sgn * n.x);
+            let ty = Vec3::new(b, sgn + n.y * n.y * a, -n.y);
+            let alpha = roughness * roughness;
+            let ve = Vec3::new((-dir).dot(tx), (-dir).dot(ty), (-dir).dot(n));
+            let u1 = rand(&mut seed);
+            let u2 = rand(&mut seed);
+            let m = sample_vndf(ve, alpha, u1, u2);
+            dir = reflect(dir, tx * m.x + ty * m.y + n * m.z);
+            let nl = n.dot(dir);
+            if nl > 0.0 {
+                let a2 = alpha * alpha;
+                throughput *= 2.0 * nl / (nl + (a2 + (1.0 - a2) * nl * nl).sqrt());
+            } else {
+                throughput = 0.0;
+            }
+            t_max = params.t_max / (1.0 + 64.0 * roughness);
+        } else {
+            dir = reflect(dir, n);
+            t_max = params.t_max;
+        }
+        if params.light.is_some() {
+            *sum += base * light.ambient;
+            if ndl > 0.0 {
+                let lit = base * ndl;
+                let (blocker, edge_margin) =
+                    intersect(scene, origin, light.direction, params.t_min, params.t_max);
+                segments.push(Segment {
+                    origin,
+                    dir: light.direction,
+                    hit: blocker,
+                    shadow: true,
+                    edge_margin,
+                });
+                if blocker.is_none() {
+                    *sum += lit;
+                }
+            }
+        } else {
+            *sum += base * headlight;
+        }
+        if throughput.partial_cmp(&params.cutoff) != Some(std::cmp::Ordering::Greater) {
+            break;
+        }
     }
 }
 
@@ -530,6 +557,27 @@ pub enum Method {
     Iterative,
     Recursive,
     Glossy,
+    /// G-buffer, screen-space march, ray fallback ([`hybrid`]).
+    Hybrid,
+    /// Glossy paths accumulated until the variance is low ([`adaptive`]).
+    Adaptive,
+}
+
+impl Method {
+    /// How many times the GPU runs the pipeline's ray generation shaders
+    /// (each in turn) over the image.
+    pub fn passes(self) -> u32 {
+        match self {
+            Method::Adaptive => adaptive::ADAPTIVE_MAX,
+            _ => 1,
+        }
+    }
+
+    /// Whether the shaders keep per-pixel state between passes (the
+    /// `scratch` buffer) and write a per-pixel count (`counts`).
+    pub fn scratch(self) -> bool {
+        matches!(self, Method::Hybrid | Method::Adaptive)
+    }
 }
 
 /// One pixel's path by `method`.
@@ -538,6 +586,8 @@ pub fn trace_pixel(scene: &Scene, params: &Params, method: Method, x: u32, y: u3
         Method::Iterative => trace_iterative(scene, params, x, y),
         Method::Recursive => trace_recursive(scene, params, x, y),
         Method::Glossy => trace_glossy(scene, params, x, y),
+        Method::Hybrid => hybrid::trace_hybrid(scene, params, x, y),
+        Method::Adaptive => adaptive::trace_adaptive(scene, params, x, y).0,
     }
 }
 
@@ -545,6 +595,13 @@ pub fn trace_pixel(scene: &Scene, params: &Params, method: Method, x: u32, y: u3
 /// with each pixel's edge margin (see [`Segment::edge_margin`]).
 pub fn render(scene: &Scene, params: &Params, method: Method) -> (Vec<u32>, Vec<f32>) {
     let n = (params.width * params.height) as usize;
+    if method == Method::Hybrid {
+        let (paths, _) = hybrid::render(scene, params);
+        return (
+            paths.iter().map(|p| pack_rgba8(p.color)).collect(),
+            paths.iter().map(PixelPath::edge_margin).collect(),
+        );
+    }
     let (mut image, mut margins) = (Vec::with_capacity(n), Vec::with_capacity(n));
     for y in 0..params.height {
         for x in 0..params.width {
@@ -674,6 +731,35 @@ mod tests {
                 "({x}, {y})"
             );
         }
+    }
+
+    #[test]
+    fn cutouts_let_primary_reflection_and_shadow_rays_through() {
+        let path =
+            std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("shaders/scenes/cutout.toml");
+        let scene = Scene::load(&path).unwrap();
+        assert!(scene.has_cutouts());
+        let mut solid = scene.clone();
+        for s in &mut solid.surfaces {
+            s.cutout = false;
+        }
+        let p = Params::for_scene(&scene, 48, 48, 3);
+        // Per ray kind: rays whose hit changes when the holes are filled.
+        let mut through = [0usize; 3];
+        for y in 0..p.height {
+            for x in 0..p.width {
+                let a = trace_iterative(&scene, &p, x, y);
+                let b = trace_iterative(&solid, &p, x, y);
+                for (k, (sa, sb)) in a.segments.iter().zip(&b.segments).enumerate() {
+                    if sa.hit.map(|h| h.triangle) != sb.hit.map(|h| h.triangle) {
+                        let kind = if sa.shadow { 2 } else { usize::from(k > 0) };
+                        through[kind] += 1;
+                        break;
+                    }
+                }
+            }
+        }
+        assert!(through.iter().all(|&n| n > 5), "{through:?}");
     }
 
     #[test]

@@ -16,6 +16,10 @@
 //! albedo = [1.0, 0.0, 1.0]
 //! metallic = 1.0             # the mirror shaders' reflectivity
 //! roughness = 0.0
+//! cutout = false             # alpha-tested against [cutout] at the mesh's UVs
+//!
+//! [cutout]                   # optional: the alpha texture, one string per row
+//! rows = ["#.", ".#"]        # '#' keeps the surface, '.' cuts it away
 //!
 //! [[mesh]]
 //! name = "ball"
@@ -38,7 +42,7 @@
 //! both sides.
 
 use super::bvh::Bvh;
-use glam::{Affine3A, EulerRot, Quat, Vec3};
+use glam::{Affine3A, EulerRot, Quat, Vec2, Vec3};
 use serde::Deserialize;
 use std::path::Path;
 
@@ -51,6 +55,8 @@ pub struct Surface {
     pub reflectivity: f32,
     pub albedo: Vec3,
     pub roughness: f32,
+    /// Alpha-tested against the scene's [`Cutout`] texture.
+    pub cutout: bool,
 }
 
 impl Surface {
@@ -76,6 +82,34 @@ pub struct Material {
     pub albedo: Vec3,
     pub metallic: f32,
     pub roughness: f32,
+    pub cutout: bool,
+}
+
+/// The alpha texture of cut-out materials: `width × height` texels, row by
+/// row, each 1 (surface) or 0 (cut away).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Cutout {
+    pub width: u32,
+    pub height: u32,
+    pub alpha: Vec<f32>,
+}
+
+impl Cutout {
+    /// Whether the surface is there at texture coordinate `uv`: the one texel
+    /// under `uv` (clamped to the texture), as the shaders' `alpha_test`.
+    pub fn keeps(&self, uv: Vec2) -> bool {
+        let size = Vec2::new(self.width as f32, self.height as f32);
+        // `uint2(clamp(uv, 0, 1) * size)`: float-to-uint truncates.
+        let texel = uv.clamp(Vec2::ZERO, Vec2::ONE) * size;
+        let x = (texel.x as u32).min(self.width - 1);
+        let y = (texel.y as u32).min(self.height - 1);
+        self.alpha[(y * self.width + x) as usize] >= 0.5
+    }
+
+    /// The texels as the GPU's RGBA32F image: alpha in every channel.
+    pub fn texels(&self) -> Vec<[f32; 4]> {
+        self.alpha.iter().map(|&a| [a; 4]).collect()
+    }
 }
 
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -91,6 +125,8 @@ pub struct Light {
 pub struct Mesh {
     pub name: String,
     pub positions: Vec<Vec3>,
+    /// Texture coordinates, one per position.
+    pub uvs: Vec<Vec2>,
     /// Three per triangle.
     pub indices: Vec<u32>,
 }
@@ -139,6 +175,17 @@ pub struct Triangle {
     /// closed edge sees the same surface on either side, so only open edges
     /// make the result a matter of rounding.
     pub open: [bool; 3],
+    /// Texture coordinates at the corners.
+    pub uvs: [Vec2; 3],
+}
+
+impl Triangle {
+    /// The texture coordinate at barycentrics `(w0, w1, w2)`, as the shaders
+    /// interpolate it: `uv0 + w1 (uv1 - uv0) + w2 (uv2 - uv0)`.
+    pub fn uv(&self, bary: [f32; 3]) -> Vec2 {
+        let [a, b, c] = self.uvs;
+        a + bary[1] * (b - a) + bary[2] * (c - a)
+    }
 }
 
 #[derive(Clone, Debug)]
@@ -146,6 +193,7 @@ pub struct Scene {
     pub name: String,
     pub camera: Vec3,
     pub light: Option<Light>,
+    pub cutout: Option<Cutout>,
     pub materials: Vec<Material>,
     pub meshes: Vec<Mesh>,
     pub instances: Vec<Instance>,
@@ -161,6 +209,7 @@ pub struct Scene {
 struct RawScene {
     camera: RawCamera,
     light: Option<RawLight>,
+    cutout: Option<RawCutout>,
     #[serde(default)]
     material: Vec<RawMaterial>,
     #[serde(default)]
@@ -185,6 +234,12 @@ struct RawLight {
 
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
+struct RawCutout {
+    rows: Vec<String>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
 struct RawMaterial {
     name: String,
     albedo: [f32; 3],
@@ -192,6 +247,8 @@ struct RawMaterial {
     metallic: f32,
     #[serde(default)]
     roughness: f32,
+    #[serde(default)]
+    cutout: bool,
 }
 
 #[derive(Deserialize)]
@@ -283,6 +340,10 @@ impl Scene {
             }
             None => None,
         };
+        let cutout = match raw.cutout {
+            Some(c) => Some(cutout(&c.rows)?),
+            None => None,
+        };
         let materials: Vec<Material> = raw
             .material
             .into_iter()
@@ -291,8 +352,17 @@ impl Scene {
                 albedo: m.albedo.into(),
                 metallic: m.metallic,
                 roughness: m.roughness,
+                cutout: m.cutout,
             })
             .collect();
+        if let Some(m) = materials.iter().find(|m| m.cutout) {
+            if cutout.is_none() {
+                return Err(format!(
+                    "material `{}` is a cut-out, but the scene has no [cutout] texture",
+                    m.name
+                ));
+            }
+        }
         let mut meshes = Vec::new();
         for m in raw.mesh {
             let mesh = match m.kind {
@@ -321,6 +391,7 @@ impl Scene {
             name: name.to_string(),
             camera: raw.camera.position.into(),
             light,
+            cutout,
             materials,
             meshes,
             instances: Vec::new(),
@@ -383,6 +454,20 @@ impl Scene {
         s
     }
 
+    /// The same scene with every triangle wound the other way: every
+    /// geometric normal the shaders read points to the other side, away
+    /// from whoever sees the surface first.
+    pub fn with_flipped_normals(&self) -> Scene {
+        let mut s = self.clone();
+        for m in &mut s.meshes {
+            for t in m.indices.chunks_exact_mut(3) {
+                t.swap(1, 2);
+            }
+        }
+        s.flatten();
+        s
+    }
+
     /// Rebuilds the world-space triangles, surfaces and BVH from the instances.
     fn flatten(&mut self) {
         self.triangles.clear();
@@ -405,10 +490,12 @@ impl Scene {
                     reflectivity: material.metallic,
                     albedo: material.albedo,
                     roughness: material.roughness,
+                    cutout: material.cutout,
                 });
                 self.triangles.push(Triangle {
                     corners: c,
                     open: [true; 3],
+                    uvs: [0, 1, 2].map(|k| mesh.uvs[tri[k] as usize]),
                 });
             }
             // Open edges: shared with no other triangle of this instance
@@ -457,9 +544,74 @@ impl Scene {
     pub fn surface_data(&self) -> Vec<[f32; 8]> {
         self.surfaces.iter().map(Surface::to_gpu).collect()
     }
+
+    /// Whether any instance is alpha-tested: only then does the GPU build
+    /// any-hit shaders and bind the texture and the `cutouts` buffer.
+    pub fn has_cutouts(&self) -> bool {
+        self.surfaces.iter().any(|s| s.cutout)
+    }
+
+    /// Whether the surface of `triangle` is there at barycentrics `bary`
+    /// (always, unless its material is a cut-out).
+    pub fn keeps(&self, triangle: usize, bary: [f32; 3]) -> bool {
+        match &self.cutout {
+            Some(c) if self.surfaces[triangle].cutout => c.keeps(self.triangles[triangle].uv(bary)),
+            _ => true,
+        }
+    }
+
+    /// The shaders' `cutouts` buffer, one record per triangle: the corners'
+    /// texture coordinates `u0 v0 u1 v1, u2 v2`, then the texture's width and
+    /// height, or 0 and 0 for a surface that is not alpha-tested.
+    pub fn cutout_data(&self) -> Vec<[f32; 8]> {
+        let (w, h) = self
+            .cutout
+            .as_ref()
+            .map_or((0.0, 0.0), |c| (c.width as f32, c.height as f32));
+        self.triangles
+            .iter()
+            .zip(&self.surfaces)
+            .map(|(t, s)| {
+                let [a, b, c] = t.uvs;
+                let (w, h) = if s.cutout { (w, h) } else { (0.0, 0.0) };
+                [a.x, a.y, b.x, b.y, c.x, c.y, w, h]
+            })
+            .collect()
+    }
 }
 
-/// A parallelogram `center ± u ± v` as two triangles facing `u × v`.
+/// Parses `[cutout] rows`: equal-length rows of `#` (kept) and `.` (cut).
+fn cutout(rows: &[String]) -> Result<Cutout, String> {
+    let width = rows.first().map_or(0, |r| r.chars().count());
+    if width == 0 || rows.len() > 256 || width > 256 {
+        return Err("cutout.rows must be 1–256 rows of 1–256 texels".into());
+    }
+    let mut alpha = Vec::with_capacity(width * rows.len());
+    for (y, r) in rows.iter().enumerate() {
+        if r.chars().count() != width {
+            return Err(format!("cutout.rows[{y}] is not {width} texels long"));
+        }
+        for ch in r.chars() {
+            alpha.push(match ch {
+                '#' => 1.0,
+                '.' => 0.0,
+                other => {
+                    return Err(format!(
+                        "cutout.rows[{y}] has `{other}`; use `#` (kept) and `.` (cut)"
+                    ))
+                }
+            });
+        }
+    }
+    Ok(Cutout {
+        width: width as u32,
+        height: rows.len() as u32,
+        alpha,
+    })
+}
+
+/// A parallelogram `center ± u ± v` as two triangles facing `u × v`; the
+/// texture runs from (0, 0) at `center - u - v` to (1, 1) at `center + u + v`.
 fn quad(center: Vec3, u: Vec3, v: Vec3) -> Mesh {
     Mesh {
         name: String::new(),
@@ -468,6 +620,12 @@ fn quad(center: Vec3, u: Vec3, v: Vec3) -> Mesh {
             center + u - v,
             center + u + v,
             center - u + v,
+        ],
+        uvs: vec![
+            Vec2::new(0.0, 0.0),
+            Vec2::new(1.0, 0.0),
+            Vec2::new(1.0, 1.0),
+            Vec2::new(0.0, 1.0),
         ],
         indices: vec![0, 1, 2, 0, 2, 3],
     }
@@ -479,6 +637,7 @@ fn cuboid(h: Vec3) -> Mesh {
     let mut m = Mesh {
         name: String::new(),
         positions: Vec::new(),
+        uvs: Vec::new(),
         indices: Vec::new(),
     };
     for axis in 0..3 {
@@ -494,6 +653,7 @@ fn cuboid(h: Vec3) -> Mesh {
             let q = quad(n * h[axis], u, v);
             let base = m.positions.len() as u32;
             m.positions.extend(q.positions);
+            m.uvs.extend(q.uvs);
             m.indices.extend(q.indices.iter().map(|i| i + base));
         }
     }
@@ -504,6 +664,7 @@ fn cuboid(h: Vec3) -> Mesh {
 /// outwards (flat facets).
 fn sphere(radius: f32, segments: u32, rings: u32) -> Mesh {
     let mut positions = Vec::new();
+    let mut uvs = Vec::new();
     for r in 0..=rings {
         let theta = std::f32::consts::PI * r as f32 / rings as f32;
         for s in 0..=segments {
@@ -512,6 +673,10 @@ fn sphere(radius: f32, segments: u32, rings: u32) -> Mesh {
                 radius * theta.sin() * phi.cos(),
                 radius * theta.cos(),
                 -radius * theta.sin() * phi.sin(),
+            ));
+            uvs.push(Vec2::new(
+                s as f32 / segments as f32,
+                r as f32 / rings as f32,
             ));
         }
     }
@@ -535,6 +700,7 @@ fn sphere(radius: f32, segments: u32, rings: u32) -> Mesh {
     Mesh {
         name: String::new(),
         positions,
+        uvs,
         indices,
     }
 }
@@ -614,9 +780,54 @@ mod tests {
             ),
             ("[camera]\nposition = [0.0, 0.0, 0.0]", "no instance"),
             ("[camera]\nposition = [0.0, 0.0, 0.0]\nfov = 3", "unknown field"),
+            (
+                "[camera]\nposition = [0.0, 0.0, 0.0]\n[cutout]\nrows = [\"#.\", \"#\"]",
+                "cutout.rows[1] is not 2 texels long",
+            ),
+            (
+                "[camera]\nposition = [0.0, 0.0, 0.0]\n[cutout]\nrows = [\"#o\"]",
+                "has `o`",
+            ),
+            (
+                "[camera]\nposition = [0.0, 0.0, 0.0]\n[[material]]\nname = \"m\"\nalbedo = [1.0, 1.0, 1.0]\ncutout = true",
+                "no [cutout] texture",
+            ),
         ] {
             let e = Scene::parse("t", text).unwrap_err();
             assert!(e.contains(what), "{e}");
+        }
+    }
+
+    #[test]
+    fn a_cutout_texel_is_looked_up_at_the_interpolated_coordinate() {
+        let c = cutout(&["#.".into(), "..".into()]).unwrap();
+        assert!(c.keeps(Vec2::new(0.25, 0.25)));
+        assert!(!c.keeps(Vec2::new(0.75, 0.25)));
+        // Clamped to the texture: beyond (0, 0) is the corner texel.
+        assert!(c.keeps(Vec2::new(-3.0, -1.0)));
+        assert!(!c.keeps(Vec2::new(1.0, 1.0)));
+        let q = quad(Vec3::ZERO, Vec3::X, Vec3::Y);
+        let t = Triangle {
+            corners: [0, 1, 2].map(|k| q.positions[q.indices[k] as usize]),
+            open: [true; 3],
+            uvs: [0, 1, 2].map(|k| q.uvs[q.indices[k] as usize]),
+        };
+        assert_eq!(t.uv([1.0, 0.0, 0.0]), Vec2::ZERO);
+        assert_eq!(t.uv([0.0, 0.0, 1.0]), Vec2::ONE);
+        assert_eq!(t.uv([0.5, 0.5, 0.0]), Vec2::new(0.5, 0.0));
+    }
+
+    #[test]
+    fn flipping_turns_every_normal_around() {
+        let s = Scene::parse("t", SCENE).unwrap();
+        let f = s.with_flipped_normals();
+        for (a, b) in s.surfaces.iter().zip(&f.surfaces) {
+            assert!(
+                (a.normal + b.normal).length() < 1e-5,
+                "{} {}",
+                a.normal,
+                b.normal
+            );
         }
     }
 

@@ -13,6 +13,7 @@
 
 pub mod compare;
 pub mod gpu;
+pub mod measure;
 
 use crate::reference::{self, Method, Params, Scene};
 use crate::vk::{spawn_command, ChildOutcome, RunningChild};
@@ -58,10 +59,35 @@ struct RawShader {
     /// a compute shader (ray queries) with its entry point and bounces.
     compute: Option<PathBuf>,
     entry: Option<String>,
+    /// The compute entry point for scenes with alpha-tested cut-outs (it
+    /// binds the alpha texture; `entry` does not).
+    cutout_entry: Option<String>,
     max_bounces: Option<u32>,
     reference: String,
     scenes: Vec<String>,
-    identical_to: Option<String>,
+    /// Shaders whose images this one's must equal, on the scenes both render.
+    #[serde(default)]
+    identical_to: OneOrMany,
+}
+
+/// A name, or a list of them.
+#[derive(Deserialize, Default)]
+#[serde(untagged)]
+enum OneOrMany {
+    #[default]
+    None,
+    One(String),
+    Many(Vec<String>),
+}
+
+impl OneOrMany {
+    fn names(&self) -> &[String] {
+        match self {
+            OneOrMany::None => &[],
+            OneOrMany::One(n) => std::slice::from_ref(n),
+            OneOrMany::Many(v) => v,
+        }
+    }
 }
 
 #[derive(Deserialize)]
@@ -84,6 +110,8 @@ pub enum Source {
     Compute {
         file: PathBuf,
         entry: String,
+        /// The entry point for scenes with cut-outs.
+        cutout_entry: Option<String>,
         max_bounces: u32,
     },
 }
@@ -92,13 +120,14 @@ pub enum Source {
 /// ray parameters, rendered with robust origins or the fixed epsilon.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Extreme {
-    /// `translate=1e3`, `tmax=inf`, `tmin=1e-3`, `roughness=0.5`, `grazing`.
+    /// `translate=1e3`, `tmax=inf`, `tmin=1e-3`, `roughness=0.5`, `grazing`,
+    /// `backfacing`.
     pub variant: String,
     pub robust: bool,
 }
 
 /// The variants of the matrix, each rendered both ways.
-pub const EXTREMES: [&str; 14] = [
+pub const EXTREMES: [&str; 15] = [
     "translate=0",
     "translate=1e3",
     "translate=1e4",
@@ -113,6 +142,7 @@ pub const EXTREMES: [&str; 14] = [
     "roughness=0.5",
     "roughness=1",
     "grazing",
+    "backfacing",
 ];
 
 impl Extreme {
@@ -140,6 +170,9 @@ impl Extreme {
                 scene.camera.y = 1e-3;
                 params.camera = scene.camera;
             }
+            // Every normal in the surfaces buffer faces away from the viewer:
+            // the shaders must turn it towards the ray before shading.
+            None if self.variant == "backfacing" => *scene = scene.with_flipped_normals(),
             _ => return Err(format!("unknown extreme `{}`", self.variant)),
         }
         Ok(())
@@ -210,8 +243,10 @@ fn method(name: &str, what: &str) -> Result<Method, String> {
         "iterative" => Ok(Method::Iterative),
         "recursive" => Ok(Method::Recursive),
         "glossy" => Ok(Method::Glossy),
+        "hybrid" => Ok(Method::Hybrid),
+        "adaptive" => Ok(Method::Adaptive),
         other => Err(format!(
-            "{what}: unknown reference `{other}` (expected `iterative`, `recursive` or `glossy`)"
+            "{what}: unknown reference `{other}` (expected `iterative`, `recursive`, `glossy`, `hybrid` or `adaptive`)"
         )),
     }
 }
@@ -239,6 +274,7 @@ impl Manifest {
                 (None, Some(c)) => Source::Compute {
                     file: dir.join(c),
                     entry: s.entry.clone().unwrap_or_else(|| "main".into()),
+                    cutout_entry: s.cutout_entry.clone(),
                     max_bounces: s.max_bounces.unwrap_or(3),
                 },
                 _ => {
@@ -264,26 +300,27 @@ impl Manifest {
             }
         }
         for s in &raw.shader {
-            let Some(other) = &s.identical_to else {
-                continue;
-            };
-            if !raw.shader.iter().any(|o| &o.name == other) {
-                return Err(format!(
-                    "{}: `{}` is to be identical to unknown shader `{other}`",
-                    path.display(),
-                    s.name
-                ));
-            }
-            for sc in &s.scenes {
-                cases.push(Case {
-                    name: format!("{}={other}/{sc}", s.name),
-                    shader: format!("{} = {other}", s.name),
-                    scene: sc.clone(),
-                    kind: CaseKind::Identical {
-                        a: format!("{}/{sc}", s.name),
-                        b: format!("{other}/{sc}"),
-                    },
-                });
+            for other in s.identical_to.names() {
+                let Some(theirs) = raw.shader.iter().find(|o| &o.name == other) else {
+                    return Err(format!(
+                        "{}: `{}` is to be identical to unknown shader `{other}`",
+                        path.display(),
+                        s.name
+                    ));
+                };
+                // Only the scenes both render (the WGSL pipelines cannot
+                // render cut-outs).
+                for sc in s.scenes.iter().filter(|sc| theirs.scenes.contains(sc)) {
+                    cases.push(Case {
+                        name: format!("{}={other}/{sc}", s.name),
+                        shader: format!("{} = {other}", s.name),
+                        scene: sc.clone(),
+                        kind: CaseKind::Identical {
+                            a: format!("{}/{sc}", s.name),
+                            b: format!("{other}/{sc}"),
+                        },
+                    });
+                }
             }
         }
         for f in &raw.expected_failure {
@@ -389,6 +426,7 @@ pub fn setup(
     scene_path: &Path,
     depth: Option<u32>,
 ) -> Result<(Loaded, Scene, Params), String> {
+    let scene = Scene::load(scene_path)?;
     let (loaded, bounces) = match source {
         Source::Pipeline(path) => {
             let mut pipeline = crate::pipeline::load(path)
@@ -407,8 +445,20 @@ pub fn setup(
         Source::Compute {
             file,
             entry,
+            cutout_entry,
             max_bounces,
         } => {
+            let entry = match cutout_entry {
+                Some(e) if scene.has_cutouts() => e,
+                _ if scene.has_cutouts() => {
+                    return Err(format!(
+                        "{}: scene {} has cut-outs, and the shader names no `cutout_entry`",
+                        file.display(),
+                        scene_path.display()
+                    ))
+                }
+                _ => entry,
+            };
             let language = crate::shader::Language::from_path(file)
                 .ok_or_else(|| format!("{}: not a shader file", file.display()))?;
             let compiled = crate::front::compile_path(file, language)
@@ -422,7 +472,6 @@ pub fn setup(
             )
         }
     };
-    let scene = Scene::load(scene_path)?;
     let params = Params::for_scene(&scene, manifest.width, manifest.height, bounces);
     Ok((loaded, scene, params))
 }
@@ -461,6 +510,8 @@ pub struct Row {
     pub self_hit: Option<f64>,
     pub time: Duration,
     pub outcome: Outcome,
+    /// What a multi-pass shader measured (paths taken, paths saved).
+    pub note: Option<String>,
 }
 
 impl Row {
@@ -553,16 +604,20 @@ pub fn run(
         }
     }
     let mut report = Report::default();
+    let mut cache = CpuCache::new();
     let mut images: Vec<(String, Vec<u32>)> = Vec::new();
     for (i, case) in cases.iter().enumerate() {
         progress(i, cases.len(), &case.name);
         let start = Instant::now();
+        let mut note = None;
         let (comparison, outcome) = match &case.kind {
             CaseKind::Render { .. } => {
-                let (c, o, image) = render_case(options, &manifest, case, &mut report)?;
+                let (c, o, image, n) =
+                    render_case(options, &manifest, case, &mut report, &mut cache)?;
                 if let Some(image) = image {
                     images.push((case.name.clone(), image));
                 }
+                note = n;
                 (c, o)
             }
             CaseKind::Identical { a, b } => {
@@ -641,6 +696,7 @@ pub fn run(
             self_hit,
             time: start.elapsed(),
             outcome,
+            note,
         });
     }
     progress(cases.len(), cases.len(), "");
@@ -658,13 +714,17 @@ fn note_device(report: &mut Report, end: &ChildOutcome) {
 }
 
 type Measured = (Comparison, Option<usize>, Option<f64>);
-type CaseResult = (Option<Measured>, Outcome, Option<Vec<u32>>);
+type CaseResult = (Option<Measured>, Outcome, Option<Vec<u32>>, Option<String>);
+
+/// CPU renders by reference method and scene.
+type CpuCache = std::collections::HashMap<String, std::rc::Rc<measure::CpuRender>>;
 
 fn render_case(
     options: &Options<'_>,
     manifest: &Manifest,
     case: &Case,
     report: &mut Report,
+    cache: &mut CpuCache,
 ) -> Result<CaseResult, String> {
     let CaseKind::Render {
         source,
@@ -684,7 +744,20 @@ fn render_case(
     let _ = std::fs::remove_file(&image_path);
     // The CPU reference renders while the child runs.
     let running = spawn((options.child)(&case.name, &image_path))?;
-    let (cpu, margins) = reference::render(&scene, &params, method);
+    // The CPU render of a case that is not an extreme is shared by every
+    // shader with the same reference and scene.
+    let key = format!("{method:?} {}", scene_path.display());
+    let cpu_render = match cache.get(&key) {
+        Some(r) if extreme.is_none() => r.clone(),
+        _ => {
+            let r = std::rc::Rc::new(measure::cpu_render(&scene, &params, method));
+            if extreme.is_none() {
+                cache.insert(key, r.clone());
+            }
+            r
+        }
+    };
+    let (cpu, margins) = (&cpu_render.image, &cpu_render.margins);
     let end = wait(running)?;
     note_device(report, &end);
     if end.code == Some(SKIP_CODE) {
@@ -693,18 +766,17 @@ fn render_case(
             .lines()
             .find_map(|l| l.strip_prefix("skip: "))
             .unwrap_or("the device cannot run it");
-        return Ok((None, Outcome::Skipped(why.to_string()), None));
+        return Ok((None, Outcome::Skipped(why.to_string()), None, None));
     }
     if end.code != Some(0) {
-        return Ok((None, Outcome::Fail(describe(&end)), None));
+        return Ok((None, Outcome::Fail(describe(&end)), None, None));
     }
-    let bytes = std::fs::read(&image_path)
-        .map_err(|e| format!("cannot read {}: {e}", image_path.display()))?;
-    let _ = std::fs::remove_file(&image_path);
-    let gpu: Vec<u32> = bytes
-        .chunks_exact(4)
-        .map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]))
-        .collect();
+    let gpu = read_words(&image_path)?;
+    let gpu_counts = if method.scratch() {
+        Some(read_words(&counts_path(&image_path))?)
+    } else {
+        None
+    };
     if gpu.len() != cpu.len() {
         return Ok((
             None,
@@ -714,9 +786,10 @@ fn render_case(
                 cpu.len()
             )),
             None,
+            None,
         ));
     }
-    let c = compare::compare(&gpu, &cpu, &margins, TOLERANCE);
+    let c = compare::compare(&gpu, cpu, margins, TOLERANCE);
     let base = options.out.join(file_name(&case.name));
     let png = |suffix: &str, image: &[u32]| {
         compare::write_png(
@@ -734,17 +807,22 @@ fn render_case(
         // than 0.1 % of the rays leaving a surface hit it again. The
         // difference to the CPU is reported, not judged (far from the
         // origin both sides round differently by design).
-        let (mut own, mut secondary) = (0usize, 0usize);
+        // The CPU's colours are checked in f32 too, before any packing.
+        let (mut own, mut secondary, mut cpu_nan) = (0usize, 0usize, 0usize);
         for y in 0..params.height {
             for x in 0..params.width {
-                let (o, n) = reference::trace_pixel(&scene, &params, method, x, y).self_hits();
+                let path = reference::trace_pixel(&scene, &params, method, x, y);
+                let (o, n) = path.self_hits();
                 own += o;
                 secondary += n;
+                cpu_nan += usize::from(!path.color.is_finite());
             }
         }
         let rate = 100.0 * own as f64 / secondary.max(1) as f64;
-        let outcome = if nan > 0 {
-            Outcome::Fail(format!("{nan} pixels are NaN or infinite"))
+        let outcome = if nan > 0 || cpu_nan > 0 {
+            Outcome::Fail(format!(
+                "{nan} GPU and {cpu_nan} CPU pixels are NaN or infinite"
+            ))
         } else if e.robust && rate >= 0.1 {
             Outcome::Fail(format!(
                 "{own} of {secondary} rays ({rate:.3} %) hit the triangle they left"
@@ -752,13 +830,37 @@ fn render_case(
         } else {
             Outcome::Pass
         };
-        return Ok((Some((c, Some(nan), Some(rate))), outcome, Some(gpu)));
+        return Ok((Some((c, Some(nan), Some(rate))), outcome, Some(gpu), None));
     }
-    let outcome = if c.passes() && nan == 0 {
+    // Multi-pass shaders: their per-pixel counts against the CPU's, and
+    // what they measured.
+    let mut counts_ok = true;
+    let note = match (&gpu_counts, &cpu_render.counts) {
+        (Some(g), Some(k)) if g.len() == k.len() => {
+            let differ = g.iter().zip(k).filter(|(a, b)| a != b).count();
+            counts_ok = differ * 1000 <= g.len();
+            let m = measure::measure(&cpu_render, g, differ);
+            if let Some(picture) = &m.picture {
+                png("paths", picture)?;
+            }
+            Some(m.note)
+        }
+        (Some(_), _) => {
+            counts_ok = false;
+            Some("the child's counts do not cover the image".into())
+        }
+        _ => None,
+    };
+    let outcome = if c.passes() && nan == 0 && counts_ok {
         Outcome::Pass
+    } else if !counts_ok {
+        Outcome::Fail(format!(
+            "more than 0.1 % of the per-pixel counts differ from the CPU's: {}",
+            note.as_deref().unwrap_or("")
+        ))
     } else {
-        png("cpu", &cpu)?;
-        png("diff", &compare::difference(&gpu, &cpu))?;
+        png("cpu", cpu)?;
+        png("diff", &compare::difference(&gpu, cpu))?;
         Outcome::Fail(format!(
             "{} pixels above {TOLERANCE}/255 ({} near an edge); images in {}",
             c.above,
@@ -766,7 +868,7 @@ fn render_case(
             options.out.display()
         ))
     };
-    Ok((Some((c, Some(nan), None)), outcome, Some(gpu)))
+    Ok((Some((c, Some(nan), None)), outcome, Some(gpu), note))
 }
 
 /// The child's side: renders case `name` on the device and writes the
@@ -801,8 +903,19 @@ pub fn child_main(
     })
     .map_err(|e| e.to_string())?;
     println!("device: {}", ctx.info().name);
+    let method = match &case.kind {
+        CaseKind::Render { method, .. } | CaseKind::ExpectedCrash { method, .. } => *method,
+        CaseKind::Identical { .. } => Method::Iterative,
+    };
     let rendered = match &loaded {
-        Loaded::Pipeline(p) => gpu::render(&ctx, p, None, &scene, &params)?,
+        Loaded::Pipeline(p) => gpu::render_passes(
+            &ctx,
+            p,
+            None,
+            &scene,
+            &params,
+            gpu::Passes::for_method(method),
+        )?,
         Loaded::Compute { words, entry } => {
             if !ctx.info().ray_query {
                 println!("skip: {} has no VK_KHR_ray_query", ctx.info().name);
@@ -813,12 +926,28 @@ pub fn child_main(
     };
     println!("trace: {:.3}", rendered.trace.as_secs_f64() * 1000.0);
     println!("total: {:.3}", rendered.total.as_secs_f64() * 1000.0);
-    let bytes: Vec<u8> = rendered
-        .image
-        .iter()
-        .flat_map(|p| p.to_le_bytes())
-        .collect();
-    std::fs::write(image, bytes).map_err(|e| format!("cannot write {}: {e}", image.display()))
+    let write = |path: &Path, words: &[u32]| {
+        let bytes: Vec<u8> = words.iter().flat_map(|p| p.to_le_bytes()).collect();
+        std::fs::write(path, bytes).map_err(|e| format!("cannot write {}: {e}", path.display()))
+    };
+    if let Some(counts) = &rendered.counts {
+        write(&counts_path(image), counts)?;
+    }
+    write(image, &rendered.image)
+}
+
+/// Where the child writes the per-pixel counts of a multi-pass shader.
+fn counts_path(image: &Path) -> PathBuf {
+    image.with_extension("counts")
+}
+
+fn read_words(path: &Path) -> Result<Vec<u32>, String> {
+    let bytes = std::fs::read(path).map_err(|e| format!("cannot read {}: {e}", path.display()))?;
+    let _ = std::fs::remove_file(path);
+    Ok(bytes
+        .chunks_exact(4)
+        .map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+        .collect())
 }
 
 /// The table's columns, in order.
@@ -900,6 +1029,11 @@ impl Report {
                 Outcome::Pass => {}
             }
         }
+        for r in &self.rows {
+            if let Some(note) = &r.note {
+                out.push_str(&format!("{}: {note}\n", r.case.name));
+            }
+        }
         out
     }
 
@@ -944,6 +1078,19 @@ mod tests {
         for c in &m.cases {
             if let Some((source, scene, depth)) = c.kind.runs() {
                 setup(&m, source, scene, depth).unwrap();
+            }
+        }
+        // Ray-query shaders run their cut-out entry point only on scenes
+        // with cut-outs.
+        for (case, want) in [
+            ("rayquery/mirror", "main"),
+            ("rayquery-hlsl/cutout", "main_alpha"),
+        ] {
+            let c = m.cases.iter().find(|c| c.name == case).unwrap();
+            let (source, scene, depth) = c.kind.runs().unwrap();
+            match setup(&m, source, scene, depth).unwrap().0 {
+                Loaded::Compute { entry, .. } => assert_eq!(entry, want),
+                Loaded::Pipeline(_) => panic!("{case} is a compute case"),
             }
         }
         // Selecting an identity case brings the renders it compares.

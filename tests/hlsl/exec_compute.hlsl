@@ -232,4 +232,20 @@ void Main()
     bool2 both = and(bool2(true, b1 > 0), bool2(b1 > 0, false));
     put(both.x ? 1 : 0);
     put(select(b1 > 0, 5, 7) + select(bool2(false, true), int2(1, 2), int2(3, 4)).x);
+    // 79..81: a ternary with a call runs only the chosen side; an int side
+    // and a float side meet in the common type
+    int tc = 0;
+    float tv = b1 > 0 ? 1 : (bump(tc) ? 2.5 : 0.5);
+    put(tv);
+    put(tc);
+    float tw = b1 < 0 ? 1 : (bump(tc) ? 2.5 : 0.5);
+    put(tw + tc);
+    // 82..83: cheap sides are selected whole: vectors and structs on a
+    // scalar condition
+    put((b1 > 0 ? float3(1, 2, 3) : float3(4, 5, 6)).y);
+    Counter other;
+    other.count = 9;
+    other.scale = 2.0;
+    Counter picked = b1 < 0 ? ctr : other;
+    put(picked.count + picked.scale);
 }

@@ -180,6 +180,8 @@ pub struct Lowerer<'a> {
     funcs: Vec<FnSig<'a>>,
     fn_by_name: HashMap<String, Vec<usize>>,
     ty_cache: HashMap<(Ty, Layout, bool), Id>,
+    /// `OpUndef` of each type id, at module scope.
+    undefs: HashMap<Id, Id>,
     consts: HashMap<(Id, u32), Id>,
     glsl: Id,
     caps: HashSet<Capability>,
@@ -472,6 +474,7 @@ impl<'a> Lowerer<'a> {
             funcs: Vec::new(),
             fn_by_name: HashMap::new(),
             ty_cache: HashMap::new(),
+            undefs: HashMap::new(),
             consts: HashMap::new(),
             glsl,
             caps,
@@ -700,8 +703,11 @@ impl<'a> Lowerer<'a> {
                 self.ray_tracing_caps();
             }
         }
-        let debug = self.emit_debug_info();
+        let mut debug = self.emit_debug_info();
         let mut module = self.b.module();
+        if let Some(d) = &mut debug {
+            Self::place_declares(&mut module, d);
+        }
         hoist_variables(&mut module);
         if let Some(d) = &debug {
             Self::place_definitions(&mut module, d);

@@ -1273,6 +1273,15 @@ impl<'a> Lowerer<'a> {
                 };
                 let val = self.convert(val, &p.ty, a.pos(), false)?;
                 self.b.store(tmp, val.id, None, [])?;
+            } else {
+                // A pure `out` temporary starts undefined at each call: a
+                // callee that returns without writing it leaves no value of
+                // an earlier call to be copied out (and kept alive).
+                let undef = self.undef(&p.ty)?;
+                if self.f.term {
+                    self.start_block(None)?;
+                }
+                self.b.store(tmp, undef, None, [])?;
             }
             temps.push(tmp);
         }

@@ -25,6 +25,21 @@ impl<'a> Lowerer<'a> {
         self.spv(t, Layout::None)
     }
 
+    /// An `OpUndef` of type `t` (one per type, at module scope).
+    pub(super) fn undef(&mut self, t: &Ty) -> Result<Id> {
+        let tid = self.ty_id(t)?;
+        if let Some(&id) = self.undefs.get(&tid) {
+            return Ok(id);
+        }
+        let id = self.b.id();
+        self.b.insert_types_global_values(
+            InsertPoint::End,
+            Instruction::new(Op::Undef, Some(tid), Some(id), vec![]),
+        );
+        self.undefs.insert(tid, id);
+        Ok(id)
+    }
+
     /// The SPIR-V type of `t` laid out per `layout`.
     pub(super) fn spv(&mut self, t: &Ty, layout: Layout) -> Result<Id> {
         let layout = match t {

@@ -244,6 +244,47 @@ impl<'a> Lowerer<'a> {
         Some(d)
     }
 
+    /// `DebugDeclare` of each local where it is declared: right after its
+    /// `OpVariable`, before the variables are hoisted to the entry block
+    /// (as DXC does; the variable's lifetime starts at its declaration).
+    /// Parameters, which have no `OpVariable`, are declared in the entry
+    /// block by `place_definitions`.
+    pub(super) fn place_declares(module: &mut dr::Module, d: &mut DebugInfo) {
+        let mut at_var: HashMap<Id, usize> = HashMap::new();
+        for (k, x) in d.declares.iter().enumerate() {
+            at_var.insert(x.2, k);
+        }
+        let mut placed = HashSet::new();
+        for f in &mut module.functions {
+            for b in &mut f.blocks {
+                let mut out = Vec::with_capacity(b.instructions.len());
+                let mut pending = Vec::new();
+                for i in b.instructions.drain(..) {
+                    // Phis stay first in their block.
+                    if i.class.opcode != Op::Phi {
+                        out.append(&mut pending);
+                    }
+                    let declared = (i.class.opcode == Op::Variable)
+                        .then(|| i.result_id.and_then(|v| at_var.get(&v).copied()))
+                        .flatten();
+                    out.push(i);
+                    if let Some(k) = declared {
+                        let (_, local, var, result) = d.declares[k];
+                        pending.push(declare(d, local, var, result));
+                        placed.insert(k);
+                    }
+                }
+                out.append(&mut pending);
+                b.instructions = out;
+            }
+        }
+        let mut k = 0;
+        d.declares.retain(|_| {
+            k += 1;
+            !placed.contains(&(k - 1))
+        });
+    }
+
     /// `DebugFunctionDefinition` in each function's entry block, after its variables.
     pub(super) fn place_definitions(module: &mut dr::Module, d: &DebugInfo) {
         for (dbg_fn, fn_id, result) in &d.definitions {
@@ -263,21 +304,9 @@ impl<'a> Lowerer<'a> {
                 .position(|i| i.class.opcode != Op::Variable)
                 .unwrap_or(block.instructions.len());
             for (_, local, var, result) in d.declares.iter().filter(|x| x.0 == *fn_id).rev() {
-                block.instructions.insert(
-                    at,
-                    Instruction::new(
-                        Op::ExtInst,
-                        Some(d.void),
-                        Some(*result),
-                        vec![
-                            Operand::IdRef(d.set),
-                            Operand::LiteralExtInstInteger(D::DebugDeclare as u32),
-                            Operand::IdRef(*local),
-                            Operand::IdRef(*var),
-                            Operand::IdRef(d.expression),
-                        ],
-                    ),
-                );
+                block
+                    .instructions
+                    .insert(at, declare(d, *local, *var, *result));
             }
             block.instructions.insert(
                 at,
@@ -295,4 +324,19 @@ impl<'a> Lowerer<'a> {
             );
         }
     }
+}
+
+fn declare(d: &DebugInfo, local: Id, var: Id, result: Id) -> Instruction {
+    Instruction::new(
+        Op::ExtInst,
+        Some(d.void),
+        Some(result),
+        vec![
+            Operand::IdRef(d.set),
+            Operand::LiteralExtInstInteger(D::DebugDeclare as u32),
+            Operand::IdRef(local),
+            Operand::IdRef(var),
+            Operand::IdRef(d.expression),
+        ],
+    )
 }

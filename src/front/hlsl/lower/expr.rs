@@ -773,62 +773,84 @@ impl<'a> Lowerer<'a> {
         pos: Pos,
     ) -> Result<Val> {
         let cv = self.expr(c)?;
-        if let Ty::Vec(_, n) = cv.ty {
-            // Vector conditions select per component; both sides are evaluated.
+        let vector = matches!(cv.ty, Ty::Vec(..));
+        if vector || (cheap_and_pure(a) && cheap_and_pure(b)) {
+            // Vector conditions select per component, both sides evaluated
+            // (as DXC); a scalar one may too when neither side can be
+            // observed running, which leaves no temporary behind.
             let av = self.expr(a)?;
             let bv = self.expr(b)?;
-            let t = self.common(&av.ty, &bv.ty, pos)?;
-            let t = match t {
-                Ty::ScalarKind(s) => Ty::Vec(s, n),
-                other => other,
+            let t = if av.ty == bv.ty {
+                av.ty.clone()
+            } else {
+                self.common(&av.ty, &bv.ty, pos)?
             };
+            let t = match (t, &cv.ty) {
+                (Ty::ScalarKind(s), Ty::Vec(_, n)) => Ty::Vec(s, *n),
+                (other, _) => other,
+            };
+            if t.is_resource() || t.is_opaque() {
+                return Err(unsupported(pos, "choosing a resource with `?:`"));
+            }
             let x = self.convert(av, &t, pos, false)?;
             let y = self.convert(bv, &t, pos, false)?;
-            let cb = self.convert(cv, &Ty::Vec(ScalarKind::Bool, t.width()), c.pos, false)?;
+            let cond_ty = match cv.ty {
+                Ty::Vec(..) => Ty::Vec(ScalarKind::Bool, t.width()),
+                _ => Ty::ScalarKind(ScalarKind::Bool),
+            };
+            let cb = self.convert(cv, &cond_ty, c.pos, false)?;
             let tid = self.ty_id(&t)?;
             let id = self.op(Op::Select, tid, &[cb.id, x.id, y.id])?;
             return Ok(Val { id, ty: t });
         }
         let cb = self.convert(cv, &Ty::ScalarKind(ScalarKind::Bool), c.pos, false)?;
-        // Only the chosen side runs. Each side leaves its value in a temporary
-        // of its own type; the result, in the common type of both, is selected
-        // after the merge (the unchosen temporary is never observed).
-        let (la, lb, merge) = (self.b.id(), self.b.id(), self.b.id());
+        // Only the chosen side runs, and its value reaches the merge through
+        // an OpPhi: no variable, so nothing of the unchosen side is read. The
+        // first side's value goes through a block of its own where it is
+        // converted to the common type, known once the second side is.
+        let (la, lb, a_conv, merge) = (self.b.id(), self.b.id(), self.b.id(), self.b.id());
         self.b
             .selection_merge(merge, spirv::SelectionControl::NONE)?;
         self.b.branch_conditional(cb.id, la, lb, [])?;
-        let side = |this: &mut Self, label: Id, e: &'a Expr| -> Result<(Id, Ty)> {
+        let side = |this: &mut Self, label: Id, e: &'a Expr| -> Result<Val> {
             this.start_block(Some(label))?;
             let v = this.expr(e)?;
             if v.ty.is_resource() || v.ty.is_opaque() {
                 // Vulkan has no function variables of resource types.
                 return Err(unsupported(pos, "choosing a resource with `?:`"));
             }
-            let tmp = this.local_var(&v.ty, "")?;
             if this.f.term {
                 this.start_block(None)?;
             }
-            this.b.store(tmp, v.id, None, [])?;
-            this.branch(merge)?;
-            Ok((tmp, v.ty))
+            Ok(v)
         };
-        let (ta, tya) = side(self, la, a)?;
-        let (tb, tyb) = side(self, lb, b)?;
-        self.start_block(Some(merge))?;
-        let t = if tya == tyb {
-            tya.clone()
+        let av = side(self, la, a)?;
+        self.branch(a_conv)?;
+        let bv = side(self, lb, b)?;
+        let t = if av.ty == bv.ty {
+            av.ty.clone()
         } else {
-            self.common(&tya, &tyb, pos)?
+            self.common(&av.ty, &bv.ty, pos)?
         };
-        let load = |this: &mut Self, tmp: Id, ty: &Ty, at: Pos| -> Result<Val> {
-            let tid = this.ty_id(ty)?;
-            let id = this.b.load(tid, None, tmp, None, [])?;
-            this.convert(Val { id, ty: ty.clone() }, &t, at, false)
-        };
-        let x = load(self, ta, &tya, a.pos)?;
-        let y = load(self, tb, &tyb, b.pos)?;
+        let y = self.convert(bv, &t, b.pos, false)?;
+        let from_b = self.f.cur_label;
+        self.branch(merge)?;
+        self.start_block(Some(a_conv))?;
+        let x = self.convert(av, &t, a.pos, false)?;
+        let from_a = self.f.cur_label;
+        self.branch(merge)?;
+        self.start_block(Some(merge))?;
         let tid = self.ty_id(&t)?;
-        let id = self.op(Op::Select, tid, &[cb.id, x.id, y.id])?;
+        let id = self.inst(
+            Op::Phi,
+            Some(tid),
+            vec![
+                Operand::IdRef(x.id),
+                Operand::IdRef(from_a),
+                Operand::IdRef(y.id),
+                Operand::IdRef(from_b),
+            ],
+        )?;
         Ok(Val { id, ty: t })
     }
 
@@ -896,5 +918,29 @@ impl<'a> Lowerer<'a> {
                 })
             }
         }
+    }
+}
+
+/// Whether evaluating `e` can have no effect the program could observe
+/// (no call, store, division or indexing that could be out of bounds) and
+/// costs a few instructions: `c ? a : b` may then evaluate both sides.
+fn cheap_and_pure(e: &Expr) -> bool {
+    match &e.kind {
+        ExprKind::Int(..)
+        | ExprKind::Int64(..)
+        | ExprKind::Float(_)
+        | ExprKind::Bool(_)
+        | ExprKind::Ident(_) => true,
+        ExprKind::Member(base, _) => cheap_and_pure(base),
+        ExprKind::Unary(op, x) => {
+            matches!(op, UnOp::Neg | UnOp::Plus | UnOp::Not | UnOp::BitNot) && cheap_and_pure(x)
+        }
+        ExprKind::Binary(op, x, y) => {
+            !matches!(op, BinOp::Div | BinOp::Rem) && cheap_and_pure(x) && cheap_and_pure(y)
+        }
+        ExprKind::Ternary(c, x, y) => cheap_and_pure(c) && cheap_and_pure(x) && cheap_and_pure(y),
+        ExprKind::Cast(_, x) => cheap_and_pure(x),
+        ExprKind::Construct(_, args) => args.iter().all(cheap_and_pure),
+        _ => false,
     }
 }

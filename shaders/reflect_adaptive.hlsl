@@ -1,0 +1,53 @@
+// Adaptive sampling in HLSL (rtlint's own compiler): the glossy GGX path of
+// reflect_glossy.hlsl, accumulated over passes. verify runs the ray
+// generation shader 16 times over the image; each pass a pixel traces one
+// more path while it has fewer than ADAPTIVE_MIN, or fewer than
+// ADAPTIVE_MAX and a variance estimate of its mean's luminance above the
+// tolerance (params.camera.w, 0.001 by default). `counts` gets the paths
+// each pixel traced; `state` keeps the sums between passes.
+#include "reflect_ggx.hlsli"
+
+struct Accumulator
+{
+    // xyz: the paths' light summed; w: how many (the bits of a uint)
+    float4 sum_samples;
+    // x: luminance summed, y: its squares summed
+    float4 luminance;
+    float4 unused0;
+    float4 unused1;
+};
+RWStructuredBuffer<uint> counts : register(u6);
+RWStructuredBuffer<Accumulator> state : register(u7);
+
+static const uint ADAPTIVE_MIN = 4;
+static const uint ADAPTIVE_MAX = 16;
+static const float3 LUMINANCE = float3(0.2126, 0.7152, 0.0722);
+
+[shader("raygeneration")]
+void raygen()
+{
+    uint2 id = DispatchRaysIndex().xy;
+    uint index = id.y * params.width + id.x;
+    Accumulator acc = state[index];
+    uint n = asuint(acc.sum_samples.w);
+    bool more = n < ADAPTIVE_MIN;
+    if (!more && n < ADAPTIVE_MAX)
+    {
+        float mean = acc.luminance.x / float(n);
+        float variance = max(acc.luminance.y / float(n) - mean * mean, 0.0);
+        more = variance / float(n) > params.camera.w;
+    }
+    if (more)
+    {
+        float3 c = float3(0.0, 0.0, 0.0);
+        glossy_sample(id, n, c);
+        float l = dot(c, LUMINANCE);
+        n += 1;
+        acc.sum_samples = float4(acc.sum_samples.xyz + c, asfloat(n));
+        acc.luminance.x += l;
+        acc.luminance.y += l * l;
+        state[index] = acc;
+    }
+    counts[index] = n;
+    image[index] = pack_rgba8(acc.sum_samples.xyz / float(max(n, 1u)));
+}

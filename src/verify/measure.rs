@@ -1,0 +1,165 @@
+//! What the multi-pass shaders measure beyond the image: the hybrid
+//! shader's reflection paths (screen space or ray) and the adaptive
+//! shader's paths per pixel, against a fixed-count render and a converged one.
+
+use crate::reference::adaptive::{self, ADAPTIVE_MAX, CONVERGED_FIRST_SAMPLE};
+use crate::reference::hybrid::{self, ReflectionPath};
+use crate::reference::{self, pack_rgba8, Method, Params, PixelPath, Scene, Vec3};
+use rayon::prelude::*;
+
+/// Paths of the converged image per pixel (independent of the first
+/// [`ADAPTIVE_MAX`]).
+pub const CONVERGED_PATHS: u32 = 64;
+
+/// What the CPU renders for a case.
+pub struct CpuRender {
+    pub image: Vec<u32>,
+    /// Each pixel's edge margin ([`reference::Segment::edge_margin`]).
+    pub margins: Vec<f32>,
+    /// The per-pixel counts a multi-pass shader writes (hybrid:
+    /// [`ReflectionPath`] codes; adaptive: paths traced).
+    pub counts: Option<Vec<u32>>,
+    /// Adaptive sampling against fixed passes and a converged image.
+    pub adaptive: Option<AdaptiveStats>,
+}
+
+/// The adaptive render's rays and error next to the fixed-count render's.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct AdaptiveStats {
+    pub rays: usize,
+    pub fixed_rays: usize,
+    /// Root mean square difference per channel against the converged image.
+    pub rmse: f64,
+    pub fixed_rmse: f64,
+}
+
+/// Renders `method`'s image on the CPU, rows in parallel.
+pub fn cpu_render(scene: &Scene, params: &Params, method: Method) -> CpuRender {
+    match method {
+        Method::Hybrid => {
+            let (paths, kinds) = hybrid::render(scene, params);
+            CpuRender {
+                image: paths.iter().map(|p| pack_rgba8(p.color)).collect(),
+                margins: paths.iter().map(PixelPath::edge_margin).collect(),
+                counts: Some(kinds.iter().map(|&k| k as u32).collect()),
+                adaptive: None,
+            }
+        }
+        Method::Adaptive => {
+            let pixels: Vec<(u32, u32)> = (0..params.height)
+                .flat_map(|y| (0..params.width).map(move |x| (x, y)))
+                .collect();
+            // Per pixel: the adaptive path, 16 fixed paths, the converged
+            // paths (sample numbers of their own).
+            let per_pixel: Vec<_> = pixels
+                .par_iter()
+                .map(|&(x, y)| {
+                    let (path, acc) = adaptive::trace_adaptive(scene, params, x, y);
+                    let (fixed, fixed_rays) = adaptive::fixed(scene, params, x, y, 0, ADAPTIVE_MAX);
+                    let (converged, _) = adaptive::fixed(
+                        scene,
+                        params,
+                        x,
+                        y,
+                        CONVERGED_FIRST_SAMPLE,
+                        CONVERGED_PATHS,
+                    );
+                    let sq = |c: Vec3| {
+                        let d = c - converged;
+                        f64::from(d.dot(d)) / 3.0
+                    };
+                    let errors = (sq(path.color), sq(fixed));
+                    (path, acc, fixed_rays, errors.0, errors.1)
+                })
+                .collect();
+            let n = per_pixel.len().max(1) as f64;
+            let mut stats = AdaptiveStats::default();
+            let (mut e, mut f) = (0.0, 0.0);
+            for (path, _, fixed_rays, ea, ef) in &per_pixel {
+                stats.rays += path.segments.len();
+                stats.fixed_rays += fixed_rays;
+                e += ea;
+                f += ef;
+            }
+            stats.rmse = (e / n).sqrt();
+            stats.fixed_rmse = (f / n).sqrt();
+            CpuRender {
+                image: per_pixel.iter().map(|p| pack_rgba8(p.0.color)).collect(),
+                margins: per_pixel.iter().map(|p| p.0.edge_margin()).collect(),
+                counts: Some(per_pixel.iter().map(|p| p.1.samples).collect()),
+                adaptive: Some(stats),
+            }
+        }
+        _ => {
+            let (image, margins) = reference::render(scene, params, method);
+            CpuRender {
+                image,
+                margins,
+                counts: None,
+                adaptive: None,
+            }
+        }
+    }
+}
+
+/// A multi-pass case's measurements, in words, and a picture of its counts.
+pub struct Measured {
+    pub note: String,
+    /// RGBA8: hybrid: grey none, green screen space, red ray; adaptive:
+    /// brighter for more paths.
+    pub picture: Option<Vec<u32>>,
+}
+
+/// `gpu` holds the GPU's per-pixel counts; `differ` how many disagree with
+/// the CPU's.
+pub fn measure(cpu: &CpuRender, gpu: &[u32], differ: usize) -> Measured {
+    let pixels = gpu.len().max(1);
+    if let Some(stats) = cpu.adaptive {
+        // Rays: the CPU's paths for the same counts (they agree with the
+        // GPU's but for `differ` pixels); errors in linear colour.
+        let traced: u64 = gpu.iter().map(|&n| u64::from(n)).sum();
+        let full = u64::from(ADAPTIVE_MAX) * pixels as u64;
+        let picture = gpu
+            .iter()
+            .map(|&n| {
+                let v = (n.min(ADAPTIVE_MAX) * 255 / ADAPTIVE_MAX) & 0xFF;
+                v | v << 8 | v << 16 | 0xFF00_0000
+            })
+            .collect();
+        return Measured {
+            note: format!(
+                "{traced} paths instead of {full} for {ADAPTIVE_MAX} fixed passes ({:.1} % saved; \
+                 rays {} instead of {}, {:.1} % saved); RMSE against {CONVERGED_PATHS} \
+                 independent paths: adaptive {:.4}, fixed {ADAPTIVE_MAX} {:.4}; counts differ from the CPU's on {differ}",
+                100.0 * (1.0 - traced as f64 / full as f64),
+                stats.rays,
+                stats.fixed_rays,
+                100.0 * (1.0 - stats.rays as f64 / stats.fixed_rays.max(1) as f64),
+                stats.rmse,
+                stats.fixed_rmse,
+            ),
+            picture: Some(picture),
+        };
+    }
+    let count = |k: ReflectionPath| gpu.iter().filter(|&&c| c == k as u32).count();
+    let (screen, ray) = (count(ReflectionPath::Screen), count(ReflectionPath::Ray));
+    let reflecting = (screen + ray).max(1);
+    let picture = gpu
+        .iter()
+        .map(|&c| match c {
+            1 => 0xFF00_C000,
+            2 => 0xFF00_00E0,
+            _ => 0xFF40_4040,
+        })
+        .collect();
+    Measured {
+        note: format!(
+            "{ray} of {} reflecting pixels traced a ray ({:.1} %; {:.1} % of all {pixels}), \
+             {screen} found their reflection on screen; paths differ from the CPU's on {differ}",
+            screen + ray,
+            100.0 * ray as f64 / reflecting as f64,
+            100.0 * ray as f64 / pixels as f64,
+        ),
+        picture: Some(picture),
+    }
+}
