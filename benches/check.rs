@@ -39,7 +39,12 @@ fn main() {
     let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
     std::env::set_current_dir(&root).unwrap();
     let mut files: Vec<PathBuf> = Vec::new();
-    for dir in ["shaders", "fixtures/wgsl", "fixtures/glsl"] {
+    for dir in [
+        "shaders",
+        "fixtures/RT001",
+        "fixtures/RT005",
+        "fixtures/glsl",
+    ] {
         let mut d: Vec<PathBuf> = std::fs::read_dir(dir)
             .unwrap()
             .map(|e| e.unwrap().path())

@@ -263,6 +263,7 @@ impl Builder {
                 // The config's `[hlsl]` folders and defines first, as `check` has them.
                 let hlsl = &input.config.hlsl;
                 let hlsl_options = hlsl::HlslOptions {
+                    enable_16bit_types: hlsl.enable_16bit_types,
                     include_dirs: hlsl
                         .include_dirs
                         .iter()

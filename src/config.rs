@@ -15,6 +15,9 @@ pub struct SourceOptions {
     /// `NAME = "VALUE"`.
     #[serde(default)]
     pub defines: BTreeMap<String, String>,
+    /// DXC's `-enable-16bit-types`.
+    #[serde(default)]
+    pub enable_16bit_types: bool,
 }
 
 /// One rule's entry under `[rules]`.

@@ -155,6 +155,9 @@ impl fmt::Display for Assumption {
             Assumption::Undescribed => f.write_str(
                 "no pipeline description: every trace may reach every hit group and miss shader",
             ),
+            Assumption::FromSubobjects => f.write_str(
+                "pipeline described by DXR subobjects, which do not give the shader table's order: every trace may reach every hit group and miss shader",
+            ),
             Assumption::DynamicSbtOffset { at: l } => write!(
                 f,
                 "trace{} has a SBT offset or stride unknown at compile time: it may reach every hit group",

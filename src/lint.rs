@@ -2,8 +2,10 @@
 //! find the inputs, pick each one's config, load each into a Program, run the
 //! rules, apply suppressions. [`check_paths`] is the one entry point.
 
+use crate::analysis::callgraph::Assumption;
 use crate::config::Config;
 use crate::diag::{Diagnostic, InputError, InputErrorKind, Severity};
+use crate::front::hlsl::subobject::Subobjects;
 use crate::front::{self, FrontOptions};
 use crate::program::Program;
 use crate::shader::Language;
@@ -320,9 +322,14 @@ pub fn inputs(paths: &[PathBuf], options: &Options) -> Inputs {
 /// Loads one input into a Program, with the config's and the options'
 /// include directories and defines.
 pub fn load(input: &Input, options: &Options) -> Result<Program, InputError> {
+    load_library(input, options).map(|(program, _)| program)
+}
+
+/// [`load`], also giving the DXR subobjects an HLSL library declares.
+pub fn load_library(input: &Input, options: &Options) -> Result<(Program, Subobjects), InputError> {
     let front_options = front_options(&input.config, options);
     let contents = input.contents.as_deref().map(|v| v.as_slice());
-    front::load_input(&input.path, contents, input.language, &front_options)
+    front::load_library(&input.path, contents, input.language, &front_options)
 }
 
 fn front_options(config: &Config, options: &Options) -> FrontOptions {
@@ -336,6 +343,7 @@ fn front_options(config: &Config, options: &Options) -> FrontOptions {
             .collect(),
         entry: options.front.entry.clone(),
         stage: options.front.stage,
+        enable_16bit_types: config.hlsl.enable_16bit_types || options.front.enable_16bit_types,
     };
     front_options
         .include_dirs
@@ -692,6 +700,8 @@ fn is_shader_like(p: &Path) -> bool {
 pub struct Checked {
     pub path: PathBuf,
     pub program: Option<Program>,
+    /// DXR subobjects the input declares (HLSL).
+    pub subobjects: Subobjects,
     pub diagnostics: Vec<Diagnostic>,
 }
 
@@ -708,20 +718,22 @@ pub fn check_input(path: &Path, language: Language, config: &Config) -> Checked 
 }
 
 fn check_input_with(input: &Input, config: &Config, options: &Options) -> Checked {
-    match load(input, options) {
-        Ok(program) => {
+    match load_library(input, options) {
+        Ok((program, subobjects)) => {
             let ignored = config.ignored_for(&input.path);
             let mut diagnostics = crate::rules::check_program(&program, config);
             drop_ignored(&mut diagnostics, &ignored);
             Checked {
                 path: input.path.clone(),
                 program: Some(program),
+                subobjects,
                 diagnostics,
             }
         }
         Err(e) => Checked {
             path: input.path.clone(),
             program: None,
+            subobjects: Subobjects::default(),
             diagnostics: vec![*e.0],
         },
     }
@@ -750,12 +762,14 @@ pub fn check_pipeline(path: &Path, config: &Config) -> Checked {
             Checked {
                 path: path.to_path_buf(),
                 program: None,
+                subobjects: Subobjects::default(),
                 diagnostics,
             }
         }
         Err(e) => Checked {
             path: path.to_path_buf(),
             program: None,
+            subobjects: Subobjects::default(),
             diagnostics: vec![*e.0],
         },
     }
@@ -869,24 +883,26 @@ fn canonical(p: &Path) -> PathBuf {
 }
 
 /// Runs the pipeline rules (RT020–RT025) on shaders no description uses:
-/// the shaders of each folder form one pipeline in which every trace may
-/// reach every hit group and miss shader, and each finding says so.
+/// an HLSL library that declares DXR subobjects is the pipeline they
+/// describe; otherwise the shaders of each folder form one pipeline in which
+/// every trace may reach every hit group and miss shader. Each finding says
+/// what was assumed.
 pub fn check_loose(
-    programs: Vec<Program>,
+    programs: Vec<(Program, Subobjects)>,
     described: &[PathBuf],
     config: &Config,
 ) -> Vec<Diagnostic> {
-    let mut groups: Vec<(PathBuf, Vec<Program>)> = Vec::new();
-    for p in programs {
+    let mut groups: Vec<(PathBuf, Vec<(Program, Subobjects)>)> = Vec::new();
+    for (p, subobjects) in programs {
         if described.contains(&canonical(&p.path)) {
             continue;
         }
-        let Some(dir) = loose_group(&p) else {
+        let Some(dir) = loose_group(&p, &subobjects) else {
             continue;
         };
         match groups.iter_mut().find(|(d, _)| *d == dir) {
-            Some((_, g)) => g.push(p),
-            None => groups.push((dir, vec![p])),
+            Some((_, g)) => g.push((p, subobjects)),
+            None => groups.push((dir, vec![(p, subobjects)])),
         }
     }
     let mut out = Vec::new();
@@ -896,35 +912,55 @@ pub fn check_loose(
     out
 }
 
-/// The loose pipeline a module belongs to: a file holding a ray generation
-/// shader and others (WGSL, HLSL) is a pipeline of its own; one-stage
-/// modules pipeline with their folder. `None` without ray-tracing stages.
-fn loose_group(p: &Program) -> Option<PathBuf> {
+/// The loose pipeline a module belongs to: an HLSL library whose DXR
+/// subobjects describe a pipeline, or a file holding a ray generation shader
+/// and others (WGSL, HLSL), is a pipeline of its own; one-stage modules
+/// pipeline with their folder. `None` without ray-tracing stages.
+fn loose_group(p: &Program, subobjects: &Subobjects) -> Option<PathBuf> {
+    let has_raygen = p
+        .entry_points
+        .iter()
+        .any(|e| e.stage == crate::shader::Stage::RayGeneration);
+    let describes = !subobjects.pipeline_configs.is_empty()
+        || !subobjects.shader_configs.is_empty()
+        || !subobjects.hit_groups.is_empty();
+    if describes && has_raygen {
+        return Some(p.path.clone());
+    }
     if !p.entry_points.iter().any(|e| e.stage.is_ray_tracing()) {
         return None;
     }
-    let whole = p
-        .entry_points
-        .iter()
-        .any(|e| e.stage == crate::shader::Stage::RayGeneration)
-        && p.entry_points.len() > 1;
-    Some(if whole {
+    Some(if has_raygen && p.entry_points.len() > 1 {
         p.path.clone()
     } else {
         p.path.parent().map(Path::to_path_buf).unwrap_or_default()
     })
 }
 
-/// The pipeline rules over one loose group, each finding noting the
-/// assumption.
-fn check_group(programs: Vec<Program>, config: &Config) -> Vec<Diagnostic> {
-    let pipeline = crate::pipeline::Pipeline::from_programs(programs);
-    let ctx = crate::rules::PipelineContext::new(&pipeline, config);
-    let note = crate::analysis::callgraph::Assumption::Undescribed.to_string();
-    crate::rules::check_pipeline(&ctx)
-        .into_iter()
-        .map(|d| d.with_note(note.clone()))
-        .collect()
+/// The pipeline rules over one loose group, each finding noting what was
+/// assumed: the pipeline a library's subobjects describe, else every trace
+/// reaching every shader.
+fn check_group(mut programs: Vec<(Program, Subobjects)>, config: &Config) -> Vec<Diagnostic> {
+    let run = |pipeline: &crate::pipeline::Pipeline, note: String| -> Vec<Diagnostic> {
+        let ctx = crate::rules::PipelineContext::new(pipeline, config);
+        crate::rules::check_pipeline(&ctx)
+            .into_iter()
+            .map(|d| d.with_note(note.clone()))
+            .collect()
+    };
+    if programs.len() == 1 {
+        let (p, subobjects) = programs.remove(0);
+        return match crate::pipeline::Pipeline::from_subobjects(p, &subobjects) {
+            Ok(pipeline) => run(&pipeline, Assumption::FromSubobjects.to_string()),
+            Err(p) => run(
+                &crate::pipeline::Pipeline::from_programs(vec![*p]),
+                Assumption::Undescribed.to_string(),
+            ),
+        };
+    }
+    let pipeline =
+        crate::pipeline::Pipeline::from_programs(programs.into_iter().map(|(p, _)| p).collect());
+    run(&pipeline, Assumption::Undescribed.to_string())
 }
 
 /// One input's outcome in [`check_paths`]: computed, or read from the cache
@@ -933,7 +969,7 @@ fn check_group(programs: Vec<Program>, config: &Config) -> Vec<Diagnostic> {
 struct Outcome {
     /// Loaded and analysed (suppressions in its files are judged).
     analysed: bool,
-    program: Option<Program>,
+    program: Option<(Program, Subobjects)>,
     diagnostics: Vec<Diagnostic>,
     /// The module's source files and the text it embeds.
     files: Vec<(PathBuf, Option<String>)>,
@@ -985,7 +1021,10 @@ fn check_cached(input: &Input, options: &Options, cache: Option<&crate::cache::C
         .iter()
         .flat_map(|p| p.files.iter().map(|f| (f.path.clone(), f.text.clone())))
         .collect();
-    let group = c.program.as_ref().and_then(loose_group);
+    let group = c
+        .program
+        .as_ref()
+        .and_then(|p| loose_group(p, &c.subobjects));
     if let (Some(cache), Some(key), Some(_)) = (cache, key, &c.program) {
         if let Some(diagnostics) = crate::cache::store_all(&c.diagnostics) {
             // Everything the module names besides the input itself: includes,
@@ -1010,7 +1049,10 @@ fn check_cached(input: &Input, options: &Options, cache: Option<&crate::cache::C
     Outcome {
         analysed: c.program.is_some(),
         // Only modules with ray-tracing stages join a loose pipeline.
-        program: c.program.filter(|_| group.is_some()),
+        program: c
+            .program
+            .filter(|_| group.is_some())
+            .map(|p| (p, c.subobjects)),
         diagnostics: c.diagnostics,
         files,
         group,
@@ -1049,7 +1091,7 @@ fn check_group_cached(
         match outcomes[i].program.take() {
             Some(p) => programs.push(p),
             // Read from the cache: load it again for the pipeline.
-            None => match load(&inputs[i], options) {
+            None => match load_library(&inputs[i], options) {
                 Ok(p) => programs.push(p),
                 Err(_) => continue,
             },
@@ -1152,7 +1194,7 @@ mod tests {
     fn loose_shaders_get_pipeline_rules_with_the_assumption() {
         let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/guards/constructed.wgsl");
         let p = front::load(&path, Language::Wgsl).unwrap();
-        let d = check_loose(vec![p], &[], &Config::default());
+        let d = check_loose(vec![(p, Subobjects::default())], &[], &Config::default());
         let rt020: Vec<_> = d.iter().filter(|d| d.code == Some("RT020")).collect();
         assert_eq!(rt020.len(), 1, "{d:?}");
         assert_eq!(rt020[0].primary.as_ref().unwrap().location.line, 42);
@@ -1162,6 +1204,7 @@ mod tests {
             .any(|n| n.contains("every trace may reach every hit group and miss shader")));
         // A shader a description uses is checked with that description only.
         let p = front::load(&path, Language::Wgsl).unwrap();
-        assert!(check_loose(vec![p], &[canonical(&path)], &Config::default()).is_empty());
+        let p = vec![(p, Subobjects::default())];
+        assert!(check_loose(p, &[canonical(&path)], &Config::default()).is_empty());
     }
 }

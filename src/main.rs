@@ -53,6 +53,9 @@ struct Common {
         requires = "entry"
     )]
     stage: Option<String>,
+    /// HLSL: DXC's `-enable-16bit-types` (`half` is then 16-bit).
+    #[arg(long = "enable-16bit-types")]
+    enable_16bit_types: bool,
     /// The name standard input (`-`) is linted under; its extension picks the language.
     #[arg(long, value_name = "PATH")]
     stdin_filename: Option<PathBuf>,
@@ -262,6 +265,9 @@ enum Command {
         /// Define a macro: NAME or NAME=VALUE.
         #[arg(short = 'D', value_name = "NAME[=VALUE]")]
         define: Vec<String>,
+        /// DXC's `-enable-16bit-types` (`half` is then 16-bit).
+        #[arg(long = "enable-16bit-types")]
+        enable_16bit_types: bool,
         /// Output: a `.spv` file (one entry point, or with --whole every entry
         /// point in one module), or a directory for one module per entry point.
         #[arg(short = 'o', long = "output")]
@@ -283,6 +289,9 @@ enum Command {
         /// A pipeline description.
         #[arg(long)]
         pipeline: Option<PathBuf>,
+        /// An HLSL library whose DXR subobjects describe the pipeline.
+        #[arg(long)]
+        library: Option<PathBuf>,
         /// Loose shaders, as `LANG:PATH`.
         #[arg(long)]
         shader: Vec<String>,
@@ -332,11 +341,21 @@ fn run(cli: Cli) -> Result<u8, String> {
             stage,
             include,
             define,
+            enable_16bit_types,
             output,
             whole,
-        } => compile(file, entry, stage, include, define, output, whole),
+        } => compile(
+            file,
+            hlsl_options(entry, stage, include, define, enable_16bit_types),
+            output,
+            whole,
+        ),
         Command::Verify(args) => verify(args),
-        Command::DriverStackSizes { pipeline, shader } => driver_stack_sizes(pipeline, shader),
+        Command::DriverStackSizes {
+            pipeline,
+            library,
+            shader,
+        } => driver_stack_sizes(pipeline, library, shader),
         Command::Rules => {
             let mut out = std::io::stdout().lock();
             for r in rtlint::rules::RULES {
@@ -398,6 +417,7 @@ fn options(common: &Common) -> Result<lint::Options, String> {
                 Some(Err(e)) => return Err(format!("-T: {e}")),
                 None => None,
             },
+            enable_16bit_types: common.enable_16bit_types,
         },
         respect_gitignore: !common.no_gitignore,
         stdin,
@@ -558,6 +578,8 @@ fn color_choice(arg: ColorArg, to_file: bool) -> ColorChoice {
 /// descriptions found, and input errors.
 struct Loaded {
     programs: Vec<rtlint::program::Program>,
+    /// The DXR subobjects of each program (empty but for HLSL libraries).
+    subobjects: Vec<rtlint::front::hlsl::subobject::Subobjects>,
     pipelines: Vec<PathBuf>,
     problems: Vec<Diagnostic>,
 }
@@ -567,14 +589,19 @@ fn load(common: &Common) -> Result<Loaded, String> {
     let inputs = lint::inputs(&common.paths, &options);
     let mut problems: Vec<Diagnostic> = inputs.errors.iter().map(|e| (*e.0).clone()).collect();
     let mut programs = Vec::new();
+    let mut subobjects = Vec::new();
     for input in &inputs.files {
-        match lint::load(input, &options) {
-            Ok(p) => programs.push(p),
+        match lint::load_library(input, &options) {
+            Ok((p, s)) => {
+                programs.push(p);
+                subobjects.push(s);
+            }
             Err(InputError(d)) => problems.push(*d),
         }
     }
     Ok(Loaded {
         programs,
+        subobjects,
         pipelines: inputs.pipelines.into_iter().map(|(p, _)| p).collect(),
         problems,
     })
@@ -623,16 +650,35 @@ fn stack(
     };
     let Loaded {
         programs,
+        subobjects,
         pipelines: descriptions,
         mut problems,
     } = load(&common)?;
     let mut pipelines = Vec::new();
+    let mut described = Vec::new();
     for p in &descriptions {
         match rtlint::pipeline::load(p) {
-            Ok(p) => pipelines.push(p),
+            Ok(p) => {
+                described.extend(p.programs.iter().map(|q| canonical(&q.path)));
+                pipelines.push(p)
+            }
             Err(InputError(d)) => problems.push(*d),
         }
     }
+    // An HLSL library no description names, declaring DXR subobjects, is
+    // the pipeline they describe.
+    let mut loose_programs = Vec::new();
+    for (program, s) in programs.into_iter().zip(subobjects) {
+        if described.contains(&canonical(&program.path)) {
+            loose_programs.push(program);
+            continue;
+        }
+        match rtlint::pipeline::Pipeline::from_subobjects(program, &s) {
+            Ok(p) => pipelines.push(p),
+            Err(program) => loose_programs.push(*program),
+        }
+    }
+    let programs = loose_programs;
     // Loose shaders: one conservative pipeline over all of them.
     if !programs.is_empty() {
         pipelines.push(rtlint::pipeline::Pipeline::from_programs(programs));
@@ -645,7 +691,7 @@ fn stack(
     #[cfg_attr(not(feature = "vulkan"), allow(unused_variables))]
     let loose: Vec<String> = pipelines
         .last()
-        .filter(|p| p.path.is_none())
+        .filter(|p| p.path.is_none() && p.subobject_library.is_none())
         .map(|p| {
             p.programs
                 .iter()
@@ -764,28 +810,42 @@ fn print_report(
     Ok(if problems.is_empty() { 0 } else { 2 })
 }
 
-fn compile(
-    file: PathBuf,
+/// `rtlint compile`'s HLSL options; `Err` is a bad `-T`.
+fn hlsl_options(
     entry: Option<String>,
     stage: Option<String>,
     include: Vec<PathBuf>,
     define: Vec<String>,
-    output: PathBuf,
-    whole: bool,
-) -> Result<u8, String> {
+    enable_16bit_types: bool,
+) -> Result<rtlint::front::hlsl::HlslOptions, String> {
     use rtlint::front::hlsl;
-    let stage = match stage.as_deref().map(hlsl::parse_stage).transpose() {
-        Ok(s) => s.flatten(),
-        Err(e) => {
-            eprintln!("error: -T: {e}");
-            return Ok(2);
-        }
-    };
-    let options = hlsl::HlslOptions {
+    let stage = stage
+        .as_deref()
+        .map(hlsl::parse_stage)
+        .transpose()?
+        .flatten();
+    Ok(hlsl::HlslOptions {
         stage,
         include_dirs: include,
         defines: define.iter().map(|d| split_define(d)).collect(),
         entry,
+        enable_16bit_types,
+    })
+}
+
+fn compile(
+    file: PathBuf,
+    options: Result<rtlint::front::hlsl::HlslOptions, String>,
+    output: PathBuf,
+    whole: bool,
+) -> Result<u8, String> {
+    use rtlint::front::hlsl;
+    let options = match options {
+        Ok(o) => o,
+        Err(e) => {
+            eprintln!("error: -T: {e}");
+            return Ok(2);
+        }
     };
     let write = |path: &std::path::Path, words: &[u32]| -> Result<(), String> {
         let bytes: Vec<u8> = words.iter().flat_map(|w| w.to_le_bytes()).collect();
@@ -964,11 +1024,14 @@ fn driver_in_child(
     };
     let mut command = std::process::Command::new(exe);
     command.arg("driver-stack-sizes");
-    match &p.path {
-        Some(path) => {
+    match (&p.path, &p.subobject_library) {
+        (Some(path), _) => {
             command.arg("--pipeline").arg(path);
         }
-        None => {
+        (None, Some(library)) => {
+            command.arg("--library").arg(library);
+        }
+        (None, None) => {
             for s in loose {
                 command.arg("--shader").arg(s);
             }
@@ -1015,10 +1078,21 @@ fn driver_in_child(
 }
 
 /// The child's side of [`driver_in_child`].
-fn driver_stack_sizes(pipeline: Option<PathBuf>, shaders: Vec<String>) -> Result<u8, String> {
-    let p = match pipeline {
-        Some(path) => rtlint::pipeline::load(&path).map_err(|e| e.0.message.clone())?,
-        None => {
+fn driver_stack_sizes(
+    pipeline: Option<PathBuf>,
+    library: Option<PathBuf>,
+    shaders: Vec<String>,
+) -> Result<u8, String> {
+    let p = match (pipeline, library) {
+        (Some(path), _) => rtlint::pipeline::load(&path).map_err(|e| e.0.message.clone())?,
+        (None, Some(path)) => {
+            let (program, subobjects) =
+                rtlint::front::load_library(&path, None, Language::Hlsl, &Default::default())
+                    .map_err(|e| e.0.message.clone())?;
+            rtlint::pipeline::Pipeline::from_subobjects(program, &subobjects)
+                .map_err(|_| format!("`{}` declares no pipeline subobjects", path.display()))?
+        }
+        (None, None) => {
             let mut programs = Vec::new();
             for s in &shaders {
                 let (lang, path) = s
@@ -1121,4 +1195,8 @@ fn measured_for(
         .filter(|(key, ..)| path == *key || path.ends_with(&format!("/{key}")))
         .map(|(_, slot, stage, b)| ((*slot, *stage), *b))
         .collect()
+}
+
+fn canonical(p: &std::path::Path) -> PathBuf {
+    std::fs::canonicalize(p).unwrap_or_else(|_| p.to_path_buf())
 }

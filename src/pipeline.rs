@@ -1,10 +1,13 @@
 //! The pipeline description (`*.pipeline.toml`): which shaders, groups and
 //! depth a scene really uses, so recursion and stack size are computed for
 //! that pipeline rather than for every shader in a folder. See
-//! `docs/pipeline.md` for the format.
+//! `docs/pipeline.md` for the format. An HLSL library that no description
+//! names may describe its pipeline itself with DXR subobjects
+//! ([`Pipeline::from_subobjects`]).
 
 use crate::diag::{InputError, InputErrorKind, Location};
 use crate::front;
+use crate::front::hlsl::subobject::Subobjects;
 use crate::program::{Id, Program};
 use crate::shader::Language;
 use crate::shader::Stage;
@@ -78,6 +81,13 @@ impl HitGroup {
     }
 }
 
+/// A number a DXR subobject declares, with the declaration.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Declared {
+    pub value: u32,
+    pub location: Location,
+}
+
 /// A value from `[constants]`, with the line that set it.
 #[derive(Clone, Debug)]
 pub struct DescribedConstant {
@@ -106,6 +116,15 @@ pub struct Pipeline {
     pub miss: Vec<ShaderRef>,
     pub hit_groups: Vec<HitGroup>,
     pub callable: Vec<ShaderRef>,
+    /// The HLSL library whose DXR subobjects describe this pipeline, when
+    /// no `*.pipeline.toml` does. They name the shaders, hit groups and
+    /// depth but not the shader table's order.
+    pub subobject_library: Option<PathBuf>,
+    /// `RaytracingPipelineConfig` depths the pipeline's HLSL files declare.
+    pub subobject_depths: Vec<Declared>,
+    /// `RaytracingShaderConfig` maximum payload and attribute sizes.
+    pub max_payload_bytes: Option<Declared>,
+    pub max_attribute_bytes: Option<Declared>,
 }
 
 impl Pipeline {
@@ -158,6 +177,10 @@ impl Pipeline {
             miss: Vec::new(),
             hit_groups: Vec::new(),
             callable: Vec::new(),
+            subobject_library: None,
+            subobject_depths: Vec::new(),
+            max_payload_bytes: None,
+            max_attribute_bytes: None,
         };
         for (i, program) in programs.iter().enumerate() {
             for e in &program.entry_points {
@@ -198,6 +221,110 @@ impl Pipeline {
         }
         p.programs = programs;
         p
+    }
+
+    /// The pipeline an HLSL library describes with DXR subobjects: its
+    /// ray generation, miss and callable shaders (`[shader("...")]`), the
+    /// hit groups it declares (each hit shader in a group of its own when it
+    /// declares none), the depth of `RaytracingPipelineConfig` and the sizes
+    /// of `RaytracingShaderConfig`. `None` when the subobjects describe no
+    /// pipeline (no pipeline config, shader config or hit group, or no ray
+    /// generation shader) or a hit group names a shader the library does not
+    /// define with that stage (it is linked from another library): then the
+    /// program comes back.
+    pub fn from_subobjects(
+        program: Program,
+        subobjects: &Subobjects,
+    ) -> Result<Pipeline, Box<Program>> {
+        let describes = !subobjects.pipeline_configs.is_empty()
+            || !subobjects.shader_configs.is_empty()
+            || !subobjects.hit_groups.is_empty();
+        let has_raygen = program
+            .entry_points
+            .iter()
+            .any(|e| e.stage == Stage::RayGeneration);
+        if !describes || !has_raygen {
+            return Err(Box::new(program));
+        }
+        let file = program.path.clone();
+        let mut p = Pipeline::from_programs(vec![program]);
+        if !subobjects.hit_groups.is_empty() {
+            let program = &p.programs[0];
+            let find = |name: &Option<String>, stage: Stage, at: &Location| {
+                let Some(name) = name else {
+                    return Some(None);
+                };
+                let e = program
+                    .entry_points
+                    .iter()
+                    .find(|e| e.name == *name && e.stage == stage)?;
+                Some(Some(ShaderRef {
+                    program: 0,
+                    entry: e.name.clone(),
+                    function: e.function,
+                    stage,
+                    file: file.clone(),
+                    location: Some(at.clone()),
+                }))
+            };
+            let group = |g: &front::hlsl::subobject::HitGroup| {
+                let at = &g.location;
+                Some(HitGroup {
+                    kind: if g.procedural {
+                        HitGroupKind::Procedural
+                    } else {
+                        HitGroupKind::Triangles
+                    },
+                    closest_hit: find(&g.closest_hit, Stage::ClosestHit, at)?,
+                    any_hit: find(&g.any_hit, Stage::AnyHit, at)?,
+                    intersection: find(&g.intersection, Stage::Intersection, at)?,
+                    location: Some(at.clone()),
+                })
+            };
+            match subobjects.hit_groups.iter().map(group).collect() {
+                Some(groups) => p.hit_groups = groups,
+                None => return Err(Box::new(p.programs.remove(0))),
+            }
+        }
+        if let Some(c) = subobjects
+            .pipeline_configs
+            .iter()
+            .max_by_key(|c| c.max_recursion_depth)
+        {
+            p.max_recursion_depth = Some(c.max_recursion_depth);
+            p.max_recursion_depth_location = Some(c.location.clone());
+        }
+        p.add_subobjects(subobjects);
+        p.subobject_library = Some(file);
+        Ok(p)
+    }
+
+    /// Records the depths and sizes a library's subobjects declare.
+    fn add_subobjects(&mut self, subobjects: &Subobjects) {
+        self.subobject_depths
+            .extend(subobjects.pipeline_configs.iter().map(|c| Declared {
+                value: c.max_recursion_depth,
+                location: c.location.clone(),
+            }));
+        let largest = |v: Option<Declared>, value: u32, location: &Location| match v {
+            Some(d) if d.value >= value => Some(d),
+            _ => Some(Declared {
+                value,
+                location: location.clone(),
+            }),
+        };
+        for c in &subobjects.shader_configs {
+            self.max_payload_bytes = largest(
+                self.max_payload_bytes.take(),
+                c.max_payload_bytes,
+                &c.location,
+            );
+            self.max_attribute_bytes = largest(
+                self.max_attribute_bytes.take(),
+                c.max_attribute_bytes,
+                &c.location,
+            );
+        }
     }
 }
 
@@ -309,6 +436,7 @@ pub fn parse(text: &str, path: &Path) -> Result<Pipeline, InputError> {
     let mut loader = Loader {
         cx: &cx,
         programs: Vec::new(),
+        subobjects: Vec::new(),
     };
     for s in &raw.raygen {
         p.raygen.push(loader.shader(s, Stage::RayGeneration)?);
@@ -360,6 +488,9 @@ pub fn parse(text: &str, path: &Path) -> Result<Pipeline, InputError> {
         }
         p.hit_groups.push(group);
     }
+    for s in &loader.subobjects {
+        p.add_subobjects(s);
+    }
     p.programs = loader.programs;
     Ok(p)
 }
@@ -407,6 +538,8 @@ impl Cx<'_> {
 struct Loader<'a> {
     cx: &'a Cx<'a>,
     programs: Vec<Program>,
+    /// DXR subobjects of the HLSL files loaded.
+    subobjects: Vec<Subobjects>,
 }
 
 impl Loader<'_> {
@@ -434,12 +567,14 @@ impl Loader<'_> {
         let index = match self.programs.iter().position(|p| p.path == file) {
             Some(i) => i,
             None => {
-                let program = front::load(&file, lang).map_err(|e| {
-                    e.with_note(format!(
-                        "the pipeline description names this file at {here}"
-                    ))
-                })?;
+                let (program, subobjects) =
+                    front::load_library(&file, None, lang, &Default::default()).map_err(|e| {
+                        e.with_note(format!(
+                            "the pipeline description names this file at {here}"
+                        ))
+                    })?;
                 self.programs.push(program);
+                self.subobjects.push(subobjects);
                 self.programs.len() - 1
             }
         };
@@ -603,6 +738,58 @@ mod tests {
         ));
         assert!(msg.starts_with("unknown hit group type `aabbs`"), "{msg}");
         assert_eq!(line, 5);
+    }
+
+    fn library(rel: &str) -> (Program, Subobjects) {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join(rel);
+        front::load_library(&path, None, Language::Hlsl, &Default::default()).unwrap()
+    }
+
+    #[test]
+    fn subobjects_describe_the_library_pipeline() {
+        let (program, subobjects) = library("fixtures/RT021/good.hlsl");
+        let p = Pipeline::from_subobjects(program, &subobjects).unwrap();
+        assert!(!p.described(), "the SBT order stays unknown");
+        assert_eq!(p.file(), p.subobject_library.clone().unwrap());
+        assert_eq!(p.max_recursion_depth, Some(3));
+        assert_eq!(p.max_recursion_depth_location.as_ref().unwrap().line, 10);
+        assert_eq!(p.max_payload_bytes.as_ref().unwrap().value, 16);
+        assert_eq!(p.max_attribute_bytes.as_ref().unwrap().value, 8);
+        let entries = |v: &[ShaderRef]| v.iter().map(|s| s.entry.clone()).collect::<Vec<_>>();
+        assert_eq!(entries(&p.raygen), ["Gen"]);
+        assert_eq!(entries(&p.miss), ["Sky"]);
+        assert_eq!(p.hit_groups.len(), 1);
+        let g = &p.hit_groups[0];
+        assert_eq!(g.kind, HitGroupKind::Triangles);
+        assert_eq!(g.closest_hit.as_ref().unwrap().entry, "MirrorHit");
+        assert!(g.any_hit.is_none());
+        assert_eq!(g.location.as_ref().unwrap().line, 8);
+    }
+
+    #[test]
+    fn subobjects_naming_shaders_of_another_library_describe_nothing() {
+        // `Spheres` names `SphereAny` and `SphereHit`, defined elsewhere.
+        let (program, subobjects) = library("tests/hlsl/subobjects.hlsl");
+        assert_eq!(subobjects.max_recursion_depth(), Some(3));
+        let program = Pipeline::from_subobjects(program, &subobjects).unwrap_err();
+        assert_eq!(program.entry_points.len(), 3);
+        // Without subobjects: no description either.
+        assert!(Pipeline::from_subobjects(*program, &Subobjects::default()).is_err());
+    }
+
+    #[test]
+    fn a_description_keeps_the_depths_its_libraries_declare() {
+        let p =
+            load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/RT026/bad.pipeline.toml"))
+                .unwrap();
+        assert_eq!(p.max_recursion_depth, Some(2));
+        let depths: Vec<(u32, u32)> = p
+            .subobject_depths
+            .iter()
+            .map(|d| (d.value, d.location.line))
+            .collect();
+        assert_eq!(depths, [(3, 10)]);
+        assert!(p.subobject_library.is_none());
     }
 
     #[test]

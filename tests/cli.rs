@@ -46,24 +46,20 @@ fn assert_input_error(path: &Path, expect: &[&str]) -> String {
 }
 
 fn good_module() -> Vec<u32> {
-    read_words(&common::root().join("fixtures/glsl/RT001_good.rgen.g.spv"))
+    read_words(&common::root().join("fixtures/RT001/good.rgen.g.spv"))
 }
 
 #[test]
 fn exit_codes() {
     // Warnings only: 0.
-    let o = run(&["check", "fixtures/glsl/RT001_bad.rgen.gV.spv"]);
+    let o = run(&["check", "fixtures/RT001/bad.rgen.gV.spv"]);
     assert_eq!(o.status.code(), Some(0), "{}", stdout(&o));
     assert!(stdout(&o).contains("warning[RT001]"));
     // --deny-warnings: 1.
-    let o = run(&[
-        "check",
-        "--deny-warnings",
-        "fixtures/glsl/RT001_bad.rgen.gV.spv",
-    ]);
+    let o = run(&["check", "--deny-warnings", "fixtures/RT001/bad.rgen.gV.spv"]);
     assert_eq!(o.status.code(), Some(1));
     // An error-level finding: 1.
-    let o = run(&["check", "fixtures/glsl/RT004_bad.rint.gV.spv"]);
+    let o = run(&["check", "fixtures/RT004/bad.rint.gV.spv"]);
     assert_eq!(o.status.code(), Some(1));
     assert!(stdout(&o).contains("error[RT004]"));
     // A larger budget silences RT001.
@@ -71,7 +67,7 @@ fn exit_codes() {
         "check",
         "--payload-budget",
         "64",
-        "fixtures/glsl/RT001_bad.rgen.gV.spv",
+        "fixtures/RT001/bad.rgen.gV.spv",
     ]);
     assert_eq!(o.status.code(), Some(0));
     assert!(!stdout(&o).contains("RT001"), "{}", stdout(&o));
@@ -82,7 +78,7 @@ fn exit_codes() {
 fn config_file_sets_levels() {
     let d = scratch("config");
     std::fs::copy(
-        common::root().join("fixtures/wgsl/RT001_bad.wgsl"),
+        common::root().join("fixtures/RT001/bad.wgsl"),
         d.join("a.wgsl"),
     )
     .unwrap();
@@ -107,7 +103,7 @@ fn config_file_sets_levels() {
 fn directories_are_walked_and_bad_files_do_not_hide_good_ones() {
     let d = scratch("walk");
     std::fs::copy(
-        common::root().join("fixtures/wgsl/RT001_bad.wgsl"),
+        common::root().join("fixtures/RT001/bad.wgsl"),
         d.join("a.wgsl"),
     )
     .unwrap();
@@ -317,20 +313,13 @@ fn json_layout_contract() {
 
 #[test]
 fn github_and_sarif_formats() {
-    let o = run(&[
-        "check",
-        "--format",
-        "github",
-        "fixtures/wgsl/RT001_bad.wgsl",
-    ]);
+    let o = run(&["check", "--format", "github", "fixtures/RT001/bad.wgsl"]);
     let text = stdout(&o);
     assert!(
-        text.starts_with(
-            "::warning title=rtlint (RT001),file=fixtures/wgsl/RT001_bad.wgsl,line=4,"
-        ),
+        text.starts_with("::warning title=rtlint (RT001),file=fixtures/RT001/bad.wgsl,line=4,"),
         "{text}"
     );
-    let o = run(&["check", "--format", "sarif", "fixtures/wgsl/RT001_bad.wgsl"]);
+    let o = run(&["check", "--format", "sarif", "fixtures/RT001/bad.wgsl"]);
     let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     assert_eq!(v["version"], "2.1.0");
     let results = v["runs"][0]["results"].as_array().unwrap();

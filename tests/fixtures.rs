@@ -54,9 +54,11 @@ fn placed_markers(source: &Path) -> BTreeSet<(PathBuf, u32, String)> {
 fn cases() -> Vec<(PathBuf, PathBuf)> {
     let mut cases = Vec::new();
     for dir in [
-        "fixtures/wgsl",
         "fixtures/glsl",
         "fixtures/hlsl",
+        "fixtures/RT001",
+        "fixtures/RT004",
+        "fixtures/RT005",
         "fixtures/RT010",
     ] {
         let mut entries: Vec<PathBuf> = std::fs::read_dir(root().join(dir))
@@ -170,19 +172,6 @@ fn every_rule_has_bad_and_good_fixtures() {
                 good |= name.starts_with("good");
             }
         }
-        for dir in ["fixtures/wgsl", "fixtures/glsl"] {
-            for e in std::fs::read_dir(root().join(dir)).unwrap() {
-                let p = e.unwrap().path();
-                let name = p.file_name().unwrap().to_str().unwrap().to_string();
-                if name.ends_with(".spv") || name.ends_with(".sh") {
-                    continue;
-                }
-                if name.starts_with(&format!("{}_bad", rule.code)) {
-                    bad |= markers(&p).iter().any(|(_, c)| c == rule.code);
-                }
-                good |= name.starts_with(&format!("{}_good", rule.code));
-            }
-        }
         assert!(bad, "{} has no bad fixture marking it", rule.code);
         assert!(good, "{} has no good fixture", rule.code);
     }
@@ -190,28 +179,32 @@ fn every_rule_has_bad_and_good_fixtures() {
 
 #[test]
 fn glsl_fixture_modules_are_current_and_valid() {
-    // Every GLSL fixture has both compiled forms, and each passes spirv-val.
+    // Every GLSL fixture compiled twice has both forms, and each passes
+    // spirv-val.
     let validate = rtlint_testkit::tool("spirv-val");
-    for e in std::fs::read_dir(root().join("fixtures/glsl")).unwrap() {
-        let p = e.unwrap().path();
-        let name = p.file_name().unwrap().to_str().unwrap().to_string();
-        if name.ends_with(".spv") {
-            if validate {
-                common::spirv_val(&common::read_words(&p))
-                    .unwrap_or_else(|e| panic!("{name}: {e}"));
+    for (dir, script) in [
+        ("fixtures/glsl", "regenerate.sh"),
+        ("fixtures/RT001", "build.sh"),
+        ("fixtures/RT004", "build.sh"),
+    ] {
+        for e in std::fs::read_dir(root().join(dir)).unwrap() {
+            let p = e.unwrap().path();
+            let name = p.file_name().unwrap().to_str().unwrap().to_string();
+            if name.ends_with(".spv") {
+                if validate {
+                    common::spirv_val(&common::read_words(&p))
+                        .unwrap_or_else(|e| panic!("{name}: {e}"));
+                }
+                continue;
             }
-            continue;
-        }
-        if name.ends_with(".sh") {
-            continue;
-        }
-        for suffix in ["g.spv", "gV.spv"] {
-            let m = p.with_file_name(format!("{name}.{suffix}"));
-            assert!(
-                m.exists(),
-                "{} is missing: run fixtures/glsl/regenerate.sh",
-                m.display()
-            );
+            let stages = [".rgen", ".rchit", ".rmiss", ".rahit", ".rint", ".rcall"];
+            if !stages.iter().any(|s| name.ends_with(s)) {
+                continue;
+            }
+            for suffix in ["g.spv", "gV.spv"] {
+                let m = p.with_file_name(format!("{name}.{suffix}"));
+                assert!(m.exists(), "{} is missing: run {dir}/{script}", m.display());
+            }
         }
     }
 }
@@ -221,18 +214,26 @@ fn wgsl_fixtures_compile_to_valid_spirv_except_the_null_ray_query() {
     if !rtlint_testkit::tool("spirv-val") {
         return;
     }
-    for e in std::fs::read_dir(root().join("fixtures/wgsl")).unwrap() {
-        let p = e.unwrap().path();
-        let text = std::fs::read_to_string(&p).unwrap();
-        let words = rtlint::front::wgsl::compile(&text, &p).unwrap();
-        let valid = common::spirv_val(&words);
-        if p.file_name().unwrap() == "RT005_bad.wgsl" {
-            // The bug RT005 exists for: naga accepts it, spirv-val does not.
-            let err = valid.expect_err("naga's null ray query should fail spirv-val");
-            assert!(err.contains("null"), "{err}");
-        } else {
-            valid.unwrap_or_else(|e| panic!("{}: {e}", p.display()));
+    for dir in ["fixtures/RT001", "fixtures/RT005"] {
+        for e in std::fs::read_dir(root().join(dir)).unwrap() {
+            let p = e.unwrap().path();
+            if p.extension().is_some_and(|x| x == "wgsl") {
+                wgsl_valid(&p);
+            }
         }
+    }
+}
+
+fn wgsl_valid(p: &Path) {
+    let text = std::fs::read_to_string(p).unwrap();
+    let words = rtlint::front::wgsl::compile(&text, p).unwrap();
+    let valid = common::spirv_val(&words);
+    if p.ends_with("RT005/bad.wgsl") {
+        // The bug RT005 exists for: naga accepts it, spirv-val does not.
+        let err = valid.expect_err("naga's null ray query should fail spirv-val");
+        assert!(err.contains("null"), "{err}");
+    } else {
+        valid.unwrap_or_else(|e| panic!("{}: {e}", p.display()));
     }
 }
 

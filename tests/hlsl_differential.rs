@@ -378,6 +378,15 @@ fn cases() -> Vec<Case> {
             dx_layout: false,
         },
         Case {
+            name: "compute-frontend",
+            file: "diff_frontend.hlsl",
+            entries: vec![("Main", Compute)],
+            shape: Shape::Compute { groups: [1, 1, 1] },
+            scene: SceneKind::None,
+            resources: vec![out(0, 64 * 4 * 16, Format::F32x4)],
+            dx_layout: false,
+        },
+        Case {
             name: "compute-memory",
             file: "exec_memory.hlsl",
             entries: vec![("Main", Compute)],
@@ -421,6 +430,11 @@ fn cases() -> Vec<Case> {
 /// HLSL test shaders the differential test does not run, and why. Every
 /// file in tests/hlsl must be in a case or here.
 const NOT_RUN: &[(&str, &str)] = &[
+    (
+        "corpus_constructs.hlsl",
+        "samples textures, uses device addresses and a pixel shader; tests/hlsl_compile.rs \
+         checks each construct's instructions",
+    ),
     (
         "pixel.hlsl",
         "a pixel shader: rtlint::vk has no graphics pipeline; tests/hlsl_compile.rs \

@@ -486,6 +486,32 @@ fn every_attribute_is_implemented_or_refused() {
         err("[[vk::image_format(\"rgba8\")]] Texture2D t;\n[numthreads(1,1,1)]\nvoid m() {}"),
         "main.hlsl:1:3: not supported: `vk::image_format` on anything but an RWTexture"
     );
+    // Inline-SPIR-V decorations on struct members only.
+    assert_eq!(
+        err("[[vk::ext_decorate(0)]] RWBuffer<uint> b;\n[numthreads(1,1,1)]\nvoid m() {}"),
+        "main.hlsl:1:3: not supported: `vk::ext_decorate` on a global declaration"
+    );
+    assert_eq!(
+        err("struct S { [[vk::ext_decorate(9999)]] float x; };\n[numthreads(1,1,1)]\nvoid m() { S s; s.x = 1; }"),
+        "main.hlsl:1:31: unknown SPIR-V decoration 9999"
+    );
+    // Early fragment tests exist for pixel shaders only.
+    assert_eq!(
+        err("[earlydepthstencil]\n[numthreads(1,1,1)]\nvoid m() {}"),
+        "main.hlsl:1:2: `[earlydepthstencil]` applies to pixel shaders only"
+    );
+}
+
+#[test]
+fn device_address_loads_are_scalars_and_vectors() {
+    assert_eq!(
+        err("struct S { float a; };\n[numthreads(1,1,1)]\nvoid m() { S s = vk::RawBufferLoad<S>(0); }"),
+        "main.hlsl:3:18: not supported: `vk::RawBufferLoad<S>` (scalars and vectors only)"
+    );
+    assert_eq!(
+        err("[numthreads(1,1,1)]\nvoid m() { uint u = vk::RawBufferLoad<uint>(0, 3); }"),
+        "main.hlsl:2:48: the alignment must be a power of two, not 3"
+    );
 }
 
 #[test]
@@ -625,4 +651,48 @@ fn ray_queries_are_returned_only_as_one_local() {
         err("RaytracingAccelerationStructure s;\nRayQuery<0> trace(RayDesc r, bool b)\n{\n    RayQuery<0> q;\n    RayQuery<0> p;\n    if (b) return p;\n    return q;\n}\n[numthreads(1,1,1)]\nvoid m()\n{\n    RayDesc r = (RayDesc)0;\n    RayQuery<0> q = trace(r, true);\n}"),
         "main.hlsl:2:1: not supported: functions returning a RayQuery other than one local variable"
     );
+}
+
+/// `half` is `float` unless 16-bit types are enabled, as in DXC; 16-bit
+/// types are then refused, never widened to 32 bits.
+#[test]
+fn sixteen_bit_types_are_refused_rather_than_widened() {
+    let src = "[numthreads(1,1,1)]\nvoid m() { half h = 1; float16_t f = h; }";
+    assert_eq!(
+        err(src),
+        "main.hlsl:2:24: not supported: 16-bit type `float16_t` (DXC needs -enable-16bit-types for it)"
+    );
+    let with_flag = |text: &str| {
+        let opts = HlslOptions {
+            enable_16bit_types: true,
+            ..Default::default()
+        };
+        let e = hlsl::compile_source(
+            Path::new("main.hlsl"),
+            text,
+            &mut MemLoader::default(),
+            &opts,
+        )
+        .unwrap_err();
+        let d = e.diagnostic();
+        let l = &d.primary.as_ref().unwrap().location;
+        format!("{}:{}: {}", l.line, l.column, d.message)
+    };
+    assert_eq!(
+        with_flag(src),
+        "2:12: not supported: 16-bit type `half` (with -enable-16bit-types)"
+    );
+    assert_eq!(
+        with_flag("[numthreads(1,1,1)]\nvoid m() { vector<min16float, 2> v = 0; }"),
+        "2:19: not supported: 16-bit type `min16float` (with -enable-16bit-types)"
+    );
+    // Without the flag, `half` and `min16float` are 32-bit floats.
+    let ok = "RWStructuredBuffer<float> o;\n[numthreads(1,1,1)]\nvoid m() { half h = 1.5; min16float g = h; o[0] = g; }";
+    assert!(hlsl::compile_source(
+        Path::new("main.hlsl"),
+        ok,
+        &mut MemLoader::default(),
+        &HlslOptions::default()
+    )
+    .is_ok());
 }

@@ -216,7 +216,7 @@ fn front_end_constructs_on_the_driver() {
     let entries = hlsl::compile(&path, &HlslOptions::default()).unwrap_or_else(|e| panic!("{e}"));
     let expected = [
         6.5f32, 2.5, 2.5, 8.0, 10.0, 3.5, 16.0, 7.0, 12.0, 56.0, 3.0, 4.0, 7.5, 7.0, 3.0, 4.5, 3.0,
-        9.0,
+        9.0, 3.0, 4.0, 6.0, 32.0, 2.5, 6.0,
     ];
     let out = storage(&ctx, (expected.len() as u64 + 4) * 4);
     // `sky`: color (1, 2, 3), intensity 0.5.

@@ -147,9 +147,9 @@ fn run(name: &str, text: &str, files: &[(String, String)]) {
 
 #[test]
 fn mutated_shaders_never_panic() {
-    // Shaders using SPIR-V newer than the validator knows need a newer one
-    // (RTLINT_SPIRV_VAL); without it they are left out here.
-    let validator = std::env::var("RTLINT_SPIRV_VAL").ok();
+    // Shaders using SPIR-V newer than Debian's validator knows need a newer
+    // one (`rtlint_testkit::new_spirv_val`); without it they are left out here.
+    let validator = rtlint_testkit::new_spirv_val().ok();
     let files: Vec<_> = shaders()
         .into_iter()
         .filter(|(n, _)| {
@@ -235,9 +235,9 @@ fn accepted_mutations_validate() {
     if !rtlint_testkit::tool("spirv-val") {
         return;
     }
-    // Shaders using SPIR-V newer than the validator knows need a newer one
-    // (RTLINT_SPIRV_VAL); without it they are left out here.
-    let validator = std::env::var("RTLINT_SPIRV_VAL").ok();
+    // Shaders using SPIR-V newer than Debian's validator knows need a newer
+    // one (`rtlint_testkit::new_spirv_val`); without it they are left out here.
+    let validator = rtlint_testkit::new_spirv_val().ok();
     let files: Vec<_> = shaders()
         .into_iter()
         .filter(|(n, _)| {

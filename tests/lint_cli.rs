@@ -631,3 +631,38 @@ fn glsl_sources_need_not_be_utf8() {
     let o = check_in(&root(), &["fixtures/live/latin1.rgen"]);
     assert_eq!(o.status.code(), Some(0), "{}", text(&o));
 }
+
+/// `half` is 32-bit unless 16-bit types are enabled, on the command line
+/// (`--enable-16bit-types`) or in `[hlsl]`; then it is refused (exit 2),
+/// never silently widened.
+#[test]
+fn sixteen_bit_types_follow_the_flag_and_the_config() {
+    let d = scratch("half");
+    let src = "RWStructuredBuffer<float> o : register(u0);\n[numthreads(1,1,1)]\nvoid m() { half h = 0.5; o[0] = h; }\n";
+    std::fs::write(d.join("m.hlsl"), src).unwrap();
+    assert_eq!(check_in(&d, &["m.hlsl"]).status.code(), Some(0));
+    let o = check_in(&d, &["--enable-16bit-types", "m.hlsl"]);
+    assert_eq!(o.status.code(), Some(2), "{}", text(&o));
+    assert!(
+        text(&o).contains("not supported: 16-bit type `half` (with -enable-16bit-types)"),
+        "{}",
+        text(&o)
+    );
+    std::fs::write(d.join("rtlint.toml"), "[hlsl]\nenable-16bit-types = true\n").unwrap();
+    assert_eq!(check_in(&d, &["m.hlsl"]).status.code(), Some(2));
+    let out = d.join("m.spv");
+    let compile = |extra: &[&str]| {
+        rtlint()
+            .arg("compile")
+            .arg(d.join("m.hlsl"))
+            .args(extra)
+            .arg("-o")
+            .arg(&out)
+            .output()
+            .unwrap()
+            .status
+            .code()
+    };
+    assert_eq!(compile(&[]), Some(0));
+    assert_eq!(compile(&["--enable-16bit-types"]), Some(2));
+}

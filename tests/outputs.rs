@@ -31,7 +31,7 @@ fn snapshot_run(name: &str, args: &[&str]) -> String {
 /// A shader of each input language, and a pipeline description with an error.
 const CHECKED: [&str; 3] = [
     "fixtures/glsl/payloads.rgen.gV.spv",
-    "fixtures/wgsl/RT001_bad.wgsl",
+    "fixtures/RT001/bad.wgsl",
     "fixtures/RT021/bad.pipeline.toml",
 ];
 
@@ -93,7 +93,7 @@ fn layout_text() {
             "layout",
             "fixtures/glsl/payloads.rgen.g.spv",
             "fixtures/hlsl/payloads.hlsl",
-            "fixtures/wgsl/RT001_bad.wgsl",
+            "fixtures/RT001/bad.wgsl",
         ],
     );
 }

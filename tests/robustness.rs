@@ -24,10 +24,16 @@ impl Rng {
 
 fn seeds() -> Vec<Vec<u32>> {
     let mut out = Vec::new();
-    for e in std::fs::read_dir(common::root().join("fixtures/glsl")).unwrap() {
-        let p = e.unwrap().path();
-        if p.extension().is_some_and(|x| x == "spv") {
-            out.push(common::read_words(&p));
+    for dir in ["fixtures/glsl", "fixtures/RT001", "fixtures/RT004"] {
+        let mut files: Vec<_> = std::fs::read_dir(common::root().join(dir))
+            .unwrap()
+            .map(|e| e.unwrap().path())
+            .collect();
+        files.sort();
+        for p in files {
+            if p.extension().is_some_and(|x| x == "spv") {
+                out.push(common::read_words(&p));
+            }
         }
     }
     let wgsl = common::root().join("shaders/reflect_iterative.wgsl");

@@ -103,10 +103,6 @@ fn every_rule_has_bad_and_good_fixtures_in_its_folder() {
             missing.push(r.code);
         }
     }
-    // Rules whose fixtures still live in the shared per-language folders
-    // (fixtures/glsl, fixtures/wgsl) are checked by tests/fixtures.rs.
-    let legacy = ["RT001", "RT004", "RT005"];
-    missing.retain(|c| !legacy.contains(c));
     assert!(
         missing.is_empty(),
         "rules without fixtures/RTnnn/{{bad,good}}.*: {missing:?}"

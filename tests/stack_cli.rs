@@ -394,3 +394,40 @@ fn driver_numbers_from_the_measurement_csv() {
         "{stderr}"
     );
 }
+
+/// An HLSL library that no description names is described by its DXR
+/// subobjects: the depth of `RaytracingPipelineConfig`, its hit group, and
+/// its own shaders; the driver's child process rebuilds it from the library.
+#[test]
+fn stack_of_a_library_described_by_its_subobjects() {
+    let out = json(&[
+        "stack",
+        "--driver",
+        "--format",
+        "json",
+        "fixtures/RT021/bad.hlsl",
+    ]);
+    let reports = out["pipelines"].as_array().unwrap();
+    assert_eq!(reports.len(), 1, "{out}");
+    let r = &reports[0];
+    assert_eq!(r["pipeline"], "fixtures/RT021/bad.hlsl (DXR subobjects)");
+    assert_eq!(r["declared_depth"], 1);
+    assert_eq!(r["required_depth"], 3);
+    let shaders: Vec<(&str, &str)> = r["shaders"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|s| (s["stage"].as_str().unwrap(), s["entry"].as_str().unwrap()))
+        .collect();
+    assert_eq!(
+        shaders,
+        [
+            ("ray_generation", "Gen"),
+            ("miss", "Sky"),
+            ("closest_hit", "MirrorHit")
+        ]
+    );
+    assert!(r["driver"].is_object(), "no driver figures: {r}");
+    let assumptions = r["assumptions"].to_string();
+    assert!(assumptions.contains("DXR subobjects"), "{assumptions}");
+}

@@ -11,7 +11,7 @@ fuzz_target!(|data: &[u8]| {
         if let Ok(p) = rtlint::program::parse(&words, path, rtlint::shader::Language::Spirv) {
             let config = rtlint::config::Config::default();
             let _ = rtlint::rules::check_program(&p, &config);
-            let _ = rtlint::lint::check_loose(vec![p], &[], &config);
+            let _ = rtlint::lint::check_loose(vec![(p, Default::default())], &[], &config);
         }
     }
 });

@@ -27,6 +27,10 @@ pub enum Assumption {
     /// No pipeline description: every trace may reach every hit group and
     /// miss shader.
     Undescribed,
+    /// The pipeline comes from an HLSL library's DXR subobjects, which do
+    /// not give the shader table's order: every trace may reach every hit
+    /// group and miss shader they declare.
+    FromSubobjects,
     /// A trace whose SBT offset or stride is not a compile-time constant may
     /// reach every hit group.
     DynamicSbtOffset { at: Option<Location> },
@@ -51,7 +55,7 @@ impl Assumption {
     /// traces by position.
     fn sort_key(&self) -> (u8, bool, String, u8) {
         match self {
-            Assumption::Undescribed => (0, false, String::new(), 0),
+            Assumption::Undescribed | Assumption::FromSubobjects => (0, false, String::new(), 0),
             Assumption::DynamicSbtOffset { at } => (
                 1,
                 at.is_none(),
@@ -148,7 +152,9 @@ pub fn trace_graph(pipeline: &Pipeline) -> TraceGraph {
             slot: Slot::Callable(i),
         });
     }
-    if !pipeline.described() {
+    if pipeline.subobject_library.is_some() {
+        g.assumptions.push(Assumption::FromSubobjects);
+    } else if !pipeline.described() {
         g.assumptions.push(Assumption::Undescribed);
     }
     let described = pipeline.described();
@@ -196,12 +202,27 @@ pub fn trace_graph(pipeline: &Pipeline) -> TraceGraph {
             if let (EdgeKind::Trace, Some(t)) = (kind, operands) {
                 let flags = t.ray_flags.constant().unwrap_or(0);
                 let dynamic_flags = t.ray_flags.constant().is_none();
-                let opaque = !dynamic_flags
-                    && (flags & FLAG_OPAQUE != 0
-                        || (pipeline.all_geometry_opaque && flags & FLAG_NO_OPAQUE == 0));
-                let skip_ch = !dynamic_flags && flags & FLAG_SKIP_CLOSEST_HIT != 0;
-                let skip_tri = !dynamic_flags && flags & FLAG_SKIP_TRIANGLES != 0;
-                let skip_aabb = !dynamic_flags && flags & FLAG_SKIP_AABBS != 0;
+                // Flags that are set whatever the dynamic part holds
+                // (`SKIP_CLOSEST_HIT | extraFlags`) prune as constants do.
+                let set = match t.ray_flags {
+                    OperandValue::Const(v) => v,
+                    // Set on every call chain that reaches the site.
+                    OperandValue::Dynamic(id) if chains.is_empty() => {
+                        program.known_ones_in(id, &[])
+                    }
+                    OperandValue::Dynamic(id) => chains
+                        .iter()
+                        .map(|c| program.known_ones_in(id, c))
+                        .fold(u64::MAX, |a, b| a & b),
+                    OperandValue::Spec { .. } => 0,
+                };
+                let opaque = set & FLAG_OPAQUE != 0
+                    || (!dynamic_flags
+                        && pipeline.all_geometry_opaque
+                        && flags & FLAG_NO_OPAQUE == 0);
+                let skip_ch = set & FLAG_SKIP_CLOSEST_HIT != 0;
+                let skip_tri = set & FLAG_SKIP_TRIANGLES != 0;
+                let skip_aabb = set & FLAG_SKIP_AABBS != 0;
                 let groups: Vec<usize> =
                     match (described, const_of(t.sbt_offset), const_of(t.sbt_stride)) {
                         (true, Some(off), Some(stride)) => {

@@ -653,10 +653,14 @@ fn counter_of(program: &Program, id: Id) -> Option<Counter> {
     if inst.class.opcode != Op::Load {
         return None;
     }
-    let (var, path) = pointer_path(program, ids(inst).next()?)?;
+    let ptr = ids(inst).next()?;
     let incoming = |v: Id| {
         global(program, v).is_some_and(|g| g.storage == StorageClass::IncomingRayPayloadKHR)
     };
+    if let Some(c) = parameter_counter(program, ptr, &[], &incoming) {
+        return Some(c);
+    }
+    let (var, path) = pointer_path(program, ptr)?;
     if incoming(var) {
         return Some(Counter::Payload { var, path });
     }
@@ -674,6 +678,72 @@ fn counter_of(program: &Program, id: Id) -> Option<Counter> {
         }
     }
     Some(Counter::Var { var, path })
+}
+
+/// A parameter passed by pointer (HLSL copies an `in` argument into a
+/// temporary and passes that): the incoming payload member every call from
+/// a hit or miss shader copies into it, when they all agree (`TraceRadianceRay(ray,
+/// payload.recursionDepth)` with the guard inside the helper).
+fn parameter_counter(
+    program: &Program,
+    param: Id,
+    path: &[u64],
+    incoming: &dyn Fn(Id) -> bool,
+) -> Option<Counter> {
+    if program.def(param)?.class.opcode != Op::FunctionParameter {
+        return None;
+    }
+    let f = program
+        .functions
+        .iter()
+        .find(|f| f.params.contains(&param))?;
+    let k = f.params.iter().position(|&p| p == param)?;
+    // Only calls from shaders that can close a recursion cycle (those with
+    // an incoming payload) matter to a depth guard: the ray generation
+    // shader's first call passes its own start value.
+    let mut in_cycle_stages: HashSet<Id> = HashSet::new();
+    for e in program.entry_points.iter().filter(|e| {
+        matches!(
+            e.stage,
+            Stage::ClosestHit | Stage::AnyHit | Stage::Miss | Stage::Intersection
+        )
+    }) {
+        in_cycle_stages.extend(program.reachable_functions(e.function));
+    }
+    let mut found: Option<Counter> = None;
+    for (_, call) in program.insts.iter().enumerate().filter(|(n, i)| {
+        i.class.opcode == Op::FunctionCall
+            && matches!(i.operands.first(), Some(Operand::IdRef(x)) if *x == f.id)
+            && program
+                .function_of(*n)
+                .and_then(|k| program.functions.get(k))
+                .is_some_and(|g| in_cycle_stages.contains(&g.id))
+    }) {
+        let Some(Operand::IdRef(arg)) = call.operands.get(1 + k) else {
+            return None;
+        };
+        let (var, mut arg_path) = pointer_path(program, *arg)?;
+        if !is_local(program, var) {
+            return None;
+        }
+        arg_path.extend_from_slice(path);
+        let sources = values_of(program, (var, arg_path));
+        let Some(Source::Read(v, p)) = sources.first() else {
+            return None;
+        };
+        if !incoming(*v) || sources.iter().any(|s| *s != sources[0]) {
+            return None;
+        }
+        let c = Counter::Payload {
+            var: *v,
+            path: p.clone(),
+        };
+        if found.as_ref().is_some_and(|f| *f != c) {
+            return None;
+        }
+        found = Some(c);
+    }
+    found
 }
 
 /// Whether `value` is `counter + c` with a constant `c > 0`; `c`.
@@ -863,6 +933,44 @@ struct Rel {
 }
 
 /// The relations that hold when `cond` has value `want`.
+/// The label of the block that defines `id`.
+fn inst_block_label(program: &Program, id: Id) -> Option<Id> {
+    let at = *program.defs.get(&id)?;
+    let f = program.functions.get(program.function_of(at)?)?;
+    let b = f.blocks.iter().find(|b| b.start <= at && at <= b.end)?;
+    program.insts[b.start].result_id
+}
+
+/// The value bool `v` must have on the edge from block `from` to block `to`:
+/// when `from` ends in a conditional branch on `v` (or on its negation)
+/// that reaches `to` on one side only (glslang's `a || b` passes `a` itself
+/// to the phi, from the block that found it true).
+fn edge_value(program: &Program, v: Id, from: Id, to: Option<Id>) -> Option<bool> {
+    let to = to?;
+    let f = program
+        .functions
+        .iter()
+        .find(|f| f.block_by_label(from).is_some())?;
+    let end = &program.insts[f.blocks[f.block_by_label(from)?].end];
+    if end.class.opcode != Op::BranchConditional {
+        return None;
+    }
+    let o: Vec<Id> = ids(end).collect();
+    let [c, t, e, ..] = o.as_slice() else {
+        return None;
+    };
+    let taken = match (*t == to, *e == to) {
+        (true, false) => true,
+        (false, true) => false,
+        _ => return None,
+    };
+    if *c == v {
+        return Some(taken);
+    }
+    let not = program.def(*c)?;
+    (not.class.opcode == Op::LogicalNot && ids(not).next() == Some(v)).then_some(!taken)
+}
+
 fn relations(program: &Program, cond: Id, want: bool, out: &mut Vec<Rel>, depth: u32) {
     if depth > 8 {
         return;
@@ -901,6 +1009,35 @@ fn relations(program: &Program, cond: Id, want: bool, out: &mut Vec<Rel>, depth:
                 c != Some(&crate::program::Constant::Bool(!want))
                     && !(want && c == Some(&crate::program::Constant::Null))
             })
+            .collect();
+        if let [only] = possible.as_slice() {
+            relations(program, *only, want, out, depth + 1);
+        }
+        return;
+    }
+    if inst.class.opcode == Op::Phi {
+        // glslang's `a || b` and `a && b`: a phi of a constant (the operand
+        // that decided) and the second operand. Where exactly one incoming
+        // value can be the wanted one, the branch implies it.
+        let possible: Vec<Id> = inst
+            .operands
+            .chunks(2)
+            .filter_map(|pair| match pair {
+                [rspirv::dr::Operand::IdRef(v), rspirv::dr::Operand::IdRef(from)] => {
+                    Some((*v, *from))
+                }
+                _ => None,
+            })
+            .filter(|&(v, from)| {
+                let c = program.constants.get(&v);
+                let known = match c {
+                    Some(crate::program::Constant::Bool(b)) => Some(*b),
+                    Some(crate::program::Constant::Null) => Some(false),
+                    _ => edge_value(program, v, from, inst_block_label(program, cond)),
+                };
+                known != Some(!want)
+            })
+            .map(|(v, _)| v)
             .collect();
         if let [only] = possible.as_slice() {
             relations(program, *only, want, out, depth + 1);
@@ -1105,12 +1242,25 @@ fn initial_value(
         }
         let shader = &graph.nodes[e.from].shader;
         let program = pipeline.program(shader)?;
-        let payload = program.sites.iter().find(|s| s.inst == e.inst)?.payload?;
+        let site = program.sites.iter().find(|s| s.inst == e.inst)?;
+        let payload = site.payload?;
+        // A helper's parameter (the depth a ray generation shader passes to
+        // the function that traces) folds per call chain.
+        let mut chains = program
+            .functions
+            .get(site.function)
+            .map(|f| call_chains(program, shader.function, f.id, super::liveness::MAX_CHAINS))
+            .unwrap_or_default();
+        if chains.is_empty() {
+            chains.push(Vec::new());
+        }
         for source in values_of(program, (payload, path.to_vec())) {
             if let Source::Value(val) = source {
-                if let Some(c) = program.fold(val) {
-                    let c = signed(program, val, c);
-                    value = Some(value.map_or(c, |v: i64| v.min(c)));
+                for chain in &chains {
+                    if let Some(c) = program.fold_in(val, chain) {
+                        let c = signed(program, val, c);
+                        value = Some(value.map_or(c, |v: i64| v.min(c)));
+                    }
                 }
             }
         }
@@ -1188,7 +1338,7 @@ pub fn trace_loops(
                             header: header_inst,
                             location,
                             site_location: program.site_location(site.inst),
-                            bound: loop_bound(program, f, &body, constants),
+                            bound: loop_bound(program, f, header, &body, constants),
                         });
                     }
                 }
@@ -1201,13 +1351,25 @@ pub fn trace_loops(
 fn loop_bound(
     program: &Program,
     f: &Function,
+    header: usize,
     body: &HashSet<usize>,
     constants: &BTreeMap<String, DescribedConstant>,
 ) -> Result<LoopBound, NoLoopBound> {
     let mut why: Option<NoLoopBound> = None;
     let mut blocks: Vec<usize> = body.iter().copied().collect();
     blocks.sort_unstable();
+    // An exit bounds the loop only when every iteration passes it: its
+    // block dominates every back edge.
+    let idom = dominators(f);
+    let latches: Vec<usize> = blocks
+        .iter()
+        .copied()
+        .filter(|&b| f.blocks[b].succs.contains(&header))
+        .collect();
     for b in blocks {
+        if !latches.iter().all(|&l| dominates(&idom, b, l)) {
+            continue;
+        }
         let term = &program.insts[f.blocks[b].end];
         if term.class.opcode != Op::BranchConditional {
             continue;
@@ -1219,9 +1381,22 @@ fn loop_bound(
         let (Some(tb), Some(eb)) = (f.block_by_label(*t), f.block_by_label(*e)) else {
             continue;
         };
-        let stay = match (body.contains(&tb), body.contains(&eb)) {
-            (true, false) => true,
-            (false, true) => false,
+        // A target outside the loop, or a block in it that only branches out
+        // (`if (…) break;`), leaves the loop.
+        let leaves = |blk: usize| {
+            if !body.contains(&blk) {
+                return true;
+            }
+            let end = &program.insts[f.blocks[blk].end];
+            end.class.opcode == Op::Branch
+                && ids(end)
+                    .next()
+                    .and_then(|l| f.block_by_label(l))
+                    .is_some_and(|to| !body.contains(&to))
+        };
+        let stay = match (leaves(tb), leaves(eb)) {
+            (false, true) => true,
+            (true, false) => false,
             _ => continue,
         };
         let mut rels = Vec::new();

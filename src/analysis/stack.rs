@@ -703,7 +703,14 @@ pub fn stack_report_with(pipeline: &Pipeline, rec: &RecursionReport) -> StackRep
         }
     }
     StackReport {
-        pipeline: pipeline.path.as_ref().map(|p| p.display().to_string()),
+        pipeline: pipeline
+            .path
+            .as_ref()
+            .map(|p| p.display().to_string())
+            .or_else(|| {
+                let lib = pipeline.subobject_library.as_ref()?;
+                Some(format!("{} (DXR subobjects)", lib.display()))
+            }),
         required_depth: rec.required_depth,
         declared_depth: pipeline.max_recursion_depth,
         device_max_depth: pipeline.device_max_recursion_depth,

@@ -27,6 +27,8 @@ pub struct Compiled {
     pub decls: Vec<(NamedDecl, Location)>,
     /// The scratch file an external compiler read instead of `path`.
     pub scratch_source: Option<PathBuf>,
+    /// DXR subobjects an HLSL file declares (empty for other languages).
+    pub subobjects: hlsl::subobject::Subobjects,
 }
 
 /// Options for front-ends that read more than one file.
@@ -40,6 +42,8 @@ pub struct FrontOptions {
     pub entry: Option<String>,
     /// HLSL: the stage of `entry` when it has no `[shader(...)]` (`-T`).
     pub stage: Option<crate::shader::Stage>,
+    /// HLSL: DXC's `-enable-16bit-types`.
+    pub enable_16bit_types: bool,
 }
 
 /// Reads and compiles one file to SPIR-V.
@@ -68,6 +72,7 @@ pub fn compile_input(
         words,
         decls,
         scratch_source: None,
+        subobjects: Default::default(),
     };
     match language {
         Language::Wgsl => {
@@ -95,10 +100,13 @@ pub fn compile_input(
                 defines: options.defines.clone(),
                 entry: options.entry.clone(),
                 stage: options.stage,
+                enable_16bit_types: options.enable_16bit_types,
             };
             let m =
                 hlsl::compile_source_whole(path, &text, &mut hlsl::pp::FsLoader, &hlsl_options)?;
-            Ok(compiled(Language::Hlsl, m.words, m.decls))
+            let mut c = compiled(Language::Hlsl, m.words, m.decls);
+            c.subobjects = m.subobjects;
+            Ok(c)
         }
         Language::Glsl => {
             // glslang takes bytes: a Latin-1 comment is no reason to refuse.
@@ -127,6 +135,17 @@ pub fn load_input(
     language: Language,
     options: &FrontOptions,
 ) -> Result<crate::program::Program, InputError> {
+    load_library(path, contents, language, options).map(|(program, _)| program)
+}
+
+/// [`load_input`], also giving the DXR subobjects an HLSL library declares
+/// (a pipeline description when no `*.pipeline.toml` names the file).
+pub fn load_library(
+    path: &Path,
+    contents: Option<&[u8]>,
+    language: Language,
+    options: &FrontOptions,
+) -> Result<(crate::program::Program, hlsl::subobject::Subobjects), InputError> {
     let c = compile_input(path, contents, language, options)?;
     let mut program = crate::program::parse(&c.words, &c.path, c.language)?;
     program.attach_named_decls(&c.decls);
@@ -137,5 +156,5 @@ pub fn load_input(
             }
         }
     }
-    Ok(program)
+    Ok((program, c.subobjects))
 }

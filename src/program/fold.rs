@@ -31,6 +31,91 @@ impl Program {
         self.fold_at(id, chain, 0)
     }
 
+    /// The bits of integer `id` that are set whatever its dynamic parts
+    /// hold, through `chain`: all of them when it folds, else the constant
+    /// side of an OR (`RAY_FLAG_SKIP_CLOSEST_HIT_SHADER | extraFlags`), the
+    /// bits every store to a local sets, and so on through copies.
+    pub fn known_ones_in(&self, id: Id, chain: &[usize]) -> u64 {
+        self.known_ones_at(id, chain, 0)
+    }
+
+    fn known_ones_at(&self, id: Id, chain: &[usize], depth: u32) -> u64 {
+        if let Some(v) = self.fold_at(id, chain, depth) {
+            return v;
+        }
+        if depth > MAX_DEPTH {
+            return 0;
+        }
+        let Some(inst) = self.def(id) else {
+            return 0;
+        };
+        let op = |k: usize| match inst.operands.get(k) {
+            Some(Operand::IdRef(x)) => self.known_ones_at(*x, chain, depth + 1),
+            _ => 0,
+        };
+        match inst.class.opcode {
+            Op::BitwiseOr => op(0) | op(1),
+            Op::BitwiseAnd => op(0) & op(1),
+            Op::CopyObject | Op::Bitcast => op(0),
+            Op::FunctionParameter => match self.argument(id, chain) {
+                Some((arg, outer)) => self.known_ones_at(arg, outer, depth + 1),
+                None => 0,
+            },
+            Op::Load => match inst.operands.first() {
+                Some(Operand::IdRef(ptr)) => self.stored_ones(*ptr, chain, depth + 1),
+                _ => 0,
+            },
+            _ => 0,
+        }
+    }
+
+    /// The bits every write to local variable `ptr` sets.
+    fn stored_ones(&self, ptr: Id, chain: &[usize], depth: u32) -> u64 {
+        let Some(var) = self.def(ptr) else { return 0 };
+        let local = var.class.opcode == Op::Variable
+            && matches!(
+                var.operands.first(),
+                Some(Operand::StorageClass(StorageClass::Function))
+            );
+        let Some(f) = self
+            .defs
+            .get(&ptr)
+            .and_then(|&d| self.function_of(d))
+            .and_then(|k| self.functions.get(k))
+            .filter(|_| local)
+        else {
+            return 0;
+        };
+        let mut ones: Option<u64> = match var.operands.get(1) {
+            Some(Operand::IdRef(init)) => Some(self.known_ones_at(*init, chain, depth)),
+            _ => None,
+        };
+        for inst in &self.insts[f.start..=f.end] {
+            let mut uses = inst
+                .operands
+                .iter()
+                .enumerate()
+                .filter(|(_, o)| matches!(o, Operand::IdRef(x) if *x == ptr));
+            let Some((k, _)) = uses.next() else { continue };
+            if self.is_debug_inst(inst) {
+                continue;
+            }
+            match inst.class.opcode {
+                Op::Load => {}
+                Op::Store if k == 0 && uses.next().is_none() => {
+                    let Some(Operand::IdRef(stored)) = inst.operands.get(1) else {
+                        return 0;
+                    };
+                    let v = self.known_ones_at(*stored, chain, depth);
+                    ones = Some(ones.map_or(v, |w| w & v));
+                }
+                // An access chain, a call or anything else may write it.
+                _ => return 0,
+            }
+        }
+        ones.unwrap_or(0)
+    }
+
     /// A trace's operands as the given call chain reaches it.
     pub fn trace_operands_in(
         &self,
@@ -175,9 +260,37 @@ impl Program {
         Some(v & mask)
     }
 
+    /// Whether the function `call` calls never stores through, nor passes
+    /// on, its parameter for operand `k` (an `in` argument's copy).
+    fn reads_only(&self, call: &rspirv::dr::Instruction, k: usize) -> bool {
+        let Some(Operand::IdRef(callee)) = call.operands.first() else {
+            return false;
+        };
+        let Some(f) = self.functions.iter().find(|f| f.id == *callee) else {
+            return false;
+        };
+        let Some(&param) = f.params.get(k - 1) else {
+            return false;
+        };
+        self.insts[f.start..=f.end].iter().all(|i| {
+            self.is_debug_inst(i)
+                || !i
+                    .operands
+                    .iter()
+                    .any(|o| matches!(o, Operand::IdRef(x) if *x == param))
+                || i.class.opcode == Op::Load
+        })
+    }
+
     /// The one value every write to local variable `ptr` stores, folded.
     fn forwarded(&self, ptr: Id, chain: &[usize], depth: u32) -> Option<u64> {
         let var = self.def(ptr)?;
+        if var.class.opcode == Op::FunctionParameter && depth <= MAX_DEPTH {
+            // A pointer parameter (HLSL's copy of an `in` argument): the
+            // temporary the chain's call passes.
+            let (arg, outer) = self.argument(ptr, chain)?;
+            return self.forwarded(arg, outer, depth + 1);
+        }
         if var.class.opcode != Op::Variable
             || !matches!(
                 var.operands.first(),
@@ -205,6 +318,9 @@ impl Program {
             }
             match inst.class.opcode {
                 Op::Load => {}
+                // Passed to a function that only reads it (HLSL's copy of an
+                // `in` argument).
+                Op::FunctionCall if k > 0 && uses.next().is_none() && self.reads_only(inst, k) => {}
                 Op::Store if k == 0 && uses.next().is_none() => {
                     let Some(Operand::IdRef(stored)) = inst.operands.get(1) else {
                         return None;

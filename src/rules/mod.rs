@@ -545,6 +545,7 @@ mod tests {
                 "RT023 depth-exceeds-device-limit",
                 "RT024 unbounded-bounce-loop",
                 "RT025 default-stack-unsafe",
+                "RT026 subobject-depth-mismatch",
                 "RT030 shadow-ray-without-accept-first-hit",
                 "RT031 visibility-ray-runs-closest-hit",
                 "RT032 visibility-ray-large-payload",

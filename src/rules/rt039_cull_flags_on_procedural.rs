@@ -81,6 +81,20 @@ fn check(ctx: &PipelineContext) -> Vec<Diagnostic> {
         if !rays::all_procedural(p, &groups) {
             continue;
         }
+        // A triangles group whose every shader the flags skip (a shadow ray's
+        // `SkipClosestHit` on a closest-hit-only group) has no edge, yet its
+        // triangles are traversed and culled all the same.
+        let runs = |stage: crate::shader::Stage| match stage {
+            crate::shader::Stage::ClosestHit => f & flags::SKIP_CLOSEST_HIT == 0,
+            crate::shader::Stage::AnyHit => f & flags::OPAQUE == 0,
+            _ => true,
+        };
+        let unseen_triangles = p.hit_groups.iter().any(|h| {
+            h.kind == crate::pipeline::HitGroupKind::Triangles && !h.shaders().any(|s| runs(s.stage))
+        });
+        if unseen_triangles {
+            continue;
+        }
         let Some(program) = p.programs.get(t.program) else {
             continue;
         };

@@ -24,6 +24,11 @@ super::declare_rule! {
     /// committed hit is whatever opaque surface lies behind. The code is valid and
     /// works while every geometry happens to be opaque.
     ///
+    /// The rule is pedantic (off unless selected): whether the loop is wrong
+    /// depends on the geometry flags the application builds, which the shader
+    /// does not show. Every finding on public shaders was latent, the scene
+    /// being built opaque (`docs/rules-precision.md`).
+    ///
     /// ## Example
     ///
     /// ```glsl
@@ -63,7 +68,7 @@ super::declare_rule! {
     /// - DirectX Raytracing specification, `RayQuery::Proceed`,
     ///   `CommitNonOpaqueTriangleHit`.
     "RT060" "ray-query-never-commits" {
-        group: Suspicious,
+        group: Pedantic,
         summary: "ray-query loop never commits non-opaque triangles",
         kind: super::Kind::Module(check),
         analysis: Full,

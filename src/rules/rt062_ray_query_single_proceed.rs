@@ -22,6 +22,11 @@ super::declare_rule! {
     /// the closest hit (often no hit at all). The single-`Proceed` idiom is only
     /// correct with the opaque flag.
     ///
+    /// The rule is pedantic (off unless selected): one `Proceed` is right as
+    /// long as the geometry is built opaque, which the shader does not show.
+    /// Every finding on public shaders was latent, the scene being built
+    /// opaque (`docs/rules-precision.md`).
+    ///
     /// ## Example
     ///
     /// ```hlsl
@@ -52,7 +57,7 @@ super::declare_rule! {
     ///   example with `RAY_FLAG_FORCE_OPAQUE`.
     /// - `GL_EXT_ray_query`: `rayQueryProceedEXT`.
     "RT062" "ray-query-single-proceed" {
-        group: Suspicious,
+        group: Pedantic,
         summary: "single Proceed per initialisation on a query that can meet non-opaque triangles",
         kind: super::Kind::Module(check),
         analysis: Full,

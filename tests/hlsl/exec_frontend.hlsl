@@ -1,12 +1,15 @@
 // Run on the driver by tests/hlsl_exec.rs: default arguments, templates,
 // classes with static and out-of-line methods, inheritance, static members,
-// operator[], sizeof, functional casts, buffers passed to functions.
+// operator[], sizeof, functional casts, buffers passed to functions; static
+// locals initialized on first use, methods of constant buffers, `S::m()`
+// inside `S`, methods returning a buffer, overloaded function templates.
 RWStructuredBuffer<float> results : register(u0);
 
 struct Sky
 {
     float3 color;
     float intensity;
+    float total() { return color.x + color.y + color.z; }
 };
 ConstantBuffer<Sky> sky : register(b1);
 
@@ -47,6 +50,9 @@ class Counter
 public:
     uint n;
     void add(uint by = 1);
+    uint get() { return n; }
+    // A method named with its struct, as C++ allows.
+    uint twice() { return Counter::get() * 2; }
     static Counter make(uint start) { Counter c; c.n = start; return c; }
 };
 
@@ -76,6 +82,28 @@ struct Packed
 };
 
 float first(RWStructuredBuffer<float> buf) { return buf[0]; }
+
+// A method returning a buffer is inlined where it is called.
+struct Output
+{
+    uint base;
+    RWStructuredBuffer<float> buffer() { return results; }
+    float peek() { RWStructuredBuffer<float> b = buffer(); return b[base]; }
+};
+
+// Initialized when first reached: the second call keeps the first total.
+float counted(float start)
+{
+    static float total = start * 2;
+    total += 1;
+    return total;
+}
+
+// Two templates whose instances share a name (`scaleBy<float>`).
+template<typename T>
+T scaleBy(T x, T k) { return x * k; }
+template<typename T>
+T scaleBy(T x) { return scaleBy(x, (T)3); }
 
 void store(uint i, float v) { results[i] = v; }
 // `return` of a void call in a void function.
@@ -116,4 +144,12 @@ void Main()
     results[15] = TraceRay(1.5);                 // 4.5
     results[16] = brightness(sky);               // (1 + 2 + 3) * 0.5 = 3
     forward(17, 9.0);                            // 9
+    results[18] = counted(1);                    // 1 * 2 + 1 = 3
+    results[19] = counted(5);                    // 3 + 1 = 4
+    results[20] = sky.total();                   // 6
+    results[21] = c.twice();                     // 32
+    Output o;
+    o.base = 1;
+    results[22] = o.peek();                      // results[1] = 2.5
+    results[23] = scaleBy(2.0);                  // 6
 }

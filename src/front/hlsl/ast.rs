@@ -45,7 +45,12 @@ pub struct Mods {
     pub row_major: bool,
     pub column_major: bool,
     pub precise: bool,
+    /// Interpolation of pixel shader inputs (`nointerpolation`, `centroid`,
+    /// `sample`, `noperspective`; `linear` is the default).
     pub nointerp: bool,
+    pub centroid: bool,
+    pub sample: bool,
+    pub noperspective: bool,
 }
 
 #[derive(Clone, Debug)]

@@ -115,7 +115,8 @@ pub const ATTRIBUTES: &[AttrInfo] = &[
         Refused("`vk::ext_instruction` (inline SPIR-V instructions)"),
         ANY,
     ),
-    a("vk::ext_decorate", Refused("`vk::ext_decorate`"), ANY),
+    // Struct members only (`OpMemberDecorate`); elsewhere refused by site.
+    a("vk::ext_decorate", Implemented, MEMBER),
     a("vk::ext_decorate_id", Refused("`vk::ext_decorate_id`"), ANY),
     a(
         "vk::ext_decorate_string",
@@ -159,7 +160,8 @@ pub const ATTRIBUTES: &[AttrInfo] = &[
         ANY,
     ),
     // Other stages and their attributes.
-    a("earlydepthstencil", Refused("`[earlydepthstencil]`"), ANY),
+    // Pixel entry points: `EarlyFragmentTests`.
+    a("earlydepthstencil", Implemented, FUNCTION),
     a("wavesize", Refused("`[WaveSize]`"), ANY),
     a("maxvertexcount", Refused("geometry shaders"), ANY),
     a("domain", Refused("tessellation shaders"), ANY),

@@ -13,15 +13,19 @@ mod expr;
 mod formats;
 mod func;
 mod heaps;
+mod inline_spirv;
 mod methods;
 mod pixel;
 mod place;
+mod raw_buffer;
+mod resource_calls;
 mod ser;
 mod stmt;
 mod templates;
 mod wave;
 
 use super::ast::*;
+use super::attrs;
 use super::error::{Error, Pos, Result};
 use super::parse::split_numeric;
 use super::subobject;
@@ -199,6 +203,8 @@ pub struct Lowerer<'a> {
     /// An entry point named on the command line with its stage, for
     /// functions without `[shader(...)]`.
     pub forced_entry: Option<(String, Stage)>,
+    /// `-enable-16bit-types`: `half` and `min16*` are 16-bit (refused).
+    pub sixteen_bit_types: bool,
     /// DXR subobjects the file declares.
     pub subobjects: super::subobject::Subobjects,
     /// Function templates by qualified name (never lowered themselves).
@@ -242,10 +248,17 @@ pub struct Lowerer<'a> {
     global_decls: Vec<(Id, String, Ty, Pos)>,
     /// Locals and parameters for debug info: (function, variable, name, type, position).
     local_decls: Vec<(usize, Id, String, Ty, Pos)>,
-    /// Descriptor variables (what a resource parameter may be given).
+    /// Descriptor variables and resource parameters: the memory object
+    /// declarations a resource parameter may be given.
     resource_vars: HashSet<Id>,
     /// Per user struct, each member's semantic and attributes (pixel-shader I/O).
     struct_io: HashMap<u32, Vec<MemberIo>>,
+    /// Per user struct, `[[vk::ext_decorate]]` member decorations:
+    /// (member, decoration, literal operands).
+    member_decorations: HashMap<u32, Vec<(u32, Decoration, Vec<u32>)>>,
+    /// Whether a device address is loaded from (`vk::RawBufferLoad`): the
+    /// module's addressing model is then `PhysicalStorageBuffer64`.
+    physical_addressing: bool,
     /// Functions outside an entry body that use derivatives: (name, position),
     /// checked against the entry points that reach them.
     fn_derivs: HashMap<usize, (&'static str, Pos)>,
@@ -255,8 +268,8 @@ pub struct Lowerer<'a> {
 #[derive(Clone, Debug, Default)]
 struct Requirements(Vec<String>, Vec<Capability>);
 
-/// A struct member's semantic and attributes.
-type MemberIo = (Option<(String, Pos)>, Vec<Attr>);
+/// A struct member's semantic, attributes and modifiers (interpolation).
+type MemberIo = (Option<(String, Pos)>, Vec<Attr>, Mods);
 
 /// Source positions of named declarations (the side table `Program` reads).
 pub type Decls = Vec<(NamedDecl, Location)>;
@@ -270,6 +283,18 @@ fn unsupported(pos: Pos, what: impl std::fmt::Display) -> Error {
 
 /// A resource reached through something other than a variable (which
 /// SPIR-V's logical addressing needs).
+/// Storage a shader may not write: constant buffers, push constants, shader
+/// records and stage inputs.
+fn read_only(class: StorageClass) -> bool {
+    matches!(
+        class,
+        StorageClass::Uniform
+            | StorageClass::PushConstant
+            | StorageClass::ShaderRecordBufferKHR
+            | StorageClass::Input
+    )
+}
+
 fn not_a_variable(pos: Pos) -> Error {
     unsupported(
         pos,
@@ -517,6 +542,9 @@ impl<'a> Lowerer<'a> {
                 })
                 .collect(),
             struct_io: HashMap::new(),
+            member_decorations: HashMap::new(),
+            physical_addressing: false,
+            sixteen_bit_types: false,
             fn_derivs: HashMap::new(),
             nonuniform: HashSet::new(),
             cbuffer_members: HashMap::new(),
@@ -692,6 +720,18 @@ impl<'a> Lowerer<'a> {
                 sig.name.clone(),
                 vars,
             );
+            let early = sig
+                .func
+                .attrs
+                .iter()
+                .find(|a| attrs::normalize(&a.name) == "earlydepthstencil");
+            if let (Some(a), false) = (early, stage == Stage::Fragment) {
+                return Err(Error::new(
+                    a.pos,
+                    "`[earlydepthstencil]` applies to pixel shaders only",
+                )
+                .len(a.name.len() as u32));
+            }
             if stage == Stage::Compute {
                 self.b
                     .execution_mode(sig.id, spirv::ExecutionMode::LocalSize, sig.numthreads);
@@ -699,12 +739,22 @@ impl<'a> Lowerer<'a> {
                 // Vulkan requires it; HLSL's SV_Position has its origin at the top left.
                 self.b
                     .execution_mode(entry_id, spirv::ExecutionMode::OriginUpperLeft, []);
+                if early.is_some() {
+                    self.b
+                        .execution_mode(entry_id, spirv::ExecutionMode::EarlyFragmentTests, []);
+                }
             } else {
                 self.ray_tracing_caps();
             }
         }
         let mut debug = self.emit_debug_info();
         let mut module = self.b.module();
+        if self.physical_addressing {
+            if let Some(mm) = module.memory_model.as_mut() {
+                mm.operands[0] =
+                    Operand::AddressingModel(spirv::AddressingModel::PhysicalStorageBuffer64);
+            }
+        }
         if let Some(d) = &mut debug {
             Self::place_declares(&mut module, d);
         }

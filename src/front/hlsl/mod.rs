@@ -33,6 +33,9 @@ pub struct HlslOptions {
     pub entry: Option<String>,
     /// The stage of `entry` when it has no `[shader(...)]` (DXC's `-T`).
     pub stage: Option<Stage>,
+    /// DXC's `-enable-16bit-types`: `half` and the `min16*` types are then
+    /// 16-bit, which this compiler refuses rather than widen.
+    pub enable_16bit_types: bool,
 }
 
 /// Reads a DXC target profile (`ps_6_5`, `cs_6_0`, `lib_6_3`) or a stage name
@@ -80,6 +83,7 @@ fn lowerer<'a>(
     if let (Some(e), Some(s)) = (&options.entry, options.stage) {
         l.forced_entry = Some((e.clone(), s));
     }
+    l.sixteen_bit_types = options.enable_16bit_types;
     l
 }
 
@@ -266,7 +270,7 @@ fn instantiate_templates(items: &mut Vec<ast::Item>, files: &[PathBuf], options:
         for inst in &needed {
             // A failure here (or an instance asked for twice) leaves the
             // instance missing: the compile then reports the use that needed it.
-            if !made.insert(inst.name.clone())
+            if !made.insert((inst.name.clone(), inst.template))
                 || made.len() > MAX_INSTANCES
                 || template::instantiate(items, inst).is_err()
             {

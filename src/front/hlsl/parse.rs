@@ -57,6 +57,10 @@ const MODIFIERS: &[&str] = &[
     "globallycoherent",
 ];
 
+/// Interpolation modifiers that are also common variable names: modifiers
+/// only when a name follows (`centroid float3 p`, not `centroid += d`).
+const SOFT_MODIFIERS: &[&str] = &["centroid", "sample", "noperspective"];
+
 /// What may follow a declarator: a semantic and a register binding.
 type PostDecl = (Option<(String, Pos)>, Option<Register>);
 
@@ -413,7 +417,7 @@ impl<'t> Parser<'t> {
             m.row_major = true;
         }
         loop {
-            match self.peek().and_then(Token::ident) {
+            match self.modifier_at(0) {
                 Some("static") => m.is_static = true,
                 Some("const") => m.is_const = true,
                 Some("groupshared") => m.groupshared = true,
@@ -431,6 +435,9 @@ impl<'t> Parser<'t> {
                 }
                 Some("precise") => m.precise = true,
                 Some("nointerpolation") => m.nointerp = true,
+                Some("centroid") => m.centroid = true,
+                Some("sample") => m.sample = true,
+                Some("noperspective") => m.noperspective = true,
                 Some(
                     "inline" | "export" | "extern" | "volatile" | "linear" | "snorm" | "unorm"
                     | "globallycoherent",
@@ -584,13 +591,20 @@ impl<'t> Parser<'t> {
     /// How many modifier keywords start at the current token.
     fn mods_len(&self) -> usize {
         let mut k = 0;
-        while let Some(w) = self.peek_at(k).and_then(Token::ident) {
-            if !MODIFIERS.contains(&w) {
-                break;
-            }
+        while self.modifier_at(k).is_some() {
             k += 1;
         }
         k
+    }
+
+    /// The modifier keyword at token `k`, if it is one there.
+    fn modifier_at(&self, k: usize) -> Option<&'t str> {
+        let w = self.peek_at(k).and_then(Token::ident)?;
+        if MODIFIERS.contains(&w) {
+            return Some(w);
+        }
+        (SOFT_MODIFIERS.contains(&w) && self.peek_at(k + 1).and_then(Token::ident).is_some())
+            .then_some(w)
     }
 
     fn item(&mut self, items: &mut Vec<Item>) -> Result<()> {

@@ -180,7 +180,7 @@ impl<'a> Lowerer<'a> {
         self.write(&p, v, a.pos)
     }
 
-    fn find_user(&self, name: &str) -> Option<Vec<usize>> {
+    pub(super) fn find_user(&self, name: &str) -> Option<Vec<usize>> {
         self.scoped_names(name)
             .iter()
             .find_map(|n| self.fn_by_name.get(n))
@@ -190,6 +190,10 @@ impl<'a> Lowerer<'a> {
     fn call(&mut self, name: &str, args: &'a [Expr], pos: Pos) -> Result<Option<Val>> {
         if let Some(this) = self.f.this_place.clone() {
             if let Ty::Struct(k) = this.ty() {
+                // `S::m(...)` inside a method of `S` is `m(...)` (on `this`
+                // when `m` is not static), as in C++.
+                let own = format!("{}::", self.structs[*k as usize].name);
+                let name = name.strip_prefix(own.as_str()).unwrap_or(name);
                 let qualified = format!("{}::{name}", self.structs[*k as usize].name);
                 if let Some(c) = self.fn_by_name.get(&qualified).cloned() {
                     if c.iter().all(|k| self.funcs[*k].this.is_none()) {
@@ -212,6 +216,9 @@ impl<'a> Lowerer<'a> {
         }
         if let Some(r) = self.ser_call(name, args, pos)? {
             return Ok(r);
+        }
+        if name == "vk::RawBufferLoad" {
+            return self.raw_buffer_load(None, args, pos).map(Some);
         }
         let user_fits = self.find_user(name).is_some_and(|c| {
             c.iter().any(|k| {
@@ -997,17 +1004,30 @@ impl<'a> Lowerer<'a> {
         let bad = || {
             Error::new(
                 dest_pos,
-                format!("`{name}` needs an int or uint in a buffer or groupshared memory"),
+                format!("`{name}` needs an int or uint in a buffer, a storage image or groupshared memory"),
             )
         };
-        let Place::Ptr {
-            ptr,
-            ty: Ty::ScalarKind(s @ (ScalarKind::Int | ScalarKind::Uint)),
-            class: class @ (StorageClass::StorageBuffer | StorageClass::Workgroup),
-            ..
-        } = dest
-        else {
-            return Err(bad());
+        let (ptr, s, class) = match dest {
+            Place::Ptr {
+                ptr,
+                ty: Ty::ScalarKind(s @ (ScalarKind::Int | ScalarKind::Uint)),
+                class: class @ (StorageClass::StorageBuffer | StorageClass::Workgroup),
+                ..
+            } => (ptr, s, class),
+            // `img[coord]` of a `RWTexture*<uint>` or `RWBuffer<uint>`: a texel pointer.
+            Place::Texel {
+                image,
+                coord,
+                ty: Ty::ScalarKind(s @ (ScalarKind::Int | ScalarKind::Uint)),
+                ..
+            } => {
+                let st = self.ty_id(&Ty::ScalarKind(s))?;
+                let pty = self.b.type_pointer(None, StorageClass::Image, st);
+                let sample = self.const_u32(0);
+                let ptr = self.op(Op::ImageTexelPointer, pty, &[image, coord, sample])?;
+                (ptr, s, StorageClass::Image)
+            }
+            _ => return Err(bad()),
         };
         let op = match (name.trim_start_matches("Interlocked"), s) {
             ("Add", _) => Op::AtomicIAdd,
@@ -1234,8 +1254,9 @@ impl<'a> Lowerer<'a> {
         // without variable pointers: the function is specialized on them.
         let mut bound = Vec::new();
         for (i, ((p, (place, v)), a)) in sig.params.iter().zip(&argv).zip(&args).enumerate() {
-            if let Ty::RayQuery(_) = p.ty {
-                // A ray query is passed as its variable (it cannot be copied).
+            if let Ty::RayQuery(_) | Ty::HitObject = p.ty {
+                // A ray query or hit object is passed as its variable (it
+                // cannot be copied).
                 if p.out || v.ty != p.ty {
                     return Err(Error::new(
                         a.pos(),
@@ -1376,91 +1397,6 @@ impl<'a> Lowerer<'a> {
         self.funcs.push(sig);
         self.specialized.insert(key, s);
         s
-    }
-
-    /// Whether `name` is a user function returning a resource.
-    pub(super) fn returns_resource(&self, name: &str) -> bool {
-        self.find_user(name)
-            .is_some_and(|c| c.iter().any(|k| self.funcs[*k].ret.is_resource()))
-    }
-
-    /// A call of a helper that returns a resource: SPIR-V's logical
-    /// addressing cannot return one, so (as DXC's legalization does) the
-    /// helper is inlined. Its body must be `return <resource expression>;`,
-    /// evaluated with the parameters bound to the arguments.
-    pub(super) fn resource_call(
-        &mut self,
-        name: &str,
-        args: &'a [Expr],
-        pos: Pos,
-    ) -> Result<Place> {
-        let cands = self.find_user(name).unwrap_or_default();
-        let Some(k) = cands.into_iter().find(|k| {
-            let f = &self.funcs[*k];
-            f.this.is_none()
-                && (f.params.len() - f.defaults.len()..=f.params.len()).contains(&args.len())
-        }) else {
-            return Err(Error::new(
-                pos,
-                format!("no overload of `{name}` takes {} argument(s)", args.len()),
-            )
-            .len(name.len() as u32));
-        };
-        let sig = self.funcs[k].clone();
-        let body = sig.func.body.as_deref().unwrap_or_default();
-        let [Stmt {
-            kind: StmtKind::Return(Some(ret)),
-            ..
-        }] = body
-        else {
-            return Err(unsupported(
-                sig.func.pos,
-                "a function returning a resource whose body is more than `return <resource>;`",
-            )
-            .len(sig.name.len() as u32));
-        };
-        if self.f.inline_depth >= 16 {
-            return Err(Error::new(
-                pos,
-                format!("`{name}` is recursive; HLSL does not allow recursion"),
-            ));
-        }
-        let first_default = sig.params.len() - sig.defaults.len();
-        let mut scope = HashMap::new();
-        for (i, (p, decl)) in sig.params.iter().zip(&sig.func.params).enumerate() {
-            let a = match args.get(i) {
-                Some(a) => a,
-                None => sig.defaults[i - first_default],
-            };
-            if p.out {
-                return Err(unsupported(
-                    decl.pos,
-                    "`out` parameters of a function returning a resource",
-                ));
-            }
-            let place = if p.ty.is_resource() {
-                self.place(a)?
-            } else {
-                let v = self.expr(a)?;
-                Place::Value(self.convert(v, &p.ty, a.pos, false)?)
-            };
-            scope.insert(decl.name.clone(), place);
-        }
-        // The helper's body sees its parameters and the globals, not the caller's locals.
-        let scopes = std::mem::replace(&mut self.f.scopes, vec![scope]);
-        let this = self.f.this_place.take();
-        let ns = std::mem::replace(&mut self.f.cur_ns, sig.func.ns.clone());
-        self.f.inline_depth += 1;
-        let r = self.place(ret);
-        self.f.inline_depth -= 1;
-        self.f.scopes = scopes;
-        self.f.this_place = this;
-        self.f.cur_ns = ns;
-        let r = r?;
-        if !r.ty().is_resource() {
-            return Err(Error::new(ret.pos, "expected a resource"));
-        }
-        Ok(r)
     }
 
     /// The value of a struct place read member by member (a constant buffer's

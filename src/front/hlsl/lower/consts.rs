@@ -206,6 +206,16 @@ impl<'a> Lowerer<'a> {
         if block {
             self.b.decorate(id, Decoration::Block, []);
         }
+        for (i, d, ops) in self.member_decorations.get(&k).cloned().unwrap_or_default() {
+            let ops: Vec<Operand> = match (d, ops.as_slice()) {
+                (Decoration::BuiltIn, [b]) => match BuiltIn::from_u32(*b) {
+                    Some(b) => vec![Operand::BuiltIn(b)],
+                    None => vec![Operand::LiteralBit32(*b)],
+                },
+                _ => ops.into_iter().map(Operand::LiteralBit32).collect(),
+            };
+            self.b.member_decorate(id, i, d, ops);
+        }
         if layout != Layout::None {
             let offsets = struct_offsets(k, layout, &self.structs);
             for (i, (f, off)) in def.fields.iter().zip(offsets).enumerate() {

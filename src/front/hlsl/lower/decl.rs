@@ -242,11 +242,12 @@ impl<'a> Lowerer<'a> {
         let mut params = Vec::new();
         for p in &f.params {
             let t = self.resolve_ty(&p.ty, &f.ns)?;
-            let t = self.apply_dims(t, &p.dims, p.pos, false)?;
-            if t.is_resource() && (matches!(t, Ty::Array(..) | Ty::RtArray(_)) || p.mods.output) {
+            let unsized_ok = t.is_resource(); // `Texture2D ts[]`, passed as its variable
+            let t = self.apply_dims(t, &p.dims, p.pos, unsized_ok)?;
+            if t.is_resource() && (bad_resource_array(&t) || p.mods.output) {
                 return Err(unsupported(
                     p.pos,
-                    "arrays of resources, or `out` resources, as function parameters",
+                    "arrays of buffers, or `out` resources, as function parameters",
                 ));
             }
             params.push(Param {
@@ -315,12 +316,12 @@ impl<'a> Lowerer<'a> {
             }
             for p in &f.params {
                 let t = self.resolve_ty(&p.ty, &f.ns)?;
-                let t = self.apply_dims(t, &p.dims, p.pos, false)?;
-                if t.is_resource() && (matches!(t, Ty::Array(..) | Ty::RtArray(_)) || p.mods.output)
-                {
+                let unsized_ok = t.is_resource(); // `Texture2D ts[]`, passed as its variable
+                let t = self.apply_dims(t, &p.dims, p.pos, unsized_ok)?;
+                if t.is_resource() && (bad_resource_array(&t) || p.mods.output) {
                     return Err(unsupported(
                         p.pos,
-                        "arrays of resources, or `out` resources, as function parameters",
+                        "arrays of buffers, or `out` resources, as function parameters",
                     ));
                 }
                 params.push(Param {
@@ -371,16 +372,27 @@ impl<'a> Lowerer<'a> {
 
     fn declare_struct_in(&mut self, s: &StructDecl, scope: &str) -> Result<()> {
         let mut fields = Vec::new();
+        let mut decorations = Vec::new();
         for b in &s.bases {
             // A base's members come first, as C++ lays them out.
             match self.resolve_ty(b, scope)? {
-                Ty::Struct(k) => fields.extend(self.structs[k as usize].fields.iter().cloned()),
+                Ty::Struct(k) => {
+                    let at = fields.len() as u32;
+                    for (i, d, ops) in self.member_decorations.get(&k).into_iter().flatten() {
+                        decorations.push((at + i, *d, ops.clone()));
+                    }
+                    fields.extend(self.structs[k as usize].fields.iter().cloned())
+                }
                 _ => return Err(Error::new(b.pos, "a base must be a struct")),
             }
         }
         for f in &s.fields {
             if let Some((_, pos)) = f.bits {
                 return Err(unsupported(pos, "bit fields"));
+            }
+            for a in f.attrs.iter().filter(|a| a.name == "vk::ext_decorate") {
+                let (d, ops) = self.ext_decoration(a)?;
+                decorations.push((fields.len() as u32, d, ops));
             }
             let t = self.resolve_ty(&f.ty, scope)?;
             let t = self.apply_dims(t, &f.dims, f.pos, false)?;
@@ -419,11 +431,14 @@ impl<'a> Lowerer<'a> {
             fields,
             pos: s.pos,
         });
+        if !decorations.is_empty() {
+            self.member_decorations.insert(k, decorations);
+        }
         self.struct_io.insert(
             k,
             s.fields
                 .iter()
-                .map(|f| (f.semantic.clone(), f.attrs.clone()))
+                .map(|f| (f.semantic.clone(), f.attrs.clone(), f.mods))
                 .collect(),
         );
         self.struct_names.insert(s.name.clone(), k);
@@ -467,6 +482,29 @@ impl<'a> Lowerer<'a> {
             }
         };
         if let Some((base, a, b)) = split_numeric(name) {
+            let sixteen = matches!(
+                base,
+                "half" | "min16float" | "min10float" | "min16int" | "min12int" | "min16uint"
+            );
+            if sixteen && self.sixteen_bit_types {
+                // 16-bit with -enable-16bit-types: refused, never widened.
+                return Err(unsupported(
+                    t.pos,
+                    format!("16-bit type `{base}` (with -enable-16bit-types)"),
+                )
+                .len(base.len() as u32));
+            }
+            if matches!(base, "float16_t" | "int16_t" | "uint16_t") {
+                // Unsupported either way (refused where used, like other
+                // unsupported types); without the flag DXC refuses it too.
+                let why = if self.sixteen_bit_types {
+                    "with -enable-16bit-types"
+                } else {
+                    "DXC needs -enable-16bit-types for it"
+                };
+                return Err(unsupported(t.pos, format!("16-bit type `{base}` ({why})"))
+                    .len(base.len() as u32));
+            }
             let sc = match base {
                 "bool" => ScalarKind::Bool,
                 "int" | "min16int" | "min12int" | "int32_t" => ScalarKind::Int,
@@ -765,55 +803,6 @@ impl<'a> Lowerer<'a> {
         Ok(())
     }
 
-    /// `[[vk::ext_builtin_input(N)]] static const T name;`: an `Input`
-    /// variable decorated `BuiltIn N` (with the extensions and capabilities
-    /// its other `vk::ext_*` attributes name, added where it is used).
-    fn declare_ext_builtin(&mut self, v: &'a VarDecl) -> Result<()> {
-        let Some(a) = v.attrs.iter().find(|a| a.name == "vk::ext_builtin_input") else {
-            return Ok(());
-        };
-        if !(v.mods.is_static && v.mods.is_const) || v.init.is_some() {
-            return Err(Error::new(
-                v.pos,
-                "a `vk::ext_builtin_input` variable must be `static const` without an initializer",
-            ));
-        }
-        let e = a
-            .args
-            .first()
-            .ok_or_else(|| Error::new(a.pos, "expected [[vk::ext_builtin_input(N)]]"))?;
-        let n = self.const_int(e)?;
-        let bi = u32::try_from(n)
-            .ok()
-            .and_then(BuiltIn::from_u32)
-            .ok_or_else(|| Error::new(e.pos, format!("unknown SPIR-V built-in {n}")))?;
-        let req = self.ext_requirements(&v.attrs)?;
-        let t = self.resolve_ty(&v.ty, "")?;
-        let t = self.apply_dims(t, &v.dims, v.pos, false)?;
-        if t.is_resource() || (matches!(t, Ty::RtArray(_)) || t.is_opaque()) {
-            return Err(Error::new(v.pos, "a built-in input must be a value type"));
-        }
-        let tid = self.ty_id(&t)?;
-        let pty = self.b.type_pointer(None, StorageClass::Input, tid);
-        let var = self.global_var(pty, StorageClass::Input, None);
-        self.b.name(var, v.name.clone());
-        self.b
-            .decorate(var, Decoration::BuiltIn, [Operand::BuiltIn(bi)]);
-        self.global_reqs.insert(var, req);
-        self.global_decls
-            .push((var, v.name.clone(), t.clone(), v.pos));
-        self.globals.insert(
-            v.name.clone(),
-            Global::Place(Place::Ptr {
-                ptr: var,
-                ty: t,
-                layout: Layout::None,
-                class: StorageClass::Input,
-            }),
-        );
-        Ok(())
-    }
-
     /// A DXR subobject: its content is recorded, nothing is emitted.
     fn declare_subobject(&mut self, v: &VarDecl) -> Result<()> {
         let Some(kind) = subobject::Kind::from_type_name(&v.ty.name) else {
@@ -977,6 +966,32 @@ impl<'a> Lowerer<'a> {
         binding: Option<(u32, u32)>,
         name: &str,
     ) -> Result<Id> {
+        let (tid, class) = self.descriptor_array_type(ty, attrs)?;
+        let pty = self.b.type_pointer(None, class, tid);
+        let var = self.global_var(pty, class, None);
+        self.b.name(var, name);
+        self.resource_vars.insert(var);
+        if let Some((set, binding)) = binding {
+            if matches!(
+                class,
+                StorageClass::Uniform | StorageClass::StorageBuffer | StorageClass::UniformConstant
+            ) {
+                self.b
+                    .decorate(var, Decoration::DescriptorSet, [Operand::LiteralBit32(set)]);
+                self.b
+                    .decorate(var, Decoration::Binding, [Operand::LiteralBit32(binding)]);
+            }
+        }
+        Ok(var)
+    }
+
+    /// The SPIR-V type of a descriptor variable of `ty` (a resource or an
+    /// array of them, sized or not) and its storage class.
+    pub(super) fn descriptor_array_type(
+        &mut self,
+        ty: &Ty,
+        attrs: &[Attr],
+    ) -> Result<(Id, StorageClass)> {
         let (inner, arrays) = {
             let mut t = ty;
             let mut arrays = Vec::new();
@@ -1009,22 +1024,7 @@ impl<'a> Lowerer<'a> {
                 }
             };
         }
-        let pty = self.b.type_pointer(None, class, tid);
-        let var = self.global_var(pty, class, None);
-        self.b.name(var, name);
-        self.resource_vars.insert(var);
-        if let Some((set, binding)) = binding {
-            if matches!(
-                class,
-                StorageClass::Uniform | StorageClass::StorageBuffer | StorageClass::UniformConstant
-            ) {
-                self.b
-                    .decorate(var, Decoration::DescriptorSet, [Operand::LiteralBit32(set)]);
-                self.b
-                    .decorate(var, Decoration::Binding, [Operand::LiteralBit32(binding)]);
-            }
-        }
-        Ok(var)
+        Ok((tid, class))
     }
 
     /// The SPIR-V type of one descriptor (or push-constant / shader-record
@@ -1444,4 +1444,17 @@ fn defaults_of(f: &Function) -> Result<Vec<&Expr>> {
             })
         })
         .collect()
+}
+
+/// Arrays of buffers cannot be function parameters (a function is copied per
+/// buffer passed); arrays of textures, samplers and acceleration structures
+/// are passed as their variable.
+fn bad_resource_array(t: &Ty) -> bool {
+    match t {
+        Ty::Array(e, _) | Ty::RtArray(e) => !matches!(
+            **e,
+            Ty::Accel | Ty::Sampler | Ty::SamplerCmp | Ty::Texture { .. }
+        ),
+        _ => false,
+    }
 }

@@ -101,12 +101,9 @@ impl<'a> Lowerer<'a> {
                 if is_bound(i) {
                     continue;
                 }
-                if p.ty == Ty::HitObject {
-                    return Err(unsupported(f.pos, "HitObject function parameters"));
-                }
                 let (class, _) = self.param_class(&p.ty);
                 let t = if p.ty.is_resource() {
-                    self.descriptor_type(&p.ty, &[])?.0
+                    self.descriptor_array_type(&p.ty, &[])?.0
                 } else {
                     self.ty_id(&p.ty)?
                 };
@@ -157,6 +154,9 @@ impl<'a> Lowerer<'a> {
                 let pty = ptys.next().unwrap_or_default();
                 let id = self.b.function_parameter(pty)?;
                 self.b.name(id, decl.name.clone());
+                if p.ty.is_resource() {
+                    self.resource_vars.insert(id);
+                }
                 self.local_decls.push((
                     self.f.cur_fn,
                     id,
@@ -215,6 +215,7 @@ impl<'a> Lowerer<'a> {
             Ty::Accel | Ty::Sampler | Ty::SamplerCmp | Ty::Texture { .. } => {
                 (StorageClass::UniformConstant, Layout::None)
             }
+            Ty::Array(e, _) | Ty::RtArray(e) if e.is_resource() => self.param_class(e),
             _ => (StorageClass::Function, Layout::None),
         }
     }

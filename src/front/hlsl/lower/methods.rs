@@ -11,6 +11,27 @@ impl<'a> Lowerer<'a> {
         pos: Pos,
     ) -> Result<Option<Val>> {
         let p = self.place(obj)?;
+        self.method_at(p, obj, name, args, pos)
+    }
+
+    /// A method of the object at `p` (the place of `obj`).
+    pub(super) fn method_at(
+        &mut self,
+        p: Place,
+        obj: &'a Expr,
+        name: &str,
+        args: &'a [Expr],
+        pos: Pos,
+    ) -> Result<Option<Val>> {
+        if let Some(c) = self.resource_method(&p, name) {
+            let r = self.inline_resource_call(name, c, Some(p), args, pos)?;
+            return self.read(&r).map(Some);
+        }
+        if let Ty::ConstantBuffer(k) = *p.ty() {
+            // `cb.m()` of a `ConstantBuffer<S>`: `S::m` on a copy of its contents.
+            let v = self.struct_of(p, k, obj.pos)?;
+            return self.method_at(Place::Value(v), obj, name, args, pos);
+        }
         let t = p.ty().clone();
         match &t {
             Ty::Struct(k) => {
@@ -22,7 +43,12 @@ impl<'a> Lowerer<'a> {
                     )
                     .len(name.len() as u32));
                 };
-                // A method of an rvalue works on a copy.
+                // A method of an rvalue, or of a constant buffer member or a
+                // stage input (which a method must not change), works on a copy.
+                let p = match p {
+                    Place::Ptr { class, .. } if read_only(class) => Place::Value(self.read(&p)?),
+                    other => other,
+                };
                 let this = match p {
                     Place::Value(v) => {
                         let tmp = self.local_var(&v.ty, "")?;

@@ -53,6 +53,7 @@ impl<'a> Lowerer<'a> {
                     &p.ty,
                     &decl.semantic,
                     &decl.attrs,
+                    decl.mods,
                     decl.pos,
                     var,
                     &mut vec![],
@@ -86,7 +87,18 @@ impl<'a> Lowerer<'a> {
             outs.push((var, sig.ret.clone(), sem, Vec::new(), f.ret.pos));
         }
         for (var, ty, sem, attrs, pos) in outs {
-            self.pixel_io(Dir::Out, &ty, &sem, &attrs, pos, var, &mut vec![], &mut io)?;
+            let mods = Mods::default();
+            self.pixel_io(
+                Dir::Out,
+                &ty,
+                &sem,
+                &attrs,
+                mods,
+                pos,
+                var,
+                &mut vec![],
+                &mut io,
+            )?;
         }
         self.b.ret()?;
         self.b.end_function()?;
@@ -102,6 +114,7 @@ impl<'a> Lowerer<'a> {
         ty: &Ty,
         sem: &Option<(String, Pos)>,
         attrs: &[Attr],
+        mods: Mods,
         pos: Pos,
         local: Id,
         path: &mut Vec<u32>,
@@ -121,9 +134,11 @@ impl<'a> Lowerer<'a> {
                     format!("`{}` as a pixel shader input or output", self.ty_name(ty)),
                 ));
             };
-            for (i, (field, (fsem, fattrs))) in fields.iter().zip(member_io).enumerate() {
+            for (i, (field, (fsem, fattrs, fmods))) in fields.iter().zip(member_io).enumerate() {
                 path.push(i as u32);
-                self.pixel_io(dir, &field.ty, &fsem, &fattrs, field.pos, local, path, io)?;
+                self.pixel_io(
+                    dir, &field.ty, &fsem, &fattrs, fmods, field.pos, local, path, io,
+                )?;
                 path.pop();
             }
             return Ok(());
@@ -265,9 +280,21 @@ impl<'a> Lowerer<'a> {
                     .decorate(var, Decoration::Location, [Operand::LiteralBit32(n)]);
                 self.b.name(var, format!("{prefix}{sem}"));
                 // Vulkan: integer fragment inputs are not interpolated.
-                if dir == Dir::In && matches!(ty.scalar(), Some(ScalarKind::Int | ScalarKind::Uint))
-                {
+                let integer = matches!(ty.scalar(), Some(ScalarKind::Int | ScalarKind::Uint));
+                if dir == Dir::In && (integer || mods.nointerp) {
                     self.b.decorate(var, Decoration::Flat, []);
+                }
+                if dir == Dir::In && !integer && !mods.nointerp {
+                    if mods.noperspective {
+                        self.b.decorate(var, Decoration::NoPerspective, []);
+                    }
+                    if mods.centroid {
+                        self.b.decorate(var, Decoration::Centroid, []);
+                    }
+                    if mods.sample {
+                        self.cap(Capability::SampleRateShading);
+                        self.b.decorate(var, Decoration::Sample, []);
+                    }
                 }
             }
             (None, None) => {}

@@ -209,6 +209,36 @@ impl<'a> Lowerer<'a> {
             ExprKind::Call(name, args) if self.returns_resource(name) => {
                 self.resource_call(name, args, e.pos)
             }
+            // A method returning a resource, called in another method.
+            ExprKind::Call(name, args)
+                if self
+                    .f
+                    .this_place
+                    .as_ref()
+                    .is_some_and(|t| self.resource_method(t, name).is_some()) =>
+            {
+                let this = self.f.this_place.clone().unwrap_or(Place::Value(Val {
+                    id: 0,
+                    ty: Ty::Void,
+                }));
+                let c = self.resource_method(&this, name).unwrap_or_default();
+                self.inline_resource_call(name, c, Some(this), args, e.pos)
+            }
+            // `obj.m(...)`: a method returning a resource names it.
+            ExprKind::Method(obj, name, args) => {
+                self.line(e.pos);
+                let this = self.place(obj)?;
+                if let Some(c) = self.resource_method(&this, name) {
+                    return self.inline_resource_call(name, c, Some(this), args, e.pos);
+                }
+                match self.method_at(this, obj, name, args, e.pos)? {
+                    Some(v) => Ok(Place::Value(v)),
+                    None => Err(Error::new(
+                        e.pos,
+                        "this call has no value (it returns void)",
+                    )),
+                }
+            }
             // `(Texture2D<float4>)ResourceDescriptorHeap[i]`.
             ExprKind::Cast(tref, inner) if Self::heap_index(inner).is_some() => {
                 let ns = self.f.cur_ns.clone();
@@ -678,13 +708,7 @@ impl<'a> Lowerer<'a> {
                 if ty.is_resource() || ty.is_opaque() {
                     return Err(unsupported(pos, "assigning resources or ray queries"));
                 }
-                if matches!(
-                    class,
-                    StorageClass::Uniform
-                        | StorageClass::PushConstant
-                        | StorageClass::ShaderRecordBufferKHR
-                        | StorageClass::Input
-                ) {
+                if read_only(*class) {
                     return Err(Error::new(
                         pos,
                         "cannot assign to a read-only value (constant buffer or input)",

@@ -346,43 +346,43 @@ impl<'a> Lowerer<'a> {
         }
         if v.mods.is_static {
             let init = match &v.init {
-                Some(e) => Some(self.const_value(e, &t)?.ok_or_else(|| {
-                    unsupported(e.pos, "non-constant initializer of a static local")
-                })?),
+                Some(e) => self.const_value(e, &t)?,
                 None => None,
             };
             let tid = self.ty_id(&t)?;
-            let init = match init {
+            let first = match init {
                 Some(i) => i,
                 None => self.b.constant_null(tid),
             };
-            let pty = self.b.type_pointer(None, StorageClass::Private, tid);
-            let b = &mut self.b;
-            // Private variables live at module scope even when declared in a function.
-            let var = b.id();
-            b.insert_types_global_values(
-                InsertPoint::End,
-                Instruction::new(
-                    Op::Variable,
-                    Some(pty),
-                    Some(var),
-                    vec![
-                        Operand::StorageClass(StorageClass::Private),
-                        Operand::IdRef(init),
-                    ],
-                ),
-            );
-            b.name(var, v.name.clone());
-            self.use_global(var);
-            self.bind(
-                &v.name,
-                Place::Ptr {
-                    ptr: var,
-                    ty: t,
-                    layout: Layout::None,
-                    class: StorageClass::Private,
-                },
-            );
+            let var = self.private_var(tid, first, &v.name);
+            let place = Place::Ptr {
+                ptr: var,
+                ty: t.clone(),
+                layout: Layout::None,
+                class: StorageClass::Private,
+            };
+            if let (None, Some(e)) = (init, &v.init) {
+                // Initialized when the declaration is first reached, as C++
+                // and DXC do: a Private flag guards the store.
+                let bool_ty = self.ty_id(&Ty::ScalarKind(ScalarKind::Bool))?;
+                let no = self.const_bool(false);
+                let flag = self.private_var(bool_ty, no, &format!("{}.init.done", v.name));
+                if self.f.term {
+                    self.start_block(None)?;
+                }
+                let done = self.b.load(bool_ty, None, flag, None, [])?;
+                let (lt, lm) = (self.b.id(), self.b.id());
+                self.b.selection_merge(lm, spirv::SelectionControl::NONE)?;
+                self.b.branch_conditional(done, lm, lt, [])?;
+                self.start_block(Some(lt))?;
+                let val = self.expr_as(e, &t)?;
+                self.b.store(var, val.id, None, [])?;
+                let yes = self.const_bool(true);
+                self.b.store(flag, yes, None, [])?;
+                self.branch(lm)?;
+                self.start_block(Some(lm))?;
+            }
+            self.bind(&v.name, place);
             return Ok(());
         }
         if v.mods.is_const && !v.mods.is_static {
@@ -485,5 +485,27 @@ impl<'a> Lowerer<'a> {
             self.b.store(var, val.id, None, [])?;
         }
         Ok(())
+    }
+
+    /// A `Private` variable (module scope, also for a function's `static`
+    /// locals) of type `tid` starting as `init`.
+    fn private_var(&mut self, tid: Id, init: Id, name: &str) -> Id {
+        let pty = self.b.type_pointer(None, StorageClass::Private, tid);
+        let var = self.b.id();
+        self.b.insert_types_global_values(
+            InsertPoint::End,
+            Instruction::new(
+                Op::Variable,
+                Some(pty),
+                Some(var),
+                vec![
+                    Operand::StorageClass(StorageClass::Private),
+                    Operand::IdRef(init),
+                ],
+            ),
+        );
+        self.b.name(var, name.to_string());
+        self.use_global(var);
+        var
     }
 }

@@ -113,7 +113,12 @@ impl<'a> Lowerer<'a> {
 
     /// Records a missing instance; the error ends this round of lowering.
     fn need(&mut self, template: Pos, args: Vec<TArg>, name: String, pos: Pos) -> Error {
-        if !self.needed.iter().any(|i| i.name == name) {
+        // Overloaded templates share an instance name (`f<float>`), one instance each.
+        if !self
+            .needed
+            .iter()
+            .any(|i| i.name == name && i.template == template)
+        {
             self.needed.push(Instance {
                 template,
                 args,
@@ -327,7 +332,13 @@ impl<'a> Lowerer<'a> {
             // The instance exists but its signature is refused.
             return Err(e.clone());
         }
-        if let Some(c) = self.fn_by_name.get(&key).cloned() {
+        // An instance of this template (an overloaded one may share the name).
+        let made = self
+            .fn_by_name
+            .get(&key)
+            .filter(|c| c.iter().any(|k| self.funcs[*k].func.pos == f.pos))
+            .cloned();
+        if let Some(c) = made {
             let mut all = Vec::new();
             if let Some(p) = this {
                 all.push(Arg::Place(p, pos));
@@ -360,6 +371,9 @@ impl<'a> Lowerer<'a> {
         }
         match self.find_fn_template(name) {
             Some(ts) => self.template_call(name, ts, targs, args, None, pos),
+            None if name == "vk::RawBufferLoad" && targs.len() == 1 => {
+                self.raw_buffer_load(targs.first(), args, pos).map(Some)
+            }
             None if name.starts_with("vk::") => {
                 Err(unsupported(pos, format!("`{name}`")).len(name.len() as u32))
             }
