@@ -164,6 +164,10 @@ pub fn check_paths(paths: &[PathBuf], options: &Options) -> Report {
         skipped: inputs.skipped.clone(),
         ..Report::default()
     };
+    // A config that cannot be read is reported once, by the first shard.
+    if options.shard.is_some_and(|s| s.index != 1) {
+        configs.errors.clear();
+    }
     let mut diagnostics: Vec<Diagnostic> = configs.errors.clone();
     diagnostics.extend(inputs.errors.iter().map(|e| (*e.0).clone()));
     let mut owned: Vec<PathBuf> = Vec::new();
@@ -1182,6 +1186,11 @@ fn keep_shard(inputs: &mut Inputs, descriptions: &[Vec<PathBuf>], shard: Shard) 
     };
     inputs.files.retain(|i| mine(&i.path));
     inputs.pipelines.retain(|(p, _)| mine(p));
+    // Paths that could not be used belong to no folder: the first shard
+    // reports them.
+    if shard.index != 1 {
+        inputs.errors.clear();
+    }
 }
 
 #[cfg(test)]

@@ -152,7 +152,9 @@ fn shards_add_up_to_the_whole_run() {
         "fixtures/RT003",
         "fixtures/RT020",
         "fixtures/RT041",
-        "fixtures/wgsl",
+        "fixtures/RT006",
+        // Missing: reported once, by the first shard.
+        "fixtures/no-such-folder",
     ];
     let run = |extra: &[&str]| {
         let mut args = vec!["--no-cache"];
