@@ -983,15 +983,9 @@ fn tradeoff(args: TradeoffArgs) -> Result<u8, String> {
         quick: args.quick,
         child: &make_child,
     };
-    let bar = indicatif::ProgressBar::new(0);
-    bar.set_style(
-        indicatif::ProgressStyle::with_template("{bar:30} {pos}/{len} {msg}")
-            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
-    );
+    let bar = progress_bar();
     let report = tradeoff::run(&options, |done, total, name| {
-        bar.set_length(total as u64);
-        bar.set_position(done as u64);
-        bar.set_message(name.to_string());
+        advance(&bar, done, total, name)
     });
     bar.finish_and_clear();
     let report = report?;
@@ -1062,15 +1056,9 @@ fn verify(args: VerifyArgs) -> Result<u8, String> {
         extremes: args.extremes,
         child: &make_child,
     };
-    let bar = indicatif::ProgressBar::new(0);
-    bar.set_style(
-        indicatif::ProgressStyle::with_template("{bar:30} {pos}/{len} {msg}")
-            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
-    );
+    let bar = progress_bar();
     let report = verify::run(&options, |done, total, name| {
-        bar.set_length(total as u64);
-        bar.set_position(done as u64);
-        bar.set_message(name.to_string());
+        advance(&bar, done, total, name)
     });
     bar.finish_and_clear();
     let report = report?;
@@ -1314,4 +1302,23 @@ fn measured_for(
 
 fn canonical(p: &std::path::Path) -> PathBuf {
     std::fs::canonicalize(p).unwrap_or_else(|_| p.to_path_buf())
+}
+
+/// The progress bar `verify` and `tradeoff` draw while their cases run.
+#[cfg(feature = "vulkan")]
+fn progress_bar() -> indicatif::ProgressBar {
+    let bar = indicatif::ProgressBar::new(0);
+    bar.set_style(
+        indicatif::ProgressStyle::with_template("{bar:30} {pos}/{len} {msg}")
+            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+    );
+    bar
+}
+
+/// Moves the bar to case `done` of `total`, named `name`.
+#[cfg(feature = "vulkan")]
+fn advance(bar: &indicatif::ProgressBar, done: usize, total: usize, name: &str) {
+    bar.set_length(total as u64);
+    bar.set_position(done as u64);
+    bar.set_message(name.to_string());
 }

@@ -1036,19 +1036,7 @@ impl Report {
             let c = r.cells();
             rows.push(pick.iter().map(|&i| c[i].clone()).collect());
         }
-        let widths: Vec<usize> = (0..pick.len())
-            .map(|k| rows.iter().map(|r| r[k].chars().count()).max().unwrap_or(0))
-            .collect();
-        let mut out = format!("{}\n", self.header());
-        for r in &rows {
-            let line: Vec<String> = r
-                .iter()
-                .zip(&widths)
-                .map(|(c, w)| format!("{c:<w$}"))
-                .collect();
-            out.push_str(line.join("  ").trim_end());
-            out.push('\n');
-        }
+        let mut out = format!("{}\n{}", self.header(), verify::aligned(&rows));
         for r in &self.rows {
             match &r.outcome {
                 Outcome::Failed(why) => {

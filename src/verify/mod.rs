@@ -1014,6 +1014,32 @@ impl Row {
     }
 }
 
+/// Rows of cells as text in left-aligned columns two spaces apart (the
+/// tables `verify` and `tradeoff` print).
+pub(crate) fn aligned(rows: &[Vec<String>]) -> String {
+    let columns = rows.iter().map(Vec::len).max().unwrap_or(0);
+    let widths: Vec<usize> = (0..columns)
+        .map(|k| {
+            rows.iter()
+                .filter_map(|r| r.get(k))
+                .map(|c| c.chars().count())
+                .max()
+                .unwrap_or(0)
+        })
+        .collect();
+    let mut out = String::new();
+    for r in rows {
+        let line: Vec<String> = r
+            .iter()
+            .zip(&widths)
+            .map(|(c, w)| format!("{c:<w$}"))
+            .collect();
+        out.push_str(line.join("  ").trim_end());
+        out.push('\n');
+    }
+    out
+}
+
 impl Report {
     /// The table as aligned text, one line per case, then the reasons of
     /// failures and expected failures.
@@ -1024,19 +1050,7 @@ impl Report {
             .chain(["result".to_string()])
             .collect()];
         rows.extend(self.rows.iter().map(Row::cells));
-        let widths: Vec<usize> = (0..rows[0].len())
-            .map(|k| rows.iter().map(|r| r[k].chars().count()).max().unwrap_or(0))
-            .collect();
-        let mut out = String::new();
-        for r in &rows {
-            let line: Vec<String> = r
-                .iter()
-                .zip(&widths)
-                .map(|(c, w)| format!("{c:<w$}"))
-                .collect();
-            out.push_str(line.join("  ").trim_end());
-            out.push('\n');
-        }
+        let mut out = aligned(&rows);
         for r in &self.rows {
             match &r.outcome {
                 Outcome::Fail(why) => out.push_str(&format!("FAIL {}: {why}\n", r.case.name)),
