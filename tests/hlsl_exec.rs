@@ -734,3 +734,62 @@ fn ray_tracing_differential_against_slang_on_the_driver() {
     }
     assert_eq!(compared, 2);
 }
+
+/// 16-bit types (`-enable-16bit-types`) compute in 16 bits on the driver:
+/// half results, int16 wrap-around, uint16 shifts, conversions both ways,
+/// and 16-bit values read from a constant buffer.
+#[test]
+fn sixteen_bit_arithmetic_on_the_driver() {
+    let Some(ctx) = common::device() else {
+        return;
+    };
+    if !ctx.info().sixteen_bit {
+        println!(
+            "16-bit part not run: {} lacks shaderFloat16/shaderInt16/16-bit storage",
+            ctx.info().name
+        );
+        return;
+    }
+    let opts = HlslOptions {
+        enable_16bit_types: true,
+        ..Default::default()
+    };
+    let words = hlsl::compile_file(&hlsl_path("exec_half.hlsl"), &opts)
+        .unwrap_or_else(|e| panic!("{e}"))
+        .words;
+    let outs: Vec<Buffer> = (0..4).map(|_| storage(&ctx, 64)).collect();
+    // scale 0.5 (half 0x3800) at 0, count 7 at 2, neg -2 at 4, base 10.0 at 8.
+    let mut cb = vec![0u8; 16];
+    cb[0..2].copy_from_slice(&0x3800u16.to_le_bytes());
+    cb[2..4].copy_from_slice(&7u16.to_le_bytes());
+    cb[4..6].copy_from_slice(&(-2i16).to_le_bytes());
+    cb[8..12].copy_from_slice(&10.0f32.to_le_bytes());
+    let ubo = Buffer::from_data(&ctx, raw::BufferUsageFlags::UNIFORM_BUFFER, &cb).unwrap();
+    let mut list: Vec<(BindingKind, Resource)> = outs
+        .iter()
+        .map(|b| (BindingKind::StorageBuffer, Resource::Buffer(b)))
+        .collect();
+    list.push((BindingKind::UniformBuffer, Resource::Buffer(&ubo)));
+    dispatch(&ctx, &words, "Main", &list);
+    let halves = |b: &Buffer, n: usize| -> Vec<u16> {
+        b.read()
+            .chunks(2)
+            .take(n)
+            .map(|c| u16::from_le_bytes([c[0], c[1]]))
+            .collect()
+    };
+    // 1.75, 2.0, 2052.0 (2051 rounded to a half), 1.5, 2.625, -3.0, and
+    // 0.1 rounded to a half (0.0999755859375).
+    assert_eq!(
+        halves(&outs[0], 7),
+        vec![0x3f00, 0x4000, 0x6802, 0x3e00, 0x4140, 0xc200, 0x2e66]
+    );
+    let ints: Vec<i16> = halves(&outs[1], 4).iter().map(|v| *v as i16).collect();
+    assert_eq!(ints, vec![-6, i16::MIN, -9, 1]);
+    assert_eq!(halves(&outs[2], 2), vec![0xe000, 0xffff]);
+    // (half)0.1 folded at compile time is the same half.
+    assert_eq!(
+        outs[3].read_f32()[..3].to_vec(),
+        vec![13.0, 0.099_975_585_937_5, 5.0]
+    );
+}

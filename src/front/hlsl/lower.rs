@@ -21,6 +21,7 @@ mod raw_buffer;
 mod resource_calls;
 mod ser;
 mod stmt;
+mod storage16;
 mod templates;
 mod wave;
 
@@ -763,6 +764,7 @@ impl<'a> Lowerer<'a> {
             Self::place_definitions(&mut module, d);
         }
         drop_unused_globals(&mut module);
+        storage16::add_16bit_storage(&mut module);
         use rspirv::binary::Assemble;
         Ok((module.assemble(), self.decls))
     }

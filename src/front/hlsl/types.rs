@@ -9,11 +9,18 @@ use super::error::Pos;
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub enum ScalarKind {
     Bool,
+    /// `int16_t`/`uint16_t` (and `min16int`/`min16uint` with
+    /// -enable-16bit-types); ordered so that mixed arithmetic widens.
+    Int16,
+    Uint16,
     Int,
     Uint,
     /// `int64_t` and `uint64_t` (ordered so that mixed arithmetic widens).
     Int64,
     Uint64,
+    /// `float16_t` (and `half`/`min16float` with -enable-16bit-types): any
+    /// float wins over any integer, as in DXC (`half * int` is `half`).
+    Half,
     Float,
 }
 
@@ -21,6 +28,9 @@ impl ScalarKind {
     pub fn name(self) -> &'static str {
         match self {
             ScalarKind::Bool => "bool",
+            ScalarKind::Int16 => "int16_t",
+            ScalarKind::Uint16 => "uint16_t",
+            ScalarKind::Half => "float16_t",
             ScalarKind::Int => "int",
             ScalarKind::Uint => "uint",
             ScalarKind::Int64 => "int64_t",
@@ -33,12 +43,32 @@ impl ScalarKind {
     pub fn size(self) -> u32 {
         match self {
             ScalarKind::Int64 | ScalarKind::Uint64 => 8,
+            ScalarKind::Int16 | ScalarKind::Uint16 | ScalarKind::Half => 2,
             _ => 4,
         }
     }
 
     pub fn is_signed(self) -> bool {
-        matches!(self, ScalarKind::Int | ScalarKind::Int64)
+        matches!(
+            self,
+            ScalarKind::Int | ScalarKind::Int64 | ScalarKind::Int16
+        )
+    }
+
+    pub fn is_float(self) -> bool {
+        matches!(self, ScalarKind::Float | ScalarKind::Half)
+    }
+
+    pub fn is_16(self) -> bool {
+        matches!(
+            self,
+            ScalarKind::Int16 | ScalarKind::Uint16 | ScalarKind::Half
+        )
+    }
+
+    /// 32-bit (or `bool`): what textures, wave intrinsics and the like take.
+    pub fn is_32(self) -> bool {
+        !self.is_64() && !self.is_16()
     }
 
     pub fn is_64(self) -> bool {
@@ -119,6 +149,10 @@ impl Ty {
             other => other.clone(),
         }
     }
+    /// The scalar type of a numeric type's components.
+    pub fn with_scalar_only(&self) -> Ty {
+        Ty::ScalarKind(self.scalar().unwrap_or(ScalarKind::Float))
+    }
     pub fn is_resource(&self) -> bool {
         match self {
             Ty::Accel
@@ -190,7 +224,8 @@ pub fn size_align(ty: &Ty, layout: Layout, structs: &[StructDef]) -> (u32, u32) 
             let offsets = struct_offsets(*k, layout, structs);
             let def = &structs[*k as usize];
             let mut end = 0;
-            let mut align = 4;
+            // A struct of 16-bit members is 2-aligned (DXC with 16-bit types).
+            let mut align = if def.fields.is_empty() { 4 } else { 1 };
             for (f, off) in def.fields.iter().zip(&offsets) {
                 let (s, a) = size_align(&f.ty, layout, structs);
                 end = off + s;

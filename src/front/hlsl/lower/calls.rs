@@ -91,6 +91,10 @@ impl<'a> Lowerer<'a> {
         }
         self.arity(name, args, 1, pos)?;
         let v = self.expr(&args[0])?;
+        if v.ty.scalar().is_some_and(ScalarKind::is_16) {
+            // Vulkan's derivatives are 32-bit; widening would change the type.
+            return Err(unsupported(pos, format!("`{name}` of 16-bit values")).len(len));
+        }
         let ty = match v.ty {
             Ty::ScalarKind(_) => Ty::ScalarKind(ScalarKind::Float),
             Ty::Vec(_, n) => Ty::Vec(ScalarKind::Float, n),
@@ -128,6 +132,22 @@ impl<'a> Lowerer<'a> {
         args.iter().map(|a| self.expr(a)).collect()
     }
 
+    /// Literal arguments beside a 16-bit one take its type (`clamp(h, 0.0,
+    /// 1.0)` stays `half`), as in binary operators.
+    fn adapt_literal_args(&mut self, args: &[Expr], vals: Vec<Val>, pos: Pos) -> Result<Vec<Val>> {
+        let Some(other) = vals
+            .iter()
+            .find(|v| v.ty.scalar().is_some_and(ScalarKind::is_16))
+            .map(|v| v.ty.clone())
+        else {
+            return Ok(vals);
+        };
+        args.iter()
+            .zip(vals)
+            .map(|(e, v)| self.adapt_literal(e, v, &other, pos))
+            .collect()
+    }
+
     pub(super) fn arity(&self, name: &str, args: &[Expr], n: usize, pos: Pos) -> Result<()> {
         if args.len() != n {
             return Err(Error::new(
@@ -149,7 +169,10 @@ impl<'a> Lowerer<'a> {
             t = self.common(&t, &v.ty, pos)?;
         }
         if float_only || t.scalar() == Some(ScalarKind::Bool) {
-            t = t.with_scalar(if float_only {
+            // GLSL.std.450 works on 16-bit floats: `half` stays `half`.
+            t = t.with_scalar(if float_only && t.scalar() == Some(ScalarKind::Half) {
+                ScalarKind::Half
+            } else if float_only {
                 ScalarKind::Float
             } else {
                 ScalarKind::Int
@@ -514,7 +537,10 @@ impl<'a> Lowerer<'a> {
             | "step" | "smoothstep" | "fmod" | "mul" | "transpose" | "determinant" | "any"
             | "all" | "asuint" | "asint" | "asfloat" | "f32tof16" | "f16tof32" | "countbits"
             | "firstbithigh" | "firstbitlow" | "reversebits" | "isnan" | "isinf" | "isfinite"
-            | "mad" | "fma" | "rcp" | "log10" => self.args(args)?,
+            | "mad" | "fma" | "rcp" | "log10" => {
+                let vals = self.args(args)?;
+                self.adapt_literal_args(args, vals, pos)?
+            }
             "ddx" | "ddy" | "ddx_fine" | "ddy_fine" | "ddx_coarse" | "ddy_coarse" | "fwidth" => {
                 return self.derivative(name, args, pos).map(Some);
             }
@@ -565,6 +591,27 @@ impl<'a> Lowerer<'a> {
                 unsupported(pos, format!("`{name}` of 64-bit integers")).len(name.len() as u32)
             );
         }
+        // 16-bit values: the arithmetic families, which keep their width.
+        if vals
+            .iter()
+            .any(|v| v.ty.scalar().is_some_and(ScalarKind::is_16))
+            && matches!(
+                name,
+                "asuint"
+                    | "asint"
+                    | "asfloat"
+                    | "f32tof16"
+                    | "f16tof32"
+                    | "countbits"
+                    | "firstbithigh"
+                    | "firstbitlow"
+                    | "reversebits"
+            )
+        {
+            return Err(
+                unsupported(pos, format!("`{name}` of 16-bit values")).len(name.len() as u32)
+            );
+        }
         match name {
             "dot" => {
                 let (t, ids) = self.unify(vals, false, pos)?;
@@ -581,7 +628,7 @@ impl<'a> Lowerer<'a> {
                         pos,
                     );
                 }
-                if s == ScalarKind::Float {
+                if s.is_float() {
                     let tid = self.ty_id(&st)?;
                     let id = self.op(Op::Dot, tid, &ids)?;
                     return Ok(Val { id, ty: st });
@@ -609,18 +656,18 @@ impl<'a> Lowerer<'a> {
             }
             "cross" => {
                 let (t, ids) = self.unify(vals, true, pos)?;
-                if t != Ty::Vec(ScalarKind::Float, 3) {
+                if !matches!(t, Ty::Vec(s, 3) if s.is_float()) {
                     return Err(Error::new(pos, "`cross` needs float3 arguments"));
                 }
                 self.glsl(G::Cross, &t, &ids)
             }
             "length" => {
-                let (_, ids) = self.unify(vals, true, pos)?;
-                self.glsl(G::Length, &f, &ids)
+                let (t, ids) = self.unify(vals, true, pos)?;
+                self.glsl(G::Length, &t.with_scalar_only(), &ids)
             }
             "distance" => {
-                let (_, ids) = self.unify(vals, true, pos)?;
-                self.glsl(G::Distance, &f, &ids)
+                let (t, ids) = self.unify(vals, true, pos)?;
+                self.glsl(G::Distance, &t.with_scalar_only(), &ids)
             }
             "reflect" => {
                 let (t, ids) = self.unify(vals, true, pos)?;
@@ -633,8 +680,8 @@ impl<'a> Lowerer<'a> {
             "refract" => {
                 let mut vals = vals;
                 let eta = vals.pop().unwrap_or_else(|| unreachable!());
-                let eta = self.convert(eta, &f, pos, false)?;
                 let (t, mut ids) = self.unify(vals, true, pos)?;
+                let eta = self.convert(eta, &t.with_scalar_only(), pos, false)?;
                 ids.push(eta.id);
                 self.glsl(G::Refract, &t, &ids)
             }
@@ -667,13 +714,13 @@ impl<'a> Lowerer<'a> {
                 let (t, ids) = self.unify(vals, false, pos)?;
                 let s = t.scalar().unwrap_or(ScalarKind::Float);
                 let inst = match (name, s) {
-                    ("clamp", ScalarKind::Float) => G::FClamp,
+                    ("clamp", s) if s.is_float() => G::FClamp,
                     ("clamp", s) if s.is_signed() => G::SClamp,
                     ("clamp", _) => G::UClamp,
-                    ("min", ScalarKind::Float) => G::FMin,
+                    ("min", s) if s.is_float() => G::FMin,
                     ("min", s) if s.is_signed() => G::SMin,
                     ("min", _) => G::UMin,
-                    (_, ScalarKind::Float) => G::FMax,
+                    (_, s) if s.is_float() => G::FMax,
                     (_, s) if s.is_signed() => G::SMax,
                     _ => G::UMax,
                 };
@@ -682,7 +729,7 @@ impl<'a> Lowerer<'a> {
             "abs" => {
                 let (t, ids) = self.unify(vals, false, pos)?;
                 match t.scalar() {
-                    Some(ScalarKind::Float) => self.glsl(G::FAbs, &t, &ids),
+                    Some(s) if s.is_float() => self.glsl(G::FAbs, &t, &ids),
                     Some(s) if s.is_signed() => self.glsl(G::SAbs, &t, &ids),
                     _ => Ok(Val { id: ids[0], ty: t }),
                 }
@@ -692,11 +739,15 @@ impl<'a> Lowerer<'a> {
                 let (t, ids) = self.unify(vals, false, pos)?;
                 let it = t.with_scalar(ScalarKind::Int);
                 match t.scalar() {
-                    Some(ScalarKind::Float) => {
+                    Some(s) if s.is_float() => {
                         let v = self.glsl(G::FSign, &t, &ids)?;
                         self.convert(v, &it, pos, true)
                     }
                     Some(ScalarKind::Int) => self.glsl(G::SSign, &t, &ids),
+                    Some(ScalarKind::Int16) => {
+                        let v = self.glsl(G::SSign, &t, &ids)?;
+                        self.convert(v, &it, pos, true)
+                    }
                     _ => {
                         let v = Val {
                             id: ids[0],

@@ -759,8 +759,8 @@ impl<'a> Lowerer<'a> {
             }
         };
         let (sc, n) = match t {
-            Ty::ScalarKind(s) if s != ScalarKind::Bool && !s.is_64() => (s, 1),
-            Ty::Vec(s, n) if s != ScalarKind::Bool && !s.is_64() => (s, n),
+            Ty::ScalarKind(s) if s != ScalarKind::Bool && s.is_32() => (s, 1),
+            Ty::Vec(s, n) if s != ScalarKind::Bool && s.is_32() => (s, n),
             Ty::Struct(_) | Ty::Array(..) => {
                 return self.load_packed(*ptr, &t, args, pos).map(Some);
             }
@@ -870,8 +870,8 @@ impl<'a> Lowerer<'a> {
     fn load_packed(&mut self, var: Id, t: &Ty, args: &'a [Expr], pos: Pos) -> Result<Val> {
         fn leaves(t: &Ty, structs: &[StructDef], out: &mut Vec<ScalarKind>) -> bool {
             match t {
-                Ty::ScalarKind(s) if *s != ScalarKind::Bool && !s.is_64() => out.push(*s),
-                Ty::Vec(s, n) if *s != ScalarKind::Bool && !s.is_64() => {
+                Ty::ScalarKind(s) if *s != ScalarKind::Bool && s.is_32() => out.push(*s),
+                Ty::Vec(s, n) if *s != ScalarKind::Bool && s.is_32() => {
                     out.extend(std::iter::repeat_n(*s, *n as usize))
                 }
                 Ty::Array(e, n) => {

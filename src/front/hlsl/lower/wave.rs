@@ -247,7 +247,7 @@ impl<'a> Lowerer<'a> {
     fn wave_value(&mut self, name: &str, e: &'a Expr) -> Result<Val> {
         let x = self.expr(e)?;
         match x.ty {
-            Ty::ScalarKind(s) | Ty::Vec(s, _) if s != ScalarKind::Bool && !s.is_64() => Ok(x),
+            Ty::ScalarKind(s) | Ty::Vec(s, _) if s != ScalarKind::Bool && s.is_32() => Ok(x),
             _ => Err(unsupported(
                 e.pos,
                 format!("`{name}` of a `{}`", self.ty_name(&x.ty)),

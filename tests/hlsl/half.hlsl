@@ -1,0 +1,56 @@
+// 16-bit types with -enable-16bit-types: `half`/`min16float` are float16_t,
+// `min16int`/`min16uint` int16_t/uint16_t. Compiled with the flag only.
+
+struct Packed
+{
+    half a;
+    half2 b;
+    float c;
+    int16_t d;
+    uint16_t e;
+};
+
+RWStructuredBuffer<Packed> packed : register(u0);
+RWStructuredBuffer<half> halves : register(u1);
+cbuffer Params : register(b0)
+{
+    half scale;
+    uint16_t count;
+    float bias;
+};
+
+[numthreads(1, 1, 1)]
+void cs(uint3 id : SV_DispatchThreadID)
+{
+    half h = 1.5;
+    float16_t3 v = float16_t3(1, 2, 3) * h;
+    h = h * 2.0 + scale;
+    int16_t i = -3;
+    uint16_t u = count + 1;
+    min16float m = (half)bias;
+    min16int mi = i;
+    Packed p;
+    p.a = sqrt(h) + length(v) + dot(v, v);
+    p.b = half2(v.x, (half)i);
+    p.c = h + bias;
+    p.d = i * 2 + (int16_t)u + abs(i) + max(mi, 5);
+    p.e = u << 2;
+    p.a += m + clamp(h, 0.0, 1.0) + lerp(h, m, 0.5) + (half)sign(h);
+    packed[id.x] = p;
+    halves[id.x] = h > m ? h : -m;
+}
+
+struct [raypayload] HalfPayload
+{
+    half3 color : read(caller) : write(closesthit);
+    half t : read(caller) : write(closesthit);
+    uint16_t flags : read(caller) : write(closesthit);
+};
+
+[shader("closesthit")]
+void hit(inout HalfPayload p, BuiltInTriangleIntersectionAttributes a)
+{
+    p.color = half3(a.barycentrics, 1.0);
+    p.t = (half)RayTCurrent();
+    p.flags = (uint16_t)HitKind();
+}
