@@ -1332,17 +1332,29 @@ fn sixteen_bit_types_with_the_flag() {
     let m = hlsl::compile_file(&path, &opts).unwrap_or_else(|e| panic!("{e}"));
     validate(&m.words, "half.hlsl-flag");
     let insts = instructions(&m.words);
-    let caps: Vec<u32> = insts
-        .iter()
-        .filter(|(op, _)| *op == 17)
-        .map(|(_, o)| o[0])
-        .collect();
+    let caps = |words: &[u32]| -> Vec<u32> {
+        instructions(words)
+            .iter()
+            .filter(|(op, _)| *op == 17)
+            .map(|(_, o)| o[0])
+            .collect()
+    };
     // Float16 (9), Int16 (22), StorageBuffer16BitAccess (4433),
-    // UniformAndStorageBuffer16BitAccess (4434); no StorageInputOutput16 (4436).
-    for c in [9, 22, 4433, 4434] {
-        assert!(caps.contains(&c), "capability {c} missing: {caps:?}");
+    // UniformAndStorageBuffer16BitAccess (4434), StoragePushConstant16 (4435),
+    // StorageInputOutput16 (4436): each where its storage class holds 16-bit values.
+    let entries = hlsl::compile(&path, &opts).unwrap_or_else(|e| panic!("{e}"));
+    let of = |name: &str| caps(&entries.iter().find(|e| e.name == name).unwrap().words);
+    let (cs, ps, hit) = (of("cs"), of("ps"), of("hit"));
+    for c in [9, 22, 4433, 4434, 4435] {
+        assert!(cs.contains(&c), "cs: capability {c} missing: {cs:?}");
     }
-    assert!(!caps.contains(&4436), "{caps:?}");
+    assert!(!cs.contains(&4436), "{cs:?}");
+    assert!(ps.contains(&4436) && !ps.contains(&4433), "{ps:?}");
+    // A payload needs no storage capability.
+    assert!(
+        hit.contains(&9) && !hit.iter().any(|c| (4433..=4436).contains(c)),
+        "{hit:?}"
+    );
     // OpExtension (10).
     assert!(insts
         .iter()

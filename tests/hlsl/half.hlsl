@@ -19,8 +19,18 @@ cbuffer Params : register(b0)
     float bias;
 };
 
-[numthreads(1, 1, 1)]
-void cs(uint3 id : SV_DispatchThreadID)
+struct Push
+{
+    half3 tint;
+    uint16_t mode;
+};
+[[vk::push_constant]] ConstantBuffer<Push> push;
+static const half K = 2.0h;
+static const int16_t N = 3;
+groupshared half shared16[4];
+
+[numthreads(4, 1, 1)]
+void cs(uint3 id : SV_DispatchThreadID, uint gi : SV_GroupIndex)
 {
     half h = 1.5;
     float16_t3 v = float16_t3(1, 2, 3) * h;
@@ -36,8 +46,32 @@ void cs(uint3 id : SV_DispatchThreadID)
     p.d = i * 2 + (int16_t)u + abs(i) + max(mi, 5);
     p.e = u << 2;
     p.a += m + clamp(h, 0.0, 1.0) + lerp(h, m, 0.5) + (half)sign(h);
+    shared16[gi] = (half)gi * push.tint.x * K;
+    GroupMemoryBarrierWithGroupSync();
+    half s = shared16[(gi + 1) % 4];
+    uint16_t2 u2 = uint16_t2(gi, push.mode);
+    switch ((int16_t)u2.y)
+    {
+    case 1:
+        s += 1.0h;
+        break;
+    default:
+        break;
+    }
+    half arr[N];
+    for (int16_t j = 0; j < N; j++)
+        arr[j] = s + j;
     packed[id.x] = p;
-    halves[id.x] = h > m ? h : -m;
+    halves[id.x] = h > m ? h : -m + arr[1];
+}
+
+// 16-bit stage inputs and outputs (StorageInputOutput16).
+[shader("pixel")]
+half4 ps(float4 pos : SV_Position, half2 uv : TEXCOORD0) : SV_Target
+{
+    half3 v = (half3)1;
+    v *= uv.x;
+    return half4(v, uv.y > 0.5h ? 1.0h : 0.0h);
 }
 
 struct [raypayload] HalfPayload
