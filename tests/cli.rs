@@ -324,8 +324,11 @@ fn layout_counts_16_bit_members() {
     ]);
     assert_eq!(o.status.code(), Some(0), "{}", stdout(&o));
     let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
-    let t = &v["files"][0]["types"][0];
-    assert_eq!(t["name"], "HalfPayload");
+    let types = v["files"][0]["types"].as_array().unwrap();
+    let t = types
+        .iter()
+        .find(|t| t["name"] == "HalfPayload")
+        .expect("HalfPayload");
     assert_eq!(t["scalar_size"], 10);
     assert_eq!(t["hlsl_packed_size"], 10);
     let members: Vec<(String, u64, u64)> = t["members"]

@@ -1374,7 +1374,11 @@ fn sixteen_bit_types_with_the_flag() {
         .iter()
         .any(|(op, o)| *op == 21 && o[1] == 16 && o[2] == 0));
     // 2-byte members: half a, half2 b (relaxed: at 2), float c, int16_t d, uint16_t e.
-    assert_eq!(member_offsets(&m.words, "Packed"), vec![0, 2, 8, 12, 14]);
+    // half3x3: three half3 columns 8 bytes apart.
+    assert_eq!(
+        member_offsets(&m.words, "Packed"),
+        vec![0, 2, 8, 12, 14, 16]
+    );
     assert_eq!(member_offsets(&m.words, "type.Params"), vec![0, 2, 4]);
     // `h * 2.0 + scale` is half arithmetic (OpFMul 133, OpFAdd 129), the
     // literal taking the type of the half beside it; int16 arithmetic (OpIMul 132).
@@ -1393,6 +1397,22 @@ fn sixteen_bit_types_with_the_flag() {
             "GLSL.std.450 {inst} on half: {glsl:?}"
         );
     }
+    // 16-bit texels live in 32-bit images (OpTypeImage 25, sampled type
+    // float); the storage image's format is Rgba16f (2).
+    let float = insts
+        .iter()
+        .find(|(op, o)| *op == 22 && o[1] == 32)
+        .map(|(_, o)| o[0])
+        .unwrap();
+    let images: Vec<&Vec<u32>> = insts
+        .iter()
+        .filter(|(op, _)| *op == 25)
+        .map(|(_, o)| o)
+        .collect();
+    assert!(images.iter().all(|o| o[1] != half), "{images:?}");
+    assert!(images
+        .iter()
+        .any(|o| o[1] == float && o[6] == 2 && o[7] == 2));
     // half + float is float: OpFConvert (115) widens.
     assert!(insts.iter().any(|(op, _)| *op == 115));
 

@@ -736,7 +736,7 @@ fn ray_tracing_differential_against_slang_on_the_driver() {
 }
 
 /// 16-bit types (`-enable-16bit-types`) compute in 16 bits on the driver:
-/// half results, int16 wrap-around, uint16 shifts, conversions both ways,
+/// half results and matrices, int16 wrap-around, uint16 shifts, conversions both ways,
 /// and 16-bit values read from a constant buffer.
 #[test]
 fn sixteen_bit_arithmetic_on_the_driver() {
@@ -778,11 +778,11 @@ fn sixteen_bit_arithmetic_on_the_driver() {
             .map(|c| u16::from_le_bytes([c[0], c[1]]))
             .collect()
     };
-    // 1.75, 2.0, 2052.0 (2051 rounded to a half), 1.5, 2.625, -3.0, and
-    // 0.1 rounded to a half (0.0999755859375).
+    // 1.75, 2.0, 2052.0 (2051 rounded to a half), 1.5, 2.625, -3.0, 0.1
+    // rounded to a half (0.0999755859375), 11.0 (a half matrix product).
     assert_eq!(
-        halves(&outs[0], 7),
-        vec![0x3f00, 0x4000, 0x6802, 0x3e00, 0x4140, 0xc200, 0x2e66]
+        halves(&outs[0], 8),
+        vec![0x3f00, 0x4000, 0x6802, 0x3e00, 0x4140, 0xc200, 0x2e66, 0x4980]
     );
     let ints: Vec<i16> = halves(&outs[1], 4).iter().map(|v| *v as i16).collect();
     assert_eq!(ints, vec![-6, i16::MIN, -9, 1]);

@@ -634,18 +634,18 @@ fn glsl_sources_need_not_be_utf8() {
 
 /// `half` is 32-bit unless 16-bit types are enabled, on the command line
 /// (`--enable-16bit-types`) or in `[hlsl]`; then it is 16-bit, and a 16-bit
-/// construct not yet lowered (a `half` matrix) is refused (exit 2), never
-/// silently widened.
+/// construct not yet lowered (`asuint` of a `half`) is refused (exit 2),
+/// never silently widened.
 #[test]
 fn sixteen_bit_types_follow_the_flag_and_the_config() {
     let d = scratch("half");
-    let src = "RWStructuredBuffer<float> o : register(u0);\n[numthreads(1,1,1)]\nvoid m() { half2x2 k = (half2x2)0; half h = 0.5; o[0] = h + k[0][0]; }\n";
+    let src = "RWStructuredBuffer<uint> o : register(u0);\n[numthreads(1,1,1)]\nvoid m() { half h = 0.5; o[0] = asuint(h); }\n";
     std::fs::write(d.join("m.hlsl"), src).unwrap();
     assert_eq!(check_in(&d, &["m.hlsl"]).status.code(), Some(0));
     let o = check_in(&d, &["--enable-16bit-types", "m.hlsl"]);
     assert_eq!(o.status.code(), Some(2), "{}", text(&o));
     assert!(
-        text(&o).contains("not supported: 16-bit matrices"),
+        text(&o).contains("not supported: `asuint` of 16-bit values"),
         "{}",
         text(&o)
     );

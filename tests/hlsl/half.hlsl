@@ -8,6 +8,7 @@ struct Packed
     float c;
     int16_t d;
     uint16_t e;
+    half3x3 basis;
 };
 
 RWStructuredBuffer<Packed> packed : register(u0);
@@ -28,6 +29,12 @@ struct Push
 static const half K = 2.0h;
 static const int16_t N = 3;
 groupshared half shared16[4];
+// 16-bit texels: the images hold 32-bit ones (as Vulkan requires); reads
+// narrow and writes widen.
+Texture2D<half4> albedo : register(t2);
+SamplerState linearSampler : register(s3);
+RWTexture2D<half4> target : register(u4);
+Buffer<uint16_t> indices : register(t5);
 
 [numthreads(4, 1, 1)]
 void cs(uint3 id : SV_DispatchThreadID, uint gi : SV_GroupIndex)
@@ -61,8 +68,18 @@ void cs(uint3 id : SV_DispatchThreadID, uint gi : SV_GroupIndex)
     half arr[N];
     for (int16_t j = 0; j < N; j++)
         arr[j] = s + j;
+    half4 texel = albedo.SampleLevel(linearSampler, float2(0.5, 0.5), 0) + albedo.Load(int3(0, 0, 0));
+    target[id.xy] = texel * h;
+    half4 back = target[id.xy];
+    arr[2] += back.w + (half)indices[gi];
+    // 16-bit matrices: built, multiplied, mixed with float ones, stored.
+    half3x3 tbn = half3x3(half3(1, 0, 0), half3(0, 1, 0), v);
+    half3 n = mul(half3(1, 2, 3), tbn) + mul(tbn, v);
+    float3x3 wide = tbn;
+    p.basis = mul(tbn, (half3x3)wide) * 2.0;
+    p.a += n.z + determinant(tbn) + tbn._m22;
     packed[id.x] = p;
-    halves[id.x] = h > m ? h : -m + arr[1];
+    halves[id.x] = h > m ? h : -m + arr[1] + arr[2];
 }
 
 // 16-bit stage inputs and outputs (StorageInputOutput16).

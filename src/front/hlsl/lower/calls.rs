@@ -810,7 +810,9 @@ impl<'a> Lowerer<'a> {
             "determinant" => {
                 let v = vals.into_iter().next().unwrap_or_else(|| unreachable!());
                 match v.ty {
-                    Ty::Mat(_, r, c) if r == c => self.glsl(G::Determinant, &f, &[v.id]),
+                    Ty::Mat(s, r, c) if r == c => {
+                        self.glsl(G::Determinant, &Ty::ScalarKind(s), &[v.id])
+                    }
                     _ => Err(Error::new(pos, "`determinant` needs a square matrix")),
                 }
             }
@@ -978,6 +980,12 @@ impl<'a> Lowerer<'a> {
             it.next().unwrap_or_else(|| unreachable!()),
         );
         let (at, bt) = (a.ty.clone(), b.ty.clone());
+        // Matrices are float or half: the wider of the two (any integer
+        // vector joins the matrix's kind).
+        let s = match (at.scalar(), bt.scalar()) {
+            (Some(x), Some(y)) if x.max(y).is_float() => x.max(y),
+            _ => ScalarKind::Float,
+        };
         match (&at, &bt) {
             (Ty::ScalarKind(_), _) | (_, Ty::ScalarKind(_)) => self.binary(BinOp::Mul, a, b, pos),
             (Ty::Vec(..), Ty::Vec(..)) => self.intrinsic("dot", vec![a, b], pos),
@@ -989,10 +997,11 @@ impl<'a> Lowerer<'a> {
                     ));
                 }
                 let (r, c) = (*r, *c);
-                let v = self.convert(b, &Ty::Vec(ScalarKind::Float, c), pos, false)?;
-                let t = Ty::Vec(ScalarKind::Float, r);
+                let m = self.convert(a, &Ty::Mat(s, r, c), pos, false)?;
+                let v = self.convert(b, &Ty::Vec(s, c), pos, false)?;
+                let t = Ty::Vec(s, r);
                 let tid = self.ty_id(&t)?;
-                let id = self.op(Op::VectorTimesMatrix, tid, &[v.id, a.id])?;
+                let id = self.op(Op::VectorTimesMatrix, tid, &[v.id, m.id])?;
                 Ok(Val { id, ty: t })
             }
             (Ty::Vec(_, n), Ty::Mat(_, r, c)) => {
@@ -1004,11 +1013,12 @@ impl<'a> Lowerer<'a> {
                         ),
                     ));
                 }
-                let c = *c;
-                let v = self.convert(a, &Ty::Vec(ScalarKind::Float, *n), pos, false)?;
-                let t = Ty::Vec(ScalarKind::Float, c);
+                let (r, c) = (*r, *c);
+                let m = self.convert(b, &Ty::Mat(s, r, c), pos, false)?;
+                let v = self.convert(a, &Ty::Vec(s, *n), pos, false)?;
+                let t = Ty::Vec(s, c);
                 let tid = self.ty_id(&t)?;
-                let id = self.op(Op::MatrixTimesVector, tid, &[b.id, v.id])?;
+                let id = self.op(Op::MatrixTimesVector, tid, &[m.id, v.id])?;
                 Ok(Val { id, ty: t })
             }
             (Ty::Mat(_, r, k), Ty::Mat(_, k2, c)) => {
@@ -1018,9 +1028,12 @@ impl<'a> Lowerer<'a> {
                         format!("`mul` of {r}x{k} and {k2}x{c} matrices"),
                     ));
                 }
-                let t = Ty::Mat(ScalarKind::Float, *r, *c);
+                let (r, k, c) = (*r, *k, *c);
+                let x = self.convert(a, &Ty::Mat(s, r, k), pos, false)?;
+                let y = self.convert(b, &Ty::Mat(s, k, c), pos, false)?;
+                let t = Ty::Mat(s, r, c);
                 let tid = self.ty_id(&t)?;
-                let id = self.op(Op::MatrixTimesMatrix, tid, &[b.id, a.id])?;
+                let id = self.op(Op::MatrixTimesMatrix, tid, &[y.id, x.id])?;
                 Ok(Val { id, ty: t })
             }
             _ => Err(Error::new(

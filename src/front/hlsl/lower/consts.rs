@@ -121,7 +121,7 @@ impl<'a> Lowerer<'a> {
                 let st = self.sc_id(if *sc == ScalarKind::Bool {
                     ScalarKind::Uint
                 } else {
-                    *sc
+                    sc.wide()
                 });
                 let (d, arrayed) = match dim {
                     Dim::D1 => (spirv::Dim::Dim1D, 0),
@@ -159,7 +159,7 @@ impl<'a> Lowerer<'a> {
                 } else {
                     spirv::ImageFormat::Unknown
                 };
-                if *rw && (*n == 2 || fmt.is_some_and(extended_format)) {
+                if *rw && extended_format(format) {
                     self.cap(Capability::StorageImageExtendedFormats);
                 }
                 if *rw && format == spirv::ImageFormat::Unknown {
@@ -189,6 +189,16 @@ impl<'a> Lowerer<'a> {
             (ScalarKind::Int, 1) => F::R32i,
             (ScalarKind::Int, 2) => F::Rg32i,
             (ScalarKind::Int, 4) => F::Rgba32i,
+            // 16-bit texels: 16-bit formats, as DXC derives them.
+            (ScalarKind::Half, 1) => F::R16f,
+            (ScalarKind::Half, 2) => F::Rg16f,
+            (ScalarKind::Half, 4) => F::Rgba16f,
+            (ScalarKind::Uint16, 1) => F::R16ui,
+            (ScalarKind::Uint16, 2) => F::Rg16ui,
+            (ScalarKind::Uint16, 4) => F::Rgba16ui,
+            (ScalarKind::Int16, 1) => F::R16i,
+            (ScalarKind::Int16, 2) => F::Rg16i,
+            (ScalarKind::Int16, 4) => F::Rgba16i,
             _ => F::Unknown,
         }
     }

@@ -588,11 +588,8 @@ impl<'a> Lowerer<'a> {
                     _ => Dim::D2Array,
                 };
                 let (sc, n) = match targ_ty(self, 0, Ty::Vec(ScalarKind::Float, 4))? {
-                    Ty::ScalarKind(s) | Ty::Vec(s, _) if s.is_16() => {
-                        return Err(unsupported(t.pos, "16-bit texture elements"))
-                    }
-                    Ty::ScalarKind(s) if s != ScalarKind::Bool && s.is_32() => (s, 1),
-                    Ty::Vec(s, n) if s != ScalarKind::Bool && s.is_32() => (s, n),
+                    Ty::ScalarKind(s) if s != ScalarKind::Bool && !s.is_64() => (s, 1),
+                    Ty::Vec(s, n) if s != ScalarKind::Bool && !s.is_64() => (s, n),
                     _ => {
                         return Err(Error::new(
                             t.pos,
@@ -661,10 +658,7 @@ impl<'a> Lowerer<'a> {
             (0, _) | (1, 0) => Ty::ScalarKind(sc),
             (n, 0) => Ty::Vec(sc, n),
             (r, c) => {
-                if sc == ScalarKind::Half {
-                    return Err(unsupported(pos, "16-bit matrices"));
-                }
-                if sc != ScalarKind::Float {
+                if !sc.is_float() {
                     return Err(unsupported(pos, "non-float matrices"));
                 }
                 if r < 2 || c < 2 {

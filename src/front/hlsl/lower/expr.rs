@@ -488,6 +488,25 @@ impl<'a> Lowerer<'a> {
                 let s = self.shrink(v.clone(), &Ty::ScalarKind(*a))?;
                 self.convert_scalar(s.id, *a, *b, to)
             }
+            // half and float matrices: row by row (OpFConvert takes no matrices).
+            (Ty::Mat(a, r, c), Ty::Mat(b, r2, c2))
+                if a != b && ((r2 <= r && c2 <= c && explicit) || (r2 == r && c2 == c)) =>
+            {
+                let same = self.convert(v.clone(), &Ty::Mat(*a, *r2, *c2), pos, explicit)?;
+                let rowt = self.ty_id(&Ty::Vec(*a, *c2))?;
+                let mut rows = Vec::new();
+                for i in 0..*r2 {
+                    let row = self.inst(
+                        Op::CompositeExtract,
+                        Some(rowt),
+                        vec![Operand::IdRef(same.id), Operand::LiteralBit32(i as u32)],
+                    )?;
+                    rows.push(self.convert_scalar(row, *a, *b, &Ty::Vec(*b, *c2))?.id);
+                }
+                let tid = self.ty_id(to)?;
+                let id = self.op(Op::CompositeConstruct, tid, &rows)?;
+                Ok(Val { id, ty: to.clone() })
+            }
             (Ty::Mat(a, r, c), Ty::Mat(b, r2, c2)) if a == b && r2 <= r && c2 <= c && explicit => {
                 let st = self.ty_id(&Ty::Vec(*a, *c2))?;
                 let mut rows = Vec::new();

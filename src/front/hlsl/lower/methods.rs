@@ -312,7 +312,7 @@ impl<'a> Lowerer<'a> {
             unreachable!("fetch on a texture")
         };
         let im = self.image(ptr, t)?;
-        let v4 = Ty::Vec(*sc, 4);
+        let v4 = Ty::Vec(sc.wide(), 4);
         let vt = self.ty_id(&v4)?;
         let mut ops = vec![Operand::IdRef(im), Operand::IdRef(coord)];
         // Texel buffers have no mip levels.
@@ -402,7 +402,7 @@ impl<'a> Lowerer<'a> {
                 let it = self.ty_id(t)?;
                 let sit = self.b.type_sampled_image(it);
                 let si = self.op(Op::SampledImage, sit, &[im, sm])?;
-                let v4 = Ty::Vec(sc, 4);
+                let v4 = Ty::Vec(sc.wide(), 4);
                 let vt = self.ty_id(&v4)?;
                 let mut ops = vec![Operand::IdRef(si), Operand::IdRef(uv.id)];
                 if name == "Sample" {
@@ -840,7 +840,7 @@ impl<'a> Lowerer<'a> {
         let it = self.ty_id(t)?;
         let sit = self.b.type_sampled_image(it);
         let si = self.op(Op::SampledImage, sit, &[im, sm])?;
-        let rt = Ty::ScalarKind(*sc);
+        let rt = Ty::ScalarKind(sc.wide());
         let rid = self.ty_id(&rt)?;
         let mut ops = vec![
             Operand::IdRef(si),
@@ -862,7 +862,7 @@ impl<'a> Lowerer<'a> {
             Op::ImageSampleDrefExplicitLod
         };
         let id = self.inst(op, Some(rid), ops)?;
-        Ok(Val { id, ty: rt })
+        self.convert_scalar(id, sc.wide(), *sc, &Ty::ScalarKind(*sc))
     }
 
     /// `Load<S>` of a struct or array: its 32-bit leaves packed one word each,
