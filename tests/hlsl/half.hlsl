@@ -78,6 +78,8 @@ void cs(uint3 id : SV_DispatchThreadID, uint gi : SV_GroupIndex)
     float3x3 wide = tbn;
     p.basis = mul(tbn, (half3x3)wide) * 2.0;
     p.a += n.z + determinant(tbn) + tbn._m22;
+    // f32tof16 takes a half as the float it is exactly.
+    p.e += (uint16_t)f32tof16(h);
     packed[id.x] = p;
     halves[id.x] = h > m ? h : -m + arr[1] + arr[2];
 }

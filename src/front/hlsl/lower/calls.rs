@@ -591,7 +591,8 @@ impl<'a> Lowerer<'a> {
                 unsupported(pos, format!("`{name}` of 64-bit integers")).len(name.len() as u32)
             );
         }
-        // 16-bit values: the arithmetic families, which keep their width.
+        // 16-bit values: the arithmetic families, which keep their width
+        // (`f32tof16`/`f16tof32` take them exactly as `float`/`uint`).
         if vals
             .iter()
             .any(|v| v.ty.scalar().is_some_and(ScalarKind::is_16))
@@ -600,8 +601,6 @@ impl<'a> Lowerer<'a> {
                 "asuint"
                     | "asint"
                     | "asfloat"
-                    | "f32tof16"
-                    | "f16tof32"
                     | "countbits"
                     | "firstbithigh"
                     | "firstbitlow"
