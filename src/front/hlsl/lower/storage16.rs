@@ -30,10 +30,10 @@ pub(super) fn add_16bit_storage(module: &mut dr::Module) {
             | Op::TypeMatrix
             | Op::TypeArray
             | Op::TypeRuntimeArray
-            | Op::TypeStruct => {
-                if refs().any(|r| has16.contains(&r)) {
-                    has16.insert(id);
-                }
+            | Op::TypeStruct
+                if refs().any(|r| has16.contains(&r)) =>
+            {
+                has16.insert(id);
             }
             Op::TypePointer => {
                 if let (Some(Operand::StorageClass(c)), Some(Operand::IdRef(t))) =
