@@ -1416,6 +1416,28 @@ fn sixteen_bit_types_with_the_flag() {
     // half + float is float: OpFConvert (115) widens.
     assert!(insts.iter().any(|(op, _)| *op == 115));
 
+    // Literals beside halves in `?:` and intrinsics stay half: no float
+    // arithmetic, no conversion (OpFConvert 115) at all.
+    let lits = "RWStructuredBuffer<half> o;\n[numthreads(1,1,1)]\nvoid m(uint3 id : SV_DispatchThreadID) { half h = (half)id.x; o[0] = h > 1 ? h : 0.5; o[1] = id.y > 0 ? o[2] + h : -1.0; o[3] = max(h, 0.25) * 2; }";
+    let m = hlsl::compile_source_whole(
+        Path::new("main.hlsl"),
+        lits,
+        &mut hlsl::pp::MemLoader::default(),
+        &opts,
+    )
+    .unwrap();
+    validate(&m.words, "half-literals");
+    let insts = instructions(&m.words);
+    assert!(!insts.iter().any(|(op, _)| *op == 115));
+    // OpSelect (169) and OpPhi (245) of half.
+    let half = insts
+        .iter()
+        .find(|(op, o)| *op == 22 && o[1] == 16)
+        .map(|(_, o)| o[0])
+        .unwrap();
+    assert!(insts.iter().any(|(op, o)| *op == 169 && o[0] == half));
+    assert!(insts.iter().any(|(op, o)| *op == 245 && o[0] == half));
+
     // Without the flag `half` and `min16*` are 32-bit: no 16-bit type at all.
     let plain = "RWStructuredBuffer<float> o;\n[numthreads(1,1,1)]\nvoid m() { half h = 1.5; min16float g = h; min16int i = 2; o[0] = g * i; }";
     let m = hlsl::compile_source_whole(

@@ -615,19 +615,7 @@ impl<'a> Lowerer<'a> {
     /// literals do: `h * 2.0` is `half` arithmetic, `i16 + 1` is `int16_t`
     /// (a float literal beside a 16-bit integer stays `float`).
     pub(super) fn adapt_literal(&mut self, e: &Expr, v: Val, other: &Ty, pos: Pos) -> Result<Val> {
-        let lit = match &e.kind {
-            ExprKind::Unary(UnOp::Neg, x) => &x.kind,
-            k => k,
-        };
-        let Some(o) = other.scalar().filter(|s| s.is_16()) else {
-            return Ok(v);
-        };
-        let to = match lit {
-            ExprKind::Float(_) if o == ScalarKind::Half => o,
-            ExprKind::Int(..) => o,
-            _ => return Ok(v),
-        };
-        let t = v.ty.with_scalar(to);
+        let t = literal_ty(e, &v.ty, other);
         self.convert(v, &t, pos, true)
     }
 
@@ -818,6 +806,16 @@ impl<'a> Lowerer<'a> {
         Ok(Val { id, ty: bool_t })
     }
 
+    /// The type of `?:`: a literal side takes a 16-bit other side's type.
+    fn ternary_ty(&self, a: &Expr, at: &Ty, b: &Expr, bt: &Ty, pos: Pos) -> Result<Ty> {
+        let (at, bt) = (literal_ty(a, at, bt), literal_ty(b, bt, at));
+        if at == bt {
+            Ok(at)
+        } else {
+            self.common(&at, &bt, pos)
+        }
+    }
+
     pub(super) fn ternary(
         &mut self,
         c: &'a Expr,
@@ -833,11 +831,7 @@ impl<'a> Lowerer<'a> {
             // observed running, which leaves no temporary behind.
             let av = self.expr(a)?;
             let bv = self.expr(b)?;
-            let t = if av.ty == bv.ty {
-                av.ty.clone()
-            } else {
-                self.common(&av.ty, &bv.ty, pos)?
-            };
+            let t = self.ternary_ty(a, &av.ty, b, &bv.ty, pos)?;
             let t = match (t, &cv.ty) {
                 (Ty::ScalarKind(s), Ty::Vec(_, n)) => Ty::Vec(s, *n),
                 (other, _) => other,
@@ -880,11 +874,7 @@ impl<'a> Lowerer<'a> {
         let av = side(self, la, a)?;
         self.branch(a_conv)?;
         let bv = side(self, lb, b)?;
-        let t = if av.ty == bv.ty {
-            av.ty.clone()
-        } else {
-            self.common(&av.ty, &bv.ty, pos)?
-        };
+        let t = self.ternary_ty(a, &av.ty, b, &bv.ty, pos)?;
         let y = self.convert(bv, &t, b.pos, false)?;
         let from_b = self.f.cur_label;
         self.branch(merge)?;
@@ -995,5 +985,20 @@ fn cheap_and_pure(e: &Expr) -> bool {
         ExprKind::Cast(_, x) => cheap_and_pure(x),
         ExprKind::Construct(_, args) => args.iter().all(cheap_and_pure),
         _ => false,
+    }
+}
+
+/// `ty` (the type of `e`), or, when `e` is an untyped literal beside a
+/// 16-bit `other`, the same shape of `other`'s scalar: `h * 2.0` is `half`
+/// as in DXC; a float literal beside a 16-bit integer stays `float`.
+fn literal_ty(e: &Expr, ty: &Ty, other: &Ty) -> Ty {
+    let lit = match &e.kind {
+        ExprKind::Unary(UnOp::Neg, x) => &x.kind,
+        k => k,
+    };
+    match (lit, other.scalar()) {
+        (ExprKind::Float(_), Some(ScalarKind::Half)) => ty.with_scalar(ScalarKind::Half),
+        (ExprKind::Int(..), Some(o)) if o.is_16() => ty.with_scalar(o),
+        _ => ty.clone(),
     }
 }
