@@ -438,7 +438,7 @@ const NOT_RUN: &[(&str, &str)] = &[
     (
         "exec_half.hlsl",
         "needs -enable-16bit-types, which the differential cases do not pass; \
-         tests/hlsl_exec.rs runs it against known values",
+         tests/hlsl_exec.rs runs it against known values and against Slang",
     ),
     (
         "corpus_constructs.hlsl",

@@ -757,23 +757,9 @@ fn sixteen_bit_arithmetic_on_the_driver() {
     let words = hlsl::compile_file(&hlsl_path("exec_half.hlsl"), &opts)
         .unwrap_or_else(|e| panic!("{e}"))
         .words;
-    let outs: Vec<Buffer> = (0..4).map(|_| storage(&ctx, 64)).collect();
-    // scale 0.5 (half 0x3800) at 0, count 7 at 2, neg -2 at 4, base 10.0 at 8.
-    let mut cb = vec![0u8; 16];
-    cb[0..2].copy_from_slice(&0x3800u16.to_le_bytes());
-    cb[2..4].copy_from_slice(&7u16.to_le_bytes());
-    cb[4..6].copy_from_slice(&(-2i16).to_le_bytes());
-    cb[8..12].copy_from_slice(&10.0f32.to_le_bytes());
-    let ubo = Buffer::from_data(&ctx, raw::BufferUsageFlags::UNIFORM_BUFFER, &cb).unwrap();
-    let mut list: Vec<(BindingKind, Resource)> = outs
-        .iter()
-        .map(|b| (BindingKind::StorageBuffer, Resource::Buffer(b)))
-        .collect();
-    list.push((BindingKind::UniformBuffer, Resource::Buffer(&ubo)));
-    dispatch(&ctx, &words, "Main", &list);
-    let halves = |b: &Buffer, n: usize| -> Vec<u16> {
-        b.read()
-            .chunks(2)
+    let outs = run_half(&ctx, &words, "Main");
+    let halves = |b: &Vec<u8>, n: usize| -> Vec<u16> {
+        b.chunks(2)
             .take(n)
             .map(|c| u16::from_le_bytes([c[0], c[1]]))
             .collect()
@@ -788,8 +774,64 @@ fn sixteen_bit_arithmetic_on_the_driver() {
     assert_eq!(ints, vec![-6, i16::MIN, -9, 1]);
     assert_eq!(halves(&outs[2], 2), vec![0xe000, 0xffff]);
     // (half)0.1 folded at compile time is the same half: 1638 / 2^14.
+    let floats: Vec<f32> = outs[3]
+        .chunks(4)
+        .take(3)
+        .map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]]))
+        .collect();
+    assert_eq!(floats, vec![13.0, 1638.0 / 16384.0, 5.0]);
+}
+
+/// Runs exec_half.hlsl's `entry` once: its four output buffers' bytes.
+fn run_half(ctx: &Context, words: &[u32], entry: &str) -> Vec<Vec<u8>> {
+    let outs: Vec<Buffer> = (0..4).map(|_| storage(ctx, 64)).collect();
+    // scale 0.5 (half 0x3800) at 0, count 7 at 2, neg -2 at 4, base 10.0 at 8.
+    let mut cb = vec![0u8; 16];
+    cb[0..2].copy_from_slice(&0x3800u16.to_le_bytes());
+    cb[2..4].copy_from_slice(&7u16.to_le_bytes());
+    cb[4..6].copy_from_slice(&(-2i16).to_le_bytes());
+    cb[8..12].copy_from_slice(&10.0f32.to_le_bytes());
+    let ubo = Buffer::from_data(ctx, raw::BufferUsageFlags::UNIFORM_BUFFER, &cb).unwrap();
+    let mut list: Vec<(BindingKind, Resource)> = outs
+        .iter()
+        .map(|b| (BindingKind::StorageBuffer, Resource::Buffer(b)))
+        .collect();
+    list.push((BindingKind::UniformBuffer, Resource::Buffer(&ubo)));
+    dispatch(ctx, words, entry, &list);
+    outs.iter().map(|b| b.read()).collect()
+}
+
+/// exec_half.hlsl compiled by Slang (whose `half` is always 16-bit) and by
+/// rtlint with -enable-16bit-types writes the same bytes on the driver.
+#[test]
+fn sixteen_bit_differential_against_slang() {
+    let Some(slang) = rtlint_testkit::slang() else {
+        return;
+    };
+    let Some(ctx) = common::device() else {
+        return;
+    };
+    if !ctx.info().sixteen_bit {
+        println!(
+            "16-bit part not run: {} lacks 16-bit support",
+            ctx.info().name
+        );
+        return;
+    }
+    let opts = HlslOptions {
+        enable_16bit_types: true,
+        ..Default::default()
+    };
+    let ours = hlsl::compile_file(&hlsl_path("exec_half.hlsl"), &opts)
+        .unwrap_or_else(|e| panic!("{e}"))
+        .words;
+    let theirs = slang_module(&slang, "exec_half.hlsl", "Main", Stage::Compute);
+    if let Some(why) = invalid_spirv(&theirs) {
+        panic!("Slang's exec_half module is invalid: {why}");
+    }
     assert_eq!(
-        outs[3].read_f32()[..3].to_vec(),
-        vec![13.0, 1638.0 / 16384.0, 5.0]
+        run_half(&ctx, &ours, "Main"),
+        run_half(&ctx, &theirs, "main"),
+        "rtlint and Slang disagree on 16-bit arithmetic"
     );
 }

@@ -1,6 +1,13 @@
 // 16-bit arithmetic on the driver (compiled with -enable-16bit-types): the
 // thread id keeps the values from being folded at compile time.
 
+#ifdef __SLANG__
+// Slang (the differential in tests/hlsl_exec.rs) has no min-precision types;
+// with -enable-16bit-types DXC makes them these.
+typedef half min16float;
+typedef int16_t min16int;
+#endif
+
 RWStructuredBuffer<half> OutH : register(u0);
 RWStructuredBuffer<int16_t> OutI : register(u1);
 RWStructuredBuffer<uint16_t> OutU : register(u2);
