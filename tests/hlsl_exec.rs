@@ -736,7 +736,7 @@ fn ray_tracing_differential_against_slang_on_the_driver() {
 }
 
 /// 16-bit types (`-enable-16bit-types`) compute in 16 bits on the driver:
-/// half results and matrices, int16 wrap-around, uint16 shifts, conversions both ways,
+/// half results and matrices, `asfloat16`/`asuint16`/`asint16`, int16 wrap-around, uint16 shifts, conversions both ways,
 /// and 16-bit values read from a constant buffer.
 #[test]
 fn sixteen_bit_arithmetic_on_the_driver() {
@@ -765,14 +765,16 @@ fn sixteen_bit_arithmetic_on_the_driver() {
             .collect()
     };
     // 1.75, 2.0, 2052.0 (2051 rounded to a half), 1.5, 2.625, -3.0, 0.1
-    // rounded to a half (0.0999755859375), 11.0 (a half matrix product).
+    // rounded to a half (0.0999755859375), 11.0 (a half matrix product),
+    // 2.5 (1.5 and 1.0 through their bits).
     assert_eq!(
-        halves(&outs[0], 8),
-        vec![0x3f00, 0x4000, 0x6802, 0x3e00, 0x4140, 0xc200, 0x2e66, 0x4980]
+        halves(&outs[0], 9),
+        vec![0x3f00, 0x4000, 0x6802, 0x3e00, 0x4140, 0xc200, 0x2e66, 0x4980, 0x4100]
     );
-    let ints: Vec<i16> = halves(&outs[1], 4).iter().map(|v| *v as i16).collect();
-    assert_eq!(ints, vec![-6, i16::MIN, -9, 1]);
-    assert_eq!(halves(&outs[2], 2), vec![0xe000, 0xffff]);
+    // ..., and the bits of half -0.5 (0xb800) as an int16.
+    let ints: Vec<i16> = halves(&outs[1], 5).iter().map(|v| *v as i16).collect();
+    assert_eq!(ints, vec![-6, i16::MIN, -9, 1, 0xb800u16 as i16]);
+    assert_eq!(halves(&outs[2], 3), vec![0xe000, 0xffff, 0x3e00]);
     // (half)0.1 folded at compile time is the same half: 1638 / 2^14.
     let floats: Vec<f32> = outs[3]
         .chunks(4)

@@ -535,9 +535,9 @@ impl<'a> Lowerer<'a> {
             "dot" | "cross" | "length" | "distance" | "reflect" | "refract" | "faceforward"
             | "lerp" | "saturate" | "clamp" | "min" | "max" | "abs" | "sign" | "pow" | "atan2"
             | "step" | "smoothstep" | "fmod" | "mul" | "transpose" | "determinant" | "any"
-            | "all" | "asuint" | "asint" | "asfloat" | "f32tof16" | "f16tof32" | "countbits"
-            | "firstbithigh" | "firstbitlow" | "reversebits" | "isnan" | "isinf" | "isfinite"
-            | "mad" | "fma" | "rcp" | "log10" => {
+            | "all" | "asuint" | "asint" | "asfloat" | "asuint16" | "asint16" | "asfloat16"
+            | "f32tof16" | "f16tof32" | "countbits" | "firstbithigh" | "firstbitlow"
+            | "reversebits" | "isnan" | "isinf" | "isfinite" | "mad" | "fma" | "rcp" | "log10" => {
                 let vals = self.args(args)?;
                 self.adapt_literal_args(args, vals, pos)?
             }
@@ -569,9 +569,9 @@ impl<'a> Lowerer<'a> {
         };
         let want = match name {
             "length" | "saturate" | "abs" | "sign" | "transpose" | "determinant" | "any"
-            | "all" | "asuint" | "asint" | "asfloat" | "f32tof16" | "f16tof32" | "countbits"
-            | "firstbithigh" | "firstbitlow" | "reversebits" | "isnan" | "isinf" | "isfinite"
-            | "rcp" | "log10" => 1,
+            | "all" | "asuint" | "asint" | "asfloat" | "asuint16" | "asint16" | "asfloat16"
+            | "f32tof16" | "f16tof32" | "countbits" | "firstbithigh" | "firstbitlow"
+            | "reversebits" | "isnan" | "isinf" | "isfinite" | "rcp" | "log10" => 1,
             "lerp" | "clamp" | "refract" | "faceforward" | "smoothstep" | "mad" | "fma" => 3,
             _ => 2,
         };
@@ -835,6 +835,30 @@ impl<'a> Lowerer<'a> {
                         ),
                     )),
                 }
+            }
+            "asuint16" | "asint16" | "asfloat16" => {
+                // DXC's 16-bit reinterpretations: the same bits, another type.
+                let v = vals.into_iter().next().unwrap_or_else(|| unreachable!());
+                let s = match name {
+                    "asuint16" => ScalarKind::Uint16,
+                    "asint16" => ScalarKind::Int16,
+                    _ => ScalarKind::Half,
+                };
+                if !matches!(v.ty, Ty::ScalarKind(_) | Ty::Vec(..))
+                    || !v.ty.scalar().is_some_and(ScalarKind::is_16)
+                {
+                    return Err(Error::new(
+                        pos,
+                        format!("`{name}` needs a 16-bit scalar or vector"),
+                    ));
+                }
+                let t = v.ty.with_scalar(s);
+                if t == v.ty {
+                    return Ok(v);
+                }
+                let tid = self.ty_id(&t)?;
+                let id = self.op(Op::Bitcast, tid, &[v.id])?;
+                Ok(Val { id, ty: t })
             }
             "asuint" | "asint" | "asfloat" => {
                 let v = vals.into_iter().next().unwrap_or_else(|| unreachable!());
