@@ -13,7 +13,7 @@ struct Packed
 
 RWStructuredBuffer<Packed> packed : register(u0);
 RWStructuredBuffer<half> halves : register(u1);
-cbuffer Params : register(b0)
+cbuffer Params : register(b6)
 {
     half scale;
     uint16_t count;
