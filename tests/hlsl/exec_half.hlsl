@@ -49,6 +49,7 @@ void Main(uint3 id : SV_DispatchThreadID)
     OutU[1] = count - 8;
     // The bits of half 1.5 (0x3e00), and back.
     OutU[2] = asuint16(scale * a);
+    OutU[3] = ~count;
     OutH[8] = asfloat16(OutU[2]) + asfloat16((int16_t)0x3c00);
     OutI[4] = asint16(-scale);
 

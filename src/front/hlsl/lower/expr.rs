@@ -932,7 +932,11 @@ impl<'a> Lowerer<'a> {
             }
             UnOp::BitNot => {
                 let v = self.expr(a)?;
-                if !matches!(v.ty.scalar(), Some(ScalarKind::Int | ScalarKind::Uint)) {
+                if !v
+                    .ty
+                    .scalar()
+                    .is_some_and(|s| s != ScalarKind::Bool && !s.is_float())
+                {
                     return Err(Error::new(pos, "`~` needs an integer"));
                 }
                 let tid = self.ty_id(&v.ty)?;
