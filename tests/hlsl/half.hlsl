@@ -1,6 +1,12 @@
 // 16-bit types with -enable-16bit-types: `half`/`min16float` are float16_t,
 // `min16int`/`min16uint` int16_t/uint16_t. Compiled with the flag only.
 
+#ifdef __SLANG__
+// Slang (tests/invariance.rs compares with it) has no min-precision types.
+typedef half min16float;
+typedef int16_t min16int;
+#endif
+
 struct Packed
 {
     half a;
