@@ -27,11 +27,17 @@ struct ParamsData
     float4 light;
     // t_min, t_max, throughput cut-off, fixed origin epsilon
     float4 ray;
+    // x: reflection rays' t_max (before the roughness shortening);
+    // y: roughness above which the environment replaces the reflection ray
+    // (read by the glossy shader only)
+    float4 knobs;
 };
 ConstantBuffer<ParamsData> params : register(b3);
 
 static const uint FLAG_LIGHT = 1;
 static const uint FLAG_ROBUST = 2;
+// The hybrid shader traces every reflection, marching none (rtlint tradeoff).
+static const uint FLAG_RAY_ONLY = 4;
 
 float3 sky(float3 dir)
 {

@@ -115,12 +115,12 @@ void glossy_sample(uint2 id, uint sample, inout float3 sum)
             {
                 throughput = 0.0;
             }
-            t_max = params.ray.y / (1.0 + 64.0 * roughness);
+            t_max = params.knobs.x / (1.0 + 64.0 * roughness);
         }
         else
         {
             dir = reflect(dir, n);
-            t_max = params.ray.y;
+            t_max = params.knobs.x;
         }
         if ((params.flags & FLAG_LIGHT) != 0)
         {
@@ -131,6 +131,13 @@ void glossy_sample(uint2 id, uint sample, inout float3 sum)
         else
         {
             sum += base * headlight;
+        }
+        // Too rough to be worth a ray: the environment answers instead of
+        // the reflection ray the next bounce would trace.
+        if (roughness > params.knobs.y && bounce < params.max_bounces)
+        {
+            sum += throughput * sky(dir);
+            break;
         }
         if (!(throughput > params.ray.z))
             break;

@@ -18,6 +18,11 @@ struct Params {
     light: vec4<f32>,
     // t_min, t_max, throughput cut-off, fixed origin epsilon
     ray: vec4<f32>,
+    // x: reflection rays' t_max (before the roughness shortening);
+    // y: roughness above which the environment replaces the reflection ray;
+    // z: roughness above which a first hit takes its reflection from the
+    // half-resolution pass (off above 1)
+    knobs: vec4<f32>,
 }
 
 // One entry per triangle (instance custom index + primitive index):
@@ -38,6 +43,10 @@ struct HitInfo {
 @group(0) @binding(1) var<storage, read_write> image: array<u32>;
 @group(0) @binding(2) var<storage, read> surfaces: array<Surface>;
 @group(0) @binding(3) var<uniform> params: Params;
+// Half-resolution reflections, one per 2×2 block: xyz = the block's
+// top-left pixel's light beyond its first hit (mean over its rays), w = the
+// roughness of that first hit (-1: not rough enough to share).
+@group(0) @binding(8) var<storage, read_write> half_res: array<vec4<f32>>;
 
 var<ray_payload> hit: HitInfo;
 // Shadow rays get a payload of their own (only `t` is used).
@@ -120,9 +129,25 @@ fn sample_vndf(ve: vec3<f32>, alpha: f32, u1: f32, u2: f32) -> vec3<f32> {
 // `loop_bound` counter per loop (its infinite-loop guard), 16 bytes more.
 @diagnostic(off, rtlint.live_state_over_budget)
 @ray_generation
-fn raygen(@builtin(ray_invocation_id) id: vec3<u32>) {
+fn raygen(
+    @builtin(ray_invocation_id) id: vec3<u32>,
+    @builtin(num_ray_invocations) launch: vec3<u32>,
+) {
+    // Half-resolution mode runs two launches: first one invocation per 2×2
+    // block (launched narrower than the image) traces the light beyond the
+    // block's top-left pixel's first hit, when that hit is rough; then
+    // every pixel whose first hit is as rough takes it instead of tracing on.
+    let half_mode = params.knobs.z <= 1.0;
+    let block_pass = half_mode && launch.x < params.width;
+    let pixel = select(id.xy, id.xy * 2u, block_pass);
+    let block = (pixel.y / 2u) * ((params.width + 1u) / 2u) + pixel.x / 2u;
+    var block_light = vec4<f32>(0.0, 0.0, 0.0, -1.0);
+    if half_mode && !block_pass {
+        block_light = half_res[block];
+    }
+    var first_roughness = -1.0;
     let size = vec2<f32>(f32(params.width), f32(params.height));
-    let uv = (vec2<f32>(id.xy) + 0.5) / size * 2.0 - 1.0;
+    let uv = (vec2<f32>(pixel) + 0.5) / size * 2.0 - 1.0;
     let samples = clamp(params.flags >> 8u, 1u, MAX_SAMPLES);
     // Every sample's light adds straight into the sum, scaled at the end.
     var sum = vec3<f32>(0.0);
@@ -130,7 +155,7 @@ fn raygen(@builtin(ray_invocation_id) id: vec3<u32>) {
         if sample >= samples {
             break;
         }
-        var seed = pcg(id.y * params.width + id.x) ^ pcg(sample + 0x9E3779B9u);
+        var seed = pcg(pixel.y * params.width + pixel.x) ^ pcg(sample + 0x9E3779B9u);
         var origin = params.camera.xyz;
         var dir = normalize(vec3<f32>(uv.x, -uv.y, -1.5));
         var t_max = params.ray.y;
@@ -147,7 +172,9 @@ fn raygen(@builtin(ray_invocation_id) id: vec3<u32>) {
             var n = select(-normal, normal, dot(normal, dir) < 0.0);
             origin = offset_ray(origin + dir * hit.t, n);
             var visible = false;
-            if (params.flags & FLAG_LIGHT) != 0u && dot(n, params.light.xyz) > 0.0 {
+            // (The block pass has no use for its first hit's own light.)
+            let local = !(block_pass && bounce == 0u);
+            if local && (params.flags & FLAG_LIGHT) != 0u && dot(n, params.light.xyz) > 0.0 {
                 shadow.t = 0.0;
                 traceRay(tlas, RayDesc(SHADOW_FLAGS, 0xFFu, params.ray.x, params.ray.y, origin, params.light.xyz), &shadow);
                 visible = shadow.t < 0.0;
@@ -179,25 +206,51 @@ fn raygen(@builtin(ray_invocation_id) id: vec3<u32>) {
                 } else {
                     throughput = 0.0;
                 }
-                t_max = params.ray.y / (1.0 + 64.0 * roughness);
+                t_max = params.knobs.x / (1.0 + 64.0 * roughness);
             } else {
                 dir = reflect(dir, n);
-                t_max = params.ray.y;
+                t_max = params.knobs.x;
             }
-            if (params.flags & FLAG_LIGHT) != 0u {
+            if bounce == 0u {
+                first_roughness = roughness;
+                // The block pass shares only rough first hits' reflections.
+                if block_pass && !(roughness > params.knobs.z) {
+                    break;
+                }
+            }
+            // The block pass's light starts beyond the first hit.
+            if local && (params.flags & FLAG_LIGHT) != 0u {
                 sum += base * params.light.w;
                 if ndl > 0.0 && visible {
                     sum += base * ndl;
                 }
-            } else {
+            } else if local {
                 sum += base * headlight;
+            }
+            if bounce == 0u && !block_pass && block_light.w == roughness && roughness > params.knobs.z {
+                sum += block_light.xyz;
+                break;
+            }
+            // Too rough to be worth a ray: the environment answers instead
+            // of the reflection ray the next bounce would trace.
+            if roughness > params.knobs.y && bounce < params.max_bounces {
+                sum += throughput * sky(dir);
+                break;
             }
             if !(throughput > params.ray.z) {
                 break;
             }
         }
+        if block_pass && !(first_roughness > params.knobs.z) {
+            break;
+        }
     }
-    image[id.y * params.width + id.x] = pack_rgba8(sum / f32(samples));
+    if block_pass {
+        let w = select(-1.0, first_roughness, first_roughness > params.knobs.z);
+        half_res[block] = vec4<f32>(sum / f32(samples), w);
+        return;
+    }
+    image[pixel.y * params.width + pixel.x] = pack_rgba8(sum / f32(samples));
 }
 
 @miss

@@ -143,9 +143,13 @@ void resolve_pass()
     {
         float3 n = g.normal_reflectivity.xyz;
         float3 r = reflect(camera_dir(id), n);
-        float3 found;
+        float3 found = float3(0.0, 0.0, 0.0);
         path = PATH_SCREEN;
-        if (!march(g.position_depth.xyz, r, found))
+        // Ray only (FLAG_RAY_ONLY): every reflection is traced, none marched.
+        bool screen = false;
+        if ((params.flags & FLAG_RAY_ONLY) == 0)
+            screen = march(g.position_depth.xyz, r, found);
+        if (!screen)
         {
             path = PATH_RAY;
             float3 from = offset_ray(g.position_depth.xyz, n);

@@ -70,6 +70,8 @@ const SSR_THICKNESS: f32 = 0.25;
 const SSR_MIN_CONFIDENCE: f32 = 0.5;
 const FLAG_LIGHT: u32 = 1u;
 const FLAG_ROBUST: u32 = 2u;
+// Ray only: every reflection is traced, none marched (rtlint tradeoff).
+const FLAG_RAY_ONLY: u32 = 4u;
 const RAY_FLAG_OPAQUE: u32 = 0x01u;
 // OPAQUE | ACCEPT_FIRST_HIT_AND_END_SEARCH | SKIP_CLOSEST_HIT_SHADER
 const SHADOW_FLAGS: u32 = 0x0Du;
@@ -211,7 +213,10 @@ fn resolve_pass(@builtin(ray_invocation_id) id: vec3<u32>) {
     if g.position_depth.w >= 0.0 && reflectivity > params.ray.z {
         let n = g.normal_reflectivity.xyz;
         let r = reflect(camera_dir(id.xy), n);
-        let found = march(g.position_depth.xyz, r);
+        var found = Found(false, vec3<f32>(0.0));
+        if (params.flags & FLAG_RAY_ONLY) == 0u {
+            found = march(g.position_depth.xyz, r);
+        }
         var light = found.light;
         path = PATH_SCREEN;
         if !found.confident {

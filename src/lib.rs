@@ -19,6 +19,8 @@ pub mod rules;
 pub mod shader;
 pub mod suppress;
 #[cfg(feature = "vulkan")]
+pub mod tradeoff;
+#[cfg(feature = "vulkan")]
 pub mod verify;
 #[cfg(feature = "vulkan")]
 pub mod vk;

@@ -183,6 +183,30 @@ struct VerifyArgs {
     child: Option<Vec<String>>,
 }
 
+/// `rtlint tradeoff`.
+#[derive(clap::Args, Clone)]
+struct TradeoffArgs {
+    /// The folder holding `verify.toml`, the shaders and `scenes/`.
+    #[arg(long, default_value = "shaders")]
+    shaders: PathBuf,
+    /// Where the CSV, Markdown table, SVG plot and PNGs go.
+    #[arg(long, default_value = "target/tradeoff")]
+    out: PathBuf,
+    /// Use the first ray-tracing device whose name contains this text.
+    #[arg(long, value_name = "NAME")]
+    device: Option<String>,
+    /// The scene (`scenes/NAME.toml`).
+    #[arg(long, value_name = "NAME", default_value = "showcase")]
+    scene: String,
+    /// A small sweep (a few settings, 32×32 pixels).
+    #[arg(long)]
+    quick: bool,
+    /// Internal: run one setting on the device, time it and write its image
+    /// (the child process `tradeoff` starts for every GPU run).
+    #[arg(long, hide = true, value_names = ["SETTING", "IMAGE"], num_args = 2)]
+    child: Option<Vec<String>>,
+}
+
 #[derive(Subcommand)]
 enum Command {
     /// Lint shaders and report best-practice violations.
@@ -255,6 +279,10 @@ enum Command {
     /// Run the reference reflection shaders on the Vulkan device and
     /// compare each image with the CPU reference renderer.
     Verify(VerifyArgs),
+    /// Sweep the reference shaders' knobs (bounces, rays per pixel, t_max,
+    /// roughness cut-off, half resolution, ray origins) and measure GPU time
+    /// against error.
+    Tradeoff(TradeoffArgs),
     /// List every rule.
     Rules,
     /// (Internal) `stack --driver` runs this in a child process per
@@ -327,6 +355,7 @@ fn run(cli: Cli) -> Result<u8, String> {
             whole,
         ),
         Command::Verify(args) => verify(args),
+        Command::Tradeoff(args) => tradeoff(args),
         Command::DriverStackSizes {
             pipeline,
             library,
@@ -861,6 +890,92 @@ fn compile(
         ));
     }
     Ok(0)
+}
+
+#[cfg(not(feature = "vulkan"))]
+fn tradeoff(_: TradeoffArgs) -> Result<u8, String> {
+    Err("tradeoff needs rtlint built with the `vulkan` feature".into())
+}
+
+/// `rtlint tradeoff`: every GPU run in a child process (this executable
+/// with `tradeoff --child SETTING IMAGE`), a progress bar, the table and
+/// the files; exit 1 when a setting failed.
+#[cfg(feature = "vulkan")]
+fn tradeoff(args: TradeoffArgs) -> Result<u8, String> {
+    use rtlint::{tradeoff, verify};
+    if let Some(child) = &args.child {
+        let [setting, image] = child.as_slice() else {
+            return Err("--child takes a setting and an image path".into());
+        };
+        return match tradeoff::child_main(
+            &args.shaders,
+            &args.scene,
+            args.quick,
+            setting,
+            std::path::Path::new(image),
+            args.device.as_deref(),
+        ) {
+            Ok(()) => Ok(0),
+            Err(e) if e == verify::SKIP => Ok(verify::SKIP_CODE as u8),
+            Err(e) => Err(e),
+        };
+    }
+    let exe = std::env::current_exe().map_err(|e| format!("cannot find rtlint itself: {e}"))?;
+    let make_child = |setting: &str, image: &std::path::Path| {
+        let mut c = std::process::Command::new(&exe);
+        c.arg("tradeoff")
+            .arg("--shaders")
+            .arg(&args.shaders)
+            .arg("--scene")
+            .arg(&args.scene)
+            .arg("--child")
+            .arg(setting)
+            .arg(image);
+        if args.quick {
+            c.arg("--quick");
+        }
+        if let Some(d) = &args.device {
+            c.arg("--device").arg(d);
+        }
+        c
+    };
+    let options = tradeoff::Options {
+        shaders: args.shaders.clone(),
+        out: args.out.clone(),
+        scene: args.scene.clone(),
+        quick: args.quick,
+        child: &make_child,
+    };
+    let bar = indicatif::ProgressBar::new(0);
+    bar.set_style(
+        indicatif::ProgressStyle::with_template("{bar:30} {pos}/{len} {msg}")
+            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+    );
+    let report = tradeoff::run(&options, |done, total, name| {
+        bar.set_length(total as u64);
+        bar.set_position(done as u64);
+        bar.set_message(name.to_string());
+    });
+    bar.finish_and_clear();
+    let report = report?;
+    report.write(&args.out)?;
+    let mut out = std::io::stdout().lock();
+    let _ = write!(out, "{}", report.text());
+    let failed = report
+        .rows
+        .iter()
+        .filter(|r| matches!(r.outcome, tradeoff::Outcome::Failed(_)))
+        .count();
+    let front: Vec<String> = report.front().iter().map(|r| r.setting.name()).collect();
+    let _ = writeln!(
+        out,
+        "{} settings, {} failed; Pareto front: {}; files in {}",
+        report.rows.len(),
+        failed,
+        front.join(", "),
+        args.out.display()
+    );
+    Ok(if failed == 0 { 0 } else { 1 })
 }
 
 #[cfg(not(feature = "vulkan"))]

@@ -60,15 +60,20 @@ const FORBIDDEN: &[(&str, &[&str])] = &[
     (
         "vk",
         &[
-            "analysis", "explain", "rules", "report", "config", "lint", "front",
+            "analysis", "explain", "rules", "report", "config", "lint", "front", "tradeoff",
         ],
     ),
     (
         "reference",
         &[
             "program", "front", "analysis", "explain", "rules", "report", "config", "pipeline",
-            "lint", "vk", "verify",
+            "lint", "vk", "verify", "tradeoff",
         ],
+    ),
+    ("verify", &["rules", "report", "lint", "build", "tradeoff"]),
+    (
+        "tradeoff",
+        &["rules", "report", "lint", "build", "explain", "config"],
     ),
 ];
 

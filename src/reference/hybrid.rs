@@ -151,8 +151,10 @@ pub fn resolve(
         return (g.local, ReflectionPath::None);
     }
     let r = reflect(camera_dir(params, x, y), g.normal);
-    if let Some(found) = march(params, gbuf, g, r) {
-        return (g.local + g.reflectivity * found, ReflectionPath::Screen);
+    if !params.ray_only {
+        if let Some(found) = march(params, gbuf, g, r) {
+            return (g.local + g.reflectivity * found, ReflectionPath::Screen);
+        }
     }
     let from = params.next_origin(g.position, g.normal);
     let (hit, edge_margin) = intersect(scene, from, r, params.t_min, params.t_max);

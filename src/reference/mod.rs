@@ -25,8 +25,10 @@ pub use scene::{Light, Scene, Surface};
 pub const FLAG_LIGHT: u32 = 1;
 /// `Params.flags`: ray origins use the robust offset, not the fixed epsilon.
 pub const FLAG_ROBUST: u32 = 2;
+/// `Params.flags`: the hybrid shader traces every reflection, marching none.
+pub const FLAG_RAY_ONLY: u32 = 4;
 
-/// The shaders' uniform block (`Params`, 64 bytes).
+/// The shaders' uniform block (`Params`, 80 bytes).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Params {
     pub width: u32,
@@ -46,6 +48,19 @@ pub struct Params {
     pub samples: u32,
     /// The adaptive shader's variance tolerance (`camera.w`).
     pub tolerance: f32,
+    /// `t_max` of the glossy shader's reflection rays (before its
+    /// shortening with roughness); primary and shadow rays keep `t_max`.
+    pub reflect_t_max: f32,
+    /// The glossy shader replaces the reflection ray off a surface rougher
+    /// than this with the environment in the sampled direction.
+    pub rough_cutoff: f32,
+    /// Half-resolution reflections: a pixel whose first hit is rougher than
+    /// this (and as rough as its 2×2 block's top-left pixel's) takes that
+    /// pixel's light beyond the first hit instead of tracing on. Off above 1.
+    pub half_res: f32,
+    /// The hybrid shader traces every reflection instead of marching the
+    /// screen first.
+    pub ray_only: bool,
 }
 
 impl Params {
@@ -65,16 +80,21 @@ impl Params {
             epsilon: 1e-3,
             samples: 4,
             tolerance: ADAPTIVE_TOLERANCE,
+            reflect_t_max: 1e4,
+            rough_cutoff: f32::INFINITY,
+            half_res: f32::INFINITY,
+            ray_only: false,
         }
     }
 
     /// The uniform buffer contents:
     /// `width, height, max_bounces, flags; camera.xyz, tolerance; light.xyz, ambient;
-    /// t_min, t_max, cutoff, epsilon`.
-    pub fn to_words(&self) -> [u32; 16] {
+    /// t_min, t_max, cutoff, epsilon; reflect_t_max, rough_cutoff, half_res, 0`.
+    pub fn to_words(&self) -> [u32; 20] {
         let f = |x: f32| x.to_bits();
         let flags = if self.light.is_some() { FLAG_LIGHT } else { 0 }
             | if self.robust { FLAG_ROBUST } else { 0 }
+            | if self.ray_only { FLAG_RAY_ONLY } else { 0 }
             | (self.samples.min(255) << 8);
         let (l, ambient) = self
             .light
@@ -98,6 +118,10 @@ impl Params {
             f(self.t_max),
             f(self.cutoff),
             f(self.epsilon),
+            f(self.reflect_t_max),
+            f(self.rough_cutoff),
+            f(self.half_res),
+            0,
         ]
     }
 
@@ -441,17 +465,73 @@ pub fn sample_vndf(ve: Vec3, alpha: f32, u1: f32, u2: f32) -> Vec3 {
 
 /// Follows `reflect_glossy`: the iterative loop with GGX-sampled reflections
 /// off rough surfaces, `params.samples` paths per pixel averaged.
+/// In half-resolution mode, the block's top-left pixel is traced first as
+/// the shader's block pass does; its rays count as that pixel's.
 pub fn trace_glossy(scene: &Scene, params: &Params, x: u32, y: u32) -> PixelPath {
     let samples = params.samples.clamp(1, 16);
     let mut sum = Vec3::ZERO;
     let mut segments = Vec::new();
+    let mut half = Half::off();
+    if params.half_res <= 1.0 {
+        let (bx, by) = (x & !1, y & !1);
+        let mut block = Half {
+            block_pass: true,
+            ..Half::off()
+        };
+        let mut block_sum = Vec3::ZERO;
+        let mut block_segments = Vec::new();
+        for sample in 0..samples {
+            glossy_path(
+                scene,
+                params,
+                (bx, by),
+                sample,
+                &mut block_sum,
+                &mut block_segments,
+                &mut block,
+            );
+            if block.first_roughness <= params.half_res {
+                break;
+            }
+        }
+        let w = if block.first_roughness > params.half_res {
+            block.first_roughness
+        } else {
+            -1.0
+        };
+        half.shared = (block_sum / samples as f32, w);
+        if (x, y) == (bx, by) {
+            segments = block_segments;
+        }
+    }
     for sample in 0..samples {
-        glossy_sample(scene, params, x, y, sample, &mut sum, &mut segments);
+        glossy_path(
+            scene,
+            params,
+            (x, y),
+            sample,
+            &mut sum,
+            &mut segments,
+            &mut half,
+        );
     }
     PixelPath {
         color: sum / samples as f32,
         segments,
     }
+}
+
+/// The mean of the glossy shader's paths `0..samples` of pixel `(x, y)`,
+/// for any number of them (the shader stops at 16): the converged image
+/// the tradeoff sweep measures against. Not clamped or packed.
+pub fn glossy_mean(scene: &Scene, params: &Params, x: u32, y: u32, samples: u32) -> Vec3 {
+    let mut sum = Vec3::ZERO;
+    let mut segments = Vec::new();
+    for sample in 0..samples.max(1) {
+        segments.clear();
+        glossy_sample(scene, params, x, y, sample, &mut sum, &mut segments);
+    }
+    sum / samples.max(1) as f32
 }
 
 /// One path of the glossy shaders (and of the adaptive one): sample number
@@ -467,12 +547,53 @@ pub fn glossy_sample(
     sum: &mut Vec3,
     segments: &mut Vec<Segment>,
 ) {
+    glossy_path(
+        scene,
+        params,
+        (x, y),
+        sample,
+        sum,
+        segments,
+        &mut Half::off(),
+    );
+}
+
+/// The glossy shader's half-resolution state for one pixel's paths.
+#[derive(Clone, Copy, Debug)]
+struct Half {
+    /// The block pass: the block's top-left pixel traced in full.
+    block_pass: bool,
+    /// What the block pass left for the pixel's block: light beyond the
+    /// first hit, and that hit's roughness (-1: nothing to share).
+    shared: (Vec3, f32),
+    first_roughness: f32,
+}
+
+impl Half {
+    fn off() -> Half {
+        Half {
+            block_pass: false,
+            shared: (Vec3::ZERO, -1.0),
+            first_roughness: -1.0,
+        }
+    }
+}
+
+fn glossy_path(
+    scene: &Scene,
+    params: &Params,
+    (x, y): (u32, u32),
+    sample: u32,
+    sum: &mut Vec3,
+    segments: &mut Vec<Segment>,
+    half: &mut Half,
+) {
     let mut seed = pcg(y * params.width + x) ^ pcg(sample.wrapping_add(0x9E37_79B9));
     let mut origin = params.camera;
     let mut dir = camera_dir(params, x, y);
     let mut t_max = params.t_max;
     let mut throughput = 1.0f32;
-    for _bounce in 0..=params.max_bounces {
+    for bounce in 0..=params.max_bounces {
         let (hit, edge_margin) = intersect(scene, origin, dir, params.t_min, t_max);
         segments.push(Segment {
             origin,
@@ -520,12 +641,21 @@ pub fn glossy_sample(
             } else {
                 throughput = 0.0;
             }
-            t_max = params.t_max / (1.0 + 64.0 * roughness);
+            t_max = params.reflect_t_max / (1.0 + 64.0 * roughness);
         } else {
             dir = reflect(dir, n);
-            t_max = params.t_max;
+            t_max = params.reflect_t_max;
         }
-        if params.light.is_some() {
+        if bounce == 0 {
+            half.first_roughness = roughness;
+            // The block pass shares only rough first hits' reflections.
+            if half.block_pass && roughness <= params.half_res {
+                break;
+            }
+        }
+        // The block pass's light starts beyond the first hit.
+        let local = !(half.block_pass && bounce == 0);
+        if local && params.light.is_some() {
             *sum += base * light.ambient;
             if ndl > 0.0 {
                 let lit = base * ndl;
@@ -542,8 +672,22 @@ pub fn glossy_sample(
                     *sum += lit;
                 }
             }
-        } else {
+        } else if local {
             *sum += base * headlight;
+        }
+        if bounce == 0
+            && !half.block_pass
+            && half.shared.1 == roughness
+            && roughness > params.half_res
+        {
+            *sum += half.shared.0;
+            break;
+        }
+        // Too rough to be worth a ray: the environment answers instead of
+        // the reflection ray the next bounce would trace.
+        if roughness > params.rough_cutoff && bounce < params.max_bounces {
+            *sum += throughput * sky(dir);
+            break;
         }
         if throughput.partial_cmp(&params.cutoff) != Some(std::cmp::Ordering::Greater) {
             break;

@@ -11,13 +11,25 @@ use crate::vk::{
 };
 use std::time::{Duration, Instant};
 
-/// The interface every reflection reference shader declares (set 0).
-pub const BINDINGS: [Binding; 4] = [
+/// The interface every reflection reference shader declares (set 0), and
+/// the glossy shader's half-resolution buffer (the others leave it unused).
+pub const BINDINGS: [Binding; 5] = [
     Binding::new(0, BindingKind::AccelerationStructure),
     Binding::new(1, BindingKind::StorageBuffer),
     Binding::new(2, BindingKind::StorageBuffer),
     Binding::new(3, BindingKind::UniformBuffer),
+    Binding::new(HALF_RES_BINDING, BindingKind::StorageBuffer),
 ];
+
+/// The binding of the glossy shader's half-resolution buffer (`rtlint
+/// tradeoff`'s `half_res` knob): one `vec4<f32>` per 2×2 block.
+pub const HALF_RES_BINDING: u32 = 8;
+
+/// The half-resolution buffer for `params`' image.
+pub fn half_res_buffer(ctx: &Context, params: &Params) -> crate::vk::Result<Buffer> {
+    let blocks = u64::from(params.width.div_ceil(2)) * u64::from(params.height.div_ceil(2));
+    Buffer::new(ctx, blocks * 16, raw::BufferUsageFlags::STORAGE_BUFFER, 1)
+}
 
 /// What a scene with alpha-tested cut-outs adds: the alpha texture (t4,
 /// read with `Load`, one texel per test) and the per-triangle texture
@@ -81,6 +93,9 @@ pub struct GpuScene {
     /// The alpha texture and the `cutouts` buffer, when the scene has
     /// alpha-tested geometry.
     pub cutout: Option<(StorageImage, Buffer)>,
+    /// What [`HALF_RES_BINDING`] gets unless the caller binds a buffer of
+    /// its own: verify never turns half resolution on, so it is never read.
+    pub half_res: Buffer,
 }
 
 impl GpuScene {
@@ -133,10 +148,12 @@ impl GpuScene {
             }
             _ => None,
         };
+        let half_res = Buffer::new(ctx, 16, raw::BufferUsageFlags::STORAGE_BUFFER, 1)?;
         Ok(GpuScene {
             tlas,
             surfaces,
             cutout,
+            half_res,
         })
     }
 
@@ -152,6 +169,7 @@ impl GpuScene {
             (1, Resource::Buffer(image)),
             (2, Resource::Buffer(&self.surfaces)),
             (3, Resource::Buffer(uniform)),
+            (HALF_RES_BINDING, Resource::Buffer(&self.half_res)),
         ];
         if let Some((texture, records)) = &self.cutout {
             r.push((4, Resource::SampledImage(texture.view())));
@@ -436,11 +454,11 @@ mod tests {
         let (p, s) = load("reflect_iterative_hlsl.pipeline.toml", "cutout");
         let built = plan(&p, &s, Passes::SINGLE).unwrap();
         assert_eq!(any_hits(&built), 2);
-        assert_eq!(built.bindings[4..], CUTOUT_BINDINGS);
+        assert_eq!(built.bindings[BINDINGS.len()..], CUTOUT_BINDINGS);
         // The hybrid shader's two passes, with their scratch buffers.
         let (p, s) = load("reflect_hybrid_hlsl.pipeline.toml", "showcase");
         let built = plan(&p, &s, Passes::for_method(Method::Hybrid)).unwrap();
         assert_eq!(built.raygens, 2);
-        assert_eq!(built.bindings[4..], SCRATCH_BINDINGS);
+        assert_eq!(built.bindings[BINDINGS.len()..], SCRATCH_BINDINGS);
     }
 }

@@ -92,6 +92,15 @@ pub struct DeviceInfo {
     pub runtime_descriptor_array: bool,
 }
 
+/// What timestamp queries on the chosen queue measure: `timestampValidBits`
+/// of its family and the device's `timestampPeriod` (nanoseconds per tick).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Timestamps {
+    /// 0: the queue cannot write timestamps.
+    pub valid_bits: u32,
+    pub period_ns: f32,
+}
+
 /// Everything the Vulkan objects need to destroy themselves; resources hold an
 /// `Arc` to it, so the device outlives every buffer, structure and pipeline.
 pub(crate) struct Shared {
@@ -105,6 +114,7 @@ pub(crate) struct Shared {
     pub(crate) command_pool: vk::CommandPool,
     pub(crate) memory: vk::PhysicalDeviceMemoryProperties,
     pub(crate) info: DeviceInfo,
+    pub(crate) timestamps: Timestamps,
     pub(crate) fence_timeout: Duration,
     /// The command pool and queue need external synchronisation.
     pub(crate) submit_lock: Mutex<()>,
@@ -151,6 +161,7 @@ struct Candidate {
     physical: vk::PhysicalDevice,
     queue_family: u32,
     info: DeviceInfo,
+    timestamps: Timestamps,
     /// Shader features enabled where the device has them, so that shaders
     /// using descriptor indexing, format-less storage images, 16-bit
     /// integers or doubles can be created.
@@ -222,6 +233,11 @@ impl Context {
 
     pub fn info(&self) -> &DeviceInfo {
         &self.shared.info
+    }
+
+    /// What timestamp queries measure on this device's queue.
+    pub fn timestamps(&self) -> Timestamps {
+        self.shared.timestamps
     }
 
     pub fn limits(&self) -> &RayTracingLimits {
@@ -335,6 +351,7 @@ fn open_device(
         command_pool,
         memory,
         info: candidate.info,
+        timestamps: candidate.timestamps,
         fence_timeout: options.fence_timeout,
         submit_lock: Mutex::new(()),
         timed_out: AtomicBool::new(false),
@@ -457,10 +474,15 @@ fn examine(
         .iter()
         .position(|q| q.queue_flags.contains(vk::QueueFlags::COMPUTE))
         .ok_or_else(|| format!("{name}: no compute queue"))? as u32;
+    let timestamps = Timestamps {
+        valid_bits: families[queue_family as usize].timestamp_valid_bits,
+        period_ns: props.limits.timestamp_period,
+    };
 
     Ok(Candidate {
         physical,
         queue_family,
+        timestamps,
         info: DeviceInfo {
             name,
             driver: format!(

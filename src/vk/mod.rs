@@ -30,6 +30,7 @@ mod image;
 mod interface;
 mod pipeline;
 mod stack_query;
+mod timing;
 mod validation;
 
 pub use accel::{Aabb, AccelerationStructure, Geometry, Instance, IDENTITY};
@@ -38,7 +39,7 @@ pub use child::{
     run_command, run_in_child, run_in_child_with_timeout, spawn_command, ChildOutcome,
     RunningChild, CHILD_ENV, DEFAULT_CHILD_TIMEOUT,
 };
-pub use context::{Context, ContextOptions, DeviceInfo, RayTracingLimits};
+pub use context::{Context, ContextOptions, DeviceInfo, RayTracingLimits, Timestamps};
 pub use descriptors::{Binding, BindingKind, Resource};
 pub use error::{Error, Result};
 pub use image::{Sampler, StorageImage};

@@ -504,6 +504,130 @@ impl RayTracingPipeline {
     }
 }
 
+impl RayTracingPipeline {
+    /// Device time of `repeats` runs of `passes` (each a trace of `[width,
+    /// height]` rays from the given ray generation group, in order, each
+    /// seeing the writes of the one before), from timestamp queries, after
+    /// `warmup` untimed runs (lavapipe compiles the pipeline at its first
+    /// dispatch). The `clear` buffers (made with `TRANSFER_DST` usage) are
+    /// zeroed before each timed run, outside its timestamps: state that
+    /// passes accumulate starts afresh. Nanoseconds per run, in order.
+    pub fn time_trace_rays(
+        &self,
+        resources: &[(u32, Resource<'_>)],
+        passes: &[(usize, [u32; 2])],
+        clear: &[&Buffer],
+        warmup: u32,
+        repeats: u32,
+    ) -> Result<Vec<f64>> {
+        for _ in 0..warmup {
+            for &(raygen, [width, height]) in passes {
+                self.trace_rays_from(raygen, resources, width, height, 1)?;
+            }
+        }
+        if let Some(&(raygen, _)) = passes.iter().find(|p| p.0 >= self.sbt.raygen.len()) {
+            return Err(Error::Invalid(format!(
+                "the pipeline has {} ray generation groups, not {}",
+                self.sbt.raygen.len(),
+                raygen + 1
+            )));
+        }
+        self.descriptors.write(resources)?;
+        let d = &self.shared.device;
+        super::timing::timed_dispatches(
+            &self.shared,
+            repeats,
+            vk::PipelineStageFlags::RAY_TRACING_SHADER_KHR,
+            |cmd| {
+                // SAFETY: cmd is recording; pipeline and set are live.
+                unsafe {
+                    d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::RAY_TRACING_KHR, self.pipeline);
+                    bind_set(
+                        d,
+                        cmd,
+                        vk::PipelineBindPoint::RAY_TRACING_KHR,
+                        &self.descriptors,
+                    );
+                    if let Some(bytes) = self.stack_size {
+                        self.shared
+                            .rt
+                            .cmd_set_ray_tracing_pipeline_stack_size(cmd, bytes);
+                    }
+                }
+            },
+            |cmd| {
+                if clear.is_empty() {
+                    return;
+                }
+                let rt = vk::PipelineStageFlags::RAY_TRACING_SHADER_KHR;
+                let transfer = vk::PipelineStageFlags::TRANSFER;
+                let to_fill = vk::MemoryBarrier::default()
+                    .src_access_mask(vk::AccessFlags::SHADER_READ | vk::AccessFlags::SHADER_WRITE)
+                    .dst_access_mask(vk::AccessFlags::TRANSFER_WRITE);
+                let to_shader = vk::MemoryBarrier::default()
+                    .src_access_mask(vk::AccessFlags::TRANSFER_WRITE)
+                    .dst_access_mask(vk::AccessFlags::SHADER_READ | vk::AccessFlags::SHADER_WRITE);
+                // SAFETY: cmd is recording; the buffers outlive the submission.
+                unsafe {
+                    d.cmd_pipeline_barrier(
+                        cmd,
+                        rt,
+                        transfer,
+                        vk::DependencyFlags::empty(),
+                        &[to_fill],
+                        &[],
+                        &[],
+                    );
+                    for b in clear {
+                        d.cmd_fill_buffer(cmd, b.raw(), b.offset(), b.size(), 0);
+                    }
+                    d.cmd_pipeline_barrier(
+                        cmd,
+                        transfer,
+                        rt,
+                        vk::DependencyFlags::empty(),
+                        &[to_shader],
+                        &[],
+                        &[],
+                    );
+                }
+            },
+            |cmd| {
+                let stage = vk::PipelineStageFlags::RAY_TRACING_SHADER_KHR;
+                let barrier = vk::MemoryBarrier::default()
+                    .src_access_mask(vk::AccessFlags::SHADER_WRITE)
+                    .dst_access_mask(vk::AccessFlags::SHADER_READ | vk::AccessFlags::SHADER_WRITE);
+                for (k, &(raygen, [width, height])) in passes.iter().enumerate() {
+                    // SAFETY: bound above; the SBT outlives the submission.
+                    unsafe {
+                        if k > 0 {
+                            d.cmd_pipeline_barrier(
+                                cmd,
+                                stage,
+                                stage,
+                                vk::DependencyFlags::empty(),
+                                &[barrier],
+                                &[],
+                                &[],
+                            );
+                        }
+                        self.shared.rt.cmd_trace_rays(
+                            cmd,
+                            &self.sbt.raygen[raygen].raw(),
+                            &self.sbt.miss.raw(),
+                            &self.sbt.hit.raw(),
+                            &self.sbt.callable.raw(),
+                            width,
+                            height,
+                            1,
+                        )
+                    }
+                }
+            },
+        )
+    }
+}
+
 impl Drop for RayTracingPipeline {
     fn drop(&mut self) {
         if self.shared.hung() {
@@ -754,6 +878,40 @@ impl ComputePipeline {
                 d.cmd_dispatch(cmd, x, y, z);
             }
         })
+    }
+}
+
+impl ComputePipeline {
+    /// As [`RayTracingPipeline::time_trace_rays`] for `x × y × z`
+    /// workgroups: nanoseconds per timed dispatch.
+    pub fn time_dispatch(
+        &self,
+        resources: &[(u32, Resource<'_>)],
+        groups: [u32; 3],
+        warmup: u32,
+        repeats: u32,
+    ) -> Result<Vec<f64>> {
+        let [x, y, z] = groups;
+        for _ in 0..warmup {
+            self.dispatch(resources, x, y, z)?;
+        }
+        self.descriptors.write(resources)?;
+        let d = &self.shared.device;
+        super::timing::timed_dispatches(
+            &self.shared,
+            repeats,
+            vk::PipelineStageFlags::COMPUTE_SHADER,
+            |cmd| {
+                // SAFETY: cmd is recording; pipeline and set are live.
+                unsafe {
+                    d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, self.pipeline);
+                    bind_set(d, cmd, vk::PipelineBindPoint::COMPUTE, &self.descriptors);
+                }
+            },
+            |_| {},
+            // SAFETY: bound above.
+            |cmd| unsafe { d.cmd_dispatch(cmd, x, y, z) },
+        )
     }
 }
 
