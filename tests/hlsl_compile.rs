@@ -1413,6 +1413,10 @@ fn sixteen_bit_types_with_the_flag() {
     assert!(images
         .iter()
         .any(|o| o[1] == float && o[6] == 2 && o[7] == 2));
+    // Wave reductions keep 16 bits: OpGroupNonUniformFAdd (350) of half,
+    // OpGroupNonUniformSMin (353) of int16_t.
+    assert!(insts.iter().any(|(op, o)| *op == 350 && o[0] == half));
+    assert!(insts.iter().any(|(op, o)| *op == 353 && o[0] == short));
     // half + float is float: OpFConvert (115) widens.
     assert!(insts.iter().any(|(op, _)| *op == 115));
 

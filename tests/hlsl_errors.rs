@@ -688,10 +688,6 @@ fn sixteen_bit_types_are_refused_rather_than_widened() {
         "2:47: not supported: `ddx` of 16-bit values"
     );
     assert_eq!(
-        with_flag("RWStructuredBuffer<half> o;\n[numthreads(1,1,1)]\nvoid m() { o[0] = WaveActiveSum(o[1]); }"),
-        "3:34: not supported: `WaveActiveSum` of a `float16_t`"
-    );
-    assert_eq!(
         with_flag("[[vk::constant_id(1)]] const half k = 1;\n[numthreads(1,1,1)]\nvoid m() { }"),
         "1:35: not supported: 16-bit specialization constants"
     );

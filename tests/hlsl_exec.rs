@@ -745,7 +745,7 @@ fn sixteen_bit_arithmetic_on_the_driver() {
     };
     if !ctx.info().sixteen_bit {
         println!(
-            "16-bit part not run: {} lacks shaderFloat16/shaderInt16/16-bit storage",
+            "16-bit part not run: {} lacks shaderFloat16/shaderInt16/16-bit storage/subgroup extended types",
             ctx.info().name
         );
         return;
@@ -766,10 +766,10 @@ fn sixteen_bit_arithmetic_on_the_driver() {
     };
     // 1.75, 2.0, 2052.0 (2051 rounded to a half), 1.5, 2.625, -3.0, 0.1
     // rounded to a half (0.0999755859375), 11.0 (a half matrix product),
-    // 2.5 (1.5 and 1.0 through their bits).
+    // 2.5 (1.5 and 1.0 through their bits), 3.0 (a one-lane wave sum).
     assert_eq!(
-        halves(&outs[0], 9),
-        vec![0x3f00, 0x4000, 0x6802, 0x3e00, 0x4140, 0xc200, 0x2e66, 0x4980, 0x4100]
+        halves(&outs[0], 10),
+        vec![0x3f00, 0x4000, 0x6802, 0x3e00, 0x4140, 0xc200, 0x2e66, 0x4980, 0x4100, 0x4200]
     );
     // ..., and the bits of half -0.5 (0xb800) as an int16.
     let ints: Vec<i16> = halves(&outs[1], 5).iter().map(|v| *v as i16).collect();

@@ -73,8 +73,9 @@ pub struct DeviceInfo {
     /// `primitive_index` needs `geometryShader`.
     pub geometry_shader: bool,
     pub shader_int64: bool,
-    /// 16-bit arithmetic (`shaderFloat16` and `shaderInt16`) and 16-bit
-    /// values in storage and uniform buffers, all enabled when present
+    /// 16-bit arithmetic (`shaderFloat16` and `shaderInt16`), 16-bit wave
+    /// operations (`shaderSubgroupExtendedTypes`) and 16-bit values in
+    /// storage and uniform buffers, all enabled when present
     /// (HLSL compiled with `-enable-16bit-types`).
     pub sixteen_bit: bool,
     /// `shaderStorageImageReadWithoutFormat` and `…WriteWithoutFormat`,
@@ -185,6 +186,8 @@ struct OptionalFeatures {
     /// shaders compiled with 16-bit types.
     shader_float16: bool,
     storage16: [bool; 4],
+    /// Group operations on 16-bit (and 8-bit, 64-bit) values.
+    subgroup_extended_types: bool,
 }
 
 impl Context {
@@ -503,6 +506,7 @@ fn examine(
             shader_int64: core.shader_int64 == vk::TRUE,
             sixteen_bit: f12.shader_float16 == vk::TRUE
                 && core.shader_int16 == vk::TRUE
+                && f12.shader_subgroup_extended_types == vk::TRUE
                 && f11.storage_buffer16_bit_access == vk::TRUE
                 && f11.uniform_and_storage_buffer16_bit_access == vk::TRUE,
             storage_image_without_format: core.shader_storage_image_read_without_format == vk::TRUE
@@ -559,6 +563,7 @@ fn examine(
             partially_bound: f12.descriptor_binding_partially_bound == vk::TRUE,
             variable_count: f12.descriptor_binding_variable_descriptor_count == vk::TRUE,
             shader_float16: f12.shader_float16 == vk::TRUE,
+            subgroup_extended_types: f12.shader_subgroup_extended_types == vk::TRUE,
             storage16: [
                 f11.storage_buffer16_bit_access == vk::TRUE,
                 f11.uniform_and_storage_buffer16_bit_access == vk::TRUE,
@@ -601,7 +606,8 @@ fn create_device(instance: &ash::Instance, c: &Candidate) -> Result<ash::Device>
         .shader_storage_texel_buffer_array_non_uniform_indexing(o.storage_texel_non_uniform)
         .descriptor_binding_partially_bound(o.partially_bound)
         .descriptor_binding_variable_descriptor_count(o.variable_count)
-        .shader_float16(o.shader_float16);
+        .shader_float16(o.shader_float16)
+        .shader_subgroup_extended_types(o.subgroup_extended_types);
     let mut f11 = vk::PhysicalDeviceVulkan11Features::default()
         .storage_buffer16_bit_access(o.storage16[0])
         .uniform_and_storage_buffer16_bit_access(o.storage16[1])

@@ -35,6 +35,8 @@ void Main(uint3 id : SV_DispatchThreadID)
     OutH[5] = m > a ? m : -m;
     OutH[6] = (half)(base / 100.0);
     // Row vector (3, 1, 0) times a half3x3: the middle column, 2*3 + 5 = 11.
+    // One lane: the sum is its own value.
+    OutH[9] = WaveActiveSum(a);
     OutH[7] = mul(half3(a, 1, 0), half3x3(1, 2, 3, 4, 5, 6, 7, 8, 9)).y;
 
     OutI[0] = neg * (int16_t)a;

@@ -86,6 +86,9 @@ void cs(uint3 id : SV_DispatchThreadID, uint gi : SV_GroupIndex)
     p.a += n.z + determinant(tbn) + tbn._m22;
     // f32tof16 takes a half as the float it is exactly.
     p.e += (uint16_t)f32tof16(h);
+    // Wave operations on 16-bit values (shaderSubgroupExtendedTypes).
+    p.a += WaveActiveSum(h) + WavePrefixProduct(m) + WaveReadLaneFirst(v).x;
+    p.d += WaveActiveMin(i) + (int16_t)WaveActiveBitOr(u);
     packed[id.x] = p;
     halves[id.x] = h > m ? h : -m + arr[1] + arr[2];
 }
