@@ -736,7 +736,8 @@ fn ray_tracing_differential_against_slang_on_the_driver() {
 }
 
 /// 16-bit types (`-enable-16bit-types`) compute in 16 bits on the driver:
-/// half results and matrices, `asfloat16`/`asuint16`/`asint16`, int16 wrap-around, uint16 shifts, conversions both ways,
+/// half results and matrices, `asfloat16`/`asuint16`/`asint16`, 16-bit
+/// `ByteAddressBuffer.Load<T>`, a wave sum, int16 wrap-around, uint16 shifts, conversions both ways,
 /// and 16-bit values read from a constant buffer.
 #[test]
 fn sixteen_bit_arithmetic_on_the_driver() {
@@ -766,15 +767,21 @@ fn sixteen_bit_arithmetic_on_the_driver() {
     };
     // 1.75, 2.0, 2052.0 (2051 rounded to a half), 1.5, 2.625, -3.0, 0.1
     // rounded to a half (0.0999755859375), 11.0 (a half matrix product),
-    // 2.5 (1.5 and 1.0 through their bits), 3.0 (a one-lane wave sum).
+    // 2.5 (1.5 and 1.0 through their bits), 3.0 (a one-lane wave sum),
+    // 9.0 (2 + 3 + 4 loaded from bytes 2, 4 and 6).
     assert_eq!(
-        halves(&outs[0], 10),
-        vec![0x3f00, 0x4000, 0x6802, 0x3e00, 0x4140, 0xc200, 0x2e66, 0x4980, 0x4100, 0x4200]
+        halves(&outs[0], 11),
+        vec![
+            0x3f00, 0x4000, 0x6802, 0x3e00, 0x4140, 0xc200, 0x2e66, 0x4980, 0x4100, 0x4200, 0x4880
+        ]
     );
     // ..., and the bits of half -0.5 (0xb800) as an int16.
     let ints: Vec<i16> = halves(&outs[1], 5).iter().map(|v| *v as i16).collect();
     assert_eq!(ints, vec![-6, i16::MIN, -9, 1, 0xb800u16 as i16]);
-    assert_eq!(halves(&outs[2], 4), vec![0xe000, 0xffff, 0x3e00, !7u16]);
+    assert_eq!(
+        halves(&outs[2], 5),
+        vec![0xe000, 0xffff, 0x3e00, !7u16, 0x4400]
+    );
     // (half)0.1 folded at compile time is the same half: 1638 / 2^14.
     let floats: Vec<f32> = outs[3]
         .chunks(4)
@@ -799,6 +806,13 @@ fn run_half(ctx: &Context, words: &[u32], entry: &str) -> Vec<Vec<u8>> {
         .map(|b| (BindingKind::StorageBuffer, Resource::Buffer(b)))
         .collect();
     list.push((BindingKind::UniformBuffer, Resource::Buffer(&ubo)));
+    // Halves 1.0, 2.0, 3.0, 4.0 for the ByteAddressBuffer's 16-bit loads.
+    let raw_bytes: Vec<u8> = [0x3c00u16, 0x4000, 0x4200, 0x4400]
+        .iter()
+        .flat_map(|h| h.to_le_bytes())
+        .collect();
+    let raw = Buffer::from_data(ctx, STORAGE, &raw_bytes).unwrap();
+    list.push((BindingKind::StorageBuffer, Resource::Buffer(&raw)));
     dispatch(ctx, words, entry, &list);
     outs.iter().map(|b| b.read()).collect()
 }

@@ -12,6 +12,7 @@ RWStructuredBuffer<half> OutH : register(u0);
 RWStructuredBuffer<int16_t> OutI : register(u1);
 RWStructuredBuffer<uint16_t> OutU : register(u2);
 RWStructuredBuffer<float> OutF : register(u3);
+ByteAddressBuffer Raw : register(t5);
 cbuffer Inputs : register(b4)
 {
     half scale;      // 0.5
@@ -52,6 +53,10 @@ void Main(uint3 id : SV_DispatchThreadID)
     // The bits of half 1.5 (0x3e00), and back.
     OutU[2] = asuint16(scale * a);
     OutU[3] = ~count;
+    // 16-bit loads at 2-byte addresses: the high half of word 0, then word 1's halves.
+    half3 raw = Raw.Load<half3>(s + 2);
+    OutH[10] = raw.x + raw.y + raw.z;
+    OutU[4] = Raw.Load<uint16_t>(s + 6);
     OutH[8] = asfloat16(OutU[2]) + asfloat16((int16_t)0x3c00);
     OutI[4] = asint16(-scale);
 
