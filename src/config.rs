@@ -69,6 +69,28 @@ impl Level {
     }
 }
 
+/// How deep `rtlint check` looks (`analysis = "fast"` in `rtlint.toml`,
+/// `--analysis` on the command line).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, PartialOrd, Ord, Hash, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum AnalysisLevel {
+    /// Layouts, ray flags and constant operands: the rules that need no
+    /// dataflow.
+    Fast,
+    /// Everything: liveness, recursion guards, uniformity, the stack model.
+    #[default]
+    Full,
+}
+
+impl AnalysisLevel {
+    pub fn as_str(self) -> &'static str {
+        match self {
+            AnalysisLevel::Fast => "fast",
+            AnalysisLevel::Full => "full",
+        }
+    }
+}
+
 #[derive(Clone, Debug, Default, serde::Deserialize)]
 #[serde(deny_unknown_fields, rename_all = "kebab-case")]
 pub struct Config {
@@ -87,6 +109,10 @@ pub struct Config {
     /// Warnings fail the run too.
     #[serde(default)]
     pub deny_warnings: bool,
+    /// Which rules run by what they need: `fast` leaves out the dataflow
+    /// rules.
+    #[serde(default)]
+    pub analysis: AnalysisLevel,
     /// Per rule, by code (`RT001`) or name (`payload-over-budget`): a level
     /// (`RT003 = "allow"`) or a table with a level and the rule's options
     /// (`[rules.RT001]` `level = "error"`, `budget = 48`).

@@ -5,6 +5,7 @@
 
 pub mod analysis;
 pub mod build;
+pub mod cache;
 pub mod config;
 pub mod diag;
 pub mod explain;

@@ -34,6 +34,8 @@ pub struct Overrides {
     pub ignore: Vec<String>,
     pub payload_budget: Option<u64>,
     pub deny_warnings: bool,
+    /// `--analysis`: which rules run by what they need.
+    pub analysis: Option<crate::config::AnalysisLevel>,
 }
 
 /// How to lint.
@@ -53,6 +55,34 @@ pub struct Options {
     pub stdin: Option<Vec<u8>>,
     /// The name standard input is linted under (`--stdin-filename`).
     pub stdin_filename: Option<PathBuf>,
+    /// The result cache's folder; `None`: no cache.
+    pub cache: Option<PathBuf>,
+    /// Check only this part of the files (`--shard K/N`).
+    pub shard: Option<Shard>,
+}
+
+/// Part `index` (1-based) of `count`: folders are dealt out whole, so the
+/// shaders a loose pipeline groups together stay on one shard.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Shard {
+    pub index: u32,
+    pub count: u32,
+}
+
+impl std::str::FromStr for Shard {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        let bad = || format!("`{s}` is not a shard: write K/N with 1 ≤ K ≤ N, e.g. 2/4");
+        let (k, n) = s.split_once('/').ok_or_else(bad)?;
+        let (index, count) = (
+            k.trim().parse::<u32>().map_err(|_| bad())?,
+            n.trim().parse::<u32>().map_err(|_| bad())?,
+        );
+        if index == 0 || index > count {
+            return Err(bad());
+        }
+        Ok(Shard { index, count })
+    }
 }
 
 impl Default for Options {
@@ -66,6 +96,8 @@ impl Default for Options {
             respect_gitignore: true,
             stdin: None,
             stdin_filename: None,
+            cache: None,
+            shard: None,
         }
     }
 }
@@ -113,37 +145,104 @@ impl Report {
 /// Lints `paths` (files, folders, or `-` for standard input).
 pub fn check_paths(paths: &[PathBuf], options: &Options) -> Report {
     let mut configs = Configs::new(options);
-    let inputs = collect(paths, options, &mut configs);
+    let mut inputs = collect(paths, options, &mut configs);
+    // Shaders a description uses are checked with it (on the description's
+    // shard), never as loose shaders: on every shard.
+    let descriptions: Vec<Vec<PathBuf>> = inputs
+        .pipelines
+        .iter()
+        .map(|(p, _)| described_shaders(p))
+        .collect();
+    if let Some(shard) = options.shard {
+        keep_shard(&mut inputs, &descriptions, shard);
+    }
+    let described: HashSet<PathBuf> = descriptions.into_iter().flatten().collect();
+    let cache = options.cache.as_deref().and_then(crate::cache::Cache::open);
     let mut report = Report {
         files: inputs.files.iter().map(|i| i.path.clone()).collect(),
         pipelines: inputs.pipelines.iter().map(|(p, _)| p.clone()).collect(),
         skipped: inputs.skipped.clone(),
         ..Report::default()
     };
+    // A config that cannot be read is reported once, by the first shard.
+    if options.shard.is_some_and(|s| s.index != 1) {
+        configs.errors.clear();
+    }
     let mut diagnostics: Vec<Diagnostic> = configs.errors.clone();
     diagnostics.extend(inputs.errors.iter().map(|e| (*e.0).clone()));
-    // Files in parallel; collected in input order, so output is the same
-    // whatever the thread count.
-    let checked: Vec<Checked> = inputs
-        .files
-        .par_iter()
-        .map(|input| check_input_with(input, &input.config, options))
-        .collect();
     let mut owned: Vec<PathBuf> = Vec::new();
-    let mut programs: Vec<(Program, Subobjects)> = Vec::new();
-    for c in checked {
-        if let Some(p) = &c.program {
-            for f in &p.files {
-                if let Some(t) = &f.text {
-                    report.embedded.push((f.path.clone(), t.clone()));
+    // The loose pipelines: each group's members (input indices) and, once
+    // checked, its findings. A folder's group is checked as soon as its last
+    // input is, and its Programs dropped: memory follows the largest folder,
+    // not the tree.
+    let mut groups: Vec<(PathBuf, Vec<usize>, Option<Vec<Diagnostic>>)> = Vec::new();
+    let mut group_of: HashMap<PathBuf, usize> = HashMap::new();
+    let folder = |p: &Path| p.parent().map(Path::to_path_buf).unwrap_or_default();
+    let mut last_in: HashMap<PathBuf, usize> = HashMap::new();
+    for (i, input) in inputs.files.iter().enumerate() {
+        last_in.insert(folder(&input.path), i);
+    }
+    let mut outcomes: Vec<Outcome> = Vec::with_capacity(inputs.files.len());
+    const CHUNK: usize = 512;
+    for (ci, chunk) in inputs.files.chunks(CHUNK).enumerate() {
+        // Files in parallel; collected in input order, so output is the
+        // same whatever the thread count.
+        let checked: Vec<Outcome> = chunk
+            .par_iter()
+            .map(|input| check_cached(input, options, cache.as_ref()))
+            .collect();
+        for (k, mut c) in checked.into_iter().enumerate() {
+            let i = ci * CHUNK + k;
+            if c.analysed {
+                for (path, text) in c.files.drain(..) {
+                    if let Some(t) = text {
+                        report.embedded.push((path.clone(), t));
+                    }
+                    owned.push(path);
                 }
-                owned.push(f.path.clone());
+                // Suppressions are judged only in inputs that were analysed.
+                owned.push(inputs.files[i].path.clone());
             }
-            // Suppressions are judged only in inputs that were analysed.
-            owned.push(c.path.clone());
+            diagnostics.append(&mut c.diagnostics);
+            if let Some(g) = &c.group {
+                match group_of.get(g) {
+                    Some(&k) => groups[k].1.push(i),
+                    None => {
+                        group_of.insert(g.clone(), groups.len());
+                        groups.push((g.clone(), vec![i], None));
+                    }
+                }
+            }
+            outcomes.push(c);
         }
-        diagnostics.extend(c.diagnostics);
-        programs.extend(c.program.map(|p| (p, c.subobjects)));
+        let done = ci * CHUNK + chunk.len();
+        let Some(first) = inputs.files.first() else {
+            continue;
+        };
+        for (dir, members, found) in groups.iter_mut() {
+            // A group named by a file (a whole pipeline in one module) is
+            // complete at once; a folder's after its last input.
+            if found.is_some() || last_in.get(dir.as_path()).is_some_and(|&l| l >= done) {
+                continue;
+            }
+            let members: Vec<usize> = members
+                .iter()
+                .copied()
+                .filter(|&i| !described.contains(&canonical(&inputs.files[i].path)))
+                .collect();
+            *found = Some(if members.is_empty() {
+                Vec::new()
+            } else {
+                check_group_cached(
+                    &members,
+                    &inputs.files,
+                    &mut outcomes,
+                    &first.config,
+                    options,
+                    cache.as_ref(),
+                )
+            });
+        }
     }
     let pipelines: Vec<Checked> = inputs
         .pipelines
@@ -155,13 +254,8 @@ pub fn check_paths(paths: &[PathBuf], options: &Options) -> Report {
     }
     // Shaders no description uses still get the pipeline rules, under the
     // assumption that every trace reaches every shader.
-    let described: Vec<PathBuf> = inputs
-        .pipelines
-        .iter()
-        .flat_map(|(p, _)| described_shaders(p))
-        .collect();
-    if let Some(first) = inputs.files.first() {
-        diagnostics.extend(check_loose(programs, &described, &first.config));
+    for (_, _, found) in groups {
+        diagnostics.extend(found.into_iter().flatten());
     }
     report.deny_warnings = options.overrides.deny_warnings
         || inputs.files.iter().any(|i| i.config.deny_warnings)
@@ -333,6 +427,9 @@ impl Configs {
             config.set_option("RT001", "budget", toml::Value::Integer(b as i64));
         }
         config.deny_warnings |= o.deny_warnings;
+        if let Some(a) = o.analysis {
+            config.analysis = a;
+        }
         let c = Arc::new(config);
         self.by_file.insert(key, c.clone());
         c
@@ -799,53 +896,301 @@ pub fn check_loose(
     described: &[PathBuf],
     config: &Config,
 ) -> Vec<Diagnostic> {
-    let mut out = Vec::new();
-    let mut run = |pipeline: &crate::pipeline::Pipeline, note: String| {
-        let ctx = crate::rules::PipelineContext::new(pipeline, config);
-        out.extend(
-            crate::rules::check_pipeline(&ctx)
-                .into_iter()
-                .map(|d| d.with_note(note.clone())),
-        );
-    };
-    let mut groups: Vec<(PathBuf, Vec<Program>)> = Vec::new();
+    let mut groups: Vec<(PathBuf, Vec<(Program, Subobjects)>)> = Vec::new();
     for (p, subobjects) in programs {
         if described.contains(&canonical(&p.path)) {
             continue;
         }
-        let p = match crate::pipeline::Pipeline::from_subobjects(p, &subobjects) {
-            Ok(pipeline) => {
-                run(&pipeline, Assumption::FromSubobjects.to_string());
-                continue;
-            }
-            Err(p) => *p,
-        };
-        let has_rt = p.entry_points.iter().any(|e| e.stage.is_ray_tracing());
-        if !has_rt {
+        let Some(dir) = loose_group(&p, &subobjects) else {
             continue;
-        }
-        // A file holding a ray generation shader and others (WGSL, HLSL) is
-        // a pipeline of its own; one-stage modules pipeline with their folder.
-        let whole = p
-            .entry_points
-            .iter()
-            .any(|e| e.stage == crate::shader::Stage::RayGeneration)
-            && p.entry_points.len() > 1;
-        let dir = if whole {
-            p.path.clone()
-        } else {
-            p.path.parent().map(Path::to_path_buf).unwrap_or_default()
         };
         match groups.iter_mut().find(|(d, _)| *d == dir) {
-            Some((_, g)) => g.push(p),
-            None => groups.push((dir, vec![p])),
+            Some((_, g)) => g.push((p, subobjects)),
+            None => groups.push((dir, vec![(p, subobjects)])),
         }
     }
+    let mut out = Vec::new();
     for (_, programs) in groups {
-        let pipeline = crate::pipeline::Pipeline::from_programs(programs);
-        run(&pipeline, Assumption::Undescribed.to_string());
+        out.extend(check_group(programs, config));
     }
     out
+}
+
+/// The loose pipeline a module belongs to: an HLSL library whose DXR
+/// subobjects describe a pipeline, or a file holding a ray generation shader
+/// and others (WGSL, HLSL), is a pipeline of its own; one-stage modules
+/// pipeline with their folder. `None` without ray-tracing stages.
+fn loose_group(p: &Program, subobjects: &Subobjects) -> Option<PathBuf> {
+    let has_raygen = p
+        .entry_points
+        .iter()
+        .any(|e| e.stage == crate::shader::Stage::RayGeneration);
+    let describes = !subobjects.pipeline_configs.is_empty()
+        || !subobjects.shader_configs.is_empty()
+        || !subobjects.hit_groups.is_empty();
+    if describes && has_raygen {
+        return Some(p.path.clone());
+    }
+    if !p.entry_points.iter().any(|e| e.stage.is_ray_tracing()) {
+        return None;
+    }
+    Some(if has_raygen && p.entry_points.len() > 1 {
+        p.path.clone()
+    } else {
+        p.path.parent().map(Path::to_path_buf).unwrap_or_default()
+    })
+}
+
+/// The pipeline rules over one loose group, each finding noting what was
+/// assumed: the pipeline a library's subobjects describe, else every trace
+/// reaching every shader.
+fn check_group(mut programs: Vec<(Program, Subobjects)>, config: &Config) -> Vec<Diagnostic> {
+    let run = |pipeline: &crate::pipeline::Pipeline, note: String| -> Vec<Diagnostic> {
+        let ctx = crate::rules::PipelineContext::new(pipeline, config);
+        crate::rules::check_pipeline(&ctx)
+            .into_iter()
+            .map(|d| d.with_note(note.clone()))
+            .collect()
+    };
+    if programs.len() == 1 {
+        let (p, subobjects) = programs.remove(0);
+        return match crate::pipeline::Pipeline::from_subobjects(p, &subobjects) {
+            Ok(pipeline) => run(&pipeline, Assumption::FromSubobjects.to_string()),
+            Err(p) => run(
+                &crate::pipeline::Pipeline::from_programs(vec![*p]),
+                Assumption::Undescribed.to_string(),
+            ),
+        };
+    }
+    let pipeline =
+        crate::pipeline::Pipeline::from_programs(programs.into_iter().map(|(p, _)| p).collect());
+    run(&pipeline, Assumption::Undescribed.to_string())
+}
+
+/// One input's outcome in [`check_paths`]: computed, or read from the cache
+/// (then without a Program, which a loose pipeline group loads only when its
+/// own entry misses).
+struct Outcome {
+    /// Loaded and analysed (suppressions in its files are judged).
+    analysed: bool,
+    program: Option<(Program, Subobjects)>,
+    diagnostics: Vec<Diagnostic>,
+    /// The module's source files and the text it embeds.
+    files: Vec<(PathBuf, Option<String>)>,
+    /// Its loose pipeline group.
+    group: Option<PathBuf>,
+    /// Its cache key, when the cache is on and the input could be read.
+    key: Option<crate::cache::Key>,
+}
+
+/// The cache key of an input under its config and the options.
+fn input_key(input: &Input, options: &Options) -> Option<crate::cache::Key> {
+    let contents;
+    let bytes = match &input.contents {
+        Some(c) => c.as_slice(),
+        None => {
+            contents = std::fs::read(&input.path).ok()?;
+            contents.as_slice()
+        }
+    };
+    let front = front_options(&input.config, options);
+    let mut k = crate::cache::base_key();
+    k.add(&input.path)
+        .add(format!("{:?}", input.language))
+        .add(bytes)
+        .add(format!("{:?}", input.config))
+        .add(format!("{front:?}"));
+    Some(k.finish())
+}
+
+fn check_cached(input: &Input, options: &Options, cache: Option<&crate::cache::Cache>) -> Outcome {
+    let key = cache.and_then(|_| input_key(input, options));
+    if let (Some(cache), Some(key)) = (cache, key) {
+        if let Some(entry) = cache.get(key) {
+            if let Some(diagnostics) = crate::cache::load_all(entry.diagnostics) {
+                return Outcome {
+                    analysed: true,
+                    program: None,
+                    diagnostics,
+                    files: entry.files,
+                    group: entry.group,
+                    key: Some(key),
+                };
+            }
+        }
+    }
+    let c = check_input_with(input, &input.config, options);
+    let files: Vec<(PathBuf, Option<String>)> = c
+        .program
+        .iter()
+        .flat_map(|p| p.files.iter().map(|f| (f.path.clone(), f.text.clone())))
+        .collect();
+    let group = c
+        .program
+        .as_ref()
+        .and_then(|p| loose_group(p, &c.subobjects));
+    if let (Some(cache), Some(key), Some(_)) = (cache, key, &c.program) {
+        if let Some(diagnostics) = crate::cache::store_all(&c.diagnostics) {
+            // Everything the module names besides the input itself: includes,
+            // and sources debug info points at (rules read their text).
+            let deps = files
+                .iter()
+                .map(|(p, _)| p)
+                .filter(|p| **p != input.path)
+                .map(|p| (p.clone(), crate::cache::dep_hash(p)))
+                .collect();
+            cache.put(
+                key,
+                &crate::cache::Entry {
+                    deps,
+                    files: files.clone(),
+                    diagnostics,
+                    group: group.clone(),
+                },
+            );
+        }
+    }
+    Outcome {
+        analysed: c.program.is_some(),
+        // Only modules with ray-tracing stages join a loose pipeline.
+        program: c
+            .program
+            .filter(|_| group.is_some())
+            .map(|p| (p, c.subobjects)),
+        diagnostics: c.diagnostics,
+        files,
+        group,
+        key,
+    }
+}
+
+/// The pipeline rules over one loose group (`members`: indices into
+/// `inputs`), from the cache when every member and the group are cached.
+fn check_group_cached(
+    members: &[usize],
+    inputs: &[Input],
+    outcomes: &mut [Outcome],
+    config: &Config,
+    options: &Options,
+    cache: Option<&crate::cache::Cache>,
+) -> Vec<Diagnostic> {
+    let key = cache.and_then(|_| {
+        let mut k = crate::cache::base_key();
+        k.add(format!("{config:?}"));
+        for &i in members {
+            k.add(&inputs[i].path).add(outcomes[i].key?);
+        }
+        Some(k.finish())
+    });
+    if let (Some(cache), Some(key)) = (cache, key) {
+        if let Some(d) = cache
+            .get_group(key)
+            .and_then(|g| crate::cache::load_all(g.diagnostics))
+        {
+            return d;
+        }
+    }
+    let mut programs = Vec::with_capacity(members.len());
+    for &i in members {
+        match outcomes[i].program.take() {
+            Some(p) => programs.push(p),
+            // Read from the cache: load it again for the pipeline.
+            None => match load_library(&inputs[i], options) {
+                Ok(p) => programs.push(p),
+                Err(_) => continue,
+            },
+        }
+    }
+    let out = check_group(programs, config);
+    if let (Some(cache), Some(key), Some(diagnostics)) = (cache, key, crate::cache::store_all(&out))
+    {
+        cache.put_group(key, &crate::cache::GroupEntry { diagnostics });
+    }
+    out
+}
+
+/// Keeps the files (and pipeline descriptions) of one shard. Folders are
+/// dealt out whole, in path order, each to the shard with the fewest files
+/// so far; a description's folder and the folders of the shaders it uses
+/// count as one, so that each finding comes from one shard.
+fn keep_shard(inputs: &mut Inputs, descriptions: &[Vec<PathBuf>], shard: Shard) {
+    let folder = |p: &Path| {
+        canonical(p)
+            .parent()
+            .map(Path::to_path_buf)
+            .unwrap_or_default()
+    };
+    // Union-find over folders.
+    let mut index: BTreeMap<PathBuf, usize> = BTreeMap::new();
+    for p in inputs
+        .files
+        .iter()
+        .map(|i| &i.path)
+        .chain(inputs.pipelines.iter().map(|(p, _)| p))
+    {
+        let n = index.len();
+        index.entry(folder(p)).or_insert(n);
+    }
+    for shaders in descriptions {
+        for s in shaders {
+            let n = index.len();
+            index.entry(folder(s)).or_insert(n);
+        }
+    }
+    let mut parent: Vec<usize> = (0..index.len()).collect();
+    fn root(parent: &mut [usize], mut v: usize) -> usize {
+        while parent[v] != v {
+            parent[v] = parent[parent[v]];
+            v = parent[v];
+        }
+        v
+    }
+    for ((p, _), shaders) in inputs.pipelines.iter().zip(descriptions) {
+        let a = index[&folder(p)];
+        for s in shaders {
+            let (ra, rb) = (root(&mut parent, a), root(&mut parent, index[&folder(s)]));
+            // The smaller index stays the root: the result is independent of
+            // the order of the unions.
+            parent[ra.max(rb)] = ra.min(rb);
+        }
+    }
+    let mut sizes: BTreeMap<usize, usize> = BTreeMap::new();
+    for i in &inputs.files {
+        let r = root(&mut parent, index[&folder(&i.path)]);
+        *sizes.entry(r).or_default() += 1;
+    }
+    for (p, _) in &inputs.pipelines {
+        let r = root(&mut parent, index[&folder(p)]);
+        sizes.entry(r).or_default();
+    }
+    // Components in the order of their first folder by path.
+    let mut order: Vec<usize> = Vec::new();
+    let mut placed = HashSet::new();
+    for &i in index.values() {
+        let r = root(&mut parent, i);
+        if sizes.contains_key(&r) && placed.insert(r) {
+            order.push(r);
+        }
+    }
+    let mut load = vec![0usize; shard.count as usize];
+    let mut owner: HashMap<usize, usize> = HashMap::new();
+    for r in order {
+        let k = (0..load.len()).min_by_key(|&k| (load[k], k)).unwrap_or(0);
+        load[k] += sizes[&r];
+        owner.insert(r, k);
+    }
+    let me = shard.index as usize - 1;
+    let mut mine = |p: &Path| {
+        let r = root(&mut parent, index[&folder(p)]);
+        owner.get(&r) == Some(&me)
+    };
+    inputs.files.retain(|i| mine(&i.path));
+    inputs.pipelines.retain(|(p, _)| mine(p));
+    // Paths that could not be used belong to no folder: the first shard
+    // reports them.
+    if shard.index != 1 {
+        inputs.errors.clear();
+    }
 }
 
 #[cfg(test)]

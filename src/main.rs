@@ -157,6 +157,30 @@ struct CheckArgs {
     /// the walked directories are applied too).
     #[arg(long)]
     pipeline: Vec<PathBuf>,
+    /// `fast`: only the rules that need layouts, ray flags and constant
+    /// operands; `full` (the default): dataflow too (liveness, recursion
+    /// guards, uniformity, the stack model). Overrides `analysis` in
+    /// rtlint.toml.
+    #[arg(long, value_enum, value_name = "LEVEL")]
+    analysis: Option<AnalysisArg>,
+    /// Do not read or write the result cache.
+    #[arg(long)]
+    no_cache: bool,
+    /// The result cache's folder [default: $RTLINT_CACHE_DIR, else
+    /// .rtlint_cache in the working directory].
+    #[arg(long, value_name = "DIR")]
+    cache_dir: Option<PathBuf>,
+    /// Check only part K of N of the files (1-based): folders are dealt out
+    /// whole and deterministically, so N runs with K = 1..N together report
+    /// what one run does.
+    #[arg(long, value_name = "K/N")]
+    shard: Option<lint::Shard>,
+}
+
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+enum AnalysisArg {
+    Fast,
+    Full,
 }
 
 /// `rtlint verify`.
@@ -454,7 +478,20 @@ fn check(args: CheckArgs) -> Result<u8, String> {
         ignore: args.ignore.clone(),
         payload_budget: args.payload_budget,
         deny_warnings: args.deny_warnings,
+        analysis: args.analysis.map(|a| match a {
+            AnalysisArg::Fast => rtlint::config::AnalysisLevel::Fast,
+            AnalysisArg::Full => rtlint::config::AnalysisLevel::Full,
+        }),
     };
+    options.shard = args.shard;
+    if !args.no_cache {
+        options.cache = Some(
+            args.cache_dir
+                .clone()
+                .or_else(|| std::env::var_os("RTLINT_CACHE_DIR").map(PathBuf::from))
+                .unwrap_or_else(|| PathBuf::from(rtlint::cache::DEFAULT_DIR)),
+        );
+    }
     let report = lint::check_paths(&args.common.paths, &options);
     let mut sources = Sources::default();
     for (p, t) in &report.embedded {

@@ -154,7 +154,9 @@ impl Stage {
 
 /// A place in a source file. Lines and columns are 1-based; a column of 0 means
 /// "the whole line" (debug info without columns).
-#[derive(Clone, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
+#[derive(
+    Clone, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, serde::Serialize, serde::Deserialize,
+)]
 pub struct Location {
     pub path: PathBuf,
     pub line: u32,

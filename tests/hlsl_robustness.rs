@@ -298,3 +298,66 @@ fn accepted_mutations_validate() {
     eprintln!("{checked} accepted mutations validated");
     assert!(checked > 0);
 }
+
+/// Compiles one shader alone: `Ok` or the error's text.
+fn compile_alone(text: &str) -> Result<(), String> {
+    let mut loader = MemLoader::default();
+    compile_source_whole(
+        Path::new("main.hlsl"),
+        text,
+        &mut loader,
+        &HlslOptions::default(),
+    )
+    .map(|_| ())
+    .map_err(|e| e.to_string())
+}
+
+/// DXC (clang) accepts 256 nested brackets: so does rtlint, and twice that,
+/// in every nesting shape, on the compiler thread's stack in a debug build;
+/// deeper ends in an error naming the position.
+#[test]
+fn nesting_as_deep_as_dxc_accepts_compiles() {
+    let shader = |body: String| {
+        format!("RWStructuredBuffer<float> o : register(u0);\n[numthreads(1,1,1)] void m() {{ float x = 1.0; {body} o[0] = x; }}\n")
+    };
+    let parens = |n: usize| shader(format!("x = {}x{};", "(".repeat(n), ")".repeat(n)));
+    for n in [48, 256, 500] {
+        assert_eq!(compile_alone(&parens(n)), Ok(()), "{n} parentheses");
+    }
+    let e = compile_alone(&parens(600)).unwrap_err();
+    assert!(e.contains("nesting too deep"), "{e}");
+    let shapes = [
+        (
+            "blocks",
+            shader(format!("{}x += 1.0;{}", "{".repeat(500), "}".repeat(500))),
+        ),
+        (
+            "ifs",
+            shader(format!(
+                "{}x += 1.0;{}",
+                "if (x > 0.0) { ".repeat(300),
+                "}".repeat(300)
+            )),
+        ),
+        ("negations", shader(format!("x = {}x;", "- ".repeat(500)))),
+        (
+            "ternaries",
+            shader(format!(
+                "x = {}x{};",
+                "x > 0.0 ? (".repeat(250),
+                ") : x".repeat(250)
+            )),
+        ),
+        (
+            "calls",
+            shader(format!("x = {}x{};", "abs(".repeat(256), ")".repeat(256))),
+        ),
+        ("sum", shader(format!("x = x{};", " + x".repeat(1000)))),
+    ];
+    for (name, text) in shapes {
+        assert_eq!(compile_alone(&text), Ok(()), "{name}");
+    }
+    // A longer chain is a tree as deep: an error, not a stack overflow.
+    let e = compile_alone(&shader(format!("x = x{};", " + x".repeat(20_000)))).unwrap_err();
+    assert!(e.contains("nesting too deep"), "{e}");
+}

@@ -50,6 +50,7 @@ const FORBIDDEN: &[(&str, &[&str])] = &[
     ),
     ("rules", &["front", "report", "lint", "vk", "build"]),
     ("lint.rs", &["report", "vk", "build"]),
+    ("cache.rs", &["report", "vk", "build"]),
     ("report", &["vk", "build"]),
     (
         "config.rs",

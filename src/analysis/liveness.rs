@@ -120,8 +120,18 @@ pub fn live_report(programs: &[Program]) -> LiveReport {
 /// recursion, but a helper called from many places multiplies them.
 pub(crate) const MAX_CHAINS: usize = 64;
 
-/// The sites of one program with the values live across each.
+/// The sites of one program with the values live across each (computed
+/// once per Program: RT010 and the stack model both ask).
 pub fn live_sites(program: &Program) -> Vec<LiveSite> {
+    struct Sites(Vec<LiveSite>);
+    program
+        .memo
+        .get_or(|| Sites(compute_live_sites(program)))
+        .0
+        .clone()
+}
+
+fn compute_live_sites(program: &Program) -> Vec<LiveSite> {
     let mut cache: HashMap<usize, FnLiveness> = HashMap::new();
     let mut out = Vec::new();
     for site in &program.sites {
@@ -885,27 +895,36 @@ impl FnLiveness {
             }
         }
         let mut live_in: Vec<HashSet<Place>> = vec![HashSet::new(); n];
-        let mut changed = true;
-        let mut rounds = 0;
-        while changed && rounds < 10_000 {
-            changed = false;
-            rounds += 1;
-            for b in (0..n).rev() {
-                let mut out: HashSet<Place> =
-                    phi_uses[b].iter().map(|&v| (v, Vec::new())).collect();
-                for &s in &f.blocks[b].succs {
-                    if let Some(li) = live_in.get(s) {
-                        out.extend(li.iter().cloned());
+        // A worklist: a block is redone only when a successor's live-in
+        // grew (every block once first, last block first), instead of every
+        // block every round until a whole round changes nothing.
+        let mut work: Vec<usize> = (0..n).collect();
+        let mut queued = vec![true; n];
+        let mut steps = 0usize;
+        while let Some(b) = work.pop() {
+            queued[b] = false;
+            steps += 1;
+            if steps > n.saturating_mul(10_000) {
+                break;
+            }
+            let mut out: HashSet<Place> = phi_uses[b].iter().map(|&v| (v, Vec::new())).collect();
+            for &s in &f.blocks[b].succs {
+                if let Some(li) = live_in.get(s) {
+                    out.extend(li.iter().cloned());
+                }
+            }
+            let mut live = out.clone();
+            for k in (f.blocks[b].start..=f.blocks[b].end).rev() {
+                self.step_back(program, k, &mut live);
+            }
+            self.live_out[b] = out;
+            if live != live_in[b] {
+                live_in[b] = live;
+                for &p in &self.preds[b] {
+                    if !queued[p] {
+                        queued[p] = true;
+                        work.push(p);
                     }
-                }
-                let mut live = out.clone();
-                for k in (f.blocks[b].start..=f.blocks[b].end).rev() {
-                    self.step_back(program, k, &mut live);
-                }
-                if out != self.live_out[b] || live != live_in[b] {
-                    self.live_out[b] = out;
-                    live_in[b] = live;
-                    changed = true;
                 }
             }
         }

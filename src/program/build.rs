@@ -125,6 +125,7 @@ pub fn parse(words: &[u32], path: &Path, language: Language) -> Result<Program, 
             language,
             version: (major, minor),
             words: words.to_vec(),
+            memo: Default::default(),
             insts: c.insts,
             offsets,
             locs: Vec::new(),
@@ -691,14 +692,34 @@ impl Builder<'_> {
             Op::TypeFloat => Some(Type::Float {
                 width: lit_at(inst, 0).unwrap_or(32),
             }),
-            Op::TypeVector => Some(Type::Vector {
-                elem: self.type_operand(i, inst, 0)?,
-                count: lit_at(inst, 1).unwrap_or(0),
-            }),
-            Op::TypeMatrix => Some(Type::Matrix {
-                column: self.type_operand(i, inst, 0)?,
-                columns: lit_at(inst, 1).unwrap_or(0),
-            }),
+            // Counts the spec allows, checked here: analyses size tables by
+            // them (a fuzzed count of 2^32 asked for gigabytes).
+            Op::TypeVector => {
+                let count = lit_at(inst, 1).unwrap_or(0);
+                if !matches!(count, 2 | 3 | 4 | 8 | 16) {
+                    return Err(self.at(
+                        i,
+                        format!("vector of {count} components (SPIR-V allows 2, 3, 4, 8 or 16)"),
+                    ));
+                }
+                Some(Type::Vector {
+                    elem: self.type_operand(i, inst, 0)?,
+                    count,
+                })
+            }
+            Op::TypeMatrix => {
+                let columns = lit_at(inst, 1).unwrap_or(0);
+                if !matches!(columns, 2..=4) {
+                    return Err(self.at(
+                        i,
+                        format!("matrix of {columns} columns (SPIR-V allows 2 to 4)"),
+                    ));
+                }
+                Some(Type::Matrix {
+                    column: self.type_operand(i, inst, 0)?,
+                    columns,
+                })
+            }
             Op::TypeArray => {
                 let elem = self.type_operand(i, inst, 0)?;
                 let len_id = id_at(inst, 1).ok_or_else(|| self.at(i, "array without a length"))?;

@@ -235,6 +235,43 @@ pub struct Program {
     /// `OpenCL.DebugInfo.100`, `DebugInfo`): their instructions only describe
     /// the code, so no analysis may count them as reads or writes.
     pub debug_sets: Vec<Id>,
+    /// Analyses of the finished Program that several rules need, computed
+    /// once ([`Memo::get_or`]).
+    pub memo: Memo,
+}
+
+/// Results computed once per Program, one per type: the module rules and
+/// the pipeline's stack model both need each shader's live state, and a
+/// Program is not changed once built.
+#[derive(Default)]
+pub struct Memo(
+    std::sync::Mutex<HashMap<std::any::TypeId, std::sync::Arc<dyn std::any::Any + Send + Sync>>>,
+);
+
+impl Memo {
+    /// The stored `T`, else `f()` stored.
+    pub fn get_or<T: std::any::Any + Send + Sync>(
+        &self,
+        f: impl FnOnce() -> T,
+    ) -> std::sync::Arc<T> {
+        let key = std::any::TypeId::of::<T>();
+        let found = self.0.lock().ok().and_then(|m| m.get(&key).cloned());
+        if let Some(v) = found.and_then(|v| v.downcast::<T>().ok()) {
+            return v;
+        }
+        // Computed without the lock: `f` may use the memo itself.
+        let v = std::sync::Arc::new(f());
+        if let Ok(mut m) = self.0.lock() {
+            m.insert(key, v.clone());
+        }
+        v
+    }
+}
+
+impl std::fmt::Debug for Memo {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("Memo")
+    }
 }
 
 impl Program {
@@ -341,15 +378,21 @@ impl Program {
 
     /// Instruction indices of the `OpFunctionCall`s that call function `f`.
     pub fn callers(&self, f: Id) -> Vec<usize> {
-        self.insts
-            .iter()
-            .enumerate()
-            .filter(|(_, inst)| {
-                inst.class.opcode == Op::FunctionCall
-                    && matches!(inst.operands.first(), Some(Operand::IdRef(x)) if *x == f)
-            })
-            .map(|(i, _)| i)
-            .collect()
+        // Every call by callee, indexed once: call chains ask per function.
+        struct Calls(HashMap<Id, Vec<usize>>);
+        let calls = self.memo.get_or(|| {
+            let mut by_callee: HashMap<Id, Vec<usize>> = HashMap::new();
+            for (i, inst) in self.insts.iter().enumerate() {
+                if inst.class.opcode != Op::FunctionCall {
+                    continue;
+                }
+                if let Some(Operand::IdRef(x)) = inst.operands.first() {
+                    by_callee.entry(*x).or_default().push(i);
+                }
+            }
+            Calls(by_callee)
+        });
+        calls.0.get(&f).cloned().unwrap_or_default()
     }
 
     /// The function (index into `functions`) containing instruction `inst`.

@@ -70,9 +70,10 @@ fn skip_ws(s: &[u8], mut i: usize) -> usize {
 }
 
 /// The struct `name`: offset of the name and the body's byte range.
-fn find_struct(s: &[u8], name: &str) -> Option<(usize, usize, usize)> {
+/// `structs`: where the word `struct` stands in `s` (found once per text).
+fn find_struct(s: &[u8], structs: &[usize], name: &str) -> Option<(usize, usize, usize)> {
     let mut found = None;
-    for at in words(s, 0, s.len(), "struct") {
+    for &at in structs {
         let n = skip_ws(s, at + 6);
         if !s[n..].starts_with(name.as_bytes())
             || s.get(n + name.len()).is_some_and(|c| is_ident(*c))
@@ -147,14 +148,23 @@ pub fn fill(program: &mut Program) {
             _ => None,
         })
         .collect();
+    // Each text without comments, and where `struct` stands in it: once,
+    // not once per struct.
+    let scanned: Vec<(u32, &String, Vec<u8>, Vec<usize>)> = texts
+        .iter()
+        .map(|(f, text)| {
+            let s = strip_comments(text);
+            let at = words(&s, 0, s.len(), "struct");
+            (*f, text, s, at)
+        })
+        .collect();
     for (id, members) in structs {
         let Some(name) = program.names.get(&id).cloned() else {
             continue;
         };
-        let mut hits = texts.iter().filter_map(|(f, text)| {
-            let s = strip_comments(text);
-            find_struct(&s, &name).map(|h| (*f, text, s, h))
-        });
+        let mut hits = scanned
+            .iter()
+            .filter_map(|(f, text, s, at)| find_struct(s, at, &name).map(|h| (*f, *text, s, h)));
         let (Some((file, text, s, (at, body, end))), None) = (hits.next(), hits.next()) else {
             continue;
         };
@@ -183,8 +193,8 @@ pub fn fill(program: &mut Program) {
                 continue;
             };
             // The member's name followed by `;`, `[`, `:` or `,` — a declarator.
-            let decl = words(&s, body, end, &m).into_iter().find(|&o| {
-                let after = skip_ws(&s, o + m.len());
+            let decl = words(s, body, end, &m).into_iter().find(|&o| {
+                let after = skip_ws(s, o + m.len());
                 matches!(s.get(after), Some(b';' | b'[' | b':' | b','))
             });
             if let Some(o) = decl {
@@ -275,12 +285,14 @@ mod tests {
     fn finds_unique_struct_outside_comments() {
         let t = "// struct P { int x; };\nstruct P [raypayload] {\n  float3 c : read(caller) : write(closesthit);\n  uint d[2];\n};\nP p;";
         let s = strip_comments(t);
-        let (at, body, end) = find_struct(&s, "P").unwrap();
+        let structs = |s: &[u8]| words(s, 0, s.len(), "struct");
+        let (at, body, end) = find_struct(&s, &structs(&s), "P").unwrap();
         assert_eq!(line_col(t, at), (2, 8));
         assert!(t[body..end].contains("uint d[2]"));
         // A second definition makes it ambiguous.
         let t2 = format!("{t}\nstruct P {{ int y; }};");
-        assert_eq!(find_struct(&strip_comments(&t2), "P"), None);
+        let s2 = strip_comments(&t2);
+        assert_eq!(find_struct(&s2, &structs(&s2), "P"), None);
     }
 
     /// glslang 12 `-gV` with `#include` names only the main file and places

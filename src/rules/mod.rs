@@ -3,7 +3,9 @@
 
 /// Declares a rule: its doc comment is the rule's page (What it does / Why is
 /// this bad? / Example / Use instead / Options / References); its group sets
-/// the default level. Defines `RULE`, and `CODE`, `NAME` and `LEVEL` for the
+/// the default level; `analysis: Fast` marks a rule that needs only layouts,
+/// ray flags and constant operands (no dataflow), so `--analysis fast` runs
+/// it (left out: `Full`). Defines `RULE`, and `CODE`, `NAME` and `LEVEL` for the
 /// rule's own findings.
 macro_rules! declare_rule {
     (
@@ -12,6 +14,7 @@ macro_rules! declare_rule {
             group: $group:ident,
             summary: $summary:literal,
             kind: $kind:expr
+            $(, analysis: $analysis:ident)?
             $(, options: [$($opt:expr),* $(,)?])?
             $(,)?
         }
@@ -31,9 +34,13 @@ macro_rules! declare_rule {
             summary: $summary,
             doc: concat!($($doc, "\n"),*),
             kind: $kind,
+            analysis: $crate::rules::declare_rule!(@analysis $($analysis)?),
             options: &[$($($opt),*)?],
         };
     };
+    // A rule that does not say what it needs runs only under `full`.
+    (@analysis) => { $crate::config::AnalysisLevel::Full };
+    (@analysis $analysis:ident) => { $crate::config::AnalysisLevel::$analysis };
 }
 pub(crate) use declare_rule;
 
@@ -115,6 +122,9 @@ pub struct Rule {
     /// The body of the rule's page: the doc comment of its declaration.
     pub doc: &'static str,
     pub kind: Kind,
+    /// The analysis level the rule needs: `--analysis fast` runs only the
+    /// rules that say `Fast`.
+    pub analysis: crate::config::AnalysisLevel,
     pub options: &'static [RuleOption],
 }
 
@@ -294,24 +304,57 @@ impl<'a> Context<'a> {
 }
 
 /// What pipeline rules read: the description and the analyses of it,
-/// computed once.
+/// each computed once, on first use (a run whose rules need no stack model
+/// never builds one).
 pub struct PipelineContext<'a> {
     pub pipeline: &'a crate::pipeline::Pipeline,
     pub config: &'a Config,
-    pub recursion: crate::analysis::RecursionReport,
-    pub stack: crate::analysis::StackReport,
+    pub recursion: Lazy<'a, crate::analysis::RecursionReport>,
+    pub stack: Lazy<'a, crate::analysis::StackReport>,
 }
 
 impl<'a> PipelineContext<'a> {
     pub fn new(pipeline: &'a crate::pipeline::Pipeline, config: &'a Config) -> Self {
-        let recursion = crate::analysis::recursion_report(pipeline);
-        let stack = crate::analysis::stack::stack_report_with(pipeline, &recursion);
+        let recursion = Lazy::new(move || crate::analysis::recursion_report(pipeline));
+        let shared = recursion.clone();
+        let stack = Lazy::new(move || crate::analysis::stack::stack_report_with(pipeline, &shared));
         PipelineContext {
             pipeline,
             config,
             recursion,
             stack,
         }
+    }
+}
+
+/// A value computed on first use; clones share it.
+pub struct Lazy<'a, T> {
+    cell: std::rc::Rc<std::cell::OnceCell<T>>,
+    init: std::rc::Rc<dyn Fn() -> T + 'a>,
+}
+
+impl<'a, T> Lazy<'a, T> {
+    pub fn new(init: impl Fn() -> T + 'a) -> Self {
+        Lazy {
+            cell: Default::default(),
+            init: std::rc::Rc::new(init),
+        }
+    }
+}
+
+impl<T> Clone for Lazy<'_, T> {
+    fn clone(&self) -> Self {
+        Lazy {
+            cell: self.cell.clone(),
+            init: self.init.clone(),
+        }
+    }
+}
+
+impl<T> std::ops::Deref for Lazy<'_, T> {
+    type Target = T;
+    fn deref(&self) -> &T {
+        self.cell.get_or_init(|| (self.init)())
     }
 }
 
@@ -352,7 +395,7 @@ pub fn enabled(rule: &Rule, config: &Config) -> bool {
         None => rule.group.on_by_default(),
     };
     on |= any(&config.extend_select);
-    on && !any(&config.ignore)
+    on && !any(&config.ignore) && rule.analysis <= config.analysis
 }
 
 /// A rule's integer option: `[rules.CODE] key = N` in `rtlint.toml` (or the

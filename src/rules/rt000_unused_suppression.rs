@@ -53,6 +53,7 @@ super::declare_rule! {
         group: Suspicious,
         summary: "suppression comment that allowed no finding",
         kind: super::Kind::Driver,
+        analysis: Fast,
     }
 }
 

@@ -58,6 +58,7 @@ super::declare_rule! {
         group: Perf,
         summary: "ray payload larger than the payload budget",
         kind: super::Kind::Module(check),
+        analysis: Fast,
         options: [super::RuleOption {
             name: "budget",
             default: "32",

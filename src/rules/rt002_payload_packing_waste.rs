@@ -70,6 +70,7 @@ super::declare_rule! {
         group: Perf,
         summary: "payload member order wastes 16-byte rows",
         kind: super::Kind::Module(check),
+        analysis: Fast,
     }
 }
 

@@ -63,6 +63,7 @@ super::declare_rule! {
         group: Perf,
         summary: "payload member crosses a 16-byte row",
         kind: super::Kind::Module(check),
+        analysis: Fast,
     }
 }
 

@@ -44,6 +44,7 @@ super::declare_rule! {
         group: Correctness,
         summary: "hit attributes larger than the 32-byte limit",
         kind: super::Kind::Module(check),
+        analysis: Fast,
     }
 }
 

@@ -51,6 +51,7 @@ super::declare_rule! {
         group: Correctness,
         summary: "ray-query object initialised from OpConstantNull",
         kind: super::Kind::Module(check),
+        analysis: Fast,
     }
 }
 

@@ -83,6 +83,7 @@ super::declare_rule! {
         group: Perf,
         summary: "payload member no shader reads, or none writes",
         kind: super::Kind::Pipeline(run),
+        analysis: Full,
     }
 }
 

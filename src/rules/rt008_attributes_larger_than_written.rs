@@ -61,6 +61,7 @@ super::declare_rule! {
         group: Perf,
         summary: "hit attribute members no intersection shader writes",
         kind: super::Kind::Module(check),
+        analysis: Full,
     }
 }
 

@@ -145,6 +145,7 @@ super::declare_rule! {
         group: Perf,
         summary: "state kept alive across a trace call above the budget",
         kind: super::Kind::Module(run),
+        analysis: Full,
         options: [super::RuleOption {
             name: "budget",
             default: "64",

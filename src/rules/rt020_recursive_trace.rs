@@ -110,6 +110,7 @@ super::declare_rule! {
         group: Perf,
         summary: "trace call from a closest-hit or miss shader",
         kind: super::Kind::Pipeline(run),
+        analysis: Full,
     }
 }
 

@@ -79,6 +79,7 @@ super::declare_rule! {
         group: Correctness,
         summary: "pipeline needs more recursion than it declares",
         kind: super::Kind::Pipeline(run),
+        analysis: Full,
     }
 }
 

@@ -86,6 +86,7 @@ super::declare_rule! {
         group: Perf,
         summary: "declared recursion depth above what the pipeline needs",
         kind: super::Kind::Pipeline(run),
+        analysis: Full,
     }
 }
 

@@ -95,6 +95,7 @@ super::declare_rule! {
         group: Correctness,
         summary: "recursion depth above the device limit",
         kind: super::Kind::Pipeline(run),
+        analysis: Full,
     }
 }
 

@@ -152,6 +152,7 @@ super::declare_rule! {
         group: Pedantic,
         summary: "bounce loop or recursion with no bound known at compile time",
         kind: super::Kind::Pipeline(run),
+        analysis: Full,
     }
 }
 

@@ -119,6 +119,7 @@ super::declare_rule! {
         group: Correctness,
         summary: "default pipeline stack above what the device is known to survive",
         kind: super::Kind::Pipeline(run),
+        analysis: Full,
         options: [super::RuleOption {
             name: "limit",
             default: "14702",

@@ -45,6 +45,7 @@ super::declare_rule! {
         group: Perf,
         summary: "visibility trace without AcceptFirstHitAndEndSearch",
         kind: super::Kind::Pipeline(check),
+        analysis: Full,
     }
 }
 

@@ -38,6 +38,7 @@ super::declare_rule! {
         group: Perf,
         summary: "visibility trace runs a closest-hit shader that only records a hit",
         kind: super::Kind::Pipeline(check),
+        analysis: Full,
     }
 }
 

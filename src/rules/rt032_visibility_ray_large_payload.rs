@@ -45,6 +45,7 @@ super::declare_rule! {
         group: Perf,
         summary: "visibility trace with a payload larger than 4 bytes",
         kind: super::Kind::Pipeline(check),
+        analysis: Full,
     }
 }
 

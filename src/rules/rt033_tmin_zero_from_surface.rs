@@ -48,6 +48,7 @@ super::declare_rule! {
         group: Suspicious,
         summary: "ray from a hit point with tMin 0 and no origin offset",
         kind: super::Kind::Module(check),
+        analysis: Fast,
     }
 }
 

@@ -43,6 +43,7 @@ super::declare_rule! {
         group: Suspicious,
         summary: "unbounded tMax on a ray whose target distance is computed",
         kind: super::Kind::Module(check),
+        analysis: Fast,
     }
 }
 

@@ -41,6 +41,7 @@ super::declare_rule! {
         group: Correctness,
         summary: "constant ray interval with tMin > tMax or a negative bound",
         kind: super::Kind::Module(check),
+        analysis: Fast,
     }
 }
 

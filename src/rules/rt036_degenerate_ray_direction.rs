@@ -35,6 +35,7 @@ super::declare_rule! {
         group: Suspicious,
         summary: "constant ray direction that is zero or not normalised",
         kind: super::Kind::Module(check),
+        analysis: Fast,
     }
 }
 

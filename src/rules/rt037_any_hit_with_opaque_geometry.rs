@@ -42,6 +42,7 @@ super::declare_rule! {
         group: Suspicious,
         summary: "any-hit shader that opaque geometry or opaque rays never run",
         kind: super::Kind::Pipeline(check),
+        analysis: Full,
     }
 }
 

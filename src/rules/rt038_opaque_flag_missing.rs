@@ -39,6 +39,7 @@ super::declare_rule! {
         group: Pedantic,
         summary: "trace without Opaque where no reachable hit group has an any-hit shader",
         kind: super::Kind::Pipeline(check),
+        analysis: Full,
     }
 }
 

@@ -39,6 +39,7 @@ super::declare_rule! {
         group: Suspicious,
         summary: "face-culling ray flags on a trace that reaches only procedural geometry",
         kind: super::Kind::Pipeline(check),
+        analysis: Full,
     }
 }
 

@@ -63,6 +63,7 @@ super::declare_rule! {
         group: Suspicious,
         summary: "descriptor array indexed by a varying value without NonUniform",
         kind: super::Kind::Module(check),
+        analysis: Full,
     }
 }
 

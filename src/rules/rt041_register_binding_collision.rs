@@ -76,6 +76,7 @@ super::declare_rule! {
         group: Suspicious,
         summary: "resources of different descriptor types share one set and binding",
         kind: super::Kind::Module(check),
+        analysis: Fast,
         options: [super::RuleOption {
             name: "vulkan",
             default: "false",

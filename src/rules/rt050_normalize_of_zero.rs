@@ -51,6 +51,7 @@ super::declare_rule! {
         group: Suspicious,
         summary: "normalize of a vector that is zero on some path",
         kind: super::Kind::Module(check),
+        analysis: Full,
     }
 }
 

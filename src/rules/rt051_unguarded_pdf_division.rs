@@ -51,6 +51,7 @@ super::declare_rule! {
         group: Pedantic,
         summary: "division by a dot product without a guard",
         kind: super::Kind::Module(check),
+        analysis: Full,
     }
 }
 

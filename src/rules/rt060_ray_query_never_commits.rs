@@ -71,6 +71,7 @@ super::declare_rule! {
         group: Pedantic,
         summary: "ray-query loop never commits non-opaque triangles",
         kind: super::Kind::Module(check),
+        analysis: Full,
     }
 }
 

@@ -56,6 +56,7 @@ super::declare_rule! {
         group: Pedantic,
         summary: "ray-query loop commits triangles but never procedural primitives",
         kind: super::Kind::Module(check),
+        analysis: Full,
     }
 }
 

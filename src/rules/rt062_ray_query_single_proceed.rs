@@ -60,6 +60,7 @@ super::declare_rule! {
         group: Pedantic,
         summary: "single Proceed per initialisation on a query that can meet non-opaque triangles",
         kind: super::Kind::Module(check),
+        analysis: Full,
     }
 }
 

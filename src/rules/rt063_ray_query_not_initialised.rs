@@ -51,6 +51,7 @@ super::declare_rule! {
         group: Correctness,
         summary: "Proceed on a ray query not initialised on every path",
         kind: super::Kind::Module(check),
+        analysis: Full,
     }
 }
 

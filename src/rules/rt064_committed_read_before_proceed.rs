@@ -49,6 +49,7 @@ super::declare_rule! {
         group: Suspicious,
         summary: "committed intersection read before the query proceeds",
         kind: super::Kind::Module(check),
+        analysis: Full,
     }
 }
 

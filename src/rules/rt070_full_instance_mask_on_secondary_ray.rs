@@ -58,6 +58,7 @@ super::declare_rule! {
         group: Pedantic,
         summary: "secondary ray traced with the full instance mask 0xFF",
         kind: super::Kind::Module(check),
+        analysis: Fast,
     }
 }
 

@@ -60,6 +60,7 @@ super::declare_rule! {
         group: Pedantic,
         summary: "any-hit shader whose only work is a texture alpha test",
         kind: super::Kind::Module(check),
+        analysis: Full,
     }
 }
 

@@ -67,6 +67,7 @@ super::declare_rule! {
         group: Pedantic,
         summary: "bounce loop over several closest-hit shaders without execution reordering",
         kind: super::Kind::Pipeline(run),
+        analysis: Full,
     }
 }
 
@@ -82,9 +83,19 @@ fn run(ctx: &super::PipelineContext) -> Vec<Diagnostic> {
     let pipeline = ctx.pipeline;
     let g = &ctx.recursion.graph;
     let mut out = Vec::new();
-    let mut seen: Vec<(usize, usize)> = Vec::new();
+    // Per program and per trace, computed once: an undescribed pipeline has
+    // an edge from every trace to every hit group.
+    let reorder: Vec<bool> = pipeline.programs.iter().map(reorders).collect();
+    let mut targets: std::collections::HashMap<(usize, usize), Vec<usize>> =
+        std::collections::HashMap::new();
+    for t in g.edges.iter().filter(|t| t.kind == EdgeKind::Trace) {
+        targets.entry((t.program, t.inst)).or_default().push(t.to);
+    }
+    let mut seen: std::collections::HashSet<(usize, usize)> = std::collections::HashSet::new();
+    let mut refused: std::collections::HashSet<(usize, usize, usize)> =
+        std::collections::HashSet::new();
     for e in g.edges.iter().filter(|e| e.kind == EdgeKind::Trace) {
-        if seen.contains(&(e.program, e.inst)) {
+        if seen.contains(&(e.program, e.inst)) || !refused.insert((e.from, e.program, e.inst)) {
             continue;
         }
         let Some(from) = g.nodes.get(e.from) else {
@@ -96,7 +107,7 @@ fn run(ctx: &super::PipelineContext) -> Vec<Diagnostic> {
         let Some(program) = pipeline.programs.get(e.program) else {
             continue;
         };
-        if reorders(program) || !is_bounce_from(program, from.shader.function, e.inst) {
+        if reorder[e.program] || !is_bounce_from(program, from.shader.function, e.inst) {
             continue;
         }
         // The traced payload's layout: hit shaders declared with another one
@@ -110,12 +121,8 @@ fn run(ctx: &super::PipelineContext) -> Vec<Diagnostic> {
             .map(|g| payload_use::shape_of(program, g.ty));
         // Distinct closest-hit shaders this trace can reach.
         let mut hits: Vec<(usize, u32)> = Vec::new();
-        for t in g
-            .edges
-            .iter()
-            .filter(|t| t.kind == EdgeKind::Trace && t.program == e.program && t.inst == e.inst)
-        {
-            if let Some(n) = g.nodes.get(t.to) {
+        for &to in targets.get(&(e.program, e.inst)).into_iter().flatten() {
+            if let Some(n) = g.nodes.get(to) {
                 let same_type = || {
                     let Some(tp) = pipeline.programs.get(n.shader.program) else {
                         return false;
@@ -138,7 +145,7 @@ fn run(ctx: &super::PipelineContext) -> Vec<Diagnostic> {
                 }
             }
         }
-        seen.push((e.program, e.inst));
+        seen.insert((e.program, e.inst));
         if hits.len() < 2 {
             continue;
         }

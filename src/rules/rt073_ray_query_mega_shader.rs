@@ -75,6 +75,7 @@ super::declare_rule! {
         group: Pedantic,
         summary: "material shading inside a ray query's candidate loop",
         kind: super::Kind::Module(check),
+        analysis: Full,
     }
 }
 

@@ -62,6 +62,7 @@ super::declare_rule! {
         group: Pedantic,
         summary: "pipeline trace used for a visibility query an inline ray query would answer",
         kind: super::Kind::Module(check),
+        analysis: Fast,
     }
 }
 

@@ -28,9 +28,11 @@ pub struct Parser<'t> {
     depth: usize,
 }
 
-/// Nesting limit: deep enough for any real shader, shallow enough that a
-/// fuzzer's `((((...` cannot overflow the stack.
-const MAX_DEPTH: usize = 96;
+/// Nesting limit, counted in parser calls (a parenthesised expression costs
+/// two): 512 parentheses, past DXC's (clang's `-fbracket-depth`, 256), and
+/// shallow enough that a fuzzer's `((((...` cannot overflow the compiler
+/// thread's stack (`tests/hlsl_robustness.rs` measures the deepest input).
+const MAX_DEPTH: usize = 1024;
 
 /// Keywords `mods` reads.
 const MODIFIERS: &[&str] = &[
@@ -1498,7 +1500,14 @@ impl<'t> Parser<'t> {
     /// Precedence climbing; `in_template` stops at `>` (template argument lists).
     fn binary(&mut self, min: u8, in_template: bool) -> Result<Expr> {
         let mut lhs = self.unary()?;
-        while let Some(Tok::Punct(p)) = self.peek().map(|t| &t.tok) {
+        // Each operator of a chain deepens the tree later passes recurse
+        // over (`a + b + c` is `(a + b) + c`): it counts as a level until the
+        // chain ends.
+        let mut chain = 0;
+        let out = loop {
+            let Some(Tok::Punct(p)) = self.peek().map(|t| &t.tok) else {
+                break lhs;
+            };
             let (prec, op) = match *p {
                 "||" => (1, BinOp::Or),
                 "&&" => (2, BinOp::And),
@@ -1518,22 +1527,23 @@ impl<'t> Parser<'t> {
                 "*" => (10, BinOp::Mul),
                 "/" => (10, BinOp::Div),
                 "%" => (10, BinOp::Rem),
-                _ => break,
+                _ => break lhs,
             };
             if prec <= min {
-                break;
+                break lhs;
             }
             let pos = self.pos();
             self.i += 1;
             self.enter()?;
+            chain += 1;
             let rhs = self.binary(prec, in_template)?;
-            self.depth -= 1;
             lhs = Expr {
                 kind: ExprKind::Binary(op, Box::new(lhs), Box::new(rhs)),
                 pos,
             };
-        }
-        Ok(lhs)
+        };
+        self.depth -= chain;
+        Ok(out)
     }
 
     fn enum_value_ahead(&self) -> bool {
@@ -1789,9 +1799,18 @@ mod tests {
         parse(&lex(s, 0).unwrap()).unwrap()
     }
 
+    /// On a thread with the compiler's stack, as the front-end runs it.
     fn err(s: &str) -> (u32, u32, String) {
-        let e = parse(&lex(s, 0).unwrap()).unwrap_err();
-        (e.pos.line, e.pos.col, e.message)
+        let s = s.to_string();
+        std::thread::Builder::new()
+            .stack_size(64 << 20)
+            .spawn(move || {
+                let e = parse(&lex(&s, 0).unwrap()).unwrap_err();
+                (e.pos.line, e.pos.col, e.message)
+            })
+            .unwrap()
+            .join()
+            .unwrap()
     }
 
     #[test]

@@ -134,6 +134,7 @@ const MAX_INCLUDE_DEPTH: usize = 64;
 /// Marker tokens for `#pragma pack_matrix(...)`, read by the parser.
 pub const PACK_ROW_MAJOR: &str = "#pragma pack_matrix(row_major)";
 pub const PACK_COLUMN_MAJOR: &str = "#pragma pack_matrix(column_major)";
+/// Tokens macro expansions may produce in one file.
 const EXPANSION_BUDGET: usize = 2_000_000;
 
 impl<'a> Preprocessor<'a> {
@@ -696,10 +697,6 @@ impl<'a> Preprocessor<'a> {
         let mut queue: std::collections::VecDeque<Token> = input.into();
         let mut out = Vec::new();
         while let Some(t) = queue.pop_front() {
-            self.budget += 1;
-            if self.budget > EXPANSION_BUDGET {
-                return Err(Error::new(t.pos, "macro expansion does not terminate"));
-            }
             let Some(name) = t.ident() else {
                 out.push(t);
                 continue;
@@ -760,6 +757,12 @@ impl<'a> Preprocessor<'a> {
                     self.substitute(&m, &args, &t, &hide)?
                 }
             };
+            // Only what macros produce counts: a big file of plain code is
+            // not an expansion that does not terminate.
+            self.budget += result.len().max(1);
+            if self.budget > EXPANSION_BUDGET {
+                return Err(Error::new(t.pos, "macro expansion does not terminate"));
+            }
             for r in result.into_iter().rev() {
                 queue.push_front(r);
             }
@@ -1202,6 +1205,22 @@ mod tests {
         // Arguments are expanded before substitution.
         assert_eq!(pp("#define ONE 1\n#define ID(x) x\nID(ONE)"), "1");
         assert_eq!(pp("#define A 1\n#undef A\nA"), "A");
+    }
+
+    /// The expansion budget counts what macros produce, not the file's own
+    /// tokens: a file of more plain tokens than the budget preprocesses.
+    #[test]
+    fn big_files_are_not_macro_bombs() {
+        let text = "a ".repeat(EXPANSION_BUDGET + 10);
+        let out = pp_with(&[("main.hlsl", &text)], &[]).unwrap();
+        assert_eq!(out.len(), text.len() - 1);
+        let bomb = "#define A0 x\n".to_string()
+            + &(1..30)
+                .map(|i| format!("#define A{i} A{p} A{p}\n", p = i - 1))
+                .collect::<String>()
+            + "A29\n";
+        let e = pp_with(&[("main.hlsl", &bomb)], &[]).unwrap_err();
+        assert!(e.contains("macro expansion does not terminate"), "{e}");
     }
 
     #[test]
