@@ -311,6 +311,48 @@ fn json_layout_contract() {
     );
 }
 
+/// With --enable-16bit-types a payload's `half` and `uint16_t` members are
+/// 2 bytes each in `rtlint layout` (without it `half` is a 4-byte float).
+#[test]
+fn layout_counts_16_bit_members() {
+    let o = run(&[
+        "layout",
+        "--enable-16bit-types",
+        "--format",
+        "json",
+        "tests/hlsl/half.hlsl",
+    ]);
+    assert_eq!(o.status.code(), Some(0), "{}", stdout(&o));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let types = v["files"][0]["types"].as_array().unwrap();
+    let t = types
+        .iter()
+        .find(|t| t["name"] == "HalfPayload")
+        .expect("HalfPayload");
+    assert_eq!(t["scalar_size"], 10);
+    assert_eq!(t["hlsl_packed_size"], 10);
+    let members: Vec<(String, u64, u64)> = t["members"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|m| {
+            (
+                m["ty"].as_str().unwrap().to_string(),
+                m["size"].as_u64().unwrap(),
+                m["scalar_offset"].as_u64().unwrap(),
+            )
+        })
+        .collect();
+    assert_eq!(
+        members,
+        vec![
+            ("half3".to_string(), 6, 0),
+            ("half".to_string(), 2, 6),
+            ("uint16_t".to_string(), 2, 8)
+        ]
+    );
+}
+
 #[test]
 fn github_and_sarif_formats() {
     let o = run(&["check", "--format", "github", "fixtures/RT001/bad.wgsl"]);

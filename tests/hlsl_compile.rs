@@ -236,6 +236,9 @@ fn program_sees_hlsl_declaration_positions() {
     assert_eq!((loc.line, loc.column), (8, 8));
 }
 
+/// Shaders written for DXC's `-enable-16bit-types`.
+const SIXTEEN_BIT: &[&str] = &["half.hlsl", "exec_half.hlsl"];
+
 /// Every shader under tests/hlsl/ (the executed ones too) validates, per
 /// entry point and as a whole file.
 #[test]
@@ -262,7 +265,10 @@ fn every_test_shader_validates() {
             &[]
         };
         let path = shader(name);
-        let opts = HlslOptions::default();
+        let opts = HlslOptions {
+            enable_16bit_types: SIXTEEN_BIT.contains(&name.as_str()),
+            ..Default::default()
+        };
         let check = |words: &[u32], what: &str| {
             if NEEDS_NEW_VALIDATOR.contains(&name.as_str()) {
                 validate_new(words, what)
@@ -1310,4 +1316,143 @@ fn constructs_from_the_public_corpus() {
     assert!(decorated("in.var.TEXCOORD2", 13));
     assert!(decorated("in.var.TEXCOORD3", 17));
     assert!(!decorated("in.var.TEXCOORD0", 14));
+}
+
+/// With -enable-16bit-types `half`, `min16float`, `float16_t`, `int16_t`,
+/// `uint16_t` and `min16int` are 16-bit: their SPIR-V types, the capabilities
+/// for 16-bit arithmetic and for 16-bit values in storage and uniform
+/// buffers, 2-byte layouts, and arithmetic that stays 16-bit.
+#[test]
+fn sixteen_bit_types_with_the_flag() {
+    let opts = HlslOptions {
+        enable_16bit_types: true,
+        ..Default::default()
+    };
+    let path = shader("half.hlsl");
+    let m = hlsl::compile_file(&path, &opts).unwrap_or_else(|e| panic!("{e}"));
+    validate(&m.words, "half.hlsl-flag");
+    let insts = instructions(&m.words);
+    let caps = |words: &[u32]| -> Vec<u32> {
+        instructions(words)
+            .iter()
+            .filter(|(op, _)| *op == 17)
+            .map(|(_, o)| o[0])
+            .collect()
+    };
+    // Float16 (9), Int16 (22), StorageBuffer16BitAccess (4433),
+    // UniformAndStorageBuffer16BitAccess (4434), StoragePushConstant16 (4435),
+    // StorageInputOutput16 (4436): each where its storage class holds 16-bit values.
+    let entries = hlsl::compile(&path, &opts).unwrap_or_else(|e| panic!("{e}"));
+    let of = |name: &str| caps(&entries.iter().find(|e| e.name == name).unwrap().words);
+    let (cs, ps, hit) = (of("cs"), of("ps"), of("hit"));
+    for c in [9, 22, 4433, 4434, 4435] {
+        assert!(cs.contains(&c), "cs: capability {c} missing: {cs:?}");
+    }
+    assert!(!cs.contains(&4436), "{cs:?}");
+    assert!(ps.contains(&4436) && !ps.contains(&4433), "{ps:?}");
+    // A payload needs no storage capability.
+    assert!(
+        hit.contains(&9) && !hit.iter().any(|c| (4433..=4436).contains(c)),
+        "{hit:?}"
+    );
+    // OpExtension (10).
+    assert!(insts
+        .iter()
+        .any(|(op, o)| *op == 10 && string_at(o) == "SPV_KHR_16bit_storage"));
+    // OpTypeFloat (22) 16, OpTypeInt (21) 16 signed and unsigned.
+    let half = insts
+        .iter()
+        .find(|(op, o)| *op == 22 && o[1] == 16)
+        .map(|(_, o)| o[0])
+        .expect("OpTypeFloat 16");
+    let short = insts
+        .iter()
+        .find(|(op, o)| *op == 21 && o[1] == 16 && o[2] == 1)
+        .map(|(_, o)| o[0])
+        .expect("OpTypeInt 16 1");
+    assert!(insts
+        .iter()
+        .any(|(op, o)| *op == 21 && o[1] == 16 && o[2] == 0));
+    // 2-byte members: half a, half2 b (relaxed: at 2), float c, int16_t d, uint16_t e.
+    // half3x3: three half3 columns 8 bytes apart.
+    assert_eq!(
+        member_offsets(&m.words, "Packed"),
+        vec![0, 2, 8, 12, 14, 16]
+    );
+    assert_eq!(member_offsets(&m.words, "type.Params"), vec![0, 2, 4]);
+    // `h * 2.0 + scale` is half arithmetic (OpFMul 133, OpFAdd 129), the
+    // literal taking the type of the half beside it; int16 arithmetic (OpIMul 132).
+    assert!(insts.iter().any(|(op, o)| *op == 133 && o[0] == half));
+    assert!(insts.iter().any(|(op, o)| *op == 129 && o[0] == half));
+    assert!(insts.iter().any(|(op, o)| *op == 132 && o[0] == short));
+    // GLSL.std.450 on halves (OpExtInst 12 with a half result: Sqrt, Length, FClamp, FMix).
+    let glsl: Vec<u32> = insts
+        .iter()
+        .filter(|(op, o)| *op == 12 && o[0] == half && o.len() > 3)
+        .map(|(_, o)| o[3])
+        .collect();
+    for inst in [31, 66, 43, 46] {
+        assert!(
+            glsl.contains(&inst),
+            "GLSL.std.450 {inst} on half: {glsl:?}"
+        );
+    }
+    // 16-bit texels live in 32-bit images (OpTypeImage 25, sampled type
+    // float); the storage image's format is Rgba16f (2).
+    let float = insts
+        .iter()
+        .find(|(op, o)| *op == 22 && o[1] == 32)
+        .map(|(_, o)| o[0])
+        .unwrap();
+    let images: Vec<&Vec<u32>> = insts
+        .iter()
+        .filter(|(op, _)| *op == 25)
+        .map(|(_, o)| o)
+        .collect();
+    assert!(images.iter().all(|o| o[1] != half), "{images:?}");
+    assert!(images
+        .iter()
+        .any(|o| o[1] == float && o[6] == 2 && o[7] == 2));
+    // Wave reductions keep 16 bits: OpGroupNonUniformFAdd (350) of half,
+    // OpGroupNonUniformSMin (353) of int16_t.
+    assert!(insts.iter().any(|(op, o)| *op == 350 && o[0] == half));
+    assert!(insts.iter().any(|(op, o)| *op == 353 && o[0] == short));
+    // half + float is float: OpFConvert (115) widens.
+    assert!(insts.iter().any(|(op, _)| *op == 115));
+
+    // Literals beside halves in `?:` and intrinsics stay half: no float
+    // arithmetic, no conversion (OpFConvert 115) at all.
+    let lits = "RWStructuredBuffer<half> o;\n[numthreads(1,1,1)]\nvoid m(uint3 id : SV_DispatchThreadID) { half h = (half)id.x; o[0] = h > 1 ? h : 0.5; o[1] = id.y > 0 ? o[2] + h : -1.0; o[3] = max(h, 0.25) * 2; }";
+    let m = hlsl::compile_source_whole(
+        Path::new("main.hlsl"),
+        lits,
+        &mut hlsl::pp::MemLoader::default(),
+        &opts,
+    )
+    .unwrap();
+    validate(&m.words, "half-literals");
+    let insts = instructions(&m.words);
+    assert!(!insts.iter().any(|(op, _)| *op == 115));
+    // OpSelect (169) and OpPhi (245) of half.
+    let half = insts
+        .iter()
+        .find(|(op, o)| *op == 22 && o[1] == 16)
+        .map(|(_, o)| o[0])
+        .unwrap();
+    assert!(insts.iter().any(|(op, o)| *op == 169 && o[0] == half));
+    assert!(insts.iter().any(|(op, o)| *op == 245 && o[0] == half));
+
+    // Without the flag `half` and `min16*` are 32-bit: no 16-bit type at all.
+    let plain = "RWStructuredBuffer<float> o;\n[numthreads(1,1,1)]\nvoid m() { half h = 1.5; min16float g = h; min16int i = 2; o[0] = g * i; }";
+    let m = hlsl::compile_source_whole(
+        Path::new("main.hlsl"),
+        plain,
+        &mut hlsl::pp::MemLoader::default(),
+        &HlslOptions::default(),
+    )
+    .unwrap();
+    validate(&m.words, "half-no-flag");
+    assert!(!instructions(&m.words)
+        .iter()
+        .any(|(op, o)| (*op == 21 || *op == 22) && o[1] == 16));
 }

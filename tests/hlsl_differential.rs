@@ -431,6 +431,16 @@ fn cases() -> Vec<Case> {
 /// file in tests/hlsl must be in a case or here.
 const NOT_RUN: &[(&str, &str)] = &[
     (
+        "half.hlsl",
+        "needs -enable-16bit-types, which the differential cases do not pass; \
+         tests/hlsl_compile.rs checks its 16-bit types, capabilities and layouts",
+    ),
+    (
+        "exec_half.hlsl",
+        "needs -enable-16bit-types, which the differential cases do not pass; \
+         tests/hlsl_exec.rs runs it against known values and against Slang",
+    ),
+    (
         "corpus_constructs.hlsl",
         "samples textures, uses device addresses and a pixel shader; tests/hlsl_compile.rs \
          checks each construct's instructions",

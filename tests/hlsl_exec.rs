@@ -734,3 +734,120 @@ fn ray_tracing_differential_against_slang_on_the_driver() {
     }
     assert_eq!(compared, 2);
 }
+
+/// 16-bit types (`-enable-16bit-types`) compute in 16 bits on the driver:
+/// half results and matrices, `asfloat16`/`asuint16`/`asint16`, 16-bit
+/// `ByteAddressBuffer.Load<T>`, a wave sum, int16 wrap-around, uint16 shifts, conversions both ways,
+/// and 16-bit values read from a constant buffer.
+#[test]
+fn sixteen_bit_arithmetic_on_the_driver() {
+    let Some(ctx) = common::device() else {
+        return;
+    };
+    if !ctx.info().sixteen_bit {
+        println!(
+            "16-bit part not run: {} lacks shaderFloat16/shaderInt16/16-bit storage/subgroup extended types",
+            ctx.info().name
+        );
+        return;
+    }
+    let opts = HlslOptions {
+        enable_16bit_types: true,
+        ..Default::default()
+    };
+    let words = hlsl::compile_file(&hlsl_path("exec_half.hlsl"), &opts)
+        .unwrap_or_else(|e| panic!("{e}"))
+        .words;
+    let outs = run_half(&ctx, &words, "Main");
+    let halves = |b: &Vec<u8>, n: usize| -> Vec<u16> {
+        b.chunks(2)
+            .take(n)
+            .map(|c| u16::from_le_bytes([c[0], c[1]]))
+            .collect()
+    };
+    // 1.75, 2.0, 2052.0 (2051 rounded to a half), 1.5, 2.625, -3.0, 0.1
+    // rounded to a half (0.0999755859375), 11.0 (a half matrix product),
+    // 2.5 (1.5 and 1.0 through their bits), 3.0 (a one-lane wave sum),
+    // 9.0 (2 + 3 + 4 loaded from bytes 2, 4 and 6).
+    assert_eq!(
+        halves(&outs[0], 11),
+        vec![
+            0x3f00, 0x4000, 0x6802, 0x3e00, 0x4140, 0xc200, 0x2e66, 0x4980, 0x4100, 0x4200, 0x4880
+        ]
+    );
+    // ..., and the bits of half -0.5 (0xb800) as an int16.
+    let ints: Vec<i16> = halves(&outs[1], 5).iter().map(|v| *v as i16).collect();
+    assert_eq!(ints, vec![-6, i16::MIN, -9, 1, 0xb800u16 as i16]);
+    assert_eq!(
+        halves(&outs[2], 5),
+        vec![0xe000, 0xffff, 0x3e00, !7u16, 0x4400]
+    );
+    // (half)0.1 folded at compile time is the same half: 1638 / 2^14.
+    let floats: Vec<f32> = outs[3]
+        .chunks(4)
+        .take(3)
+        .map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]]))
+        .collect();
+    assert_eq!(floats, vec![13.0, 1638.0 / 16384.0, 5.0]);
+}
+
+/// Runs exec_half.hlsl's `entry` once: its four output buffers' bytes.
+fn run_half(ctx: &Context, words: &[u32], entry: &str) -> Vec<Vec<u8>> {
+    let outs: Vec<Buffer> = (0..4).map(|_| storage(ctx, 64)).collect();
+    // scale 0.5 (half 0x3800) at 0, count 7 at 2, neg -2 at 4, base 10.0 at 8.
+    let mut cb = vec![0u8; 16];
+    cb[0..2].copy_from_slice(&0x3800u16.to_le_bytes());
+    cb[2..4].copy_from_slice(&7u16.to_le_bytes());
+    cb[4..6].copy_from_slice(&(-2i16).to_le_bytes());
+    cb[8..12].copy_from_slice(&10.0f32.to_le_bytes());
+    let ubo = Buffer::from_data(ctx, raw::BufferUsageFlags::UNIFORM_BUFFER, &cb).unwrap();
+    let mut list: Vec<(BindingKind, Resource)> = outs
+        .iter()
+        .map(|b| (BindingKind::StorageBuffer, Resource::Buffer(b)))
+        .collect();
+    list.push((BindingKind::UniformBuffer, Resource::Buffer(&ubo)));
+    // Halves 1.0, 2.0, 3.0, 4.0 for the ByteAddressBuffer's 16-bit loads.
+    let raw_bytes: Vec<u8> = [0x3c00u16, 0x4000, 0x4200, 0x4400]
+        .iter()
+        .flat_map(|h| h.to_le_bytes())
+        .collect();
+    let raw = Buffer::from_data(ctx, STORAGE, &raw_bytes).unwrap();
+    list.push((BindingKind::StorageBuffer, Resource::Buffer(&raw)));
+    dispatch(ctx, words, entry, &list);
+    outs.iter().map(|b| b.read()).collect()
+}
+
+/// exec_half.hlsl compiled by Slang (whose `half` is always 16-bit) and by
+/// rtlint with -enable-16bit-types writes the same bytes on the driver.
+#[test]
+fn sixteen_bit_differential_against_slang() {
+    let Some(slang) = rtlint_testkit::slang() else {
+        return;
+    };
+    let Some(ctx) = common::device() else {
+        return;
+    };
+    if !ctx.info().sixteen_bit {
+        println!(
+            "16-bit part not run: {} lacks 16-bit support",
+            ctx.info().name
+        );
+        return;
+    }
+    let opts = HlslOptions {
+        enable_16bit_types: true,
+        ..Default::default()
+    };
+    let ours = hlsl::compile_file(&hlsl_path("exec_half.hlsl"), &opts)
+        .unwrap_or_else(|e| panic!("{e}"))
+        .words;
+    let theirs = slang_module(&slang, "exec_half.hlsl", "Main", Stage::Compute);
+    if let Some(why) = invalid_spirv(&theirs) {
+        panic!("Slang's exec_half module is invalid: {why}");
+    }
+    assert_eq!(
+        run_half(&ctx, &ours, "Main"),
+        run_half(&ctx, &theirs, "main"),
+        "rtlint and Slang disagree on 16-bit arithmetic"
+    );
+}

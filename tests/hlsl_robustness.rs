@@ -132,6 +132,14 @@ fn mutate(rng: &mut Rng, src: &str) -> String {
     s.into_iter().collect()
 }
 
+/// The 16-bit shaders are written for -enable-16bit-types (and mutated under it).
+fn options_for(name: &str) -> HlslOptions {
+    HlslOptions {
+        enable_16bit_types: name.ends_with("half.hlsl"),
+        ..Default::default()
+    }
+}
+
 fn run(name: &str, text: &str, files: &[(String, String)]) {
     let mut loader = MemLoader(
         files
@@ -140,7 +148,7 @@ fn run(name: &str, text: &str, files: &[(String, String)]) {
             .chain([(PathBuf::from(name), text.to_string())])
             .collect(),
     );
-    let opts = HlslOptions::default();
+    let opts = options_for(name);
     let _ = parse_source(Path::new(name), text, &mut loader, &opts);
     let _ = compile_source_whole(Path::new(name), text, &mut loader, &opts);
 }
@@ -266,12 +274,9 @@ fn accepted_mutations_validate() {
                     .map(|(n, t)| (PathBuf::from(n), t.clone()))
                     .collect(),
             );
-            let Ok(m) = compile_source_whole(
-                Path::new(name),
-                &input,
-                &mut loader,
-                &HlslOptions::default(),
-            ) else {
+            let Ok(m) =
+                compile_source_whole(Path::new(name), &input, &mut loader, &options_for(name))
+            else {
                 continue;
             };
             let file = dir.join("m.spv");

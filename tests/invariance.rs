@@ -426,7 +426,12 @@ fn analyses_do_not_depend_on_debug_info() {
     assert!(others.len() >= 10, "{others:?}");
     for path in &others {
         let language = Language::from_path(path).unwrap();
-        let c = rtlint::front::compile_path(path, language)
+        // The 16-bit test shaders are written for -enable-16bit-types.
+        let options = rtlint::front::FrontOptions {
+            enable_16bit_types: path.to_string_lossy().ends_with("half.hlsl"),
+            ..Default::default()
+        };
+        let c = rtlint::front::compile_input(path, None, language, &options)
             .unwrap_or_else(|e| panic!("{}: {e:?}", path.display()));
         let mut with = parse(&c.words, path, c.language);
         with.attach_named_decls(&c.decls);
@@ -683,8 +688,12 @@ fn hlsl_compilers_agree() {
         // The HLSL tests' shaders (tests/hlsl) declare resources Slang drops
         // as unused: only findings, depth and kept bytes are compared there.
         let all_facts = rel.starts_with("fixtures/");
-        let entries = rtlint::front::hlsl::compile(file, &Default::default())
-            .unwrap_or_else(|e| panic!("{rel}: {e:?}"));
+        let options = rtlint::front::hlsl::HlslOptions {
+            enable_16bit_types: rel.ends_with("half.hlsl"),
+            ..Default::default()
+        };
+        let entries =
+            rtlint::front::hlsl::compile(file, &options).unwrap_or_else(|e| panic!("{rel}: {e:?}"));
         let mut ours = Vec::new();
         let mut theirs = Vec::new();
         for e in entries.iter().filter(|e| e.stage.is_ray_tracing()) {

@@ -633,36 +633,44 @@ fn glsl_sources_need_not_be_utf8() {
 }
 
 /// `half` is 32-bit unless 16-bit types are enabled, on the command line
-/// (`--enable-16bit-types`) or in `[hlsl]`; then it is refused (exit 2),
+/// (`--enable-16bit-types`) or in `[hlsl]`; then it is 16-bit, and a 16-bit
+/// construct not yet lowered (`asuint` of a `half`) is refused (exit 2),
 /// never silently widened.
 #[test]
 fn sixteen_bit_types_follow_the_flag_and_the_config() {
     let d = scratch("half");
-    let src = "RWStructuredBuffer<float> o : register(u0);\n[numthreads(1,1,1)]\nvoid m() { half h = 0.5; o[0] = h; }\n";
+    let src = "RWStructuredBuffer<uint> o : register(u0);\n[numthreads(1,1,1)]\nvoid m() { half h = 0.5; o[0] = asuint(h); }\n";
     std::fs::write(d.join("m.hlsl"), src).unwrap();
     assert_eq!(check_in(&d, &["m.hlsl"]).status.code(), Some(0));
     let o = check_in(&d, &["--enable-16bit-types", "m.hlsl"]);
     assert_eq!(o.status.code(), Some(2), "{}", text(&o));
     assert!(
-        text(&o).contains("not supported: 16-bit type `half` (with -enable-16bit-types)"),
+        text(&o).contains("not supported: `asuint` of 16-bit values"),
         "{}",
         text(&o)
     );
     std::fs::write(d.join("rtlint.toml"), "[hlsl]\nenable-16bit-types = true\n").unwrap();
     assert_eq!(check_in(&d, &["m.hlsl"]).status.code(), Some(2));
-    let out = d.join("m.spv");
+    // `compile` reads the flag: `half` becomes OpTypeFloat 16.
+    let scalar = "RWStructuredBuffer<float> o : register(u0);\n[numthreads(1,1,1)]\nvoid m() { half h = 0.5; o[0] = h; }\n";
+    std::fs::write(d.join("s.hlsl"), scalar).unwrap();
+    let out = d.join("s.spv");
     let compile = |extra: &[&str]| {
-        rtlint()
+        let o = rtlint()
             .arg("compile")
-            .arg(d.join("m.hlsl"))
+            .arg(d.join("s.hlsl"))
             .args(extra)
             .arg("-o")
             .arg(&out)
             .output()
-            .unwrap()
-            .status
-            .code()
+            .unwrap();
+        assert_eq!(o.status.code(), Some(0), "{}", text(&o));
+        let words = rtlint_testkit::words_of_bytes(&std::fs::read(&out).unwrap());
+        // OpTypeFloat (22, 3 words) of width 16.
+        words
+            .windows(3)
+            .any(|w| w[0] == (3 << 16 | 22) && w[2] == 16)
     };
-    assert_eq!(compile(&[]), Some(0));
-    assert_eq!(compile(&["--enable-16bit-types"]), Some(2));
+    assert!(!compile(&[]));
+    assert!(compile(&["--enable-16bit-types"]));
 }

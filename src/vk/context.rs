@@ -73,6 +73,11 @@ pub struct DeviceInfo {
     /// `primitive_index` needs `geometryShader`.
     pub geometry_shader: bool,
     pub shader_int64: bool,
+    /// 16-bit arithmetic (`shaderFloat16` and `shaderInt16`), 16-bit wave
+    /// operations (`shaderSubgroupExtendedTypes`) and 16-bit values in
+    /// storage and uniform buffers, all enabled when present
+    /// (HLSL compiled with `-enable-16bit-types`).
+    pub sixteen_bit: bool,
     /// `shaderStorageImageReadWithoutFormat` and `…WriteWithoutFormat`,
     /// enabled when the device has both: storage images whose SPIR-V type
     /// names no format (HLSL `RWTexture2D<float3>`, Slang's images) need them.
@@ -177,6 +182,12 @@ struct OptionalFeatures {
     storage_texel_non_uniform: bool,
     partially_bound: bool,
     variable_count: bool,
+    /// `shaderFloat16`, and the 16-bit storage features (Vulkan 1.1), for
+    /// shaders compiled with 16-bit types.
+    shader_float16: bool,
+    storage16: [bool; 4],
+    /// Group operations on 16-bit (and 8-bit, 64-bit) values.
+    subgroup_extended_types: bool,
 }
 
 impl Context {
@@ -418,11 +429,13 @@ fn examine(
     }
     let ray_query = has(vk::KHR_RAY_QUERY_NAME);
 
+    let mut f11 = vk::PhysicalDeviceVulkan11Features::default();
     let mut f12 = vk::PhysicalDeviceVulkan12Features::default();
     let mut f13 = vk::PhysicalDeviceVulkan13Features::default();
     let mut fas = vk::PhysicalDeviceAccelerationStructureFeaturesKHR::default();
     let mut frt = vk::PhysicalDeviceRayTracingPipelineFeaturesKHR::default();
     let mut features = vk::PhysicalDeviceFeatures2::default()
+        .push_next(&mut f11)
         .push_next(&mut f12)
         .push_next(&mut f13)
         .push_next(&mut fas)
@@ -491,6 +504,11 @@ fn examine(
             ray_query,
             geometry_shader: core.geometry_shader == vk::TRUE,
             shader_int64: core.shader_int64 == vk::TRUE,
+            sixteen_bit: f12.shader_float16 == vk::TRUE
+                && core.shader_int16 == vk::TRUE
+                && f12.shader_subgroup_extended_types == vk::TRUE
+                && f11.storage_buffer16_bit_access == vk::TRUE
+                && f11.uniform_and_storage_buffer16_bit_access == vk::TRUE,
             storage_image_without_format: core.shader_storage_image_read_without_format == vk::TRUE
                 && core.shader_storage_image_write_without_format == vk::TRUE,
             ray_tracing: RayTracingLimits {
@@ -544,6 +562,14 @@ fn examine(
                 == vk::TRUE,
             partially_bound: f12.descriptor_binding_partially_bound == vk::TRUE,
             variable_count: f12.descriptor_binding_variable_descriptor_count == vk::TRUE,
+            shader_float16: f12.shader_float16 == vk::TRUE,
+            subgroup_extended_types: f12.shader_subgroup_extended_types == vk::TRUE,
+            storage16: [
+                f11.storage_buffer16_bit_access == vk::TRUE,
+                f11.uniform_and_storage_buffer16_bit_access == vk::TRUE,
+                f11.storage_push_constant16 == vk::TRUE,
+                f11.storage_input_output16 == vk::TRUE,
+            ],
         },
     })
 }
@@ -579,7 +605,14 @@ fn create_device(instance: &ash::Instance, c: &Candidate) -> Result<ash::Device>
         .shader_uniform_texel_buffer_array_non_uniform_indexing(o.uniform_texel_non_uniform)
         .shader_storage_texel_buffer_array_non_uniform_indexing(o.storage_texel_non_uniform)
         .descriptor_binding_partially_bound(o.partially_bound)
-        .descriptor_binding_variable_descriptor_count(o.variable_count);
+        .descriptor_binding_variable_descriptor_count(o.variable_count)
+        .shader_float16(o.shader_float16)
+        .shader_subgroup_extended_types(o.subgroup_extended_types);
+    let mut f11 = vk::PhysicalDeviceVulkan11Features::default()
+        .storage_buffer16_bit_access(o.storage16[0])
+        .uniform_and_storage_buffer16_bit_access(o.storage16[1])
+        .storage_push_constant16(o.storage16[2])
+        .storage_input_output16(o.storage16[3]);
     let mut f13 = vk::PhysicalDeviceVulkan13Features::default()
         .synchronization2(true)
         .maintenance4(true);
@@ -590,6 +623,7 @@ fn create_device(instance: &ash::Instance, c: &Candidate) -> Result<ash::Device>
     let mut frq = vk::PhysicalDeviceRayQueryFeaturesKHR::default().ray_query(true);
     let mut features = vk::PhysicalDeviceFeatures2::default()
         .features(core)
+        .push_next(&mut f11)
         .push_next(&mut f12)
         .push_next(&mut f13)
         .push_next(&mut fas)

@@ -21,6 +21,7 @@ mod raw_buffer;
 mod resource_calls;
 mod ser;
 mod stmt;
+mod storage16;
 mod templates;
 mod wave;
 
@@ -763,6 +764,7 @@ impl<'a> Lowerer<'a> {
             Self::place_definitions(&mut module, d);
         }
         drop_unused_globals(&mut module);
+        storage16::add_16bit_storage(&mut module);
         use rspirv::binary::Assemble;
         Ok((module.assemble(), self.decls))
     }
@@ -971,5 +973,32 @@ mod tests {
             .convert(v, &Ty::ScalarKind(ScalarKind::Float), Pos::default(), false)
             .unwrap();
         assert_eq!(l.known(&f), Some((ScalarKind::Float, 7.0f32.to_bits())));
+    }
+
+    #[test]
+    fn half_conversions_round_to_nearest_even() {
+        use consts::{f16_to_f32, f32_to_f16};
+        assert_eq!(f32_to_f16(1.0), 0x3c00);
+        assert_eq!(f32_to_f16(-2.0), 0xc000);
+        assert_eq!(f32_to_f16(0.1), 0x2e66);
+        assert_eq!(f32_to_f16(65504.0), 0x7bff);
+        // Past the largest half (and its rounding midpoint): infinity.
+        assert_eq!(f32_to_f16(65520.0), 0x7c00);
+        assert_eq!(f32_to_f16(f32::NEG_INFINITY), 0xfc00);
+        assert_eq!(f32_to_f16(f32::NAN) & 0x7c00, 0x7c00);
+        assert_ne!(f32_to_f16(f32::NAN) & 0x3ff, 0);
+        // Ties go to the even mantissa: 2049 to 2048, 2051 to 2052.
+        assert_eq!(f32_to_f16(2049.0), 0x6800);
+        assert_eq!(f32_to_f16(2051.0), 0x6802);
+        // Subnormals, the smallest one, and what rounds to zero.
+        assert_eq!(f32_to_f16(2f32.powi(-24)), 0x0001);
+        assert_eq!(f32_to_f16(2f32.powi(-15)), 0x0200);
+        assert_eq!(f32_to_f16(2f32.powi(-26)), 0x0000);
+        assert_eq!(f32_to_f16(-0.0), 0x8000);
+        for h in [0x0001u16, 0x0200, 0x3c00, 0x2e66, 0x7bff, 0xc000, 0x8000] {
+            assert_eq!(f32_to_f16(f16_to_f32(h)), h);
+        }
+        assert_eq!(f16_to_f32(0x7c00), f32::INFINITY);
+        assert!(f16_to_f32(0x7e00).is_nan());
     }
 }

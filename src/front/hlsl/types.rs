@@ -9,11 +9,18 @@ use super::error::Pos;
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub enum ScalarKind {
     Bool,
+    /// `int16_t`/`uint16_t` (and `min16int`/`min16uint` with
+    /// -enable-16bit-types); ordered so that mixed arithmetic widens.
+    Int16,
+    Uint16,
     Int,
     Uint,
     /// `int64_t` and `uint64_t` (ordered so that mixed arithmetic widens).
     Int64,
     Uint64,
+    /// `float16_t` (and `half`/`min16float` with -enable-16bit-types): any
+    /// float wins over any integer, as in DXC (`half * int` is `half`).
+    Half,
     Float,
 }
 
@@ -21,6 +28,9 @@ impl ScalarKind {
     pub fn name(self) -> &'static str {
         match self {
             ScalarKind::Bool => "bool",
+            ScalarKind::Int16 => "int16_t",
+            ScalarKind::Uint16 => "uint16_t",
+            ScalarKind::Half => "float16_t",
             ScalarKind::Int => "int",
             ScalarKind::Uint => "uint",
             ScalarKind::Int64 => "int64_t",
@@ -33,12 +43,43 @@ impl ScalarKind {
     pub fn size(self) -> u32 {
         match self {
             ScalarKind::Int64 | ScalarKind::Uint64 => 8,
+            ScalarKind::Int16 | ScalarKind::Uint16 | ScalarKind::Half => 2,
             _ => 4,
         }
     }
 
     pub fn is_signed(self) -> bool {
-        matches!(self, ScalarKind::Int | ScalarKind::Int64)
+        matches!(
+            self,
+            ScalarKind::Int | ScalarKind::Int64 | ScalarKind::Int16
+        )
+    }
+
+    pub fn is_float(self) -> bool {
+        matches!(self, ScalarKind::Float | ScalarKind::Half)
+    }
+
+    pub fn is_16(self) -> bool {
+        matches!(
+            self,
+            ScalarKind::Int16 | ScalarKind::Uint16 | ScalarKind::Half
+        )
+    }
+
+    /// The 32-bit type of the same kind: what an image of 16-bit texels
+    /// holds (Vulkan images have 32-bit sampled types), as DXC does.
+    pub fn wide(self) -> ScalarKind {
+        match self {
+            ScalarKind::Half => ScalarKind::Float,
+            ScalarKind::Int16 => ScalarKind::Int,
+            ScalarKind::Uint16 => ScalarKind::Uint,
+            s => s,
+        }
+    }
+
+    /// 32-bit (or `bool`): what textures, wave intrinsics and the like take.
+    pub fn is_32(self) -> bool {
+        !self.is_64() && !self.is_16()
     }
 
     pub fn is_64(self) -> bool {
@@ -119,6 +160,10 @@ impl Ty {
             other => other.clone(),
         }
     }
+    /// The scalar type of a numeric type's components.
+    pub fn with_scalar_only(&self) -> Ty {
+        Ty::ScalarKind(self.scalar().unwrap_or(ScalarKind::Float))
+    }
     pub fn is_resource(&self) -> bool {
         match self {
             Ty::Accel
@@ -174,7 +219,7 @@ pub fn size_align(ty: &Ty, layout: Layout, structs: &[StructDef]) -> (u32, u32) 
         (Ty::Vec(s, n), _) => (s.size() * *n as u32, s.size() * if *n == 2 { 2 } else { 4 }),
         (Ty::Mat(..), _) => {
             let (count, stride, n) = matrix_layout(ty, false, layout);
-            matrix_size_align(count, stride, n, layout)
+            matrix_size_align(count, stride, n, ty, layout)
         }
         (Ty::Array(e, len), _) => {
             let stride = array_stride(e, layout, structs);
@@ -190,7 +235,8 @@ pub fn size_align(ty: &Ty, layout: Layout, structs: &[StructDef]) -> (u32, u32) 
             let offsets = struct_offsets(*k, layout, structs);
             let def = &structs[*k as usize];
             let mut end = 0;
-            let mut align = 4;
+            // A struct of 16-bit members is 2-aligned (DXC with 16-bit types).
+            let mut align = if def.fields.is_empty() { 4 } else { 1 };
             for (f, off) in def.fields.iter().zip(&offsets) {
                 let (s, a) = size_align(&f.ty, layout, structs);
                 end = off + s;
@@ -207,9 +253,10 @@ pub fn size_align(ty: &Ty, layout: Layout, structs: &[StructDef]) -> (u32, u32) 
     }
 }
 
-fn matrix_size_align(count: u32, stride: u32, n: u32, layout: Layout) -> (u32, u32) {
+fn matrix_size_align(count: u32, stride: u32, n: u32, ty: &Ty, layout: Layout) -> (u32, u32) {
+    let e = ty.scalar().map_or(4, ScalarKind::size);
     if layout == Layout::CBuffer {
-        (stride * (count - 1) + 4 * n, 16)
+        (stride * (count - 1) + e * n, 16)
     } else {
         (stride * count, stride.min(16))
     }
@@ -226,9 +273,11 @@ pub fn array_stride(elem: &Ty, layout: Layout, structs: &[StructDef]) -> u32 {
 /// A matrix in memory: (vector count, stride, vector length). Default HLSL
 /// (column-major) packing stores HLSL columns; in SPIR-V terms that is RowMajor.
 pub fn matrix_layout(ty: &Ty, row_major: bool, layout: Layout) -> (u32, u32, u32) {
-    let Ty::Mat(_, r, c) = ty else {
+    let Ty::Mat(s, r, c) = ty else {
         return (1, 16, 4);
     };
+    // Vectors of 1, 2, or 3-4 components, aligned like vectors.
+    let e = s.size();
     let (count, n) = if row_major {
         (*r as u32, *c as u32)
     } else {
@@ -238,11 +287,11 @@ pub fn matrix_layout(ty: &Ty, row_major: bool, layout: Layout) -> (u32, u32, u32
         Layout::CBuffer => 16,
         _ => {
             if n == 2 {
-                8
+                2 * e
             } else if n == 1 {
-                4
+                e
             } else {
-                16
+                4 * e
             }
         }
     };
@@ -257,7 +306,7 @@ pub fn struct_offsets(k: u32, layout: Layout, structs: &[StructDef]) -> Vec<u32>
     for f in &def.fields {
         let (size, align) = if let Ty::Mat(..) = f.ty {
             let (count, stride, n) = matrix_layout(&f.ty, f.row_major, layout);
-            matrix_size_align(count, stride, n, layout)
+            matrix_size_align(count, stride, n, &f.ty, layout)
         } else {
             size_align(&f.ty, layout, structs)
         };
@@ -287,7 +336,7 @@ pub fn packed_size(ty: &Ty, structs: &[StructDef]) -> Option<u32> {
     Some(match ty {
         Ty::ScalarKind(s) => s.size(),
         Ty::Vec(s, n) => s.size() * *n as u32,
-        Ty::Mat(_, r, c) => 4 * *r as u32 * *c as u32,
+        Ty::Mat(s, r, c) => s.size() * *r as u32 * *c as u32,
         Ty::Array(e, n) => packed_size(e, structs)? * n,
         Ty::Struct(k) => {
             let mut total = 0;

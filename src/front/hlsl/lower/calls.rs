@@ -91,6 +91,10 @@ impl<'a> Lowerer<'a> {
         }
         self.arity(name, args, 1, pos)?;
         let v = self.expr(&args[0])?;
+        if v.ty.scalar().is_some_and(ScalarKind::is_16) {
+            // Vulkan's derivatives are 32-bit; widening would change the type.
+            return Err(unsupported(pos, format!("`{name}` of 16-bit values")).len(len));
+        }
         let ty = match v.ty {
             Ty::ScalarKind(_) => Ty::ScalarKind(ScalarKind::Float),
             Ty::Vec(_, n) => Ty::Vec(ScalarKind::Float, n),
@@ -128,6 +132,22 @@ impl<'a> Lowerer<'a> {
         args.iter().map(|a| self.expr(a)).collect()
     }
 
+    /// Literal arguments beside a 16-bit one take its type (`clamp(h, 0.0,
+    /// 1.0)` stays `half`), as in binary operators.
+    fn adapt_literal_args(&mut self, args: &[Expr], vals: Vec<Val>, pos: Pos) -> Result<Vec<Val>> {
+        let Some(other) = vals
+            .iter()
+            .find(|v| v.ty.scalar().is_some_and(ScalarKind::is_16))
+            .map(|v| v.ty.clone())
+        else {
+            return Ok(vals);
+        };
+        args.iter()
+            .zip(vals)
+            .map(|(e, v)| self.adapt_literal(e, v, &other, pos))
+            .collect()
+    }
+
     pub(super) fn arity(&self, name: &str, args: &[Expr], n: usize, pos: Pos) -> Result<()> {
         if args.len() != n {
             return Err(Error::new(
@@ -149,7 +169,10 @@ impl<'a> Lowerer<'a> {
             t = self.common(&t, &v.ty, pos)?;
         }
         if float_only || t.scalar() == Some(ScalarKind::Bool) {
-            t = t.with_scalar(if float_only {
+            // GLSL.std.450 works on 16-bit floats: `half` stays `half`.
+            t = t.with_scalar(if float_only && t.scalar() == Some(ScalarKind::Half) {
+                ScalarKind::Half
+            } else if float_only {
                 ScalarKind::Float
             } else {
                 ScalarKind::Int
@@ -512,9 +535,12 @@ impl<'a> Lowerer<'a> {
             "dot" | "cross" | "length" | "distance" | "reflect" | "refract" | "faceforward"
             | "lerp" | "saturate" | "clamp" | "min" | "max" | "abs" | "sign" | "pow" | "atan2"
             | "step" | "smoothstep" | "fmod" | "mul" | "transpose" | "determinant" | "any"
-            | "all" | "asuint" | "asint" | "asfloat" | "f32tof16" | "f16tof32" | "countbits"
-            | "firstbithigh" | "firstbitlow" | "reversebits" | "isnan" | "isinf" | "isfinite"
-            | "mad" | "fma" | "rcp" | "log10" => self.args(args)?,
+            | "all" | "asuint" | "asint" | "asfloat" | "asuint16" | "asint16" | "asfloat16"
+            | "f32tof16" | "f16tof32" | "countbits" | "firstbithigh" | "firstbitlow"
+            | "reversebits" | "isnan" | "isinf" | "isfinite" | "mad" | "fma" | "rcp" | "log10" => {
+                let vals = self.args(args)?;
+                self.adapt_literal_args(args, vals, pos)?
+            }
             "ddx" | "ddy" | "ddx_fine" | "ddy_fine" | "ddx_coarse" | "ddy_coarse" | "fwidth" => {
                 return self.derivative(name, args, pos).map(Some);
             }
@@ -543,9 +569,9 @@ impl<'a> Lowerer<'a> {
         };
         let want = match name {
             "length" | "saturate" | "abs" | "sign" | "transpose" | "determinant" | "any"
-            | "all" | "asuint" | "asint" | "asfloat" | "f32tof16" | "f16tof32" | "countbits"
-            | "firstbithigh" | "firstbitlow" | "reversebits" | "isnan" | "isinf" | "isfinite"
-            | "rcp" | "log10" => 1,
+            | "all" | "asuint" | "asint" | "asfloat" | "asuint16" | "asint16" | "asfloat16"
+            | "f32tof16" | "f16tof32" | "countbits" | "firstbithigh" | "firstbitlow"
+            | "reversebits" | "isnan" | "isinf" | "isfinite" | "rcp" | "log10" => 1,
             "lerp" | "clamp" | "refract" | "faceforward" | "smoothstep" | "mad" | "fma" => 3,
             _ => 2,
         };
@@ -565,6 +591,26 @@ impl<'a> Lowerer<'a> {
                 unsupported(pos, format!("`{name}` of 64-bit integers")).len(name.len() as u32)
             );
         }
+        // 16-bit values: the arithmetic families, which keep their width
+        // (`f32tof16`/`f16tof32` take them exactly as `float`/`uint`).
+        if vals
+            .iter()
+            .any(|v| v.ty.scalar().is_some_and(ScalarKind::is_16))
+            && matches!(
+                name,
+                "asuint"
+                    | "asint"
+                    | "asfloat"
+                    | "countbits"
+                    | "firstbithigh"
+                    | "firstbitlow"
+                    | "reversebits"
+            )
+        {
+            return Err(
+                unsupported(pos, format!("`{name}` of 16-bit values")).len(name.len() as u32)
+            );
+        }
         match name {
             "dot" => {
                 let (t, ids) = self.unify(vals, false, pos)?;
@@ -581,7 +627,7 @@ impl<'a> Lowerer<'a> {
                         pos,
                     );
                 }
-                if s == ScalarKind::Float {
+                if s.is_float() {
                     let tid = self.ty_id(&st)?;
                     let id = self.op(Op::Dot, tid, &ids)?;
                     return Ok(Val { id, ty: st });
@@ -609,18 +655,18 @@ impl<'a> Lowerer<'a> {
             }
             "cross" => {
                 let (t, ids) = self.unify(vals, true, pos)?;
-                if t != Ty::Vec(ScalarKind::Float, 3) {
+                if !matches!(t, Ty::Vec(s, 3) if s.is_float()) {
                     return Err(Error::new(pos, "`cross` needs float3 arguments"));
                 }
                 self.glsl(G::Cross, &t, &ids)
             }
             "length" => {
-                let (_, ids) = self.unify(vals, true, pos)?;
-                self.glsl(G::Length, &f, &ids)
+                let (t, ids) = self.unify(vals, true, pos)?;
+                self.glsl(G::Length, &t.with_scalar_only(), &ids)
             }
             "distance" => {
-                let (_, ids) = self.unify(vals, true, pos)?;
-                self.glsl(G::Distance, &f, &ids)
+                let (t, ids) = self.unify(vals, true, pos)?;
+                self.glsl(G::Distance, &t.with_scalar_only(), &ids)
             }
             "reflect" => {
                 let (t, ids) = self.unify(vals, true, pos)?;
@@ -633,8 +679,8 @@ impl<'a> Lowerer<'a> {
             "refract" => {
                 let mut vals = vals;
                 let eta = vals.pop().unwrap_or_else(|| unreachable!());
-                let eta = self.convert(eta, &f, pos, false)?;
                 let (t, mut ids) = self.unify(vals, true, pos)?;
+                let eta = self.convert(eta, &t.with_scalar_only(), pos, false)?;
                 ids.push(eta.id);
                 self.glsl(G::Refract, &t, &ids)
             }
@@ -667,13 +713,13 @@ impl<'a> Lowerer<'a> {
                 let (t, ids) = self.unify(vals, false, pos)?;
                 let s = t.scalar().unwrap_or(ScalarKind::Float);
                 let inst = match (name, s) {
-                    ("clamp", ScalarKind::Float) => G::FClamp,
+                    ("clamp", s) if s.is_float() => G::FClamp,
                     ("clamp", s) if s.is_signed() => G::SClamp,
                     ("clamp", _) => G::UClamp,
-                    ("min", ScalarKind::Float) => G::FMin,
+                    ("min", s) if s.is_float() => G::FMin,
                     ("min", s) if s.is_signed() => G::SMin,
                     ("min", _) => G::UMin,
-                    (_, ScalarKind::Float) => G::FMax,
+                    (_, s) if s.is_float() => G::FMax,
                     (_, s) if s.is_signed() => G::SMax,
                     _ => G::UMax,
                 };
@@ -682,7 +728,7 @@ impl<'a> Lowerer<'a> {
             "abs" => {
                 let (t, ids) = self.unify(vals, false, pos)?;
                 match t.scalar() {
-                    Some(ScalarKind::Float) => self.glsl(G::FAbs, &t, &ids),
+                    Some(s) if s.is_float() => self.glsl(G::FAbs, &t, &ids),
                     Some(s) if s.is_signed() => self.glsl(G::SAbs, &t, &ids),
                     _ => Ok(Val { id: ids[0], ty: t }),
                 }
@@ -692,11 +738,15 @@ impl<'a> Lowerer<'a> {
                 let (t, ids) = self.unify(vals, false, pos)?;
                 let it = t.with_scalar(ScalarKind::Int);
                 match t.scalar() {
-                    Some(ScalarKind::Float) => {
+                    Some(s) if s.is_float() => {
                         let v = self.glsl(G::FSign, &t, &ids)?;
                         self.convert(v, &it, pos, true)
                     }
                     Some(ScalarKind::Int) => self.glsl(G::SSign, &t, &ids),
+                    Some(ScalarKind::Int16) => {
+                        let v = self.glsl(G::SSign, &t, &ids)?;
+                        self.convert(v, &it, pos, true)
+                    }
                     _ => {
                         let v = Val {
                             id: ids[0],
@@ -759,7 +809,9 @@ impl<'a> Lowerer<'a> {
             "determinant" => {
                 let v = vals.into_iter().next().unwrap_or_else(|| unreachable!());
                 match v.ty {
-                    Ty::Mat(_, r, c) if r == c => self.glsl(G::Determinant, &f, &[v.id]),
+                    Ty::Mat(s, r, c) if r == c => {
+                        self.glsl(G::Determinant, &Ty::ScalarKind(s), &[v.id])
+                    }
                     _ => Err(Error::new(pos, "`determinant` needs a square matrix")),
                 }
             }
@@ -783,6 +835,30 @@ impl<'a> Lowerer<'a> {
                         ),
                     )),
                 }
+            }
+            "asuint16" | "asint16" | "asfloat16" => {
+                // DXC's 16-bit reinterpretations: the same bits, another type.
+                let v = vals.into_iter().next().unwrap_or_else(|| unreachable!());
+                let s = match name {
+                    "asuint16" => ScalarKind::Uint16,
+                    "asint16" => ScalarKind::Int16,
+                    _ => ScalarKind::Half,
+                };
+                if !matches!(v.ty, Ty::ScalarKind(_) | Ty::Vec(..))
+                    || !v.ty.scalar().is_some_and(ScalarKind::is_16)
+                {
+                    return Err(Error::new(
+                        pos,
+                        format!("`{name}` needs a 16-bit scalar or vector"),
+                    ));
+                }
+                let t = v.ty.with_scalar(s);
+                if t == v.ty {
+                    return Ok(v);
+                }
+                let tid = self.ty_id(&t)?;
+                let id = self.op(Op::Bitcast, tid, &[v.id])?;
+                Ok(Val { id, ty: t })
             }
             "asuint" | "asint" | "asfloat" => {
                 let v = vals.into_iter().next().unwrap_or_else(|| unreachable!());
@@ -927,6 +1003,12 @@ impl<'a> Lowerer<'a> {
             it.next().unwrap_or_else(|| unreachable!()),
         );
         let (at, bt) = (a.ty.clone(), b.ty.clone());
+        // Matrices are float or half: the wider of the two (any integer
+        // vector joins the matrix's kind).
+        let s = match (at.scalar(), bt.scalar()) {
+            (Some(x), Some(y)) if x.max(y).is_float() => x.max(y),
+            _ => ScalarKind::Float,
+        };
         match (&at, &bt) {
             (Ty::ScalarKind(_), _) | (_, Ty::ScalarKind(_)) => self.binary(BinOp::Mul, a, b, pos),
             (Ty::Vec(..), Ty::Vec(..)) => self.intrinsic("dot", vec![a, b], pos),
@@ -938,10 +1020,11 @@ impl<'a> Lowerer<'a> {
                     ));
                 }
                 let (r, c) = (*r, *c);
-                let v = self.convert(b, &Ty::Vec(ScalarKind::Float, c), pos, false)?;
-                let t = Ty::Vec(ScalarKind::Float, r);
+                let m = self.convert(a, &Ty::Mat(s, r, c), pos, false)?;
+                let v = self.convert(b, &Ty::Vec(s, c), pos, false)?;
+                let t = Ty::Vec(s, r);
                 let tid = self.ty_id(&t)?;
-                let id = self.op(Op::VectorTimesMatrix, tid, &[v.id, a.id])?;
+                let id = self.op(Op::VectorTimesMatrix, tid, &[v.id, m.id])?;
                 Ok(Val { id, ty: t })
             }
             (Ty::Vec(_, n), Ty::Mat(_, r, c)) => {
@@ -953,11 +1036,12 @@ impl<'a> Lowerer<'a> {
                         ),
                     ));
                 }
-                let c = *c;
-                let v = self.convert(a, &Ty::Vec(ScalarKind::Float, *n), pos, false)?;
-                let t = Ty::Vec(ScalarKind::Float, c);
+                let (r, c) = (*r, *c);
+                let m = self.convert(b, &Ty::Mat(s, r, c), pos, false)?;
+                let v = self.convert(a, &Ty::Vec(s, *n), pos, false)?;
+                let t = Ty::Vec(s, c);
                 let tid = self.ty_id(&t)?;
-                let id = self.op(Op::MatrixTimesVector, tid, &[b.id, v.id])?;
+                let id = self.op(Op::MatrixTimesVector, tid, &[m.id, v.id])?;
                 Ok(Val { id, ty: t })
             }
             (Ty::Mat(_, r, k), Ty::Mat(_, k2, c)) => {
@@ -967,9 +1051,12 @@ impl<'a> Lowerer<'a> {
                         format!("`mul` of {r}x{k} and {k2}x{c} matrices"),
                     ));
                 }
-                let t = Ty::Mat(ScalarKind::Float, *r, *c);
+                let (r, k, c) = (*r, *k, *c);
+                let x = self.convert(a, &Ty::Mat(s, r, k), pos, false)?;
+                let y = self.convert(b, &Ty::Mat(s, k, c), pos, false)?;
+                let t = Ty::Mat(s, r, c);
                 let tid = self.ty_id(&t)?;
-                let id = self.op(Op::MatrixTimesMatrix, tid, &[b.id, a.id])?;
+                let id = self.op(Op::MatrixTimesMatrix, tid, &[y.id, x.id])?;
                 Ok(Val { id, ty: t })
             }
             _ => Err(Error::new(

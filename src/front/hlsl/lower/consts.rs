@@ -18,6 +18,18 @@ impl<'a> Lowerer<'a> {
                 self.b.type_int(64, 0)
             }
             ScalarKind::Float => self.b.type_float(32, None),
+            ScalarKind::Int16 => {
+                self.cap(Capability::Int16);
+                self.b.type_int(16, 1)
+            }
+            ScalarKind::Uint16 => {
+                self.cap(Capability::Int16);
+                self.b.type_int(16, 0)
+            }
+            ScalarKind::Half => {
+                self.cap(Capability::Float16);
+                self.b.type_float(16, None)
+            }
         }
     }
 
@@ -109,7 +121,7 @@ impl<'a> Lowerer<'a> {
                 let st = self.sc_id(if *sc == ScalarKind::Bool {
                     ScalarKind::Uint
                 } else {
-                    *sc
+                    sc.wide()
                 });
                 let (d, arrayed) = match dim {
                     Dim::D1 => (spirv::Dim::Dim1D, 0),
@@ -147,7 +159,7 @@ impl<'a> Lowerer<'a> {
                 } else {
                     spirv::ImageFormat::Unknown
                 };
-                if *rw && (*n == 2 || fmt.is_some_and(extended_format)) {
+                if *rw && extended_format(format) {
                     self.cap(Capability::StorageImageExtendedFormats);
                 }
                 if *rw && format == spirv::ImageFormat::Unknown {
@@ -177,6 +189,16 @@ impl<'a> Lowerer<'a> {
             (ScalarKind::Int, 1) => F::R32i,
             (ScalarKind::Int, 2) => F::Rg32i,
             (ScalarKind::Int, 4) => F::Rgba32i,
+            // 16-bit texels: 16-bit formats, as DXC derives them.
+            (ScalarKind::Half, 1) => F::R16f,
+            (ScalarKind::Half, 2) => F::Rg16f,
+            (ScalarKind::Half, 4) => F::Rgba16f,
+            (ScalarKind::Uint16, 1) => F::R16ui,
+            (ScalarKind::Uint16, 2) => F::Rg16ui,
+            (ScalarKind::Uint16, 4) => F::Rgba16ui,
+            (ScalarKind::Int16, 1) => F::R16i,
+            (ScalarKind::Int16, 2) => F::Rg16i,
+            (ScalarKind::Int16, 4) => F::Rgba16i,
             _ => F::Unknown,
         }
     }
@@ -355,6 +377,20 @@ impl<'a> Lowerer<'a> {
                 self.b.constant_bit64(t, i as u64)
             }
             ScalarKind::Float => self.const_f32(f as f32),
+            // One word: zero-extended, or sign-extended for signed types
+            // (SPIR-V's rule for literals narrower than 32 bits).
+            ScalarKind::Int16 => {
+                let t = self.sc_id(s);
+                self.const_bits(t, i as i16 as i32 as u32)
+            }
+            ScalarKind::Uint16 => {
+                let t = self.sc_id(s);
+                self.const_bits(t, i as u16 as u32)
+            }
+            ScalarKind::Half => {
+                let t = self.sc_id(s);
+                self.const_bits(t, f32_to_f16(f as f32) as u32)
+            }
         }
     }
 
@@ -711,5 +747,57 @@ impl Lowerer<'_> {
             },
             _ => Err(refuse()),
         }
+    }
+}
+
+/// IEEE binary16 bits of `x`, rounded to nearest even (as DXC folds
+/// `(half)x`): overflow gives infinity, tiny values subnormals or zero.
+pub(super) fn f32_to_f16(x: f32) -> u16 {
+    let b = x.to_bits();
+    let sign = ((b >> 16) & 0x8000) as u16;
+    let exp = ((b >> 23) & 0xff) as i32;
+    let man = b & 0x7f_ffff;
+    if exp == 0xff {
+        // Infinity stays infinity; NaN stays a (quiet) NaN.
+        return sign | 0x7c00 | if man != 0 { 0x200 } else { 0 };
+    }
+    let e = exp - 127 + 15;
+    if e >= 0x1f {
+        return sign | 0x7c00;
+    }
+    if e <= 0 {
+        if e < -10 {
+            return sign;
+        }
+        // Subnormal: the implicit bit joins the mantissa, shifted into place.
+        let m = man | 0x80_0000;
+        let shift = (14 - e) as u32;
+        let half = 1u32 << (shift - 1);
+        let rest = m & ((1 << shift) - 1);
+        let mut r = m >> shift;
+        if rest > half || (rest == half && r & 1 == 1) {
+            r += 1;
+        }
+        return sign | r as u16;
+    }
+    let rest = man & 0x1fff;
+    let mut r = ((e as u32) << 10) | (man >> 13);
+    if rest > 0x1000 || (rest == 0x1000 && r & 1 == 1) {
+        // A carry into the exponent is right (up to infinity).
+        r += 1;
+    }
+    sign | r as u16
+}
+
+/// The value of IEEE binary16 bits.
+pub(super) fn f16_to_f32(h: u16) -> f32 {
+    let sign = if h & 0x8000 != 0 { -1.0 } else { 1.0 };
+    let exp = ((h >> 10) & 0x1f) as i32;
+    let man = (h & 0x3ff) as f32;
+    sign * match exp {
+        0 => man * (-24f32).exp2(),
+        0x1f if man == 0.0 => f32::INFINITY,
+        0x1f => f32::NAN,
+        _ => (1.0 + man / 1024.0) * ((exp - 15) as f32).exp2(),
     }
 }

@@ -45,9 +45,9 @@ impl<'a> Lowerer<'a> {
                 // DWARF-style encodings: Boolean 2, Float 3, Signed 4, Unsigned 6.
                 let enc = self.const_u32(match s {
                     ScalarKind::Bool => 2,
-                    ScalarKind::Float => 3,
-                    ScalarKind::Int | ScalarKind::Int64 => 4,
-                    ScalarKind::Uint | ScalarKind::Uint64 => 6,
+                    ScalarKind::Float | ScalarKind::Half => 3,
+                    ScalarKind::Int | ScalarKind::Int64 | ScalarKind::Int16 => 4,
+                    ScalarKind::Uint | ScalarKind::Uint64 | ScalarKind::Uint16 => 6,
                 });
                 let flags = self.const_u32(0);
                 self.dbg_inst(d, D::DebugTypeBasic, &[name, size, enc, flags])

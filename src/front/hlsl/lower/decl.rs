@@ -22,7 +22,7 @@ impl<'a> Lowerer<'a> {
                         self.f.cur_ns = saved;
                         if let Ok(Some(c)) = c {
                             let c = match (s, c) {
-                                (ScalarKind::Float, c) => ConstValue::F(c.as_f64()),
+                                (s, c) if s.is_float() => ConstValue::F(c.as_f64()),
                                 (_, ConstValue::F(f)) => ConstValue::I(f as i64),
                                 (_, c) => c,
                             };
@@ -482,31 +482,25 @@ impl<'a> Lowerer<'a> {
             }
         };
         if let Some((base, a, b)) = split_numeric(name) {
-            let sixteen = matches!(
-                base,
-                "half" | "min16float" | "min10float" | "min16int" | "min12int" | "min16uint"
-            );
-            if sixteen && self.sixteen_bit_types {
-                // 16-bit with -enable-16bit-types: refused, never widened.
+            if !self.sixteen_bit_types && matches!(base, "float16_t" | "int16_t" | "uint16_t") {
+                // DXC refuses these without the flag too.
                 return Err(unsupported(
                     t.pos,
-                    format!("16-bit type `{base}` (with -enable-16bit-types)"),
+                    format!("16-bit type `{base}` (DXC needs -enable-16bit-types for it)"),
                 )
                 .len(base.len() as u32));
             }
-            if matches!(base, "float16_t" | "int16_t" | "uint16_t") {
-                // Unsupported either way (refused where used, like other
-                // unsupported types); without the flag DXC refuses it too.
-                let why = if self.sixteen_bit_types {
-                    "with -enable-16bit-types"
-                } else {
-                    "DXC needs -enable-16bit-types for it"
-                };
-                return Err(unsupported(t.pos, format!("16-bit type `{base}` ({why})"))
-                    .len(base.len() as u32));
-            }
+            // With -enable-16bit-types DXC maps `half` and the min-precision
+            // types to 16-bit ones; without it they are 32-bit.
+            let sixteen = self.sixteen_bit_types;
             let sc = match base {
                 "bool" => ScalarKind::Bool,
+                "int16_t" => ScalarKind::Int16,
+                "uint16_t" => ScalarKind::Uint16,
+                "float16_t" => ScalarKind::Half,
+                "min16int" | "min12int" if sixteen => ScalarKind::Int16,
+                "min16uint" if sixteen => ScalarKind::Uint16,
+                "half" | "min16float" | "min10float" if sixteen => ScalarKind::Half,
                 "int" | "min16int" | "min12int" | "int32_t" => ScalarKind::Int,
                 "uint" | "dword" | "min16uint" | "uint32_t" => ScalarKind::Uint,
                 "int64_t" => ScalarKind::Int64,
@@ -664,7 +658,7 @@ impl<'a> Lowerer<'a> {
             (0, _) | (1, 0) => Ty::ScalarKind(sc),
             (n, 0) => Ty::Vec(sc, n),
             (r, c) => {
-                if sc != ScalarKind::Float {
+                if !sc.is_float() {
                     return Err(unsupported(pos, "non-float matrices"));
                 }
                 if r < 2 || c < 2 {
@@ -1283,7 +1277,7 @@ impl<'a> Lowerer<'a> {
             if let (Ty::ScalarKind(s), Some(e)) = (&t, &v.init) {
                 if let Some(c) = self.const_eval(e)? {
                     let c = match (s, c) {
-                        (ScalarKind::Float, c) => ConstValue::F(c.as_f64()),
+                        (s, c) if s.is_float() => ConstValue::F(c.as_f64()),
                         (_, ConstValue::F(f)) => ConstValue::I(f as i64),
                         (_, c) => c,
                     };
@@ -1347,6 +1341,9 @@ impl<'a> Lowerer<'a> {
                 ))
             }
         };
+        if s.is_16() {
+            return Err(unsupported(v.pos, "16-bit specialization constants"));
+        }
         let tid = self.sc_id(*s);
         let id = match s {
             ScalarKind::Bool => {

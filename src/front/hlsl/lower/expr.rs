@@ -188,9 +188,11 @@ impl<'a> Lowerer<'a> {
                 if matches!(op, BinOp::And | BinOp::Or) {
                     return self.logical(*op, a, b, e.pos);
                 }
-                let a = self.expr(a)?;
-                let b = self.expr(b)?;
-                self.binary(*op, a, b, e.pos)?
+                let av = self.expr(a)?;
+                let bv = self.expr(b)?;
+                let av = self.adapt_literal(a, av, &bv.ty, e.pos)?;
+                let bv = self.adapt_literal(b, bv, &av.ty, e.pos)?;
+                self.binary(*op, av, bv, e.pos)?
             }
             ExprKind::Assign(op, lhs, rhs) => {
                 let p = self.place(lhs)?;
@@ -203,6 +205,7 @@ impl<'a> Lowerer<'a> {
                     Some(op) => {
                         let cur = self.read(&p)?;
                         let r = self.expr(rhs)?;
+                        let r = self.adapt_literal(rhs, r, &cur.ty, e.pos)?;
                         let v = self.binary(*op, cur, r, e.pos)?;
                         self.convert(v, &t, e.pos, true)?
                     }
@@ -485,6 +488,25 @@ impl<'a> Lowerer<'a> {
                 let s = self.shrink(v.clone(), &Ty::ScalarKind(*a))?;
                 self.convert_scalar(s.id, *a, *b, to)
             }
+            // half and float matrices: row by row (OpFConvert takes no matrices).
+            (Ty::Mat(a, r, c), Ty::Mat(b, r2, c2))
+                if a != b && ((r2 <= r && c2 <= c && explicit) || (r2 == r && c2 == c)) =>
+            {
+                let same = self.convert(v.clone(), &Ty::Mat(*a, *r2, *c2), pos, explicit)?;
+                let rowt = self.ty_id(&Ty::Vec(*a, *c2))?;
+                let mut rows = Vec::new();
+                for i in 0..*r2 {
+                    let row = self.inst(
+                        Op::CompositeExtract,
+                        Some(rowt),
+                        vec![Operand::IdRef(same.id), Operand::LiteralBit32(i as u32)],
+                    )?;
+                    rows.push(self.convert_scalar(row, *a, *b, &Ty::Vec(*b, *c2))?.id);
+                }
+                let tid = self.ty_id(to)?;
+                let id = self.op(Op::CompositeConstruct, tid, &rows)?;
+                Ok(Val { id, ty: to.clone() })
+            }
             (Ty::Mat(a, r, c), Ty::Mat(b, r2, c2)) if a == b && r2 <= r && c2 <= c && explicit => {
                 let st = self.ty_id(&Ty::Vec(*a, *c2))?;
                 let mut rows = Vec::new();
@@ -518,12 +540,17 @@ impl<'a> Lowerer<'a> {
             if from != ScalarKind::Bool && to != ScalarKind::Bool && from != to {
                 let (f, i) = match from {
                     ScalarKind::Float => (f32::from_bits(bits) as f64, f32::from_bits(bits) as i64),
-                    ScalarKind::Int => (bits as i32 as f64, bits as i32 as i64),
+                    ScalarKind::Half => {
+                        let v = consts::f16_to_f32(bits as u16);
+                        (v as f64, v as i64)
+                    }
+                    // 16-bit signed constants are stored sign-extended.
+                    ScalarKind::Int | ScalarKind::Int16 => (bits as i32 as f64, bits as i32 as i64),
                     _ => (bits as f64, bits as i64),
                 };
                 // Between integers the value is sign- or zero-extended from its
                 // own type (then wraps to the target); float conversions convert.
-                let i = if from != ScalarKind::Float && to != ScalarKind::Float {
+                let i = if !from.is_float() && !to.is_float() {
                     if from.is_signed() {
                         bits as i32 as i64
                     } else {
@@ -549,33 +576,47 @@ impl<'a> Lowerer<'a> {
             }
             (_, ScalarKind::Bool) => {
                 let zero = self.const_splat(&from_ty, 0.0)?;
-                let op = if from == ScalarKind::Float {
+                let op = if from.is_float() {
                     Op::FUnordNotEqual
                 } else {
                     Op::INotEqual
                 };
                 self.op(op, tid, &[id, zero])?
             }
-            (s, ScalarKind::Float) if s.is_signed() => self.op(Op::ConvertSToF, tid, &[id])?,
-            (_, ScalarKind::Float) => self.op(Op::ConvertUToF, tid, &[id])?,
-            (ScalarKind::Float, s) if s.is_signed() => self.op(Op::ConvertFToS, tid, &[id])?,
-            (ScalarKind::Float, _) => self.op(Op::ConvertFToU, tid, &[id])?,
+            (s, t) if s.is_float() && t.is_float() => self.op(Op::FConvert, tid, &[id])?,
+            (s, t) if t.is_float() && s.is_signed() => self.op(Op::ConvertSToF, tid, &[id])?,
+            (_, t) if t.is_float() => self.op(Op::ConvertUToF, tid, &[id])?,
+            (s, t) if s.is_float() && t.is_signed() => self.op(Op::ConvertFToS, tid, &[id])?,
+            (s, _) if s.is_float() => self.op(Op::ConvertFToU, tid, &[id])?,
             // Integers of another width: extended by the source's signedness,
             // or truncated (the result type's signedness is its own).
-            (s, t) if s.size() != t.size() => {
-                let op = if s.is_signed() {
-                    Op::SConvert
-                } else {
-                    Op::UConvert
+            (s, t) if s.size() != t.size() && s.is_signed() => self.op(Op::SConvert, tid, &[id])?,
+            (s, t) if s.size() != t.size() && t.is_signed() => {
+                // OpUConvert makes an unsigned result: then reinterpret it.
+                let u = match t {
+                    ScalarKind::Int16 => ScalarKind::Uint16,
+                    ScalarKind::Int64 => ScalarKind::Uint64,
+                    _ => ScalarKind::Uint,
                 };
-                self.op(op, tid, &[id])?
+                let ut = self.ty_id(&to_ty.with_scalar(u))?;
+                let w = self.op(Op::UConvert, ut, &[id])?;
+                self.op(Op::Bitcast, tid, &[w])?
             }
+            (s, t) if s.size() != t.size() => self.op(Op::UConvert, tid, &[id])?,
             _ => self.op(Op::Bitcast, tid, &[id])?,
         };
         Ok(Val {
             id,
             ty: to_ty.clone(),
         })
+    }
+
+    /// A literal beside a 16-bit operand takes its type, as DXC's untyped
+    /// literals do: `h * 2.0` is `half` arithmetic, `i16 + 1` is `int16_t`
+    /// (a float literal beside a 16-bit integer stays `float`).
+    pub(super) fn adapt_literal(&mut self, e: &Expr, v: Val, other: &Ty, pos: Pos) -> Result<Val> {
+        let t = literal_ty(e, &v.ty, other);
+        self.convert(v, &t, pos, true)
     }
 
     /// The type both operands of an arithmetic operator convert to.
@@ -624,7 +665,7 @@ impl<'a> Lowerer<'a> {
             };
             ct = ct.with_scalar(ls);
         }
-        if bits && ct.scalar() == Some(ScalarKind::Float) {
+        if bits && ct.scalar().is_some_and(ScalarKind::is_float) {
             return Err(Error::new(
                 pos,
                 format!("`{}` needs integer operands", op.as_str()),
@@ -676,7 +717,7 @@ impl<'a> Lowerer<'a> {
             return Ok(Val { id, ty: mt });
         }
         let s = ct.scalar().unwrap_or(ScalarKind::Float);
-        let f = s == ScalarKind::Float;
+        let f = s.is_float();
         let signed = s.is_signed();
         let class = if f {
             0
@@ -765,6 +806,16 @@ impl<'a> Lowerer<'a> {
         Ok(Val { id, ty: bool_t })
     }
 
+    /// The type of `?:`: a literal side takes a 16-bit other side's type.
+    fn ternary_ty(&self, a: &Expr, at: &Ty, b: &Expr, bt: &Ty, pos: Pos) -> Result<Ty> {
+        let (at, bt) = (literal_ty(a, at, bt), literal_ty(b, bt, at));
+        if at == bt {
+            Ok(at)
+        } else {
+            self.common(&at, &bt, pos)
+        }
+    }
+
     pub(super) fn ternary(
         &mut self,
         c: &'a Expr,
@@ -780,11 +831,7 @@ impl<'a> Lowerer<'a> {
             // observed running, which leaves no temporary behind.
             let av = self.expr(a)?;
             let bv = self.expr(b)?;
-            let t = if av.ty == bv.ty {
-                av.ty.clone()
-            } else {
-                self.common(&av.ty, &bv.ty, pos)?
-            };
+            let t = self.ternary_ty(a, &av.ty, b, &bv.ty, pos)?;
             let t = match (t, &cv.ty) {
                 (Ty::ScalarKind(s), Ty::Vec(_, n)) => Ty::Vec(s, *n),
                 (other, _) => other,
@@ -827,11 +874,7 @@ impl<'a> Lowerer<'a> {
         let av = side(self, la, a)?;
         self.branch(a_conv)?;
         let bv = side(self, lb, b)?;
-        let t = if av.ty == bv.ty {
-            av.ty.clone()
-        } else {
-            self.common(&av.ty, &bv.ty, pos)?
-        };
+        let t = self.ternary_ty(a, &av.ty, b, &bv.ty, pos)?;
         let y = self.convert(bv, &t, b.pos, false)?;
         let from_b = self.f.cur_label;
         self.branch(merge)?;
@@ -889,7 +932,11 @@ impl<'a> Lowerer<'a> {
             }
             UnOp::BitNot => {
                 let v = self.expr(a)?;
-                if !matches!(v.ty.scalar(), Some(ScalarKind::Int | ScalarKind::Uint)) {
+                if !v
+                    .ty
+                    .scalar()
+                    .is_some_and(|s| s != ScalarKind::Bool && !s.is_float())
+                {
                     return Err(Error::new(pos, "`~` needs an integer"));
                 }
                 let tid = self.ty_id(&v.ty)?;
@@ -942,5 +989,20 @@ fn cheap_and_pure(e: &Expr) -> bool {
         ExprKind::Cast(_, x) => cheap_and_pure(x),
         ExprKind::Construct(_, args) => args.iter().all(cheap_and_pure),
         _ => false,
+    }
+}
+
+/// `ty` (the type of `e`), or, when `e` is an untyped literal beside a
+/// 16-bit `other`, the same shape of `other`'s scalar: `h * 2.0` is `half`
+/// as in DXC; a float literal beside a 16-bit integer stays `float`.
+fn literal_ty(e: &Expr, ty: &Ty, other: &Ty) -> Ty {
+    let lit = match &e.kind {
+        ExprKind::Unary(UnOp::Neg, x) => &x.kind,
+        k => k,
+    };
+    match (lit, other.scalar()) {
+        (ExprKind::Float(_), Some(ScalarKind::Half)) => ty.with_scalar(ScalarKind::Half),
+        (ExprKind::Int(..), Some(o)) if o.is_16() => ty.with_scalar(o),
+        _ => ty.clone(),
     }
 }

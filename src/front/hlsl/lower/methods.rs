@@ -312,7 +312,7 @@ impl<'a> Lowerer<'a> {
             unreachable!("fetch on a texture")
         };
         let im = self.image(ptr, t)?;
-        let v4 = Ty::Vec(*sc, 4);
+        let v4 = Ty::Vec(sc.wide(), 4);
         let vt = self.ty_id(&v4)?;
         let mut ops = vec![Operand::IdRef(im), Operand::IdRef(coord)];
         // Texel buffers have no mip levels.
@@ -402,7 +402,7 @@ impl<'a> Lowerer<'a> {
                 let it = self.ty_id(t)?;
                 let sit = self.b.type_sampled_image(it);
                 let si = self.op(Op::SampledImage, sit, &[im, sm])?;
-                let v4 = Ty::Vec(sc, 4);
+                let v4 = Ty::Vec(sc.wide(), 4);
                 let vt = self.ty_id(&v4)?;
                 let mut ops = vec![Operand::IdRef(si), Operand::IdRef(uv.id)];
                 if name == "Sample" {
@@ -759,8 +759,11 @@ impl<'a> Lowerer<'a> {
             }
         };
         let (sc, n) = match t {
-            Ty::ScalarKind(s) if s != ScalarKind::Bool && !s.is_64() => (s, 1),
-            Ty::Vec(s, n) if s != ScalarKind::Bool && !s.is_64() => (s, n),
+            Ty::ScalarKind(s) if s != ScalarKind::Bool && s.is_32() => (s, 1),
+            Ty::Vec(s, n) if s != ScalarKind::Bool && s.is_32() => (s, n),
+            Ty::ScalarKind(s) | Ty::Vec(s, _) if s.is_16() => {
+                return self.load_16(*ptr, &t, s, args, pos).map(Some);
+            }
             Ty::Struct(_) | Ty::Array(..) => {
                 return self.load_packed(*ptr, &t, args, pos).map(Some);
             }
@@ -789,6 +792,62 @@ impl<'a> Lowerer<'a> {
         let tid = self.ty_id(&t)?;
         let id = self.op(Op::Bitcast, tid, &[words.id])?;
         Ok(Some(Val { id, ty: t }))
+    }
+
+    /// `Load<T>` of 16-bit scalars and vectors: each component is the low or
+    /// high half of the word holding its byte address, as DXC loads them.
+    fn load_16(
+        &mut self,
+        var: Id,
+        t: &Ty,
+        sc: ScalarKind,
+        args: &'a [Expr],
+        pos: Pos,
+    ) -> Result<Val> {
+        self.arity("Load", args, 1, pos)?;
+        let u = Ty::ScalarKind(ScalarKind::Uint);
+        let a = self.expr(&args[0])?;
+        let a = self.convert(a, &u, args[0].pos, false)?;
+        let ut = self.ty_id(&u)?;
+        let pty = self.b.type_pointer(None, StorageClass::StorageBuffer, ut);
+        let st = self.sc_id(sc);
+        let ust = self.sc_id(ScalarKind::Uint16);
+        let (zero, two, three) = (self.const_u32(0), self.const_u32(2), self.const_u32(3));
+        let mut comps = Vec::new();
+        for k in 0..t.width() as u32 {
+            let off = self.const_u32(2 * k);
+            let at = self.op(Op::IAdd, ut, &[a.id, off])?;
+            let word = self.op(Op::ShiftRightLogical, ut, &[at, two])?;
+            let ptr = self.inst(
+                Op::AccessChain,
+                Some(pty),
+                vec![
+                    Operand::IdRef(var),
+                    Operand::IdRef(zero),
+                    Operand::IdRef(word),
+                ],
+            )?;
+            let w = self.b.load(ut, None, ptr, None, [])?;
+            // Bit 1 of the address picks the half: a shift of 0 or 16.
+            let half = self.op(Op::BitwiseAnd, ut, &[at, two])?;
+            let shift = self.op(Op::ShiftLeftLogical, ut, &[half, three])?;
+            let bits = self.op(Op::ShiftRightLogical, ut, &[w, shift])?;
+            let low = self.op(Op::UConvert, ust, &[bits])?;
+            comps.push(if sc == ScalarKind::Uint16 {
+                low
+            } else {
+                self.op(Op::Bitcast, st, &[low])?
+            });
+        }
+        if comps.len() == 1 {
+            return Ok(Val {
+                id: comps[0],
+                ty: t.clone(),
+            });
+        }
+        let tid = self.ty_id(t)?;
+        let id = self.op(Op::CompositeConstruct, tid, &comps)?;
+        Ok(Val { id, ty: t.clone() })
     }
 
     /// `SampleCmp`, `SampleCmpLevelZero`, `SampleCmpLevel`: depth-comparison
@@ -840,7 +899,7 @@ impl<'a> Lowerer<'a> {
         let it = self.ty_id(t)?;
         let sit = self.b.type_sampled_image(it);
         let si = self.op(Op::SampledImage, sit, &[im, sm])?;
-        let rt = Ty::ScalarKind(*sc);
+        let rt = Ty::ScalarKind(sc.wide());
         let rid = self.ty_id(&rt)?;
         let mut ops = vec![
             Operand::IdRef(si),
@@ -862,7 +921,7 @@ impl<'a> Lowerer<'a> {
             Op::ImageSampleDrefExplicitLod
         };
         let id = self.inst(op, Some(rid), ops)?;
-        Ok(Val { id, ty: rt })
+        self.convert_scalar(id, sc.wide(), *sc, &Ty::ScalarKind(*sc))
     }
 
     /// `Load<S>` of a struct or array: its 32-bit leaves packed one word each,
@@ -870,8 +929,8 @@ impl<'a> Lowerer<'a> {
     fn load_packed(&mut self, var: Id, t: &Ty, args: &'a [Expr], pos: Pos) -> Result<Val> {
         fn leaves(t: &Ty, structs: &[StructDef], out: &mut Vec<ScalarKind>) -> bool {
             match t {
-                Ty::ScalarKind(s) if *s != ScalarKind::Bool && !s.is_64() => out.push(*s),
-                Ty::Vec(s, n) if *s != ScalarKind::Bool && !s.is_64() => {
+                Ty::ScalarKind(s) if *s != ScalarKind::Bool && s.is_32() => out.push(*s),
+                Ty::Vec(s, n) if *s != ScalarKind::Bool && s.is_32() => {
                     out.extend(std::iter::repeat_n(*s, *n as usize))
                 }
                 Ty::Array(e, n) => {

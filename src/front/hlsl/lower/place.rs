@@ -549,7 +549,7 @@ impl<'a> Lowerer<'a> {
             } => {
                 let it = self.ty_id(img)?;
                 let im = self.b.load(it, None, *image, None, [])?;
-                let s = ty.scalar().unwrap_or(ScalarKind::Float);
+                let s = ty.scalar().unwrap_or(ScalarKind::Float).wide();
                 let v4 = self.ty_id(&Ty::Vec(s, 4))?;
                 let id = self.op(Op::ImageRead, v4, &[im, *coord])?;
                 self.shrink(
@@ -681,6 +681,13 @@ impl<'a> Lowerer<'a> {
         if &v.ty == to {
             return Ok(v);
         }
+        // A 16-bit texel read as its 32-bit kind: narrowed after shrinking.
+        if let (Some(from), Some(s)) = (v.ty.scalar(), to.scalar()) {
+            if from != s {
+                let wide = self.shrink(v, &to.with_scalar(from))?;
+                return self.convert_scalar(wide.id, from, s, to);
+            }
+        }
         let tid = self.ty_id(to)?;
         let id = match to {
             Ty::ScalarKind(_) => self.inst(
@@ -781,7 +788,9 @@ impl<'a> Lowerer<'a> {
                 let Ty::Texture { rw: true, .. } = img else {
                     return Err(Error::new(pos, "cannot write to a read-only texture"));
                 };
-                let s = ty.scalar().unwrap_or(ScalarKind::Float);
+                // 16-bit texels are stored as their 32-bit kind.
+                let s = ty.scalar().unwrap_or(ScalarKind::Float).wide();
+                let v = self.convert(v, &ty.with_scalar(s), pos, true)?;
                 let v4 = self.widen4(v, s)?;
                 let it = self.ty_id(img)?;
                 let im = self.b.load(it, None, *image, None, [])?;

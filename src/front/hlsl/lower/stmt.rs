@@ -240,7 +240,8 @@ impl<'a> Lowerer<'a> {
         let v = self.expr(sel)?;
         let v = match v.ty {
             Ty::ScalarKind(ScalarKind::Int) | Ty::ScalarKind(ScalarKind::Uint) => v,
-            Ty::ScalarKind(ScalarKind::Bool) => {
+            // Case labels are 32-bit: a 16-bit selector is extended (same cases).
+            Ty::ScalarKind(ScalarKind::Bool | ScalarKind::Int16 | ScalarKind::Uint16) => {
                 self.convert(v, &Ty::ScalarKind(ScalarKind::Int), sel.pos, false)?
             }
             _ => return Err(Error::new(sel.pos, "switch needs an integer scalar")),

@@ -192,8 +192,8 @@ impl<'a> Lowerer<'a> {
                 self.cap(Capability::GroupNonUniformArithmetic);
                 let x = self.wave_value(name, &args[0])?;
                 let op = match x.ty.scalar() {
-                    Some(ScalarKind::Float) => fop,
-                    Some(ScalarKind::Int) => sop,
+                    Some(s) if s.is_float() => fop,
+                    Some(s) if s.is_signed() => sop,
                     _ => uop,
                 };
                 group_op(
@@ -206,7 +206,12 @@ impl<'a> Lowerer<'a> {
             Wave::Bits(op) => {
                 self.cap(Capability::GroupNonUniformArithmetic);
                 let x = self.wave_value(name, &args[0])?;
-                if !matches!(x.ty.scalar(), Some(ScalarKind::Int | ScalarKind::Uint)) {
+                if !matches!(
+                    x.ty.scalar(),
+                    Some(
+                        ScalarKind::Int | ScalarKind::Uint | ScalarKind::Int16 | ScalarKind::Uint16
+                    )
+                ) {
                     return Err(Error::new(
                         args[0].pos,
                         format!("`{name}` needs an integer, not a `{}`", self.ty_name(&x.ty)),
@@ -247,6 +252,7 @@ impl<'a> Lowerer<'a> {
     fn wave_value(&mut self, name: &str, e: &'a Expr) -> Result<Val> {
         let x = self.expr(e)?;
         match x.ty {
+            // 16-bit values need the device's shaderSubgroupExtendedTypes.
             Ty::ScalarKind(s) | Ty::Vec(s, _) if s != ScalarKind::Bool && !s.is_64() => Ok(x),
             _ => Err(unsupported(
                 e.pos,
