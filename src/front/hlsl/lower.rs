@@ -14,6 +14,7 @@ mod formats;
 mod func;
 mod heaps;
 mod inline_spirv;
+mod intrinsics;
 mod methods;
 mod pixel;
 mod place;

@@ -21,8 +21,6 @@ impl Arg<'_> {
     }
 }
 
-const RG_CH_MISS: &[Stage] = &[Stage::RayGeneration, Stage::ClosestHit, Stage::Miss];
-
 impl<'a> Lowerer<'a> {
     pub(super) fn call_expr(&mut self, e: &'a Expr) -> Result<Option<Val>> {
         self.line(e.pos);
@@ -59,16 +57,14 @@ impl<'a> Lowerer<'a> {
 
     /// `ddx`, `ddy`, their `_fine`/`_coarse` forms and `fwidth` → `OpDPdx`... on
     /// float scalars and vectors (integers convert, as in DXC).
-    fn derivative(&mut self, name: &str, args: &'a [Expr], pos: Pos) -> Result<Val> {
-        let (op, static_name): (Op, &'static str) = match name {
-            "ddx" => (Op::DPdx, "ddx"),
-            "ddy" => (Op::DPdy, "ddy"),
-            "ddx_fine" => (Op::DPdxFine, "ddx_fine"),
-            "ddy_fine" => (Op::DPdyFine, "ddy_fine"),
-            "ddx_coarse" => (Op::DPdxCoarse, "ddx_coarse"),
-            "ddy_coarse" => (Op::DPdyCoarse, "ddy_coarse"),
-            _ => (Op::Fwidth, "fwidth"),
-        };
+    pub(super) fn derivative(
+        &mut self,
+        op: Op,
+        name: &'static str,
+        arity: usize,
+        args: &'a [Expr],
+        pos: Pos,
+    ) -> Result<Val> {
         let len = name.len() as u32;
         match self.f.cur_stage {
             Some(Stage::Fragment) => {}
@@ -84,12 +80,10 @@ impl<'a> Lowerer<'a> {
             }
             // In a helper: checked against the entry points that reach it.
             None => {
-                self.fn_derivs
-                    .entry(self.f.cur_fn)
-                    .or_insert((static_name, pos));
+                self.fn_derivs.entry(self.f.cur_fn).or_insert((name, pos));
             }
         }
-        self.arity(name, args, 1, pos)?;
+        self.arity(name, args, arity, pos)?;
         let v = self.expr(&args[0])?;
         if v.ty.scalar().is_some_and(ScalarKind::is_16) {
             // Vulkan's derivatives are 32-bit; widening would change the type.
@@ -117,7 +111,7 @@ impl<'a> Lowerer<'a> {
         Ok(Val { id, ty })
     }
 
-    fn glsl(&mut self, inst: G, ty: &Ty, args: &[Id]) -> Result<Val> {
+    pub(super) fn glsl(&mut self, inst: G, ty: &Ty, args: &[Id]) -> Result<Val> {
         let tid = self.ty_id(ty)?;
         let mut ops = vec![
             Operand::IdRef(self.glsl),
@@ -128,13 +122,18 @@ impl<'a> Lowerer<'a> {
         Ok(Val { id, ty: ty.clone() })
     }
 
-    fn args(&mut self, args: &'a [Expr]) -> Result<Vec<Val>> {
+    pub(super) fn args(&mut self, args: &'a [Expr]) -> Result<Vec<Val>> {
         args.iter().map(|a| self.expr(a)).collect()
     }
 
     /// Literal arguments beside a 16-bit one take its type (`clamp(h, 0.0,
     /// 1.0)` stays `half`), as in binary operators.
-    fn adapt_literal_args(&mut self, args: &[Expr], vals: Vec<Val>, pos: Pos) -> Result<Vec<Val>> {
+    pub(super) fn adapt_literal_args(
+        &mut self,
+        args: &[Expr],
+        vals: Vec<Val>,
+        pos: Pos,
+    ) -> Result<Vec<Val>> {
         let Some(other) = vals
             .iter()
             .find(|v| v.ty.scalar().is_some_and(ScalarKind::is_16))
@@ -160,7 +159,12 @@ impl<'a> Lowerer<'a> {
     }
 
     /// Arguments converted to one common type (`float_only` forces float).
-    fn unify(&mut self, vals: Vec<Val>, float_only: bool, pos: Pos) -> Result<(Ty, Vec<Id>)> {
+    pub(super) fn unify(
+        &mut self,
+        vals: Vec<Val>,
+        float_only: bool,
+        pos: Pos,
+    ) -> Result<(Ty, Vec<Id>)> {
         let mut t = vals
             .first()
             .map(|v| v.ty.clone())
@@ -196,7 +200,7 @@ impl<'a> Lowerer<'a> {
     }
 
     /// Writes `v` to an `out` argument, converting to its type.
-    fn store_out(&mut self, a: &'a Expr, v: Val) -> Result<()> {
+    pub(super) fn store_out(&mut self, a: &'a Expr, v: Val) -> Result<()> {
         let p = self.place(a)?;
         let t = p.ty().clone();
         let v = self.convert(v, &t, a.pos, true)?;
@@ -299,287 +303,19 @@ impl<'a> Lowerer<'a> {
             }
             return Ok(Some(v));
         }
-        let f = Ty::ScalarKind(ScalarKind::Float);
-        let one_float = |this: &mut Self, inst: G| -> Result<Option<Val>> {
-            this.arity(name, args, 1, pos)?;
-            let vals = this.args(args)?;
-            let (t, ids) = this.unify(vals, true, pos)?;
-            Ok(Some(this.glsl(inst, &t, &ids)?))
-        };
-        let unary_glsl = match name {
-            "sin" => Some(G::Sin),
-            "cos" => Some(G::Cos),
-            "tan" => Some(G::Tan),
-            "asin" => Some(G::Asin),
-            "acos" => Some(G::Acos),
-            "atan" => Some(G::Atan),
-            "sinh" => Some(G::Sinh),
-            "cosh" => Some(G::Cosh),
-            "tanh" => Some(G::Tanh),
-            "exp" => Some(G::Exp),
-            "log" => Some(G::Log),
-            "exp2" => Some(G::Exp2),
-            "log2" => Some(G::Log2),
-            "sqrt" => Some(G::Sqrt),
-            "rsqrt" => Some(G::InverseSqrt),
-            "floor" => Some(G::Floor),
-            "ceil" => Some(G::Ceil),
-            "frac" => Some(G::Fract),
-            "trunc" => Some(G::Trunc),
-            "round" => Some(G::RoundEven),
-            "radians" => Some(G::Radians),
-            "degrees" => Some(G::Degrees),
-            "normalize" => Some(G::Normalize),
-            _ => None,
-        };
-        if let Some(inst) = unary_glsl {
-            return one_float(self, inst);
-        }
-        match name {
-            "TraceRay" => return self.trace_ray(args, pos).map(|_| None),
-            "CallShader" => {
-                self.arity(name, args, 2, pos)?;
-                self.stage_check(
-                    name,
-                    &[
-                        Stage::RayGeneration,
-                        Stage::ClosestHit,
-                        Stage::Miss,
-                        Stage::Callable,
-                    ],
-                    pos,
-                )?;
-                let idx = self.expr(&args[0])?;
-                let idx =
-                    self.convert(idx, &Ty::ScalarKind(ScalarKind::Uint), args[0].pos, false)?;
-                let p = self.place(&args[1])?;
-                let t = p.ty().clone();
-                if !matches!(t, Ty::Struct(_)) {
-                    return Err(Error::new(args[1].pos, "callable data must be a struct"));
-                }
-                let var = self.rt_var(StorageClass::CallableDataKHR, &t)?;
-                let v = self.read(&p)?;
-                self.b.store(var, v.id, None, [])?;
-                self.inst(
-                    Op::ExecuteCallableKHR,
-                    None,
-                    vec![Operand::IdRef(idx.id), Operand::IdRef(var)],
-                )?;
-                let tid = self.ty_id(&t)?;
-                let back = self.b.load(tid, None, var, None, [])?;
-                self.write(&p, Val { id: back, ty: t }, args[1].pos)?;
-                return Ok(None);
-            }
-            "ReportHit" => {
-                self.arity(name, args, 3, pos)?;
-                self.stage_check(name, &[Stage::Intersection], pos)?;
-                let t = self.expr(&args[0])?;
-                let t = self.convert(t, &f, args[0].pos, false)?;
-                let k = self.expr(&args[1])?;
-                let k = self.convert(k, &Ty::ScalarKind(ScalarKind::Uint), args[1].pos, false)?;
-                let a = self.expr(&args[2])?;
-                if !matches!(a.ty, Ty::Struct(_)) {
-                    return Err(Error::new(args[2].pos, "hit attributes must be a struct"));
-                }
-                let var = self.rt_var(StorageClass::HitAttributeKHR, &a.ty)?;
-                self.b.store(var, a.id, None, [])?;
-                let bt = self.ty_id(&Ty::ScalarKind(ScalarKind::Bool))?;
-                let id = self.op(Op::ReportIntersectionKHR, bt, &[t.id, k.id])?;
-                return Ok(Some(Val {
-                    id,
-                    ty: Ty::ScalarKind(ScalarKind::Bool),
-                }));
-            }
-            "IgnoreHit" | "AcceptHitAndEndSearch" => {
-                self.arity(name, args, 0, pos)?;
-                self.stage_check(name, &[Stage::AnyHit], pos)?;
-                self.ray_tracing_caps();
-                if self.f.term {
-                    self.start_block(None)?;
-                }
-                if name == "IgnoreHit" {
-                    self.b.ignore_intersection_khr()?;
-                } else {
-                    self.b.terminate_ray_khr()?;
-                }
-                self.f.term = true;
-                return Ok(None);
-            }
-            "NonUniformResourceIndex" => {
-                self.arity(name, args, 1, pos)?;
-                let v = self.expr(&args[0])?;
-                self.cap(Capability::ShaderNonUniform);
-                self.ext("SPV_EXT_descriptor_indexing");
-                self.nonuniform.insert(v.id);
-                return Ok(Some(v));
-            }
-            "GroupMemoryBarrierWithGroupSync"
-            | "GroupMemoryBarrier"
-            | "AllMemoryBarrierWithGroupSync"
-            | "DeviceMemoryBarrierWithGroupSync"
-            | "AllMemoryBarrier"
-            | "DeviceMemoryBarrier" => {
-                self.arity(name, args, 0, pos)?;
-                let group = name.starts_with("Group");
-                let mem = self.const_u32(if group { 2 } else { 1 });
-                // AcquireRelease | WorkgroupMemory (| UniformMemory | ImageMemory).
-                let sem = self.const_u32(if group {
-                    0x108
-                } else {
-                    0x8 | 0x40 | 0x100 | 0x800
-                });
-                if name.ends_with("WithGroupSync") {
-                    let wg = self.const_u32(2);
-                    self.inst(
-                        Op::ControlBarrier,
-                        None,
-                        vec![Operand::IdRef(wg), Operand::IdRef(mem), Operand::IdRef(sem)],
-                    )?;
-                } else {
-                    self.inst(
-                        Op::MemoryBarrier,
-                        None,
-                        vec![Operand::IdRef(mem), Operand::IdRef(sem)],
-                    )?;
-                }
-                return Ok(None);
-            }
-            _ => {}
+        if let Some(row) = intrinsics::lookup(name) {
+            return self.lower_intrinsic(row, args, pos);
         }
         if name.starts_with("Interlocked") {
             return self.interlocked(name, args, pos);
         }
-        match name {
-            "and" | "or" => {
-                // HLSL 2021's component-wise logic (`&&` no longer is on vectors).
-                self.arity(name, args, 2, pos)?;
-                let a = self.expr(&args[0])?;
-                let b = self.expr(&args[1])?;
-                let t = self
-                    .common(&a.ty, &b.ty, pos)?
-                    .with_scalar(ScalarKind::Bool);
-                if let Ty::Mat(..) = t {
-                    return Err(unsupported(pos, format!("matrix arguments to `{name}`")));
-                }
-                let x = self.convert(a, &t, pos, false)?;
-                let y = self.convert(b, &t, pos, false)?;
-                let tid = self.ty_id(&t)?;
-                let op = if name == "and" {
-                    Op::LogicalAnd
-                } else {
-                    Op::LogicalOr
-                };
-                let id = self.op(op, tid, &[x.id, y.id])?;
-                return Ok(Some(Val { id, ty: t }));
-            }
-            "select" => {
-                self.arity(name, args, 3, pos)?;
-                let c = self.expr(&args[0])?;
-                let a = self.expr(&args[1])?;
-                let b = self.expr(&args[2])?;
-                let mut t = self.common(&a.ty, &b.ty, pos)?;
-                if let (Ty::Vec(_, n), Ty::ScalarKind(s)) = (&c.ty, &t) {
-                    t = Ty::Vec(*s, *n);
-                }
-                if let Ty::Mat(..) = t {
-                    return Err(unsupported(pos, "matrix arguments to `select`"));
-                }
-                let ct = t.with_scalar(ScalarKind::Bool);
-                let cb = self.convert(c, &ct, args[0].pos, false)?;
-                let x = self.convert(a, &t, args[1].pos, false)?;
-                let y = self.convert(b, &t, args[2].pos, false)?;
-                let tid = self.ty_id(&t)?;
-                let id = self.op(Op::Select, tid, &[cb.id, x.id, y.id])?;
-                return Ok(Some(Val { id, ty: t }));
-            }
-            "sincos" => {
-                self.arity(name, args, 3, pos)?;
-                let x = self.expr(&args[0])?;
-                let (t, ids) = self.unify(vec![x], true, pos)?;
-                let sn = self.glsl(G::Sin, &t, &ids)?;
-                let cs = self.glsl(G::Cos, &t, &ids)?;
-                self.store_out(&args[1], sn)?;
-                self.store_out(&args[2], cs)?;
-                return Ok(None);
-            }
-            "modf" => {
-                // modf(x, out ip): the integer part truncates toward zero.
-                self.arity(name, args, 2, pos)?;
-                let x = self.expr(&args[0])?;
-                let (t, ids) = self.unify(vec![x], true, pos)?;
-                let ip = self.glsl(G::Trunc, &t, &ids)?;
-                let frac = self.binary(
-                    BinOp::Sub,
-                    Val {
-                        id: ids[0],
-                        ty: t.clone(),
-                    },
-                    ip.clone(),
-                    pos,
-                )?;
-                self.store_out(&args[1], ip)?;
-                return Ok(Some(frac));
-            }
-            "ldexp" => {
-                self.arity(name, args, 2, pos)?;
-                let vals = self.args(args)?;
-                let (t, ids) = self.unify(vals, true, pos)?;
-                let p = self.glsl(G::Exp2, &t, &ids[1..])?;
-                return self
-                    .binary(BinOp::Mul, Val { id: ids[0], ty: t }, p, pos)
-                    .map(Some);
-            }
-            _ => {}
+        if name.starts_with("Wave") || name.starts_with("Quad") {
+            return Err(unsupported(pos, format!("wave intrinsic `{name}`")).len(name.len() as u32));
         }
-        let vals = match name {
-            "dot" | "cross" | "length" | "distance" | "reflect" | "refract" | "faceforward"
-            | "lerp" | "saturate" | "clamp" | "min" | "max" | "abs" | "sign" | "pow" | "atan2"
-            | "step" | "smoothstep" | "fmod" | "mul" | "transpose" | "determinant" | "any"
-            | "all" | "asuint" | "asint" | "asfloat" | "asuint16" | "asint16" | "asfloat16"
-            | "f32tof16" | "f16tof32" | "countbits" | "firstbithigh" | "firstbitlow"
-            | "reversebits" | "isnan" | "isinf" | "isfinite" | "mad" | "fma" | "rcp" | "log10" => {
-                let vals = self.args(args)?;
-                self.adapt_literal_args(args, vals, pos)?
-            }
-            "ddx" | "ddy" | "ddx_fine" | "ddy_fine" | "ddx_coarse" | "ddy_coarse" | "fwidth" => {
-                return self.derivative(name, args, pos).map(Some);
-            }
-            "clip" => {
-                return Err(unsupported(pos, format!("`{name}` (pixel shaders only)"))
-                    .len(name.len() as u32));
-            }
-            _ if name.starts_with("Wave") => {
-                if let Some(v) = self.wave(name, args, pos)? {
-                    return Ok(Some(v));
-                }
-                return Err(
-                    unsupported(pos, format!("wave intrinsic `{name}`")).len(name.len() as u32)
-                );
-            }
-            _ if name.starts_with("Quad") => {
-                return Err(
-                    unsupported(pos, format!("wave intrinsic `{name}`")).len(name.len() as u32)
-                );
-            }
-            _ => {
-                return Err(
-                    Error::new(pos, format!("unknown function `{name}`")).len(name.len() as u32)
-                )
-            }
-        };
-        let want = match name {
-            "length" | "saturate" | "abs" | "sign" | "transpose" | "determinant" | "any"
-            | "all" | "asuint" | "asint" | "asfloat" | "asuint16" | "asint16" | "asfloat16"
-            | "f32tof16" | "f16tof32" | "countbits" | "firstbithigh" | "firstbitlow"
-            | "reversebits" | "isnan" | "isinf" | "isfinite" | "rcp" | "log10" => 1,
-            "lerp" | "clamp" | "refract" | "faceforward" | "smoothstep" | "mad" | "fma" => 3,
-            _ => 2,
-        };
-        self.arity(name, args, want, pos)?;
-        self.intrinsic(name, vals, pos).map(Some)
+        Err(Error::new(pos, format!("unknown function `{name}`")).len(name.len() as u32))
     }
 
-    fn intrinsic(&mut self, name: &str, vals: Vec<Val>, pos: Pos) -> Result<Val> {
+    pub(super) fn intrinsic(&mut self, name: &str, vals: Vec<Val>, pos: Pos) -> Result<Val> {
         let f = Ty::ScalarKind(ScalarKind::Float);
         // 64-bit integers: the min/max/clamp/abs family only.
         if vals
@@ -1170,9 +906,7 @@ impl<'a> Lowerer<'a> {
         Ok(None)
     }
 
-    fn trace_ray(&mut self, args: &'a [Expr], pos: Pos) -> Result<()> {
-        self.arity("TraceRay", args, 8, pos)?;
-        self.stage_check("TraceRay", RG_CH_MISS, pos)?;
+    pub(super) fn trace_ray(&mut self, args: &'a [Expr], pos: Pos) -> Result<()> {
         let accel = self.expr(&args[0])?;
         if accel.ty != Ty::Accel {
             return Err(Error::new(

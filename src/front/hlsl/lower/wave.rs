@@ -1,11 +1,12 @@
 //! Wave intrinsics (SM 6.0) → SPIR-V group non-uniform instructions at
-//! subgroup scope, as DXC maps them. One table: name, arity, lowering.
+//! subgroup scope, as DXC maps them: the wave family of the intrinsic table.
 
+use super::intrinsics::{any, Intrinsic, Lowering};
 use super::*;
 
 /// How a wave intrinsic is lowered.
 #[derive(Clone, Copy)]
-enum Wave {
+pub(super) enum Wave {
     /// A built-in input: `WaveGetLaneIndex`, `WaveGetLaneCount`.
     Lane(BuiltIn),
     /// `WaveIsFirstLane`: `OpGroupNonUniformElect`.
@@ -28,99 +29,108 @@ enum Wave {
     CountBits(spirv::GroupOperation),
 }
 
-/// The wave family of the intrinsic table: name, arity, lowering.
-const WAVE: &[(&str, usize, Wave)] = {
+/// The wave family of the intrinsic table.
+pub(super) const WAVE: &[Intrinsic] = {
     use spirv::GroupOperation::{ExclusiveScan, Reduce};
+    use Lowering::Wave as W;
     use Op::*;
     &[
-        (
+        any(
             "WaveGetLaneIndex",
             0,
-            Wave::Lane(BuiltIn::SubgroupLocalInvocationId),
+            W(Wave::Lane(BuiltIn::SubgroupLocalInvocationId)),
         ),
-        ("WaveGetLaneCount", 0, Wave::Lane(BuiltIn::SubgroupSize)),
-        ("WaveIsFirstLane", 0, Wave::Elect),
-        ("WaveActiveAnyTrue", 1, Wave::Vote(GroupNonUniformAny)),
-        ("WaveActiveAllTrue", 1, Wave::Vote(GroupNonUniformAll)),
-        ("WaveActiveAllEqual", 1, Wave::AllEqual),
-        ("WaveActiveBallot", 1, Wave::Ballot),
-        ("WaveReadLaneFirst", 1, Wave::First),
-        ("WaveReadLaneAt", 2, Wave::ReadAt),
-        (
+        any("WaveGetLaneCount", 0, W(Wave::Lane(BuiltIn::SubgroupSize))),
+        any("WaveIsFirstLane", 0, W(Wave::Elect)),
+        any("WaveActiveAnyTrue", 1, W(Wave::Vote(GroupNonUniformAny))),
+        any("WaveActiveAllTrue", 1, W(Wave::Vote(GroupNonUniformAll))),
+        any("WaveActiveAllEqual", 1, W(Wave::AllEqual)),
+        any("WaveActiveBallot", 1, W(Wave::Ballot)),
+        any("WaveReadLaneFirst", 1, W(Wave::First)),
+        any("WaveReadLaneAt", 2, W(Wave::ReadAt)),
+        any(
             "WaveActiveSum",
             1,
-            Wave::Arith(
+            W(Wave::Arith(
                 GroupNonUniformFAdd,
                 GroupNonUniformIAdd,
                 GroupNonUniformIAdd,
                 Reduce,
-            ),
+            )),
         ),
-        (
+        any(
             "WaveActiveProduct",
             1,
-            Wave::Arith(
+            W(Wave::Arith(
                 GroupNonUniformFMul,
                 GroupNonUniformIMul,
                 GroupNonUniformIMul,
                 Reduce,
-            ),
+            )),
         ),
-        (
+        any(
             "WaveActiveMin",
             1,
-            Wave::Arith(
+            W(Wave::Arith(
                 GroupNonUniformFMin,
                 GroupNonUniformSMin,
                 GroupNonUniformUMin,
                 Reduce,
-            ),
+            )),
         ),
-        (
+        any(
             "WaveActiveMax",
             1,
-            Wave::Arith(
+            W(Wave::Arith(
                 GroupNonUniformFMax,
                 GroupNonUniformSMax,
                 GroupNonUniformUMax,
                 Reduce,
-            ),
+            )),
         ),
-        (
+        any(
             "WavePrefixSum",
             1,
-            Wave::Arith(
+            W(Wave::Arith(
                 GroupNonUniformFAdd,
                 GroupNonUniformIAdd,
                 GroupNonUniformIAdd,
                 ExclusiveScan,
-            ),
+            )),
         ),
-        (
+        any(
             "WavePrefixProduct",
             1,
-            Wave::Arith(
+            W(Wave::Arith(
                 GroupNonUniformFMul,
                 GroupNonUniformIMul,
                 GroupNonUniformIMul,
                 ExclusiveScan,
-            ),
+            )),
         ),
-        ("WaveActiveBitAnd", 1, Wave::Bits(GroupNonUniformBitwiseAnd)),
-        ("WaveActiveBitOr", 1, Wave::Bits(GroupNonUniformBitwiseOr)),
-        ("WaveActiveBitXor", 1, Wave::Bits(GroupNonUniformBitwiseXor)),
-        ("WaveActiveCountBits", 1, Wave::CountBits(Reduce)),
-        ("WavePrefixCountBits", 1, Wave::CountBits(ExclusiveScan)),
+        any(
+            "WaveActiveBitAnd",
+            1,
+            W(Wave::Bits(GroupNonUniformBitwiseAnd)),
+        ),
+        any(
+            "WaveActiveBitOr",
+            1,
+            W(Wave::Bits(GroupNonUniformBitwiseOr)),
+        ),
+        any(
+            "WaveActiveBitXor",
+            1,
+            W(Wave::Bits(GroupNonUniformBitwiseXor)),
+        ),
+        any("WaveActiveCountBits", 1, W(Wave::CountBits(Reduce))),
+        any("WavePrefixCountBits", 1, W(Wave::CountBits(ExclusiveScan))),
     ]
 };
 
 impl<'a> Lowerer<'a> {
-    /// A wave intrinsic, or `None` when `name` is not one.
-    pub(super) fn wave(&mut self, name: &str, args: &'a [Expr], pos: Pos) -> Result<Option<Val>> {
-        let Some(&(_, arity, kind)) = WAVE.iter().find(|(n, ..)| *n == name) else {
-            return Ok(None);
-        };
-        self.arity(name, args, arity, pos)?;
+    /// A wave intrinsic of the kind `kind` (arity already checked).
+    pub(super) fn wave(&mut self, kind: Wave, name: &str, args: &'a [Expr]) -> Result<Val> {
         self.cap(Capability::GroupNonUniform);
         let u = Ty::ScalarKind(ScalarKind::Uint);
         let b = Ty::ScalarKind(ScalarKind::Bool);
@@ -245,7 +255,7 @@ impl<'a> Lowerer<'a> {
                 )?
             }
         };
-        Ok(Some(v))
+        Ok(v)
     }
 
     /// A numeric scalar or vector argument of a wave intrinsic.
