@@ -1,6 +1,7 @@
 //! Calls: user functions (overloads, `in`/`out`/`inout` by copy), intrinsics,
 //! ray-tracing operations and methods of resources and ray queries.
 
+use super::intrinsics::{Bit, FpClass, Math};
 use super::*;
 use spirv::GlslStd450Op as G;
 
@@ -315,13 +316,19 @@ impl<'a> Lowerer<'a> {
         Err(Error::new(pos, format!("unknown function `{name}`")).len(name.len() as u32))
     }
 
-    pub(super) fn intrinsic(&mut self, name: &str, vals: Vec<Val>, pos: Pos) -> Result<Val> {
+    pub(super) fn intrinsic(
+        &mut self,
+        m: Math,
+        name: &str,
+        vals: Vec<Val>,
+        pos: Pos,
+    ) -> Result<Val> {
         let f = Ty::ScalarKind(ScalarKind::Float);
         // 64-bit integers: the min/max/clamp/abs family only.
         if vals
             .iter()
             .any(|v| v.ty.scalar().is_some_and(ScalarKind::is_64))
-            && !matches!(name, "min" | "max" | "clamp" | "abs")
+            && !matches!(m, Math::MinMax(..) | Math::Abs)
         {
             return Err(
                 unsupported(pos, format!("`{name}` of 64-bit integers")).len(name.len() as u32)
@@ -332,23 +339,14 @@ impl<'a> Lowerer<'a> {
         if vals
             .iter()
             .any(|v| v.ty.scalar().is_some_and(ScalarKind::is_16))
-            && matches!(
-                name,
-                "asuint"
-                    | "asint"
-                    | "asfloat"
-                    | "countbits"
-                    | "firstbithigh"
-                    | "firstbitlow"
-                    | "reversebits"
-            )
+            && matches!(m, Math::As32(_) | Math::Bits(_))
         {
             return Err(
                 unsupported(pos, format!("`{name}` of 16-bit values")).len(name.len() as u32)
             );
         }
-        match name {
-            "dot" => {
+        match m {
+            Math::Dot => {
                 let (t, ids) = self.unify(vals, false, pos)?;
                 let s = t.scalar().unwrap_or(ScalarKind::Float);
                 let st = Ty::ScalarKind(s);
@@ -389,30 +387,30 @@ impl<'a> Lowerer<'a> {
                 }
                 Ok(acc)
             }
-            "cross" => {
+            Math::Cross => {
                 let (t, ids) = self.unify(vals, true, pos)?;
                 if !matches!(t, Ty::Vec(s, 3) if s.is_float()) {
                     return Err(Error::new(pos, "`cross` needs float3 arguments"));
                 }
                 self.glsl(G::Cross, &t, &ids)
             }
-            "length" => {
+            Math::Length => {
                 let (t, ids) = self.unify(vals, true, pos)?;
                 self.glsl(G::Length, &t.with_scalar_only(), &ids)
             }
-            "distance" => {
+            Math::Distance => {
                 let (t, ids) = self.unify(vals, true, pos)?;
                 self.glsl(G::Distance, &t.with_scalar_only(), &ids)
             }
-            "reflect" => {
+            Math::Reflect => {
                 let (t, ids) = self.unify(vals, true, pos)?;
                 self.glsl(G::Reflect, &t, &ids)
             }
-            "faceforward" => {
+            Math::FaceForward => {
                 let (t, ids) = self.unify(vals, true, pos)?;
                 self.glsl(G::FaceForward, &t, &ids)
             }
-            "refract" => {
+            Math::Refract => {
                 let mut vals = vals;
                 let eta = vals.pop().unwrap_or_else(|| unreachable!());
                 let (t, mut ids) = self.unify(vals, true, pos)?;
@@ -420,16 +418,11 @@ impl<'a> Lowerer<'a> {
                 ids.push(eta.id);
                 self.glsl(G::Refract, &t, &ids)
             }
-            "lerp" | "smoothstep" | "fma" => {
+            Math::Glsl(inst) => {
                 let (t, ids) = self.unify(vals, true, pos)?;
-                let inst = match name {
-                    "lerp" => G::FMix,
-                    "fma" => G::Fma,
-                    _ => G::SmoothStep,
-                };
                 self.glsl(inst, &t, &ids)
             }
-            "mad" => {
+            Math::Mad => {
                 let mut it = vals.into_iter();
                 let (a, b, c) = (
                     it.next().unwrap_or_else(|| unreachable!()),
@@ -439,29 +432,25 @@ impl<'a> Lowerer<'a> {
                 let ab = self.binary(BinOp::Mul, a, b, pos)?;
                 self.binary(BinOp::Add, ab, c, pos)
             }
-            "saturate" => {
+            Math::Saturate => {
                 let (t, ids) = self.unify(vals, true, pos)?;
                 let zero = self.const_splat(&t, 0.0)?;
                 let one = self.const_splat(&t, 1.0)?;
                 self.glsl(G::FClamp, &t, &[ids[0], zero, one])
             }
-            "clamp" | "min" | "max" => {
+            Math::MinMax(fi, si, ui) => {
                 let (t, ids) = self.unify(vals, false, pos)?;
                 let s = t.scalar().unwrap_or(ScalarKind::Float);
-                let inst = match (name, s) {
-                    ("clamp", s) if s.is_float() => G::FClamp,
-                    ("clamp", s) if s.is_signed() => G::SClamp,
-                    ("clamp", _) => G::UClamp,
-                    ("min", s) if s.is_float() => G::FMin,
-                    ("min", s) if s.is_signed() => G::SMin,
-                    ("min", _) => G::UMin,
-                    (_, s) if s.is_float() => G::FMax,
-                    (_, s) if s.is_signed() => G::SMax,
-                    _ => G::UMax,
+                let inst = if s.is_float() {
+                    fi
+                } else if s.is_signed() {
+                    si
+                } else {
+                    ui
                 };
                 self.glsl(inst, &t, &ids)
             }
-            "abs" => {
+            Math::Abs => {
                 let (t, ids) = self.unify(vals, false, pos)?;
                 match t.scalar() {
                     Some(s) if s.is_float() => self.glsl(G::FAbs, &t, &ids),
@@ -469,7 +458,7 @@ impl<'a> Lowerer<'a> {
                     _ => Ok(Val { id: ids[0], ty: t }),
                 }
             }
-            "sign" => {
+            Math::Sign => {
                 // HLSL's sign returns int components.
                 let (t, ids) = self.unify(vals, false, pos)?;
                 let it = t.with_scalar(ScalarKind::Int);
@@ -493,16 +482,7 @@ impl<'a> Lowerer<'a> {
                     }
                 }
             }
-            "pow" | "atan2" | "step" => {
-                let (t, ids) = self.unify(vals, true, pos)?;
-                let inst = match name {
-                    "pow" => G::Pow,
-                    "atan2" => G::Atan2,
-                    _ => G::Step,
-                };
-                self.glsl(inst, &t, &ids)
-            }
-            "fmod" => {
+            Math::Fmod => {
                 let (t, ids) = self.unify(vals, true, pos)?;
                 self.binary(
                     BinOp::Rem,
@@ -514,7 +494,7 @@ impl<'a> Lowerer<'a> {
                     pos,
                 )
             }
-            "rcp" => {
+            Math::Rcp => {
                 let (t, ids) = self.unify(vals, true, pos)?;
                 let one = Val {
                     id: self.const_splat(&t, 1.0)?,
@@ -522,7 +502,7 @@ impl<'a> Lowerer<'a> {
                 };
                 self.binary(BinOp::Div, one, Val { id: ids[0], ty: t }, pos)
             }
-            "log10" => {
+            Math::Log10 => {
                 let (t, ids) = self.unify(vals, true, pos)?;
                 let l = self.glsl(G::Log2, &t, &ids)?;
                 let k = Val {
@@ -531,8 +511,8 @@ impl<'a> Lowerer<'a> {
                 };
                 self.binary(BinOp::Mul, l, k, pos)
             }
-            "mul" => self.mul(vals, pos),
-            "transpose" => {
+            Math::Mul => self.mul(vals, pos),
+            Math::Transpose => {
                 let v = vals.into_iter().next().unwrap_or_else(|| unreachable!());
                 let Ty::Mat(s, r, c) = v.ty else {
                     return Err(Error::new(pos, "`transpose` needs a matrix"));
@@ -542,7 +522,7 @@ impl<'a> Lowerer<'a> {
                 let id = self.op(Op::Transpose, tid, &[v.id])?;
                 Ok(Val { id, ty: t })
             }
-            "determinant" => {
+            Math::Determinant => {
                 let v = vals.into_iter().next().unwrap_or_else(|| unreachable!());
                 match v.ty {
                     Ty::Mat(s, r, c) if r == c => {
@@ -551,7 +531,7 @@ impl<'a> Lowerer<'a> {
                     _ => Err(Error::new(pos, "`determinant` needs a square matrix")),
                 }
             }
-            "any" | "all" => {
+            Math::AnyAll(op) => {
                 let v = vals.into_iter().next().unwrap_or_else(|| unreachable!());
                 let bt = Ty::ScalarKind(ScalarKind::Bool);
                 match v.ty.clone() {
@@ -559,8 +539,7 @@ impl<'a> Lowerer<'a> {
                     Ty::Vec(_, n) => {
                         let b = self.convert(v, &Ty::Vec(ScalarKind::Bool, n), pos, false)?;
                         let tid = self.ty_id(&bt)?;
-                        let id =
-                            self.op(if name == "any" { Op::Any } else { Op::All }, tid, &[b.id])?;
+                        let id = self.op(op, tid, &[b.id])?;
                         Ok(Val { id, ty: bt })
                     }
                     other => Err(Error::new(
@@ -572,14 +551,9 @@ impl<'a> Lowerer<'a> {
                     )),
                 }
             }
-            "asuint16" | "asint16" | "asfloat16" => {
+            Math::As16(s) => {
                 // DXC's 16-bit reinterpretations: the same bits, another type.
                 let v = vals.into_iter().next().unwrap_or_else(|| unreachable!());
-                let s = match name {
-                    "asuint16" => ScalarKind::Uint16,
-                    "asint16" => ScalarKind::Int16,
-                    _ => ScalarKind::Half,
-                };
                 if !matches!(v.ty, Ty::ScalarKind(_) | Ty::Vec(..))
                     || !v.ty.scalar().is_some_and(ScalarKind::is_16)
                 {
@@ -596,13 +570,8 @@ impl<'a> Lowerer<'a> {
                 let id = self.op(Op::Bitcast, tid, &[v.id])?;
                 Ok(Val { id, ty: t })
             }
-            "asuint" | "asint" | "asfloat" => {
+            Math::As32(s) => {
                 let v = vals.into_iter().next().unwrap_or_else(|| unreachable!());
-                let s = match name {
-                    "asuint" => ScalarKind::Uint,
-                    "asint" => ScalarKind::Int,
-                    _ => ScalarKind::Float,
-                };
                 if !matches!(v.ty, Ty::ScalarKind(_) | Ty::Vec(..))
                     || v.ty.scalar() == Some(ScalarKind::Bool)
                 {
@@ -619,9 +588,8 @@ impl<'a> Lowerer<'a> {
                 let id = self.op(Op::Bitcast, tid, &[v.id])?;
                 Ok(Val { id, ty: t })
             }
-            "f32tof16" | "f16tof32" => {
+            Math::F16(to_half) => {
                 let v = vals.into_iter().next().unwrap_or_else(|| unreachable!());
-                let to_half = name == "f32tof16";
                 let src = v.ty.with_scalar(if to_half {
                     ScalarKind::Float
                 } else {
@@ -664,7 +632,7 @@ impl<'a> Lowerer<'a> {
                 let mut it = out.into_iter();
                 self.build(&t, &mut it, pos)
             }
-            "countbits" | "reversebits" | "firstbithigh" | "firstbitlow" => {
+            Math::Bits(bit) => {
                 let v = vals.into_iter().next().unwrap_or_else(|| unreachable!());
                 let s = v.ty.scalar();
                 if !matches!(s, Some(ScalarKind::Int | ScalarKind::Uint))
@@ -676,22 +644,22 @@ impl<'a> Lowerer<'a> {
                     ));
                 }
                 let t = v.ty.clone();
-                let r = match name {
-                    "countbits" => {
+                let r = match bit {
+                    Bit::Count => {
                         let tid = self.ty_id(&t)?;
                         Val {
                             id: self.op(Op::BitCount, tid, &[v.id])?,
                             ty: t.clone(),
                         }
                     }
-                    "reversebits" => {
+                    Bit::Reverse => {
                         let tid = self.ty_id(&t)?;
                         Val {
                             id: self.op(Op::BitReverse, tid, &[v.id])?,
                             ty: t.clone(),
                         }
                     }
-                    "firstbithigh" => self.glsl(
+                    Bit::High => self.glsl(
                         if s == Some(ScalarKind::Int) {
                             G::FindSMsb
                         } else {
@@ -700,16 +668,16 @@ impl<'a> Lowerer<'a> {
                         &t,
                         &[v.id],
                     )?,
-                    _ => self.glsl(G::FindILsb, &t, &[v.id])?,
+                    Bit::Low => self.glsl(G::FindILsb, &t, &[v.id])?,
                 };
                 // HLSL returns uint components for all four.
                 self.convert(r, &t.with_scalar(ScalarKind::Uint), pos, true)
             }
-            "isnan" | "isinf" | "isfinite" => {
+            Math::Class(class) => {
                 let (t, ids) = self.unify(vals, true, pos)?;
                 let bt = t.with_scalar(ScalarKind::Bool);
                 let tid = self.ty_id(&bt)?;
-                if name == "isfinite" {
+                if class == FpClass::Finite {
                     let a = self.op(Op::IsNan, tid, &ids)?;
                     let b = self.op(Op::IsInf, tid, &ids)?;
                     let o = self.op(Op::LogicalOr, tid, &[a, b])?;
@@ -717,7 +685,7 @@ impl<'a> Lowerer<'a> {
                     return Ok(Val { id, ty: bt });
                 }
                 let id = self.op(
-                    if name == "isnan" {
+                    if class == FpClass::Nan {
                         Op::IsNan
                     } else {
                         Op::IsInf
@@ -727,7 +695,6 @@ impl<'a> Lowerer<'a> {
                 )?;
                 Ok(Val { id, ty: bt })
             }
-            _ => Err(Error::new(pos, format!("unknown function `{name}`"))),
         }
     }
 
@@ -747,7 +714,7 @@ impl<'a> Lowerer<'a> {
         };
         match (&at, &bt) {
             (Ty::ScalarKind(_), _) | (_, Ty::ScalarKind(_)) => self.binary(BinOp::Mul, a, b, pos),
-            (Ty::Vec(..), Ty::Vec(..)) => self.intrinsic("dot", vec![a, b], pos),
+            (Ty::Vec(..), Ty::Vec(..)) => self.intrinsic(Math::Dot, "dot", vec![a, b], pos),
             (Ty::Mat(_, r, c), Ty::Vec(_, n)) => {
                 if n != c {
                     return Err(Error::new(

@@ -21,8 +21,8 @@ pub(super) enum Lowering {
     /// A GLSL.std.450 instruction on one float scalar or vector.
     Glsl(G),
     /// The arguments first (literals beside 16-bit ones adapted), then
-    /// `intrinsic`, which lowers by name.
-    Eval,
+    /// `intrinsic`.
+    Eval(Math),
     /// `ddx` and its kin: the instruction; pixel shaders only.
     Derivative(Op),
     /// A wave intrinsic (`lower/wave.rs`).
@@ -31,6 +31,59 @@ pub(super) enum Lowering {
     Special(Special),
     /// Not lowered: pixel shaders only, which rtlint does not compile.
     PixelOnly,
+}
+
+/// The intrinsics `intrinsic` lowers from evaluated arguments.
+#[derive(Clone, Copy)]
+pub(super) enum Math {
+    Dot,
+    Cross,
+    Length,
+    Distance,
+    Reflect,
+    FaceForward,
+    Refract,
+    /// A GLSL.std.450 instruction on float arguments of one type.
+    Glsl(G),
+    Mad,
+    Saturate,
+    /// `min`, `max`, `clamp`: the float, signed and unsigned instructions.
+    MinMax(G, G, G),
+    Abs,
+    Sign,
+    Fmod,
+    Rcp,
+    Log10,
+    Mul,
+    Transpose,
+    Determinant,
+    /// `any` (`OpAny`) and `all` (`OpAll`).
+    AnyAll(Op),
+    /// `asuint16`, `asint16`, `asfloat16`: the result's scalar.
+    As16(ScalarKind),
+    /// `asuint`, `asint`, `asfloat`: the result's scalar.
+    As32(ScalarKind),
+    /// `f32tof16` (true) and `f16tof32`.
+    F16(bool),
+    Bits(Bit),
+    Class(FpClass),
+}
+
+/// `countbits`, `reversebits`, `firstbithigh`, `firstbitlow`.
+#[derive(Clone, Copy)]
+pub(super) enum Bit {
+    Count,
+    Reverse,
+    High,
+    Low,
+}
+
+/// `isnan`, `isinf`, `isfinite`.
+#[derive(Clone, Copy, PartialEq)]
+pub(super) enum FpClass {
+    Nan,
+    Inf,
+    Finite,
 }
 
 /// The intrinsics lowered by their own code in `special`.
@@ -113,25 +166,29 @@ const GLSL_UNARY: &[Intrinsic] = {
 const MATH: &[Intrinsic] = {
     use Lowering::{Eval, Special as S};
     &[
-        any("lerp", 3, Eval),
-        any("saturate", 1, Eval),
-        any("clamp", 3, Eval),
-        any("min", 2, Eval),
-        any("max", 2, Eval),
-        any("abs", 1, Eval),
-        any("sign", 1, Eval),
-        any("pow", 2, Eval),
-        any("atan2", 2, Eval),
-        any("step", 2, Eval),
-        any("smoothstep", 3, Eval),
-        any("fmod", 2, Eval),
-        any("mad", 3, Eval),
-        any("fma", 3, Eval),
-        any("rcp", 1, Eval),
-        any("log10", 1, Eval),
-        any("isnan", 1, Eval),
-        any("isinf", 1, Eval),
-        any("isfinite", 1, Eval),
+        any("lerp", 3, Eval(Math::Glsl(G::FMix))),
+        any("saturate", 1, Eval(Math::Saturate)),
+        any(
+            "clamp",
+            3,
+            Eval(Math::MinMax(G::FClamp, G::SClamp, G::UClamp)),
+        ),
+        any("min", 2, Eval(Math::MinMax(G::FMin, G::SMin, G::UMin))),
+        any("max", 2, Eval(Math::MinMax(G::FMax, G::SMax, G::UMax))),
+        any("abs", 1, Eval(Math::Abs)),
+        any("sign", 1, Eval(Math::Sign)),
+        any("pow", 2, Eval(Math::Glsl(G::Pow))),
+        any("atan2", 2, Eval(Math::Glsl(G::Atan2))),
+        any("step", 2, Eval(Math::Glsl(G::Step))),
+        any("smoothstep", 3, Eval(Math::Glsl(G::SmoothStep))),
+        any("fmod", 2, Eval(Math::Fmod)),
+        any("mad", 3, Eval(Math::Mad)),
+        any("fma", 3, Eval(Math::Glsl(G::Fma))),
+        any("rcp", 1, Eval(Math::Rcp)),
+        any("log10", 1, Eval(Math::Log10)),
+        any("isnan", 1, Eval(Math::Class(FpClass::Nan))),
+        any("isinf", 1, Eval(Math::Class(FpClass::Inf))),
+        any("isfinite", 1, Eval(Math::Class(FpClass::Finite))),
         any("sincos", 3, S(Special::Sincos)),
         any("modf", 2, S(Special::Modf)),
         any("ldexp", 2, S(Special::Ldexp)),
@@ -142,18 +199,18 @@ const MATH: &[Intrinsic] = {
 const VECTOR: &[Intrinsic] = {
     use Lowering::{Eval, Special as S};
     &[
-        any("dot", 2, Eval),
-        any("cross", 2, Eval),
-        any("length", 1, Eval),
-        any("distance", 2, Eval),
-        any("reflect", 2, Eval),
-        any("refract", 3, Eval),
-        any("faceforward", 3, Eval),
-        any("mul", 2, Eval),
-        any("transpose", 1, Eval),
-        any("determinant", 1, Eval),
-        any("any", 1, Eval),
-        any("all", 1, Eval),
+        any("dot", 2, Eval(Math::Dot)),
+        any("cross", 2, Eval(Math::Cross)),
+        any("length", 1, Eval(Math::Length)),
+        any("distance", 2, Eval(Math::Distance)),
+        any("reflect", 2, Eval(Math::Reflect)),
+        any("refract", 3, Eval(Math::Refract)),
+        any("faceforward", 3, Eval(Math::FaceForward)),
+        any("mul", 2, Eval(Math::Mul)),
+        any("transpose", 1, Eval(Math::Transpose)),
+        any("determinant", 1, Eval(Math::Determinant)),
+        any("any", 1, Eval(Math::AnyAll(Op::Any))),
+        any("all", 1, Eval(Math::AnyAll(Op::All))),
         any("and", 2, S(Special::Logic)),
         any("or", 2, S(Special::Logic)),
         any("select", 3, S(Special::Select)),
@@ -164,18 +221,18 @@ const VECTOR: &[Intrinsic] = {
 const BITS: &[Intrinsic] = {
     use Lowering::Eval;
     &[
-        any("asuint", 1, Eval),
-        any("asint", 1, Eval),
-        any("asfloat", 1, Eval),
-        any("asuint16", 1, Eval),
-        any("asint16", 1, Eval),
-        any("asfloat16", 1, Eval),
-        any("f32tof16", 1, Eval),
-        any("f16tof32", 1, Eval),
-        any("countbits", 1, Eval),
-        any("firstbithigh", 1, Eval),
-        any("firstbitlow", 1, Eval),
-        any("reversebits", 1, Eval),
+        any("asuint", 1, Eval(Math::As32(ScalarKind::Uint))),
+        any("asint", 1, Eval(Math::As32(ScalarKind::Int))),
+        any("asfloat", 1, Eval(Math::As32(ScalarKind::Float))),
+        any("asuint16", 1, Eval(Math::As16(ScalarKind::Uint16))),
+        any("asint16", 1, Eval(Math::As16(ScalarKind::Int16))),
+        any("asfloat16", 1, Eval(Math::As16(ScalarKind::Half))),
+        any("f32tof16", 1, Eval(Math::F16(true))),
+        any("f16tof32", 1, Eval(Math::F16(false))),
+        any("countbits", 1, Eval(Math::Bits(Bit::Count))),
+        any("firstbithigh", 1, Eval(Math::Bits(Bit::High))),
+        any("firstbitlow", 1, Eval(Math::Bits(Bit::Low))),
+        any("reversebits", 1, Eval(Math::Bits(Bit::Reverse))),
     ]
 };
 
@@ -256,11 +313,11 @@ impl<'a> Lowerer<'a> {
         let name = row.name;
         match row.lower {
             // The arguments' own errors come before an arity error.
-            Lowering::Eval => {
+            Lowering::Eval(m) => {
                 let vals = self.args(args)?;
                 let vals = self.adapt_literal_args(args, vals, pos)?;
                 self.arity(name, args, row.arity, pos)?;
-                self.intrinsic(name, vals, pos).map(Some)
+                self.intrinsic(m, name, vals, pos).map(Some)
             }
             // The stage rule (deferred in helpers) comes before the arity.
             Lowering::Derivative(op) => self.derivative(op, name, row.arity, args, pos).map(Some),
@@ -462,5 +519,22 @@ impl<'a> Lowerer<'a> {
                     .map(Some)
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_intrinsic_has_one_row() {
+        // `lookup` takes the first row of a name: a second would be dead.
+        let mut seen = HashSet::new();
+        for r in FAMILIES.iter().flat_map(|f| f.iter()) {
+            assert!(seen.insert(r.name), "`{}` has two rows", r.name);
+        }
+        assert_eq!(lookup("WaveActiveSum").map(|r| r.arity), Some(1));
+        assert_eq!(lookup("TraceRay").map(|r| r.arity), Some(8));
+        assert!(lookup("InterlockedAdd").is_none());
     }
 }
