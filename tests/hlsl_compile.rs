@@ -773,6 +773,88 @@ fn position_fetch_is_a_built_in_input_with_its_extension_and_capability() {
         .any(|(op, ops)| *op == 17 && ops[0] == 5336));
 }
 
+#[test]
+fn ext_builtin_output_is_an_output_built_in_the_shader_writes() {
+    let path = shader("ext_builtin_output.hlsl");
+    let entries = hlsl::compile(&path, &HlslOptions::default()).unwrap();
+    for e in &entries {
+        validate(&e.words, &format!("ext_builtin_output-{}", e.name));
+    }
+    let ps = entries.iter().find(|e| e.name == "Stencil").unwrap();
+    let var = named(&ps.words, "gl_FragStencilRefARB")[0];
+    let insts = instructions(&ps.words);
+    // OpCapability (17) StencilExportEXT (5013), OpExtension (10).
+    assert!(insts.iter().any(|(op, ops)| *op == 17 && ops[0] == 5013));
+    assert!(insts
+        .iter()
+        .any(|(op, ops)| *op == 10 && string_at(ops) == "SPV_EXT_shader_stencil_export"));
+    // OpDecorate (71) var BuiltIn (11) FragStencilRefEXT (5014).
+    assert!(insts
+        .iter()
+        .any(|(op, ops)| *op == 71 && ops[..] == [var, 11, 5014]));
+    // OpVariable (59) of storage class Output (3), stored to (OpStore, 62),
+    // and in the entry point's interface (OpEntryPoint, 15).
+    assert!(insts
+        .iter()
+        .any(|(op, ops)| *op == 59 && ops[1] == var && ops[2] == 3));
+    assert!(insts.iter().any(|(op, ops)| *op == 62 && ops[0] == var));
+    assert!(insts
+        .iter()
+        .any(|(op, ops)| *op == 15 && ops[2..].contains(&var)));
+    let plain = entries.iter().find(|e| e.name == "Plain").unwrap();
+    assert!(named(&plain.words, "gl_FragStencilRefARB").is_empty());
+    assert!(!instructions(&plain.words)
+        .iter()
+        .any(|(op, ops)| *op == 17 && ops[0] == 5013));
+}
+
+#[test]
+fn ext_instruction_calls_are_the_instructions() {
+    let path = shader("ext_instruction.hlsl");
+    let entries = hlsl::compile(&path, &HlslOptions::default()).unwrap();
+    let m = &entries[0];
+    validate(&m.words, "ext_instruction-main");
+    let insts = instructions(&m.words);
+    let result_of = |opcode: u32| -> Vec<Vec<u32>> {
+        insts
+            .iter()
+            .filter(|(op, _)| *op == opcode)
+            .map(|(_, ops)| ops.clone())
+            .collect()
+    };
+    // OpExtInstImport (11) "GLSL.std.450"; OpExtInst (12) of it, Sin (13),
+    // on `x` (loaded from its variable).
+    let glsl = result_of(11)
+        .into_iter()
+        .find(|ops| string_at(&ops[1..]) == "GLSL.std.450")
+        .unwrap()[0];
+    let x = named(&m.words, "x")[0];
+    let loads_of_x: Vec<u32> = result_of(61)
+        .into_iter()
+        .filter(|ops| ops[2] == x)
+        .map(|ops| ops[1])
+        .collect();
+    assert!(result_of(12)
+        .iter()
+        .any(|ops| ops[2] == glsl && ops[3] == 13 && loads_of_x.contains(&ops[4])));
+    // OpReadClockKHR (5056) with its capability (5055) and extension.
+    assert_eq!(result_of(5056).len(), 1);
+    assert!(insts.iter().any(|(op, ops)| *op == 17 && ops[0] == 5055));
+    assert!(insts
+        .iter()
+        .any(|(op, ops)| *op == 10 && string_at(ops) == "SPV_KHR_shader_clock"));
+    // OpCompositeExtract (81): type, result, vector, literal 2.
+    assert!(result_of(81)
+        .iter()
+        .any(|ops| ops.len() == 4 && ops[3] == 2));
+    // OpLoad (61) of `x`'s pointer: the `vk::ext_reference` operand.
+    assert!(loads_of_x.len() >= 2, "{loads_of_x:?}");
+    // OpMemoryBarrier (225): no result, two id operands.
+    let barriers = result_of(225);
+    assert_eq!(barriers.len(), 1);
+    assert_eq!(barriers[0].len(), 2);
+}
+
 /// (set, binding) of the variable named `name`.
 fn binding_of(words: &[u32], name: &str) -> (u32, u32) {
     let id = named(words, name)[0];

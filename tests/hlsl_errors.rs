@@ -503,6 +503,37 @@ fn every_attribute_is_implemented_or_refused() {
 }
 
 #[test]
+fn inline_spirv_instructions_and_outputs_refuse_what_they_cannot_do() {
+    const CS: &str = "[numthreads(1,1,1)]\nvoid m()\n{\n";
+    assert_eq!(
+        err(&format!("[[vk::ext_instruction(81)]] float e(float4 v, [[vk::ext_literal]] int i);\n{CS}    int k = 1;\n    float f = e(1, k);\n}}")),
+        "main.hlsl:6:20: a `vk::ext_literal` argument must be a constant"
+    );
+    assert_eq!(
+        err(&format!("[[vk::ext_instruction(61)]] float l([[vk::ext_reference]] float x);\n{CS}    float f = l(1.0);\n}}")),
+        "main.hlsl:5:17: not supported: a `vk::ext_reference` argument other than a variable of type `float`"
+    );
+    assert_eq!(
+        err(&format!(
+            "[[vk::ext_instruction(65000)]] float u(float x);\n{CS}    float f = u(1.0);\n}}"
+        )),
+        "main.hlsl:1:23: not supported: SPIR-V opcode 65000 (unknown to rtlint)"
+    );
+    assert_eq!(
+        err(&format!("[[vk::ext_instruction(13, \"GLSL.std.450\")]] float s(float x) {{ return x; }}\n{CS}}}")),
+        "main.hlsl:1:3: a `vk::ext_instruction` function is a declaration without a body"
+    );
+    assert_eq!(
+        err(&format!("[[vk::ext_instruction(13, \"GLSL.std.450\")]] float s(out float x);\n{CS}    float f;\n    s(f);\n}}")),
+        "main.hlsl:1:63: not supported: `out` parameters of a `vk::ext_instruction` function (use `vk::ext_reference`)"
+    );
+    assert_eq!(
+        err(&format!("[[vk::ext_builtin_output(5014)]] static const int s;\n{CS}}}")),
+        "main.hlsl:1:51: a `vk::ext_builtin_output` variable must be `static` without an initializer"
+    );
+}
+
+#[test]
 fn device_address_loads_are_scalars_and_vectors() {
     assert_eq!(
         err("struct S { float a; };\n[numthreads(1,1,1)]\nvoid m() { S s = vk::RawBufferLoad<S>(0); }"),

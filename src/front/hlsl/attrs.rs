@@ -105,16 +105,11 @@ pub const ATTRIBUTES: &[AttrInfo] = &[
     a("vk::ext_builtin_input", Implemented, GLOBAL),
     a("vk::ext_extension", Implemented, GLOBAL | FUNCTION),
     a("vk::ext_capability", Implemented, GLOBAL | FUNCTION),
-    a(
-        "vk::ext_builtin_output",
-        Refused("`vk::ext_builtin_output` (output built-ins)"),
-        ANY,
-    ),
-    a(
-        "vk::ext_instruction",
-        Refused("`vk::ext_instruction` (inline SPIR-V instructions)"),
-        ANY,
-    ),
+    a("vk::ext_builtin_output", Implemented, GLOBAL),
+    // A function declaration whose calls are the instruction.
+    a("vk::ext_instruction", Implemented, FUNCTION),
+    a("vk::ext_reference", Implemented, PARAM),
+    a("vk::ext_literal", Implemented, PARAM),
     // Struct members only (`OpMemberDecorate`); elsewhere refused by site.
     a("vk::ext_decorate", Implemented, MEMBER),
     a("vk::ext_decorate_id", Refused("`vk::ext_decorate_id`"), ANY),
@@ -129,8 +124,6 @@ pub const ATTRIBUTES: &[AttrInfo] = &[
         ANY,
     ),
     a("vk::ext_type_def", Refused("`vk::ext_type_def`"), ANY),
-    a("vk::ext_reference", Refused("`vk::ext_reference`"), ANY),
-    a("vk::ext_literal", Refused("`vk::ext_literal`"), ANY),
     a("vk::builtin", Refused("`vk::builtin`"), ANY),
     a(
         "vk::index",

@@ -185,6 +185,10 @@ pub struct Lowerer<'a> {
     globals: HashMap<String, Global>,
     funcs: Vec<FnSig<'a>>,
     fn_by_name: HashMap<String, Vec<usize>>,
+    /// `[[vk::ext_instruction]]` declarations by name: a call is the instruction.
+    ext_insts: HashMap<String, &'a Function>,
+    /// Instruction sets imported for `vk::ext_instruction`, by name.
+    ext_sets: HashMap<String, Id>,
     ty_cache: HashMap<(Ty, Layout, bool), Id>,
     /// `OpUndef` of each type id, at module scope.
     undefs: HashMap<Id, Id>,
@@ -500,6 +504,8 @@ impl<'a> Lowerer<'a> {
             globals: HashMap::new(),
             funcs: Vec::new(),
             fn_by_name: HashMap::new(),
+            ext_insts: HashMap::new(),
+            ext_sets: HashMap::new(),
             ty_cache: HashMap::new(),
             undefs: HashMap::new(),
             consts: HashMap::new(),

@@ -245,6 +245,9 @@ impl<'a> Lowerer<'a> {
         if let Some(r) = self.ser_call(name, args, pos)? {
             return Ok(r);
         }
+        if let Some(r) = self.ext_instruction_call(name, args, pos)? {
+            return Ok(r);
+        }
         if name == "vk::RawBufferLoad" {
             return self.raw_buffer_load(None, args, pos).map(Some);
         }

@@ -172,6 +172,16 @@ impl<'a> Lowerer<'a> {
                 }
                 Err(e) => return Err(e),
             };
+            if let Some(a) = f.attrs.iter().find(|a| a.name == "vk::ext_instruction") {
+                if f.body.is_some() {
+                    return Err(Error::new(
+                        a.pos,
+                        "a `vk::ext_instruction` function is a declaration without a body",
+                    ));
+                }
+                self.ext_insts.insert(f.name.clone(), f);
+                continue;
+            }
             let id = self.b.id();
             if f.body.is_none() {
                 // A prototype: the definition carries the signature, the
@@ -741,7 +751,7 @@ impl<'a> Lowerer<'a> {
                 Item::CBuffer { attrs, .. } => attrs,
                 _ => &Vec::new(),
             };
-            if !attrs.iter().any(|a| a.name == "vk::ext_builtin_input") {
+            if !attrs.iter().any(is_ext_builtin) {
                 let req = self.ext_requirements(attrs)?;
                 self.require(&req);
             }
@@ -766,7 +776,7 @@ impl<'a> Lowerer<'a> {
                     let members: Vec<&VarDecl> = members.iter().collect();
                     self.declare_cbuffer(attrs, name, *pos, binding, &members)?;
                 }
-                Item::Var(v) if v.attrs.iter().any(|a| a.name == "vk::ext_builtin_input") => {
+                Item::Var(v) if v.attrs.iter().any(is_ext_builtin) => {
                     self.declare_ext_builtin(v)?
                 }
                 Item::Var(v) if subobject::Kind::from_type_name(&v.ty.name).is_some() => {
@@ -1454,4 +1464,13 @@ fn bad_resource_array(t: &Ty) -> bool {
         ),
         _ => false,
     }
+}
+
+/// `vk::ext_builtin_input` or `vk::ext_builtin_output`: the variable is a
+/// built-in, its extensions and capabilities needed only where it is used.
+fn is_ext_builtin(a: &Attr) -> bool {
+    matches!(
+        a.name.as_str(),
+        "vk::ext_builtin_input" | "vk::ext_builtin_output"
+    )
 }
