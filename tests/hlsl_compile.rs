@@ -837,6 +837,15 @@ fn ext_instruction_calls_are_the_instructions() {
     assert!(result_of(12)
         .iter()
         .any(|ops| ops[2] == glsl && ops[3] == 13 && loads_of_x.contains(&ops[4])));
+    // The void one: OpExtInst %void of "NonSemantic.rtlint.test", 7.
+    let set = result_of(11)
+        .into_iter()
+        .find(|ops| string_at(&ops[1..]) == "NonSemantic.rtlint.test")
+        .unwrap()[0];
+    let void = result_of(19)[0][0];
+    assert!(result_of(12)
+        .iter()
+        .any(|ops| ops[0] == void && ops[2] == set && ops[3] == 7 && ops.len() == 5));
     // OpReadClockKHR (5056) with its capability (5055) and extension.
     assert_eq!(result_of(5056).len(), 1);
     assert!(insts.iter().any(|(op, ops)| *op == 17 && ops[0] == 5055));

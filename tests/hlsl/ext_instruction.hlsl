@@ -25,6 +25,12 @@ float LoadOf([[vk::ext_reference]] float x);
 [[vk::ext_instruction(225)]]
 void Barrier(uint scope, uint semantics);
 
+// A void instruction of an imported set: `OpExtInst %void`. A
+// non-semantic set is one spirv-val accepts without knowing it.
+[[vk::ext_extension("SPV_KHR_non_semantic_info")]]
+[[vk::ext_instruction(7, "NonSemantic.rtlint.test")]]
+void Mark(uint value);
+
 RWStructuredBuffer<float> output : register(u0);
 
 [numthreads(8, 1, 1)]
@@ -33,6 +39,7 @@ void main(uint3 id : SV_DispatchThreadID)
     float x = (float)id.x;
     float s = spvSin(x);
     Barrier(2, 0x108);
+    Mark(id.x);
     uint2 t = ReadClock(3);
     output[id.x] = s + Extract(float4(1, 2, 3, 4), 2) + LoadOf(x) + (float)(t.x & 1);
 }
