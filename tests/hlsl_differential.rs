@@ -508,6 +508,16 @@ const NOT_RUN: &[(&str, &str)] = &[
         "front-end construct (matrix layout): tests/hlsl_compile.rs checks the decorations",
     ),
     (
+        "ext_builtin_output.hlsl",
+        "a pixel shader: rtlint::vk has no graphics pipeline; tests/hlsl_compile.rs checks \
+         the built-in output's variable, decoration, store, capability and extension",
+    ),
+    (
+        "ext_instruction.hlsl",
+        "its output depends on the shader clock; tests/hlsl_compile.rs checks each inline \
+         instruction and its operands",
+    ),
+    (
         "position_fetch.hlsl",
         "needs VK_KHR_ray_tracing_position_fetch, which lavapipe lacks",
     ),
