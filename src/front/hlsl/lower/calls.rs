@@ -319,6 +319,17 @@ impl<'a> Lowerer<'a> {
         Err(Error::new(pos, format!("unknown function `{name}`")).len(name.len() as u32))
     }
 
+    /// The same bits as another scalar kind (`asuint`, `asfloat16`, ...).
+    fn reinterpret(&mut self, v: Val, s: ScalarKind) -> Result<Val> {
+        let t = v.ty.with_scalar(s);
+        if t == v.ty {
+            return Ok(v);
+        }
+        let tid = self.ty_id(&t)?;
+        let id = self.op(Op::Bitcast, tid, &[v.id])?;
+        Ok(Val { id, ty: t })
+    }
+
     pub(super) fn intrinsic(
         &mut self,
         m: Math,
@@ -565,13 +576,7 @@ impl<'a> Lowerer<'a> {
                         format!("`{name}` needs a 16-bit scalar or vector"),
                     ));
                 }
-                let t = v.ty.with_scalar(s);
-                if t == v.ty {
-                    return Ok(v);
-                }
-                let tid = self.ty_id(&t)?;
-                let id = self.op(Op::Bitcast, tid, &[v.id])?;
-                Ok(Val { id, ty: t })
+                self.reinterpret(v, s)
             }
             Math::As32(s) => {
                 let v = vals.into_iter().next().unwrap_or_else(|| unreachable!());
@@ -583,13 +588,7 @@ impl<'a> Lowerer<'a> {
                         format!("`{name}` needs a 32-bit scalar or vector"),
                     ));
                 }
-                let t = v.ty.with_scalar(s);
-                if t == v.ty {
-                    return Ok(v);
-                }
-                let tid = self.ty_id(&t)?;
-                let id = self.op(Op::Bitcast, tid, &[v.id])?;
-                Ok(Val { id, ty: t })
+                self.reinterpret(v, s)
             }
             Math::F16(to_half) => {
                 let v = vals.into_iter().next().unwrap_or_else(|| unreachable!());
