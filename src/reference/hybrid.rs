@@ -5,7 +5,7 @@
 
 use std::cmp::Ordering;
 
-use super::{camera_dir, intersect, reflect, shade, sky, Params, PixelPath, Scene, Segment, Vec3};
+use super::{camera_dir, record, reflect, shade, sky, Params, PixelPath, Scene, Segment, Vec3};
 
 /// March steps, each this far along the reflection (world units).
 pub const SSR_STEPS: u32 = 64;
@@ -53,14 +53,15 @@ pub fn gbuffer_texel(
 ) -> GTexel {
     let origin = params.camera;
     let dir = camera_dir(params, x, y);
-    let (hit, edge_margin) = intersect(scene, origin, dir, params.t_min, params.t_max);
-    segments.push(Segment {
+    let hit = record(
+        scene,
         origin,
         dir,
-        hit,
-        shadow: false,
-        edge_margin,
-    });
+        params.t_min,
+        params.t_max,
+        false,
+        segments,
+    );
     let Some(hit) = hit else {
         return GTexel {
             position: Vec3::ZERO,
@@ -157,14 +158,7 @@ pub fn resolve(
         }
     }
     let from = params.next_origin(g.position, g.normal);
-    let (hit, edge_margin) = intersect(scene, from, r, params.t_min, params.t_max);
-    segments.push(Segment {
-        origin: from,
-        dir: r,
-        hit,
-        shadow: false,
-        edge_margin,
-    });
+    let hit = record(scene, from, r, params.t_min, params.t_max, false, segments);
     let reflected = match hit {
         None => sky(r),
         Some(hit) => shade(scene, params, from, r, hit, None, segments).local,
@@ -211,6 +205,7 @@ pub fn render(scene: &Scene, params: &Params) -> (Vec<PixelPath>, Vec<Reflection
 
 #[cfg(test)]
 mod tests {
+    use super::super::intersect;
     use super::*;
 
     fn scene(name: &str) -> Scene {

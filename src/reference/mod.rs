@@ -230,6 +230,28 @@ pub fn camera_dir(params: &Params, x: u32, y: u32) -> Vec3 {
     Vec3::new(uv[0], -uv[1], -1.5).normalize()
 }
 
+/// [`intersect`], with the ray recorded in `segments` (what `verify` reads
+/// decision margins and self-hits from); the hit.
+pub(crate) fn record(
+    scene: &Scene,
+    origin: Vec3,
+    dir: Vec3,
+    t_min: f32,
+    t_max: f32,
+    shadow: bool,
+    segments: &mut Vec<Segment>,
+) -> Option<Hit> {
+    let (hit, edge_margin) = intersect(scene, origin, dir, t_min, t_max);
+    segments.push(Segment {
+        origin,
+        dir,
+        hit,
+        shadow,
+        edge_margin,
+    });
+    hit
+}
+
 /// The closest triangle hit with `t` in `[t_min, t_max]` that is opaque or
 /// whose alpha texel keeps it (with
 /// `any`, the first found, as `ACCEPT_FIRST_HIT_AND_END_SEARCH` allows: only
@@ -308,15 +330,15 @@ pub(crate) fn shade(
             let ndl = n.dot(light.direction);
             let mut c = base * light.ambient;
             if ndl > 0.0 {
-                let (blocker, edge_margin) =
-                    intersect(scene, from, light.direction, params.t_min, params.t_max);
-                segments.push(Segment {
-                    origin: from,
-                    dir: light.direction,
-                    hit: blocker,
-                    shadow: true,
-                    edge_margin,
-                });
+                let blocker = record(
+                    scene,
+                    from,
+                    light.direction,
+                    params.t_min,
+                    params.t_max,
+                    true,
+                    segments,
+                );
                 if blocker.is_none() {
                     c += base * ndl;
                 }
@@ -341,14 +363,15 @@ pub fn trace_iterative(scene: &Scene, params: &Params, x: u32, y: u32) -> PixelP
     let mut throughput = 1.0f32;
     let mut segments = Vec::new();
     for _bounce in 0..=params.max_bounces {
-        let (hit, edge_margin) = intersect(scene, origin, dir, params.t_min, params.t_max);
-        segments.push(Segment {
+        let hit = record(
+            scene,
             origin,
             dir,
-            hit,
-            shadow: false,
-            edge_margin,
-        });
+            params.t_min,
+            params.t_max,
+            false,
+            &mut segments,
+        );
         let Some(hit) = hit else {
             color += throughput * sky(dir);
             break;
@@ -399,14 +422,15 @@ fn radiance(
     throughput: f32,
     segments: &mut Vec<Segment>,
 ) -> Vec3 {
-    let (hit, edge_margin) = intersect(scene, origin, dir, params.t_min, params.t_max);
-    segments.push(Segment {
+    let hit = record(
+        scene,
         origin,
         dir,
-        hit,
-        shadow: false,
-        edge_margin,
-    });
+        params.t_min,
+        params.t_max,
+        false,
+        segments,
+    );
     let Some(hit) = hit else {
         return sky(dir);
     };
@@ -594,14 +618,7 @@ fn glossy_path(
     let mut t_max = params.t_max;
     let mut throughput = 1.0f32;
     for bounce in 0..=params.max_bounces {
-        let (hit, edge_margin) = intersect(scene, origin, dir, params.t_min, t_max);
-        segments.push(Segment {
-            origin,
-            dir,
-            hit,
-            shadow: false,
-            edge_margin,
-        });
+        let hit = record(scene, origin, dir, params.t_min, t_max, false, segments);
         let Some(hit) = hit else {
             *sum += throughput * sky(dir);
             break;
@@ -659,15 +676,15 @@ fn glossy_path(
             *sum += base * light.ambient;
             if ndl > 0.0 {
                 let lit = base * ndl;
-                let (blocker, edge_margin) =
-                    intersect(scene, origin, light.direction, params.t_min, params.t_max);
-                segments.push(Segment {
+                let blocker = record(
+                    scene,
                     origin,
-                    dir: light.direction,
-                    hit: blocker,
-                    shadow: true,
-                    edge_margin,
-                });
+                    light.direction,
+                    params.t_min,
+                    params.t_max,
+                    true,
+                    segments,
+                );
                 if blocker.is_none() {
                     *sum += lit;
                 }
