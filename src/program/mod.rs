@@ -558,3 +558,20 @@ impl Program {
         debug::type_name(self, id, self.language)
     }
 }
+
+/// Whether `op` reads a texture (samples, fetches or gathers): the texture
+/// work rules look for in any-hit shaders and ray-query loops.
+pub fn is_texture_read(op: spirv::Op) -> bool {
+    use spirv::Op;
+    matches!(
+        op,
+        Op::ImageSampleImplicitLod
+            | Op::ImageSampleExplicitLod
+            | Op::ImageSampleDrefImplicitLod
+            | Op::ImageSampleDrefExplicitLod
+            | Op::ImageSampleProjImplicitLod
+            | Op::ImageSampleProjExplicitLod
+            | Op::ImageFetch
+            | Op::ImageGather
+    )
+}

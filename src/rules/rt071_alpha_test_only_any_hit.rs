@@ -64,20 +64,6 @@ super::declare_rule! {
     }
 }
 
-fn is_sample(op: Op) -> bool {
-    matches!(
-        op,
-        Op::ImageSampleImplicitLod
-            | Op::ImageSampleExplicitLod
-            | Op::ImageSampleDrefImplicitLod
-            | Op::ImageSampleDrefExplicitLod
-            | Op::ImageSampleProjImplicitLod
-            | Op::ImageSampleProjExplicitLod
-            | Op::ImageFetch
-            | Op::ImageGather
-    )
-}
-
 fn check(ctx: &Context) -> Vec<Diagnostic> {
     let program = ctx.program;
     let mut out = Vec::new();
@@ -102,7 +88,7 @@ fn check(ctx: &Context) -> Vec<Diagnostic> {
         for f in functions.iter().filter_map(|f| program.function(*f)) {
             for inst in &program.insts[f.start..=f.end] {
                 let op = inst.class.opcode;
-                if is_sample(op) {
+                if crate::program::is_texture_read(op) {
                     samples += 1;
                 }
                 let name = format!("{op:?}");

@@ -79,20 +79,6 @@ super::declare_rule! {
     }
 }
 
-fn is_sample(op: Op) -> bool {
-    matches!(
-        op,
-        Op::ImageSampleImplicitLod
-            | Op::ImageSampleExplicitLod
-            | Op::ImageSampleDrefImplicitLod
-            | Op::ImageSampleDrefExplicitLod
-            | Op::ImageSampleProjImplicitLod
-            | Op::ImageSampleProjExplicitLod
-            | Op::ImageFetch
-            | Op::ImageGather
-    )
-}
-
 /// The loops around instruction `inst`: the innermost loop of its function
 /// holding it, else (a helper, as naga wraps every ray-query call) the loops
 /// around the calls of its function, up to three calls out.
@@ -151,7 +137,7 @@ fn check(ctx: &Context) -> Vec<Diagnostic> {
                 continue;
             }
             count += 1;
-            if is_sample(inst.class.opcode) {
+            if crate::program::is_texture_read(inst.class.opcode) {
                 samples += 1;
             }
             if inst.class.opcode == Op::FunctionCall {
@@ -173,7 +159,7 @@ fn check(ctx: &Context) -> Vec<Diagnostic> {
                     continue;
                 }
                 count += 1;
-                if is_sample(inst.class.opcode) {
+                if crate::program::is_texture_read(inst.class.opcode) {
                     samples += 1;
                 }
             }
