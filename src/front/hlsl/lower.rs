@@ -585,8 +585,13 @@ impl<'a> Lowerer<'a> {
     /// namespace (or struct) and each enclosing one, the global scope, then the
     /// `using namespace`s.
     fn scoped_names(&self, name: &str) -> Vec<String> {
+        self.names_in_scope(&self.f.cur_ns, name)
+    }
+
+    /// [`Self::scoped_names`] seen from namespace `ns` instead of the current one.
+    fn names_in_scope(&self, ns: &str, name: &str) -> Vec<String> {
         let mut out = Vec::new();
-        let mut prefix = self.f.cur_ns.as_str();
+        let mut prefix = ns;
         loop {
             out.push(format!("{prefix}{name}"));
             if prefix.is_empty() {

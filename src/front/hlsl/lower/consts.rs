@@ -544,23 +544,9 @@ impl<'a> Lowerer<'a> {
     /// A named constant: looked up in the current namespace (or struct),
     /// then each enclosing one, then the `using` namespaces.
     pub(super) fn enum_value(&self, n: &str) -> Option<ConstValue> {
-        let mut prefix = self.f.cur_ns.as_str();
-        loop {
-            if let Some(c) = self.const_items.get(&format!("{prefix}{n}")) {
-                return Some(c.clone());
-            }
-            if prefix.is_empty() {
-                break;
-            }
-            let inner = &prefix[..prefix.len() - 2];
-            prefix = match inner.rfind("::") {
-                Some(k) => &inner[..k + 2],
-                None => "",
-            };
-        }
-        self.usings
+        self.scoped_names(n)
             .iter()
-            .find_map(|u| self.const_items.get(&format!("{u}{n}")))
+            .find_map(|k| self.const_items.get(k))
             .cloned()
     }
 

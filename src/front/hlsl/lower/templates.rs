@@ -16,45 +16,17 @@ pub(super) enum TVal {
 impl<'a> Lowerer<'a> {
     /// Function templates named `name`, looked up like functions.
     pub(super) fn find_fn_template(&self, name: &str) -> Option<Vec<&'a Function>> {
-        let mut prefix = self.f.cur_ns.as_str();
-        loop {
-            if let Some(v) = self.fn_templates.get(&format!("{prefix}{name}")) {
-                return Some(v.clone());
-            }
-            if prefix.is_empty() {
-                break;
-            }
-            let inner = &prefix[..prefix.len() - 2];
-            prefix = match inner.rfind("::") {
-                Some(k) => &inner[..k + 2],
-                None => "",
-            };
-        }
-        self.usings
+        self.scoped_names(name)
             .iter()
-            .find_map(|u| self.fn_templates.get(&format!("{u}{name}")))
+            .find_map(|k| self.fn_templates.get(k))
             .cloned()
     }
 
     /// A struct template named `name` (looked up like a type).
     pub(super) fn find_struct_template(&self, name: &str, ns: &str) -> Option<&'a StructDecl> {
-        let mut prefix = ns;
-        loop {
-            if let Some(s) = self.struct_templates.get(&format!("{prefix}{name}")) {
-                return Some(s);
-            }
-            if prefix.is_empty() {
-                break;
-            }
-            let inner = &prefix[..prefix.len() - 2];
-            prefix = match inner.rfind("::") {
-                Some(k) => &inner[..k + 2],
-                None => "",
-            };
-        }
-        self.usings
+        self.names_in_scope(ns, name)
             .iter()
-            .find_map(|u| self.struct_templates.get(&format!("{u}{name}")))
+            .find_map(|k| self.struct_templates.get(k))
             .copied()
     }
 
