@@ -5,8 +5,19 @@
 
 /// Indices `0..` as bits; grows on insert. Sets are equal when they hold
 /// the same indices, whatever their capacity.
-#[derive(Clone, Debug, Default)]
+#[derive(Debug, Default)]
 pub(crate) struct BitSet(Vec<u64>);
+
+impl Clone for BitSet {
+    fn clone(&self) -> BitSet {
+        BitSet(self.0.clone())
+    }
+
+    /// Reuses this set's words (the fixpoint copies sets in a loop).
+    fn clone_from(&mut self, source: &BitSet) {
+        self.0.clone_from(&source.0);
+    }
+}
 
 impl BitSet {
     /// Adds `i`; whether it was absent.
@@ -130,6 +141,10 @@ mod tests {
         let mut c = b.clone();
         c.union_with(&BitSet::default());
         assert_eq!(c, b);
+        let mut d = BitSet::default();
+        d.insert(900);
+        d.clone_from(&a);
+        assert_eq!(d, a, "clone_from replaces, not merges");
     }
 
     impl BitSet {

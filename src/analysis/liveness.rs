@@ -130,12 +130,24 @@ pub(crate) const MAX_CHAINS: usize = 64;
 /// The sites of one program with the values live across each (computed
 /// once per Program: RT010 and the stack model both ask).
 pub fn live_sites(program: &Program) -> Vec<LiveSite> {
-    struct Sites(Vec<LiveSite>);
+    shared_live_sites(program).to_vec()
+}
+
+/// [`live_sites`] without copying them out of the Program's memo.
+pub(crate) fn shared_live_sites(program: &Program) -> std::sync::Arc<LiveSites> {
     program
         .memo
-        .get_or(|| Sites(compute_live_sites(program)))
-        .0
-        .clone()
+        .get_or(|| LiveSites(compute_live_sites(program)))
+}
+
+/// The live sites a Program keeps once computed.
+pub(crate) struct LiveSites(Vec<LiveSite>);
+
+impl std::ops::Deref for LiveSites {
+    type Target = [LiveSite];
+    fn deref(&self) -> &[LiveSite] {
+        &self.0
+    }
 }
 
 fn compute_live_sites(program: &Program) -> Vec<LiveSite> {
@@ -756,7 +768,8 @@ impl FnLiveness {
         let f = &program.functions[func];
         let mut vars = HashSet::default();
         let mut roots: HashMap<Id, LocalPtr> = HashMap::default();
-        let mut ssa = HashSet::default();
+        // Most results are SSA values: sized once, not grown step by step.
+        let mut ssa = HashSet::with_capacity_and_hasher(f.end + 1 - f.start, Default::default());
         for inst in &program.insts[f.start..=f.end] {
             let Some(r) = inst.result_id else { continue };
             if program.is_debug_inst(inst) {
@@ -1280,25 +1293,29 @@ impl FnLiveness {
         let mut work: Vec<usize> = (0..n).collect();
         let mut queued = vec![true; n];
         let mut steps = 0usize;
+        // Reused for each block's live set, to spare an allocation a visit.
+        let mut scratch = BitSet::default();
         while let Some(b) = work.pop() {
             queued[b] = false;
             steps += 1;
             if steps > n.saturating_mul(10_000) {
                 break;
             }
-            let mut out = phi_uses[b].clone();
+            let mut out = std::mem::take(&mut self.live_out[b]);
+            out.clone_from(&phi_uses[b]);
             for &s in &f.blocks[b].succs {
                 if let Some(li) = live_in.get(s) {
                     out.union_with(li);
                 }
             }
-            let mut live = out.clone();
+            let mut live = std::mem::take(&mut scratch);
+            live.clone_from(&out);
             for k in (f.blocks[b].start..=f.blocks[b].end).rev() {
                 self.step_back(program, k, &mut live);
             }
             self.live_out[b] = out;
             if live != live_in[b] {
-                live_in[b] = live;
+                std::mem::swap(&mut live_in[b], &mut live);
                 for &p in &self.preds[b] {
                     if !queued[p] {
                         queued[p] = true;
@@ -1306,6 +1323,7 @@ impl FnLiveness {
                     }
                 }
             }
+            scratch = live;
         }
         // Forward: variables possibly written on some path. What each
         // block writes itself is the same every round.
@@ -1522,7 +1540,13 @@ impl FnLiveness {
                     })
                 })
             };
-            let use_at = self.first_use_after(program, inst, id);
+            // A variable is read only where it is mentioned: look nowhere else.
+            let mentions = if is_var {
+                self.mentions(program).get(&id).cloned()
+            } else {
+                None
+            };
+            let use_at = self.first_use_after(program, inst, id, mentions.as_deref());
             out.push(LiveValue {
                 name: value_name(program, id, def.as_ref()),
                 ty: program.type_name(ty),
@@ -1573,12 +1597,22 @@ impl FnLiveness {
 
     /// The position of the first instruction after `inst` that reads `id`
     /// (breadth-first over the CFG, loops included).
-    fn first_use_after(&self, program: &Program, inst: usize, id: Id) -> Option<Location> {
+    fn first_use_after(
+        &self,
+        program: &Program,
+        inst: usize,
+        id: Id,
+        only: Option<&[usize]>,
+    ) -> Option<Location> {
         let f = self.function(program);
         let b0 = f.block_of(inst)?;
+        let reads = |k: usize| {
+            only.is_none_or(|m| m.binary_search(&k).is_ok())
+                && self.reads(program, &program.insts[k], id)
+        };
         let mut found = None;
         for k in inst + 1..=f.blocks[b0].end {
-            if self.reads(program, &program.insts[k], id) {
+            if reads(k) {
                 found = Some(k);
                 break;
             }
@@ -1591,7 +1625,7 @@ impl FnLiveness {
                     continue;
                 }
                 for k in f.blocks[b].start..=f.blocks[b].end {
-                    if self.reads(program, &program.insts[k], id) {
+                    if reads(k) {
                         found = Some(k);
                         break 'bfs;
                     }
