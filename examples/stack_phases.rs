@@ -1,5 +1,6 @@
 //! Times the phases of the stack model on freshly loaded pipelines:
-//! `cargo run --release --example stack_phases -- [ITERS] [PIPELINE.toml...]`.
+//! `cargo run --release --example stack_phases -- [ITERS] [PIPELINE.toml...]`
+//! (default: the repository's pipelines); `STATS=1` prints each program's size instead.
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
 

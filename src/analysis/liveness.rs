@@ -1351,8 +1351,8 @@ impl FnLiveness {
         while changed && rounds < 10_000 {
             changed = false;
             rounds += 1;
-            for b in 0..n {
-                let mut d = own[b].clone();
+            for (b, written) in own.iter().enumerate() {
+                let mut d = written.clone();
                 for &p in &self.preds[b] {
                     d.union_with(&self.defined_out[p]);
                 }
