@@ -137,11 +137,11 @@ pub fn live_sites(program: &Program) -> Vec<LiveSite> {
 pub(crate) fn shared_live_sites(program: &Program) -> std::sync::Arc<LiveSites> {
     program
         .memo
-        .get_or(|| LiveSites(compute_live_sites(program)))
+        .get_or(|| LiveSites(compute_live_sites(program, true)))
 }
 
 /// The live sites a Program keeps once computed.
-pub(crate) struct LiveSites(Vec<LiveSite>);
+pub struct LiveSites(Vec<LiveSite>);
 
 impl std::ops::Deref for LiveSites {
     type Target = [LiveSite];
@@ -150,7 +150,45 @@ impl std::ops::Deref for LiveSites {
     }
 }
 
-fn compute_live_sites(program: &Program) -> Vec<LiveSite> {
+/// Live sites without what only a reader needs: each value's name, type
+/// and positions (first use, definition), the payload's description.
+/// Bytes, ids, storage and recomputability are the same as [`LiveSites`]'s.
+pub struct LiveBytes(Vec<LiveSite>);
+
+/// The sites the stack model reads: the described ones when something
+/// (RT010, `rtlint live`) already computed them, else [`LiveBytes`].
+pub enum SitesForBytes {
+    Described(std::sync::Arc<LiveSites>),
+    Bytes(std::sync::Arc<LiveBytes>),
+}
+
+impl std::ops::Deref for SitesForBytes {
+    type Target = [LiveSite];
+    fn deref(&self) -> &[LiveSite] {
+        match self {
+            SitesForBytes::Described(s) => &s.0,
+            SitesForBytes::Bytes(s) => &s.0,
+        }
+    }
+}
+
+/// The live sites' bytes, ids and recomputability, computed once per
+/// Program: the stack model asks for nothing else, and naming, typing and
+/// placing each value was about a third of the liveness time.
+pub fn shared_live_bytes(program: &Program) -> SitesForBytes {
+    match program.memo.get::<LiveSites>() {
+        Some(s) => SitesForBytes::Described(s),
+        None => SitesForBytes::Bytes(
+            program
+                .memo
+                .get_or(|| LiveBytes(compute_live_sites(program, false))),
+        ),
+    }
+}
+
+/// The live sites; with `described`, each value's name, type and
+/// positions and the payload's description too.
+fn compute_live_sites(program: &Program, described: bool) -> Vec<LiveSite> {
     let mut cache: HashMap<usize, FnLiveness> = HashMap::default();
     let mut shared = Shared::default();
     let mut out = Vec::new();
@@ -183,12 +221,14 @@ fn compute_live_sites(program: &Program) -> Vec<LiveSite> {
                         .entry(fi)
                         .or_insert_with(|| FnLiveness::shared(program, fi, &mut shared));
                     let extra = fl.arguments_of(program, p, &carried);
-                    for v in fl.live_across(program, p, &extra) {
+                    let mut places = fl.places_after(program, p);
+                    places.extend(extra);
+                    for v in fl.live_across(program, p, &places, described) {
                         if seen.insert(v.id) {
                             values.push(v);
                         }
                     }
-                    carried = fl.param_parts_across(program, p, &extra);
+                    carried = fl.param_parts_across(program, &places);
                 }
                 // The query object is the site's own state, like a payload.
                 values.retain(|v| Some(v.id) != site.payload);
@@ -204,7 +244,10 @@ fn compute_live_sites(program: &Program) -> Vec<LiveSite> {
                 let location = std::iter::once(site.inst)
                     .chain(chain.iter().rev().copied())
                     .find_map(|i| program.inst_location(i));
-                let payload = site.payload.map(|id| payload_info(program, id));
+                let payload = site
+                    .payload
+                    .filter(|_| described)
+                    .map(|id| payload_info(program, id));
                 out.push(LiveSite {
                     path: program.path.clone(),
                     line: location.as_ref().map(|l| l.line),
@@ -585,7 +628,7 @@ pub struct FnLiveness {
     step_uses: Vec<u32>,
     /// The instructions that define or use each variable, in order (built
     /// on first use).
-    mentions: Option<HashMap<Id, Vec<usize>>>,
+    mentions: Option<HashMap<Id, std::rc::Rc<[usize]>>>,
 }
 
 impl FnLiveness {
@@ -1426,7 +1469,6 @@ impl FnLiveness {
         d
     }
 
-    /// The values live across instruction `inst`, described.
     /// The places in this function that call `call` passes for the
     /// callee's parameter parts in `params` (parameter index, path).
     fn arguments_of(
@@ -1453,34 +1495,32 @@ impl FnLiveness {
             .collect()
     }
 
-    /// Parts behind this function's pointer parameters live across
-    /// instruction `inst` (with `extra` places also live), by parameter
-    /// index.
+    /// Parts behind this function's pointer parameters among the `places`
+    /// live across an instruction, by parameter index.
     fn param_parts_across(
         &self,
         program: &Program,
-        inst: usize,
-        extra: &[Place],
+        places: &HashSet<Place>,
     ) -> Vec<(usize, Vec<u32>)> {
         let f = self.function(program);
-        let mut places = self.places_after(program, inst);
-        places.extend(extra.iter().cloned());
         let mut out: Vec<(usize, Vec<u32>)> = places
-            .into_iter()
-            .filter_map(|(v, path)| Some((f.params.iter().position(|&p| p == v)?, path)))
+            .iter()
+            .filter_map(|(v, path)| Some((f.params.iter().position(|p| p == v)?, path.clone())))
             .collect();
         out.sort();
         out
     }
 
+    /// The values among `places` (those live just after instruction
+    /// `inst`, with the caller's parts passed to this function) that count
+    /// across `inst`; with `described`, named, typed and placed too.
     pub fn live_across(
         &mut self,
         program: &Program,
         inst: usize,
-        extra: &[Place],
+        places: &HashSet<Place>,
+        described: bool,
     ) -> Vec<LiveValue> {
-        let mut places = self.places_after(program, inst);
-        places.extend(extra.iter().cloned());
         let live: HashSet<Id> = places.iter().map(|(id, _)| *id).collect();
         let defined = self.defined_before(program, inst);
         let result = program.insts.get(inst).and_then(|i| i.result_id);
@@ -1523,6 +1563,36 @@ impl FnLiveness {
             } else {
                 self.remat_ssa(program, id, 0)
             };
+            let size = if is_var {
+                let paths: Vec<&Vec<u32>> = places
+                    .iter()
+                    .filter(|(v, _)| *v == id)
+                    .map(|(_, p)| p)
+                    .collect();
+                FnLiveness::live_part_size(program, ty, &paths)
+            } else {
+                scalar_size(program, ty).unwrap_or(0)
+            };
+            let storage = if is_var {
+                Storage::Variable
+            } else {
+                Storage::Ssa
+            };
+            if !described {
+                out.push(LiveValue {
+                    name: String::new(),
+                    ty: String::new(),
+                    size,
+                    rematerializable,
+                    storage,
+                    def_line: None,
+                    use_line: None,
+                    id,
+                    def: None,
+                    use_at: None,
+                });
+                continue;
+            }
             let def = if is_var {
                 self.var_def_location(program, id)
             } else {
@@ -1550,22 +1620,9 @@ impl FnLiveness {
             out.push(LiveValue {
                 name: value_name(program, id, def.as_ref()),
                 ty: program.type_name(ty),
-                size: if is_var {
-                    let paths: Vec<&Vec<u32>> = places
-                        .iter()
-                        .filter(|(v, _)| *v == id)
-                        .map(|(_, p)| p)
-                        .collect();
-                    FnLiveness::live_part_size(program, ty, &paths)
-                } else {
-                    scalar_size(program, ty).unwrap_or(0)
-                },
+                size,
                 rematerializable,
-                storage: if is_var {
-                    Storage::Variable
-                } else {
-                    Storage::Ssa
-                },
+                storage,
                 def_line: def.as_ref().map(|l| l.line),
                 use_line: use_at.as_ref().map(|l| l.line),
                 id,
@@ -1784,12 +1841,9 @@ impl FnLiveness {
         let reaching = self.reaching_writes(program, var, at);
         let mut ok = true;
         let mut stored: Vec<(Vec<u32>, Id)> = Vec::new();
-        let mentions = self
-            .mentions(program)
-            .get(&var)
-            .cloned()
-            .unwrap_or_default();
-        for i in mentions {
+        // Shared, not copied: the loop below recurses into `self`.
+        let mentions = self.mentions(program).get(&var).cloned();
+        for &i in mentions.iter().flat_map(|m| m.iter()) {
             let inst = &program.insts[i];
             let ids: Vec<Id> = id_operands(inst).collect();
             match inst.class.opcode {
@@ -1851,7 +1905,7 @@ impl FnLiveness {
 
     /// The instructions (not debug info) that define a variable or use a
     /// pointer into it, per variable, in order.
-    fn mentions(&mut self, program: &Program) -> &HashMap<Id, Vec<usize>> {
+    fn mentions(&mut self, program: &Program) -> &HashMap<Id, std::rc::Rc<[usize]>> {
         if self.mentions.is_none() {
             let f = &program.functions[self.func];
             let mut m: HashMap<Id, Vec<usize>> = HashMap::default();
@@ -1869,7 +1923,7 @@ impl FnLiveness {
                     }
                 }
             }
-            self.mentions = Some(m);
+            self.mentions = Some(m.into_iter().map(|(v, l)| (v, l.into())).collect());
         }
         self.mentions.get_or_insert_with(HashMap::default)
     }

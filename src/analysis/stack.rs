@@ -16,7 +16,7 @@
 //! are in `docs/stack.md`.
 
 use super::callgraph::{Assumption, EdgeKind};
-use super::liveness::{live_sites, shared_live_sites, LiveSite};
+use super::liveness::{shared_live_bytes, LiveSite};
 use super::recursion::{recursion_report, ChainStep, NoGuard, RecursionReport};
 use crate::pipeline::Pipeline;
 use crate::pipeline::Slot;
@@ -313,7 +313,7 @@ fn global_size(program: &Program, id: u32) -> u64 {
 
 /// Breakdown of one entry point of a program.
 pub fn breakdown(program: &Program, entry: &str) -> Breakdown {
-    breakdown_with(program, entry, &live_sites(program))
+    breakdown_with(program, entry, &shared_live_bytes(program))
 }
 
 /// [`breakdown`] with the program's live sites already computed.
@@ -642,7 +642,7 @@ pub fn stack_report(pipeline: &Pipeline) -> StackReport {
 /// [`stack_report`] over a recursion analysis the caller already has.
 pub fn stack_report_with(pipeline: &Pipeline, rec: &RecursionReport) -> StackReport {
     let mut cache: HashMap<(usize, String), Breakdown> = HashMap::new();
-    let sites: Vec<_> = pipeline.programs.iter().map(shared_live_sites).collect();
+    let sites: Vec<_> = pipeline.programs.iter().map(shared_live_bytes).collect();
     let mut shaders = Vec::new();
     for node in &rec.graph.nodes {
         let s = &node.shader;

@@ -249,6 +249,13 @@ pub struct Memo(
 );
 
 impl Memo {
+    /// The stored `T`, if something computed it.
+    pub fn get<T: std::any::Any + Send + Sync>(&self) -> Option<std::sync::Arc<T>> {
+        let key = std::any::TypeId::of::<T>();
+        let found = self.0.lock().ok().and_then(|m| m.get(&key).cloned());
+        found.and_then(|v| v.downcast::<T>().ok())
+    }
+
     /// The stored `T`, else `f()` stored.
     pub fn get_or<T: std::any::Any + Send + Sync>(
         &self,
