@@ -1269,11 +1269,12 @@ impl FnLiveness {
     /// Variables an instruction may write. A constant initializer does not
     /// count: until something else is stored, the variable holds a
     /// constant, which is recomputed rather than kept across a call.
-    fn writes(&self, program: &Program, inst: &Instruction) -> Vec<Id> {
-        if program.is_debug_inst(inst) {
-            return Vec::new();
-        }
+    /// (Given to `each` one by one: asked of every instruction, and most
+    /// write nothing.)
+    fn writes(&self, program: &Program, inst: &Instruction, each: impl FnMut(Id)) {
         match inst.class.opcode {
+            Op::Load | Op::AccessChain | Op::InBoundsAccessChain | Op::PtrAccessChain => {}
+            _ if program.is_debug_inst(inst) => {}
             Op::Variable if inst.operands.len() > 1 => {
                 let constant = matches!(
                     inst.operands.get(1),
@@ -1281,16 +1282,13 @@ impl FnLiveness {
                         if program.constants.contains_key(init)
                             || program.spec_constants.contains_key(init)
                 );
-                if constant {
-                    Vec::new()
-                } else {
-                    inst.result_id.into_iter().collect()
+                if !constant {
+                    inst.result_id.into_iter().for_each(each);
                 }
             }
-            Op::Load | Op::AccessChain | Op::InBoundsAccessChain | Op::PtrAccessChain => Vec::new(),
             _ => id_operands(inst)
                 .filter_map(|id| self.root(id))
-                .collect::<Vec<_>>(),
+                .for_each(each),
         }
     }
 
@@ -1378,12 +1376,12 @@ impl FnLiveness {
             .map(|block| {
                 let mut set = BitSet::default();
                 for inst in &program.insts[block.start..=block.end] {
-                    for id in self.writes(program, inst) {
+                    self.writes(program, inst, |id| {
                         set.insert(*index.entry(id).or_insert_with(|| {
                             written.push(id);
                             written.len() as u32 - 1
                         }));
-                    }
+                    });
                 }
                 set
             })
@@ -1464,7 +1462,9 @@ impl FnLiveness {
             d.extend(self.defined_out[p].iter().map(|i| self.written[i as usize]));
         }
         for k in f.blocks[b].start..inst {
-            d.extend(self.writes(program, &program.insts[k]));
+            self.writes(program, &program.insts[k], |id| {
+                d.insert(id);
+            });
         }
         d
     }
@@ -1952,7 +1952,7 @@ impl FnLiveness {
         };
         // (block, last instruction to look at)
         let mut work: Vec<(usize, usize)> = vec![(b0, at)];
-        let mut seen: HashSet<usize> = HashSet::default();
+        let mut seen = vec![false; f.blocks.len()];
         while let Some((b, last)) = work.pop() {
             let block = &f.blocks[b];
             let mut killed = false;
@@ -1977,7 +1977,7 @@ impl FnLiveness {
                 }
             }
             for &p in &self.preds[b] {
-                if seen.insert(p) {
+                if !std::mem::replace(&mut seen[p], true) {
                     work.push((p, f.blocks[p].end + 1));
                 }
             }

@@ -393,11 +393,12 @@ pub fn breakdown_with(program: &Program, entry: &str, sites: &[LiveSite]) -> Bre
         }
     }
     // Shader calls only: an inline ray query keeps its state in registers.
+    let mut loops = Loops::default();
     for site in sites
         .iter()
         .filter(|s| s.entry == entry && s.kind != crate::analysis::liveness::LiveSiteKind::RayQuery)
     {
-        let (call_data, payload) = other_call_data_live(program, site.inst);
+        let (call_data, payload) = other_call_data_live(program, site.inst, &mut loops);
         b.outlived_payloads = b.outlived_payloads.max(payload);
         let kept = site.live_bytes - site.rematerializable_bytes + call_data;
         let aggregates: u64 = site
@@ -409,7 +410,7 @@ pub fn breakdown_with(program: &Program, entry: &str, sites: &[LiveSite]) -> Bre
         b.live_blocks = b.live_blocks.max(aggregates + call_data);
         b.live_state_total = b.live_state_total.max(site.live_bytes + call_data);
         b.live_state = b.live_state.max(kept);
-        if in_loop(program, site.chain.first().copied().unwrap_or(site.inst)) {
+        if loops.contain(program, site.chain.first().copied().unwrap_or(site.inst)) {
             b.loop_live_state = b.loop_live_state.max(kept);
         }
     }
@@ -437,7 +438,7 @@ fn is_aggregate_variable(program: &Program, id: u32) -> bool {
 /// caller's frame; such a payload cost a few bytes whatever its size.
 /// (GLSL declares both as globals, which live-state analysis does not
 /// count; HLSL's locals are counted there.)
-fn other_call_data_live(program: &Program, inst: usize) -> (u64, u64) {
+fn other_call_data_live(program: &Program, inst: usize, loops: &mut Loops) -> (u64, u64) {
     use spirv::Op;
     let Some(site) = program.sites.iter().find(|s| s.inst == inst) else {
         return (0, 0);
@@ -448,7 +449,7 @@ fn other_call_data_live(program: &Program, inst: usize) -> (u64, u64) {
     let Some(f) = program.functions.get(site.function) else {
         return (0, 0);
     };
-    let looped = in_loop(program, inst);
+    let looped = loops.contain(program, inst);
     let (mut callable, mut payload) = (0, 0);
     for g in program.globals.iter().filter(|g| {
         matches!(
@@ -492,20 +493,36 @@ fn other_call_data_live(program: &Program, inst: usize) -> (u64, u64) {
     (callable, payload)
 }
 
-/// Whether instruction `inst` lies in a loop of its function.
-fn in_loop(program: &Program, inst: usize) -> bool {
-    let Some(f) = program
-        .function_of(inst)
-        .and_then(|i| program.functions.get(i))
-    else {
-        return false;
-    };
-    let Some(block) = f.block_of(inst) else {
-        return false;
-    };
-    crate::program::cfg::natural_loops(f)
-        .iter()
-        .any(|(_, body)| body.contains(&block))
+/// Which blocks of each function lie in a loop, worked out once per
+/// function: natural loops need the dominator tree, and every site asked.
+#[derive(Default)]
+struct Loops(HashMap<usize, Vec<bool>>);
+
+impl Loops {
+    /// Whether instruction `inst` lies in a loop of its function.
+    fn contain(&mut self, program: &Program, inst: usize) -> bool {
+        let Some(fi) = program.function_of(inst) else {
+            return false;
+        };
+        let Some(f) = program.functions.get(fi) else {
+            return false;
+        };
+        let Some(block) = f.block_of(inst) else {
+            return false;
+        };
+        let looped = self.0.entry(fi).or_insert_with(|| {
+            let mut looped = vec![false; f.blocks.len()];
+            for (_, body) in crate::program::cfg::natural_loops(f) {
+                for b in body {
+                    if let Some(x) = looped.get_mut(b) {
+                        *x = true;
+                    }
+                }
+            }
+            looped
+        });
+        looped.get(block).copied().unwrap_or(false)
+    }
 }
 
 fn stage_max(shaders: &[(Stage, u64)]) -> StageMax {
