@@ -369,6 +369,26 @@ impl Group {
     }
 }
 
+/// The sites a rule has reported: one finding per site and position. A
+/// site reached along several call chains or targets is reported once
+/// where it is; two sites that share a position, or have none (a module
+/// without debug info), stay two findings, so how many findings a module
+/// gets does not depend on its debug info.
+#[derive(Default)]
+pub struct Reported(Vec<(usize, usize, Option<Location>)>);
+
+impl Reported {
+    /// True the first time site `inst` of program `program` is seen at `at`.
+    pub fn first(&mut self, program: usize, inst: usize, at: &Option<Location>) -> bool {
+        let key = (program, inst, at.clone());
+        if self.0.contains(&key) {
+            return false;
+        }
+        self.0.push(key);
+        true
+    }
+}
+
 /// Whether a selector (`ALL`, a code, a code prefix such as `RT02`, a name
 /// or a group) picks `rule`.
 pub fn selects(selector: &str, rule: &Rule) -> bool {
