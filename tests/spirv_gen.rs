@@ -5,8 +5,8 @@
 //! with and without debug info).
 //!
 //! `RTLINT_GEN_SEEDS=N` checks seeds `0..N` instead of the default few
-//! hundred (`RTLINT_GEN_FIRST` moves the start); the long runs in
-//! docs/performance.md use it.
+//! hundred (`RTLINT_GEN_FIRST` moves the start, `RTLINT_GEN_SECONDS` stops
+//! early after that long); the long runs in docs/performance.md use them.
 
 use rtlint_testkit::gen::module_of_seed;
 use rtlint_testkit::gen_check::check_pair;
@@ -51,19 +51,42 @@ fn generation_does_not_depend_on_debug_info() {
 
 #[test]
 fn generated_modules_keep_the_invariants() {
-    let mut sites = 0;
-    for seed in seeds(300) {
+    let mut traces = 0;
+    let mut failures = Vec::new();
+    let range = seeds(300);
+    let limit = std::env::var("RTLINT_GEN_SECONDS")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .map(std::time::Duration::from_secs);
+    let start = std::time::Instant::now();
+    let mut n = 0;
+    for seed in range {
+        if limit.is_some_and(|l| start.elapsed() > l) {
+            break;
+        }
+        n += 1;
         let plain = module_of_seed(seed, false);
         let debug = module_of_seed(seed, true);
-        let r = std::panic::catch_unwind(|| check_pair(&plain, &debug));
-        match r {
+        match std::panic::catch_unwind(|| check_pair(&plain, &debug)) {
             Ok(Ok(())) => {}
-            Ok(Err(e)) => panic!("seed {seed}: {e}"),
-            Err(_) => panic!("seed {seed}: an analysis panics"),
+            Ok(Err(e)) => failures.push(format!("seed {seed}: {e}")),
+            Err(_) => failures.push(format!("seed {seed}: an analysis panics")),
         }
-        sites += plain.entries.iter().map(|e| e.traces.len()).sum::<usize>();
+        traces += plain.entries.iter().map(|e| e.traces.len()).sum::<usize>();
     }
-    assert!(sites > 0, "no trace generated");
+    eprintln!(
+        "{n} seeds, {traces} traces, {} failures, {:.0} s",
+        failures.len(),
+        start.elapsed().as_secs_f64()
+    );
+    // Every failing seed, so one long run shows them all.
+    assert!(
+        failures.is_empty(),
+        "{} of {n} seeds fail:\n{}",
+        failures.len(),
+        failures.join("\n")
+    );
+    assert!(traces > 0, "no trace generated");
 }
 
 /// `RTLINT_GEN_DUMP=SEED` writes that seed's module, with and without

@@ -613,6 +613,7 @@ impl Gen {
             calls: Vec::new(),
             traces: Vec::new(),
             incoming,
+            returns_float,
             budget: 4 + src.below(24),
             depth: 0,
             dbg_fn: None,
@@ -656,22 +657,7 @@ impl Gen {
             fg.new_local(self, t);
         }
         fg.statements(self, src);
-        // Return.
-        if returns_float {
-            let v = fg
-                .value(self, src, &Ty::F32)
-                .unwrap_or_else(|| self.fconst(1.0));
-            fg.cur.push(Instruction::new(
-                Op::ReturnValue,
-                None,
-                None,
-                vec![Operand::IdRef(v)],
-            ));
-        } else {
-            fg.cur
-                .push(Instruction::new(Op::Return, None, None, vec![]));
-        }
-        fg.end_block();
+        fg.exit(self, src, false);
         // Variables first in the entry block, then the debug declarations.
         let mut blocks = std::mem::take(&mut fg.blocks);
         let first = &mut blocks[0].instructions;
@@ -871,6 +857,7 @@ struct FnGen {
     calls: Vec<Word>,
     traces: Vec<GenTrace>,
     incoming: Option<(Word, Ty)>,
+    returns_float: bool,
     budget: u32,
     depth: u32,
     dbg_fn: Option<Word>,
@@ -1038,10 +1025,24 @@ impl FnGen {
         }
         let p = g.ptr(sc, &st);
         let mut ops = vec![Operand::IdRef(var)];
+        let mut at = ty.clone();
         for i in path {
-            ops.push(Operand::IdRef(g.uconst(i)));
+            // Now and then an element of an array or vector chosen at run
+            // time: the pointer no longer names one part.
+            let (next, dynamic_ok) = match &at {
+                Ty::Arr(e, _) => ((**e).clone(), true),
+                Ty::Vec(_) => (Ty::F32, true),
+                Ty::Struct(m) => (m[i as usize].clone(), false),
+                _ => (at.clone(), false),
+            };
+            let index = if dynamic_ok && src.chance(15) {
+                self.value(g, src, &Ty::U32).unwrap()
+            } else {
+                g.uconst(i)
+            };
+            ops.push(Operand::IdRef(index));
+            at = next;
         }
-        // A dynamic index now and then (an array element chosen at run time).
         (self.push(g, Op::AccessChain, p, ops), st)
     }
 
@@ -1058,7 +1059,7 @@ impl FnGen {
 
     fn statement(&mut self, g: &mut Gen, src: &mut Source) {
         self.dbg_line(g);
-        match src.below(14) {
+        match src.below(15) {
             0 | 1 => self.arith(g, src),
             2 | 3 => {
                 // Load a part of a local.
@@ -1111,12 +1112,33 @@ impl FnGen {
             }
             7 if self.depth < 3 => self.if_else(g, src),
             8 if self.depth < 3 => self.counted_loop(g, src),
-            9 | 10 if self.can_trace() => self.trace(g, src),
+            9 | 10 | 14 if self.can_trace() => self.trace(g, src),
             11 if self.can_call() => self.execute_callable(g, src),
             12 => self.call(g, src),
             13 => self.stage_specific(g, src),
             _ => self.arith(g, src),
         }
+    }
+
+    /// Ends the current block by leaving the function: a return, or with
+    /// `early` in an any-hit shader sometimes `OpTerminateRayKHR` or
+    /// `OpIgnoreIntersectionKHR`.
+    fn exit(&mut self, g: &mut Gen, src: &mut Source, early: bool) {
+        let inst = if early && self.stage() == Some(Stage::AnyHit) && src.chance(60) {
+            let op = if src.chance(50) {
+                Op::TerminateRayKHR
+            } else {
+                Op::IgnoreIntersectionKHR
+            };
+            Instruction::new(op, None, None, vec![])
+        } else if self.returns_float {
+            let v = self.value(g, src, &Ty::F32).unwrap();
+            Instruction::new(Op::ReturnValue, None, None, vec![Operand::IdRef(v)])
+        } else {
+            Instruction::new(Op::Return, None, None, vec![])
+        };
+        self.cur.push(inst);
+        self.end_block();
     }
 
     fn arith(&mut self, g: &mut Gen, src: &mut Source) {
@@ -1173,6 +1195,8 @@ impl FnGen {
         ));
         self.end_block();
         let phi_ty = Self::scalar(src);
+        // The then-branch may leave the function instead of reaching the merge.
+        let then_exits = src.chance(12);
         let mut incoming = Vec::new();
         for (label, present) in [(then_l, true), (else_l, has_else)] {
             if !present {
@@ -1184,6 +1208,12 @@ impl FnGen {
             self.depth += 1;
             self.scopes.push(Vec::new());
             self.statements(g, src);
+            if label == then_l && then_exits {
+                self.exit(g, src, true);
+                self.scopes.pop();
+                self.depth -= 1;
+                continue;
+            }
             let v = self.value(g, src, &phi_ty).unwrap();
             incoming.push((v, self.label));
             self.scopes.pop();
