@@ -52,6 +52,7 @@ fn generation_does_not_depend_on_debug_info() {
 #[test]
 fn generated_modules_keep_the_invariants() {
     let mut traces = 0;
+    let mut stages = std::collections::BTreeSet::new();
     let mut failures = Vec::new();
     let range = seeds(300);
     let limit = std::env::var("RTLINT_GEN_SECONDS")
@@ -73,6 +74,7 @@ fn generated_modules_keep_the_invariants() {
             Err(_) => failures.push(format!("seed {seed}: an analysis panics")),
         }
         traces += plain.entries.iter().map(|e| e.traces.len()).sum::<usize>();
+        stages.extend(plain.entries.iter().map(|e| e.stage.as_str()));
     }
     eprintln!(
         "{n} seeds, {traces} traces, {} failures, {:.0} s",
@@ -87,6 +89,25 @@ fn generated_modules_keep_the_invariants() {
         failures.join("\n")
     );
     assert!(traces > 0, "no trace generated");
+    assert!(n < 100 || stages.len() == 6, "stages generated: {stages:?}");
+}
+
+/// Seeds that found a fault, and what it was; they keep being checked
+/// whatever range a run covers.
+const FOUND: &[(u64, &str)] = &[(
+    0,
+    "RT070 and RT038 merged every site without a position (no debug info) into one finding",
+)];
+
+#[test]
+fn seeds_that_found_faults_stay_fixed() {
+    for (seed, what) in FOUND {
+        let plain = module_of_seed(*seed, false);
+        let debug = module_of_seed(*seed, true);
+        if let Err(e) = check_pair(&plain, &debug) {
+            panic!("seed {seed} ({what}) fails again: {e}");
+        }
+    }
 }
 
 /// `RTLINT_GEN_DUMP=SEED` writes that seed's module, with and without

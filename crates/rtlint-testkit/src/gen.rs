@@ -227,6 +227,9 @@ struct Gen {
     vec3: Word,
     accel: Word,
     accel_ty: Word,
+    /// Whether the module uses inline ray queries, and their type.
+    queries: bool,
+    query_ty: Word,
     payloads: Vec<(Word, Ty)>,
     callable_data: Vec<(Word, Ty)>,
     hit_attr: Word,
@@ -275,6 +278,8 @@ impl Gen {
             vec3,
             accel: 0,
             accel_ty,
+            queries: false,
+            query_ty: 0,
             payloads: Vec::new(),
             callable_data: Vec::new(),
             hit_attr: 0,
@@ -395,6 +400,12 @@ impl Gen {
         self.b.capability(Capability::Shader);
         self.b.capability(Capability::RayTracingKHR);
         self.b.extension("SPV_KHR_ray_tracing");
+        self.queries = src.chance(40);
+        if self.queries {
+            self.b.capability(Capability::RayQueryKHR);
+            self.b.extension("SPV_KHR_ray_query");
+            self.query_ty = self.b.type_ray_query_khr();
+        }
         if self.debug {
             self.b.extension("SPV_KHR_non_semantic_info");
         }
@@ -1059,7 +1070,7 @@ impl FnGen {
 
     fn statement(&mut self, g: &mut Gen, src: &mut Source) {
         self.dbg_line(g);
-        match src.below(15) {
+        match src.below(16) {
             0 | 1 => self.arith(g, src),
             2 | 3 => {
                 // Load a part of a local.
@@ -1116,6 +1127,7 @@ impl FnGen {
             11 if self.can_call() => self.execute_callable(g, src),
             12 => self.call(g, src),
             13 => self.stage_specific(g, src),
+            15 if g.queries && self.depth < 3 => self.ray_query(g, src),
             _ => self.arith(g, src),
         }
     }
@@ -1239,6 +1251,123 @@ impl FnGen {
                 .push(Instruction::new(Op::Phi, Some(t), Some(id), ops));
             self.scopes.last_mut().unwrap().push((id, phi_ty));
         }
+    }
+
+    /// An inline ray query: initialised, a `OpRayQueryProceedKHR` loop
+    /// whose body holds more statements (reading the candidate, sometimes
+    /// confirming it), then the committed intersection's type read.
+    fn ray_query(&mut self, g: &mut Gen, src: &mut Source) {
+        let ptr = g.b.type_pointer(None, StorageClass::Function, g.query_ty);
+        let rq = g.b.id();
+        self.vars.push(Instruction::new(
+            Op::Variable,
+            Some(ptr),
+            Some(rq),
+            vec![Operand::StorageClass(StorageClass::Function)],
+        ));
+        let name = g.fresh_name("query");
+        g.b.name(rq, name);
+        self.use_global(g.accel);
+        let accel = self.push(g, Op::Load, g.accel_ty, vec![Operand::IdRef(g.accel)]);
+        let flags = g.uconst(if src.chance(30) { 1 } else { 0 });
+        let mask = g.uconst(0xff);
+        let origin = self.vec3(g, src);
+        let tmin = g.fconst(0.001);
+        let dir = self.vec3(g, src);
+        let tmax = self.value(g, src, &Ty::F32).unwrap();
+        self.cur.push(Instruction::new(
+            Op::RayQueryInitializeKHR,
+            None,
+            None,
+            [rq, accel, flags, mask, origin, tmin, dir, tmax]
+                .into_iter()
+                .map(Operand::IdRef)
+                .collect(),
+        ));
+        let (header, body, cont, merge) = (g.b.id(), g.b.id(), g.b.id(), g.b.id());
+        self.cur.push(Instruction::new(
+            Op::Branch,
+            None,
+            None,
+            vec![Operand::IdRef(header)],
+        ));
+        self.end_block();
+        self.start_block(header);
+        let more = self.push(
+            g,
+            Op::RayQueryProceedKHR,
+            g.bool_ty,
+            vec![Operand::IdRef(rq)],
+        );
+        self.cur.push(Instruction::new(
+            Op::LoopMerge,
+            None,
+            None,
+            vec![
+                Operand::IdRef(merge),
+                Operand::IdRef(cont),
+                Operand::LoopControl(LoopControl::NONE),
+            ],
+        ));
+        self.cur.push(Instruction::new(
+            Op::BranchConditional,
+            None,
+            None,
+            vec![
+                Operand::IdRef(more),
+                Operand::IdRef(body),
+                Operand::IdRef(merge),
+            ],
+        ));
+        self.end_block();
+        self.start_block(body);
+        self.depth += 1;
+        self.scopes.push(Vec::new());
+        if src.chance(60) {
+            let candidate = g.uconst(0);
+            let t = self.push(
+                g,
+                Op::RayQueryGetIntersectionTypeKHR,
+                g.u32,
+                vec![Operand::IdRef(rq), Operand::IdRef(candidate)],
+            );
+            self.add_value(g, src, t, Ty::U32);
+        }
+        self.statements(g, src);
+        if src.chance(40) {
+            self.cur.push(Instruction::new(
+                Op::RayQueryConfirmIntersectionKHR,
+                None,
+                None,
+                vec![Operand::IdRef(rq)],
+            ));
+        }
+        self.cur.push(Instruction::new(
+            Op::Branch,
+            None,
+            None,
+            vec![Operand::IdRef(cont)],
+        ));
+        self.end_block();
+        self.scopes.pop();
+        self.depth -= 1;
+        self.start_block(cont);
+        self.cur.push(Instruction::new(
+            Op::Branch,
+            None,
+            None,
+            vec![Operand::IdRef(header)],
+        ));
+        self.end_block();
+        self.start_block(merge);
+        let committed = g.uconst(1);
+        let t = self.push(
+            g,
+            Op::RayQueryGetIntersectionTypeKHR,
+            g.u32,
+            vec![Operand::IdRef(rq), Operand::IdRef(committed)],
+        );
+        self.add_value(g, src, t, Ty::U32);
     }
 
     fn counted_loop(&mut self, g: &mut Gen, src: &mut Source) {
