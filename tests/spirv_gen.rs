@@ -92,10 +92,11 @@ fn generated_modules_keep_the_invariants() {
     assert!(n < 100 || stages.len() == 6, "stages generated: {stages:?}");
 }
 
-/// Seeds that found a fault, and what it was; they keep being checked
+/// Seeds that show a fault once found (with the generator as it is now;
+/// without the fix each fails), and what it was; they keep being checked
 /// whatever range a run covers.
 const FOUND: &[(u64, &str)] = &[(
-    0,
+    5,
     "RT070 and RT038 merged every site without a position (no debug info) into one finding",
 )];
 
