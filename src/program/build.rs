@@ -748,10 +748,12 @@ impl Builder<'_> {
                     Some(Operand::StorageClass(s)) => *s,
                     _ => return Err(self.at(i, "pointer type without a storage class")),
                 };
-                // Declared before, as every operand type: a forward-declared
-                // pointer (OpTypeForwardPointer) is the pointer being defined,
-                // never its pointee, which cannot be the pointer itself.
-                let pointee = self.type_operand(i, inst, 1)?;
+                // Not checked against the types read so far: pointees may be
+                // types this reader does not model (`OpTypeHitObjectNV`). But
+                // never the pointer itself (a forward-declared pointer could
+                // be): naming it recursed without end.
+                let pointee =
+                    id_at(inst, 1).ok_or_else(|| self.at(i, "pointer type without a pointee"))?;
                 if pointee == r {
                     return Err(self.at(i, format!("pointer type %{r} points to itself")));
                 }
