@@ -1244,6 +1244,10 @@ fn cli_names_a_classic_entry_point_with_its_stage() {
             .args(args)
             .arg(&file)
             .env("NO_COLOR", "1")
+            .env(
+                "RTLINT_CACHE_DIR",
+                std::env::temp_dir().join("rtlint-test-cache"),
+            )
             .output()
             .unwrap()
     };
