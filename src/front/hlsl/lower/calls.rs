@@ -287,7 +287,7 @@ impl<'a> Lowerer<'a> {
         if let Some(c) = self.find_user(name) {
             return self.call_user(name, c, args.iter().map(Arg::Expr).collect(), pos);
         }
-        if let Some((bi, ty, stages)) = system_value(name) {
+        if let Some(sv) = system_value(name) {
             self.arity(name, args, 0, pos)?;
             if self.f.cur_stage == Some(Stage::Compute) {
                 return Err(Error::new(
@@ -296,10 +296,10 @@ impl<'a> Lowerer<'a> {
                 )
                 .len(name.len() as u32));
             }
-            self.stage_check(name, stages, pos)?;
+            self.stage_check(name, sv.stages, pos)?;
             self.ray_tracing_caps();
-            let v = self.read_builtin(bi, &ty)?;
-            if name.ends_with("3x4") || name == "ObjectToWorld" || name == "WorldToObject" {
+            let v = self.read_builtin(sv.builtin, &sv.ty)?;
+            if sv.transpose {
                 let t = Ty::Mat(ScalarKind::Float, 3, 4);
                 let tid = self.ty_id(&t)?;
                 let id = self.op(Op::Transpose, tid, &[v.id])?;

@@ -37,7 +37,8 @@ impl<'a> Lowerer<'a> {
         self.spv(t, Layout::None)
     }
 
-    /// An `OpUndef` of type `t` (one per type, at module scope).
+    /// An `OpUndef` of type `t` (one per type, at module scope, where
+    /// `Builder::undef` would not put it while a block is selected).
     pub(super) fn undef(&mut self, t: &Ty) -> Result<Id> {
         let tid = self.ty_id(t)?;
         if let Some(&id) = self.undefs.get(&tid) {

@@ -1356,20 +1356,8 @@ impl<'a> Lowerer<'a> {
         }
         let tid = self.sc_id(*s);
         let id = match s {
-            ScalarKind::Bool => {
-                let on = default.as_f64() != 0.0;
-                let id = self.b.id();
-                let op = if on {
-                    Op::SpecConstantTrue
-                } else {
-                    Op::SpecConstantFalse
-                };
-                self.b.insert_types_global_values(
-                    InsertPoint::End,
-                    Instruction::new(op, Some(tid), Some(id), vec![]),
-                );
-                id
-            }
+            ScalarKind::Bool if default.as_f64() != 0.0 => self.b.spec_constant_true(tid),
+            ScalarKind::Bool => self.b.spec_constant_false(tid),
             ScalarKind::Float => self
                 .b
                 .spec_constant_bit32(tid, (default.as_f64() as f32).to_bits()),

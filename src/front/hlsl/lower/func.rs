@@ -344,7 +344,8 @@ impl<'a> Lowerer<'a> {
         Ok(var)
     }
 
-    /// A module-scope variable, even while a function is being emitted.
+    /// A module-scope variable, even while a function is being emitted
+    /// (`Builder::variable` would put it in the selected block).
     pub(super) fn global_var(&mut self, pty: Id, class: StorageClass, init: Option<Id>) -> Id {
         let id = self.b.id();
         let mut ops = vec![Operand::StorageClass(class)];
