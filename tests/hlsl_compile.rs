@@ -1547,3 +1547,36 @@ fn sixteen_bit_types_with_the_flag() {
         .iter()
         .any(|(op, o)| (*op == 21 || *op == 22) && o[1] == 16));
 }
+
+/// `[[vk::ext_decorate]]` on a resource, a `static` global, a `groupshared`
+/// array and a parameter: each one's variable or `OpFunctionParameter` has
+/// the decoration (tests/hlsl/ext_decorate.hlsl).
+#[test]
+fn ext_decorate_on_variables_and_parameters() {
+    compile_all("ext_decorate.hlsl");
+    let m = hlsl::compile(&shader("ext_decorate.hlsl"), &HlslOptions::default()).unwrap();
+    let words = &m[0].words;
+    let insts = instructions(words);
+    // OpDecorate (71) target decoration.
+    let decorations = |name: &str| -> Vec<u32> {
+        let ids = named(words, name);
+        insts
+            .iter()
+            .filter(|(op, ops)| *op == 71 && ids.contains(&ops[0]))
+            .map(|(_, ops)| ops[1])
+            .collect()
+    };
+    // Restrict (19) beside the binding's DescriptorSet (34) and Binding (33).
+    let mut results = decorations("gResults");
+    results.sort_unstable();
+    assert_eq!(results, [19, 33, 34]);
+    // RelaxedPrecision (0).
+    assert_eq!(decorations("gScale"), [0]);
+    assert_eq!(decorations("gShared"), [0]);
+    // The parameter `x` is an OpFunctionParameter (55) with the decoration.
+    let x = named(words, "x");
+    assert!(insts
+        .iter()
+        .any(|(op, ops)| *op == 55 && x.contains(&ops[1])));
+    assert_eq!(decorations("x"), [0]);
+}

@@ -486,10 +486,27 @@ fn every_attribute_is_implemented_or_refused() {
         err("[[vk::image_format(\"rgba8\")]] Texture2D t;\n[numthreads(1,1,1)]\nvoid m() {}"),
         "main.hlsl:1:3: not supported: `vk::image_format` on anything but an RWTexture"
     );
-    // Inline-SPIR-V decorations on struct members only.
+    // Inline-SPIR-V decorations on members, variables and parameters; a
+    // declaration that becomes no variable of its own refuses them.
     assert_eq!(
-        err("[[vk::ext_decorate(0)]] RWBuffer<uint> b;\n[numthreads(1,1,1)]\nvoid m() {}"),
-        "main.hlsl:1:3: not supported: `vk::ext_decorate` on a global declaration"
+        err("[[vk::ext_decorate(0)]] static const uint K = 3;\n[numthreads(1,1,1)]\nvoid m() {}"),
+        "main.hlsl:1:3: not supported: `vk::ext_decorate` on a constant"
+    );
+    assert_eq!(
+        err("[[vk::ext_decorate(0)]] float g;\n[numthreads(1,1,1)]\nvoid m() {}"),
+        "main.hlsl:1:3: not supported: `vk::ext_decorate` on a member of `$Globals`"
+    );
+    assert_eq!(
+        err("[[vk::ext_decorate(0)]] cbuffer C { float c; };\n[numthreads(1,1,1)]\nvoid m() {}"),
+        "main.hlsl:1:3: not supported: `vk::ext_decorate` on a `cbuffer`"
+    );
+    assert_eq!(
+        err("[numthreads(1,1,1)]\nvoid m([[vk::ext_decorate(0)]] uint3 id : SV_DispatchThreadID) {}"),
+        "main.hlsl:2:10: not supported: `vk::ext_decorate` on an entry point's parameter"
+    );
+    assert_eq!(
+        err("[numthreads(1,1,1)]\nvoid m()\n{\n    [[vk::ext_decorate(0)]] uint x = 0;\n}"),
+        "main.hlsl:4:7: not supported: `vk::ext_decorate` on a statement"
     );
     assert_eq!(
         err("struct S { [[vk::ext_decorate(9999)]] float x; };\n[numthreads(1,1,1)]\nvoid m() { S s; s.x = 1; }"),

@@ -1,6 +1,7 @@
 //! Declarations: structs, typedefs, enums, functions and methods, globals,
 //! constant buffers and resource bindings.
 
+use super::inline_spirv::no_ext_decorate;
 use super::*;
 
 impl<'a> Lowerer<'a> {
@@ -773,23 +774,30 @@ impl<'a> Lowerer<'a> {
                             _ => self.auto_binding(&mut used, &mut next_auto),
                         }),
                     };
+                    no_ext_decorate(attrs, "a `cbuffer`")?;
                     let members: Vec<&VarDecl> = members.iter().collect();
                     self.declare_cbuffer(attrs, name, *pos, binding, &members)?;
                 }
                 Item::Var(v) if v.attrs.iter().any(is_ext_builtin) => {
-                    self.declare_ext_builtin(v)?
+                    self.declare_ext_builtin(v)?;
+                    self.ext_decorate_global(v)?;
                 }
                 Item::Var(v) if subobject::Kind::from_type_name(&v.ty.name).is_some() => {
+                    no_ext_decorate(&v.attrs, "a subobject")?;
                     self.declare_subobject(v)?
                 }
-                Item::Var(v) if self.in_implicit_globals(v)? => globals_members.push(v),
+                Item::Var(v) if self.in_implicit_globals(v)? => {
+                    no_ext_decorate(&v.attrs, "a member of `$Globals`")?;
+                    globals_members.push(v)
+                }
                 Item::Var(v) => {
                     // A namespace's or struct's names are in scope in its initializers.
                     let scope = v.name.rsplit_once("::").map(|(n, _)| format!("{n}::"));
                     let saved = std::mem::replace(&mut self.f.cur_ns, scope.unwrap_or_default());
                     let r = self.declare_global_var(v, &mut used, &mut next_auto);
                     self.f.cur_ns = saved;
-                    r?
+                    r?;
+                    self.ext_decorate_global(v)?;
                 }
                 _ => {}
             }
@@ -805,6 +813,21 @@ impl<'a> Lowerer<'a> {
         let samplers = self.auto_binding(&mut used, &mut next_auto);
         self.heap_bindings = (resources, samplers);
         Ok(())
+    }
+
+    /// `[[vk::ext_decorate]]` on a global: decorates its variable; a global
+    /// that became a constant has none, and is refused.
+    fn ext_decorate_global(&mut self, v: &VarDecl) -> Result<()> {
+        if !v.attrs.iter().any(|a| a.name == "vk::ext_decorate") {
+            return Ok(());
+        }
+        match self.globals.get(&v.name) {
+            Some(Global::Place(Place::Ptr { ptr, .. })) => {
+                let ptr = *ptr;
+                self.ext_decorate(&v.attrs, ptr)
+            }
+            _ => no_ext_decorate(&v.attrs, "a constant"),
+        }
     }
 
     /// A DXR subobject: its content is recorded, nothing is emitted.
