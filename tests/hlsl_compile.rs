@@ -1441,6 +1441,31 @@ fn sixteen_bit_types_with_the_flag() {
     }
     assert!(!cs.contains(&4436), "{cs:?}");
     assert!(ps.contains(&4436) && !ps.contains(&4433), "{ps:?}");
+    // ddx and fwidth of half values: OpDPdx (207) and OpFwidth (209) take an
+    // OpFConvert (115) of the value and their result is converted back.
+    let ps_words = &entries.iter().find(|e| e.name == "ps").unwrap().words;
+    let ps_insts = instructions(ps_words);
+    let fconverts: Vec<&Vec<u32>> = ps_insts
+        .iter()
+        .filter(|(op, _)| *op == 115)
+        .map(|(_, ops)| ops)
+        .collect();
+    let derivatives: Vec<&Vec<u32>> = ps_insts
+        .iter()
+        .filter(|(op, _)| *op == 207 || *op == 209)
+        .map(|(_, ops)| ops)
+        .collect();
+    assert_eq!(derivatives.len(), 2);
+    for d in derivatives {
+        assert!(
+            fconverts.iter().any(|c| c[1] == d[2]),
+            "operand not widened"
+        );
+        assert!(
+            fconverts.iter().any(|c| c[2] == d[1]),
+            "result not narrowed"
+        );
+    }
     // A payload needs no storage capability.
     assert!(
         hit.contains(&9) && !hit.iter().any(|c| (4433..=4436).contains(c)),

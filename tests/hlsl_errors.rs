@@ -732,8 +732,10 @@ fn sixteen_bit_types_are_refused_rather_than_widened() {
         "3:37: not supported: `asuint` of 16-bit values"
     );
     assert_eq!(
-        with_flag("[shader(\"pixel\")]\nhalf4 p(half4 c : COLOR) : SV_Target { return ddx(c); }"),
-        "2:47: not supported: `ddx` of 16-bit values"
+        with_flag(
+            "[shader(\"pixel\")]\nhalf4 p(int16_t4 c : COLOR) : SV_Target { return ddx(c); }"
+        ),
+        "2:50: not supported: `ddx` of 16-bit integers"
     );
     assert_eq!(
         with_flag("[[vk::constant_id(1)]] const half k = 1;\n[numthreads(1,1,1)]\nvoid m() { }"),

@@ -86,10 +86,15 @@ impl<'a> Lowerer<'a> {
         }
         self.arity(name, args, arity, pos)?;
         let v = self.expr(&args[0])?;
-        if v.ty.scalar().is_some_and(ScalarKind::is_16) {
-            // Vulkan's derivatives are 32-bit; widening would change the type.
-            return Err(unsupported(pos, format!("`{name}` of 16-bit values")).len(len));
-        }
+        // Vulkan's derivatives are 32-bit: a 16-bit float is widened for the
+        // instruction and the result narrowed back to its type, as DXC does.
+        let narrow_to = match v.ty.scalar() {
+            Some(ScalarKind::Half) => Some(v.ty.clone()),
+            Some(s) if s.is_16() => {
+                return Err(unsupported(pos, format!("`{name}` of 16-bit integers")).len(len))
+            }
+            _ => None,
+        };
         let ty = match v.ty {
             Ty::ScalarKind(_) => Ty::ScalarKind(ScalarKind::Float),
             Ty::Vec(_, n) => Ty::Vec(ScalarKind::Float, n),
@@ -109,7 +114,10 @@ impl<'a> Lowerer<'a> {
         }
         let tid = self.ty_id(&ty)?;
         let id = self.inst(op, Some(tid), vec![Operand::IdRef(v.id)])?;
-        Ok(Val { id, ty })
+        match narrow_to {
+            Some(t) => self.convert(Val { id, ty }, &t, pos, true),
+            None => Ok(Val { id, ty }),
+        }
     }
 
     pub(super) fn glsl(&mut self, inst: G, ty: &Ty, args: &[Id]) -> Result<Val> {
