@@ -237,7 +237,7 @@ fn program_sees_hlsl_declaration_positions() {
 }
 
 /// Shaders written for DXC's `-enable-16bit-types`.
-const SIXTEEN_BIT: &[&str] = &["half.hlsl", "exec_half.hlsl"];
+const SIXTEEN_BIT: &[&str] = &["half.hlsl", "exec_half.hlsl", "half_spec.hlsl"];
 
 /// Every shader under tests/hlsl/ (the executed ones too) validates, per
 /// entry point and as a whole file.
@@ -1604,4 +1604,55 @@ fn ext_decorate_on_variables_and_parameters() {
         .iter()
         .any(|(op, ops)| *op == 55 && x.contains(&ops[1])));
     assert_eq!(decorations("x"), [0]);
+}
+
+/// 16-bit specialization constants: `OpSpecConstant` (50) of `half` and of
+/// 16-bit integers, the default's bits in the low half of the literal word
+/// (sign-extended for `int16_t`), each with its `SpecId` (1).
+#[test]
+fn sixteen_bit_specialization_constants() {
+    let opts = HlslOptions {
+        enable_16bit_types: true,
+        ..Default::default()
+    };
+    let m = hlsl::compile(&shader("half_spec.hlsl"), &opts).unwrap_or_else(|e| panic!("{e}"));
+    let words = &m[0].words;
+    validate(words, "half_spec.hlsl-Main");
+    let insts = instructions(words);
+    let spec = |name: &str| -> (u32, u32) {
+        let id = named(words, name)[0];
+        let value = insts
+            .iter()
+            .find(|(op, ops)| *op == 50 && ops[1] == id)
+            .map(|(_, ops)| ops[2])
+            .unwrap();
+        let spec_id = insts
+            .iter()
+            .find(|(op, ops)| *op == 71 && ops[0] == id && ops[1] == 1)
+            .map(|(_, ops)| ops[2])
+            .unwrap();
+        (spec_id, value)
+    };
+    // 1.5 as a half is 0x3e00.
+    assert_eq!(spec("kGain"), (7, 0x3e00));
+    assert_eq!(spec("kBias"), (8, 0xffff_fffe));
+    assert_eq!(spec("kCount"), (9, 40000));
+    // The constants' types are 16 bits wide: OpTypeFloat (22) 16 and
+    // OpTypeInt (21) 16, signed and unsigned.
+    let type_of = |name: &str| {
+        let id = named(words, name)[0];
+        let t = insts
+            .iter()
+            .find(|(op, ops)| *op == 50 && ops[1] == id)
+            .map(|(_, ops)| ops[0])
+            .unwrap();
+        insts
+            .iter()
+            .find(|(op, ops)| (*op == 21 || *op == 22) && ops[0] == t)
+            .map(|(op, ops)| (*op, ops[1..].to_vec()))
+            .unwrap()
+    };
+    assert_eq!(type_of("kGain"), (22, vec![16]));
+    assert_eq!(type_of("kBias"), (21, vec![16, 1]));
+    assert_eq!(type_of("kCount"), (21, vec![16, 0]));
 }

@@ -1374,9 +1374,6 @@ impl<'a> Lowerer<'a> {
                 ))
             }
         };
-        if s.is_16() {
-            return Err(unsupported(v.pos, "16-bit specialization constants"));
-        }
         let tid = self.sc_id(*s);
         let id = match s {
             ScalarKind::Bool if default.as_f64() != 0.0 => self.b.spec_constant_true(tid),
@@ -1384,6 +1381,12 @@ impl<'a> Lowerer<'a> {
             ScalarKind::Float => self
                 .b
                 .spec_constant_bit32(tid, (default.as_f64() as f32).to_bits()),
+            // A 16-bit literal is one word: the value in its low bits,
+            // zero-extended (floats, unsigned) or sign-extended (signed).
+            ScalarKind::Half => self.b.spec_constant_bit32(
+                tid,
+                super::consts::f32_to_f16(default.as_f64() as f32) as u32,
+            ),
             _ => {
                 let i = match default {
                     ConstValue::I(i) => i,
@@ -1391,6 +1394,10 @@ impl<'a> Lowerer<'a> {
                 };
                 if s.is_64() {
                     self.b.spec_constant_bit64(tid, i as u64)
+                } else if *s == ScalarKind::Int16 {
+                    self.b.spec_constant_bit32(tid, i as i16 as i32 as u32)
+                } else if *s == ScalarKind::Uint16 {
+                    self.b.spec_constant_bit32(tid, i as u16 as u32)
                 } else {
                     self.b.spec_constant_bit32(tid, i as u32)
                 }
