@@ -23,7 +23,11 @@ fn validate_with(words: &[u32], what: &str, extra: &[&str]) {
 
 /// Shaders using SPIR-V newer than Debian bookworm's spirv-val (2023.1)
 /// knows: ray-tracing position fetch, shader invocation reorder.
-const NEEDS_NEW_VALIDATOR: &[&str] = &["position_fetch.hlsl", "ser.hlsl"];
+const NEEDS_NEW_VALIDATOR: &[&str] = &[
+    "position_fetch.hlsl",
+    "exec_position_fetch.hlsl",
+    "ser.hlsl",
+];
 
 /// Validates a module that needs a spirv-val of 2024 or later
 /// (`rtlint_testkit::new_spirv_val`), under the skip policy.

@@ -519,7 +519,13 @@ const NOT_RUN: &[(&str, &str)] = &[
     ),
     (
         "position_fetch.hlsl",
-        "needs VK_KHR_ray_tracing_position_fetch, which lavapipe lacks",
+        "checked for its built-in, capability and extension by tests/hlsl_compile.rs; \
+         tests/hlsl_exec.rs runs exec_position_fetch.hlsl against hand-computed values",
+    ),
+    (
+        "exec_position_fetch.hlsl",
+        "tests/hlsl_exec.rs runs it against hand-computed values (face normal, weighted \
+         sum of the vertex positions) on drivers with VK_KHR_ray_tracing_position_fetch",
     ),
     (
         "records.hlsl",

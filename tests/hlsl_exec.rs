@@ -851,3 +851,102 @@ fn sixteen_bit_differential_against_slang() {
         "rtlint and Slang disagree on 16-bit arithmetic"
     );
 }
+
+/// The hit triangle's vertex positions through DXC's inline-SPIR-V built-in
+/// (`VK_KHR_ray_tracing_position_fetch`), read from a structure built with
+/// data access allowed: the face normal and a weighted sum of the positions
+/// that any permutation or zeroed vertex would change.
+#[test]
+fn position_fetch_on_the_driver() {
+    let Some(ctx) = common::device() else {
+        return;
+    };
+    if !ctx.info().position_fetch {
+        // An optional extension (lavapipe has it since Mesa 25.0): the
+        // compile test still validates the module.
+        println!(
+            "position fetch not run: {} lacks VK_KHR_ray_tracing_position_fetch",
+            ctx.info().name
+        );
+        return;
+    }
+    let words = compile_whole("exec_position_fetch.hlsl");
+    let stages = one_module(
+        &words,
+        &[
+            ("Gen", Stage::RayGeneration),
+            ("Miss", Stage::Miss),
+            ("FaceNormal", Stage::ClosestHit),
+        ],
+    );
+    let groups = [
+        Group::General(0),
+        Group::General(1),
+        Group::Triangles {
+            closest_hit: Some(2),
+            any_hit: None,
+        },
+    ];
+    let v = [[-0.9f32, -0.9, 1.0], [0.9, -0.9, 1.5], [-0.9, 0.9, 1.0]];
+    let blas = AccelerationStructure::bottom_level_readable(
+        &ctx,
+        &[Geometry::Triangles {
+            positions: &v,
+            indices: &[0, 1, 2],
+            opaque: true,
+        }],
+    )
+    .unwrap();
+    let tlas = AccelerationStructure::top_level(&ctx, &[Instance::identity(&blas)]).unwrap();
+    let out = storage(&ctx, 16 * 16);
+    let (layout, resources) = bindings(&[
+        (
+            BindingKind::AccelerationStructure,
+            Resource::AccelerationStructure(&tlas),
+        ),
+        (BindingKind::StorageBuffer, Resource::Buffer(&out)),
+    ]);
+    let pipeline = RayTracingPipeline::new(
+        &ctx,
+        &RayTracingPipelineDesc {
+            stages: &stages,
+            groups: &groups,
+            max_recursion_depth: 1,
+            bindings: &layout,
+            push_constant_size: 0,
+            stack_size: None,
+        },
+    )
+    .unwrap_or_else(|e| panic!("pipeline: {e}"));
+    pipeline
+        .trace_rays(&resources, 4, 4, 1)
+        .unwrap_or_else(|e| panic!("trace: {e}"));
+    let got = read4(&out.read(), 16);
+    let sub = |a: [f32; 3], b: [f32; 3]| [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
+    let (e1, e2) = (sub(v[1], v[0]), sub(v[2], v[0]));
+    let n = [
+        e1[1] * e2[2] - e1[2] * e2[1],
+        e1[2] * e2[0] - e1[0] * e2[2],
+        e1[0] * e2[1] - e1[1] * e2[0],
+    ];
+    let len = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+    let s: Vec<f32> = (0..3)
+        .map(|k| v[0][k] + 2.0 * v[1][k] + 3.0 * v[2][k])
+        .collect();
+    let hit = [
+        n[0] / len,
+        n[1] / len,
+        n[2] / len,
+        s[0] + 10.0 * s[1] + 100.0 * s[2],
+    ];
+    // The triangle covers x + y < 0 of the launch's (shifted) pixel centres.
+    compare(&got, |x, y| {
+        let (px, py) = pixel(x, y);
+        if px + py < 0.0 {
+            hit
+        } else {
+            [-1.0; 4]
+        }
+    });
+    assert!(got.iter().any(|g| g[3] != -1.0) && got.iter().any(|g| g[3] == -1.0));
+}

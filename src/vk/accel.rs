@@ -115,6 +115,36 @@ impl AccelerationStructure {
 
     /// Builds a bottom-level structure from one or more geometries.
     pub fn bottom_level(ctx: &Context, geometries: &[Geometry<'_>]) -> Result<Self> {
+        Self::bottom_level_with(
+            ctx,
+            geometries,
+            vk::BuildAccelerationStructureFlagsKHR::empty(),
+        )
+    }
+
+    /// Builds a bottom-level structure whose triangles' vertex positions hit
+    /// shaders may read (`ALLOW_DATA_ACCESS`, for ray-tracing position fetch).
+    /// Fails on a device without `VK_KHR_ray_tracing_position_fetch`, where
+    /// the flag is invalid.
+    pub fn bottom_level_readable(ctx: &Context, geometries: &[Geometry<'_>]) -> Result<Self> {
+        if !ctx.info().position_fetch {
+            return Err(Error::Invalid(format!(
+                "{} lacks VK_KHR_ray_tracing_position_fetch",
+                ctx.info().name
+            )));
+        }
+        Self::bottom_level_with(
+            ctx,
+            geometries,
+            vk::BuildAccelerationStructureFlagsKHR::ALLOW_DATA_ACCESS,
+        )
+    }
+
+    fn bottom_level_with(
+        ctx: &Context,
+        geometries: &[Geometry<'_>],
+        flags: vk::BuildAccelerationStructureFlagsKHR,
+    ) -> Result<Self> {
         if geometries.is_empty() {
             return Err(Error::Invalid(
                 "a bottom-level structure needs a geometry".into(),
@@ -199,6 +229,7 @@ impl AccelerationStructure {
             &vk_geometries,
             &ranges,
             Vec::new(),
+            flags,
         )
     }
 
@@ -259,6 +290,7 @@ impl AccelerationStructure {
             &[geometry],
             &[instances.len() as u32],
             children,
+            vk::BuildAccelerationStructureFlagsKHR::empty(),
         );
         drop(data);
         built
@@ -299,11 +331,12 @@ fn build(
     geometries: &[vk::AccelerationStructureGeometryKHR<'_>],
     primitive_counts: &[u32],
     children: Vec<AccelerationStructure>,
+    flags: vk::BuildAccelerationStructureFlagsKHR,
 ) -> Result<AccelerationStructure> {
     let shared = &ctx.shared;
     let mut info = vk::AccelerationStructureBuildGeometryInfoKHR::default()
         .ty(level)
-        .flags(vk::BuildAccelerationStructureFlagsKHR::PREFER_FAST_TRACE)
+        .flags(vk::BuildAccelerationStructureFlagsKHR::PREFER_FAST_TRACE | flags)
         .mode(vk::BuildAccelerationStructureModeKHR::BUILD)
         .geometries(geometries);
     let mut sizes = vk::AccelerationStructureBuildSizesInfoKHR::default();

@@ -69,6 +69,9 @@ pub struct DeviceInfo {
     pub device_type: vk::PhysicalDeviceType,
     /// `VK_KHR_ray_query` was present and is enabled.
     pub ray_query: bool,
+    /// `VK_KHR_ray_tracing_position_fetch` and its `rayTracingPositionFetch`
+    /// feature were present and are enabled.
+    pub position_fetch: bool,
     /// Core features enabled because the device has them; naga's
     /// `primitive_index` needs `geometryShader`.
     pub geometry_shader: bool,
@@ -434,12 +437,17 @@ fn examine(
     let mut f13 = vk::PhysicalDeviceVulkan13Features::default();
     let mut fas = vk::PhysicalDeviceAccelerationStructureFeaturesKHR::default();
     let mut frt = vk::PhysicalDeviceRayTracingPipelineFeaturesKHR::default();
+    let mut fpf = vk::PhysicalDeviceRayTracingPositionFetchFeaturesKHR::default();
+    let has_position_fetch = has(vk::KHR_RAY_TRACING_POSITION_FETCH_NAME);
     let mut features = vk::PhysicalDeviceFeatures2::default()
         .push_next(&mut f11)
         .push_next(&mut f12)
         .push_next(&mut f13)
         .push_next(&mut fas)
         .push_next(&mut frt);
+    if has_position_fetch {
+        features = features.push_next(&mut fpf);
+    }
     // SAFETY: the chain holds only structures of this device's version and extensions.
     unsafe { instance.get_physical_device_features2(physical, &mut features) };
     let core = features.features;
@@ -502,6 +510,7 @@ fn examine(
             vendor_id: props.vendor_id,
             device_type: props.device_type,
             ray_query,
+            position_fetch: has_position_fetch && fpf.ray_tracing_position_fetch == vk::TRUE,
             geometry_shader: core.geometry_shader == vk::TRUE,
             shader_int64: core.shader_int64 == vk::TRUE,
             sixteen_bit: f12.shader_float16 == vk::TRUE
@@ -582,6 +591,9 @@ fn create_device(instance: &ash::Instance, c: &Candidate) -> Result<ash::Device>
     if c.info.ray_query {
         extensions.push(vk::KHR_RAY_QUERY_NAME.as_ptr());
     }
+    if c.info.position_fetch {
+        extensions.push(vk::KHR_RAY_TRACING_POSITION_FETCH_NAME.as_ptr());
+    }
     let priorities = [1.0f32];
     let queues = [vk::DeviceQueueCreateInfo::default()
         .queue_family_index(c.queue_family)
@@ -630,6 +642,11 @@ fn create_device(instance: &ash::Instance, c: &Candidate) -> Result<ash::Device>
         .push_next(&mut frt);
     if c.info.ray_query {
         features = features.push_next(&mut frq);
+    }
+    let mut fpf = vk::PhysicalDeviceRayTracingPositionFetchFeaturesKHR::default()
+        .ray_tracing_position_fetch(true);
+    if c.info.position_fetch {
+        features = features.push_next(&mut fpf);
     }
     let create = vk::DeviceCreateInfo::default()
         .queue_create_infos(&queues)
