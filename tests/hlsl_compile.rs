@@ -241,7 +241,7 @@ fn program_sees_hlsl_declaration_positions() {
 }
 
 /// Shaders written for DXC's `-enable-16bit-types`.
-const SIXTEEN_BIT: &[&str] = &["half.hlsl", "exec_half.hlsl", "half_spec.hlsl"];
+const SIXTEEN_BIT: &[&str] = &["half.hlsl", "exec_half.hlsl", "spec_half.hlsl"];
 
 /// Every shader under tests/hlsl/ (the executed ones too) validates, per
 /// entry point and as a whole file.
@@ -1619,9 +1619,9 @@ fn sixteen_bit_specialization_constants() {
         enable_16bit_types: true,
         ..Default::default()
     };
-    let m = hlsl::compile(&shader("half_spec.hlsl"), &opts).unwrap_or_else(|e| panic!("{e}"));
+    let m = hlsl::compile(&shader("spec_half.hlsl"), &opts).unwrap_or_else(|e| panic!("{e}"));
     let words = &m[0].words;
-    validate(words, "half_spec.hlsl-Main");
+    validate(words, "spec_half.hlsl-Main");
     let insts = instructions(words);
     let spec = |name: &str| -> (u32, u32) {
         let id = named(words, name)[0];
