@@ -241,7 +241,12 @@ fn program_sees_hlsl_declaration_positions() {
 }
 
 /// Shaders written for DXC's `-enable-16bit-types`.
-const SIXTEEN_BIT: &[&str] = &["half.hlsl", "exec_half.hlsl", "spec_half.hlsl"];
+const SIXTEEN_BIT: &[&str] = &[
+    "half.hlsl",
+    "exec_half.hlsl",
+    "spec_half.hlsl",
+    "bits_half.hlsl",
+];
 
 /// Every shader under tests/hlsl/ (the executed ones too) validates, per
 /// entry point and as a whole file.
@@ -1659,4 +1664,36 @@ fn sixteen_bit_specialization_constants() {
     assert_eq!(type_of("kGain"), (22, vec![16]));
     assert_eq!(type_of("kBias"), (21, vec![16, 1]));
     assert_eq!(type_of("kCount"), (21, vec![16, 0]));
+}
+
+/// `countbits` of 16-bit integers: `OpBitCount` (205) of an `OpUConvert`
+/// (113) to 32 bits (zero-extended, also for `int16_t`), as DXC lowers it,
+/// never of the 16-bit value itself (tests/hlsl/bits_half.hlsl).
+#[test]
+fn countbits_of_sixteen_bit_integers_counts_the_zero_extended_value() {
+    let opts = HlslOptions {
+        enable_16bit_types: true,
+        ..Default::default()
+    };
+    let m = hlsl::compile(&shader("bits_half.hlsl"), &opts).unwrap_or_else(|e| panic!("{e}"));
+    let words = &m[0].words;
+    validate(words, "bits_half.hlsl-Main");
+    let insts = instructions(words);
+    let uconverts: Vec<u32> = insts
+        .iter()
+        .filter(|(op, _)| *op == 113)
+        .map(|(_, ops)| ops[1])
+        .collect();
+    let counts: Vec<&Vec<u32>> = insts
+        .iter()
+        .filter(|(op, _)| *op == 205)
+        .map(|(_, ops)| ops)
+        .collect();
+    assert_eq!(counts.len(), 2);
+    for c in counts {
+        assert!(
+            uconverts.contains(&c[2]),
+            "OpBitCount of a value not widened"
+        );
+    }
 }

@@ -731,6 +731,11 @@ fn sixteen_bit_types_are_refused_rather_than_widened() {
         with_flag("RWStructuredBuffer<uint> o;\n[numthreads(1,1,1)]\nvoid m() { min16float h = 1; o[0] = asuint(h); }"),
         "3:37: not supported: `asuint` of 16-bit values"
     );
+    // Like DXC, only `countbits` of the bit family takes 16-bit integers.
+    assert_eq!(
+        with_flag("RWStructuredBuffer<uint> o;\n[numthreads(1,1,1)]\nvoid m() { uint16_t u = 3; o[0] = firstbithigh(u); }"),
+        "3:35: not supported: `firstbithigh` of 16-bit values"
+    );
     assert_eq!(
         with_flag(
             "[shader(\"pixel\")]\nhalf4 p(int16_t4 c : COLOR) : SV_Target { return ddx(c); }"

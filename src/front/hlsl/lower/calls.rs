@@ -357,11 +357,13 @@ impl<'a> Lowerer<'a> {
             );
         }
         // 16-bit values: the arithmetic families, which keep their width
-        // (`f32tof16`/`f16tof32` take them exactly as `float`/`uint`).
+        // (`f32tof16`/`f16tof32` take them exactly as `float`/`uint`), and
+        // `countbits` of 16-bit integers, widened below as DXC does.
         if vals
             .iter()
             .any(|v| v.ty.scalar().is_some_and(ScalarKind::is_16))
             && matches!(m, Math::As32(_) | Math::Bits(_))
+            && !matches!(m, Math::Bits(Bit::Count))
         {
             return Err(
                 unsupported(pos, format!("`{name}` of 16-bit values")).len(name.len() as u32)
@@ -643,7 +645,17 @@ impl<'a> Lowerer<'a> {
                 self.build(&t, &mut it, pos)
             }
             Math::Bits(bit) => {
-                let v = vals.into_iter().next().unwrap_or_else(|| unreachable!());
+                let mut v = vals.into_iter().next().unwrap_or_else(|| unreachable!());
+                if matches!(v.ty.scalar(), Some(ScalarKind::Int16 | ScalarKind::Uint16))
+                    && matches!(v.ty, Ty::ScalarKind(_) | Ty::Vec(..))
+                {
+                    // Vulkan's OpBitCount is 32-bit: zero-extended first
+                    // (`OpUConvert`, whatever the signedness), as DXC does.
+                    let t = v.ty.with_scalar(ScalarKind::Uint);
+                    let tid = self.ty_id(&t)?;
+                    let id = self.op(Op::UConvert, tid, &[v.id])?;
+                    v = Val { id, ty: t };
+                }
                 let s = v.ty.scalar();
                 if !matches!(s, Some(ScalarKind::Int | ScalarKind::Uint))
                     || matches!(v.ty, Ty::Mat(..))
