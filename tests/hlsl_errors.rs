@@ -731,7 +731,7 @@ fn sixteen_bit_types_are_refused_rather_than_widened() {
         with_flag("RWStructuredBuffer<uint> o;\n[numthreads(1,1,1)]\nvoid m() { min16float h = 1; o[0] = asuint(h); }"),
         "3:37: not supported: `asuint` of 16-bit values"
     );
-    // Like DXC, only `countbits` of the bit family takes 16-bit integers.
+    // `countbits` of 16-bit integers is lowered; the other bit operations are not.
     assert_eq!(
         with_flag("RWStructuredBuffer<uint> o;\n[numthreads(1,1,1)]\nvoid m() { uint16_t u = 3; o[0] = firstbithigh(u); }"),
         "3:35: not supported: `firstbithigh` of 16-bit values"
