@@ -486,6 +486,17 @@ fn every_attribute_is_implemented_or_refused() {
         err("[[vk::image_format(\"rgba8\")]] Texture2D t;\n[numthreads(1,1,1)]\nvoid m() {}"),
         "main.hlsl:1:3: not supported: `vk::image_format` on anything but an RWTexture"
     );
+    // A capability only OpenCL kernels have (ImageBasic, 13, implies Kernel)
+    // would make the module invalid for Vulkan: refused at the number.
+    assert_eq!(
+        err("[[vk::ext_capability(13)]]\n[numthreads(1,1,1)]\nvoid m() {}"),
+        "main.hlsl:1:22: capability `ImageBasic` (13) is for OpenCL kernels (it implies `Kernel`), which Vulkan does not allow"
+    );
+    // An instruction set spirv-val does not know is refused at its name.
+    assert_eq!(
+        err("[[vk::ext_instruction(1, \"MySet.1\")]]\nvoid f();\n[numthreads(1,1,1)]\nvoid m() { f(); }"),
+        "main.hlsl:1:26: not supported: extended instruction set \"MySet.1\""
+    );
     // Inline-SPIR-V decorations on members, variables and parameters; a
     // declaration that becomes no variable of its own refuses them.
     assert_eq!(

@@ -348,6 +348,27 @@ fn builtin_constant(name: &str) -> Option<u32> {
     })
 }
 
+/// The OpenCL-only capability (`Kernel`, `Addresses`, `Linkage`) that `c` is
+/// or implicitly declares, by the SPIR-V grammar rspirv carries: a module
+/// declaring it fails Vulkan validation, so it is refused where written.
+fn kernel_only(c: Capability) -> Option<Capability> {
+    let mut todo = vec![c];
+    let mut seen = Vec::new();
+    while let Some(c) = todo.pop() {
+        if matches!(
+            c,
+            Capability::Kernel | Capability::Addresses | Capability::Linkage
+        ) {
+            return Some(c);
+        }
+        if !seen.contains(&c) {
+            seen.push(c);
+            todo.extend(Operand::Capability(c).required_capabilities());
+        }
+    }
+    None
+}
+
 fn swizzle_comps(s: &str) -> Option<Vec<u32>> {
     if s.is_empty() || s.len() > 4 {
         return None;
@@ -593,6 +614,15 @@ impl<'a> Lowerer<'a> {
                         .ok_or_else(|| {
                             Error::new(e.pos, format!("unknown SPIR-V capability {n}"))
                         })?;
+                    if let Some(base) = kernel_only(c) {
+                        return Err(Error::new(
+                            e.pos,
+                            format!(
+                                "capability `{c:?}` ({n}) is for OpenCL kernels (it implies `{base:?}`), \
+                                 which Vulkan does not allow"
+                            ),
+                        ));
+                    }
                     req.1.push(c);
                 }
                 _ => {}

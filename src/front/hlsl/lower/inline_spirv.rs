@@ -104,6 +104,22 @@ impl<'a> Lowerer<'a> {
     }
 }
 
+/// Extended instruction sets a Vulkan module may import: GLSL.std.450, the
+/// debug-info sets, AMD's, and any non-semantic one (`NonSemantic.*`).
+fn known_instruction_set(name: &str) -> bool {
+    name.starts_with("NonSemantic.")
+        || matches!(
+            name,
+            "GLSL.std.450"
+                | "DebugInfo"
+                | "OpenCL.DebugInfo.100"
+                | "SPV_AMD_shader_ballot"
+                | "SPV_AMD_shader_explicit_vertex_parameter"
+                | "SPV_AMD_gcn_shader"
+                | "SPV_AMD_shader_trinary_minmax"
+        )
+}
+
 /// A decoration's literal operands as rspirv operands (a `BuiltIn` typed,
 /// so the module disassembles by name).
 pub(super) fn decoration_operands(d: Decoration, ops: Vec<u32>) -> Vec<Operand> {
@@ -155,6 +171,13 @@ impl<'a> Lowerer<'a> {
         let (op_e, set) = match &a.args[..] {
             [o] => (o, None),
             [o, s] => match &s.kind {
+                // A set spirv-val does not know makes the module invalid.
+                ExprKind::Str(name) if !known_instruction_set(name) => {
+                    return Err(unsupported(
+                        s.pos,
+                        format!("extended instruction set \"{name}\""),
+                    ))
+                }
                 ExprKind::Str(s) => (o, Some(s.clone())),
                 _ => return Err(expected()),
             },
