@@ -769,6 +769,9 @@ impl Builder<'_> {
             }
             Op::TypeAccelerationStructureKHR => Some(Type::AccelerationStructure),
             Op::TypeRayQueryKHR => Some(Type::RayQuery),
+            // Shader execution reordering's hit object (HLSL `dx::HitObject`),
+            // opaque like a ray query; pointers to it are Function locals.
+            Op::TypeHitObjectNV | Op::TypeHitObjectEXT => Some(Type::Other("hit object")),
             Op::TypeImage => Some(Type::Image),
             Op::TypeSampler => Some(Type::Sampler),
             Op::TypeSampledImage => Some(Type::SampledImage),
