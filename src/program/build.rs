@@ -749,7 +749,7 @@ impl Builder<'_> {
                     _ => return Err(self.at(i, "pointer type without a storage class")),
                 };
                 // Not checked against the types read so far: pointees may be
-                // types this reader does not model (`OpTypeHitObjectNV`). But
+                // types this reader does not model (a new extension's). But
                 // never the pointer itself (a forward-declared pointer could
                 // be): naming it recursed without end.
                 let pointee =
