@@ -46,6 +46,25 @@ fn time<F: FnMut()>(iters: usize, mut f: F) -> Duration {
     )
 }
 
+/// The median time of `f` on a fresh `setup()` each time, neither the
+/// setup nor dropping its result timed (subtracting a separately timed
+/// setup left mostly noise when the setup takes ten times as long as `f`).
+fn time_fresh<T, S: FnMut() -> T, F: FnMut(&T)>(iters: usize, mut setup: S, mut f: F) -> Duration {
+    f(&setup()); // warm
+    median(
+        (0..iters.max(1))
+            .map(|_| {
+                let input = setup();
+                let t = Instant::now();
+                f(&input);
+                let elapsed = t.elapsed();
+                drop(input);
+                elapsed
+            })
+            .collect(),
+    )
+}
+
 fn ms(d: Duration) -> f64 {
     d.as_secs_f64() * 1e3
 }
@@ -356,11 +375,13 @@ fn main() {
         });
         // On a fresh Program each time: a Program keeps what its analyses
         // computed (live sites), so a second run of the rules is cheaper.
-        let rules = time(iters, || {
-            let program = rtlint::front::load(f, Language::Wgsl).unwrap();
-            std::hint::black_box(rtlint::rules::check_program(&program, &config));
-        })
-        .saturating_sub(loaded);
+        let rules = time_fresh(
+            iters,
+            || rtlint::front::load(f, Language::Wgsl).unwrap(),
+            |program| {
+                std::hint::black_box(rtlint::rules::check_program(program, &config));
+            },
+        );
         for (k, d) in [ours, naga_floor, compiled, loaded, rules]
             .into_iter()
             .enumerate()
@@ -410,14 +431,13 @@ fn main() {
         };
         // On freshly loaded Programs: a Program keeps its live sites once
         // computed, so a second stack report of the same one costs less.
-        let load = time(iters * 2, || {
-            std::hint::black_box(rtlint::pipeline::load(p).unwrap());
-        });
-        let model = time(iters * 2, || {
-            let fresh = rtlint::pipeline::load(p).unwrap();
-            std::hint::black_box(rtlint::analysis::stack_report(&fresh));
-        })
-        .saturating_sub(load);
+        let model = time_fresh(
+            iters * 2,
+            || rtlint::pipeline::load(p).unwrap(),
+            |fresh| {
+                std::hint::black_box(rtlint::analysis::stack_report(fresh));
+            },
+        );
         model_total += model;
         model_each.push(ms(model));
         #[cfg(feature = "vulkan")]

@@ -14,6 +14,7 @@
 //! caller's live values live across it too, so each site is expanded along
 //! each call chain from an entry point.
 
+use super::bitset::BitSet;
 use crate::diag::Location;
 use crate::program::cfg::call_chains;
 use crate::program::scalar::scalar_size;
@@ -21,7 +22,13 @@ use crate::program::{Constant, Function, Id, Program, SiteKind, Type};
 use crate::shader::Stage;
 use rspirv::dr::{Instruction, Operand};
 use spirv::{Op, StorageClass};
-use std::collections::{HashMap, HashSet, VecDeque};
+use std::cell::RefCell;
+use std::collections::VecDeque;
+
+// Ids and small paths hash far faster with Fx than with SipHash, and no
+// input here is adversarial to a hash table (a module's ids are its own).
+type HashMap<K, V> = rustc_hash::FxHashMap<K, V>;
+type HashSet<T> = rustc_hash::FxHashSet<T>;
 use std::path::PathBuf;
 
 /// What suspends the shader.
@@ -123,16 +130,29 @@ pub(crate) const MAX_CHAINS: usize = 64;
 /// The sites of one program with the values live across each (computed
 /// once per Program: RT010 and the stack model both ask).
 pub fn live_sites(program: &Program) -> Vec<LiveSite> {
-    struct Sites(Vec<LiveSite>);
+    shared_live_sites(program).to_vec()
+}
+
+/// [`live_sites`] without copying them out of the Program's memo.
+pub(crate) fn shared_live_sites(program: &Program) -> std::sync::Arc<LiveSites> {
     program
         .memo
-        .get_or(|| Sites(compute_live_sites(program)))
-        .0
-        .clone()
+        .get_or(|| LiveSites(compute_live_sites(program)))
+}
+
+/// The live sites a Program keeps once computed.
+pub(crate) struct LiveSites(Vec<LiveSite>);
+
+impl std::ops::Deref for LiveSites {
+    type Target = [LiveSite];
+    fn deref(&self) -> &[LiveSite] {
+        &self.0
+    }
 }
 
 fn compute_live_sites(program: &Program) -> Vec<LiveSite> {
-    let mut cache: HashMap<usize, FnLiveness> = HashMap::new();
+    let mut cache: HashMap<usize, FnLiveness> = HashMap::default();
+    let mut shared = Shared::default();
     let mut out = Vec::new();
     for site in &program.sites {
         let kind = match site.kind {
@@ -150,7 +170,7 @@ fn compute_live_sites(program: &Program) -> Vec<LiveSite> {
                 let mut points = vec![site.inst];
                 points.extend(chain.iter().rev().copied());
                 let mut values: Vec<LiveValue> = Vec::new();
-                let mut seen: HashSet<Id> = HashSet::new();
+                let mut seen: HashSet<Id> = HashSet::default();
                 // Parts behind the previous level's pointer parameters that
                 // it still needs after the site: the caller's memory, counted
                 // where the caller passes it.
@@ -161,7 +181,7 @@ fn compute_live_sites(program: &Program) -> Vec<LiveSite> {
                     };
                     let fl = cache
                         .entry(fi)
-                        .or_insert_with(|| FnLiveness::new(program, fi));
+                        .or_insert_with(|| FnLiveness::shared(program, fi, &mut shared));
                     let extra = fl.arguments_of(program, p, &carried);
                     for v in fl.live_across(program, p, &extra) {
                         if seen.insert(v.id) {
@@ -255,6 +275,52 @@ fn pointee(program: &Program, ptr_ty: Id) -> Option<Id> {
     }
 }
 
+/// Whether a value of type `ty` points at memory whose parts liveness
+/// tracks (any pointer but a `PhysicalStorageBuffer` address).
+fn is_pointer_type(program: &Program, ty: Option<Id>) -> bool {
+    matches!(
+        ty.and_then(|t| program.ty(t)),
+        Some(Type::Pointer { storage, .. }) if *storage != StorageClass::PhysicalStorageBuffer
+    )
+}
+
+/// Whether function parameter `id` is tracked like a variable.
+fn is_pointer_param(program: &Program, id: Id) -> bool {
+    program.def(id).is_some_and(|inst| {
+        inst.class.opcode == Op::FunctionParameter
+            && !program.is_debug_inst(inst)
+            && is_pointer_type(program, inst.result_type)
+    })
+}
+
+/// Whether `op` is an atomic, ray-query, group or subgroup operation: one
+/// that does not give the same value when done again. (By name, without
+/// allocating: this is asked for every value whose recomputation is weighed.)
+fn varies(op: Op) -> bool {
+    struct Name([u8; 64], usize);
+    impl std::fmt::Write for Name {
+        fn write_str(&mut self, s: &str) -> std::fmt::Result {
+            let room = self.0.len() - self.1;
+            let n = s.len().min(room);
+            self.0[self.1..self.1 + n].copy_from_slice(&s.as_bytes()[..n]);
+            self.1 += n;
+            Ok(())
+        }
+    }
+    let mut name = Name([0; 64], 0);
+    let _ = std::fmt::Write::write_fmt(&mut name, format_args!("{op:?}"));
+    let name = &name.0[..name.1];
+    [
+        &b"Atomic"[..],
+        b"RayQuery",
+        b"GroupNonUniform",
+        b"Subgroup",
+        b"Group",
+    ]
+    .iter()
+    .any(|p| name.starts_with(p))
+}
+
 /// A name for a value: its `OpName`, the variable it was loaded from, or the
 /// `let`/`var` the source line at its definition declares (naga names no
 /// `let` bindings in SPIR-V); else `%id`.
@@ -308,6 +374,120 @@ fn id_operands(inst: &Instruction) -> impl Iterator<Item = Id> + '_ {
 /// reach it from the variable (empty: all of it).
 type Place = (Id, Vec<u32>);
 
+/// The places one function's liveness has met, each with a dense index:
+/// a live set is a [`BitSet`] of indices.
+#[derive(Debug, Default)]
+struct Places {
+    list: Vec<Place>,
+    /// The whole-id place of each id from `lo` on (SSA values, whole
+    /// variables): most places, found without hashing.
+    whole: Vec<u32>,
+    lo: Id,
+    /// Places of other ids, and all parts below a variable: by id and hash
+    /// of the path, `next` chaining the others with the same key (a
+    /// variable split into its elements has many parts).
+    first: HashMap<(Id, u64), u32>,
+    next: Vec<u32>,
+    /// Each id's parts (non-empty paths), by index.
+    parts: HashMap<Id, Vec<u32>>,
+}
+
+impl Places {
+    const NONE: u32 = u32::MAX;
+
+    /// For the ids `lo..=hi` defined in one function.
+    fn new(lo: Id, hi: Id) -> Places {
+        let n = hi.saturating_sub(lo) as usize + 1;
+        Places {
+            // A module with huge, sparse ids falls back to hashing.
+            whole: if n <= 1 << 20 {
+                vec![Self::NONE; n]
+            } else {
+                Vec::new()
+            },
+            lo,
+            ..Places::default()
+        }
+    }
+
+    fn path_hash(path: &[u32]) -> u64 {
+        use std::hash::{BuildHasher, BuildHasherDefault};
+        BuildHasherDefault::<rustc_hash::FxHasher>::default().hash_one(path)
+    }
+
+    fn slot(&self, id: Id) -> Option<usize> {
+        let k = id.checked_sub(self.lo)? as usize;
+        (k < self.whole.len()).then_some(k)
+    }
+
+    fn find(&self, mut i: u32, path: &[u32]) -> Option<u32> {
+        while i != Self::NONE {
+            if self.list[i as usize].1.as_slice() == path {
+                return Some(i);
+            }
+            i = self.next[i as usize];
+        }
+        None
+    }
+
+    /// The index of place `(id, path)`, added when new.
+    fn intern(&mut self, id: Id, path: &[u32]) -> u32 {
+        let slot = if path.is_empty() { self.slot(id) } else { None };
+        if let Some(k) = slot {
+            if self.whole[k] != Self::NONE {
+                return self.whole[k];
+            }
+        }
+        let key = (id, Self::path_hash(path));
+        let old = match slot {
+            Some(_) => Self::NONE,
+            None => self.first.get(&key).copied().unwrap_or(Self::NONE),
+        };
+        if let Some(i) = self.find(old, path) {
+            return i;
+        }
+        let i = self.list.len() as u32;
+        self.list.push((id, path.to_vec()));
+        self.next.push(old);
+        match slot {
+            Some(k) => self.whole[k] = i,
+            // In front of the chain.
+            None => {
+                self.first.insert(key, i);
+            }
+        }
+        if !path.is_empty() {
+            self.parts.entry(id).or_default().push(i);
+        }
+        i
+    }
+
+    /// The index of place `(id, path)`, if met.
+    fn get(&self, id: Id, path: &[u32]) -> Option<u32> {
+        if path.is_empty() {
+            if let Some(k) = self.slot(id) {
+                return Some(self.whole[k]).filter(|&i| i != Self::NONE);
+            }
+        }
+        self.find(*self.first.get(&(id, Self::path_hash(path)))?, path)
+    }
+
+    /// Every place of `id` met so far (the whole, then its parts), by index.
+    fn of(&self, id: Id) -> impl Iterator<Item = u32> + '_ {
+        self.get(id, &[]).into_iter().chain(
+            self.parts
+                .get(&id)
+                .map_or(&[][..], Vec::as_slice)
+                .iter()
+                .copied(),
+        )
+    }
+
+    fn place(&self, i: u32) -> &Place {
+        &self.list[i as usize]
+    }
+}
+
 /// A pointer into a function-local variable.
 #[derive(Clone, Debug)]
 struct LocalPtr {
@@ -329,6 +509,40 @@ struct ParamEffect {
 
 /// Per parameter of a function.
 type ExposedParams = Vec<ParamEffect>;
+
+/// What the functions of one program share while their liveness is built:
+/// answers that depend on nothing but the function (see
+/// [`FnLiveness::exposed_params`]), so each function is solved once
+/// instead of once per caller that reaches it.
+#[derive(Default)]
+struct Shared {
+    exposed: HashMap<usize, ExposedParams>,
+    /// Callees solved exactly on the way, for their own sites.
+    built: HashMap<usize, FnLiveness>,
+}
+
+/// One top-level build: every answer met on the way, exact or not, and
+/// the program's shared exact ones.
+#[derive(Default)]
+struct Builds {
+    memo: HashMap<usize, (ExposedParams, bool)>,
+    shared: Shared,
+}
+
+/// One instruction's backward transfer, prepared before solving.
+#[derive(Clone, Debug)]
+enum Step {
+    /// Debug info: reads and writes nothing.
+    Skip,
+    /// Kills place `def` (or none: [`Places::NONE`]), then makes the places
+    /// `FnLiveness::step_uses[uses]` live.
+    Plain {
+        def: u32,
+        uses: std::ops::Range<u32>,
+    },
+    /// Stores, copies, calls and variables: worked out each time.
+    Other,
+}
 
 /// Parts are tracked separately up to this many elements per composite.
 const MAX_SPLIT: u32 = 64;
@@ -352,38 +566,82 @@ pub struct FnLiveness {
     copy_loads: HashSet<usize>,
     /// SSA values that count as state: defined here, not pointers to locals.
     ssa: HashSet<Id>,
-    live_out: Vec<HashSet<Place>>,
+    /// Live places at each block's end, as indices into `places`.
+    live_out: Vec<BitSet>,
+    /// Every place met while solving (the live sets' members).
+    places: RefCell<Places>,
     /// Variables possibly written at each block's end.
-    defined_out: Vec<HashSet<Id>>,
+    /// (As indices into `written`.)
+    defined_out: Vec<BitSet>,
+    /// The roots something in the function writes, indexed for `defined_out`.
+    written: Vec<Id>,
     preds: Vec<Vec<usize>>,
     remat: HashMap<Id, bool>,
     /// Variables' rematerialisation as read at an instruction.
     remat_at: HashMap<(Id, usize, Vec<Vec<u32>>), bool>,
+    /// Each instruction's backward transfer (from the function's start).
+    steps: Vec<Step>,
+    /// The places `Step::Plain` reads.
+    step_uses: Vec<u32>,
+    /// The instructions that define or use each variable, in order (built
+    /// on first use).
+    mentions: Option<HashMap<Id, Vec<usize>>>,
 }
 
 impl FnLiveness {
     pub fn new(program: &Program, func: usize) -> FnLiveness {
-        Self::build(program, func, &mut HashMap::new(), 0)
+        Self::build(program, func, &mut Builds::default(), 0).0
+    }
+
+    /// The liveness of function `func`, built once per program: taken from
+    /// `shared` when a callee's build already made it exactly, else built
+    /// as [`FnLiveness::new`] would.
+    fn shared(program: &Program, func: usize, shared: &mut Shared) -> FnLiveness {
+        if let Some(fl) = shared.built.remove(&func) {
+            return fl;
+        }
+        let mut builds = Builds {
+            memo: HashMap::default(),
+            shared: std::mem::take(shared),
+        };
+        let (fl, _) = Self::build(program, func, &mut builds, 0);
+        *shared = builds.shared;
+        fl
     }
 
     /// The parts of each pointer parameter of function `func` that it may
     /// read before writing them (`None`: not a pointer, or not known).
+    ///
+    /// The second value says whether the answer is exact: no call below
+    /// was cut off by depth or met while its own answer was in progress
+    /// (only then may another build reuse it).
     fn exposed_params(
         program: &Program,
         func: usize,
-        memo: &mut HashMap<usize, ExposedParams>,
+        builds: &mut Builds,
         depth: u32,
-    ) -> ExposedParams {
-        if let Some(e) = memo.get(&func) {
-            return e.clone();
+    ) -> (ExposedParams, bool) {
+        if let Some((e, exact)) = builds.memo.get(&func) {
+            return (e.clone(), *exact);
+        }
+        if let Some(e) = builds.shared.exposed.get(&func) {
+            builds.memo.insert(func, (e.clone(), true));
+            return (e.clone(), true);
         }
         let f = &program.functions[func];
         let unknown: ExposedParams = vec![ParamEffect::default(); f.params.len()];
-        if depth > 16 {
-            return unknown;
+        // Without pointer parameters a callee reads and writes nothing of
+        // its caller's: no need to solve it for that.
+        if !f.params.iter().any(|&p| is_pointer_param(program, p)) {
+            builds.memo.insert(func, (unknown.clone(), true));
+            builds.shared.exposed.insert(func, unknown.clone());
+            return (unknown, true);
         }
-        memo.insert(func, unknown);
-        let fl = Self::build(program, func, memo, depth + 1);
+        if depth > 16 {
+            return (unknown, false);
+        }
+        builds.memo.insert(func, (unknown, false));
+        let (fl, exact) = Self::build(program, func, builds, depth + 1);
         let entry = f.blocks.first().map(|b| b.start);
         let live = entry
             .map(|i| fl.places_after(program, i))
@@ -406,8 +664,12 @@ impl FnLiveness {
                 }
             })
             .collect();
-        memo.insert(func, exposed.clone());
-        exposed
+        builds.memo.insert(func, (exposed.clone(), exact));
+        if exact {
+            builds.shared.exposed.insert(func, exposed.clone());
+            builds.shared.built.insert(func, fl);
+        }
+        (exposed, exact)
     }
 
     /// The parts of pointer parameter (or variable) `var` that every path
@@ -455,8 +717,11 @@ impl FnLiveness {
             changed = false;
             rounds += 1;
             for b in 0..n {
-                let mut inset: Option<HashSet<Vec<u32>>> =
-                    if b == 0 { Some(HashSet::new()) } else { None };
+                let mut inset: Option<HashSet<Vec<u32>>> = if b == 0 {
+                    Some(HashSet::default())
+                } else {
+                    None
+                };
                 for &p in &self.preds[b] {
                     if let Some(o) = &out[p] {
                         inset = Some(match inset {
@@ -492,16 +757,19 @@ impl FnLiveness {
         v
     }
 
+    /// The liveness of `func`, and whether every callee's answer it used
+    /// was exact.
     fn build(
         program: &Program,
         func: usize,
-        memo: &mut HashMap<usize, ExposedParams>,
+        builds: &mut Builds,
         depth: u32,
-    ) -> FnLiveness {
+    ) -> (FnLiveness, bool) {
         let f = &program.functions[func];
-        let mut vars = HashSet::new();
-        let mut roots: HashMap<Id, LocalPtr> = HashMap::new();
-        let mut ssa = HashSet::new();
+        let mut vars = HashSet::default();
+        let mut roots: HashMap<Id, LocalPtr> = HashMap::default();
+        // Most results are SSA values: sized once, not grown step by step.
+        let mut ssa = HashSet::with_capacity_and_hasher(f.end + 1 - f.start, Default::default());
         for inst in &program.insts[f.start..=f.end] {
             let Some(r) = inst.result_id else { continue };
             if program.is_debug_inst(inst) {
@@ -510,13 +778,7 @@ impl FnLiveness {
             match inst.class.opcode {
                 // A pointer parameter is tracked like a variable (its
                 // contents belong to the caller, which counts them).
-                Op::FunctionParameter
-                    if matches!(
-                        inst.result_type.and_then(|t| program.ty(t)),
-                        Some(Type::Pointer { storage, .. })
-                            if *storage != StorageClass::PhysicalStorageBuffer
-                    ) =>
-                {
+                Op::FunctionParameter if is_pointer_type(program, inst.result_type) => {
                     roots.insert(
                         r,
                         LocalPtr {
@@ -586,26 +848,18 @@ impl FnLiveness {
         }
         // Copies from one local part to another: `%v = OpLoad %a; OpStore %b %v`
         // with `%v` used nowhere else and nothing between the two.
-        let mut uses: HashMap<Id, usize> = HashMap::new();
-        for inst in &program.insts[f.start..=f.end] {
-            if program.is_debug_inst(inst) {
-                continue;
-            }
-            for id in id_operands(inst) {
-                *uses.entry(id).or_default() += 1;
-            }
-        }
-        let mut copies = HashMap::new();
+        // Candidates first; then the uses of their loaded values only.
+        let mut candidates: Vec<(usize, usize, Id)> = Vec::new();
         for block in &f.blocks {
-            let body: Vec<usize> = (block.start..=block.end)
-                .filter(|&i| {
-                    let inst = &program.insts[i];
-                    !program.is_debug_inst(inst)
-                        && !matches!(inst.class.opcode, Op::Line | Op::NoLine)
-                })
-                .collect();
-            for w in body.windows(2) {
-                let (load, store) = (&program.insts[w[0]], &program.insts[w[1]]);
+            let mut prev: Option<usize> = None;
+            for i in block.start..=block.end {
+                let inst = &program.insts[i];
+                if program.is_debug_inst(inst) || matches!(inst.class.opcode, Op::Line | Op::NoLine)
+                {
+                    continue;
+                }
+                let Some(l) = prev.replace(i) else { continue };
+                let (load, store) = (&program.insts[l], inst);
                 if load.class.opcode != Op::Load || store.class.opcode != Op::Store {
                     continue;
                 }
@@ -614,18 +868,33 @@ impl FnLiveness {
                 };
                 let ops: Vec<Id> = id_operands(store).collect();
                 let exact = |p: Id| roots.get(&p).is_some_and(|r| r.exact);
-                if ops.len() == 2
-                    && ops[1] == v
-                    && uses.get(&v) == Some(&1)
-                    && exact(src)
-                    && exact(ops[0])
-                {
-                    copies.insert(w[1], w[0]);
+                if ops.len() == 2 && ops[1] == v && exact(src) && exact(ops[0]) {
+                    candidates.push((i, l, v));
+                }
+            }
+        }
+        let mut copies = HashMap::default();
+        if !candidates.is_empty() {
+            let mut uses: HashMap<Id, usize> = candidates.iter().map(|c| (c.2, 0)).collect();
+            for inst in &program.insts[f.start..=f.end] {
+                if program.is_debug_inst(inst) {
+                    continue;
+                }
+                for id in id_operands(inst) {
+                    if let Some(n) = uses.get_mut(&id) {
+                        *n += 1;
+                    }
+                }
+            }
+            for (store, load, v) in candidates {
+                if uses.get(&v) == Some(&1) {
+                    copies.insert(store, load);
                 }
             }
         }
         // What each call reads through the pointers it passes.
-        let mut call_reads = HashMap::new();
+        let mut call_reads = HashMap::default();
+        let mut exact = true;
         for i in f.start..=f.end {
             let inst = &program.insts[i];
             if inst.class.opcode != Op::FunctionCall {
@@ -635,9 +904,15 @@ impl FnLiveness {
                 .next()
                 .and_then(|c| program.function_index(c));
             if let Some(c) = callee {
-                call_reads.insert(i, Self::exposed_params(program, c, memo, depth));
+                let (e, e_exact) = Self::exposed_params(program, c, builds, depth);
+                exact &= e_exact;
+                call_reads.insert(i, e);
             }
         }
+        let ids = program.insts[f.start..=f.end]
+            .iter()
+            .filter_map(|i| i.result_id);
+        let (lo, hi) = ids.fold((Id::MAX, 0), |(lo, hi), r| (lo.min(r), hi.max(r)));
         let mut fl = FnLiveness {
             func,
             vars,
@@ -646,14 +921,84 @@ impl FnLiveness {
             copy_loads: copies.values().copied().collect(),
             copies,
             ssa,
-            live_out: vec![HashSet::new(); n],
-            defined_out: vec![HashSet::new(); n],
+            live_out: vec![BitSet::default(); n],
+            places: RefCell::new(Places::new(lo, hi)),
+            defined_out: vec![BitSet::default(); n],
+            written: Vec::new(),
             preds,
-            remat: HashMap::new(),
-            remat_at: HashMap::new(),
+            remat: HashMap::default(),
+            remat_at: HashMap::default(),
+            steps: Vec::new(),
+            step_uses: Vec::new(),
+            mentions: None,
         };
+        fl.prepare_steps(program);
         fl.solve(program);
-        fl
+        (fl, exact)
+    }
+
+    /// Prepares the backward transfer of every instruction that only kills
+    /// its result and reads its operands (most of them), so the fixpoint
+    /// does no lookups for those.
+    fn prepare_steps(&mut self, program: &Program) {
+        let f = &program.functions[self.func];
+        let places = self.places.get_mut();
+        let mut steps = Vec::with_capacity(f.end + 1 - f.start);
+        let mut pool = Vec::new();
+        for at in f.start..=f.end {
+            let inst = &program.insts[at];
+            let op = inst.class.opcode;
+            if program.is_debug_inst(inst) {
+                steps.push(Step::Skip);
+                continue;
+            }
+            if self.copies.contains_key(&at)
+                || matches!(
+                    op,
+                    Op::Store
+                        | Op::CopyMemory
+                        | Op::CopyMemorySized
+                        | Op::FunctionCall
+                        | Op::Variable
+                )
+            {
+                steps.push(Step::Other);
+                continue;
+            }
+            // Only SSA values and variables (pointer parameters) are ever
+            // places; another result cannot be live.
+            let def = inst
+                .result_id
+                .filter(|r| self.ssa.contains(r) || self.roots.get(r).is_some_and(|p| p.var == *r))
+                .map_or(Places::NONE, |r| places.intern(r, &[]));
+            let start = pool.len() as u32;
+            // A copy's load reads nothing here (the store does), and phi
+            // operands are used on the incoming edge (`solve`).
+            if !(op == Op::Phi || (op == Op::Load && self.copy_loads.contains(&at))) {
+                let derives = matches!(
+                    op,
+                    Op::AccessChain
+                        | Op::InBoundsAccessChain
+                        | Op::PtrAccessChain
+                        | Op::CopyObject
+                        | Op::Bitcast
+                );
+                for id in id_operands(inst) {
+                    if self.ssa.contains(&id) {
+                        pool.push(places.intern(id, &[]));
+                    }
+                    if let Some(p) = self.roots.get(&id).filter(|_| !derives) {
+                        pool.push(places.intern(p.var, &p.path));
+                    }
+                }
+            }
+            steps.push(Step::Plain {
+                def,
+                uses: start..pool.len() as u32,
+            });
+        }
+        self.steps = steps;
+        self.step_uses = pool;
     }
 
     fn function<'p>(&self, program: &'p Program) -> &'p Function {
@@ -666,32 +1011,53 @@ impl FnLiveness {
 
     /// Backward transfer of one instruction over the live set. Debug-info
     /// instructions (`DebugDeclare`, `DebugValue`) neither read nor write.
-    fn step_back(&self, program: &Program, at: usize, live: &mut HashSet<Place>) {
+    fn step_back(&self, program: &Program, at: usize, live: &mut BitSet) {
+        let start = program.functions[self.func].start;
+        match at.checked_sub(start).and_then(|k| self.steps.get(k)) {
+            Some(Step::Skip) => return,
+            Some(Step::Plain { def, uses }) => {
+                if *def != Places::NONE {
+                    live.remove(*def);
+                }
+                for &u in &self.step_uses[uses.start as usize..uses.end as usize] {
+                    live.insert(u);
+                }
+                return;
+            }
+            _ => {}
+        }
         let inst = &program.insts[at];
         if program.is_debug_inst(inst) {
             return;
         }
+        let places = &mut *self.places.borrow_mut();
         let op = inst.class.opcode;
         if let Some(r) = inst.result_id {
-            live.remove(&(r, Vec::new()));
+            if let Some(i) = places.get(r, &[]) {
+                live.remove(i);
+            }
             // An initializer writes the whole variable.
             if op == Op::Variable {
-                live.retain(|(v, _)| *v != r);
+                for i in places.of(r) {
+                    live.remove(i);
+                }
             }
         }
         if let Some(&load) = self.copies.get(&at) {
             // A copy: the parts of the target live after it were the same
             // parts of the source.
-            let ops: Vec<Id> = id_operands(inst).collect();
+            let mut ops = id_operands(inst);
+            let dst_ptr = ops.next();
             let src_ptr = id_operands(&program.insts[load]).next();
             if let (Some(dst), Some(src)) = (
-                self.roots.get(&ops[0]),
+                dst_ptr.and_then(|p| self.roots.get(&p)),
                 src_ptr.and_then(|p| self.roots.get(&p)),
             ) {
-                let wanted: Vec<Vec<u32>> = live
-                    .iter()
-                    .filter(|(v, _)| *v == dst.var)
-                    .filter_map(|(_, q)| {
+                let wanted: Vec<Vec<u32>> = places
+                    .of(dst.var)
+                    .filter(|&i| live.contains(i))
+                    .filter_map(|i| {
+                        let q = &places.place(i).1;
                         if let Some(rest) = q.strip_prefix(dst.path.as_slice()) {
                             Some(rest.to_vec())
                         } else if dst.path.starts_with(q) {
@@ -701,19 +1067,19 @@ impl FnLiveness {
                         }
                     })
                     .collect();
-                self.kill(program, live, dst);
+                self.kill(program, places, live, dst);
                 for r in wanted {
                     let mut path = src.path.clone();
                     path.extend(r);
-                    live.insert((src.var, path));
+                    live.insert(places.intern(src.var, &path));
                 }
                 return;
             }
         }
         if op == Op::Load && self.copy_loads.contains(&at) {
             // Its read is the copy's, handled at the store.
-            if let Some(r) = inst.result_id {
-                live.remove(&(r, Vec::new()));
+            if let Some(i) = inst.result_id.and_then(|r| places.get(r, &[])) {
+                live.remove(i);
             }
             return;
         }
@@ -723,7 +1089,7 @@ impl FnLiveness {
             Op::Store | Op::CopyMemory | Op::CopyMemorySized => {
                 if let Some(Operand::IdRef(ptr)) = inst.operands.first() {
                     if let Some(p) = self.roots.get(ptr).filter(|p| p.exact) {
-                        self.kill(program, live, p);
+                        self.kill(program, places, live, p);
                     }
                 }
             }
@@ -739,7 +1105,7 @@ impl FnLiveness {
         );
         for (k, id) in id_operands(inst).enumerate() {
             if self.ssa.contains(&id) {
-                live.insert((id, Vec::new()));
+                live.insert(places.intern(id, &[]));
             }
             if let Some(p) = self.roots.get(&id) {
                 // Deriving a pointer reads nothing; a store's target is
@@ -765,6 +1131,7 @@ impl FnLiveness {
                         path.extend_from_slice(w);
                         self.kill(
                             program,
+                            places,
                             live,
                             &LocalPtr {
                                 var: p.var,
@@ -779,11 +1146,11 @@ impl FnLiveness {
                         for q in parts {
                             let mut path = p.path.clone();
                             path.extend_from_slice(q);
-                            live.insert((p.var, path));
+                            live.insert(places.intern(p.var, &path));
                         }
                     }
                     None => {
-                        live.insert((p.var, p.path.clone()));
+                        live.insert(places.intern(p.var, &p.path));
                     }
                 }
             }
@@ -793,19 +1160,31 @@ impl FnLiveness {
     /// A write of exactly `ptr`'s part: that part and everything inside it
     /// is dead before the write; a live enclosing part stays live only in
     /// the pieces the write does not cover.
-    fn kill(&self, program: &Program, live: &mut HashSet<Place>, ptr: &LocalPtr) {
-        let parts: Vec<Vec<u32>> = live
-            .iter()
-            .filter(|(v, _)| *v == ptr.var)
-            .map(|(_, q)| q.clone())
+    fn kill(&self, program: &Program, places: &mut Places, live: &mut BitSet, ptr: &LocalPtr) {
+        let parts: Vec<(u32, bool)> = places
+            .of(ptr.var)
+            .filter(|&i| live.contains(i))
+            .filter_map(|i| {
+                let q = &places.place(i).1;
+                if q.starts_with(&ptr.path) {
+                    Some((i, true))
+                } else if ptr.path.starts_with(q) {
+                    Some((i, false))
+                } else {
+                    None
+                }
+            })
             .collect();
-        for q in parts {
-            if q.starts_with(&ptr.path) {
-                live.remove(&(ptr.var, q));
-            } else if ptr.path.starts_with(&q) {
-                if let Some(pieces) = self.split(program, ptr.var, &q, &ptr.path) {
-                    live.remove(&(ptr.var, q));
-                    live.extend(pieces.into_iter().map(|p| (ptr.var, p)));
+        for (i, inside) in parts {
+            if inside {
+                live.remove(i);
+                continue;
+            }
+            let q = places.place(i).1.clone();
+            if let Some(pieces) = self.split(program, ptr.var, &q, &ptr.path) {
+                live.remove(i);
+                for p in pieces {
+                    live.insert(places.intern(ptr.var, &p));
                 }
             }
         }
@@ -894,32 +1273,49 @@ impl FnLiveness {
                 }
             }
         }
-        let mut live_in: Vec<HashSet<Place>> = vec![HashSet::new(); n];
+        let mut live_in: Vec<BitSet> = vec![BitSet::default(); n];
+        let phi_uses: Vec<BitSet> = {
+            let places = &mut *self.places.borrow_mut();
+            phi_uses
+                .iter()
+                .map(|uses| {
+                    let mut set = BitSet::default();
+                    for &v in uses {
+                        set.insert(places.intern(v, &[]));
+                    }
+                    set
+                })
+                .collect()
+        };
         // A worklist: a block is redone only when a successor's live-in
         // grew (every block once first, last block first), instead of every
         // block every round until a whole round changes nothing.
         let mut work: Vec<usize> = (0..n).collect();
         let mut queued = vec![true; n];
         let mut steps = 0usize;
+        // Reused for each block's live set, to spare an allocation a visit.
+        let mut scratch = BitSet::default();
         while let Some(b) = work.pop() {
             queued[b] = false;
             steps += 1;
             if steps > n.saturating_mul(10_000) {
                 break;
             }
-            let mut out: HashSet<Place> = phi_uses[b].iter().map(|&v| (v, Vec::new())).collect();
+            let mut out = std::mem::take(&mut self.live_out[b]);
+            out.clone_from(&phi_uses[b]);
             for &s in &f.blocks[b].succs {
                 if let Some(li) = live_in.get(s) {
-                    out.extend(li.iter().cloned());
+                    out.union_with(li);
                 }
             }
-            let mut live = out.clone();
+            let mut live = std::mem::take(&mut scratch);
+            live.clone_from(&out);
             for k in (f.blocks[b].start..=f.blocks[b].end).rev() {
                 self.step_back(program, k, &mut live);
             }
             self.live_out[b] = out;
             if live != live_in[b] {
-                live_in[b] = live;
+                std::mem::swap(&mut live_in[b], &mut live);
                 for &p in &self.preds[b] {
                     if !queued[p] {
                         queued[p] = true;
@@ -927,20 +1323,38 @@ impl FnLiveness {
                     }
                 }
             }
+            scratch = live;
         }
-        // Forward: variables possibly written on some path.
+        // Forward: variables possibly written on some path. What each
+        // block writes itself is the same every round.
+        let mut index: HashMap<Id, u32> = HashMap::default();
+        let mut written = Vec::new();
+        let own: Vec<BitSet> = f
+            .blocks
+            .iter()
+            .map(|block| {
+                let mut set = BitSet::default();
+                for inst in &program.insts[block.start..=block.end] {
+                    for id in self.writes(program, inst) {
+                        set.insert(*index.entry(id).or_insert_with(|| {
+                            written.push(id);
+                            written.len() as u32 - 1
+                        }));
+                    }
+                }
+                set
+            })
+            .collect();
+        self.written = written;
         let mut changed = true;
         let mut rounds = 0;
         while changed && rounds < 10_000 {
             changed = false;
             rounds += 1;
-            for b in 0..n {
-                let mut d: HashSet<Id> = HashSet::new();
+            for (b, written) in own.iter().enumerate() {
+                let mut d = written.clone();
                 for &p in &self.preds[b] {
-                    d.extend(self.defined_out[p].iter().copied());
-                }
-                for inst in &program.insts[f.blocks[b].start..=f.blocks[b].end] {
-                    d.extend(self.writes(program, inst));
+                    d.union_with(&self.defined_out[p]);
                 }
                 if d != self.defined_out[b] {
                     self.defined_out[b] = d;
@@ -962,13 +1376,14 @@ impl FnLiveness {
     fn places_after(&self, program: &Program, inst: usize) -> HashSet<Place> {
         let f = self.function(program);
         let Some(b) = f.block_of(inst) else {
-            return HashSet::new();
+            return HashSet::default();
         };
         let mut live = self.live_out[b].clone();
         for k in (inst + 1..=f.blocks[b].end).rev() {
             self.step_back(program, k, &mut live);
         }
-        live
+        let places = self.places.borrow();
+        live.iter().map(|i| places.place(i).clone()).collect()
     }
 
     /// Bytes of the live parts of variable `var` (of type `ty`): all of it
@@ -999,11 +1414,11 @@ impl FnLiveness {
     fn defined_before(&self, program: &Program, inst: usize) -> HashSet<Id> {
         let f = self.function(program);
         let Some(b) = f.block_of(inst) else {
-            return HashSet::new();
+            return HashSet::default();
         };
-        let mut d: HashSet<Id> = HashSet::new();
+        let mut d: HashSet<Id> = HashSet::default();
         for &p in &self.preds[b] {
-            d.extend(self.defined_out[p].iter().copied());
+            d.extend(self.defined_out[p].iter().map(|i| self.written[i as usize]));
         }
         for k in f.blocks[b].start..inst {
             d.extend(self.writes(program, &program.insts[k]));
@@ -1125,7 +1540,13 @@ impl FnLiveness {
                     })
                 })
             };
-            let use_at = self.first_use_after(program, inst, id);
+            // A variable is read only where it is mentioned: look nowhere else.
+            let mentions = if is_var {
+                self.mentions(program).get(&id).cloned()
+            } else {
+                None
+            };
+            let use_at = self.first_use_after(program, inst, id, mentions.as_deref());
             out.push(LiveValue {
                 name: value_name(program, id, def.as_ref()),
                 ty: program.type_name(ty),
@@ -1176,12 +1597,22 @@ impl FnLiveness {
 
     /// The position of the first instruction after `inst` that reads `id`
     /// (breadth-first over the CFG, loops included).
-    fn first_use_after(&self, program: &Program, inst: usize, id: Id) -> Option<Location> {
+    fn first_use_after(
+        &self,
+        program: &Program,
+        inst: usize,
+        id: Id,
+        only: Option<&[usize]>,
+    ) -> Option<Location> {
         let f = self.function(program);
         let b0 = f.block_of(inst)?;
+        let reads = |k: usize| {
+            only.is_none_or(|m| m.binary_search(&k).is_ok())
+                && self.reads(program, &program.insts[k], id)
+        };
         let mut found = None;
         for k in inst + 1..=f.blocks[b0].end {
-            if self.reads(program, &program.insts[k], id) {
+            if reads(k) {
                 found = Some(k);
                 break;
             }
@@ -1194,7 +1625,7 @@ impl FnLiveness {
                     continue;
                 }
                 for k in f.blocks[b].start..=f.blocks[b].end {
-                    if self.reads(program, &program.insts[k], id) {
+                    if reads(k) {
                         found = Some(k);
                         break 'bfs;
                     }
@@ -1244,20 +1675,12 @@ impl FnLiveness {
         }
         // Cycles through phis are loop-carried: not recomputable.
         self.remat.insert(id, false);
-        let name = format!("{op:?}");
         let r = match op {
             Op::Phi | Op::FunctionCall | Op::FunctionParameter | Op::Variable => false,
             // A clock reads time, and subgroup operations depend on which
             // invocations are active: neither gives the same value again.
             Op::ReadClockKHR => false,
-            _ if name.starts_with("Atomic")
-                || name.starts_with("RayQuery")
-                || name.starts_with("GroupNonUniform")
-                || name.starts_with("Subgroup")
-                || name.starts_with("Group") =>
-            {
-                false
-            }
+            _ if varies(op) => false,
             Op::Load => {
                 let ptr = id_operands(inst).next().unwrap_or(0);
                 match self.root(ptr) {
@@ -1358,20 +1781,17 @@ impl FnLiveness {
             return r;
         }
         self.remat_at.insert(key.clone(), false);
-        let f = self.function(program);
-        let (start, end) = (f.start, f.end);
         let reaching = self.reaching_writes(program, var, at);
         let mut ok = true;
         let mut stored: Vec<(Vec<u32>, Id)> = Vec::new();
-        for i in start..=end {
+        let mentions = self
+            .mentions(program)
+            .get(&var)
+            .cloned()
+            .unwrap_or_default();
+        for i in mentions {
             let inst = &program.insts[i];
-            if program.is_debug_inst(inst) {
-                continue;
-            }
             let ids: Vec<Id> = id_operands(inst).collect();
-            if !ids.iter().any(|x| self.root(*x) == Some(var)) && inst.result_id != Some(var) {
-                continue;
-            }
             match inst.class.opcode {
                 Op::Variable => {
                     if let Some(&init) = ids.first().filter(|_| reaching.contains(&i)) {
@@ -1429,12 +1849,37 @@ impl FnLiveness {
         ok
     }
 
+    /// The instructions (not debug info) that define a variable or use a
+    /// pointer into it, per variable, in order.
+    fn mentions(&mut self, program: &Program) -> &HashMap<Id, Vec<usize>> {
+        if self.mentions.is_none() {
+            let f = &program.functions[self.func];
+            let mut m: HashMap<Id, Vec<usize>> = HashMap::default();
+            for i in f.start..=f.end {
+                let inst = &program.insts[i];
+                if program.is_debug_inst(inst) {
+                    continue;
+                }
+                let used = id_operands(inst).filter_map(|x| self.root(x));
+                let defined = inst.result_id.filter(|r| self.vars.contains(r));
+                for v in defined.into_iter().chain(used) {
+                    let list = m.entry(v).or_default();
+                    if list.last() != Some(&i) {
+                        list.push(i);
+                    }
+                }
+            }
+            self.mentions = Some(m);
+        }
+        self.mentions.get_or_insert_with(HashMap::default)
+    }
+
     /// The writes to `var` (stores, and its `OpVariable` when it has an
     /// initializer) that can give the value read at `at`: walking back from
     /// `at` along every path, up to a store of the whole variable.
     fn reaching_writes(&self, program: &Program, var: Id, at: usize) -> HashSet<usize> {
         let f = self.function(program);
-        let mut found = HashSet::new();
+        let mut found = HashSet::default();
         let Some(b0) = f.block_of(at) else {
             return found;
         };
@@ -1453,7 +1898,7 @@ impl FnLiveness {
         };
         // (block, last instruction to look at)
         let mut work: Vec<(usize, usize)> = vec![(b0, at)];
-        let mut seen: HashSet<usize> = HashSet::new();
+        let mut seen: HashSet<usize> = HashSet::default();
         while let Some((b, last)) = work.pop() {
             let block = &f.blocks[b];
             let mut killed = false;
@@ -1515,6 +1960,47 @@ mod tests {
             .collect();
         v.sort();
         v
+    }
+
+    #[test]
+    fn places_intern_once_and_list_each_ids_parts() {
+        let mut p = Places::new(10, 20);
+        let whole = p.intern(12, &[]);
+        assert_eq!(p.intern(12, &[]), whole, "interned once");
+        let a = p.intern(12, &[1, 2]);
+        let b = p.intern(12, &[1]);
+        assert!(a != b && a != whole && b != whole);
+        assert_eq!(p.intern(12, &[1, 2]), a);
+        assert_eq!(p.get(12, &[1]), Some(b));
+        assert_eq!(p.get(12, &[2]), None);
+        assert_eq!(p.get(13, &[]), None);
+        // Ids outside the dense range go through the hash table.
+        let far = p.intern(5, &[]);
+        let far_part = p.intern(1_000, &[0]);
+        assert_eq!(p.get(5, &[]), Some(far));
+        assert_eq!(p.get(1_000, &[0]), Some(far_part));
+        assert_eq!(p.of(12).collect::<Vec<_>>(), [whole, a, b]);
+        assert_eq!(p.of(1_000).collect::<Vec<_>>(), [far_part]);
+        assert_eq!(p.of(14).count(), 0);
+        assert_eq!(p.place(a), &(12, vec![1, 2]));
+    }
+
+    #[test]
+    fn places_with_colliding_keys_stay_apart() {
+        // A huge id range has no dense table: every place is hashed, and
+        // many parts of one variable share chains of the same key space.
+        let mut p = Places::new(0, u32::MAX);
+        let ids: Vec<u32> = (0..200u32)
+            .map(|i| p.intern(7, &[i % 10, i / 10]))
+            .collect();
+        for (i, &ix) in ids.iter().enumerate() {
+            let i = i as u32;
+            assert_eq!(p.get(7, &[i % 10, i / 10]), Some(ix));
+        }
+        let mut sorted = ids.clone();
+        sorted.sort();
+        sorted.dedup();
+        assert_eq!(sorted.len(), 200, "distinct paths, distinct indices");
     }
 
     #[test]

@@ -1,6 +1,7 @@
 //! Analyses: pure functions over a [`Program`](crate::program::Program) (and a
 //! [`Pipeline`](crate::pipeline::Pipeline) where the scene matters).
 
+pub(crate) mod bitset;
 pub mod callgraph;
 pub mod layout;
 pub mod liveness;

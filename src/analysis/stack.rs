@@ -16,7 +16,7 @@
 //! are in `docs/stack.md`.
 
 use super::callgraph::{Assumption, EdgeKind};
-use super::liveness::{live_sites, LiveSite};
+use super::liveness::{live_sites, shared_live_sites, LiveSite};
 use super::recursion::{recursion_report, ChainStep, NoGuard, RecursionReport};
 use crate::pipeline::Pipeline;
 use crate::pipeline::Slot;
@@ -461,24 +461,20 @@ fn other_call_data_live(program: &Program, inst: usize) -> (u64, u64) {
         let (mut stored, mut read) = (false, false);
         for k in f.start..=f.end {
             let i = &program.insts[k];
-            let ops: Vec<u32> = i
-                .operands
-                .iter()
-                .filter_map(|o| match o {
-                    rspirv::dr::Operand::IdRef(id) => Some(*id),
-                    _ => None,
-                })
-                .collect();
+            let first = i.operands.iter().find_map(|o| match o {
+                rspirv::dr::Operand::IdRef(id) => Some(*id),
+                _ => None,
+            });
             match i.class.opcode {
                 Op::AccessChain | Op::InBoundsAccessChain
-                    if ops.first().is_some_and(|b| ptrs.contains(b)) =>
+                    if first.is_some_and(|b| ptrs.contains(&b)) =>
                 {
                     ptrs.extend(i.result_id);
                 }
-                Op::Store if ops.first().is_some_and(|p| ptrs.contains(p)) => {
+                Op::Store if first.is_some_and(|p| ptrs.contains(&p)) => {
                     stored |= k < inst || looped;
                 }
-                Op::Load if ops.first().is_some_and(|p| ptrs.contains(p)) => {
+                Op::Load if first.is_some_and(|p| ptrs.contains(&p)) => {
                     read |= k > inst;
                 }
                 _ => {}
@@ -646,7 +642,7 @@ pub fn stack_report(pipeline: &Pipeline) -> StackReport {
 /// [`stack_report`] over a recursion analysis the caller already has.
 pub fn stack_report_with(pipeline: &Pipeline, rec: &RecursionReport) -> StackReport {
     let mut cache: HashMap<(usize, String), Breakdown> = HashMap::new();
-    let sites: Vec<Vec<LiveSite>> = pipeline.programs.iter().map(live_sites).collect();
+    let sites: Vec<_> = pipeline.programs.iter().map(shared_live_sites).collect();
     let mut shaders = Vec::new();
     for node in &rec.graph.nodes {
         let s = &node.shader;

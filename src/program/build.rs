@@ -748,9 +748,15 @@ impl Builder<'_> {
                     Some(Operand::StorageClass(s)) => *s,
                     _ => return Err(self.at(i, "pointer type without a storage class")),
                 };
-                // The pointee may be forward-declared (OpTypeForwardPointer).
+                // Not checked against the types read so far: pointees may be
+                // types this reader does not model (a new extension's). But
+                // never the pointer itself (a forward-declared pointer could
+                // be): naming it recursed without end.
                 let pointee =
                     id_at(inst, 1).ok_or_else(|| self.at(i, "pointer type without a pointee"))?;
+                if pointee == r {
+                    return Err(self.at(i, format!("pointer type %{r} points to itself")));
+                }
                 Some(Type::Pointer { storage, pointee })
             }
             Op::TypeFunction => {
@@ -763,6 +769,9 @@ impl Builder<'_> {
             }
             Op::TypeAccelerationStructureKHR => Some(Type::AccelerationStructure),
             Op::TypeRayQueryKHR => Some(Type::RayQuery),
+            // Shader execution reordering's hit object (HLSL `dx::HitObject`),
+            // opaque like a ray query; pointers to it are Function locals.
+            Op::TypeHitObjectNV | Op::TypeHitObjectEXT => Some(Type::Other("hit object")),
             Op::TypeImage => Some(Type::Image),
             Op::TypeSampler => Some(Type::Sampler),
             Op::TypeSampledImage => Some(Type::SampledImage),
@@ -1065,6 +1074,48 @@ pub fn is_terminator(op: Op) -> bool {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    fn pointer_module(cycle_through_array: bool) -> Vec<u32> {
+        use rspirv::binary::Assemble;
+        use rspirv::spirv::{AddressingModel, Capability, MemoryModel, StorageClass};
+        let mut b = rspirv::dr::Builder::new();
+        b.capability(Capability::Shader);
+        b.capability(Capability::PhysicalStorageBufferAddresses);
+        b.memory_model(
+            AddressingModel::PhysicalStorageBuffer64,
+            MemoryModel::GLSL450,
+        );
+        let u = b.type_int(32, 0);
+        let four = b.constant_bit32(u, 4);
+        let p = b.id();
+        b.type_forward_pointer(p, StorageClass::PhysicalStorageBuffer);
+        let pointee = if cycle_through_array {
+            b.type_array(p, four)
+        } else {
+            p
+        };
+        b.type_pointer(Some(p), StorageClass::PhysicalStorageBuffer, pointee);
+        b.module().assemble()
+    }
+
+    /// Found by fuzzing: a pointer to itself sent naming into an endless
+    /// recursion; now an input error. A cycle through a forward-declared
+    /// pointer and an array is legal, and its name is cut short.
+    #[test]
+    fn types_that_contain_themselves() {
+        let path = Path::new("t.spv");
+        let e = parse(&pointer_module(false), path, Language::Spirv).unwrap_err();
+        assert!(e.to_string().contains("points to itself"), "{e}");
+        let p = parse(&pointer_module(true), path, Language::Hlsl).unwrap();
+        let ptr = p
+            .types
+            .iter()
+            .find(|(_, t)| matches!(t, Type::Pointer { pointee, .. } if *pointee != 0))
+            .map(|(id, _)| *id)
+            .unwrap();
+        let name = p.type_name(ptr);
+        assert!(name.starts_with("ptr<ptr<") && name.contains('…'), "{name}");
+    }
 
     /// glslang 12 `-gV` gives `main` line 0; such positions, and lines past
     /// the end of the file, are dropped rather than relayed.

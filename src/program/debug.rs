@@ -51,6 +51,18 @@ fn resolve_unnormalized(named: &str, module_path: &Path) -> PathBuf {
 
 /// The name of a type in the source language's spelling.
 pub fn type_name(program: &Program, id: Id, lang: Language) -> String {
+    name_at(program, id, lang, 0)
+}
+
+/// Nesting past which a name is cut short: forward-declared pointers let
+/// a type contain itself (a valid `buffer_reference` list, or a fuzzed
+/// module), so the walk through pointees must end.
+const MAX_NAME_DEPTH: u32 = 8;
+
+fn name_at(program: &Program, id: Id, lang: Language, depth: u32) -> String {
+    if depth > MAX_NAME_DEPTH {
+        return "…".into();
+    }
     let wgsl = lang == Language::Wgsl;
     if lang == Language::Glsl {
         return glsl_type_name(program, id);
@@ -165,20 +177,22 @@ pub fn type_name(program: &Program, id: Id, lang: Language) -> String {
                     .map(|v| v.to_string())
                     .unwrap_or_else(|| "N".into());
                 if wgsl {
-                    format!("array<{}, {n}>", type_name(program, *elem, lang))
+                    format!("array<{}, {n}>", name_at(program, *elem, lang, depth + 1))
                 } else {
-                    format!("{}[{n}]", type_name(program, *elem, lang))
+                    format!("{}[{n}]", name_at(program, *elem, lang, depth + 1))
                 }
             }
             Type::RuntimeArray { elem } => {
                 if wgsl {
-                    format!("array<{}>", type_name(program, *elem, lang))
+                    format!("array<{}>", name_at(program, *elem, lang, depth + 1))
                 } else {
-                    format!("{}[]", type_name(program, *elem, lang))
+                    format!("{}[]", name_at(program, *elem, lang, depth + 1))
                 }
             }
             Type::Struct { .. } => program.display_name(id),
-            Type::Pointer { pointee, .. } => format!("ptr<{}>", type_name(program, *pointee, lang)),
+            Type::Pointer { pointee, .. } => {
+                format!("ptr<{}>", name_at(program, *pointee, lang, depth + 1))
+            }
             Type::AccelerationStructure => {
                 if wgsl {
                     "acceleration_structure".into()

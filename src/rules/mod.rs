@@ -340,6 +340,12 @@ impl<'a, T> Lazy<'a, T> {
             init: std::rc::Rc::new(init),
         }
     }
+
+    /// Whether a rule has asked for the value (tests hold fast rules to
+    /// never asking).
+    pub fn is_computed(&self) -> bool {
+        self.cell.get().is_some()
+    }
 }
 
 impl<T> Clone for Lazy<'_, T> {

@@ -70,7 +70,8 @@ pub struct DeviceInfo {
     /// `VK_KHR_ray_query` was present and is enabled.
     pub ray_query: bool,
     /// `VK_KHR_ray_tracing_position_fetch` and its `rayTracingPositionFetch`
-    /// feature were present and are enabled.
+    /// feature were present and are enabled (not under a validation layer
+    /// older than the extension).
     pub position_fetch: bool,
     /// Core features enabled because the device has them; naga's
     /// `primitive_index` needs `geometryShader`.
@@ -204,7 +205,8 @@ impl Context {
         // SAFETY: loading the system's Vulkan loader runs its initialisers,
         // which is what any Vulkan program does.
         let entry = unsafe { ash::Entry::load() }.map_err(|e| Error::Loader(e.to_string()))?;
-        let (instance, validating) = create_instance(&entry, options.validation)?;
+        let (instance, layer_version) = create_instance(&entry, options.validation)?;
+        let validating = layer_version.is_some();
         let validation = if validating {
             match Validation::new(&entry, &instance) {
                 Ok(v) => Some(v),
@@ -217,7 +219,7 @@ impl Context {
         } else {
             None
         };
-        match open_device(&entry, &instance, options) {
+        match open_device(&entry, &instance, options, layer_version) {
             Ok(mut shared) => {
                 shared.validation = validation;
                 Ok(Context {
@@ -286,23 +288,27 @@ impl Context {
 }
 
 /// The instance, and whether the validation layer (with debug utils) is on.
-fn create_instance(entry: &ash::Entry, validation: bool) -> Result<(ash::Instance, bool)> {
+/// Creates the instance; with `validation`, also the validation layer where
+/// installed, whose spec version is returned.
+fn create_instance(entry: &ash::Entry, validation: bool) -> Result<(ash::Instance, Option<u32>)> {
     let app = vk::ApplicationInfo::default()
         .application_name(c"rtlint")
         .engine_name(c"rtlint")
         .api_version(vk::API_VERSION_1_3);
     let mut layers = Vec::new();
     let mut extensions = Vec::new();
+    let mut layer_version = None;
     if validation {
         // SAFETY: plain query.
         let available = unsafe { entry.enumerate_instance_layer_properties() }
             .map_err(vk_err("vkEnumerateInstanceLayerProperties"))?;
-        if available
+        if let Some(layer) = available
             .iter()
-            .any(|l| l.layer_name_as_c_str() == Ok(LAYER))
+            .find(|l| l.layer_name_as_c_str() == Ok(LAYER))
         {
             layers.push(LAYER.as_ptr());
             extensions.push(vk::EXT_DEBUG_UTILS_NAME.as_ptr());
+            layer_version = Some(layer.spec_version);
         }
     }
     let create = vk::InstanceCreateInfo::default()
@@ -318,7 +324,7 @@ fn create_instance(entry: &ash::Entry, validation: bool) -> Result<(ash::Instanc
                 result,
             },
         })?;
-    Ok((instance, !layers.is_empty()))
+    Ok((instance, layer_version))
 }
 
 /// Opens the device; on error everything it made is destroyed, and the
@@ -327,8 +333,15 @@ fn open_device(
     entry: &ash::Entry,
     instance: &ash::Instance,
     options: &ContextOptions,
+    layer_version: Option<u32>,
 ) -> Result<Shared> {
-    let candidate = select_device(instance, options)?;
+    let mut candidate = select_device(instance, options)?;
+    // A validation layer older than an optional extension rejects its
+    // structures at device creation (Debian bookworm's 1.3.239 layer and
+    // position fetch, which came with the 1.3.250 headers): leave it off.
+    if layer_version.is_some_and(|v| v < vk::make_api_version(0, 1, 3, 250)) {
+        candidate.info.position_fetch = false;
+    }
     let device = create_device(instance, &candidate)?;
     // SAFETY: queue family and index were requested at device creation.
     let queue = unsafe { device.get_device_queue(candidate.queue_family, 0) };

@@ -1,0 +1,159 @@
+//! A growable set of small indices, one bit each: the live sets of the
+//! liveness dataflow, whose members are interned places (dense indices), so
+//! that joining, copying and comparing sets in the fixpoint loop is word
+//! arithmetic instead of hashing.
+
+/// Indices `0..` as bits; grows on insert. Sets are equal when they hold
+/// the same indices, whatever their capacity.
+#[derive(Debug, Default)]
+pub(crate) struct BitSet(Vec<u64>);
+
+impl Clone for BitSet {
+    fn clone(&self) -> BitSet {
+        BitSet(self.0.clone())
+    }
+
+    /// Reuses this set's words (the fixpoint copies sets in a loop).
+    fn clone_from(&mut self, source: &BitSet) {
+        self.0.clone_from(&source.0);
+    }
+}
+
+impl BitSet {
+    /// Adds `i`; whether it was absent.
+    pub fn insert(&mut self, i: u32) -> bool {
+        let (w, b) = (i as usize / 64, i % 64);
+        if w >= self.0.len() {
+            self.0.resize(w + 1, 0);
+        }
+        let had = self.0[w] >> b & 1 == 1;
+        self.0[w] |= 1 << b;
+        !had
+    }
+
+    /// Removes `i`; whether it was present.
+    pub fn remove(&mut self, i: u32) -> bool {
+        let (w, b) = (i as usize / 64, i % 64);
+        match self.0.get_mut(w) {
+            Some(word) if *word >> b & 1 == 1 => {
+                *word &= !(1 << b);
+                true
+            }
+            _ => false,
+        }
+    }
+
+    pub fn contains(&self, i: u32) -> bool {
+        self.0
+            .get(i as usize / 64)
+            .is_some_and(|w| w >> (i % 64) & 1 == 1)
+    }
+
+    /// Adds every index of `other`.
+    pub fn union_with(&mut self, other: &BitSet) {
+        if other.0.len() > self.0.len() {
+            self.0.resize(other.0.len(), 0);
+        }
+        for (a, b) in self.0.iter_mut().zip(&other.0) {
+            *a |= b;
+        }
+    }
+
+    /// The indices, smallest first.
+    pub fn iter(&self) -> impl Iterator<Item = u32> + '_ {
+        self.0.iter().enumerate().flat_map(|(w, &word)| {
+            let mut rest = word;
+            std::iter::from_fn(move || {
+                if rest == 0 {
+                    return None;
+                }
+                let b = rest.trailing_zeros();
+                rest &= rest - 1;
+                Some(w as u32 * 64 + b)
+            })
+        })
+    }
+}
+
+impl PartialEq for BitSet {
+    fn eq(&self, other: &BitSet) -> bool {
+        let (short, long) = if self.0.len() <= other.0.len() {
+            (&self.0, &other.0)
+        } else {
+            (&other.0, &self.0)
+        };
+        short == &long[..short.len()] && long[short.len()..].iter().all(|&w| w == 0)
+    }
+}
+
+impl Eq for BitSet {}
+
+#[cfg(test)]
+mod tests {
+    use super::BitSet;
+
+    #[test]
+    fn insert_remove_contains() {
+        let mut s = BitSet::default();
+        assert!(!s.contains(5));
+        assert!(s.insert(5));
+        assert!(!s.insert(5), "second insert finds it there");
+        assert!(s.insert(200));
+        assert!(s.contains(5) && s.contains(200) && !s.contains(6) && !s.contains(1000));
+        assert!(s.remove(5));
+        assert!(!s.remove(5));
+        assert!(!s.remove(10_000), "far beyond the capacity: absent");
+        assert_eq!(s.iter().collect::<Vec<_>>(), [200]);
+    }
+
+    #[test]
+    fn iterates_in_order_across_words() {
+        let mut s = BitSet::default();
+        for i in [130, 0, 63, 64, 1, 127] {
+            s.insert(i);
+        }
+        assert_eq!(s.iter().collect::<Vec<_>>(), [0, 1, 63, 64, 127, 130]);
+    }
+
+    #[test]
+    fn equality_ignores_capacity() {
+        let mut a = BitSet::default();
+        let mut b = BitSet::default();
+        a.insert(3);
+        b.insert(3);
+        b.insert(500);
+        assert_ne!(a, b);
+        b.remove(500);
+        assert_eq!(a, b, "b has more words, all zero");
+        assert_eq!(b, a);
+        assert_eq!(BitSet::default(), b.clone().tap_clear());
+    }
+
+    #[test]
+    fn union() {
+        let mut a = BitSet::default();
+        a.insert(1);
+        let mut b = BitSet::default();
+        b.insert(2);
+        b.insert(300);
+        a.union_with(&b);
+        assert_eq!(a.iter().collect::<Vec<_>>(), [1, 2, 300]);
+        let mut c = b.clone();
+        c.union_with(&BitSet::default());
+        assert_eq!(c, b);
+        let mut d = BitSet::default();
+        d.insert(900);
+        d.clone_from(&a);
+        assert_eq!(d, a, "clone_from replaces, not merges");
+    }
+
+    impl BitSet {
+        fn tap_clear(mut self) -> BitSet {
+            let all: Vec<u32> = self.iter().collect();
+            for i in all {
+                self.remove(i);
+            }
+            self
+        }
+    }
+}
