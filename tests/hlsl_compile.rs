@@ -27,6 +27,7 @@ const NEEDS_NEW_VALIDATOR: &[&str] = &[
     "position_fetch.hlsl",
     "exec_position_fetch.hlsl",
     "ser.hlsl",
+    "exec_ser.hlsl",
 ];
 
 /// Validates a module that needs a spirv-val of 2024 or later
