@@ -18,4 +18,6 @@ seed wgsl shaders fixtures -name '*.wgsl'
 seed spirv fixtures -name '*.spv'
 seed config . -path ./target -prune -o -path ./fuzz -prune -o -name 'rtlint.toml'
 seed pipeline shaders fixtures tests -name '*.pipeline.toml'
+# spirv_gen's inputs are generator choices: any bytes make a module.
+mkdir -p fuzz/corpus/spirv_gen
 for t in fuzz/corpus/*; do echo "$t: $(ls "$t" | wc -l) seeds"; done

@@ -1,10 +1,12 @@
 // Adaptive sampling in HLSL (rtlint's own compiler): the glossy GGX path of
 // reflect_glossy.hlsl, accumulated over passes. verify runs the ray
-// generation shader 16 times over the image; each pass a pixel traces one
-// more path while it has fewer than ADAPTIVE_MIN, or fewer than
-// ADAPTIVE_MAX and a variance estimate of its mean's luminance above the
-// tolerance (params.camera.w, 0.001 by default). `counts` gets the paths
-// each pixel traced; `state` keeps the sums between passes.
+// generation shader once per pass, as many passes as the most paths per
+// pixel (16 by default); each pass a pixel traces one more path while it
+// has fewer than the fewest (4 by default), or fewer than the most and a
+// variance estimate of its mean's luminance above the tolerance
+// (params.camera.w, 0.001 by default). The fewest and the most are
+// params.knobs.w's halves. `counts` gets the paths each pixel traced;
+// `state` keeps the sums between passes.
 #include "reflect_ggx.hlsli"
 
 struct Accumulator
@@ -19,8 +21,6 @@ struct Accumulator
 RWStructuredBuffer<uint> counts : register(u6);
 RWStructuredBuffer<Accumulator> state : register(u7);
 
-static const uint ADAPTIVE_MIN = 4;
-static const uint ADAPTIVE_MAX = 16;
 static const float3 LUMINANCE = float3(0.2126, 0.7152, 0.0722);
 
 [shader("raygeneration")]
@@ -30,8 +30,9 @@ void raygen()
     uint index = id.y * params.width + id.x;
     Accumulator acc = state[index];
     uint n = asuint(acc.sum_samples.w);
-    bool more = n < ADAPTIVE_MIN;
-    if (!more && n < ADAPTIVE_MAX)
+    uint paths = asuint(params.knobs.w);
+    bool more = n < (paths & 0xFFFFu);
+    if (!more && n < (paths >> 16u))
     {
         float mean = acc.luminance.x / float(n);
         float variance = max(acc.luminance.y / float(n) - mean * mean, 0.0);

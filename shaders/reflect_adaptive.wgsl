@@ -1,8 +1,9 @@
 // Adaptive sampling in WGSL: the glossy GGX path of reflect_glossy.wgsl,
-// accumulated over passes. verify runs the ray generation shader 16 times
-// over the image; each pass a pixel traces one more path while it has fewer
-// than ADAPTIVE_MIN, or fewer than ADAPTIVE_MAX and a variance estimate of
-// its mean's luminance above the tolerance (params.camera.w, 0.001 by
+// accumulated over passes. verify runs the ray generation shader once per
+// pass, as many passes as the most paths per pixel (16 by default); each
+// pass a pixel traces one more path while it has fewer than the fewest
+// (4 by default), or fewer than the most and a variance estimate of its
+// mean's luminance above the tolerance (params.camera.w, 0.001 by
 // default). `counts` gets the paths each pixel traced; `state` keeps the
 // sums between passes. Same math as reflect_adaptive.hlsl.
 enable wgpu_ray_tracing_pipeline;
@@ -19,6 +20,9 @@ struct Params {
     light: vec4<f32>,
     // t_min, t_max, throughput cut-off, fixed origin epsilon
     ray: vec4<f32>,
+    // xyz: the glossy shader's (unread here); w: the bits of a u32, the
+    // fewest paths per pixel | the most << 16
+    knobs: vec4<f32>,
 }
 
 // One entry per triangle (instance custom index + primitive index):
@@ -58,8 +62,6 @@ var<ray_payload> shadow: HitInfo;
 var<incoming_ray_payload> incoming: HitInfo;
 
 const MISS_T: f32 = -1.0;
-const ADAPTIVE_MIN: u32 = 4u;
-const ADAPTIVE_MAX: u32 = 16u;
 const LUMINANCE: vec3<f32> = vec3<f32>(0.2126, 0.7152, 0.0722);
 const FLAG_LIGHT: u32 = 1u;
 const FLAG_ROBUST: u32 = 2u;
@@ -206,8 +208,9 @@ fn raygen(@builtin(ray_invocation_id) id: vec3<u32>) {
     let index = id.y * params.width + id.x;
     var acc = state[index];
     var n = bitcast<u32>(acc.sum_samples.w);
-    var more = n < ADAPTIVE_MIN;
-    if !more && n < ADAPTIVE_MAX {
+    let paths = bitcast<u32>(params.knobs.w);
+    var more = n < (paths & 0xFFFFu);
+    if !more && n < (paths >> 16u) {
         let mean = acc.luminance.x / f32(n);
         let variance = max(acc.luminance.y / f32(n) - mean * mean, 0.0);
         more = variance / f32(n) > params.camera.w;

@@ -29,7 +29,8 @@ struct ParamsData
     float4 ray;
     // x: reflection rays' t_max (before the roughness shortening);
     // y: roughness above which the environment replaces the reflection ray
-    // (read by the glossy shader only)
+    // (read by the glossy shader only); w: the bits of a uint, the adaptive
+    // shader's fewest paths per pixel | the most << 16
     float4 knobs;
 };
 ConstantBuffer<ParamsData> params : register(b3);

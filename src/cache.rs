@@ -13,14 +13,33 @@
 //! changed, appeared or vanished misses. Entries are written whole to a
 //! temporary file and renamed, so runs sharing the folder (CI shards) never
 //! read half an entry.
+//!
+//! Old entries are pruned by age, not by the last run: an entry's
+//! modification time is its last use (a hit refreshes it when it is over a
+//! day old), and at most once a day a run removes entries unused for
+//! [`MAX_AGE`] and temporary files of runs that died. Pruning what the
+//! current run did not use would throw away the other shards' entries
+//! (shards share the folder) and a whole tree's after a run over one
+//! folder; ruff's cache likewise drops files it has not seen for a while.
 
 use crate::diag::{Diagnostic, Fix, Label, Severity};
 use std::hash::{Hash, Hasher};
 use std::path::{Path, PathBuf};
+use std::time::{Duration, SystemTime};
 
 /// Where the CLI keeps its cache when neither `--cache-dir` nor
 /// `RTLINT_CACHE_DIR` says: this folder in the working directory.
 pub const DEFAULT_DIR: &str = ".rtlint_cache";
+
+/// Entries unused for this long are removed.
+pub const MAX_AGE: Duration = Duration::from_secs(30 * 24 * 60 * 60);
+
+/// How often a run looks for old entries, and how stale a hit's time may
+/// get before the hit refreshes it (one write per entry per day at most).
+pub const PRUNE_EVERY: Duration = Duration::from_secs(24 * 60 * 60);
+
+/// A temporary file this old belongs to a run that died.
+const TMP_AGE: Duration = Duration::from_secs(60 * 60);
 
 /// A 128-bit content hash (two SipHash passes with different prefixes):
 /// wide enough that a collision between two inputs is not a concern.
@@ -213,8 +232,17 @@ impl Cache {
     }
 
     fn read<T: serde::de::DeserializeOwned>(&self, kind: &str, key: Key) -> Option<T> {
-        let bytes = std::fs::read(self.path(kind, key)).ok()?;
-        serde_json::from_slice(&bytes).ok()
+        let path = self.path(kind, key);
+        let bytes = std::fs::read(&path).ok()?;
+        let value = serde_json::from_slice(&bytes).ok()?;
+        // A hit is a use: keep the entry from being pruned.
+        if age(&path).is_some_and(|a| a > PRUNE_EVERY) {
+            let now = SystemTime::now();
+            if let Ok(f) = std::fs::File::options().write(true).open(&path) {
+                let _ = f.set_modified(now);
+            }
+        }
+        Some(value)
     }
 
     fn write<T: serde::Serialize>(&self, kind: &str, key: Key, value: &T) {
@@ -254,6 +282,45 @@ impl Cache {
     pub fn put_group(&self, key: Key, entry: &GroupEntry) {
         self.write("groups", key, entry);
     }
+
+    /// Removes entries unused for [`MAX_AGE`] and temporary files of runs
+    /// that died, when the last look was over [`PRUNE_EVERY`] ago (a marker
+    /// file's time says when). Returns how many files went.
+    pub fn prune(&self) -> usize {
+        let marker = self.dir.join("last-prune");
+        if age(&marker).is_some_and(|a| a < PRUNE_EVERY) {
+            return 0;
+        }
+        // Claimed first, so that runs finishing together do not all walk.
+        if std::fs::write(&marker, "").is_err() {
+            return 0;
+        }
+        let mut removed = 0;
+        for kind in ["files", "groups"] {
+            let Ok(dir) = std::fs::read_dir(self.dir.join(kind)) else {
+                continue;
+            };
+            for e in dir.flatten() {
+                let path = e.path();
+                let limit = match path.extension().and_then(|x| x.to_str()) {
+                    Some("json") => MAX_AGE,
+                    Some("tmp") => TMP_AGE,
+                    _ => continue,
+                };
+                if age(&path).is_some_and(|a| a > limit) && std::fs::remove_file(&path).is_ok() {
+                    removed += 1;
+                }
+            }
+        }
+        removed
+    }
+}
+
+/// How long ago `path` was last modified (`None`: it does not exist, or
+/// its time is in the future).
+fn age(path: &Path) -> Option<Duration> {
+    let modified = std::fs::metadata(path).ok()?.modified().ok()?;
+    SystemTime::now().duration_since(modified).ok()
 }
 
 /// A dependency's contents hash as an entry stores it.

@@ -10,7 +10,7 @@ use crate::front::{self, FrontOptions};
 use crate::program::Program;
 use crate::shader::Language;
 use rayon::prelude::*;
-use std::collections::{BTreeMap, HashMap, HashSet};
+use std::collections::{BTreeMap, BTreeSet, HashMap, HashSet};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
@@ -170,13 +170,18 @@ pub fn check_paths(paths: &[PathBuf], options: &Options) -> Report {
     }
     let mut diagnostics: Vec<Diagnostic> = configs.errors.clone();
     diagnostics.extend(inputs.errors.iter().map(|e| (*e.0).clone()));
-    let mut owned: Vec<PathBuf> = Vec::new();
+    // Sets: a header or embedded source shared by many inputs is kept once.
+    let mut owned: BTreeSet<PathBuf> = BTreeSet::new();
+    let mut embedded: HashSet<PathBuf> = HashSet::new();
     // The loose pipelines: each group's members (input indices) and, once
     // checked, its findings. A folder's group is checked as soon as its last
     // input is, and its Programs dropped: memory follows the largest folder,
     // not the tree.
     let mut groups: Vec<(PathBuf, Vec<usize>, Option<Vec<Diagnostic>>)> = Vec::new();
     let mut group_of: HashMap<PathBuf, usize> = HashMap::new();
+    // Groups not yet checked: looked at after each chunk (all groups would
+    // make the run quadratic in the number of files).
+    let mut pending: Vec<usize> = Vec::new();
     let folder = |p: &Path| p.parent().map(Path::to_path_buf).unwrap_or_default();
     let mut last_in: HashMap<PathBuf, usize> = HashMap::new();
     for (i, input) in inputs.files.iter().enumerate() {
@@ -194,21 +199,24 @@ pub fn check_paths(paths: &[PathBuf], options: &Options) -> Report {
         for (k, mut c) in checked.into_iter().enumerate() {
             let i = ci * CHUNK + k;
             if c.analysed {
-                for (path, text) in c.files.drain(..) {
+                for (path, text) in std::mem::take(&mut c.files) {
                     if let Some(t) = text {
-                        report.embedded.push((path.clone(), t));
+                        if embedded.insert(path.clone()) {
+                            report.embedded.push((path.clone(), t));
+                        }
                     }
-                    owned.push(path);
+                    owned.insert(path);
                 }
                 // Suppressions are judged only in inputs that were analysed.
-                owned.push(inputs.files[i].path.clone());
+                owned.insert(inputs.files[i].path.clone());
             }
-            diagnostics.append(&mut c.diagnostics);
+            diagnostics.extend(std::mem::take(&mut c.diagnostics));
             if let Some(g) = &c.group {
                 match group_of.get(g) {
                     Some(&k) => groups[k].1.push(i),
                     None => {
                         group_of.insert(g.clone(), groups.len());
+                        pending.push(groups.len());
                         groups.push((g.clone(), vec![i], None));
                     }
                 }
@@ -219,10 +227,13 @@ pub fn check_paths(paths: &[PathBuf], options: &Options) -> Report {
         let Some(first) = inputs.files.first() else {
             continue;
         };
-        for (dir, members, found) in groups.iter_mut() {
+        let mut waiting = Vec::with_capacity(pending.len());
+        for k in pending.drain(..) {
+            let (dir, members, found) = &mut groups[k];
             // A group named by a file (a whole pipeline in one module) is
             // complete at once; a folder's after its last input.
-            if found.is_some() || last_in.get(dir.as_path()).is_some_and(|&l| l >= done) {
+            if last_in.get(dir.as_path()).is_some_and(|&l| l >= done) {
+                waiting.push(k);
                 continue;
             }
             let members: Vec<usize> = members
@@ -243,6 +254,7 @@ pub fn check_paths(paths: &[PathBuf], options: &Options) -> Report {
                 )
             });
         }
+        pending = waiting;
     }
     let pipelines: Vec<Checked> = inputs
         .pipelines
@@ -273,8 +285,6 @@ pub fn check_paths(paths: &[PathBuf], options: &Options) -> Report {
             d.subject.clone(),
         ))
     });
-    owned.sort();
-    owned.dedup();
     let owned: Vec<(PathBuf, Arc<Config>)> = owned
         .into_iter()
         .map(|p| {
@@ -283,6 +293,9 @@ pub fn check_paths(paths: &[PathBuf], options: &Options) -> Report {
         })
         .collect();
     report.diagnostics = apply_suppressions(diagnostics, &owned, &report.embedded);
+    if let Some(cache) = &cache {
+        cache.prune();
+    }
     report
 }
 
@@ -921,19 +934,16 @@ pub fn check_loose(
 /// and others (WGSL, HLSL), is a pipeline of its own; one-stage modules
 /// pipeline with their folder. `None` without ray-tracing stages.
 fn loose_group(p: &Program, subobjects: &Subobjects) -> Option<PathBuf> {
-    let has_raygen = p
-        .entry_points
-        .iter()
-        .any(|e| e.stage == crate::shader::Stage::RayGeneration);
-    let describes = !subobjects.pipeline_configs.is_empty()
-        || !subobjects.shader_configs.is_empty()
-        || !subobjects.hit_groups.is_empty();
-    if describes && has_raygen {
+    if crate::pipeline::Pipeline::subobjects_describe(p, subobjects) {
         return Some(p.path.clone());
     }
     if !p.entry_points.iter().any(|e| e.stage.is_ray_tracing()) {
         return None;
     }
+    let has_raygen = p
+        .entry_points
+        .iter()
+        .any(|e| e.stage == crate::shader::Stage::RayGeneration);
     Some(if has_raygen && p.entry_points.len() > 1 {
         p.path.clone()
     } else {
@@ -973,7 +983,9 @@ fn check_group(mut programs: Vec<(Program, Subobjects)>, config: &Config) -> Vec
 struct Outcome {
     /// Loaded and analysed (suppressions in its files are judged).
     analysed: bool,
-    program: Option<(Program, Subobjects)>,
+    /// Boxed: a Program is large, and every input keeps its outcome until
+    /// the end of the run (unboxed, about 1 KiB per file at 100,000 files).
+    program: Option<Box<(Program, Subobjects)>>,
     diagnostics: Vec<Diagnostic>,
     /// The module's source files and the text it embeds.
     files: Vec<(PathBuf, Option<String>)>,
@@ -1000,6 +1012,10 @@ fn input_key(input: &Input, options: &Options) -> Option<crate::cache::Key> {
         .add(bytes)
         .add(format!("{:?}", input.config))
         .add(format!("{front:?}"));
+    // Only GLSL inputs run glslang, so only they ask which one it is.
+    if input.language == Language::Glsl {
+        k.add(front::glsl::version());
+    }
     Some(k.finish())
 }
 
@@ -1020,10 +1036,21 @@ fn check_cached(input: &Input, options: &Options, cache: Option<&crate::cache::C
         }
     }
     let c = check_input_with(input, &input.config, options);
+    // Reports and suppressions read a file from disk before its embedded
+    // text: only texts of files not on disk are kept, so neither the run's
+    // memory nor the cache entries grow by every input's source.
     let files: Vec<(PathBuf, Option<String>)> = c
         .program
         .iter()
-        .flat_map(|p| p.files.iter().map(|f| (f.path.clone(), f.text.clone())))
+        .flat_map(|p| {
+            p.files.iter().map(|f| {
+                let text = f
+                    .text
+                    .as_ref()
+                    .filter(|_| std::fs::File::open(&f.path).is_err());
+                (f.path.clone(), text.cloned())
+            })
+        })
         .collect();
     let group = c
         .program
@@ -1056,7 +1083,7 @@ fn check_cached(input: &Input, options: &Options, cache: Option<&crate::cache::C
         program: c
             .program
             .filter(|_| group.is_some())
-            .map(|p| (p, c.subobjects)),
+            .map(|p| Box::new((p, c.subobjects))),
         diagnostics: c.diagnostics,
         files,
         group,
@@ -1093,7 +1120,7 @@ fn check_group_cached(
     let mut programs = Vec::with_capacity(members.len());
     for &i in members {
         match outcomes[i].program.take() {
-            Some(p) => programs.push(p),
+            Some(p) => programs.push(*p),
             // Read from the cache: load it again for the pipeline.
             None => match load_library(&inputs[i], options) {
                 Ok(p) => programs.push(p),

@@ -223,6 +223,21 @@ impl Pipeline {
         p
     }
 
+    /// Whether `subobjects` describe a pipeline around `program`: it has a
+    /// ray generation shader and they hold a pipeline config, a shader
+    /// config or a hit group. ([`Pipeline::from_subobjects`] can still
+    /// refuse: a hit group may name a shader of another library.)
+    pub fn subobjects_describe(program: &Program, subobjects: &Subobjects) -> bool {
+        let describes = !subobjects.pipeline_configs.is_empty()
+            || !subobjects.shader_configs.is_empty()
+            || !subobjects.hit_groups.is_empty();
+        describes
+            && program
+                .entry_points
+                .iter()
+                .any(|e| e.stage == Stage::RayGeneration)
+    }
+
     /// The pipeline an HLSL library describes with DXR subobjects: its
     /// ray generation, miss and callable shaders (`[shader("...")]`), the
     /// hit groups it declares (each hit shader in a group of its own when it
@@ -236,14 +251,7 @@ impl Pipeline {
         program: Program,
         subobjects: &Subobjects,
     ) -> Result<Pipeline, Box<Program>> {
-        let describes = !subobjects.pipeline_configs.is_empty()
-            || !subobjects.shader_configs.is_empty()
-            || !subobjects.hit_groups.is_empty();
-        let has_raygen = program
-            .entry_points
-            .iter()
-            .any(|e| e.stage == Stage::RayGeneration);
-        if !describes || !has_raygen {
+        if !Pipeline::subobjects_describe(&program, subobjects) {
             return Err(Box::new(program));
         }
         let file = program.path.clone();

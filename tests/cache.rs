@@ -5,6 +5,7 @@ mod common;
 use common::{root, rtlint};
 use std::path::{Path, PathBuf};
 use std::process::Output;
+use std::time::{Duration, SystemTime};
 
 fn scratch(name: &str) -> PathBuf {
     let d = std::env::temp_dir().join(format!("rtlint-cache-{}-{name}", std::process::id()));
@@ -94,10 +95,116 @@ fn the_cache_is_never_stale() {
     assert_eq!(entries(&cache), before);
     assert!(!uncached.join(".rtlint_cache").exists());
     // The default folder is in the working directory and ignores itself.
-    let o = check(&d, &["."]);
+    let o = rtlint()
+        .current_dir(&d)
+        .env_remove("RTLINT_CACHE_DIR")
+        .args(["check", "--format", "concise", "--quiet", "."])
+        .output()
+        .unwrap();
     assert_eq!(o.status.code(), Some(0), "{}", text(&o));
     let ignore = std::fs::read_to_string(d.join(".rtlint_cache/.gitignore")).unwrap();
     assert!(ignore.lines().any(|l| l == "*"), "{ignore}");
+}
+
+fn set_age(path: &Path, days: u64) {
+    let t = SystemTime::now() - Duration::from_secs(days * 24 * 60 * 60);
+    std::fs::File::options()
+        .write(true)
+        .open(path)
+        .unwrap()
+        .set_modified(t)
+        .unwrap();
+}
+
+fn age_days(path: &Path) -> u64 {
+    let m = std::fs::metadata(path).unwrap().modified().unwrap();
+    SystemTime::now().duration_since(m).unwrap().as_secs() / (24 * 60 * 60)
+}
+
+/// Entries unused for 30 days go, once a day; a hit counts as a use, so
+/// what this run (or another shard) used stays.
+#[test]
+fn old_unused_entries_are_pruned_and_used_ones_kept() {
+    let d = scratch("prune");
+    std::fs::write(d.join("payload.hlsli"), PAYLOAD).unwrap();
+    std::fs::write(d.join("gen.hlsl"), shader()).unwrap();
+    let cache = d.join("c");
+    let args = ["--cache-dir", cache.to_str().unwrap(), "."];
+    let cold = check(&d, &args);
+    let used: Vec<PathBuf> = std::fs::read_dir(cache.join("files"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .collect();
+    assert_eq!(used.len(), 1);
+    // An entry of a file long gone, a temporary file of a run that died, and
+    // the used entry made old as well.
+    let stale = cache.join("files/00000000000000000000000000000000.json");
+    let tmp = cache.join("files/00000000000000000000000000000001.4242.ThreadId(2).tmp");
+    std::fs::copy(&used[0], &stale).unwrap();
+    std::fs::write(&tmp, "{").unwrap();
+    for p in [&stale, &tmp, &used[0]] {
+        set_age(p, 40);
+    }
+    // Pruned less than a day ago: nothing goes yet.
+    assert_eq!(text(&check(&d, &args)), text(&cold));
+    assert!(stale.exists() && tmp.exists());
+    assert_eq!(age_days(&used[0]), 0, "a hit refreshes its entry");
+    set_age(&used[0], 40);
+    set_age(&cache.join("last-prune"), 2);
+    let warm = check(&d, &args);
+    assert_eq!(text(&warm), text(&cold));
+    assert!(!stale.exists(), "an unused old entry is left");
+    assert!(!tmp.exists(), "a dead run's temporary file is left");
+    assert!(used[0].exists(), "the entry this run used was pruned");
+    assert_eq!(age_days(&cache.join("last-prune")), 0);
+}
+
+/// A GLSL input's key holds what `glslangValidator --version` says: another
+/// glslang misses the cache. (Other languages never run it.)
+#[test]
+fn another_glslang_misses_the_cache() {
+    if !rtlint_testkit::tool("glslangValidator") {
+        return;
+    }
+    let d = scratch("glslang");
+    std::fs::copy(
+        root().join("fixtures/RT034/good.rchit"),
+        d.join("hit.rchit"),
+    )
+    .unwrap();
+    // A glslang that says the version it is told and compiles as the real one.
+    let fake = d.join("glslang.sh");
+    std::fs::write(
+        &fake,
+        "#!/bin/sh\nif [ \"$1\" = --version ]; then echo \"Glslang Version: $FAKE_GLSLANG\"; exit 0; fi\nexec glslangValidator \"$@\"\n",
+    )
+    .unwrap();
+    std::process::Command::new("chmod")
+        .arg("+x")
+        .arg(&fake)
+        .status()
+        .unwrap();
+    let cache = d.join("c");
+    let run = |version: &str| {
+        let o = rtlint()
+            .current_dir(&d)
+            .env("RTLINT_GLSLANG", &fake)
+            .env("FAKE_GLSLANG", version)
+            .args(["check", "--format", "concise", "--quiet", "--cache-dir"])
+            .arg(&cache)
+            .arg(".")
+            .output()
+            .unwrap();
+        assert_ne!(o.status.code(), Some(2), "{}", text(&o));
+        std::fs::read_dir(cache.join("files")).unwrap().count()
+    };
+    assert_eq!(run("11:12.0.0"), 1);
+    assert_eq!(run("11:12.0.0"), 1, "the same glslang reads its entry");
+    assert_eq!(
+        run("11:15.1.0"),
+        2,
+        "another glslang wrote no entry of its own"
+    );
 }
 
 /// A shader without a cache entry whose folder's other shaders are cached:
@@ -213,16 +320,35 @@ fn shards_add_up_to_the_whole_run() {
 fn fast_analysis_leaves_out_the_dataflow_rules() {
     use rtlint::config::AnalysisLevel;
     use rtlint::rules::{Kind, RULES};
-    // Fast never needs a pipeline's recursion or stack analysis.
+    // Fast never needs a pipeline's recursion or stack analysis: a fast
+    // pipeline rule over its fixtures' descriptions leaves both uncomputed.
+    let mut fast_pipeline_findings = 0;
     for r in RULES {
-        if r.analysis == AnalysisLevel::Fast {
+        let (AnalysisLevel::Fast, Kind::Pipeline(run)) = (r.analysis, r.kind) else {
+            continue;
+        };
+        let dir = root().join("fixtures").join(r.code);
+        for e in std::fs::read_dir(&dir).unwrap() {
+            let path = e.unwrap().path();
+            if !path.to_string_lossy().ends_with(".pipeline.toml") {
+                continue;
+            }
+            let pipeline = rtlint::pipeline::load(&path).unwrap();
+            let config = rtlint::config::Config::default();
+            let ctx = rtlint::rules::PipelineContext::new(&pipeline, &config);
+            fast_pipeline_findings += run(&ctx).len();
             assert!(
-                !matches!(r.kind, Kind::Pipeline(_)),
-                "{} is fast but a pipeline rule",
-                r.code
+                !ctx.recursion.is_computed() && !ctx.stack.is_computed(),
+                "{} is fast but analysed {}",
+                r.code,
+                path.display()
             );
         }
     }
+    assert!(
+        fast_pipeline_findings > 0,
+        "no fast pipeline rule found anything"
+    );
     let full = check(
         &root(),
         &["--no-cache", "--select", "RT010", "fixtures/RT010"],

@@ -1,7 +1,7 @@
 //! Replays the fuzz regression corpus (`fuzz/regressions/<target>/*`: inputs
 //! that once crashed or hung a `cargo fuzz` target, minimised) through the
 //! same calls as each target in `fuzz/fuzz_targets/`: each must end in a
-//! result or an input error.
+//! result or an input error (`spirv_gen`: keep the generator's invariants).
 
 mod common;
 
@@ -58,6 +58,14 @@ fn run(target: &str, data: &[u8]) {
         "pipeline" => {
             if let Some(t) = text {
                 let _ = rtlint::pipeline::parse(t, Path::new("fuzz.pipeline.toml"));
+            }
+        }
+        "spirv_gen" => {
+            use rtlint_testkit::gen::{module, Source};
+            let plain = module(&mut Source::bytes(data), false);
+            let debug = module(&mut Source::bytes(data), true);
+            if let Err(e) = rtlint_testkit::gen_check::check_pair(&plain, &debug) {
+                panic!("{e}");
             }
         }
         other => panic!("fuzz/regressions/{other}: no such fuzz target"),

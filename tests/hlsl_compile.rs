@@ -27,6 +27,7 @@ const NEEDS_NEW_VALIDATOR: &[&str] = &[
     "position_fetch.hlsl",
     "exec_position_fetch.hlsl",
     "ser.hlsl",
+    "exec_ser.hlsl",
 ];
 
 /// Validates a module that needs a spirv-val of 2024 or later
@@ -241,7 +242,12 @@ fn program_sees_hlsl_declaration_positions() {
 }
 
 /// Shaders written for DXC's `-enable-16bit-types`.
-const SIXTEEN_BIT: &[&str] = &["half.hlsl", "exec_half.hlsl"];
+const SIXTEEN_BIT: &[&str] = &[
+    "half.hlsl",
+    "exec_half.hlsl",
+    "spec_half.hlsl",
+    "bits_half.hlsl",
+];
 
 /// Every shader under tests/hlsl/ (the executed ones too) validates, per
 /// entry point and as a whole file.
@@ -1244,6 +1250,10 @@ fn cli_names_a_classic_entry_point_with_its_stage() {
             .args(args)
             .arg(&file)
             .env("NO_COLOR", "1")
+            .env(
+                "RTLINT_CACHE_DIR",
+                std::env::temp_dir().join("rtlint-test-cache"),
+            )
             .output()
             .unwrap()
     };
@@ -1445,6 +1455,31 @@ fn sixteen_bit_types_with_the_flag() {
     }
     assert!(!cs.contains(&4436), "{cs:?}");
     assert!(ps.contains(&4436) && !ps.contains(&4433), "{ps:?}");
+    // ddx and fwidth of half values: OpDPdx (207) and OpFwidth (209) take an
+    // OpFConvert (115) of the value and their result is converted back.
+    let ps_words = &entries.iter().find(|e| e.name == "ps").unwrap().words;
+    let ps_insts = instructions(ps_words);
+    let fconverts: Vec<&Vec<u32>> = ps_insts
+        .iter()
+        .filter(|(op, _)| *op == 115)
+        .map(|(_, ops)| ops)
+        .collect();
+    let derivatives: Vec<&Vec<u32>> = ps_insts
+        .iter()
+        .filter(|(op, _)| *op == 207 || *op == 209)
+        .map(|(_, ops)| ops)
+        .collect();
+    assert_eq!(derivatives.len(), 2);
+    for d in derivatives {
+        assert!(
+            fconverts.iter().any(|c| c[1] == d[2]),
+            "operand not widened"
+        );
+        assert!(
+            fconverts.iter().any(|c| c[2] == d[1]),
+            "result not narrowed"
+        );
+    }
     // A payload needs no storage capability.
     assert!(
         hit.contains(&9) && !hit.iter().any(|c| (4433..=4436).contains(c)),
@@ -1550,4 +1585,120 @@ fn sixteen_bit_types_with_the_flag() {
     assert!(!instructions(&m.words)
         .iter()
         .any(|(op, o)| (*op == 21 || *op == 22) && o[1] == 16));
+}
+
+/// `[[vk::ext_decorate]]` on a resource, a `static` global, a `groupshared`
+/// array and a parameter: each one's variable or `OpFunctionParameter` has
+/// the decoration (tests/hlsl/ext_decorate.hlsl).
+#[test]
+fn ext_decorate_on_variables_and_parameters() {
+    compile_all("ext_decorate.hlsl");
+    let m = hlsl::compile(&shader("ext_decorate.hlsl"), &HlslOptions::default()).unwrap();
+    let words = &m[0].words;
+    let insts = instructions(words);
+    // OpDecorate (71) target decoration.
+    let decorations = |name: &str| -> Vec<u32> {
+        let ids = named(words, name);
+        insts
+            .iter()
+            .filter(|(op, ops)| *op == 71 && ids.contains(&ops[0]))
+            .map(|(_, ops)| ops[1])
+            .collect()
+    };
+    // Restrict (19) beside the binding's DescriptorSet (34) and Binding (33).
+    let mut results = decorations("gResults");
+    results.sort_unstable();
+    assert_eq!(results, [19, 33, 34]);
+    // RelaxedPrecision (0).
+    assert_eq!(decorations("gScale"), [0]);
+    assert_eq!(decorations("gShared"), [0]);
+    // The parameter `x` is an OpFunctionParameter (55) with the decoration.
+    let x = named(words, "x");
+    assert!(insts
+        .iter()
+        .any(|(op, ops)| *op == 55 && x.contains(&ops[1])));
+    assert_eq!(decorations("x"), [0]);
+}
+
+/// 16-bit specialization constants: `OpSpecConstant` (50) of `half` and of
+/// 16-bit integers, the default's bits in the low half of the literal word
+/// (sign-extended for `int16_t`), each with its `SpecId` (1).
+#[test]
+fn sixteen_bit_specialization_constants() {
+    let opts = HlslOptions {
+        enable_16bit_types: true,
+        ..Default::default()
+    };
+    let m = hlsl::compile(&shader("spec_half.hlsl"), &opts).unwrap_or_else(|e| panic!("{e}"));
+    let words = &m[0].words;
+    validate(words, "spec_half.hlsl-Main");
+    let insts = instructions(words);
+    let spec = |name: &str| -> (u32, u32) {
+        let id = named(words, name)[0];
+        let value = insts
+            .iter()
+            .find(|(op, ops)| *op == 50 && ops[1] == id)
+            .map(|(_, ops)| ops[2])
+            .unwrap();
+        let spec_id = insts
+            .iter()
+            .find(|(op, ops)| *op == 71 && ops[0] == id && ops[1] == 1)
+            .map(|(_, ops)| ops[2])
+            .unwrap();
+        (spec_id, value)
+    };
+    // 1.5 as a half is 0x3e00.
+    assert_eq!(spec("kGain"), (7, 0x3e00));
+    assert_eq!(spec("kBias"), (8, 0xffff_fffe));
+    assert_eq!(spec("kCount"), (9, 40000));
+    // The constants' types are 16 bits wide: OpTypeFloat (22) 16 and
+    // OpTypeInt (21) 16, signed and unsigned.
+    let type_of = |name: &str| {
+        let id = named(words, name)[0];
+        let t = insts
+            .iter()
+            .find(|(op, ops)| *op == 50 && ops[1] == id)
+            .map(|(_, ops)| ops[0])
+            .unwrap();
+        insts
+            .iter()
+            .find(|(op, ops)| (*op == 21 || *op == 22) && ops[0] == t)
+            .map(|(op, ops)| (*op, ops[1..].to_vec()))
+            .unwrap()
+    };
+    assert_eq!(type_of("kGain"), (22, vec![16]));
+    assert_eq!(type_of("kBias"), (21, vec![16, 1]));
+    assert_eq!(type_of("kCount"), (21, vec![16, 0]));
+}
+
+/// `countbits` of 16-bit integers: `OpBitCount` (205) of an `OpUConvert`
+/// (113) to 32 bits (zero-extended, also for `int16_t`), as DXC lowers it,
+/// never of the 16-bit value itself (tests/hlsl/bits_half.hlsl).
+#[test]
+fn countbits_of_sixteen_bit_integers_counts_the_zero_extended_value() {
+    let opts = HlslOptions {
+        enable_16bit_types: true,
+        ..Default::default()
+    };
+    let m = hlsl::compile(&shader("bits_half.hlsl"), &opts).unwrap_or_else(|e| panic!("{e}"));
+    let words = &m[0].words;
+    validate(words, "bits_half.hlsl-Main");
+    let insts = instructions(words);
+    let uconverts: Vec<u32> = insts
+        .iter()
+        .filter(|(op, _)| *op == 113)
+        .map(|(_, ops)| ops[1])
+        .collect();
+    let counts: Vec<&Vec<u32>> = insts
+        .iter()
+        .filter(|(op, _)| *op == 205)
+        .map(|(_, ops)| ops)
+        .collect();
+    assert_eq!(counts.len(), 2);
+    for c in counts {
+        assert!(
+            uconverts.contains(&c[2]),
+            "OpBitCount of a value not widened"
+        );
+    }
 }

@@ -486,10 +486,38 @@ fn every_attribute_is_implemented_or_refused() {
         err("[[vk::image_format(\"rgba8\")]] Texture2D t;\n[numthreads(1,1,1)]\nvoid m() {}"),
         "main.hlsl:1:3: not supported: `vk::image_format` on anything but an RWTexture"
     );
-    // Inline-SPIR-V decorations on struct members only.
+    // A capability only OpenCL kernels have (ImageBasic, 13, implies Kernel)
+    // would make the module invalid for Vulkan: refused at the number.
     assert_eq!(
-        err("[[vk::ext_decorate(0)]] RWBuffer<uint> b;\n[numthreads(1,1,1)]\nvoid m() {}"),
-        "main.hlsl:1:3: not supported: `vk::ext_decorate` on a global declaration"
+        err("[[vk::ext_capability(13)]]\n[numthreads(1,1,1)]\nvoid m() {}"),
+        "main.hlsl:1:22: capability `ImageBasic` (13) is for OpenCL kernels (it implies `Kernel`), which Vulkan does not allow"
+    );
+    // An instruction set spirv-val does not know is refused at its name.
+    assert_eq!(
+        err("[[vk::ext_instruction(1, \"MySet.1\")]]\nvoid f();\n[numthreads(1,1,1)]\nvoid m() { f(); }"),
+        "main.hlsl:1:26: not supported: extended instruction set \"MySet.1\""
+    );
+    // Inline-SPIR-V decorations on members, variables and parameters; a
+    // declaration that becomes no variable of its own refuses them.
+    assert_eq!(
+        err("[[vk::ext_decorate(0)]] static const uint K = 3;\n[numthreads(1,1,1)]\nvoid m() {}"),
+        "main.hlsl:1:3: not supported: `vk::ext_decorate` on a constant"
+    );
+    assert_eq!(
+        err("[[vk::ext_decorate(0)]] float g;\n[numthreads(1,1,1)]\nvoid m() {}"),
+        "main.hlsl:1:3: not supported: `vk::ext_decorate` on a member of `$Globals`"
+    );
+    assert_eq!(
+        err("[[vk::ext_decorate(0)]] cbuffer C { float c; };\n[numthreads(1,1,1)]\nvoid m() {}"),
+        "main.hlsl:1:3: not supported: `vk::ext_decorate` on a `cbuffer`"
+    );
+    assert_eq!(
+        err("[numthreads(1,1,1)]\nvoid m([[vk::ext_decorate(0)]] uint3 id : SV_DispatchThreadID) {}"),
+        "main.hlsl:2:10: not supported: `vk::ext_decorate` on an entry point's parameter"
+    );
+    assert_eq!(
+        err("[numthreads(1,1,1)]\nvoid m()\n{\n    [[vk::ext_decorate(0)]] uint x = 0;\n}"),
+        "main.hlsl:4:7: not supported: `vk::ext_decorate` on a statement"
     );
     assert_eq!(
         err("struct S { [[vk::ext_decorate(9999)]] float x; };\n[numthreads(1,1,1)]\nvoid m() { S s; s.x = 1; }"),
@@ -714,13 +742,16 @@ fn sixteen_bit_types_are_refused_rather_than_widened() {
         with_flag("RWStructuredBuffer<uint> o;\n[numthreads(1,1,1)]\nvoid m() { min16float h = 1; o[0] = asuint(h); }"),
         "3:37: not supported: `asuint` of 16-bit values"
     );
+    // `countbits` of 16-bit integers is lowered; the other bit operations are not.
     assert_eq!(
-        with_flag("[shader(\"pixel\")]\nhalf4 p(half4 c : COLOR) : SV_Target { return ddx(c); }"),
-        "2:47: not supported: `ddx` of 16-bit values"
+        with_flag("RWStructuredBuffer<uint> o;\n[numthreads(1,1,1)]\nvoid m() { uint16_t u = 3; o[0] = firstbithigh(u); }"),
+        "3:35: not supported: `firstbithigh` of 16-bit values"
     );
     assert_eq!(
-        with_flag("[[vk::constant_id(1)]] const half k = 1;\n[numthreads(1,1,1)]\nvoid m() { }"),
-        "1:35: not supported: 16-bit specialization constants"
+        with_flag(
+            "[shader(\"pixel\")]\nhalf4 p(int16_t4 c : COLOR) : SV_Target { return ddx(c); }"
+        ),
+        "2:50: not supported: `ddx` of 16-bit integers"
     );
     // Without the flag, `half` and `min16float` are 32-bit floats.
     let ok = "RWStructuredBuffer<float> o;\n[numthreads(1,1,1)]\nvoid m() { half h = 1.5; min16float g = h; o[0] = g; }";

@@ -239,6 +239,19 @@ fn quick_sweep_writes_a_true_front_and_error_falls_with_rays_per_pixel() {
     let (e16, r16) = glossy("16");
     assert!(r1 < r4 && r4 < r16, "rays {r1} {r4} {r16}");
     assert!(e1 > e4 && e4 > e16, "rmse {e1} {e4} {e16}");
+    // The adaptive shader's fewest and most paths are uniforms the GPU
+    // follows (each row matched its own CPU reference above): fewer paths
+    // at either bound, fewer rays.
+    let rays = |name: &str| {
+        let r = measured
+            .iter()
+            .find(|r| r["setting"] == name)
+            .unwrap_or_else(|| panic!("no row `{name}`: {stdout}"));
+        number(r, "rays")
+    };
+    let adaptive = rays("adaptive");
+    assert!(rays("adaptive min_paths=1") < adaptive, "{stdout}");
+    assert!(rays("adaptive max_paths=8") < adaptive, "{stdout}");
     let svg = std::fs::read_to_string(out.join("tradeoff.svg")).unwrap();
     check_xml(&svg).unwrap();
     assert!(svg.contains("on the Pareto front"));

@@ -37,6 +37,20 @@ pub fn glslang() -> PathBuf {
         .unwrap_or_else(|| PathBuf::from("glslangValidator"))
 }
 
+/// What `glslang() --version` prints (empty when it does not run), asked
+/// once per process: part of a GLSL input's cache key, since another
+/// glslang writes other SPIR-V.
+pub fn version() -> &'static str {
+    static VERSION: std::sync::OnceLock<String> = std::sync::OnceLock::new();
+    VERSION.get_or_init(|| {
+        Command::new(glslang())
+            .arg("--version")
+            .output()
+            .map(|o| String::from_utf8_lossy(&o.stdout).into_owned())
+            .unwrap_or_default()
+    })
+}
+
 /// Compiles `path` (whose contents are `text`, from disk or standard
 /// input) to SPIR-V; also returns the scratch file glslang read, which the
 /// debug info names.

@@ -748,10 +748,12 @@ impl Builder<'_> {
                     Some(Operand::StorageClass(s)) => *s,
                     _ => return Err(self.at(i, "pointer type without a storage class")),
                 };
-                // Declared before, as every operand type: a forward-declared
-                // pointer (OpTypeForwardPointer) is the pointer being defined,
-                // never its pointee, which cannot be the pointer itself.
-                let pointee = self.type_operand(i, inst, 1)?;
+                // Not checked against the types read so far: pointees may be
+                // types this reader does not model (a new extension's). But
+                // never the pointer itself (a forward-declared pointer could
+                // be): naming it recursed without end.
+                let pointee =
+                    id_at(inst, 1).ok_or_else(|| self.at(i, "pointer type without a pointee"))?;
                 if pointee == r {
                     return Err(self.at(i, format!("pointer type %{r} points to itself")));
                 }
@@ -767,6 +769,9 @@ impl Builder<'_> {
             }
             Op::TypeAccelerationStructureKHR => Some(Type::AccelerationStructure),
             Op::TypeRayQueryKHR => Some(Type::RayQuery),
+            // Shader execution reordering's hit object (HLSL `dx::HitObject`),
+            // opaque like a ray query; pointers to it are Function locals.
+            Op::TypeHitObjectNV | Op::TypeHitObjectEXT => Some(Type::Other("hit object")),
             Op::TypeImage => Some(Type::Image),
             Op::TypeSampler => Some(Type::Sampler),
             Op::TypeSampledImage => Some(Type::SampledImage),

@@ -1,7 +1,8 @@
 //! The adaptive shader's math (`shaders/reflect_adaptive.*`): glossy paths
 //! accumulated pass by pass; a pixel traces one more path per pass until,
-//! after [`ADAPTIVE_MIN`] paths, its variance estimate is within the
-//! tolerance, or it has [`ADAPTIVE_MAX`].
+//! after `Params::adaptive_min` paths ([`ADAPTIVE_MIN`] by default), its
+//! variance estimate is within the tolerance, or it has
+//! `Params::adaptive_max` ([`ADAPTIVE_MAX`]).
 
 use super::{glossy_sample, Params, PixelPath, Scene, Vec3};
 
@@ -12,7 +13,7 @@ pub const ADAPTIVE_TOLERANCE: f32 = 1e-3;
 /// Rec. 709 luminance weights.
 pub const LUMINANCE: Vec3 = Vec3::new(0.2126, 0.7152, 0.0722);
 /// The converged image's paths start at this sample number, so that they
-/// share no random numbers with the first [`ADAPTIVE_MAX`].
+/// share no random numbers with the adaptive ones (at most `0xFFFF`).
 pub const CONVERGED_FIRST_SAMPLE: u32 = 1 << 16;
 
 /// What the shader keeps per pixel between passes.
@@ -26,18 +27,18 @@ pub struct Accumulator {
 
 impl Accumulator {
     /// Whether the next pass traces another path: below the minimum, or
-    /// below the maximum with the variance of the mean above `tolerance`.
-    pub fn wants_more(&self, tolerance: f32) -> bool {
-        if self.samples < ADAPTIVE_MIN {
+    /// below the maximum with the variance of the mean above the tolerance.
+    pub fn wants_more(&self, params: &Params) -> bool {
+        if self.samples < params.adaptive_min {
             return true;
         }
-        if self.samples >= ADAPTIVE_MAX {
+        if self.samples >= params.adaptive_max {
             return false;
         }
         let n = self.samples as f32;
         let mean = self.lum_sum / n;
         let variance = (self.lum_sq_sum / n - mean * mean).max(0.0);
-        variance / n > tolerance
+        variance / n > params.tolerance
     }
 
     pub fn add(&mut self, c: Vec3) {
@@ -57,7 +58,7 @@ impl Accumulator {
 pub fn trace_adaptive(scene: &Scene, params: &Params, x: u32, y: u32) -> (PixelPath, Accumulator) {
     let mut acc = Accumulator::default();
     let mut segments = Vec::new();
-    while acc.wants_more(params.tolerance) {
+    while acc.wants_more(params) {
         let mut c = Vec3::ZERO;
         glossy_sample(scene, params, x, y, acc.samples, &mut c, &mut segments);
         acc.add(c);
@@ -94,6 +95,7 @@ pub fn fixed(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::reference::Method;
 
     fn scene(name: &str) -> Scene {
         let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -123,5 +125,36 @@ mod tests {
         assert!(counts
             .iter()
             .all(|&n| (ADAPTIVE_MIN..=ADAPTIVE_MAX).contains(&n)));
+    }
+
+    #[test]
+    fn the_passes_bound_the_paths_per_pixel() {
+        let s = scene("mirror");
+        let mut p = Params::for_scene(&s, 8, 8, 3);
+        p.adaptive_min = 2;
+        p.adaptive_max = 8;
+        assert_eq!(Method::Adaptive.passes(&p), 8);
+        // Noise-free pixels stop at the minimum, whatever it is.
+        assert_eq!(trace_adaptive(&s, &p, 3, 3).1.samples, 2);
+        let s = scene("showcase");
+        let mut p = Params::for_scene(&s, 32, 32, 3);
+        p.tolerance = 0.0;
+        let counts = |p: &Params| -> Vec<u32> {
+            (0..32 * 32)
+                .map(|i| trace_adaptive(&s, p, i % 32, i / 32).1.samples)
+                .collect()
+        };
+        for (min, max) in [(2, 8), (4, 32)] {
+            p.adaptive_min = min;
+            p.adaptive_max = max;
+            let counts = counts(&p);
+            assert!(counts.iter().all(|&n| (min..=max).contains(&n)));
+            // A tolerance of 0 sends every noisy pixel to the maximum.
+            assert!(counts.contains(&max), "{min} {max}");
+        }
+        // One path has no variance to estimate: a minimum of 1 stops every
+        // pixel there, whatever the tolerance.
+        p.adaptive_min = 1;
+        assert!(counts(&p).iter().all(|&n| n == 1));
     }
 }

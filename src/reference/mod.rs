@@ -48,6 +48,10 @@ pub struct Params {
     pub samples: u32,
     /// The adaptive shader's variance tolerance (`camera.w`).
     pub tolerance: f32,
+    /// The adaptive shader's fewest and most paths per pixel (`knobs.w`:
+    /// `min | max << 16`); it runs `adaptive_max` passes.
+    pub adaptive_min: u32,
+    pub adaptive_max: u32,
     /// `t_max` of the glossy shader's reflection rays (before its
     /// shortening with roughness); primary and shadow rays keep `t_max`.
     pub reflect_t_max: f32,
@@ -80,6 +84,8 @@ impl Params {
             epsilon: 1e-3,
             samples: 4,
             tolerance: ADAPTIVE_TOLERANCE,
+            adaptive_min: adaptive::ADAPTIVE_MIN,
+            adaptive_max: adaptive::ADAPTIVE_MAX,
             reflect_t_max: 1e4,
             rough_cutoff: f32::INFINITY,
             half_res: f32::INFINITY,
@@ -89,7 +95,8 @@ impl Params {
 
     /// The uniform buffer contents:
     /// `width, height, max_bounces, flags; camera.xyz, tolerance; light.xyz, ambient;
-    /// t_min, t_max, cutoff, epsilon; reflect_t_max, rough_cutoff, half_res, 0`.
+    /// t_min, t_max, cutoff, epsilon; reflect_t_max, rough_cutoff, half_res,
+    /// adaptive_min | adaptive_max << 16`.
     pub fn to_words(&self) -> [u32; 20] {
         let f = |x: f32| x.to_bits();
         let flags = if self.light.is_some() { FLAG_LIGHT } else { 0 }
@@ -121,7 +128,7 @@ impl Params {
             f(self.reflect_t_max),
             f(self.rough_cutoff),
             f(self.half_res),
-            0,
+            (self.adaptive_min & 0xFFFF) | (self.adaptive_max.min(0xFFFF) << 16),
         ]
     }
 
@@ -727,9 +734,9 @@ pub enum Method {
 impl Method {
     /// How many times the GPU runs the pipeline's ray generation shaders
     /// (each in turn) over the image.
-    pub fn passes(self) -> u32 {
+    pub fn passes(self, params: &Params) -> u32 {
         match self {
-            Method::Adaptive => adaptive::ADAPTIVE_MAX,
+            Method::Adaptive => params.adaptive_max,
             _ => 1,
         }
     }
@@ -816,6 +823,7 @@ mod tests {
         assert_eq!(&w[..4], &[64, 32, 3, FLAG_LIGHT | FLAG_ROBUST | 4 << 8]);
         assert_eq!(f32::from_bits(w[4]), s.camera.x);
         assert_eq!(f32::from_bits(w[13]), 1e4);
+        assert_eq!(w[19], 4 | 16 << 16, "the adaptive shader's passes");
     }
 
     #[test]

@@ -340,6 +340,12 @@ impl<'a, T> Lazy<'a, T> {
             init: std::rc::Rc::new(init),
         }
     }
+
+    /// Whether a rule has asked for the value (tests hold fast rules to
+    /// never asking).
+    pub fn is_computed(&self) -> bool {
+        self.cell.get().is_some()
+    }
 }
 
 impl<T> Clone for Lazy<'_, T> {
@@ -366,6 +372,26 @@ impl Group {
             Group::Perf => "perf",
             Group::Pedantic => "pedantic",
         }
+    }
+}
+
+/// The sites a rule has reported: one finding per site and position. A
+/// site reached along several call chains or targets is reported once
+/// where it is; two sites that share a position, or have none (a module
+/// without debug info), stay two findings, so how many findings a module
+/// gets does not depend on its debug info.
+#[derive(Default)]
+pub struct Reported(Vec<(usize, usize, Option<Location>)>);
+
+impl Reported {
+    /// True the first time site `inst` of program `program` is seen at `at`.
+    pub fn first(&mut self, program: usize, inst: usize, at: &Option<Location>) -> bool {
+        let key = (program, inst, at.clone());
+        if self.0.contains(&key) {
+            return false;
+        }
+        self.0.push(key);
+        true
     }
 }
 

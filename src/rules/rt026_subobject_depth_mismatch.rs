@@ -97,6 +97,8 @@ super::declare_rule! {
         group: Suspicious,
         summary: "subobject recursion depth differs from the pipeline description",
         kind: super::Kind::Pipeline(run),
+        // Two declared numbers compared: no recursion analysis.
+        analysis: Fast,
     }
 }
 

@@ -51,6 +51,7 @@ super::declare_rule! {
 
 fn check(ctx: &PipelineContext) -> Vec<Diagnostic> {
     let mut out: Vec<Diagnostic> = Vec::new();
+    let mut reported = super::Reported::default();
     for v in rays::visibility_traces(ctx.pipeline, &ctx.recursion.graph) {
         if v.flags & flags::TERMINATE_ON_FIRST_HIT != 0 {
             continue;
@@ -71,7 +72,7 @@ fn check(ctx: &PipelineContext) -> Vec<Diagnostic> {
             v.flags
         ))
         .with_help(format!("add `{}` to the ray flags", flag_name(program.language)));
-        if !out.iter().any(|o| o.primary == d.primary) {
+        if reported.first(v.program, v.inst, &v.location) {
             out.push(d);
         }
     }

@@ -44,6 +44,7 @@ super::declare_rule! {
 
 fn check(ctx: &PipelineContext) -> Vec<Diagnostic> {
     let mut out: Vec<Diagnostic> = Vec::new();
+    let mut reported = super::Reported::default();
     for v in rays::visibility_traces(ctx.pipeline, &ctx.recursion.graph) {
         if v.recording_closest_hits == 0 {
             continue;
@@ -70,7 +71,7 @@ fn check(ctx: &PipelineContext) -> Vec<Diagnostic> {
             "set `{}`, initialise the payload to the hit value and store the miss value in the miss shader",
             flag_name(program.language)
         ));
-        if !out.iter().any(|o| o.primary == d.primary) {
+        if reported.first(v.program, v.inst, &v.location) {
             out.push(d);
         }
     }

@@ -51,6 +51,7 @@ super::declare_rule! {
 
 fn check(ctx: &PipelineContext) -> Vec<Diagnostic> {
     let mut out: Vec<Diagnostic> = Vec::new();
+    let mut reported = super::Reported::default();
     let g = &ctx.recursion.graph;
     let visibility = rays::visibility_traces(ctx.pipeline, g);
     // Payload types that other traces use for more than a hit flag.
@@ -105,7 +106,7 @@ fn check(ctx: &PipelineContext) -> Vec<Diagnostic> {
             "the shaders it can run write only {member}; other traces use the same payload type for more"
         ))
         .with_help("give visibility traces their own 4-byte payload (a `uint` or `bool`)");
-        if !out.iter().any(|o| o.primary == d.primary) {
+        if reported.first(v.program, v.inst, &v.location) {
             out.push(d);
         }
     }

@@ -50,6 +50,7 @@ fn check(ctx: &PipelineContext) -> Vec<Diagnostic> {
     let p = ctx.pipeline;
     let g = &ctx.recursion.graph;
     let mut out: Vec<Diagnostic> = Vec::new();
+    let mut reported = super::Reported::default();
     if p.described() && p.all_geometry_opaque {
         for (n, node) in g.nodes.iter().enumerate() {
             if node.shader.stage != Stage::AnyHit {
@@ -114,7 +115,7 @@ fn check(ctx: &PipelineContext) -> Vec<Diagnostic> {
         .with_primary(t.location.clone(), "`Opaque` ray flag")
         .with_note(format!("hit groups it can reach: {list}; their any-hit shaders never run for this ray"))
         .with_help("drop the `Opaque` flag if the any-hit shaders must run for this ray");
-        if !out.iter().any(|o| o.primary == d.primary) {
+        if reported.first(t.program, t.inst, &t.location) {
             out.push(d);
         }
     }

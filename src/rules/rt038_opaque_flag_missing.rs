@@ -47,6 +47,7 @@ fn check(ctx: &PipelineContext) -> Vec<Diagnostic> {
     let p = ctx.pipeline;
     let g = &ctx.recursion.graph;
     let mut out: Vec<Diagnostic> = Vec::new();
+    let mut reported = super::Reported::default();
     if p.all_geometry_opaque {
         return out;
     }
@@ -80,7 +81,7 @@ fn check(ctx: &PipelineContext) -> Vec<Diagnostic> {
         .with_code(CODE)
         .with_primary(t.location.clone(), "ray flags without `Opaque`")
         .with_help("add `Opaque` to the ray flags");
-        if !out.iter().any(|o| o.primary == d.primary) {
+        if reported.first(t.program, t.inst, &t.location) {
             out.push(d);
         }
     }

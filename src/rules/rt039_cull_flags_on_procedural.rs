@@ -47,16 +47,19 @@ fn check(ctx: &PipelineContext) -> Vec<Diagnostic> {
     let p = ctx.pipeline;
     let g = &ctx.recursion.graph;
     let mut out: Vec<Diagnostic> = Vec::new();
+    let mut reported = super::Reported::default();
     let cull = flags::CULL_BACK_FACING | flags::CULL_FRONT_FACING;
     // Culling with SkipTriangles, whatever the pipeline.
-    for program in &p.programs {
+    for (pi, program) in p.programs.iter().enumerate() {
         for r in rays::rays(program) {
             let Some(f) = r.flags else { continue };
             if f & cull == 0 || f & flags::SKIP_TRIANGLES == 0 {
                 continue;
             }
+            let inst = program.sites[r.site].inst;
             push(
                 &mut out,
+                (&mut reported, pi, inst),
                 Diagnostic::new(
                     LEVEL,
                     NAME,
@@ -105,6 +108,7 @@ fn check(ctx: &PipelineContext) -> Vec<Diagnostic> {
             .join(", ");
         push(
             &mut out,
+            (&mut reported, t.program, t.inst),
             Diagnostic::new(
                 LEVEL,
                 NAME,
@@ -120,8 +124,13 @@ fn check(ctx: &PipelineContext) -> Vec<Diagnostic> {
     out
 }
 
-fn push(out: &mut Vec<Diagnostic>, d: Diagnostic) {
-    if !out.iter().any(|o| o.primary == d.primary) {
+fn push(
+    out: &mut Vec<Diagnostic>,
+    (reported, program, inst): (&mut super::Reported, usize, usize),
+    d: Diagnostic,
+) {
+    let at = d.primary.as_ref().map(|l| l.location.clone());
+    if reported.first(program, inst, &at) {
         out.push(d);
     }
 }

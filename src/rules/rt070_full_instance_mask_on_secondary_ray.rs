@@ -65,7 +65,7 @@ super::declare_rule! {
 fn check(ctx: &Context) -> Vec<Diagnostic> {
     let program = ctx.program;
     let mut out: Vec<Diagnostic> = Vec::new();
-    let mut seen = Vec::new();
+    let mut reported = super::Reported::default();
     for t in reached_traces(program) {
         let site = &program.sites[t.site];
         let secondary = match t.stage {
@@ -79,10 +79,9 @@ fn check(ctx: &Context) -> Vec<Diagnostic> {
             continue;
         }
         let at = program.location_in(site.inst, &t.chain);
-        if seen.contains(&at) {
+        if !reported.first(0, site.inst, &at) {
             continue;
         }
-        seen.push(at.clone());
         let why = match t.stage {
             Stage::RayGeneration => "in a loop of the ray generation shader",
             Stage::Miss => "from a miss shader",

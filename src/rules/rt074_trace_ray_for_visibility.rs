@@ -69,7 +69,7 @@ super::declare_rule! {
 fn check(ctx: &Context) -> Vec<Diagnostic> {
     let program = ctx.program;
     let mut out = Vec::new();
-    let mut seen = Vec::new();
+    let mut reported = super::Reported::default();
     for t in reached_traces(program) {
         let OperandValue::Const(flags) = t.operands.ray_flags else {
             continue;
@@ -79,10 +79,9 @@ fn check(ctx: &Context) -> Vec<Diagnostic> {
         }
         let site = &program.sites[t.site];
         let at = program.location_in(site.inst, &t.chain);
-        if seen.contains(&at) {
+        if !reported.first(0, site.inst, &at) {
             continue;
         }
-        seen.push(at.clone());
         let entry = &program.entry_points[t.entry];
         out.push(
             ctx.diagnostic(

@@ -45,6 +45,20 @@ fn number<T: std::str::FromStr>(knob: &str, v: &str) -> Result<T, String> {
         .map_err(|_| format!("bad value `{v}` for knob `{knob}`"))
 }
 
+/// A count of adaptive paths per pixel: 1 to [`MAX_PATHS`].
+fn paths(knob: &str, v: &str) -> Result<u32, String> {
+    let n: u32 = number(knob, v)?;
+    if !(1..=MAX_PATHS).contains(&n) {
+        return Err(format!("{knob} must be 1–{MAX_PATHS}"));
+    }
+    Ok(n)
+}
+
+/// The most adaptive paths per pixel a setting may ask for: each is a pass
+/// over the image, and the converged image's sample numbers start above
+/// them ([`reference::adaptive::CONVERGED_FIRST_SAMPLE`]).
+pub const MAX_PATHS: u32 = 1024;
+
 /// The knobs, in sweep order. Adding one is adding a row (and, when it is a
 /// new shader input, the field in [`Params`] and the shaders that read it).
 pub const KNOBS: &[Knob] = &[
@@ -155,7 +169,7 @@ pub const KNOBS: &[Knob] = &[
     Knob {
         name: "tolerance",
         doc: "the adaptive shader's variance tolerance (`Params.camera.w`); it traces 4 to 16 \
-              paths per pixel over 16 passes",
+              paths per pixel over 16 passes by default",
         shaders: &["adaptive", "adaptive-hlsl"],
         values: &["1e-2", "1e-3", "1e-4", "1e-5"],
         quick_shaders: &["adaptive"],
@@ -166,6 +180,32 @@ pub const KNOBS: &[Knob] = &[
                 return Err("tolerance must be 0 or above".into());
             }
             p.tolerance = t;
+            Ok(())
+        },
+    },
+    Knob {
+        name: "min_paths",
+        doc: "the adaptive shader's fewest paths per pixel, at the default most (16) and \
+              tolerance (`Params.knobs.w` bits 0–15)",
+        shaders: &["adaptive", "adaptive-hlsl"],
+        values: &["1", "2", "4", "8"],
+        quick_shaders: &["adaptive"],
+        quick_values: &["1"],
+        apply: |p, _, v| {
+            p.adaptive_min = paths("min_paths", v)?;
+            Ok(())
+        },
+    },
+    Knob {
+        name: "max_paths",
+        doc: "the adaptive shader's most paths per pixel, which is also its pass count, at the \
+              default fewest (4) and tolerance (`Params.knobs.w` bits 16–31)",
+        shaders: &["adaptive", "adaptive-hlsl"],
+        values: &["8", "16", "32", "64"],
+        quick_shaders: &["adaptive"],
+        quick_values: &["8"],
+        apply: |p, _, v| {
+            p.adaptive_max = paths("max_paths", v)?;
             Ok(())
         },
     },
@@ -279,6 +319,14 @@ impl Setting {
     pub fn apply(&self, params: &mut Params, scene: &Scene) -> Result<(), String> {
         for (k, v) in &self.knobs {
             (knob(k)?.apply)(params, scene, v)?;
+        }
+        if params.adaptive_min > params.adaptive_max {
+            return Err(format!(
+                "setting `{}`: min_paths {} is above max_paths {}",
+                self.name(),
+                params.adaptive_min,
+                params.adaptive_max
+            ));
         }
         Ok(())
     }
@@ -480,7 +528,7 @@ pub fn child_main(
     }
     // Multi-pass shaders (hybrid, adaptive) keep per-pixel state between
     // passes: zeroed before each timed run, as for a fresh frame.
-    let passes = verify::gpu::Passes::for_method(p.method);
+    let passes = verify::gpu::Passes::for_method(p.method, params);
     let usage = crate::vk::raw::BufferUsageFlags::STORAGE_BUFFER
         | crate::vk::raw::BufferUsageFlags::TRANSFER_DST;
     let scratch = if passes.scratch {
@@ -1124,6 +1172,30 @@ mod tests {
         assert_eq!(p.params.samples, 16);
         assert_eq!(p.params.reflect_t_max, 0.5 * diagonal(&p.scene));
         assert_eq!((p.params.rough_cutoff, p.params.robust), (0.2, false));
+        // The adaptive shader's paths: the uniform's last word, and the
+        // passes the GPU runs.
+        let p = prepare(
+            &shaders(),
+            "showcase",
+            &QUICK,
+            &Setting::parse("adaptive min_paths=2 max_paths=32").unwrap(),
+        )
+        .unwrap();
+        assert_eq!(p.params.to_words()[19], 2 | 32 << 16);
+        assert_eq!(p.method.passes(&p.params), 32);
+        assert!(all.iter().any(|s| s.name() == "adaptive-hlsl max_paths=64"));
+        assert!(!all.iter().any(|s| s.name() == "adaptive min_paths=4"));
+        for bad in [
+            "adaptive min_paths=0",
+            "adaptive min_paths=32",
+            "adaptive max_paths=5000",
+        ] {
+            let setting = Setting::parse(bad).unwrap();
+            assert!(
+                prepare(&shaders(), "showcase", &QUICK, &setting).is_err(),
+                "{bad}"
+            );
+        }
         assert!(Setting::parse("glossy warp=9").is_err());
         assert!(prepare(
             &shaders(),

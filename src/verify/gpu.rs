@@ -76,9 +76,9 @@ impl Passes {
         scratch: false,
     };
 
-    pub fn for_method(method: crate::reference::Method) -> Passes {
+    pub fn for_method(method: crate::reference::Method, params: &Params) -> Passes {
         Passes {
-            repeat: method.passes(),
+            repeat: method.passes(params),
             scratch: method.scratch(),
         }
     }
@@ -457,7 +457,12 @@ mod tests {
         assert_eq!(built.bindings[BINDINGS.len()..], CUTOUT_BINDINGS);
         // The hybrid shader's two passes, with their scratch buffers.
         let (p, s) = load("reflect_hybrid_hlsl.pipeline.toml", "showcase");
-        let built = plan(&p, &s, Passes::for_method(Method::Hybrid)).unwrap();
+        let built = plan(
+            &p,
+            &s,
+            Passes::for_method(Method::Hybrid, &Params::for_scene(&s, 8, 8, 1)),
+        )
+        .unwrap();
         assert_eq!(built.raygens, 2);
         assert_eq!(built.bindings[BINDINGS.len()..], SCRATCH_BINDINGS);
     }

@@ -2,13 +2,13 @@
 //! shader's reflection paths (screen space or ray) and the adaptive
 //! shader's paths per pixel, against a fixed-count render and a converged one.
 
-use crate::reference::adaptive::{self, ADAPTIVE_MAX, CONVERGED_FIRST_SAMPLE};
+use crate::reference::adaptive::{self, CONVERGED_FIRST_SAMPLE};
 use crate::reference::hybrid::{self, ReflectionPath};
 use crate::reference::{self, pack_rgba8, Method, Params, PixelPath, Scene, Vec3};
 use rayon::prelude::*;
 
-/// Paths of the converged image per pixel (independent of the first
-/// [`ADAPTIVE_MAX`]).
+/// Paths of the converged image per pixel (independent of the adaptive
+/// ones).
 pub const CONVERGED_PATHS: u32 = 64;
 
 /// What the CPU renders for a case.
@@ -26,6 +26,8 @@ pub struct CpuRender {
 /// The adaptive render's rays and error next to the fixed-count render's.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct AdaptiveStats {
+    /// The most paths per pixel: the fixed-count render traces this many.
+    pub max_paths: u32,
     pub rays: usize,
     pub fixed_rays: usize,
     /// Root mean square difference per channel against the converged image.
@@ -49,13 +51,14 @@ pub fn cpu_render(scene: &Scene, params: &Params, method: Method) -> CpuRender {
             let pixels: Vec<(u32, u32)> = (0..params.height)
                 .flat_map(|y| (0..params.width).map(move |x| (x, y)))
                 .collect();
-            // Per pixel: the adaptive path, 16 fixed paths, the converged
+            // Per pixel: the adaptive path, the maximum's fixed paths, the converged
             // paths (sample numbers of their own).
             let per_pixel: Vec<_> = pixels
                 .par_iter()
                 .map(|&(x, y)| {
                     let (path, acc) = adaptive::trace_adaptive(scene, params, x, y);
-                    let (fixed, fixed_rays) = adaptive::fixed(scene, params, x, y, 0, ADAPTIVE_MAX);
+                    let (fixed, fixed_rays) =
+                        adaptive::fixed(scene, params, x, y, 0, params.adaptive_max);
                     let (converged, _) = adaptive::fixed(
                         scene,
                         params,
@@ -73,7 +76,10 @@ pub fn cpu_render(scene: &Scene, params: &Params, method: Method) -> CpuRender {
                 })
                 .collect();
             let n = per_pixel.len().max(1) as f64;
-            let mut stats = AdaptiveStats::default();
+            let mut stats = AdaptiveStats {
+                max_paths: params.adaptive_max,
+                ..AdaptiveStats::default()
+            };
             let (mut e, mut f) = (0.0, 0.0);
             for (path, _, fixed_rays, ea, ef) in &per_pixel {
                 stats.rays += path.segments.len();
@@ -118,19 +124,20 @@ pub fn measure(cpu: &CpuRender, gpu: &[u32], differ: usize) -> Measured {
         // Rays: the CPU's paths for the same counts (they agree with the
         // GPU's but for `differ` pixels); errors in linear colour.
         let traced: u64 = gpu.iter().map(|&n| u64::from(n)).sum();
-        let full = u64::from(ADAPTIVE_MAX) * pixels as u64;
+        let max = stats.max_paths.max(1);
+        let full = u64::from(max) * pixels as u64;
         let picture = gpu
             .iter()
             .map(|&n| {
-                let v = (n.min(ADAPTIVE_MAX) * 255 / ADAPTIVE_MAX) & 0xFF;
+                let v = (n.min(max) * 255 / max) & 0xFF;
                 v | v << 8 | v << 16 | 0xFF00_0000
             })
             .collect();
         return Measured {
             note: format!(
-                "{traced} paths instead of {full} for {ADAPTIVE_MAX} fixed passes ({:.1} % saved; \
+                "{traced} paths instead of {full} for {max} fixed passes ({:.1} % saved; \
                  rays {} instead of {}, {:.1} % saved); RMSE against {CONVERGED_PATHS} \
-                 independent paths: adaptive {:.4}, fixed {ADAPTIVE_MAX} {:.4}; counts differ from the CPU's on {differ}",
+                 independent paths: adaptive {:.4}, fixed {max} {:.4}; counts differ from the CPU's on {differ}",
                 100.0 * (1.0 - traced as f64 / full as f64),
                 stats.rays,
                 stats.fixed_rays,

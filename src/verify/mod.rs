@@ -932,7 +932,7 @@ pub fn child_main(
             None,
             &scene,
             &params,
-            gpu::Passes::for_method(method),
+            gpu::Passes::for_method(method, &params),
         )?,
         Loaded::Compute { words, entry } => {
             if !ctx.info().ray_query {

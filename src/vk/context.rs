@@ -73,6 +73,9 @@ pub struct DeviceInfo {
     /// feature were present and are enabled (not under a validation layer
     /// older than the extension).
     pub position_fetch: bool,
+    /// `VK_NV_ray_tracing_invocation_reorder` (shader execution reordering,
+    /// HLSL `dx::HitObject`) and its feature were present and are enabled.
+    pub invocation_reorder: bool,
     /// Core features enabled because the device has them; naga's
     /// `primitive_index` needs `geometryShader`.
     pub geometry_shader: bool,
@@ -339,8 +342,12 @@ fn open_device(
     // A validation layer older than an optional extension rejects its
     // structures at device creation (Debian bookworm's 1.3.239 layer and
     // position fetch, which came with the 1.3.250 headers): leave it off.
+    // Invocation reorder came with the 1.3.235 headers.
     if layer_version.is_some_and(|v| v < vk::make_api_version(0, 1, 3, 250)) {
         candidate.info.position_fetch = false;
+    }
+    if layer_version.is_some_and(|v| v < vk::make_api_version(0, 1, 3, 235)) {
+        candidate.info.invocation_reorder = false;
     }
     let device = create_device(instance, &candidate)?;
     // SAFETY: queue family and index were requested at device creation.
@@ -452,6 +459,8 @@ fn examine(
     let mut frt = vk::PhysicalDeviceRayTracingPipelineFeaturesKHR::default();
     let mut fpf = vk::PhysicalDeviceRayTracingPositionFetchFeaturesKHR::default();
     let has_position_fetch = has(vk::KHR_RAY_TRACING_POSITION_FETCH_NAME);
+    let mut fir = vk::PhysicalDeviceRayTracingInvocationReorderFeaturesNV::default();
+    let has_reorder = has(vk::NV_RAY_TRACING_INVOCATION_REORDER_NAME);
     let mut features = vk::PhysicalDeviceFeatures2::default()
         .push_next(&mut f11)
         .push_next(&mut f12)
@@ -460,6 +469,9 @@ fn examine(
         .push_next(&mut frt);
     if has_position_fetch {
         features = features.push_next(&mut fpf);
+    }
+    if has_reorder {
+        features = features.push_next(&mut fir);
     }
     // SAFETY: the chain holds only structures of this device's version and extensions.
     unsafe { instance.get_physical_device_features2(physical, &mut features) };
@@ -524,6 +536,7 @@ fn examine(
             device_type: props.device_type,
             ray_query,
             position_fetch: has_position_fetch && fpf.ray_tracing_position_fetch == vk::TRUE,
+            invocation_reorder: has_reorder && fir.ray_tracing_invocation_reorder == vk::TRUE,
             geometry_shader: core.geometry_shader == vk::TRUE,
             shader_int64: core.shader_int64 == vk::TRUE,
             sixteen_bit: f12.shader_float16 == vk::TRUE
@@ -607,6 +620,9 @@ fn create_device(instance: &ash::Instance, c: &Candidate) -> Result<ash::Device>
     if c.info.position_fetch {
         extensions.push(vk::KHR_RAY_TRACING_POSITION_FETCH_NAME.as_ptr());
     }
+    if c.info.invocation_reorder {
+        extensions.push(vk::NV_RAY_TRACING_INVOCATION_REORDER_NAME.as_ptr());
+    }
     let priorities = [1.0f32];
     let queues = [vk::DeviceQueueCreateInfo::default()
         .queue_family_index(c.queue_family)
@@ -660,6 +676,11 @@ fn create_device(instance: &ash::Instance, c: &Candidate) -> Result<ash::Device>
         .ray_tracing_position_fetch(true);
     if c.info.position_fetch {
         features = features.push_next(&mut fpf);
+    }
+    let mut fir = vk::PhysicalDeviceRayTracingInvocationReorderFeaturesNV::default()
+        .ray_tracing_invocation_reorder(true);
+    if c.info.invocation_reorder {
+        features = features.push_next(&mut fir);
     }
     let create = vk::DeviceCreateInfo::default()
         .queue_create_infos(&queues)

@@ -48,10 +48,22 @@ pub fn snapshot(name: &str, actual: &str) {
     );
 }
 
+/// The CLI, run in the checkout. Its result cache goes to a folder under
+/// the system's temporary one, never into the checkout (a test that wants
+/// the default folder removes `RTLINT_CACHE_DIR`).
 pub fn rtlint() -> Command {
     let mut c = Command::new(env!("CARGO_BIN_EXE_rtlint"));
-    c.current_dir(root()).env("NO_COLOR", "1");
+    c.current_dir(root())
+        .env("NO_COLOR", "1")
+        .env("RTLINT_CACHE_DIR", test_cache_dir());
     c
+}
+
+/// The result cache of the tests' CLI runs, shared by every test process
+/// (entries are keyed by the build and written whole, so runs never see
+/// each other's half-written or stale results).
+pub fn test_cache_dir() -> std::path::PathBuf {
+    std::env::temp_dir().join("rtlint-test-cache")
 }
 
 /// The ray-tracing device, under the skip policy ([`rtlint_testkit::require`]):

@@ -17,6 +17,8 @@
 //! that need them print [`NO_RAY_QUERY`] and return; `scripts/device-tests`
 //! counts those as skipped.
 
+pub mod gen;
+pub mod gen_check;
 pub mod slang;
 
 pub use slang::{find_library, stage_name, Slang};

@@ -110,8 +110,10 @@ pub const ATTRIBUTES: &[AttrInfo] = &[
     a("vk::ext_instruction", Implemented, FUNCTION),
     a("vk::ext_reference", Implemented, PARAM),
     a("vk::ext_literal", Implemented, PARAM),
-    // Struct members only (`OpMemberDecorate`); elsewhere refused by site.
-    a("vk::ext_decorate", Implemented, MEMBER),
+    // `OpMemberDecorate` on struct members, `OpDecorate` on global variables
+    // and function parameters; elsewhere refused (by site, or where the
+    // declaration becomes no variable: `lower/inline_spirv.rs`).
+    a("vk::ext_decorate", Implemented, MEMBER | GLOBAL | PARAM),
     a("vk::ext_decorate_id", Refused("`vk::ext_decorate_id`"), ANY),
     a(
         "vk::ext_decorate_string",

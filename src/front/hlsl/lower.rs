@@ -23,6 +23,7 @@ mod resource_calls;
 mod ser;
 mod stmt;
 mod storage16;
+mod system_values;
 mod templates;
 mod wave;
 
@@ -39,6 +40,7 @@ use rspirv::dr::{self, Builder, InsertPoint, Instruction, Operand};
 use spirv::{BuiltIn, Capability, Decoration, Op, StorageClass, Word as Id};
 use std::collections::{BTreeSet, HashMap, HashSet};
 use std::path::PathBuf;
+use system_values::system_value;
 
 #[derive(Clone, Debug)]
 pub struct Val {
@@ -346,50 +348,25 @@ fn builtin_constant(name: &str) -> Option<u32> {
     })
 }
 
-/// System-value intrinsics: builtin, type, stages that may read it.
-fn system_value(name: &str) -> Option<(BuiltIn, Ty, &'static [Stage])> {
-    use Stage::*;
-    const ALL: &[Stage] = &[
-        RayGeneration,
-        ClosestHit,
-        AnyHit,
-        Miss,
-        Intersection,
-        Callable,
-    ];
-    const RAY: &[Stage] = &[ClosestHit, AnyHit, Miss, Intersection];
-    const HIT: &[Stage] = &[ClosestHit, AnyHit, Intersection];
-    let f3 = Ty::Vec(ScalarKind::Float, 3);
-    let u = Ty::ScalarKind(ScalarKind::Uint);
-    let f = Ty::ScalarKind(ScalarKind::Float);
-    Some(match name {
-        "DispatchRaysIndex" => (BuiltIn::LaunchIdKHR, Ty::Vec(ScalarKind::Uint, 3), ALL),
-        "DispatchRaysDimensions" => (BuiltIn::LaunchSizeKHR, Ty::Vec(ScalarKind::Uint, 3), ALL),
-        "WorldRayOrigin" => (BuiltIn::WorldRayOriginKHR, f3, RAY),
-        "WorldRayDirection" => (BuiltIn::WorldRayDirectionKHR, f3, RAY),
-        "ObjectRayOrigin" => (BuiltIn::ObjectRayOriginKHR, f3, HIT),
-        "ObjectRayDirection" => (BuiltIn::ObjectRayDirectionKHR, f3, HIT),
-        "RayTMin" => (BuiltIn::RayTminKHR, f, RAY),
-        "RayTCurrent" => (BuiltIn::RayTmaxKHR, f, RAY),
-        "RayFlags" => (BuiltIn::IncomingRayFlagsKHR, u, RAY),
-        "InstanceIndex" => (BuiltIn::InstanceId, u, HIT),
-        "InstanceID" => (BuiltIn::InstanceCustomIndexKHR, u, HIT),
-        "GeometryIndex" => (BuiltIn::RayGeometryIndexKHR, u, HIT),
-        "PrimitiveIndex" => (BuiltIn::PrimitiveId, u, HIT),
-        "HitKind" => (BuiltIn::HitKindKHR, u, &[ClosestHit, AnyHit]),
-        // SPIR-V holds these as 4 columns of float3, which is HLSL's float4x3.
-        "ObjectToWorld4x3" | "ObjectToWorld3x4" | "ObjectToWorld" => (
-            BuiltIn::ObjectToWorldKHR,
-            Ty::Mat(ScalarKind::Float, 4, 3),
-            HIT,
-        ),
-        "WorldToObject4x3" | "WorldToObject3x4" | "WorldToObject" => (
-            BuiltIn::WorldToObjectKHR,
-            Ty::Mat(ScalarKind::Float, 4, 3),
-            HIT,
-        ),
-        _ => return None,
-    })
+/// The OpenCL-only capability (`Kernel`, `Addresses`, `Linkage`) that `c` is
+/// or implicitly declares, by the SPIR-V grammar rspirv carries: a module
+/// declaring it fails Vulkan validation, so it is refused where written.
+fn kernel_only(c: Capability) -> Option<Capability> {
+    let mut todo = vec![c];
+    let mut seen = Vec::new();
+    while let Some(c) = todo.pop() {
+        if matches!(
+            c,
+            Capability::Kernel | Capability::Addresses | Capability::Linkage
+        ) {
+            return Some(c);
+        }
+        if !seen.contains(&c) {
+            seen.push(c);
+            todo.extend(Operand::Capability(c).required_capabilities());
+        }
+    }
+    None
 }
 
 fn swizzle_comps(s: &str) -> Option<Vec<u32>> {
@@ -637,6 +614,15 @@ impl<'a> Lowerer<'a> {
                         .ok_or_else(|| {
                             Error::new(e.pos, format!("unknown SPIR-V capability {n}"))
                         })?;
+                    if let Some(base) = kernel_only(c) {
+                        return Err(Error::new(
+                            e.pos,
+                            format!(
+                                "capability `{c:?}` ({n}) is for OpenCL kernels (it implies `{base:?}`), \
+                                 which Vulkan does not allow"
+                            ),
+                        ));
+                    }
                     req.1.push(c);
                 }
                 _ => {}
@@ -932,25 +918,7 @@ mod tests {
     }
 
     #[test]
-    fn system_values_follow_dxc() {
-        let (b, t, stages) = system_value("RayTCurrent").unwrap();
-        assert_eq!(
-            (b, t),
-            (BuiltIn::RayTmaxKHR, Ty::ScalarKind(ScalarKind::Float))
-        );
-        assert!(!stages.contains(&Stage::RayGeneration));
-        assert_eq!(
-            system_value("InstanceIndex").unwrap().0,
-            BuiltIn::InstanceId
-        );
-        assert_eq!(
-            system_value("InstanceID").unwrap().0,
-            BuiltIn::InstanceCustomIndexKHR
-        );
-        assert_eq!(
-            system_value("ObjectToWorld4x3").unwrap().1,
-            Ty::Mat(ScalarKind::Float, 4, 3)
-        );
+    fn builtin_constants_and_stages_follow_dxc() {
         assert_eq!(
             builtin_constant("RAY_FLAG_SKIP_PROCEDURAL_PRIMITIVES"),
             Some(0x200)

@@ -86,10 +86,15 @@ impl<'a> Lowerer<'a> {
         }
         self.arity(name, args, arity, pos)?;
         let v = self.expr(&args[0])?;
-        if v.ty.scalar().is_some_and(ScalarKind::is_16) {
-            // Vulkan's derivatives are 32-bit; widening would change the type.
-            return Err(unsupported(pos, format!("`{name}` of 16-bit values")).len(len));
-        }
+        // Vulkan's derivatives are 32-bit: a 16-bit float is widened for the
+        // instruction and the result narrowed back to its type, as DXC does.
+        let narrow_to = match v.ty.scalar() {
+            Some(ScalarKind::Half) => Some(v.ty.clone()),
+            Some(s) if s.is_16() => {
+                return Err(unsupported(pos, format!("`{name}` of 16-bit integers")).len(len))
+            }
+            _ => None,
+        };
         let ty = match v.ty {
             Ty::ScalarKind(_) => Ty::ScalarKind(ScalarKind::Float),
             Ty::Vec(_, n) => Ty::Vec(ScalarKind::Float, n),
@@ -109,7 +114,10 @@ impl<'a> Lowerer<'a> {
         }
         let tid = self.ty_id(&ty)?;
         let id = self.inst(op, Some(tid), vec![Operand::IdRef(v.id)])?;
-        Ok(Val { id, ty })
+        match narrow_to {
+            Some(t) => self.convert(Val { id, ty }, &t, pos, true),
+            None => Ok(Val { id, ty }),
+        }
     }
 
     pub(super) fn glsl(&mut self, inst: G, ty: &Ty, args: &[Id]) -> Result<Val> {
@@ -287,7 +295,7 @@ impl<'a> Lowerer<'a> {
         if let Some(c) = self.find_user(name) {
             return self.call_user(name, c, args.iter().map(Arg::Expr).collect(), pos);
         }
-        if let Some((bi, ty, stages)) = system_value(name) {
+        if let Some(sv) = system_value(name) {
             self.arity(name, args, 0, pos)?;
             if self.f.cur_stage == Some(Stage::Compute) {
                 return Err(Error::new(
@@ -296,10 +304,10 @@ impl<'a> Lowerer<'a> {
                 )
                 .len(name.len() as u32));
             }
-            self.stage_check(name, stages, pos)?;
+            self.stage_check(name, sv.stages, pos)?;
             self.ray_tracing_caps();
-            let v = self.read_builtin(bi, &ty)?;
-            if name.ends_with("3x4") || name == "ObjectToWorld" || name == "WorldToObject" {
+            let v = self.read_builtin(sv.builtin, &sv.ty)?;
+            if sv.transpose {
                 let t = Ty::Mat(ScalarKind::Float, 3, 4);
                 let tid = self.ty_id(&t)?;
                 let id = self.op(Op::Transpose, tid, &[v.id])?;
@@ -349,11 +357,13 @@ impl<'a> Lowerer<'a> {
             );
         }
         // 16-bit values: the arithmetic families, which keep their width
-        // (`f32tof16`/`f16tof32` take them exactly as `float`/`uint`).
+        // (`f32tof16`/`f16tof32` take them exactly as `float`/`uint`), and
+        // `countbits` of 16-bit integers, widened below as DXC does.
         if vals
             .iter()
             .any(|v| v.ty.scalar().is_some_and(ScalarKind::is_16))
             && matches!(m, Math::As32(_) | Math::Bits(_))
+            && !matches!(m, Math::Bits(Bit::Count))
         {
             return Err(
                 unsupported(pos, format!("`{name}` of 16-bit values")).len(name.len() as u32)
@@ -635,7 +645,17 @@ impl<'a> Lowerer<'a> {
                 self.build(&t, &mut it, pos)
             }
             Math::Bits(bit) => {
-                let v = vals.into_iter().next().unwrap_or_else(|| unreachable!());
+                let mut v = vals.into_iter().next().unwrap_or_else(|| unreachable!());
+                if matches!(v.ty.scalar(), Some(ScalarKind::Int16 | ScalarKind::Uint16))
+                    && matches!(v.ty, Ty::ScalarKind(_) | Ty::Vec(..))
+                {
+                    // Vulkan's OpBitCount is 32-bit: zero-extended first
+                    // (`OpUConvert`, whatever the signedness), as DXC does.
+                    let t = v.ty.with_scalar(ScalarKind::Uint);
+                    let tid = self.ty_id(&t)?;
+                    let id = self.op(Op::UConvert, tid, &[v.id])?;
+                    v = Val { id, ty: t };
+                }
                 let s = v.ty.scalar();
                 if !matches!(s, Some(ScalarKind::Int | ScalarKind::Uint))
                     || matches!(v.ty, Ty::Mat(..))

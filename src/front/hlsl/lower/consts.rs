@@ -1,6 +1,7 @@
 //! SPIR-V types and constants: type ids, layouts, constant folding and
 //! evaluation of constant expressions.
 
+use super::inline_spirv::decoration_operands;
 use super::*;
 
 impl<'a> Lowerer<'a> {
@@ -37,7 +38,8 @@ impl<'a> Lowerer<'a> {
         self.spv(t, Layout::None)
     }
 
-    /// An `OpUndef` of type `t` (one per type, at module scope).
+    /// An `OpUndef` of type `t` (one per type, at module scope, where
+    /// `Builder::undef` would not put it while a block is selected).
     pub(super) fn undef(&mut self, t: &Ty) -> Result<Id> {
         let tid = self.ty_id(t)?;
         if let Some(&id) = self.undefs.get(&tid) {
@@ -229,14 +231,8 @@ impl<'a> Lowerer<'a> {
             self.b.decorate(id, Decoration::Block, []);
         }
         for (i, d, ops) in self.member_decorations.get(&k).cloned().unwrap_or_default() {
-            let ops: Vec<Operand> = match (d, ops.as_slice()) {
-                (Decoration::BuiltIn, [b]) => match BuiltIn::from_u32(*b) {
-                    Some(b) => vec![Operand::BuiltIn(b)],
-                    None => vec![Operand::LiteralBit32(*b)],
-                },
-                _ => ops.into_iter().map(Operand::LiteralBit32).collect(),
-            };
-            self.b.member_decorate(id, i, d, ops);
+            self.b
+                .member_decorate(id, i, d, decoration_operands(d, ops));
         }
         if layout != Layout::None {
             let offsets = struct_offsets(k, layout, &self.structs);

@@ -20,6 +20,8 @@ pub(super) struct DebugInfo {
 }
 
 impl<'a> Lowerer<'a> {
+    /// A debug instruction at module scope (`Builder::ext_inst` emits only
+    /// into a block).
     fn dbg_inst(&mut self, d: &DebugInfo, which: D, args: &[Id]) -> Id {
         let id = self.b.id();
         let mut ops = vec![

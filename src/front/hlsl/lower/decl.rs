@@ -1,6 +1,7 @@
 //! Declarations: structs, typedefs, enums, functions and methods, globals,
 //! constant buffers and resource bindings.
 
+use super::inline_spirv::no_ext_decorate;
 use super::*;
 
 impl<'a> Lowerer<'a> {
@@ -773,23 +774,30 @@ impl<'a> Lowerer<'a> {
                             _ => self.auto_binding(&mut used, &mut next_auto),
                         }),
                     };
+                    no_ext_decorate(attrs, "a `cbuffer`")?;
                     let members: Vec<&VarDecl> = members.iter().collect();
                     self.declare_cbuffer(attrs, name, *pos, binding, &members)?;
                 }
                 Item::Var(v) if v.attrs.iter().any(is_ext_builtin) => {
-                    self.declare_ext_builtin(v)?
+                    self.declare_ext_builtin(v)?;
+                    self.ext_decorate_global(v)?;
                 }
                 Item::Var(v) if subobject::Kind::from_type_name(&v.ty.name).is_some() => {
+                    no_ext_decorate(&v.attrs, "a subobject")?;
                     self.declare_subobject(v)?
                 }
-                Item::Var(v) if self.in_implicit_globals(v)? => globals_members.push(v),
+                Item::Var(v) if self.in_implicit_globals(v)? => {
+                    no_ext_decorate(&v.attrs, "a member of `$Globals`")?;
+                    globals_members.push(v)
+                }
                 Item::Var(v) => {
                     // A namespace's or struct's names are in scope in its initializers.
                     let scope = v.name.rsplit_once("::").map(|(n, _)| format!("{n}::"));
                     let saved = std::mem::replace(&mut self.f.cur_ns, scope.unwrap_or_default());
                     let r = self.declare_global_var(v, &mut used, &mut next_auto);
                     self.f.cur_ns = saved;
-                    r?
+                    r?;
+                    self.ext_decorate_global(v)?;
                 }
                 _ => {}
             }
@@ -805,6 +813,21 @@ impl<'a> Lowerer<'a> {
         let samplers = self.auto_binding(&mut used, &mut next_auto);
         self.heap_bindings = (resources, samplers);
         Ok(())
+    }
+
+    /// `[[vk::ext_decorate]]` on a global: decorates its variable; a global
+    /// that became a constant has none, and is refused.
+    fn ext_decorate_global(&mut self, v: &VarDecl) -> Result<()> {
+        if !v.attrs.iter().any(|a| a.name == "vk::ext_decorate") {
+            return Ok(());
+        }
+        match self.globals.get(&v.name) {
+            Some(Global::Place(Place::Ptr { ptr, .. })) => {
+                let ptr = *ptr;
+                self.ext_decorate(&v.attrs, ptr)
+            }
+            _ => no_ext_decorate(&v.attrs, "a constant"),
+        }
     }
 
     /// A DXR subobject: its content is recorded, nothing is emitted.
@@ -1351,28 +1374,19 @@ impl<'a> Lowerer<'a> {
                 ))
             }
         };
-        if s.is_16() {
-            return Err(unsupported(v.pos, "16-bit specialization constants"));
-        }
         let tid = self.sc_id(*s);
         let id = match s {
-            ScalarKind::Bool => {
-                let on = default.as_f64() != 0.0;
-                let id = self.b.id();
-                let op = if on {
-                    Op::SpecConstantTrue
-                } else {
-                    Op::SpecConstantFalse
-                };
-                self.b.insert_types_global_values(
-                    InsertPoint::End,
-                    Instruction::new(op, Some(tid), Some(id), vec![]),
-                );
-                id
-            }
+            ScalarKind::Bool if default.as_f64() != 0.0 => self.b.spec_constant_true(tid),
+            ScalarKind::Bool => self.b.spec_constant_false(tid),
             ScalarKind::Float => self
                 .b
                 .spec_constant_bit32(tid, (default.as_f64() as f32).to_bits()),
+            // A 16-bit literal is one word: the value in its low bits,
+            // zero-extended (floats, unsigned) or sign-extended (signed).
+            ScalarKind::Half => self.b.spec_constant_bit32(
+                tid,
+                super::consts::f32_to_f16(default.as_f64() as f32) as u32,
+            ),
             _ => {
                 let i = match default {
                     ConstValue::I(i) => i,
@@ -1380,6 +1394,10 @@ impl<'a> Lowerer<'a> {
                 };
                 if s.is_64() {
                     self.b.spec_constant_bit64(tid, i as u64)
+                } else if *s == ScalarKind::Int16 {
+                    self.b.spec_constant_bit32(tid, i as i16 as i32 as u32)
+                } else if *s == ScalarKind::Uint16 {
+                    self.b.spec_constant_bit32(tid, i as u16 as u32)
                 } else {
                     self.b.spec_constant_bit32(tid, i as u32)
                 }

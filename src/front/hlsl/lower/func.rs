@@ -1,6 +1,7 @@
 //! Functions: bodies, entry-point parameters, stage variables and the
 //! per-function emission helpers.
 
+use super::inline_spirv::no_ext_decorate;
 use super::*;
 
 impl<'a> Lowerer<'a> {
@@ -144,7 +145,8 @@ impl<'a> Lowerer<'a> {
             let first = sig.this.is_some() as usize;
             for (j, (p, decl)) in params.zip(&f.params).enumerate() {
                 if let Some((_, place)) = sig.bound.iter().find(|(b, _)| *b == j + first) {
-                    // A buffer this copy is specialized on.
+                    // A buffer this copy is specialized on: no parameter.
+                    no_ext_decorate(&decl.attrs, "a resource parameter")?;
                     if let Place::Ptr { ptr, .. } = place {
                         self.use_global(*ptr);
                     }
@@ -154,6 +156,11 @@ impl<'a> Lowerer<'a> {
                 let pty = ptys.next().unwrap_or_default();
                 let id = self.b.function_parameter(pty)?;
                 self.b.name(id, decl.name.clone());
+                if sig.stage.is_some() {
+                    // A pixel entry point's parameters are its inputs.
+                    no_ext_decorate(&decl.attrs, "an entry point's parameter")?;
+                }
+                self.ext_decorate(&decl.attrs, id)?;
                 if p.ty.is_resource() {
                     self.resource_vars.insert(id);
                 }
@@ -227,6 +234,8 @@ impl<'a> Lowerer<'a> {
         stage: Stage,
     ) -> Result<()> {
         for (i, (p, decl)) in sig.params.iter().zip(&f.params).enumerate() {
+            // Entry point parameters become stage variables or payloads.
+            no_ext_decorate(&decl.attrs, "an entry point's parameter")?;
             let is_struct = matches!(p.ty, Ty::Struct(_));
             // DXR fixes the parameters by position: payload (or callable data)
             // first, `inout`; hit attributes second, `in`.
@@ -344,7 +353,8 @@ impl<'a> Lowerer<'a> {
         Ok(var)
     }
 
-    /// A module-scope variable, even while a function is being emitted.
+    /// A module-scope variable, even while a function is being emitted
+    /// (`Builder::variable` would put it in the selected block).
     pub(super) fn global_var(&mut self, pty: Id, class: StorageClass, init: Option<Id>) -> Id {
         let id = self.b.id();
         let mut ops = vec![Operand::StorageClass(class)];

@@ -92,6 +92,55 @@ impl<'a> Lowerer<'a> {
         }
         Ok((d, ops))
     }
+
+    /// `[[vk::ext_decorate]]` on a global variable or a parameter: an
+    /// `OpDecorate` of `target` per attribute, as DXC emits them.
+    pub(super) fn ext_decorate(&mut self, attrs: &[Attr], target: Id) -> Result<()> {
+        for a in attrs.iter().filter(|a| a.name == "vk::ext_decorate") {
+            let (d, ops) = self.ext_decoration(a)?;
+            self.b.decorate(target, d, decoration_operands(d, ops));
+        }
+        Ok(())
+    }
+}
+
+/// Extended instruction sets a Vulkan module may import: GLSL.std.450, the
+/// debug-info sets, AMD's, and any non-semantic one (`NonSemantic.*`).
+fn known_instruction_set(name: &str) -> bool {
+    name.starts_with("NonSemantic.")
+        || matches!(
+            name,
+            "GLSL.std.450"
+                | "DebugInfo"
+                | "OpenCL.DebugInfo.100"
+                | "SPV_AMD_shader_ballot"
+                | "SPV_AMD_shader_explicit_vertex_parameter"
+                | "SPV_AMD_gcn_shader"
+                | "SPV_AMD_shader_trinary_minmax"
+        )
+}
+
+/// A decoration's literal operands as rspirv operands (a `BuiltIn` typed,
+/// so the module disassembles by name).
+pub(super) fn decoration_operands(d: Decoration, ops: Vec<u32>) -> Vec<Operand> {
+    match (d, ops.as_slice()) {
+        (Decoration::BuiltIn, [b]) => match BuiltIn::from_u32(*b) {
+            Some(b) => vec![Operand::BuiltIn(b)],
+            None => vec![Operand::LiteralBit32(*b)],
+        },
+        _ => ops.into_iter().map(Operand::LiteralBit32).collect(),
+    }
+}
+
+/// Refuses `[[vk::ext_decorate]]` on a declaration that becomes no variable
+/// of its own (`on` says what it is), rather than dropping it.
+pub(super) fn no_ext_decorate(attrs: &[Attr], on: &str) -> Result<()> {
+    match attrs.iter().find(|a| a.name == "vk::ext_decorate") {
+        Some(a) => {
+            Err(unsupported(a.pos, format!("`vk::ext_decorate` on {on}")).len(a.name.len() as u32))
+        }
+        None => Ok(()),
+    }
 }
 
 impl<'a> Lowerer<'a> {
@@ -122,6 +171,13 @@ impl<'a> Lowerer<'a> {
         let (op_e, set) = match &a.args[..] {
             [o] => (o, None),
             [o, s] => match &s.kind {
+                // A set spirv-val does not know makes the module invalid.
+                ExprKind::Str(name) if !known_instruction_set(name) => {
+                    return Err(unsupported(
+                        s.pos,
+                        format!("extended instruction set \"{name}\""),
+                    ))
+                }
                 ExprKind::Str(s) => (o, Some(s.clone())),
                 _ => return Err(expected()),
             },
@@ -148,6 +204,7 @@ impl<'a> Lowerer<'a> {
         for (p, e) in f.params.iter().zip(args) {
             let t = self.resolve_ty(&p.ty, &f.ns)?;
             let t = self.apply_dims(t, &p.dims, p.pos, false)?;
+            no_ext_decorate(&p.attrs, "a parameter of a `vk::ext_instruction` function")?;
             let has = |n: &str| p.attrs.iter().any(|a| a.name == n);
             if has("vk::ext_reference") {
                 // The pointer itself: only a variable holding exactly the

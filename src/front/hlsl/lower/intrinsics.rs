@@ -236,7 +236,7 @@ const BITS: &[Intrinsic] = {
     ]
 };
 
-/// Ray-tracing calls (system values are `system_value`'s table).
+/// Ray-tracing calls (system values are the table in `lower/system_values.rs`).
 const RAY_TRACING: &[Intrinsic] = {
     use Lowering::Special as S;
     use Stage::*;

@@ -492,19 +492,7 @@ impl<'a> Lowerer<'a> {
     /// locals) of type `tid` starting as `init`.
     fn private_var(&mut self, tid: Id, init: Id, name: &str) -> Id {
         let pty = self.b.type_pointer(None, StorageClass::Private, tid);
-        let var = self.b.id();
-        self.b.insert_types_global_values(
-            InsertPoint::End,
-            Instruction::new(
-                Op::Variable,
-                Some(pty),
-                Some(var),
-                vec![
-                    Operand::StorageClass(StorageClass::Private),
-                    Operand::IdRef(init),
-                ],
-            ),
-        );
+        let var = self.global_var(pty, StorageClass::Private, Some(init));
         self.b.name(var, name.to_string());
         self.use_global(var);
         var
