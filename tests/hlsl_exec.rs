@@ -277,12 +277,21 @@ fn scene(ctx: &Context, geom: Geom) -> AccelerationStructure {
 /// `groups`, traces a 4×4 launch with `geom`'s scene at binding 0 and a
 /// 256-byte storage buffer at binding 1, and returns that buffer's bytes.
 fn trace(ctx: &Context, stages: &[ShaderStage<'_>], groups: &[Group], geom: Geom) -> Vec<u8> {
-    let tlas = scene(ctx, geom);
+    trace_in(ctx, stages, groups, &scene(ctx, geom))
+}
+
+/// [`trace`] in the scene `tlas`.
+fn trace_in(
+    ctx: &Context,
+    stages: &[ShaderStage<'_>],
+    groups: &[Group],
+    tlas: &AccelerationStructure,
+) -> Vec<u8> {
     let out = storage(ctx, 16 * 16);
     let (layout, resources) = bindings(&[
         (
             BindingKind::AccelerationStructure,
-            Resource::AccelerationStructure(&tlas),
+            Resource::AccelerationStructure(tlas),
         ),
         (BindingKind::StorageBuffer, Resource::Buffer(&out)),
     ]);
@@ -899,30 +908,7 @@ fn position_fetch_on_the_driver() {
     )
     .unwrap();
     let tlas = AccelerationStructure::top_level(&ctx, &[Instance::identity(&blas)]).unwrap();
-    let out = storage(&ctx, 16 * 16);
-    let (layout, resources) = bindings(&[
-        (
-            BindingKind::AccelerationStructure,
-            Resource::AccelerationStructure(&tlas),
-        ),
-        (BindingKind::StorageBuffer, Resource::Buffer(&out)),
-    ]);
-    let pipeline = RayTracingPipeline::new(
-        &ctx,
-        &RayTracingPipelineDesc {
-            stages: &stages,
-            groups: &groups,
-            max_recursion_depth: 1,
-            bindings: &layout,
-            push_constant_size: 0,
-            stack_size: None,
-        },
-    )
-    .unwrap_or_else(|e| panic!("pipeline: {e}"));
-    pipeline
-        .trace_rays(&resources, 4, 4, 1)
-        .unwrap_or_else(|e| panic!("trace: {e}"));
-    let got = read4(&out.read(), 16);
+    let got = read4(&trace_in(&ctx, &stages, &groups, &tlas), 16);
     let sub = |a: [f32; 3], b: [f32; 3]| [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
     let (e1, e2) = (sub(v[1], v[0]), sub(v[2], v[0]));
     let n = [

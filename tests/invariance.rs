@@ -100,30 +100,7 @@ fn parse(words: &[u32], path: &Path, language: Language) -> Program {
 /// Replaces what may legitimately differ (positions, the folder a mode's
 /// modules live in) so the rest can be compared.
 fn scrub(v: &mut Value, roots: &[String]) {
-    match v {
-        Value::Object(m) => {
-            for k in [
-                "line",
-                "column",
-                "end_line",
-                "end_column",
-                "path",
-                "file",
-                "def_line",
-                "use_line",
-                "location",
-                "pipeline",
-            ] {
-                m.remove(k);
-            }
-            for x in m.values_mut() {
-                scrub(x, roots);
-            }
-        }
-        Value::Array(a) => a.iter_mut().for_each(|x| scrub(x, roots)),
-        Value::String(s) => *s = scrub_text(s, roots),
-        _ => {}
-    }
+    rtlint_testkit::gen_check::scrub_json(v, &|s| scrub_text(s, roots));
 }
 
 fn scrub_text(s: &str, roots: &[String]) -> String {
@@ -144,25 +121,7 @@ fn scrub_text(s: &str, roots: &[String]) -> String {
 }
 
 fn findings(d: &[Diagnostic], roots: &[String]) -> Vec<String> {
-    let mut v: Vec<String> = d
-        .iter()
-        .map(|d| {
-            let notes: Vec<String> = d.notes.iter().map(|n| scrub_text(n, roots)).collect();
-            format!(
-                "{} {:?} {} | {} | {}",
-                d.code.unwrap_or("-"),
-                d.severity,
-                scrub_text(&d.message, roots),
-                notes.join(" / "),
-                d.help
-                    .as_deref()
-                    .map(|h| scrub_text(h, roots))
-                    .unwrap_or_default()
-            )
-        })
-        .collect();
-    v.sort();
-    v
+    rtlint_testkit::gen_check::findings_with(d, &|s| scrub_text(s, roots))
 }
 
 /// Everything the module-level analyses say, positions removed.

@@ -80,18 +80,17 @@ pub fn facts(words: &[u32]) -> Result<Value, String> {
         v.sort();
         v
     };
-    let module_findings = findings(&rtlint::rules::check_program(&p, &config));
-    let loose = findings(&rtlint::lint::check_loose(
-        vec![(parse(words)?, Default::default())],
-        &[],
-        &config,
-    ));
+    let module_findings = findings_with(&rtlint::rules::check_program(&p, &config), &scrub_text);
+    let loose = findings_with(
+        &rtlint::lint::check_loose(vec![(parse(words)?, Default::default())], &[], &config),
+        &scrub_text,
+    );
     let pipeline = described(p);
     let rec = recursion_report(&pipeline);
     let mut stack = serde_json::to_value(stack_report(&pipeline)).unwrap();
-    scrub(&mut stack);
+    scrub_json(&mut stack, &scrub_text);
     let ctx = rtlint::rules::PipelineContext::new(&pipeline, &config);
-    let pipeline_findings = findings(&rtlint::rules::check_pipeline(&ctx));
+    let pipeline_findings = findings_with(&rtlint::rules::check_pipeline(&ctx), &scrub_text);
     Ok(serde_json::json!({
         "live": sites,
         "findings": module_findings,
@@ -116,7 +115,10 @@ pub fn described(p: Program) -> Pipeline {
     pipeline
 }
 
-fn scrub(v: &mut Value) {
+/// Removes from analysis output what may legitimately differ between two
+/// builds of one shader (positions, paths) and passes every string through
+/// `text`; shared with tests/invariance.rs.
+pub fn scrub_json(v: &mut Value, text: &dyn Fn(&str) -> String) {
     match v {
         Value::Object(m) => {
             for k in [
@@ -133,15 +135,14 @@ fn scrub(v: &mut Value) {
             ] {
                 m.remove(k);
             }
-            m.values_mut().for_each(scrub);
+            m.values_mut().for_each(|x| scrub_json(x, text));
         }
-        Value::Array(a) => a.iter_mut().for_each(scrub),
-        Value::String(s) => *s = scrub_text(s),
+        Value::Array(a) => a.iter_mut().for_each(|x| scrub_json(x, text)),
+        Value::String(s) => *s = text(s),
         _ => {}
     }
 }
 
-/// SSA values are named `%id`, and ids differ once debug info is added.
 fn scrub_text(s: &str) -> String {
     let mut out = String::new();
     let mut chars = s.chars().peekable();
@@ -156,17 +157,20 @@ fn scrub_text(s: &str) -> String {
     out
 }
 
-fn findings(d: &[Diagnostic]) -> Vec<String> {
+/// Each finding as one sortable line (code, severity, message, notes,
+/// help), its texts passed through `text`; shared with tests/invariance.rs.
+pub fn findings_with(d: &[Diagnostic], text: &dyn Fn(&str) -> String) -> Vec<String> {
     let mut v: Vec<String> = d
         .iter()
         .map(|d| {
+            let notes: Vec<String> = d.notes.iter().map(|n| text(n)).collect();
             format!(
                 "{} {:?} {} | {} | {}",
                 d.code.unwrap_or("-"),
                 d.severity,
-                scrub_text(&d.message),
-                scrub_text(&d.notes.join(" / ")),
-                scrub_text(d.help.as_deref().unwrap_or_default())
+                text(&d.message),
+                notes.join(" / "),
+                d.help.as_deref().map(text).unwrap_or_default()
             )
         })
         .collect();
