@@ -2407,4 +2407,52 @@ mod tests {
             assert!(kept.contains(&(24, "Ray")), "{rel}: {kept:?}");
         }
     }
+    /// The stack model's undescribed sites carry the same bytes, values and
+    /// recomputability as the described ones, and nothing that describes.
+    #[test]
+    fn bytes_only_sites_match_the_described_ones() {
+        let key = |s: &LiveSite| {
+            let mut v: Vec<_> = s
+                .values
+                .iter()
+                .map(|v| (v.id, v.size, v.rematerializable, v.storage == Storage::Ssa))
+                .collect();
+            v.sort();
+            (
+                s.inst,
+                s.chain.clone(),
+                s.entry.clone(),
+                s.kind,
+                s.live_bytes,
+                s.rematerializable_bytes,
+                v,
+            )
+        };
+        let (mut compared, mut live) = (0, 0);
+        for rel in [
+            "shaders/reflect_hybrid.hlsl",
+            "shaders/reflect_recursive.wgsl",
+            "shaders/reflect_adaptive.hlsl",
+            "fixtures/RT010/bad.rgen.spv",
+        ] {
+            let p = program(rel);
+            let described = compute_live_sites(&p, true);
+            let bytes = compute_live_sites(&p, false);
+            assert_eq!(
+                described.iter().map(key).collect::<Vec<_>>(),
+                bytes.iter().map(key).collect::<Vec<_>>(),
+                "{rel}"
+            );
+            live += described.iter().map(|s| s.live_bytes).sum::<u64>();
+            assert!(bytes
+                .iter()
+                .flat_map(|s| &s.values)
+                .all(|v| v.name.is_empty() && v.def.is_none() && v.use_at.is_none()));
+            compared += described.len();
+        }
+        assert!(
+            compared > 4 && live > 0,
+            "{compared} sites, {live} bytes compared"
+        );
+    }
 }
