@@ -1018,14 +1018,7 @@ impl FnLiveness {
             // A copy's load reads nothing here (the store does), and phi
             // operands are used on the incoming edge (`solve`).
             if !(op == Op::Phi || (op == Op::Load && self.copy_loads.contains(&at))) {
-                let derives = matches!(
-                    op,
-                    Op::AccessChain
-                        | Op::InBoundsAccessChain
-                        | Op::PtrAccessChain
-                        | Op::CopyObject
-                        | Op::Bitcast
-                );
+                let derives = derives_pointer(op);
                 for id in id_operands(inst) {
                     if self.ssa.contains(&id) {
                         pool.push(places.intern(id, &[]));
@@ -1138,14 +1131,7 @@ impl FnLiveness {
             }
             _ => {}
         }
-        let derives = matches!(
-            op,
-            Op::AccessChain
-                | Op::InBoundsAccessChain
-                | Op::PtrAccessChain
-                | Op::CopyObject
-                | Op::Bitcast
-        );
+        let derives = derives_pointer(op);
         for (k, id) in id_operands(inst).enumerate() {
             if self.ssa.contains(&id) {
                 live.insert(places.intern(id, &[]));
@@ -1984,6 +1970,19 @@ impl FnLiveness {
         }
         found
     }
+}
+
+/// Whether `op` makes a pointer into (or a copy of) its operand: using the
+/// result is what reads the variable, not this instruction.
+fn derives_pointer(op: Op) -> bool {
+    matches!(
+        op,
+        Op::AccessChain
+            | Op::InBoundsAccessChain
+            | Op::PtrAccessChain
+            | Op::CopyObject
+            | Op::Bitcast
+    )
 }
 
 #[cfg(test)]
