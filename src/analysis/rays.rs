@@ -523,19 +523,24 @@ pub struct TraceTargets {
 /// The trace edges of a graph grouped by site and caller.
 pub fn trace_targets(graph: &TraceGraph) -> Vec<TraceTargets> {
     let mut out: Vec<TraceTargets> = Vec::new();
+    // (from, program, inst) → index in `out`, which keeps first-seen order.
+    let mut index = std::collections::HashMap::new();
     for e in graph.edges.iter().filter(|e| e.kind == EdgeKind::Trace) {
-        match out
-            .iter_mut()
-            .find(|t| t.from == e.from && t.program == e.program && t.inst == e.inst)
-        {
-            Some(t) => t.targets.push(e.to),
-            None => out.push(TraceTargets {
-                from: e.from,
-                program: e.program,
-                inst: e.inst,
-                location: e.location.clone(),
-                targets: vec![e.to],
-            }),
+        match index.get(&(e.from, e.program, e.inst)) {
+            Some(&i) => {
+                let t: &mut TraceTargets = &mut out[i];
+                t.targets.push(e.to)
+            }
+            None => {
+                index.insert((e.from, e.program, e.inst), out.len());
+                out.push(TraceTargets {
+                    from: e.from,
+                    program: e.program,
+                    inst: e.inst,
+                    location: e.location.clone(),
+                    targets: vec![e.to],
+                })
+            }
         }
     }
     out
@@ -570,6 +575,10 @@ pub fn trace_payload_ty(program: &Program, inst: usize) -> Option<Id> {
 /// taken as reachable (the driver could not pass it that payload).
 pub fn visibility_traces(pipeline: &Pipeline, graph: &TraceGraph) -> Vec<VisibilityTrace> {
     let mut out = Vec::new();
+    // Per shader, not per trace and target: a folder's loose pipeline joins
+    // every trace to every hit shader.
+    let mut uses: std::collections::HashMap<(usize, Id), PayloadUse> =
+        std::collections::HashMap::new();
     for t in trace_targets(graph) {
         let Some(program) = pipeline.programs.get(t.program) else {
             continue;
@@ -590,7 +599,9 @@ pub fn visibility_traces(pipeline: &Pipeline, graph: &TraceGraph) -> Vec<Visibil
                 visibility = false;
                 break;
             };
-            let u = payload_use(callee, node.shader.function);
+            let u = uses
+                .entry((node.shader.program, node.shader.function))
+                .or_insert_with(|| payload_use(callee, node.shader.function));
             if !pipeline.described() {
                 let matches = match (&sig, u.ty) {
                     (Some(s), Some(ty)) => signature(callee, ty) == *s,

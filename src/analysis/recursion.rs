@@ -185,8 +185,11 @@ pub fn recursion_report(pipeline: &Pipeline) -> RecursionReport {
     let graph = trace_graph(pipeline);
     let n = graph.nodes.len();
     let mut adj: Vec<Vec<usize>> = vec![Vec::new(); n];
+    // First-seen order, without a scan per edge (a folder's loose pipeline
+    // joins every trace to every hit shader).
+    let mut seen = std::collections::HashSet::new();
     for e in graph.traces() {
-        if !adj[e.from].contains(&e.to) {
+        if seen.insert((e.from, e.to)) {
             adj[e.from].push(e.to);
         }
     }
@@ -358,13 +361,10 @@ pub fn recursion_report(pipeline: &Pipeline) -> RecursionReport {
     }
     chain.reverse();
     let mut recursive_sites: Vec<RecursiveSite> = Vec::new();
+    let mut listed = std::collections::HashSet::new();
     for e in graph.traces() {
         let stage = graph.nodes[e.from].shader.stage;
-        if matches!(stage, Stage::ClosestHit | Stage::Miss)
-            && !recursive_sites
-                .iter()
-                .any(|s| s.program == e.program && s.inst == e.inst)
-        {
+        if matches!(stage, Stage::ClosestHit | Stage::Miss) && listed.insert((e.program, e.inst)) {
             recursive_sites.push(RecursiveSite {
                 node: e.from,
                 program: e.program,

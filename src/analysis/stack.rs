@@ -570,8 +570,14 @@ pub fn exact_call_chain(rec: &RecursionReport, sizes: &[u64]) -> Option<u64> {
     let g = &rec.graph;
     let n = g.nodes.len();
     // Callable chains on top of each node.
+    // Each node's callable edges, gathered once (not a scan of every edge
+    // per node: a loose pipeline has edges from every trace to every shader).
+    let mut callables: Vec<Vec<usize>> = vec![Vec::new(); n];
+    for e in g.edges.iter().filter(|e| e.kind == EdgeKind::Callable) {
+        callables[e.from].push(e.to);
+    }
     fn with_callables(
-        g: &super::callgraph::TraceGraph,
+        callables: &[Vec<usize>],
         sizes: &[u64],
         v: usize,
         memo: &mut HashMap<usize, u64>,
@@ -581,13 +587,12 @@ pub fn exact_call_chain(rec: &RecursionReport, sizes: &[u64]) -> Option<u64> {
             return x;
         }
         let own = sizes.get(v).copied().unwrap_or(0);
-        if depth > g.nodes.len() {
+        if depth > callables.len() {
             return own;
         }
-        let above = g
-            .edges_from(v)
-            .filter(|e| e.kind == EdgeKind::Callable)
-            .map(|e| with_callables(g, sizes, e.to, memo, depth + 1))
+        let above = callables[v]
+            .iter()
+            .map(|&to| with_callables(callables, sizes, to, memo, depth + 1))
             .max()
             .unwrap_or(0);
         memo.insert(v, own + above);
@@ -595,7 +600,7 @@ pub fn exact_call_chain(rec: &RecursionReport, sizes: &[u64]) -> Option<u64> {
     }
     let mut memo = HashMap::new();
     let mut w: Vec<u64> = (0..n)
-        .map(|v| with_callables(g, sizes, v, &mut memo, 0))
+        .map(|v| with_callables(&callables, sizes, v, &mut memo, 0))
         .collect();
     // Intersection and any-hit of a procedural group are active together.
     for v in 0..n {

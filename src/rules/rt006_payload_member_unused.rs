@@ -146,6 +146,10 @@ fn run(ctx: &super::PipelineContext) -> Vec<Diagnostic> {
     let pipeline = ctx.pipeline;
     let graph = &ctx.recursion.graph;
     let mut types: Vec<RayType> = Vec::new();
+    // Each shader's incoming payloads, once: a folder's loose pipeline joins
+    // every trace to every hit shader.
+    let mut incoming: std::collections::HashMap<(usize, Id), Vec<Id>> =
+        std::collections::HashMap::new();
     for e in graph.edges.iter().filter(|e| e.kind == EdgeKind::Trace) {
         let Some(program) = pipeline.programs.get(e.program) else {
             continue;
@@ -213,11 +217,16 @@ fn run(ctx: &super::PipelineContext) -> Vec<Diagnostic> {
         let Some(tp) = pipeline.programs.get(to.shader.program) else {
             continue;
         };
-        for w in payload_use::globals_used(
-            tp,
-            to.shader.function,
-            StorageClass::IncomingRayPayloadKHR,
-        ) {
+        let used = incoming
+            .entry((to.shader.program, to.shader.function))
+            .or_insert_with(|| {
+                payload_use::globals_used(
+                    tp,
+                    to.shader.function,
+                    StorageClass::IncomingRayPayloadKHR,
+                )
+            });
+        for &w in used.iter() {
             let Some(g) = tp.globals.iter().find(|g| g.id == w) else {
                 continue;
             };
