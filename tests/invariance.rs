@@ -16,7 +16,7 @@ mod common;
 
 use common::root;
 use rtlint::analysis::layout::interface_layouts;
-use rtlint::analysis::liveness::{live_sites, Storage};
+use rtlint::analysis::liveness::live_sites;
 use rtlint::analysis::recursion::recursion_report;
 use rtlint::analysis::stack::stack_report;
 use rtlint::config::Config;
@@ -134,13 +134,7 @@ fn module_facts(p: &Program, roots: &[String]) -> Value {
             let mut values: Vec<String> = s
                 .values
                 .iter()
-                .map(|v| {
-                    let name = match v.storage {
-                        Storage::Variable => v.name.as_str(),
-                        Storage::Ssa => "_",
-                    };
-                    format!("{name} {} {} {}", v.ty, v.size, v.rematerializable)
-                })
+                .map(rtlint_testkit::gen_check::value_line)
                 .collect();
             values.sort();
             serde_json::json!({

@@ -920,6 +920,11 @@ impl FnGen {
         self.label = label;
     }
 
+    /// An instruction without a result (stores, branches, merges, traces).
+    fn stmt(&mut self, op: Op, ops: Vec<Operand>) {
+        self.cur.push(Instruction::new(op, None, None, ops));
+    }
+
     fn push(&mut self, g: &mut Gen, op: Op, ty: Word, ops: Vec<Operand>) -> Word {
         let id = g.b.id();
         self.cur.push(Instruction::new(op, Some(ty), Some(id), ops));
@@ -1086,12 +1091,7 @@ impl FnGen {
                 if let Some((var, ty, _)) = src.pick(&self.locals) {
                     let (p, st) = self.leaf_ptr(g, src, StorageClass::Function, var, &ty);
                     let v = self.value(g, src, &st).unwrap();
-                    self.cur.push(Instruction::new(
-                        Op::Store,
-                        None,
-                        None,
-                        vec![Operand::IdRef(p), Operand::IdRef(v)],
-                    ));
+                    self.stmt(Op::Store, vec![Operand::IdRef(p), Operand::IdRef(v)]);
                 }
             }
             6 => {
@@ -1112,12 +1112,7 @@ impl FnGen {
                         }
                     } else {
                         let z = g.null(t);
-                        self.cur.push(Instruction::new(
-                            Op::Store,
-                            None,
-                            None,
-                            vec![Operand::IdRef(var), Operand::IdRef(z)],
-                        ));
+                        self.stmt(Op::Store, vec![Operand::IdRef(var), Operand::IdRef(z)]);
                     }
                 }
             }
@@ -1186,25 +1181,21 @@ impl FnGen {
         let (then_l, else_l, merge) = (g.b.id(), g.b.id(), g.b.id());
         let has_else = src.chance(60);
         let before = self.label;
-        self.cur.push(Instruction::new(
+        self.stmt(
             Op::SelectionMerge,
-            None,
-            None,
             vec![
                 Operand::IdRef(merge),
                 Operand::SelectionControl(SelectionControl::NONE),
             ],
-        ));
-        self.cur.push(Instruction::new(
+        );
+        self.stmt(
             Op::BranchConditional,
-            None,
-            None,
             vec![
                 Operand::IdRef(cond),
                 Operand::IdRef(then_l),
                 Operand::IdRef(if has_else { else_l } else { merge }),
             ],
-        ));
+        );
         self.end_block();
         let phi_ty = Self::scalar(src);
         // The then-branch may leave the function instead of reaching the merge.
@@ -1230,12 +1221,7 @@ impl FnGen {
             incoming.push((v, self.label));
             self.scopes.pop();
             self.depth -= 1;
-            self.cur.push(Instruction::new(
-                Op::Branch,
-                None,
-                None,
-                vec![Operand::IdRef(merge)],
-            ));
+            self.stmt(Op::Branch, vec![Operand::IdRef(merge)]);
             self.end_block();
         }
         self.start_block(merge);
@@ -1275,22 +1261,15 @@ impl FnGen {
         let tmin = g.fconst(0.001);
         let dir = self.vec3(g, src);
         let tmax = self.value(g, src, &Ty::F32).unwrap();
-        self.cur.push(Instruction::new(
+        self.stmt(
             Op::RayQueryInitializeKHR,
-            None,
-            None,
             [rq, accel, flags, mask, origin, tmin, dir, tmax]
                 .into_iter()
                 .map(Operand::IdRef)
                 .collect(),
-        ));
+        );
         let (header, body, cont, merge) = (g.b.id(), g.b.id(), g.b.id(), g.b.id());
-        self.cur.push(Instruction::new(
-            Op::Branch,
-            None,
-            None,
-            vec![Operand::IdRef(header)],
-        ));
+        self.stmt(Op::Branch, vec![Operand::IdRef(header)]);
         self.end_block();
         self.start_block(header);
         let more = self.push(
@@ -1299,26 +1278,22 @@ impl FnGen {
             g.bool_ty,
             vec![Operand::IdRef(rq)],
         );
-        self.cur.push(Instruction::new(
+        self.stmt(
             Op::LoopMerge,
-            None,
-            None,
             vec![
                 Operand::IdRef(merge),
                 Operand::IdRef(cont),
                 Operand::LoopControl(LoopControl::NONE),
             ],
-        ));
-        self.cur.push(Instruction::new(
+        );
+        self.stmt(
             Op::BranchConditional,
-            None,
-            None,
             vec![
                 Operand::IdRef(more),
                 Operand::IdRef(body),
                 Operand::IdRef(merge),
             ],
-        ));
+        );
         self.end_block();
         self.start_block(body);
         self.depth += 1;
@@ -1335,29 +1310,14 @@ impl FnGen {
         }
         self.statements(g, src);
         if src.chance(40) {
-            self.cur.push(Instruction::new(
-                Op::RayQueryConfirmIntersectionKHR,
-                None,
-                None,
-                vec![Operand::IdRef(rq)],
-            ));
+            self.stmt(Op::RayQueryConfirmIntersectionKHR, vec![Operand::IdRef(rq)]);
         }
-        self.cur.push(Instruction::new(
-            Op::Branch,
-            None,
-            None,
-            vec![Operand::IdRef(cont)],
-        ));
+        self.stmt(Op::Branch, vec![Operand::IdRef(cont)]);
         self.end_block();
         self.scopes.pop();
         self.depth -= 1;
         self.start_block(cont);
-        self.cur.push(Instruction::new(
-            Op::Branch,
-            None,
-            None,
-            vec![Operand::IdRef(header)],
-        ));
+        self.stmt(Op::Branch, vec![Operand::IdRef(header)]);
         self.end_block();
         self.start_block(merge);
         let committed = g.uconst(1);
@@ -1374,12 +1334,7 @@ impl FnGen {
         let (header, body, cont, merge) = (g.b.id(), g.b.id(), g.b.id(), g.b.id());
         let pre = self.label;
         let init = self.value(g, src, &Ty::F32).unwrap();
-        self.cur.push(Instruction::new(
-            Op::Branch,
-            None,
-            None,
-            vec![Operand::IdRef(header)],
-        ));
+        self.stmt(Op::Branch, vec![Operand::IdRef(header)]);
         self.end_block();
         self.start_block(header);
         let (i, i_next, acc, acc_next) = (g.b.id(), g.b.id(), g.b.id(), g.b.id());
@@ -1408,22 +1363,15 @@ impl FnGen {
                 Operand::IdRef(cont),
             ],
         ));
-        self.cur.push(Instruction::new(
+        self.stmt(
             Op::LoopMerge,
-            None,
-            None,
             vec![
                 Operand::IdRef(merge),
                 Operand::IdRef(cont),
                 Operand::LoopControl(LoopControl::NONE),
             ],
-        ));
-        self.cur.push(Instruction::new(
-            Op::Branch,
-            None,
-            None,
-            vec![Operand::IdRef(body)],
-        ));
+        );
+        self.stmt(Op::Branch, vec![Operand::IdRef(body)]);
         self.end_block();
         // The header dominates the body, the continue block and the merge.
         self.scopes
@@ -1435,12 +1383,7 @@ impl FnGen {
         self.scopes.push(Vec::new());
         self.statements(g, src);
         let step = self.value(g, src, &Ty::F32).unwrap();
-        self.cur.push(Instruction::new(
-            Op::Branch,
-            None,
-            None,
-            vec![Operand::IdRef(cont)],
-        ));
+        self.stmt(Op::Branch, vec![Operand::IdRef(cont)]);
         self.end_block();
         self.scopes.pop();
         self.depth -= 1;
@@ -1463,16 +1406,14 @@ impl FnGen {
             g.bool_ty,
             vec![Operand::IdRef(i_next), Operand::IdRef(count)],
         );
-        self.cur.push(Instruction::new(
+        self.stmt(
             Op::BranchConditional,
-            None,
-            None,
             vec![
                 Operand::IdRef(more),
                 Operand::IdRef(header),
                 Operand::IdRef(merge),
             ],
-        ));
+        );
         self.end_block();
         self.start_block(merge);
     }
@@ -1491,12 +1432,7 @@ impl FnGen {
         if src.chance(50) {
             let (p, st) = self.leaf_ptr(g, src, StorageClass::RayPayloadKHR, payload, &pty);
             let v = self.value(g, src, &st).unwrap();
-            self.cur.push(Instruction::new(
-                Op::Store,
-                None,
-                None,
-                vec![Operand::IdRef(p), Operand::IdRef(v)],
-            ));
+            self.stmt(Op::Store, vec![Operand::IdRef(p), Operand::IdRef(v)]);
         }
         let accel = self.push(g, Op::Load, g.accel_ty, vec![Operand::IdRef(g.accel)]);
         // Flags: none, or opaque (which only keeps any-hit shaders out).
@@ -1529,17 +1465,15 @@ impl FnGen {
         let dir = self.vec3(g, src);
         let tmin = g.fconst(0.001);
         let tmax = self.value(g, src, &Ty::F32).unwrap();
-        self.cur.push(Instruction::new(
+        self.stmt(
             Op::TraceRayKHR,
-            None,
-            None,
             [
                 accel, flags, mask, off, stride, miss, origin, tmin, dir, tmax, payload,
             ]
             .into_iter()
             .map(Operand::IdRef)
             .collect(),
-        ));
+        );
         self.traces.push(GenTrace {
             sbt_offset,
             miss_index,
@@ -1558,23 +1492,16 @@ impl FnGen {
         self.use_global(data);
         let (p, st) = self.leaf_ptr(g, src, StorageClass::CallableDataKHR, data, &dty);
         let v = self.value(g, src, &st).unwrap();
-        self.cur.push(Instruction::new(
-            Op::Store,
-            None,
-            None,
-            vec![Operand::IdRef(p), Operand::IdRef(v)],
-        ));
+        self.stmt(Op::Store, vec![Operand::IdRef(p), Operand::IdRef(v)]);
         let index = if src.chance(80) {
             g.uconst(src.below(g.n_callable + 1))
         } else {
             self.value(g, src, &Ty::U32).unwrap()
         };
-        self.cur.push(Instruction::new(
+        self.stmt(
             Op::ExecuteCallableKHR,
-            None,
-            None,
             vec![Operand::IdRef(index), Operand::IdRef(data)],
-        ));
+        );
         if src.chance(60) {
             let (p, st) = self.leaf_ptr(g, src, StorageClass::CallableDataKHR, data, &dty);
             let t = g.ty(&st);
@@ -1641,12 +1568,7 @@ impl FnGen {
                     self.add_value(g, src, v, st);
                 } else {
                     let v = self.value(g, src, &st).unwrap();
-                    self.cur.push(Instruction::new(
-                        Op::Store,
-                        None,
-                        None,
-                        vec![Operand::IdRef(p), Operand::IdRef(v)],
-                    ));
+                    self.stmt(Op::Store, vec![Operand::IdRef(p), Operand::IdRef(v)]);
                 }
                 if matches!(self.stage(), Some(Stage::ClosestHit | Stage::AnyHit)) && src.chance(50)
                 {
@@ -1660,12 +1582,10 @@ impl FnGen {
                 self.use_global(g.hit_attr);
                 let t = g.ty(&Ty::Vec(2));
                 let z = g.null(t);
-                self.cur.push(Instruction::new(
+                self.stmt(
                     Op::Store,
-                    None,
-                    None,
                     vec![Operand::IdRef(g.hit_attr), Operand::IdRef(z)],
-                ));
+                );
                 let hit_t = self.value(g, src, &Ty::F32).unwrap();
                 let kind = g.uconst(src.below(4));
                 let v = self.push(

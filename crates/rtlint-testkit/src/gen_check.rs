@@ -25,7 +25,7 @@
 //!    between the module and the same module with its debug info.
 
 use crate::gen::{GenEntry, Generated};
-use rtlint::analysis::liveness::{live_sites, Storage};
+use rtlint::analysis::liveness::{live_sites, LiveValue, Storage};
 use rtlint::analysis::recursion::recursion_report;
 use rtlint::analysis::stack::stack_report;
 use rtlint::config::Config;
@@ -54,17 +54,7 @@ pub fn facts(words: &[u32]) -> Result<Value, String> {
         let mut v: Vec<String> = live_sites(&p)
             .iter()
             .map(|s| {
-                let mut values: Vec<String> = s
-                    .values
-                    .iter()
-                    .map(|v| {
-                        let name = match v.storage {
-                            Storage::Variable => v.name.as_str(),
-                            Storage::Ssa => "_",
-                        };
-                        format!("{name} {} {} {}", v.ty, v.size, v.rematerializable)
-                    })
-                    .collect();
+                let mut values: Vec<String> = s.values.iter().map(value_line).collect();
                 values.sort();
                 format!(
                     "{} {} live {} remat {} payload {:?}: {}",
@@ -113,6 +103,17 @@ pub fn described(p: Program) -> Pipeline {
     let mut pipeline = Pipeline::from_programs(vec![p]);
     pipeline.path = Some(PathBuf::from("gen/generated.pipeline.toml"));
     pipeline
+}
+
+/// A live value as two builds of one shader must agree on: variables by
+/// name, SSA values (named only with debug info) by type and size alone;
+/// shared with tests/invariance.rs.
+pub fn value_line(v: &LiveValue) -> String {
+    let name = match v.storage {
+        Storage::Variable => v.name.as_str(),
+        Storage::Ssa => "_",
+    };
+    format!("{name} {} {} {}", v.ty, v.size, v.rematerializable)
 }
 
 /// Removes from analysis output what may legitimately differ between two
