@@ -61,12 +61,21 @@ impl Query {
     }
 }
 
-/// The ray-query objects of `p`, in order of their first use.
-pub fn queries(p: &Program) -> Vec<Query> {
+/// The ray-query objects of `p`, in order of their first use: computed once
+/// per Program, since five rules ask.
+pub fn queries(p: &Program) -> std::sync::Arc<Vec<Query>> {
+    struct Queries(std::sync::Arc<Vec<Query>>);
+    p.memo
+        .get_or(|| Queries(std::sync::Arc::new(find_queries(p))))
+        .0
+        .clone()
+}
+
+fn find_queries(p: &Program) -> Vec<Query> {
     let mut out: Vec<Query> = Vec::new();
     for (i, inst) in p.insts.iter().enumerate() {
         let op = inst.class.opcode;
-        if !format!("{op:?}").starts_with("RayQuery") {
+        if !crate::program::is_ray_query_op(op) {
             continue;
         }
         let Some(Operand::IdRef(ptr)) = inst.operands.first() else {

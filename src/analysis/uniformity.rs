@@ -220,7 +220,7 @@ pub fn varying(p: &Program) -> Varying {
                         mark(r, &mut v);
                     }
                 }
-                _ if format!("{op:?}").starts_with("RayQuery") => {
+                _ if crate::program::is_ray_query_op(op) => {
                     if let Some(r) = inst.result_id {
                         mark(r, &mut v);
                     }

@@ -79,6 +79,7 @@ pub fn declarations(
     source: &str,
     path: &Path,
 ) -> Vec<(NamedDecl, Location)> {
+    let lines = Lines::new(source);
     let mut out = Vec::new();
     for (handle, ty) in module.types.iter() {
         let (Some(name), naga::TypeInner::Struct { members, .. }) = (&ty.name, &ty.inner) else {
@@ -91,7 +92,7 @@ pub fn declarations(
         let at = find_ident(source, range.start, range.end, name).unwrap_or(range.start);
         out.push((
             NamedDecl::Type(name.clone()),
-            name_location(path, source, at, name),
+            lines.location(path, at, name),
         ));
         // Members are found by name inside the struct's body, in order.
         let mut from = source[range.clone()]
@@ -103,7 +104,7 @@ pub fn declarations(
             if let Some(at) = find_ident(source, from, range.end, mname) {
                 out.push((
                     NamedDecl::Member(name.clone(), k as u32),
-                    name_location(path, source, at, mname),
+                    lines.location(path, at, mname),
                 ));
                 from = at + mname.len();
             }
@@ -116,7 +117,7 @@ pub fn declarations(
             let at = find_ident(source, range.start, range.end, name).unwrap_or(range.start);
             out.push((
                 NamedDecl::Global(name.clone()),
-                name_location(path, source, at, name),
+                lines.location(path, at, name),
             ));
         }
     }
@@ -125,7 +126,7 @@ pub fn declarations(
             let at = find_ident(source, range.start, range.end, name).unwrap_or(range.start);
             out.push((
                 NamedDecl::Function(name.clone()),
-                name_location(path, source, at, name),
+                lines.location(path, at, name),
             ));
         }
     }
@@ -133,7 +134,7 @@ pub fn declarations(
         if let Some(at) = find_fn(source, &ep.name) {
             out.push((
                 NamedDecl::Function(ep.name.clone()),
-                name_location(path, source, at, &ep.name),
+                lines.location(path, at, &ep.name),
             ));
         }
     }
@@ -166,19 +167,54 @@ pub fn declarations(
         if let Some(at) = find_ident(source, start + ep.len(), end, name) {
             out.push((
                 NamedDecl::Global(name.to_string()),
-                name_location(path, source, at, name),
+                lines.location(path, at, name),
             ));
         }
     }
     out
 }
 
-fn name_location(path: &Path, source: &str, at: usize, name: &str) -> Location {
-    span_location(
-        path,
-        source,
-        naga::Span::new(at as u32, (at + name.len()) as u32),
-    )
+/// Where each line of a source starts: a declaration's position costs a
+/// binary search, not a scan from the top of the file.
+struct Lines<'a> {
+    source: &'a str,
+    starts: Vec<usize>,
+}
+
+impl<'a> Lines<'a> {
+    fn new(source: &'a str) -> Self {
+        let starts = std::iter::once(0)
+            .chain(source.match_indices('\n').map(|(i, _)| i + 1))
+            .collect();
+        Lines { source, starts }
+    }
+
+    /// [`line_col`], from the index.
+    fn line_col(&self, offset: usize) -> (u32, u32) {
+        let mut offset = offset.min(self.source.len());
+        while !self.source.is_char_boundary(offset) {
+            offset -= 1;
+        }
+        let line = self.starts.partition_point(|&s| s <= offset);
+        let line_start = self.starts[line - 1];
+        let column = self.source[line_start..offset].chars().count() as u32 + 1;
+        (line as u32, column)
+    }
+
+    /// The location of `name` written at byte `at`.
+    fn location(&self, path: &Path, at: usize, name: &str) -> Location {
+        let start = at.min(self.source.len());
+        let end = (at + name.len()).clamp(start, self.source.len());
+        let (line, column) = self.line_col(start);
+        let (end_line, end_column) = self.line_col(end);
+        Location {
+            path: path.to_path_buf(),
+            line,
+            column,
+            end_line,
+            end_column,
+        }
+    }
 }
 
 fn is_ident_byte(b: u8) -> bool {
@@ -303,5 +339,31 @@ pub fn span_location(path: &Path, source: &str, span: naga::Span) -> Location {
         column,
         end_line,
         end_column,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The line index gives what scanning from the top gives, at every byte
+    /// (inside multi-byte characters, at `\r\n`, past the end).
+    #[test]
+    fn line_index_agrees_with_line_col() {
+        for source in [
+            "",
+            "\n",
+            "a\r\nbé\n\nfn f() {}\nλx",
+            "struct S {\n  a: f32, // ü\n}",
+        ] {
+            let lines = Lines::new(source);
+            for at in 0..=source.len() + 2 {
+                assert_eq!(
+                    lines.line_col(at),
+                    line_col(source, at),
+                    "{source:?} at {at}"
+                );
+            }
+        }
     }
 }

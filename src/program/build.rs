@@ -130,29 +130,29 @@ pub fn parse(words: &[u32], path: &Path, language: Language) -> Result<Program, 
             offsets,
             locs: Vec::new(),
             files: Vec::new(),
-            types: HashMap::new(),
-            names: HashMap::new(),
-            member_names: HashMap::new(),
-            decorations: HashMap::new(),
-            member_decorations: HashMap::new(),
-            constants: HashMap::new(),
-            spec_constants: HashMap::new(),
+            types: FastMap::default(),
+            names: FastMap::default(),
+            member_names: FastMap::default(),
+            decorations: FastMap::default(),
+            member_decorations: FastMap::default(),
+            constants: FastMap::default(),
+            spec_constants: FastMap::default(),
             globals: Vec::new(),
             entry_points: Vec::new(),
             functions: Vec::new(),
             sites: Vec::new(),
-            decl_pos: HashMap::new(),
-            defs: HashMap::new(),
+            decl_pos: FastMap::default(),
+            defs: FastMap::default(),
             debug_info_set: None,
             debug_sets: Vec::new(),
         },
-        strings: HashMap::new(),
-        file_of_string: HashMap::new(),
-        dbg_sources: HashMap::new(),
-        dbg_members: HashMap::new(),
+        strings: FastMap::default(),
+        file_of_string: FastMap::default(),
+        dbg_sources: FastMap::default(),
+        dbg_members: FastMap::default(),
         dbg_composites: Vec::new(),
-        dbg_functions: HashMap::new(),
-        dbg_locals: HashMap::new(),
+        dbg_functions: FastMap::default(),
+        dbg_locals: FastMap::default(),
     };
     b.check_ids(bound)?;
     b.collect()?;
@@ -230,17 +230,17 @@ fn opname(words: &[u32], offset: u32) -> String {
 struct Builder<'a> {
     path: &'a Path,
     p: Program,
-    strings: HashMap<Id, String>,
+    strings: FastMap<Id, String>,
     /// File index for each `OpString` naming a source file.
-    file_of_string: HashMap<Id, u32>,
+    file_of_string: FastMap<Id, u32>,
     /// `DebugSource` result id → file index.
-    dbg_sources: HashMap<Id, u32>,
+    dbg_sources: FastMap<Id, u32>,
     /// `DebugTypeMember` result id → its position.
-    dbg_members: HashMap<Id, SrcPos>,
+    dbg_members: FastMap<Id, SrcPos>,
     /// `DebugTypeComposite`: name, position, member ids.
     dbg_composites: Vec<(String, SrcPos, Vec<Id>)>,
-    dbg_functions: HashMap<Id, SrcPos>,
-    dbg_locals: HashMap<Id, SrcPos>,
+    dbg_functions: FastMap<Id, SrcPos>,
+    dbg_locals: FastMap<Id, SrcPos>,
 }
 
 fn id_at(inst: &dr::Instruction, i: usize) -> Option<Id> {
@@ -272,9 +272,10 @@ impl Builder<'_> {
     fn at(&self, inst: usize, msg: impl std::fmt::Display) -> InputError {
         err(
             self.path,
+            // From the words: `collect` holds the instructions out of `p`.
             format!(
-                "{msg} (instruction Op{:?} at word {})",
-                self.p.insts[inst].class.opcode,
+                "{msg} (instruction {} at word {})",
+                opname(&self.p.words, self.word(inst)),
                 self.word(inst)
             ),
         )
@@ -289,10 +290,12 @@ impl Builder<'_> {
             .iter()
             .map(|f| {
                 // glslang `-gV` embeds no text: the file on disk, if any.
-                f.text
-                    .clone()
-                    .or_else(|| std::fs::read_to_string(&f.path).ok())
-                    .map(|t| t.lines().count())
+                match &f.text {
+                    Some(t) => Some(t.lines().count()),
+                    None => std::fs::read_to_string(&f.path)
+                        .ok()
+                        .map(|t| t.lines().count()),
+                }
             })
             .collect();
         let possible = |p: &SrcPos| {
@@ -390,16 +393,25 @@ impl Builder<'_> {
     /// Module-level pass: names, decorations, types, constants, globals, entry
     /// points, debug info, and the source position of every instruction.
     fn collect(&mut self) -> Result<(), InputError> {
-        let n = self.p.insts.len();
-        self.p.locs = vec![None; n];
+        self.p.locs = vec![None; self.p.insts.len()];
+        // Taken out while read, not cloned per instruction; put back on
+        // every path out.
+        let insts = std::mem::take(&mut self.p.insts);
+        let result = self.collect_from(&insts);
+        self.p.insts = insts;
+        result
+    }
+
+    fn collect_from(&mut self, insts: &[dr::Instruction]) -> Result<(), InputError> {
         let mut cur: Option<SrcPos> = None;
         let mut last_source_file: Option<u32> = None;
-        for i in 0..n {
-            let inst = self.p.insts[i].clone();
+        // Module-scope variables come before the first OpFunction.
+        let mut in_function = false;
+        for (i, inst) in insts.iter().enumerate() {
             let op = inst.class.opcode;
             match op {
                 Op::String => {
-                    if let (Some(r), Some(s)) = (inst.result_id, str_at(&inst, 0)) {
+                    if let (Some(r), Some(s)) = (inst.result_id, str_at(inst, 0)) {
                         self.strings.insert(r, s.to_string());
                     }
                 }
@@ -416,36 +428,36 @@ impl Builder<'_> {
                             };
                         }
                     }
-                    if let Some(file_id) = id_at(&inst, 2) {
+                    if let Some(file_id) = id_at(inst, 2) {
                         let f = self.file_for_string(file_id);
-                        if let (Some(f), Some(text)) = (f, str_at(&inst, 3)) {
+                        if let (Some(f), Some(text)) = (f, str_at(inst, 3)) {
                             self.p.files[f as usize].text = Some(text.to_string());
                         }
                         last_source_file = f;
                     }
                 }
                 Op::SourceContinued => {
-                    if let (Some(f), Some(s)) = (last_source_file, str_at(&inst, 0)) {
+                    if let (Some(f), Some(s)) = (last_source_file, str_at(inst, 0)) {
                         if let Some(t) = &mut self.p.files[f as usize].text {
                             t.push_str(s);
                         }
                     }
                 }
                 Op::Name => {
-                    if let (Some(id), Some(s)) = (id_at(&inst, 0), str_at(&inst, 1)) {
+                    if let (Some(id), Some(s)) = (id_at(inst, 0), str_at(inst, 1)) {
                         self.p.names.insert(id, s.to_string());
                     }
                 }
                 Op::MemberName => {
                     if let (Some(id), Some(m), Some(s)) =
-                        (id_at(&inst, 0), lit_at(&inst, 1), str_at(&inst, 2))
+                        (id_at(inst, 0), lit_at(inst, 1), str_at(inst, 2))
                     {
                         self.p.member_names.insert((id, m), s.to_string());
                     }
                 }
                 Op::Decorate => {
                     if let (Some(id), Some(Operand::Decoration(d))) =
-                        (id_at(&inst, 0), inst.operands.get(1))
+                        (id_at(inst, 0), inst.operands.get(1))
                     {
                         let lits = inst.operands[2..].iter().filter_map(lit_of).collect();
                         self.p.decorations.entry(id).or_default().push((*d, lits));
@@ -453,7 +465,7 @@ impl Builder<'_> {
                 }
                 Op::MemberDecorate => {
                     if let (Some(id), Some(m), Some(Operand::Decoration(d))) =
-                        (id_at(&inst, 0), lit_at(&inst, 1), inst.operands.get(2))
+                        (id_at(inst, 0), lit_at(inst, 1), inst.operands.get(2))
                     {
                         let lits = inst.operands[3..].iter().filter_map(lit_of).collect();
                         self.p
@@ -464,7 +476,7 @@ impl Builder<'_> {
                     }
                 }
                 Op::ExtInstImport => {
-                    let set = str_at(&inst, 0).unwrap_or("");
+                    let set = str_at(inst, 0).unwrap_or("");
                     if set == "NonSemantic.Shader.DebugInfo.100" {
                         self.p.debug_info_set = inst.result_id;
                     }
@@ -480,9 +492,9 @@ impl Builder<'_> {
                         Some(Operand::ExecutionModel(m)) => *m,
                         _ => return Err(self.at(i, "entry point without an execution model")),
                     };
-                    let function = id_at(&inst, 1)
+                    let function = id_at(inst, 1)
                         .ok_or_else(|| self.at(i, "entry point without a function"))?;
-                    let name = str_at(&inst, 2).unwrap_or("").to_string();
+                    let name = str_at(inst, 2).unwrap_or("").to_string();
                     let interface = inst.operands[3..]
                         .iter()
                         .filter_map(|o| match o {
@@ -498,9 +510,9 @@ impl Builder<'_> {
                     });
                 }
                 Op::Line => {
-                    let file = id_at(&inst, 0).and_then(|f| self.file_for_string(f));
+                    let file = id_at(inst, 0).and_then(|f| self.file_for_string(f));
                     if let (Some(file), Some(line), Some(column)) =
-                        (file, lit_at(&inst, 1), lit_at(&inst, 2))
+                        (file, lit_at(inst, 1), lit_at(inst, 2))
                     {
                         // naga's writer puts `OpLine 1 1` on code that has no
                         // span (its generated helpers): that is no position.
@@ -517,15 +529,16 @@ impl Builder<'_> {
                 }
                 Op::NoLine | Op::Label | Op::FunctionEnd => cur = None,
                 Op::ExtInst
-                    if id_at(&inst, 0) == self.p.debug_info_set
+                    if id_at(inst, 0) == self.p.debug_info_set
                         && self.p.debug_info_set.is_some() =>
                 {
-                    self.debug_ext_inst(i, &inst, &mut cur);
+                    self.debug_ext_inst(i, inst, &mut cur);
                 }
                 _ => {
-                    self.type_or_constant(i, &inst)?;
+                    self.type_or_constant(i, inst, in_function)?;
                 }
             }
+            in_function |= op == Op::Function;
             // OpLine applies to the instructions after it, up to the block's end.
             if !matches!(op, Op::Line | Op::NoLine) {
                 self.p.locs[i] = cur;
@@ -666,7 +679,12 @@ impl Builder<'_> {
         }
     }
 
-    fn type_or_constant(&mut self, i: usize, inst: &dr::Instruction) -> Result<(), InputError> {
+    fn type_or_constant(
+        &mut self,
+        i: usize,
+        inst: &dr::Instruction,
+        in_function: bool,
+    ) -> Result<(), InputError> {
         let op = inst.class.opcode;
         let r = inst.result_id.unwrap_or(0);
         if op == Op::TypeForwardPointer {
@@ -834,7 +852,7 @@ impl Builder<'_> {
             }
             return Ok(());
         }
-        if op == Op::Variable && !self.in_function(i) {
+        if op == Op::Variable && !in_function {
             let storage = match inst.operands.first() {
                 Some(Operand::StorageClass(s)) => *s,
                 _ => return Err(self.at(i, "variable without a storage class")),
@@ -863,13 +881,6 @@ impl Builder<'_> {
             });
         }
         Ok(())
-    }
-
-    fn in_function(&self, i: usize) -> bool {
-        // Module-scope variables come before the first OpFunction.
-        self.p.insts[..i]
-            .iter()
-            .any(|x| x.class.opcode == Op::Function)
     }
 
     fn type_operand(&self, i: usize, inst: &dr::Instruction, k: usize) -> Result<Id, InputError> {
@@ -1007,7 +1018,7 @@ impl Builder<'_> {
                     Op::ReportIntersectionKHR => SiteKind::ReportIntersection,
                     Op::IgnoreIntersectionKHR => SiteKind::IgnoreIntersection,
                     Op::TerminateRayKHR => SiteKind::TerminateRay,
-                    _ if format!("{op:?}").starts_with("RayQuery") => SiteKind::RayQuery,
+                    _ if super::is_ray_query_op(op) => SiteKind::RayQuery,
                     _ => continue,
                 };
                 let o = |n| {

@@ -30,6 +30,10 @@ use std::path::PathBuf;
 
 pub type Id = u32;
 
+/// The Program's maps: keys are small integers, hashed on every lookup the
+/// analyses make, for which SipHash's resistance to chosen keys buys nothing.
+pub type FastMap<K, V> = rustc_hash::FxHashMap<K, V>;
+
 /// Decorations with their literal operands.
 pub type Decorations = Vec<(spirv::Decoration, Vec<u32>)>;
 
@@ -213,22 +217,22 @@ pub struct Program {
     /// Source position in effect at each instruction.
     pub locs: Vec<Option<SrcPos>>,
     pub files: Vec<SourceFile>,
-    pub types: HashMap<Id, Type>,
-    pub names: HashMap<Id, String>,
-    pub member_names: HashMap<(Id, u32), String>,
+    pub types: FastMap<Id, Type>,
+    pub names: FastMap<Id, String>,
+    pub member_names: FastMap<(Id, u32), String>,
     /// `OpDecorate` on ids: decoration and its literal operands.
-    pub decorations: HashMap<Id, Decorations>,
-    pub member_decorations: HashMap<(Id, u32), Decorations>,
-    pub constants: HashMap<Id, Constant>,
+    pub decorations: FastMap<Id, Decorations>,
+    pub member_decorations: FastMap<(Id, u32), Decorations>,
+    pub constants: FastMap<Id, Constant>,
     /// Default values of specialization constants.
-    pub spec_constants: HashMap<Id, Constant>,
+    pub spec_constants: FastMap<Id, Constant>,
     pub globals: Vec<Global>,
     pub entry_points: Vec<EntryPoint>,
     pub functions: Vec<Function>,
     pub sites: Vec<RtSite>,
-    pub decl_pos: HashMap<Decl, SrcPos>,
+    pub decl_pos: FastMap<Decl, SrcPos>,
     /// Instruction index defining each result id.
-    pub defs: HashMap<Id, usize>,
+    pub defs: FastMap<Id, usize>,
     /// The id of the `NonSemantic.Shader.DebugInfo.100` import, if any.
     pub debug_info_set: Option<Id>,
     /// Imports of instruction sets without semantics (`NonSemantic.*`,
@@ -563,6 +567,94 @@ impl Program {
     /// spelling, since that is what most ray-tracing shaders are written in).
     pub fn type_name(&self, id: Id) -> String {
         debug::type_name(self, id, self.language)
+    }
+}
+
+/// Whether `op` is a ray-query instruction (`OpRayQuery*`): a match, not
+/// the opcode's name, since analyses ask it of every instruction.
+pub fn is_ray_query_op(op: Op) -> bool {
+    matches!(
+        op,
+        Op::RayQueryInitializeKHR
+            | Op::RayQueryTerminateKHR
+            | Op::RayQueryGenerateIntersectionKHR
+            | Op::RayQueryConfirmIntersectionKHR
+            | Op::RayQueryProceedKHR
+            | Op::RayQueryGetIntersectionTypeKHR
+            | Op::RayQueryGetIntersectionTriangleVertexPositionsKHR
+            | Op::RayQueryGetIntersectionClusterIdNV
+            | Op::RayQueryGetIntersectionSpherePositionNV
+            | Op::RayQueryGetIntersectionSphereRadiusNV
+            | Op::RayQueryGetIntersectionLSSPositionsNV
+            | Op::RayQueryGetIntersectionLSSRadiiNV
+            | Op::RayQueryGetIntersectionLSSHitValueNV
+            | Op::RayQueryIsSphereHitNV
+            | Op::RayQueryIsLSSHitNV
+            | Op::RayQueryGetRayTMinKHR
+            | Op::RayQueryGetRayFlagsKHR
+            | Op::RayQueryGetIntersectionTKHR
+            | Op::RayQueryGetIntersectionInstanceCustomIndexKHR
+            | Op::RayQueryGetIntersectionInstanceIdKHR
+            | Op::RayQueryGetIntersectionInstanceShaderBindingTableRecordOffsetKHR
+            | Op::RayQueryGetIntersectionGeometryIndexKHR
+            | Op::RayQueryGetIntersectionPrimitiveIndexKHR
+            | Op::RayQueryGetIntersectionBarycentricsKHR
+            | Op::RayQueryGetIntersectionFrontFaceKHR
+            | Op::RayQueryGetIntersectionCandidateAABBOpaqueKHR
+            | Op::RayQueryGetIntersectionObjectRayDirectionKHR
+            | Op::RayQueryGetIntersectionObjectRayOriginKHR
+            | Op::RayQueryGetWorldRayDirectionKHR
+            | Op::RayQueryGetWorldRayOriginKHR
+            | Op::RayQueryGetIntersectionObjectToWorldKHR
+            | Op::RayQueryGetIntersectionWorldToObjectKHR
+    )
+}
+
+/// Whether `op` is an ordered or unordered float comparison
+/// (`OpFOrd*`, `OpFUnord*`).
+pub fn is_float_compare_op(op: Op) -> bool {
+    matches!(
+        op,
+        Op::FOrdEqual
+            | Op::FUnordEqual
+            | Op::FOrdNotEqual
+            | Op::FUnordNotEqual
+            | Op::FOrdLessThan
+            | Op::FUnordLessThan
+            | Op::FOrdGreaterThan
+            | Op::FUnordGreaterThan
+            | Op::FOrdLessThanEqual
+            | Op::FUnordLessThanEqual
+            | Op::FOrdGreaterThanEqual
+            | Op::FUnordGreaterThanEqual
+    )
+}
+
+#[cfg(test)]
+mod op_tests {
+    /// The matches above are the opcodes whose names say so: every opcode
+    /// the `spirv` crate knows, by its name.
+    #[test]
+    fn opcode_families_match_their_names() {
+        let mut ray_query = 0;
+        for w in 0..=0xffffu32 {
+            let Some(op) = spirv::Op::from_u32(w) else {
+                continue;
+            };
+            let name = format!("{op:?}");
+            assert_eq!(
+                super::is_ray_query_op(op),
+                name.starts_with("RayQuery"),
+                "{name}"
+            );
+            assert_eq!(
+                super::is_float_compare_op(op),
+                name.starts_with("FOrd") || name.starts_with("FUnord"),
+                "{name}"
+            );
+            ray_query += name.starts_with("RayQuery") as usize;
+        }
+        assert_eq!(ray_query, 32);
     }
 }
 

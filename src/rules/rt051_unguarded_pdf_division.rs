@@ -207,9 +207,8 @@ fn guarded(p: &Program, dot: Id) -> bool {
     }
     p.insts[f.start..=f.end].iter().any(|inst| {
         let uses = |k: usize| matches!(inst.operands.get(k), Some(Operand::IdRef(x)) if same.contains(x));
-        let name = format!("{:?}", inst.class.opcode);
         match inst.class.opcode {
-            _ if name.starts_with("FOrd") || name.starts_with("FUnord") => uses(0) || uses(1),
+            op if crate::program::is_float_compare_op(op) => uses(0) || uses(1),
             Op::FAdd => (uses(0) || uses(1)) && inst.operands.iter().any(|o| matches!(o, Operand::IdRef(x) if positive_const(p, *x))),
             Op::ExtInst => {
                 matches!(inst.operands.get(1), Some(Operand::LiteralExtInstInteger(n)) if BOUNDING.contains(n))

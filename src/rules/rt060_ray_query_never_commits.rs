@@ -78,7 +78,7 @@ super::declare_rule! {
 fn check(ctx: &Context) -> Vec<Diagnostic> {
     let p = ctx.program;
     let mut out = Vec::new();
-    for q in rayquery::queries(p) {
+    for q in rayquery::queries(p).iter() {
         if q.proceeds.is_empty() || !q.confirms.is_empty() || !q.flags_known() {
             continue;
         }

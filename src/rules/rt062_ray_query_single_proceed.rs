@@ -68,7 +68,7 @@ fn check(ctx: &Context) -> Vec<Diagnostic> {
     let p = ctx.program;
     let mut out = Vec::new();
     let opaque = FLAG_OPAQUE | FLAG_CULL_NO_OPAQUE | FLAG_SKIP_TRIANGLES;
-    for q in rayquery::queries(p) {
+    for q in rayquery::queries(p).iter() {
         if !q.flags_known() {
             continue;
         }

@@ -58,7 +58,7 @@ super::declare_rule! {
 fn check(ctx: &Context) -> Vec<Diagnostic> {
     let p = ctx.program;
     let mut out = Vec::new();
-    for q in rayquery::queries(p) {
+    for q in rayquery::queries(p).iter() {
         let name = p.display_name(q.var);
         for i in rayquery::reached_without(p, &q, PathFact::Initialised, &q.proceeds) {
             let never = q.inits.is_empty();
