@@ -71,8 +71,17 @@ pub struct Bound {
 
 /// Every trace and ray-query initialisation of a module, once per call
 /// chain position (a helper traced from several places yields one ray per
-/// distinct position).
-pub fn rays(program: &Program) -> Vec<Ray> {
+/// distinct position). Computed once per Program: five rules ask.
+pub fn rays(program: &Program) -> std::sync::Arc<Vec<Ray>> {
+    struct Rays(std::sync::Arc<Vec<Ray>>);
+    program
+        .memo
+        .get_or(|| Rays(std::sync::Arc::new(find_rays(program))))
+        .0
+        .clone()
+}
+
+fn find_rays(program: &Program) -> Vec<Ray> {
     let mut out: Vec<Ray> = Vec::new();
     let mut seen: BTreeSet<(usize, String)> = BTreeSet::new();
     for ep in &program.entry_points {

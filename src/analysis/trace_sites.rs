@@ -37,8 +37,18 @@ pub fn inst_in_loop(program: &Program, inst: usize) -> bool {
     natural_loops(f).iter().any(|(_, body)| body.contains(&b))
 }
 
-/// The traces (`OpTraceRayKHR`) each ray-tracing entry point reaches.
-pub fn reached_traces(program: &Program) -> Vec<ReachedTrace> {
+/// The traces (`OpTraceRayKHR`) each ray-tracing entry point reaches,
+/// computed once per Program (two rules ask).
+pub fn reached_traces(program: &Program) -> std::sync::Arc<Vec<ReachedTrace>> {
+    struct Reached(std::sync::Arc<Vec<ReachedTrace>>);
+    program
+        .memo
+        .get_or(|| Reached(std::sync::Arc::new(find_reached_traces(program))))
+        .0
+        .clone()
+}
+
+fn find_reached_traces(program: &Program) -> Vec<ReachedTrace> {
     let mut out = Vec::new();
     for (e, entry) in program.entry_points.iter().enumerate() {
         if !entry.stage.is_ray_tracing() {

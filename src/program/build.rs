@@ -86,7 +86,17 @@ pub fn parse(words: &[u32], path: &Path, language: Language) -> Result<Program, 
     // a Latin-1 comment), and spirv-val accepts that: parse a copy whose
     // strings have each invalid byte replaced by `?`.
     let cleaned = valid_utf8_strings(words, &offsets);
-    if let Err(e) = rspirv::binary::parse_words(cleaned.as_deref().unwrap_or(words), &mut c) {
+    let input = cleaned.as_deref().unwrap_or(words);
+    if let Some(insts) = super::decode::decode(input, &offsets) {
+        let (major, minor) = (
+            ((words[1] >> 16) & 0xff) as u8,
+            ((words[1] >> 8) & 0xff) as u8,
+        );
+        let mut header = ModuleHeader::new(bound);
+        header.set_version(major, minor);
+        c.header = Some(header);
+        c.insts = insts;
+    } else if let Err(e) = rspirv::binary::parse_words(input, &mut c) {
         use rspirv::binary::ParseState as S;
         let at = |n: usize| offsets.get(n).copied().unwrap_or(words.len() as u32);
         let msg = match e {

@@ -10,6 +10,7 @@ mod binary;
 mod build;
 pub mod cfg;
 pub mod debug;
+pub mod decode;
 mod fold;
 pub mod scalar;
 mod textdecl;

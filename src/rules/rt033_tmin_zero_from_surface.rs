@@ -54,7 +54,7 @@ super::declare_rule! {
 
 fn check(ctx: &Context) -> Vec<Diagnostic> {
     let mut out = Vec::new();
-    for r in rays::rays(ctx.program) {
+    for r in rays::rays(ctx.program).iter() {
         if r.origin != Origin::HitPoint || r.tmin != Some(0.0) {
             continue;
         }

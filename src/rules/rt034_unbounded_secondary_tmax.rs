@@ -49,7 +49,7 @@ super::declare_rule! {
 
 fn check(ctx: &Context) -> Vec<Diagnostic> {
     let mut out = Vec::new();
-    for r in rays::rays(ctx.program) {
+    for r in rays::rays(ctx.program).iter() {
         let (Some(bound), Some(tmax)) = (&r.bound, r.tmax) else {
             continue;
         };

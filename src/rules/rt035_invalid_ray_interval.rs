@@ -47,7 +47,7 @@ super::declare_rule! {
 
 fn check(ctx: &Context) -> Vec<Diagnostic> {
     let mut out = Vec::new();
-    for r in rays::rays(ctx.program) {
+    for r in rays::rays(ctx.program).iter() {
         let problem = match (r.tmin, r.tmax) {
             (Some(a), _) if a.is_nan() => "`tMin` is not a number".to_string(),
             (_, Some(b)) if b.is_nan() => "`tMax` is not a number".to_string(),

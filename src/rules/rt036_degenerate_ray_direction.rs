@@ -41,7 +41,7 @@ super::declare_rule! {
 
 fn check(ctx: &Context) -> Vec<Diagnostic> {
     let mut out = Vec::new();
-    for r in rays::rays(ctx.program) {
+    for r in rays::rays(ctx.program).iter() {
         let Some(d) = r.direction.as_ref().filter(|d| d.len() == 3) else {
             continue;
         };

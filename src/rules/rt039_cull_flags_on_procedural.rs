@@ -51,7 +51,7 @@ fn check(ctx: &PipelineContext) -> Vec<Diagnostic> {
     let cull = flags::CULL_BACK_FACING | flags::CULL_FRONT_FACING;
     // Culling with SkipTriangles, whatever the pipeline.
     for (pi, program) in p.programs.iter().enumerate() {
-        for r in rays::rays(program) {
+        for r in rays::rays(program).iter() {
             let Some(f) = r.flags else { continue };
             if f & cull == 0 || f & flags::SKIP_TRIANGLES == 0 {
                 continue;

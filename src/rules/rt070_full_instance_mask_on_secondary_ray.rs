@@ -66,7 +66,7 @@ fn check(ctx: &Context) -> Vec<Diagnostic> {
     let program = ctx.program;
     let mut out: Vec<Diagnostic> = Vec::new();
     let mut reported = super::Reported::default();
-    for t in reached_traces(program) {
+    for t in reached_traces(program).iter() {
         let site = &program.sites[t.site];
         let secondary = match t.stage {
             Stage::ClosestHit | Stage::Miss => true,

@@ -70,7 +70,7 @@ fn check(ctx: &Context) -> Vec<Diagnostic> {
     let program = ctx.program;
     let mut out = Vec::new();
     let mut reported = super::Reported::default();
-    for t in reached_traces(program) {
+    for t in reached_traces(program).iter() {
         let OperandValue::Const(flags) = t.operands.ray_flags else {
             continue;
         };
