@@ -196,8 +196,9 @@ fn steps(iters: usize, files: &[PathBuf]) {
         "program::parse",
         "attach_named_decls",
         "drop Program",
+        "read the file",
     ];
-    let mut sums = [Duration::ZERO; 7];
+    let mut sums = [Duration::ZERO; 8];
     for f in files {
         let text = std::fs::read_to_string(f).unwrap();
         let (module, info) = rtlint::front::wgsl::parse(&text, f).unwrap();
@@ -265,8 +266,11 @@ fn steps(iters: usize, files: &[PathBuf]) {
                 }
                 median(total)
             },
+            time(iters, || {
+                std::hint::black_box(rtlint::front::read_text(f).unwrap());
+            }),
         ];
-        for k in 0..7 {
+        for k in 0..8 {
             sums[k] += d[k];
         }
     }

@@ -25,16 +25,23 @@ pub struct ReachedTrace {
 
 /// Whether instruction `inst` sits in a natural loop of its function.
 pub fn inst_in_loop(program: &Program, inst: usize) -> bool {
-    let Some(f) = program
-        .function_of(inst)
-        .and_then(|i| program.functions.get(i))
-    else {
-        return false;
-    };
-    let Some(b) = f.block_of(inst) else {
-        return false;
-    };
-    natural_loops(f).iter().any(|(_, body)| body.contains(&b))
+    // Every instruction marked once per Program: asked per trace and per
+    // call on each of its chains, the loops were found again each time.
+    struct InLoop(Vec<bool>);
+    let marks = program.memo.get_or(|| {
+        let mut marks = vec![false; program.insts.len()];
+        for f in &program.functions {
+            for (_, body) in natural_loops(f) {
+                for &b in &body {
+                    if let Some(block) = f.blocks.get(b) {
+                        marks[block.start..=block.end].fill(true);
+                    }
+                }
+            }
+        }
+        InLoop(marks)
+    });
+    marks.0.get(inst).copied().unwrap_or(false)
 }
 
 /// The traces (`OpTraceRayKHR`) each ray-tracing entry point reaches,

@@ -326,6 +326,7 @@ impl Builder<'_> {
 
     /// Every id used must be defined somewhere in the module and below the bound.
     fn check_ids(&mut self, bound: u32) -> Result<(), InputError> {
+        self.p.defs.reserve(self.p.insts.len());
         for (i, inst) in self.p.insts.iter().enumerate() {
             if let Some(r) = inst.result_id {
                 if r == 0 || r >= bound {

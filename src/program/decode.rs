@@ -158,7 +158,8 @@ fn width_of(widths: &[Width], id: u32) -> Width {
 fn instruction(g: Grammar, w: &mut Words, widths: &[Width]) -> Option<Instruction> {
     let mut result_type = None;
     let mut result_id = None;
-    let mut operands = Vec::new();
+    // At most one operand per word: one allocation, never grown.
+    let mut operands = Vec::with_capacity(w.w.len());
     let mut k = 0;
     while k < g.operands.len() {
         let lop = &g.operands[k];
