@@ -200,6 +200,14 @@ fn valid_utf8_strings(words: &[u32], offsets: &[u32]) -> Option<Vec<u32>> {
         let Some(k) = string_word(op, count) else {
             continue;
         };
+        // Plain ASCII up to the terminating zero is valid as it stands: no
+        // copy of the bytes for the strings nearly every module has.
+        let string = &words[at + k..at + count];
+        let ascii_end = string.iter().position(|w| w & 0x8080_8080 != 0);
+        let nul_word = string.iter().position(|w| w.to_le_bytes().contains(&0));
+        if nul_word.is_some_and(|z| ascii_end.is_none_or(|a| z < a)) {
+            continue;
+        }
         let mut bytes: Vec<u8> = words[at + k..at + count]
             .iter()
             .flat_map(|w| w.to_le_bytes())
