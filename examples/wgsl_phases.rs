@@ -2,8 +2,8 @@
 //! `benches/peers.rs` without the rest of that benchmark, plus each rule's
 //! share: `cargo run --release --example wgsl_phases -- [ITERS] [FILE.wgsl...]`
 //! (default: every WGSL file under shaders/ and fixtures/ that loads).
-//! `LOOP=parse|load|rules|check N` repeats one phase N times over the files
-//! instead, for a profiler.
+//! `LOOP=parse|load|rules|check` repeats one phase ITERS times over the
+//! files instead, for a profiler; `STEPS=1` times the steps of reading.
 use rtlint::config::Config;
 use rtlint::shader::Language;
 use std::path::{Path, PathBuf};
@@ -180,7 +180,7 @@ fn main() {
         ms(loaded.saturating_sub(compiled)),
         ms(rules)
     );
-    per_rule.sort_by(|a, b| b.1.cmp(&a.1));
+    per_rule.sort_by_key(|r| std::cmp::Reverse(r.1));
     for (code, d) in per_rule.iter().take(12) {
         println!("    {code} {:.3} ms", ms(*d));
     }

@@ -631,6 +631,23 @@ pub fn is_float_compare_op(op: Op) -> bool {
     )
 }
 
+/// Whether `op` reads a texture (samples, fetches or gathers): the texture
+/// work rules look for in any-hit shaders and ray-query loops.
+pub fn is_texture_read(op: spirv::Op) -> bool {
+    use spirv::Op;
+    matches!(
+        op,
+        Op::ImageSampleImplicitLod
+            | Op::ImageSampleExplicitLod
+            | Op::ImageSampleDrefImplicitLod
+            | Op::ImageSampleDrefExplicitLod
+            | Op::ImageSampleProjImplicitLod
+            | Op::ImageSampleProjExplicitLod
+            | Op::ImageFetch
+            | Op::ImageGather
+    )
+}
+
 #[cfg(test)]
 mod op_tests {
     /// The matches above are the opcodes whose names say so: every opcode
@@ -657,21 +674,4 @@ mod op_tests {
         }
         assert_eq!(ray_query, 32);
     }
-}
-
-/// Whether `op` reads a texture (samples, fetches or gathers): the texture
-/// work rules look for in any-hit shaders and ray-query loops.
-pub fn is_texture_read(op: spirv::Op) -> bool {
-    use spirv::Op;
-    matches!(
-        op,
-        Op::ImageSampleImplicitLod
-            | Op::ImageSampleExplicitLod
-            | Op::ImageSampleDrefImplicitLod
-            | Op::ImageSampleDrefExplicitLod
-            | Op::ImageSampleProjImplicitLod
-            | Op::ImageSampleProjExplicitLod
-            | Op::ImageFetch
-            | Op::ImageGather
-    )
 }

@@ -60,7 +60,7 @@ fn check(ctx: &Context) -> Vec<Diagnostic> {
     let mut out = Vec::new();
     for q in rayquery::queries(p).iter() {
         let name = p.display_name(q.var);
-        for i in rayquery::reached_without(p, &q, PathFact::Initialised, &q.proceeds) {
+        for i in rayquery::reached_without(p, q, PathFact::Initialised, &q.proceeds) {
             let never = q.inits.is_empty();
             out.push(
                 ctx.diagnostic(

@@ -57,7 +57,7 @@ fn check(ctx: &Context) -> Vec<Diagnostic> {
     let p = ctx.program;
     let mut out = Vec::new();
     for q in rayquery::queries(p).iter() {
-        let misses = rayquery::reached_without(p, &q, PathFact::Proceeded, &q.committed_reads);
+        let misses = rayquery::reached_without(p, q, PathFact::Proceeded, &q.committed_reads);
         let Some(&first) = misses.first() else {
             continue;
         };
