@@ -447,6 +447,71 @@ mod tests {
         out
     }
 
+    /// Offsets as `build::parse` checks them first: `None` where a word
+    /// count is 0 or runs past the end.
+    fn checked_offsets(words: &[u32]) -> Option<Vec<u32>> {
+        let mut out = Vec::new();
+        let mut i = 5;
+        while i < words.len() {
+            let count = (words[i] >> 16) as usize;
+            if count == 0 || i + count > words.len() {
+                return None;
+            }
+            out.push(i as u32);
+            i += count;
+        }
+        Some(out)
+    }
+
+    /// Damaged modules: wherever the decoder gives instructions, rspirv
+    /// parses the module too and gives the same ones.
+    #[test]
+    fn damaged_modules_decode_as_rspirv_or_not_at_all() {
+        let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+        let mut all = Vec::new();
+        files(&root.join("fixtures"), &mut all);
+        all.retain(|f| f.extension().is_some_and(|e| e == "spv"));
+        all.sort();
+        let mut seed: u64 = 0x9e37_79b9_7f4a_7c15;
+        let mut next = move || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            seed
+        };
+        let (mut decoded, mut tried) = (0, 0);
+        for f in &all {
+            let bytes = std::fs::read(f).unwrap();
+            let Ok(words) = crate::program::words_from_bytes(&bytes, f) else {
+                continue;
+            };
+            for _ in 0..40 {
+                let mut w = words.clone();
+                let at = 5 + (next() as usize) % (w.len() - 5);
+                // A small value, a flipped bit or an opcode-sized change.
+                w[at] = match next() % 3 {
+                    0 => (next() % 8) as u32,
+                    1 => w[at] ^ (1 << (next() % 32)),
+                    _ => w[at].wrapping_add((next() % 5) as u32).wrapping_sub(2),
+                };
+                let Some(offs) = checked_offsets(&w) else {
+                    continue;
+                };
+                tried += 1;
+                if let Some(got) = decode(&w, &offs) {
+                    let expected = rspirv_insts(&w);
+                    assert!(
+                        expected.as_ref() == Some(&got),
+                        "{} with word {at} damaged",
+                        f.display()
+                    );
+                    decoded += 1;
+                }
+            }
+        }
+        assert!(tried > 500 && decoded > 100, "{decoded} of {tried}");
+    }
+
     /// On every module of the repository (SPIR-V files, and the WGSL and
     /// HLSL sources compiled), the decoder gives rspirv's instructions or
     /// leaves the module to rspirv; every WGSL module it decodes itself.
