@@ -25,7 +25,10 @@ use crate::shader::Language;
 use crate::shader::Stage;
 use rspirv::dr::{Instruction, Operand};
 use spirv::{Op, StorageClass};
-use std::collections::HashMap;
+// Ids hash far faster with Fx than with SipHash, and the analyses look
+// ids up all the time (`defs`, `constants`, `types`); a module's ids are
+// its own, not adversarial input to a hash table.
+type HashMap<K, V> = rustc_hash::FxHashMap<K, V>;
 use std::path::PathBuf;
 
 pub type Id = u32;
@@ -388,7 +391,7 @@ impl Program {
         // Every call by callee, indexed once: call chains ask per function.
         struct Calls(HashMap<Id, Vec<usize>>);
         let calls = self.memo.get_or(|| {
-            let mut by_callee: HashMap<Id, Vec<usize>> = HashMap::new();
+            let mut by_callee: HashMap<Id, Vec<usize>> = HashMap::default();
             for (i, inst) in self.insts.iter().enumerate() {
                 if inst.class.opcode != Op::FunctionCall {
                     continue;
