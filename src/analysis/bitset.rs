@@ -59,6 +59,13 @@ impl BitSet {
         }
     }
 
+    /// Removes every index of `other`.
+    pub fn subtract(&mut self, other: &BitSet) {
+        for (a, b) in self.0.iter_mut().zip(&other.0) {
+            *a &= !b;
+        }
+    }
+
     /// The indices, smallest first.
     pub fn iter(&self) -> impl Iterator<Item = u32> + '_ {
         self.0.iter().enumerate().flat_map(|(w, &word)| {
@@ -127,6 +134,22 @@ mod tests {
         assert_eq!(a, b, "b has more words, all zero");
         assert_eq!(b, a);
         assert_eq!(BitSet::default(), b.clone().tap_clear());
+    }
+
+    #[test]
+    fn subtract() {
+        let mut a = BitSet::default();
+        for i in [1, 2, 70, 300] {
+            a.insert(i);
+        }
+        let mut b = BitSet::default();
+        b.insert(2);
+        b.insert(300);
+        b.insert(1000);
+        a.subtract(&b);
+        assert_eq!(a.iter().collect::<Vec<_>>(), [1, 70]);
+        b.subtract(&a);
+        assert_eq!(b.iter().collect::<Vec<_>>(), [2, 300, 1000]);
     }
 
     #[test]

@@ -531,6 +531,111 @@ impl Places {
     }
 }
 
+/// Facts about the ids one function defines, by id: a slot per id from
+/// the function's lowest result id (a module numbers its ids densely, so
+/// this is a load instead of a hash lookup per operand), hashing only for
+/// huge, sparse ids.
+#[derive(Debug)]
+enum IdMap<T> {
+    /// Slot `id - lo` holds the index into `values`, or [`IdMap::NONE`]
+    /// (the values kept apart so that dropping the map is one free). The
+    /// few ids outside the range (parameters: compilers number them with
+    /// the function, before its body) are listed in `outside`.
+    Dense {
+        lo: Id,
+        slots: Vec<u32>,
+        values: Vec<T>,
+        outside: Vec<(Id, u32)>,
+    },
+    Sparse(HashMap<Id, T>),
+}
+
+impl<T> IdMap<T> {
+    const NONE: u32 = u32::MAX;
+
+    /// For the ids `lo..=hi`.
+    fn new(lo: Id, hi: Id) -> IdMap<T> {
+        let n = hi.saturating_sub(lo) as usize + 1;
+        if n <= 1 << 20 {
+            IdMap::Dense {
+                lo,
+                slots: vec![Self::NONE; n],
+                values: Vec::new(),
+                outside: Vec::new(),
+            }
+        } else {
+            IdMap::Sparse(HashMap::default())
+        }
+    }
+
+    fn get(&self, id: &Id) -> Option<&T> {
+        match self {
+            IdMap::Dense {
+                lo,
+                slots,
+                values,
+                outside,
+            } => {
+                let k = match id.checked_sub(*lo).and_then(|k| slots.get(k as usize)) {
+                    Some(&k) => k,
+                    None => outside.iter().find(|(x, _)| x == id)?.1,
+                };
+                values.get(k as usize)
+            }
+            IdMap::Sparse(m) => m.get(id),
+        }
+    }
+
+    fn contains_key(&self, id: &Id) -> bool {
+        self.get(id).is_some()
+    }
+
+    fn insert(&mut self, id: Id, value: T) {
+        match self {
+            IdMap::Dense {
+                lo,
+                slots,
+                values,
+                outside,
+            } => {
+                let next = values.len() as u32;
+                let k = match id.checked_sub(*lo).and_then(|k| slots.get_mut(k as usize)) {
+                    Some(s) if *s == Self::NONE => std::mem::replace(s, next),
+                    Some(s) => *s,
+                    None => match outside.iter().find(|(x, _)| *x == id) {
+                        Some(&(_, k)) => k,
+                        None => {
+                            outside.push((id, next));
+                            Self::NONE
+                        }
+                    },
+                };
+                if k == Self::NONE {
+                    values.push(value);
+                } else {
+                    values[k as usize] = value;
+                }
+            }
+            IdMap::Sparse(m) => {
+                m.insert(id, value);
+            }
+        }
+    }
+}
+
+/// A set of the ids one function defines (see [`IdMap`]).
+type IdSet = IdMap<()>;
+
+impl IdSet {
+    fn contains(&self, id: &Id) -> bool {
+        self.contains_key(id)
+    }
+
+    fn add(&mut self, id: Id) {
+        self.insert(id, ());
+    }
+}
+
 /// A pointer into a function-local variable.
 #[derive(Clone, Debug)]
 struct LocalPtr {
@@ -587,16 +692,34 @@ enum Step {
     Other,
 }
 
+/// A piece of one block's backward transfer (see [`FnLiveness::blocks`]).
+#[derive(Debug)]
+enum Segment {
+    /// A run of [`Step::Plain`]s folded into one: kills `kill`, then
+    /// makes `gen` live.
+    Run { kill: BitSet, gen: BitSet },
+    /// An instruction whose transfer depends on the live set.
+    Inst(usize),
+}
+
 /// Parts are tracked separately up to this many elements per composite.
 const MAX_SPLIT: u32 = 64;
+
+/// Variables possibly written on some path to each block's end.
+struct Defined {
+    /// Per block, as indices into `written`.
+    out: Vec<BitSet>,
+    /// The roots something in the function writes.
+    written: Vec<Id>,
+}
 
 /// Liveness facts of one function.
 pub struct FnLiveness {
     func: usize,
     /// Function-local `OpVariable`s.
-    vars: HashSet<Id>,
+    vars: IdSet,
     /// Pointer ids derived from a local variable or a pointer parameter.
-    roots: HashMap<Id, LocalPtr>,
+    roots: IdMap<LocalPtr>,
     /// For each `OpFunctionCall` (by instruction index), the parts each
     /// pointer argument's callee parameter may read before writing.
     call_reads: HashMap<usize, ExposedParams>,
@@ -608,16 +731,15 @@ pub struct FnLiveness {
     /// The loads of `copies`.
     copy_loads: HashSet<usize>,
     /// SSA values that count as state: defined here, not pointers to locals.
-    ssa: HashSet<Id>,
+    ssa: IdSet,
     /// Live places at each block's end, as indices into `places`.
     live_out: Vec<BitSet>,
     /// Every place met while solving (the live sets' members).
     places: RefCell<Places>,
-    /// Variables possibly written at each block's end.
-    /// (As indices into `written`.)
-    defined_out: Vec<BitSet>,
-    /// The roots something in the function writes, indexed for `defined_out`.
-    written: Vec<Id>,
+    /// Variables possibly written at each block's end (as indices into
+    /// [`Defined::written`]): only asked where a site is, so worked out
+    /// on first use (a callee solved for its parameters never asks).
+    defined: std::cell::OnceCell<Defined>,
     preds: Vec<Vec<usize>>,
     remat: HashMap<Id, bool>,
     /// Variables' rematerialisation as read at an instruction.
@@ -626,6 +748,13 @@ pub struct FnLiveness {
     steps: Vec<Step>,
     /// The places `Step::Plain` reads.
     step_uses: Vec<u32>,
+    /// Each block's backward transfer, last instruction first: the
+    /// fixpoint visits a block with a few word operations per run of
+    /// plain steps instead of stepping every instruction.
+    segments: Vec<Segment>,
+    /// Where each block's segments start in `segments` (one more entry
+    /// than blocks).
+    block_segments: Vec<u32>,
     /// The instructions that define or use each variable, in order (built
     /// on first use).
     mentions: Option<HashMap<Id, std::rc::Rc<[usize]>>>,
@@ -752,6 +881,10 @@ impl FnLiveness {
             w
         };
         let own: Vec<Vec<Vec<u32>>> = (0..n).map(own).collect();
+        // Nothing written here at all: nothing written on every path.
+        if own.iter().all(Vec::is_empty) {
+            return Vec::new();
+        }
         // Forward must-analysis: `None` is "everything" (not reached yet).
         let mut out: Vec<Option<HashSet<Vec<u32>>>> = vec![None; n];
         let mut changed = true;
@@ -809,10 +942,16 @@ impl FnLiveness {
         depth: u32,
     ) -> (FnLiveness, bool) {
         let f = &program.functions[func];
-        let mut vars = HashSet::default();
-        let mut roots: HashMap<Id, LocalPtr> = HashMap::default();
-        // Most results are SSA values: sized once, not grown step by step.
-        let mut ssa = HashSet::with_capacity_and_hasher(f.end + 1 - f.start, Default::default());
+        // The body's ids: the function's own and its parameters' are often
+        // numbered long before it, and would widen the dense tables.
+        let ids = program.insts[f.start..=f.end]
+            .iter()
+            .filter(|i| !matches!(i.class.opcode, Op::Function | Op::FunctionParameter))
+            .filter_map(|i| i.result_id);
+        let (lo, hi) = ids.fold((Id::MAX, 0), |(lo, hi), r| (lo.min(r), hi.max(r)));
+        let mut vars = IdSet::new(lo, hi);
+        let mut roots: IdMap<LocalPtr> = IdMap::new(lo, hi);
+        let mut ssa = IdSet::new(lo, hi);
         for inst in &program.insts[f.start..=f.end] {
             let Some(r) = inst.result_id else { continue };
             if program.is_debug_inst(inst) {
@@ -832,7 +971,7 @@ impl FnLiveness {
                     );
                 }
                 Op::Variable => {
-                    vars.insert(r);
+                    vars.add(r);
                     roots.insert(
                         r,
                         LocalPtr {
@@ -847,8 +986,8 @@ impl FnLiveness {
                 | Op::PtrAccessChain
                 | Op::CopyObject
                 | Op::Bitcast => {
-                    let ids: Vec<Id> = id_operands(inst).collect();
-                    match ids.first().and_then(|b| roots.get(b)).cloned() {
+                    let mut ids = id_operands(inst);
+                    match ids.next().and_then(|b| roots.get(&b)).cloned() {
                         Some(mut ptr) => {
                             let chain = matches!(
                                 inst.class.opcode,
@@ -860,7 +999,7 @@ impl FnLiveness {
                                 ptr.exact = false;
                             }
                             if chain {
-                                for &ix in &ids[1..] {
+                                for ix in ids {
                                     match program.const_u64(ix) {
                                         Some(c) if ptr.exact => ptr.path.push(c as u32),
                                         _ => ptr.exact = false,
@@ -870,13 +1009,13 @@ impl FnLiveness {
                             roots.insert(r, ptr);
                         }
                         None => {
-                            ssa.insert(r);
+                            ssa.add(r);
                         }
                     }
                 }
                 Op::Label | Op::Function => {}
                 _ => {
-                    ssa.insert(r);
+                    ssa.add(r);
                 }
             }
         }
@@ -952,10 +1091,6 @@ impl FnLiveness {
                 call_reads.insert(i, e);
             }
         }
-        let ids = program.insts[f.start..=f.end]
-            .iter()
-            .filter_map(|i| i.result_id);
-        let (lo, hi) = ids.fold((Id::MAX, 0), |(lo, hi), r| (lo.min(r), hi.max(r)));
         let mut fl = FnLiveness {
             func,
             vars,
@@ -966,13 +1101,14 @@ impl FnLiveness {
             ssa,
             live_out: vec![BitSet::default(); n],
             places: RefCell::new(Places::new(lo, hi)),
-            defined_out: vec![BitSet::default(); n],
-            written: Vec::new(),
+            defined: std::cell::OnceCell::new(),
             preds,
             remat: HashMap::default(),
             remat_at: HashMap::default(),
             steps: Vec::new(),
             step_uses: Vec::new(),
+            segments: Vec::new(),
+            block_segments: Vec::new(),
             mentions: None,
         };
         fl.prepare_steps(program);
@@ -1033,8 +1169,59 @@ impl FnLiveness {
                 uses: start..pool.len() as u32,
             });
         }
+        // Fold each block's runs of plain steps: stepping back over
+        // "kill d, then make U live" after (kill K, then make G live) is
+        // (kill K ∪ {d}, then make (G − {d}) ∪ U live).
+        let mut segments = Vec::new();
+        let mut block_segments = Vec::with_capacity(f.blocks.len() + 1);
+        let mut run: Option<(BitSet, BitSet)> = None;
+        for block in &f.blocks {
+            block_segments.push(segments.len() as u32);
+            for at in (block.start..=block.end).rev() {
+                match &steps[at - f.start] {
+                    Step::Skip => {}
+                    Step::Plain { def, uses } => {
+                        let (kill, gen) = run.get_or_insert_with(Default::default);
+                        if *def != Places::NONE {
+                            kill.insert(*def);
+                            gen.remove(*def);
+                        }
+                        for &u in &pool[uses.start as usize..uses.end as usize] {
+                            gen.insert(u);
+                        }
+                    }
+                    Step::Other => {
+                        if let Some((kill, gen)) = run.take() {
+                            segments.push(Segment::Run { kill, gen });
+                        }
+                        segments.push(Segment::Inst(at));
+                    }
+                }
+            }
+            if let Some((kill, gen)) = run.take() {
+                segments.push(Segment::Run { kill, gen });
+            }
+        }
+        block_segments.push(segments.len() as u32);
         self.steps = steps;
         self.step_uses = pool;
+        self.segments = segments;
+        self.block_segments = block_segments;
+    }
+
+    /// Backward transfer of a whole block over the live set (as stepping
+    /// back over each of its instructions).
+    fn block_back(&self, program: &Program, b: usize, live: &mut BitSet) {
+        let range = self.block_segments[b] as usize..self.block_segments[b + 1] as usize;
+        for seg in &self.segments[range] {
+            match seg {
+                Segment::Run { kill, gen } => {
+                    live.subtract(kill);
+                    live.union_with(gen);
+                }
+                Segment::Inst(at) => self.step_back(program, *at, live),
+            }
+        }
     }
 
     fn function<'p>(&self, program: &'p Program) -> &'p Function {
@@ -1337,9 +1524,7 @@ impl FnLiveness {
             }
             let mut live = std::mem::take(&mut scratch);
             live.clone_from(&out);
-            for k in (f.blocks[b].start..=f.blocks[b].end).rev() {
-                self.step_back(program, k, &mut live);
-            }
+            self.block_back(program, b, &mut live);
             self.live_out[b] = out;
             if live != live_in[b] {
                 std::mem::swap(&mut live_in[b], &mut live);
@@ -1352,43 +1537,51 @@ impl FnLiveness {
             }
             scratch = live;
         }
-        // Forward: variables possibly written on some path. What each
-        // block writes itself is the same every round.
-        let mut index: HashMap<Id, u32> = HashMap::default();
-        let mut written = Vec::new();
-        let own: Vec<BitSet> = f
-            .blocks
-            .iter()
-            .map(|block| {
-                let mut set = BitSet::default();
-                for inst in &program.insts[block.start..=block.end] {
-                    self.writes(program, inst, |id| {
-                        set.insert(*index.entry(id).or_insert_with(|| {
-                            written.push(id);
-                            written.len() as u32 - 1
-                        }));
-                    });
-                }
-                set
-            })
-            .collect();
-        self.written = written;
-        let mut changed = true;
-        let mut rounds = 0;
-        while changed && rounds < 10_000 {
-            changed = false;
-            rounds += 1;
-            for (b, written) in own.iter().enumerate() {
-                let mut d = written.clone();
-                for &p in &self.preds[b] {
-                    d.union_with(&self.defined_out[p]);
-                }
-                if d != self.defined_out[b] {
-                    self.defined_out[b] = d;
-                    changed = true;
+    }
+
+    /// Variables possibly written on some path to each block's end.
+    fn defined(&self, program: &Program) -> &Defined {
+        self.defined.get_or_init(|| {
+            let f = self.function(program);
+            // What each block writes itself is the same every round.
+            let mut index: HashMap<Id, u32> = HashMap::default();
+            let mut written = Vec::new();
+            let own: Vec<BitSet> = f
+                .blocks
+                .iter()
+                .map(|block| {
+                    let mut set = BitSet::default();
+                    for inst in &program.insts[block.start..=block.end] {
+                        self.writes(program, inst, |id| {
+                            set.insert(*index.entry(id).or_insert_with(|| {
+                                written.push(id);
+                                written.len() as u32 - 1
+                            }));
+                        });
+                    }
+                    set
+                })
+                .collect();
+            let mut out = vec![BitSet::default(); f.blocks.len()];
+            let mut d = BitSet::default();
+            let mut changed = true;
+            let mut rounds = 0;
+            while changed && rounds < 10_000 {
+                changed = false;
+                rounds += 1;
+                for (b, own) in own.iter().enumerate() {
+                    d.clone_from(own);
+                    for &p in &self.preds[b] {
+                        d.union_with(&out[p]);
+                    }
+                    if d != out[b] {
+                        std::mem::swap(&mut out[b], &mut d);
+                        changed = true;
+                    }
                 }
             }
-        }
+            Defined { out, written }
+        })
     }
 
     /// Ids live just after instruction `inst` (SSA values and variables).
@@ -1443,9 +1636,10 @@ impl FnLiveness {
         let Some(b) = f.block_of(inst) else {
             return HashSet::default();
         };
+        let defined = self.defined(program);
         let mut d: HashSet<Id> = HashSet::default();
         for &p in &self.preds[b] {
-            d.extend(self.defined_out[p].iter().map(|i| self.written[i as usize]));
+            d.extend(defined.out[p].iter().map(|i| defined.written[i as usize]));
         }
         for k in f.blocks[b].start..inst {
             self.writes(program, &program.insts[k], |id| {
@@ -1824,17 +2018,19 @@ impl FnLiveness {
             return r;
         }
         self.remat_at.insert(key.clone(), false);
-        let reaching = self.reaching_writes(program, var, at);
-        let mut ok = true;
-        let mut stored: Vec<(Vec<u32>, Id)> = Vec::new();
         // Shared, not copied: the loop below recurses into `self`.
         let mentions = self.mentions(program).get(&var).cloned();
+        let reaching = self.reaching_writes(program, var, at, mentions.as_deref().unwrap_or(&[]));
+        let mut ok = true;
+        let mut stored: Vec<(Vec<u32>, Id)> = Vec::new();
         for &i in mentions.iter().flat_map(|m| m.iter()) {
             let inst = &program.insts[i];
-            let ids: Vec<Id> = id_operands(inst).collect();
+            // The operands one by one: a vector of them per mention was a
+            // good part of this function's time.
+            let mut ids = id_operands(inst);
             match inst.class.opcode {
                 Op::Variable => {
-                    if let Some(&init) = ids.first().filter(|_| reaching.contains(&i)) {
+                    if let Some(init) = ids.next().filter(|_| reaching.binary_search(&i).is_ok()) {
                         if !matches!(
                             program.constants.get(&init),
                             Some(Constant::Int(_) | Constant::Float(_) | Constant::Bool(_))
@@ -1847,12 +2043,12 @@ impl FnLiveness {
                     }
                 }
                 // A store that cannot reach `at` does not give the value read there.
-                Op::Store if !reaching.contains(&i) => {}
+                Op::Store if reaching.binary_search(&i).is_err() => {}
                 Op::Store => {
-                    let value = ids.get(1).copied().unwrap_or(0);
-                    let path = ids
-                        .first()
-                        .and_then(|p| self.roots.get(p))
+                    let ptr = ids.next();
+                    let value = ids.next().unwrap_or(0);
+                    let path = ptr
+                        .and_then(|p| self.roots.get(&p))
                         .map(|p| p.path.clone())
                         .unwrap_or_default();
                     let overlaps = parts.is_empty()
@@ -1872,10 +2068,7 @@ impl FnLiveness {
                 }
                 Op::Load => {}
                 Op::AccessChain | Op::InBoundsAccessChain | Op::PtrAccessChain => {
-                    if !ids[1..]
-                        .iter()
-                        .all(|&x| self.remat_ssa(program, x, depth + 1))
-                    {
+                    if !ids.skip(1).all(|x| self.remat_ssa(program, x, depth + 1)) {
                         ok = false;
                     }
                 }
@@ -1916,10 +2109,18 @@ impl FnLiveness {
 
     /// The writes to `var` (stores, and its `OpVariable` when it has an
     /// initializer) that can give the value read at `at`: walking back from
-    /// `at` along every path, up to a store of the whole variable.
-    fn reaching_writes(&self, program: &Program, var: Id, at: usize) -> HashSet<usize> {
+    /// `at` along every path, up to a store of the whole variable; sorted.
+    /// Only the variable's `mentions` (sorted) can write it: a block is
+    /// searched through those, not instruction by instruction.
+    fn reaching_writes(
+        &self,
+        program: &Program,
+        var: Id,
+        at: usize,
+        mentions: &[usize],
+    ) -> Vec<usize> {
         let f = self.function(program);
-        let mut found = HashSet::default();
+        let mut found = Vec::new();
         let Some(b0) = f.block_of(at) else {
             return found;
         };
@@ -1942,9 +2143,11 @@ impl FnLiveness {
         while let Some((b, last)) = work.pop() {
             let block = &f.blocks[b];
             let mut killed = false;
-            for i in (block.start..last).rev() {
+            let from = mentions.partition_point(|&i| i < block.start);
+            let to = mentions.partition_point(|&i| i < last);
+            for &i in mentions[from..to.max(from)].iter().rev() {
                 if let Some(w) = whole(i) {
-                    found.insert(i);
+                    found.push(i);
                     if w {
                         killed = true;
                         break;
@@ -1958,7 +2161,7 @@ impl FnLiveness {
                 // The entry block holds the variables and their initializers.
                 if let Some(&d) = program.defs.get(&var) {
                     if whole(d) == Some(true) {
-                        found.insert(d);
+                        found.push(d);
                     }
                 }
             }
@@ -1968,6 +2171,8 @@ impl FnLiveness {
                 }
             }
         }
+        found.sort_unstable();
+        found.dedup();
         found
     }
 }
