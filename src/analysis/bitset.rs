@@ -59,11 +59,18 @@ impl BitSet {
         }
     }
 
-    /// Removes every index of `other`.
-    pub fn subtract(&mut self, other: &BitSet) {
-        for (a, b) in self.0.iter_mut().zip(&other.0) {
-            *a &= !b;
+    /// Makes room for the indices below `n` at once (the words a set
+    /// would otherwise grow one insert or union at a time).
+    pub fn reserve_indices(&mut self, n: u32) {
+        let words = (n as usize).div_ceil(64);
+        if words > self.0.len() {
+            self.0.resize(words, 0);
         }
+    }
+
+    /// Removes every index, keeping the words for reuse.
+    pub fn clear(&mut self) {
+        self.0.fill(0);
     }
 
     /// The indices, smallest first.
@@ -89,7 +96,10 @@ impl PartialEq for BitSet {
         } else {
             (&other.0, &self.0)
         };
-        short == &long[..short.len()] && long[short.len()..].iter().all(|&w| w == 0)
+        // Word by word: the sets are a few words long, and the fixpoint
+        // compares them at every visit (a `memcmp` call each was slower).
+        short.iter().zip(long.iter()).all(|(a, b)| a == b)
+            && long[short.len()..].iter().all(|&w| w == 0)
     }
 }
 
@@ -137,19 +147,28 @@ mod tests {
     }
 
     #[test]
-    fn subtract() {
+    fn reserve_keeps_members() {
         let mut a = BitSet::default();
-        for i in [1, 2, 70, 300] {
-            a.insert(i);
-        }
-        let mut b = BitSet::default();
-        b.insert(2);
-        b.insert(300);
-        b.insert(1000);
-        a.subtract(&b);
-        assert_eq!(a.iter().collect::<Vec<_>>(), [1, 70]);
-        b.subtract(&a);
-        assert_eq!(b.iter().collect::<Vec<_>>(), [2, 300, 1000]);
+        a.insert(5);
+        a.reserve_indices(1000);
+        assert_eq!(a.iter().collect::<Vec<_>>(), [5]);
+        assert_eq!(a, {
+            let mut b = BitSet::default();
+            b.insert(5);
+            b
+        });
+        assert!(a.insert(999) && a.contains(999));
+    }
+
+    #[test]
+    fn clear() {
+        let mut a = BitSet::default();
+        a.insert(3);
+        a.insert(700);
+        a.clear();
+        assert_eq!(a.iter().count(), 0);
+        assert_eq!(a, BitSet::default());
+        assert!(a.insert(700), "absent after clearing");
     }
 
     #[test]

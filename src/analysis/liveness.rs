@@ -239,7 +239,7 @@ fn compute_live_sites(program: &Program, described: bool) -> Vec<LiveSite> {
                     b.size
                         .cmp(&a.size)
                         .then(a.rematerializable.cmp(&b.rematerializable))
-                        .then(a.name.cmp(&b.name))
+                        .then_with(|| a.name.cmp(&b.name))
                 });
                 let location = std::iter::once(site.inst)
                     .chain(chain.iter().rev().copied())
@@ -412,6 +412,28 @@ fn id_operands(inst: &Instruction) -> impl Iterator<Item = Id> + '_ {
     })
 }
 
+/// Whether `path` begins with `prefix`. Paths are a few indices long: a
+/// loop, not a `memcmp` call per comparison (which `starts_with` and `==`
+/// make, and which was a sixth of the model's time in `kill`).
+fn has_prefix(path: &[u32], prefix: &[u32]) -> bool {
+    if prefix.len() > path.len() {
+        return false;
+    }
+    let mut k = 0;
+    while k < prefix.len() {
+        if path[k] != prefix[k] {
+            return false;
+        }
+        k += 1;
+    }
+    true
+}
+
+/// Whether two paths are equal (see [`has_prefix`]).
+fn same_path(a: &[u32], b: &[u32]) -> bool {
+    a.len() == b.len() && has_prefix(a, b)
+}
+
 /// What backward liveness tracks: an SSA value (empty path), or part of a
 /// function-local variable, named by the constant access-chain indices that
 /// reach it from the variable (empty: all of it).
@@ -438,10 +460,13 @@ struct Places {
 impl Places {
     const NONE: u32 = u32::MAX;
 
-    /// For the ids `lo..=hi` defined in one function.
-    fn new(lo: Id, hi: Id) -> Places {
+    /// For the ids `lo..=hi` defined in one function of `insts`
+    /// instructions (about as many places, made room for at once).
+    fn new(lo: Id, hi: Id, insts: usize) -> Places {
         let n = hi.saturating_sub(lo) as usize + 1;
         Places {
+            list: Vec::with_capacity(insts),
+            next: Vec::with_capacity(insts),
             // A module with huge, sparse ids falls back to hashing.
             whole: if n <= 1 << 20 {
                 vec![Self::NONE; n]
@@ -465,7 +490,7 @@ impl Places {
 
     fn find(&self, mut i: u32, path: &[u32]) -> Option<u32> {
         while i != Self::NONE {
-            if self.list[i as usize].1.as_slice() == path {
+            if same_path(&self.list[i as usize].1, path) {
                 return Some(i);
             }
             i = self.next[i as usize];
@@ -695,9 +720,13 @@ enum Step {
 /// A piece of one block's backward transfer (see [`FnLiveness::blocks`]).
 #[derive(Debug)]
 enum Segment {
-    /// A run of [`Step::Plain`]s folded into one: kills `kill`, then
-    /// makes `gen` live.
-    Run { kill: BitSet, gen: BitSet },
+    /// A run of [`Step::Plain`]s folded into one: kills the places
+    /// `FnLiveness::step_uses[kill]`, then makes `step_uses[gen]` live
+    /// (index lists in the shared pool, not two sets per run).
+    Run {
+        kill: std::ops::Range<u32>,
+        gen: std::ops::Range<u32>,
+    },
     /// An instruction whose transfer depends on the live set.
     Inst(usize),
 }
@@ -1100,7 +1129,7 @@ impl FnLiveness {
             copies,
             ssa,
             live_out: vec![BitSet::default(); n],
-            places: RefCell::new(Places::new(lo, hi)),
+            places: RefCell::new(Places::new(lo, hi, f.end + 1 - f.start)),
             defined: std::cell::OnceCell::new(),
             preds,
             remat: HashMap::default(),
@@ -1123,7 +1152,8 @@ impl FnLiveness {
         let f = &program.functions[self.func];
         let places = self.places.get_mut();
         let mut steps = Vec::with_capacity(f.end + 1 - f.start);
-        let mut pool = Vec::new();
+        // About two operands an instruction, and as many run entries.
+        let mut pool = Vec::with_capacity(4 * (f.end + 1 - f.start));
         for at in f.start..=f.end {
             let inst = &program.insts[at];
             let op = inst.class.opcode;
@@ -1174,32 +1204,50 @@ impl FnLiveness {
         // (kill K ∪ {d}, then make (G − {d}) ∪ U live).
         let mut segments = Vec::new();
         let mut block_segments = Vec::with_capacity(f.blocks.len() + 1);
-        let mut run: Option<(BitSet, BitSet)> = None;
+        // The run being folded, as sets; written to the pool when it ends.
+        let (mut kill, mut gen) = (BitSet::default(), BitSet::default());
+        let mut in_run = false;
+        let end_run = |kill: &mut BitSet,
+                       gen: &mut BitSet,
+                       pool: &mut Vec<u32>,
+                       segments: &mut Vec<Segment>| {
+            let k0 = pool.len() as u32;
+            pool.extend(kill.iter());
+            let g0 = pool.len() as u32;
+            pool.extend(gen.iter());
+            let g1 = pool.len() as u32;
+            segments.push(Segment::Run {
+                kill: k0..g0,
+                gen: g0..g1,
+            });
+            kill.clear();
+            gen.clear();
+        };
         for block in &f.blocks {
             block_segments.push(segments.len() as u32);
             for at in (block.start..=block.end).rev() {
                 match &steps[at - f.start] {
                     Step::Skip => {}
                     Step::Plain { def, uses } => {
-                        let (kill, gen) = run.get_or_insert_with(Default::default);
+                        in_run = true;
                         if *def != Places::NONE {
                             kill.insert(*def);
                             gen.remove(*def);
                         }
-                        for &u in &pool[uses.start as usize..uses.end as usize] {
-                            gen.insert(u);
+                        for k in uses.start..uses.end {
+                            gen.insert(pool[k as usize]);
                         }
                     }
                     Step::Other => {
-                        if let Some((kill, gen)) = run.take() {
-                            segments.push(Segment::Run { kill, gen });
+                        if std::mem::take(&mut in_run) {
+                            end_run(&mut kill, &mut gen, &mut pool, &mut segments);
                         }
                         segments.push(Segment::Inst(at));
                     }
                 }
             }
-            if let Some((kill, gen)) = run.take() {
-                segments.push(Segment::Run { kill, gen });
+            if std::mem::take(&mut in_run) {
+                end_run(&mut kill, &mut gen, &mut pool, &mut segments);
             }
         }
         block_segments.push(segments.len() as u32);
@@ -1216,8 +1264,12 @@ impl FnLiveness {
         for seg in &self.segments[range] {
             match seg {
                 Segment::Run { kill, gen } => {
-                    live.subtract(kill);
-                    live.union_with(gen);
+                    for &k in &self.step_uses[kill.start as usize..kill.end as usize] {
+                        live.remove(k);
+                    }
+                    for &g in &self.step_uses[gen.start as usize..gen.end as usize] {
+                        live.insert(g);
+                    }
                 }
                 Segment::Inst(at) => self.step_back(program, *at, live),
             }
@@ -1281,9 +1333,9 @@ impl FnLiveness {
                     .filter(|&i| live.contains(i))
                     .filter_map(|i| {
                         let q = &places.place(i).1;
-                        if let Some(rest) = q.strip_prefix(dst.path.as_slice()) {
-                            Some(rest.to_vec())
-                        } else if dst.path.starts_with(q) {
+                        if has_prefix(q, &dst.path) {
+                            Some(q[dst.path.len()..].to_vec())
+                        } else if has_prefix(&dst.path, q) {
                             Some(Vec::new())
                         } else {
                             None
@@ -1382,9 +1434,9 @@ impl FnLiveness {
             .filter(|&i| live.contains(i))
             .filter_map(|i| {
                 let q = &places.place(i).1;
-                if q.starts_with(&ptr.path) {
+                if has_prefix(q, &ptr.path) {
                     Some((i, true))
-                } else if ptr.path.starts_with(q) {
+                } else if has_prefix(&ptr.path, q) {
                     Some((i, false))
                 } else {
                     None
@@ -1490,7 +1542,7 @@ impl FnLiveness {
         let mut live_in: Vec<BitSet> = vec![BitSet::default(); n];
         let phi_uses: Vec<BitSet> = {
             let places = &mut *self.places.borrow_mut();
-            phi_uses
+            let mut sets: Vec<BitSet> = phi_uses
                 .iter()
                 .map(|uses| {
                     let mut set = BitSet::default();
@@ -1499,7 +1551,14 @@ impl FnLiveness {
                     }
                     set
                 })
-                .collect()
+                .collect();
+            // Every place met so far fits from the start: the sets copied
+            // from these do not grow word by word in the loop below.
+            let known = places.list.len() as u32;
+            for set in &mut sets {
+                set.reserve_indices(known);
+            }
+            sets
         };
         // A worklist: a block is redone only when a successor's live-in
         // grew (every block once first, last block first), instead of every
@@ -1615,7 +1674,7 @@ impl FnLiveness {
         }
         let outer = paths
             .iter()
-            .filter(|p| !paths.iter().any(|q| q.len() < p.len() && p.starts_with(q)));
+            .filter(|p| !paths.iter().any(|q| q.len() < p.len() && has_prefix(p, q)));
         let mut sum = 0;
         for p in outer {
             let mut t = ty;
@@ -2054,13 +2113,13 @@ impl FnLiveness {
                     let overlaps = parts.is_empty()
                         || parts
                             .iter()
-                            .any(|q| q.starts_with(&path) || path.starts_with(q));
+                            .any(|q| has_prefix(q, &path) || has_prefix(&path, q));
                     if !overlaps {
                         continue;
                     }
                     let clash = stored
                         .iter()
-                        .any(|(q, v)| *v != value && (q.starts_with(&path) || path.starts_with(q)));
+                        .any(|(q, v)| *v != value && (has_prefix(q, &path) || has_prefix(&path, q)));
                     if clash || !self.remat_ssa(program, value, depth + 1) {
                         ok = false;
                     }
