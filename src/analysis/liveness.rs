@@ -559,91 +559,110 @@ impl Places {
 /// Facts about the ids one function defines, by id: a slot per id from
 /// the function's lowest result id (a module numbers its ids densely, so
 /// this is a load instead of a hash lookup per operand), hashing only for
-/// huge, sparse ids.
+/// huge, sparse ids. Each id added gets the next ordinal (its value's
+/// index), so per-id data can also live in plain vectors.
 #[derive(Debug)]
-enum IdMap<T> {
-    /// Slot `id - lo` holds the index into `values`, or [`IdMap::NONE`]
-    /// (the values kept apart so that dropping the map is one free). The
-    /// few ids outside the range (parameters: compilers number them with
-    /// the function, before its body) are listed in `outside`.
+struct IdMap<T> {
+    index: IdIndex,
+    values: Vec<T>,
+}
+
+#[derive(Debug)]
+enum IdIndex {
+    /// Slot `id - lo` holds the ordinal, or [`IdIndex::NONE`]. The few ids
+    /// outside the range (parameters: compilers number them with the
+    /// function, before its body) are listed in `outside`.
     Dense {
         lo: Id,
         slots: Vec<u32>,
-        values: Vec<T>,
         outside: Vec<(Id, u32)>,
     },
-    Sparse(HashMap<Id, T>),
+    Sparse(HashMap<Id, u32>),
 }
 
-impl<T> IdMap<T> {
+impl IdIndex {
     const NONE: u32 = u32::MAX;
 
-    /// For the ids `lo..=hi`.
-    fn new(lo: Id, hi: Id) -> IdMap<T> {
-        let n = hi.saturating_sub(lo) as usize + 1;
-        if n <= 1 << 20 {
-            IdMap::Dense {
-                lo,
-                slots: vec![Self::NONE; n],
-                values: Vec::new(),
-                outside: Vec::new(),
+    fn find(&self, id: Id) -> Option<u32> {
+        match self {
+            IdIndex::Dense { lo, slots, outside } => {
+                match id.checked_sub(*lo).and_then(|k| slots.get(k as usize)) {
+                    Some(&k) => (k != Self::NONE).then_some(k),
+                    None => outside.iter().find(|(x, _)| *x == id).map(|&(_, k)| k),
+                }
             }
-        } else {
-            IdMap::Sparse(HashMap::default())
+            IdIndex::Sparse(m) => m.get(&id).copied(),
         }
     }
 
-    fn get(&self, id: &Id) -> Option<&T> {
+    /// The ordinal of `id`, given `next` when it is new.
+    fn find_or_add(&mut self, id: Id, next: u32) -> u32 {
         match self {
-            IdMap::Dense {
-                lo,
-                slots,
-                values,
-                outside,
-            } => {
-                let k = match id.checked_sub(*lo).and_then(|k| slots.get(k as usize)) {
-                    Some(&k) => k,
-                    None => outside.iter().find(|(x, _)| x == id)?.1,
-                };
-                values.get(k as usize)
-            }
-            IdMap::Sparse(m) => m.get(id),
-        }
-    }
-
-    fn contains_key(&self, id: &Id) -> bool {
-        self.get(id).is_some()
-    }
-
-    fn insert(&mut self, id: Id, value: T) {
-        match self {
-            IdMap::Dense {
-                lo,
-                slots,
-                values,
-                outside,
-            } => {
-                let next = values.len() as u32;
-                let k = match id.checked_sub(*lo).and_then(|k| slots.get_mut(k as usize)) {
-                    Some(s) if *s == Self::NONE => std::mem::replace(s, next),
-                    Some(s) => *s,
+            IdIndex::Dense { lo, slots, outside } => {
+                match id.checked_sub(*lo).and_then(|k| slots.get_mut(k as usize)) {
+                    Some(s) => {
+                        if *s == Self::NONE {
+                            *s = next;
+                        }
+                        *s
+                    }
                     None => match outside.iter().find(|(x, _)| *x == id) {
                         Some(&(_, k)) => k,
                         None => {
                             outside.push((id, next));
-                            Self::NONE
+                            next
                         }
                     },
-                };
-                if k == Self::NONE {
-                    values.push(value);
-                } else {
-                    values[k as usize] = value;
                 }
             }
-            IdMap::Sparse(m) => {
-                m.insert(id, value);
+            IdIndex::Sparse(m) => *m.entry(id).or_insert(next),
+        }
+    }
+}
+
+impl<T> IdMap<T> {
+    /// For the ids `lo..=hi`.
+    fn new(lo: Id, hi: Id) -> IdMap<T> {
+        let n = hi.saturating_sub(lo) as usize + 1;
+        let index = if n <= 1 << 20 {
+            IdIndex::Dense {
+                lo,
+                slots: vec![IdIndex::NONE; n],
+                outside: Vec::new(),
             }
+        } else {
+            IdIndex::Sparse(HashMap::default())
+        };
+        IdMap {
+            index,
+            values: Vec::new(),
+        }
+    }
+
+    fn get(&self, id: &Id) -> Option<&T> {
+        self.values.get(self.index.find(*id)? as usize)
+    }
+
+    fn contains_key(&self, id: &Id) -> bool {
+        self.index.find(*id).is_some()
+    }
+
+    /// The ordinal of `id`: `0..` in the order ids were added.
+    fn ordinal(&self, id: Id) -> Option<usize> {
+        self.index.find(id).map(|k| k as usize)
+    }
+
+    fn len(&self) -> usize {
+        self.values.len()
+    }
+
+    fn insert(&mut self, id: Id, value: T) {
+        let next = self.values.len() as u32;
+        let k = self.index.find_or_add(id, next);
+        if k == next {
+            self.values.push(value);
+        } else {
+            self.values[k as usize] = value;
         }
     }
 }
@@ -786,7 +805,7 @@ pub struct FnLiveness {
     block_segments: Vec<u32>,
     /// The instructions that define or use each variable, in order (built
     /// on first use).
-    mentions: Option<HashMap<Id, std::rc::Rc<[usize]>>>,
+    mentions: Option<Vec<std::rc::Rc<[usize]>>>,
 }
 
 impl FnLiveness {
@@ -1086,19 +1105,25 @@ impl FnLiveness {
         }
         let mut copies = HashMap::default();
         if !candidates.is_empty() {
-            let mut uses: HashMap<Id, usize> = candidates.iter().map(|c| (c.2, 0)).collect();
+            // Counted by the loaded values' ordinals: a dense lookup per
+            // operand of every instruction, not a hash.
+            let mut loaded: IdSet = IdMap::new(lo, hi);
+            for c in &candidates {
+                loaded.add(c.2);
+            }
+            let mut uses = vec![0usize; loaded.len()];
             for inst in &program.insts[f.start..=f.end] {
                 if program.is_debug_inst(inst) {
                     continue;
                 }
                 for id in id_operands(inst) {
-                    if let Some(n) = uses.get_mut(&id) {
-                        *n += 1;
+                    if let Some(k) = loaded.ordinal(id) {
+                        uses[k] += 1;
                     }
                 }
             }
             for (store, load, v) in candidates {
-                if uses.get(&v) == Some(&1) {
+                if loaded.ordinal(v).map(|k| uses[k]) == Some(1) {
                     copies.insert(store, load);
                 }
             }
@@ -1851,7 +1876,7 @@ impl FnLiveness {
             };
             // A variable is read only where it is mentioned: look nowhere else.
             let mentions = if is_var {
-                self.mentions(program).get(&id).cloned()
+                self.mentions(program, id)
             } else {
                 None
             };
@@ -2078,7 +2103,7 @@ impl FnLiveness {
         }
         self.remat_at.insert(key.clone(), false);
         // Shared, not copied: the loop below recurses into `self`.
-        let mentions = self.mentions(program).get(&var).cloned();
+        let mentions = self.mentions(program, var);
         let reaching = self.reaching_writes(program, var, at, mentions.as_deref().unwrap_or(&[]));
         let mut ok = true;
         let mut stored: Vec<(Vec<u32>, Id)> = Vec::new();
@@ -2143,10 +2168,12 @@ impl FnLiveness {
 
     /// The instructions (not debug info) that define a variable or use a
     /// pointer into it, per variable, in order.
-    fn mentions(&mut self, program: &Program) -> &HashMap<Id, std::rc::Rc<[usize]>> {
+    fn mentions(&mut self, program: &Program, var: Id) -> Option<std::rc::Rc<[usize]>> {
         if self.mentions.is_none() {
+            // By the variable's ordinal among the roots (every variable
+            // and pointer parameter is its own root): no hashing per mention.
             let f = &program.functions[self.func];
-            let mut m: HashMap<Id, Vec<usize>> = HashMap::default();
+            let mut m: Vec<Vec<usize>> = vec![Vec::new(); self.roots.len()];
             for i in f.start..=f.end {
                 let inst = &program.insts[i];
                 if program.is_debug_inst(inst) {
@@ -2155,15 +2182,18 @@ impl FnLiveness {
                 let used = id_operands(inst).filter_map(|x| self.root(x));
                 let defined = inst.result_id.filter(|r| self.vars.contains(r));
                 for v in defined.into_iter().chain(used) {
-                    let list = m.entry(v).or_default();
+                    let Some(list) = self.roots.ordinal(v).and_then(|k| m.get_mut(k)) else {
+                        continue;
+                    };
                     if list.last() != Some(&i) {
                         list.push(i);
                     }
                 }
             }
-            self.mentions = Some(m.into_iter().map(|(v, l)| (v, l.into())).collect());
+            self.mentions = Some(m.into_iter().map(Into::into).collect());
         }
-        self.mentions.get_or_insert_with(HashMap::default)
+        let list = self.mentions.as_ref()?.get(self.roots.ordinal(var)?)?;
+        (!list.is_empty()).then(|| list.clone())
     }
 
     /// The writes to `var` (stores, and its `OpVariable` when it has an
