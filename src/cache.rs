@@ -23,6 +23,7 @@
 //! folder; ruff's cache likewise drops files it has not seen for a while.
 
 use crate::diag::{Diagnostic, Fix, Label, Severity};
+use std::collections::HashMap;
 use std::hash::{Hash, Hasher};
 use std::path::{Path, PathBuf};
 use std::time::{Duration, SystemTime};
@@ -72,6 +73,16 @@ impl KeyBuilder {
         part.hash(&mut self.0);
         part.hash(&mut self.1);
         self
+    }
+
+    /// Adds a file's bytes in one pass (the file is the bulk of what a
+    /// key hashes; `add` would hash it twice): the two halves share this
+    /// 64-bit digest, a collision of which between two versions of one
+    /// input path is still not a concern.
+    pub fn add_bytes(&mut self, bytes: &[u8]) -> &mut Self {
+        let mut h = std::collections::hash_map::DefaultHasher::new();
+        h.write(bytes);
+        self.add((bytes.len(), h.finish()))
     }
 
     pub fn finish(&self) -> Key {
@@ -199,9 +210,12 @@ pub fn load_all(stored: Vec<CachedDiagnostic>) -> Option<Vec<Diagnostic>> {
 }
 
 /// The cache folder.
-#[derive(Clone, Debug)]
+#[derive(Debug)]
 pub struct Cache {
     dir: PathBuf,
+    /// Dependencies' hashes, each computed once a run: many inputs share a
+    /// header, and files do not change under a run.
+    deps: std::sync::Mutex<HashMap<PathBuf, Option<String>>>,
 }
 
 impl Cache {
@@ -224,6 +238,7 @@ impl Cache {
         }
         Some(Cache {
             dir: dir.to_path_buf(),
+            deps: Default::default(),
         })
     }
 
@@ -232,14 +247,22 @@ impl Cache {
     }
 
     fn read<T: serde::de::DeserializeOwned>(&self, kind: &str, key: Key) -> Option<T> {
+        use std::io::Read;
         let path = self.path(kind, key);
-        let bytes = std::fs::read(&path).ok()?;
+        let mut file = std::fs::File::open(&path).ok()?;
+        // One look at the open file: its size, and its time below.
+        let meta = file.metadata().ok()?;
+        let mut bytes = Vec::with_capacity(meta.len() as usize);
+        file.read_to_end(&mut bytes).ok()?;
         let value = serde_json::from_slice(&bytes).ok()?;
         // A hit is a use: keep the entry from being pruned.
-        if age(&path).is_some_and(|a| a > PRUNE_EVERY) {
-            let now = SystemTime::now();
+        let modified = meta.modified().ok();
+        let old = modified
+            .and_then(|m| SystemTime::now().duration_since(m).ok())
+            .is_some_and(|a| a > PRUNE_EVERY);
+        if old {
             if let Ok(f) = std::fs::File::options().write(true).open(&path) {
-                let _ = f.set_modified(now);
+                let _ = f.set_modified(SystemTime::now());
             }
         }
         Some(value)
@@ -267,8 +290,21 @@ impl Cache {
         entry
             .deps
             .iter()
-            .all(|(p, h)| dep_hash(p) == *h)
+            .all(|(p, h)| self.dep_hash(p) == *h)
             .then_some(entry)
+    }
+
+    /// [`dep_hash`], once per path and run.
+    pub fn dep_hash(&self, path: &Path) -> Option<String> {
+        if let Some(h) = self.deps.lock().ok().and_then(|m| m.get(path).cloned()) {
+            return h;
+        }
+        // Hashed outside the lock: two threads may both hash a file once.
+        let h = dep_hash(path);
+        if let Ok(mut m) = self.deps.lock() {
+            m.insert(path.to_path_buf(), h.clone());
+        }
+        h
     }
 
     pub fn put(&self, key: Key, entry: &Entry) {

@@ -106,6 +106,50 @@ fn the_cache_is_never_stale() {
     assert!(ignore.lines().any(|l| l == "*"), "{ignore}");
 }
 
+/// Suppressions are judged the same on a warm run: in the input (read once
+/// for its key there) and in a header, and an edit to either counts.
+#[test]
+fn suppressions_hold_on_a_warm_run() {
+    let d = scratch("suppress");
+    let fat =
+        "// rtlint: allow(RT001)\nstruct Fat {\n    float4 a;\n    float4 b;\n    float4 c;\n};\n";
+    std::fs::write(d.join("payload.hlsli"), fat).unwrap();
+    let unused = format!("// rtlint: allow(RT002)\n{}", shader());
+    std::fs::write(d.join("gen.hlsl"), &unused).unwrap();
+    let cache = d.join("c");
+    let run = || check(&d, &["--cache-dir", cache.to_str().unwrap(), "."]);
+    let cold = run();
+    let n = entries(&cache);
+    let warm = run();
+    assert_eq!(text(&warm), text(&cold));
+    assert_eq!(entries(&cache), n, "a warm run wrote new entries");
+    // The header's suppression allows RT001; the input's allows nothing.
+    assert!(!text(&warm).contains("RT001"), "{}", text(&warm));
+    assert!(
+        text(&warm).contains("gen.hlsl:1:4: warning[RT000]"),
+        "{}",
+        text(&warm)
+    );
+    // Without the unused one in the input: nothing left.
+    std::fs::write(d.join("gen.hlsl"), shader()).unwrap();
+    let o = run();
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o));
+    assert!(!text(&o).contains("RT0"), "{}", text(&o));
+    // Without the header's: RT001 comes back (the header is a dependency
+    // of the input's entry, so the input is analysed again).
+    std::fs::write(
+        d.join("payload.hlsli"),
+        fat.replace("// rtlint: allow(RT001)\n", ""),
+    )
+    .unwrap();
+    let o = run();
+    assert!(
+        text(&o).contains("payload.hlsli:1:8: warning[RT001]"),
+        "{}",
+        text(&o)
+    );
+}
+
 fn set_age(path: &Path, days: u64) {
     let t = SystemTime::now() - Duration::from_secs(days * 24 * 60 * 60);
     std::fs::File::options()

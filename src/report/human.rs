@@ -6,13 +6,49 @@ use codespan_reporting::diagnostic::{
     Diagnostic as CsDiagnostic, Label, LabelStyle, Severity as CsSeverity,
 };
 use codespan_reporting::files::SimpleFiles;
-use codespan_reporting::term::{self, termcolor::WriteColor};
+use codespan_reporting::term;
+use codespan_reporting::term::termcolor::{Buffer, WriteColor};
 use std::collections::HashMap;
 use std::path::PathBuf;
 
 pub fn render(
     diagnostics: &[Diagnostic],
     sources: &mut Sources,
+    out: &mut dyn WriteColor,
+) -> std::io::Result<()> {
+    use rayon::prelude::*;
+    sources.prefetch(
+        diagnostics
+            .iter()
+            .flat_map(|d| d.primary.iter().chain(&d.secondary))
+            .map(|l| l.location.path.as_path()),
+    );
+    let sources = &*sources;
+    // Rendered in parallel by chunks, each into a buffer, written in order:
+    // a run over thousands of files prints thousands of findings.
+    const CHUNK: usize = 64;
+    let color = out.supports_color();
+    let chunks: Vec<std::io::Result<Buffer>> = diagnostics
+        .par_chunks(CHUNK)
+        .map(|chunk| {
+            let mut buf = if color {
+                Buffer::ansi()
+            } else {
+                Buffer::no_color()
+            };
+            render_chunk(chunk, sources, &mut buf)?;
+            Ok(buf)
+        })
+        .collect();
+    for buf in chunks {
+        out.write_all(buf?.as_slice())?;
+    }
+    Ok(())
+}
+
+fn render_chunk(
+    diagnostics: &[Diagnostic],
+    sources: &Sources,
     out: &mut dyn WriteColor,
 ) -> std::io::Result<()> {
     let mut files = SimpleFiles::new();
@@ -38,8 +74,8 @@ pub fn render(
             let path = &label.location.path;
             let id = *ids.entry(path.clone()).or_insert_with(|| {
                 sources
-                    .text(path)
-                    .map(|t| files.add(path.display().to_string(), t.to_string()))
+                    .read_before(path)
+                    .map(|t| files.add(path.display().to_string(), t))
             });
             let range = id.and_then(|id| {
                 let text = files.get(id).ok()?.source();

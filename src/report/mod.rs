@@ -86,6 +86,27 @@ impl Sources {
         }
     }
 
+    /// Reads the texts of `paths` not read yet, in parallel.
+    pub fn prefetch<'a>(&mut self, paths: impl Iterator<Item = &'a Path>) {
+        use rayon::prelude::*;
+        let mut todo: Vec<&Path> = paths.filter(|p| !self.cache.contains_key(*p)).collect();
+        todo.sort_unstable();
+        todo.dedup();
+        let texts: Vec<Option<String>> = todo
+            .par_iter()
+            .map(|p| std::fs::read_to_string(p).ok())
+            .collect();
+        for (p, text) in todo.into_iter().zip(texts) {
+            let text = text.or_else(|| self.embedded.get(p).cloned());
+            self.cache.insert(p.to_path_buf(), text);
+        }
+    }
+
+    /// A text [`Sources::text`] or [`Sources::prefetch`] read before.
+    pub fn read_before(&self, path: &Path) -> Option<&str> {
+        self.cache.get(path).and_then(|t| t.as_deref())
+    }
+
     pub fn text(&mut self, path: &Path) -> Option<&str> {
         if !self.cache.contains_key(path) {
             let text = std::fs::read_to_string(path)
