@@ -14,5 +14,8 @@ fn main() {
         let rec = rtlint::analysis::recursion_report(p);
         std::hint::black_box(rtlint::analysis::stack::stack_report_with(p, &rec));
     }
-    eprintln!("model: {:.3} ms per pipeline", t.elapsed().as_secs_f64() * 1e3 / ps.len() as f64);
+    eprintln!(
+        "model: {:.3} ms per pipeline",
+        t.elapsed().as_secs_f64() * 1e3 / ps.len() as f64
+    );
 }

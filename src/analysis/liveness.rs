@@ -2142,9 +2142,9 @@ impl FnLiveness {
                     if !overlaps {
                         continue;
                     }
-                    let clash = stored
-                        .iter()
-                        .any(|(q, v)| *v != value && (has_prefix(q, &path) || has_prefix(&path, q)));
+                    let clash = stored.iter().any(|(q, v)| {
+                        *v != value && (has_prefix(q, &path) || has_prefix(&path, q))
+                    });
                     if clash || !self.remat_ssa(program, value, depth + 1) {
                         ok = false;
                     }
@@ -2311,7 +2311,7 @@ mod tests {
 
     #[test]
     fn places_intern_once_and_list_each_ids_parts() {
-        let mut p = Places::new(10, 20);
+        let mut p = Places::new(10, 20, 4);
         let whole = p.intern(12, &[]);
         assert_eq!(p.intern(12, &[]), whole, "interned once");
         let a = p.intern(12, &[1, 2]);
@@ -2333,10 +2333,83 @@ mod tests {
     }
 
     #[test]
+    fn id_maps_dense_with_parameters_apart_and_sparse() {
+        // A small range is a table; the huge one hashes.
+        for (lo, hi) in [(100, 200), (0, u32::MAX)] {
+            let mut m: IdMap<&str> = IdMap::new(lo, hi);
+            m.insert(150, "a");
+            // Below the body's range, as a parameter numbered before it.
+            m.insert(7, "param");
+            m.insert(150, "b");
+            assert_eq!(m.get(&150), Some(&"b"), "replaced, not added");
+            assert_eq!(m.get(&7), Some(&"param"));
+            assert!(m.contains_key(&7) && !m.contains_key(&151));
+            assert_eq!(m.get(&300), None, "above the range");
+            assert_eq!(m.get(&99), None, "below the range, never added");
+            assert_eq!(
+                (m.ordinal(150), m.ordinal(7), m.ordinal(8), m.len()),
+                (Some(0), Some(1), None, 2)
+            );
+        }
+    }
+
+    #[test]
+    fn folded_blocks_step_like_their_instructions() {
+        // The fixpoint applies each block's folded runs; stepping back over
+        // every instruction must give the same set, from the solved set at
+        // the block's end and from one holding every place met.
+        for rel in [
+            "shaders/reflect_adaptive.hlsl",
+            "shaders/reflect_iterative.wgsl",
+            "fixtures/live/loop_local.rgen.gV.spv",
+        ] {
+            let p = program(rel);
+            let mut runs = 0;
+            for func in 0..p.functions.len() {
+                let fl = FnLiveness::new(&p, func);
+                runs += fl
+                    .segments
+                    .iter()
+                    .filter(|s| matches!(s, Segment::Run { .. }))
+                    .count();
+                let mut all = BitSet::default();
+                for i in 0..fl.places.borrow().list.len() as u32 {
+                    all.insert(i);
+                }
+                let f = &p.functions[func];
+                for (b, block) in f.blocks.iter().enumerate() {
+                    for start in [&fl.live_out[b], &all] {
+                        let mut by_block = start.clone();
+                        fl.block_back(&p, b, &mut by_block);
+                        let mut by_inst = start.clone();
+                        for k in (block.start..=block.end).rev() {
+                            fl.step_back(&p, k, &mut by_inst);
+                        }
+                        assert_eq!(by_block, by_inst, "{rel}: function {func}, block {b}");
+                    }
+                }
+            }
+            assert!(runs > 0, "{rel}: some runs were folded");
+        }
+    }
+
+    #[test]
+    fn path_prefixes() {
+        assert!(has_prefix(&[1, 2, 3], &[1, 2]));
+        assert!(has_prefix(&[1, 2], &[]));
+        assert!(has_prefix(&[1, 2], &[1, 2]));
+        assert!(!has_prefix(&[1, 2], &[1, 2, 3]));
+        assert!(!has_prefix(&[1, 3], &[1, 2]));
+        assert!(same_path(&[4, 5], &[4, 5]));
+        assert!(!same_path(&[4, 5], &[4]) && !same_path(&[4], &[4, 5]));
+        assert!(same_path(&[], &[]));
+    }
+
+    #[test]
     fn places_with_colliding_keys_stay_apart() {
         // A huge id range has no dense table: every place is hashed, and
         // many parts of one variable share chains of the same key space.
-        let mut p = Places::new(0, u32::MAX);
+        let mut p = Places::new(0, u32::MAX, 0);
         let ids: Vec<u32> = (0..200u32)
             .map(|i| p.intern(7, &[i % 10, i / 10]))
             .collect();
