@@ -461,18 +461,32 @@ impl Program {
 
     /// Function ids reachable from `root` through `OpFunctionCall`, `root` first.
     pub fn reachable_functions(&self, root: Id) -> Vec<Id> {
-        let mut seen = vec![root];
-        let mut i = 0;
-        while i < seen.len() {
-            if let Some(f) = self.function(seen[i]) {
+        // Each function's callees, in the order of its calls, listed once
+        // per Program: the analyses ask per shader and per entry point, and
+        // scanning every reachable instruction each time added up.
+        struct Callees(HashMap<Id, Vec<Id>>);
+        let callees = self.memo.get_or(|| {
+            let mut by_caller: HashMap<Id, Vec<Id>> = HashMap::default();
+            for f in &self.functions {
+                let mut list = Vec::new();
                 for inst in &self.insts[f.start..=f.end] {
                     if inst.class.opcode == Op::FunctionCall {
                         if let Some(Operand::IdRef(callee)) = inst.operands.first() {
-                            if !seen.contains(callee) {
-                                seen.push(*callee);
-                            }
+                            list.push(*callee);
                         }
                     }
+                }
+                // The first function of an id wins, as `function` finds it.
+                by_caller.entry(f.id).or_insert(list);
+            }
+            Callees(by_caller)
+        });
+        let mut seen = vec![root];
+        let mut i = 0;
+        while i < seen.len() {
+            for callee in callees.0.get(&seen[i]).map_or(&[][..], Vec::as_slice) {
+                if !seen.contains(callee) {
+                    seen.push(*callee);
                 }
             }
             i += 1;
