@@ -9,7 +9,9 @@
 //! - the WGSL path against naga's own parse + validate, with where rtlint's
 //!   extra time goes (SPIR-V out, reading the module, rules).
 //! - the static stack model against creating the pipeline and asking the
-//!   driver (`vkGetRayTracingShaderGroupStackSizeKHR`), when a device is there.
+//!   driver (`vkGetRayTracingShaderGroupStackSizeKHR`), when a device is there,
+//!   with the driver's shader caches off (`RTLINT_BENCH_DRIVER_CACHE=1`
+//!   keeps them: a repeated creation is then a cache lookup).
 //! - scaling: 1..10,000 files and one HLSL file growing 1×..64× (entry
 //!   points, instructions, includes): wall time and peak memory (maxrss of
 //!   the `rtlint` child).
@@ -216,6 +218,7 @@ fn main() {
     if !quick && !args.iter().any(|a| a == "--bench") {
         return;
     }
+    let caches_off = rtlint_testkit::driver_caches_off();
     let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
     std::env::set_current_dir(&root).unwrap();
     let iters = if quick { 3 } else { 15 };
@@ -462,7 +465,8 @@ fn main() {
         ),
         ours_ms: ms(model_total),
         peer: if driver_n > 0 {
-            format!("driver({driver_n})")
+            let cache = if caches_off { "compiling" } else { "cache on" };
+            format!("driver({driver_n}, {cache})")
         } else {
             "no device".into()
         },

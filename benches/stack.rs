@@ -30,6 +30,7 @@ fn main() {
     if !std::env::args().any(|a| a == "--bench") {
         return;
     }
+    let caches_off = rtlint_testkit::driver_caches_off();
     let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
     std::env::set_current_dir(&root).unwrap();
     let mut paths: Vec<PathBuf> = std::env::args()
@@ -56,7 +57,12 @@ fn main() {
         }
     };
     if let Some(c) = &ctx {
-        println!("device: {} ({})", c.info().name, c.info().driver);
+        println!(
+            "device: {} ({}), driver shader caches {}",
+            c.info().name,
+            c.info().driver,
+            if caches_off { "off" } else { "on" }
+        );
     }
     println!(
         "{:<48} {:>10} {:>12} {:>9}",

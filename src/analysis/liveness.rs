@@ -239,7 +239,7 @@ fn compute_live_sites(program: &Program, described: bool) -> Vec<LiveSite> {
                     b.size
                         .cmp(&a.size)
                         .then(a.rematerializable.cmp(&b.rematerializable))
-                        .then(a.name.cmp(&b.name))
+                        .then_with(|| a.name.cmp(&b.name))
                 });
                 let location = std::iter::once(site.inst)
                     .chain(chain.iter().rev().copied())
@@ -412,6 +412,28 @@ fn id_operands(inst: &Instruction) -> impl Iterator<Item = Id> + '_ {
     })
 }
 
+/// Whether `path` begins with `prefix`. Paths are a few indices long: a
+/// loop, not a `memcmp` call per comparison (which `starts_with` and `==`
+/// make, and which was a sixth of the model's time in `kill`).
+fn has_prefix(path: &[u32], prefix: &[u32]) -> bool {
+    if prefix.len() > path.len() {
+        return false;
+    }
+    let mut k = 0;
+    while k < prefix.len() {
+        if path[k] != prefix[k] {
+            return false;
+        }
+        k += 1;
+    }
+    true
+}
+
+/// Whether two paths are equal (see [`has_prefix`]).
+fn same_path(a: &[u32], b: &[u32]) -> bool {
+    a.len() == b.len() && has_prefix(a, b)
+}
+
 /// What backward liveness tracks: an SSA value (empty path), or part of a
 /// function-local variable, named by the constant access-chain indices that
 /// reach it from the variable (empty: all of it).
@@ -438,10 +460,13 @@ struct Places {
 impl Places {
     const NONE: u32 = u32::MAX;
 
-    /// For the ids `lo..=hi` defined in one function.
-    fn new(lo: Id, hi: Id) -> Places {
+    /// For the ids `lo..=hi` defined in one function of `insts`
+    /// instructions (about as many places, made room for at once).
+    fn new(lo: Id, hi: Id, insts: usize) -> Places {
         let n = hi.saturating_sub(lo) as usize + 1;
         Places {
+            list: Vec::with_capacity(insts),
+            next: Vec::with_capacity(insts),
             // A module with huge, sparse ids falls back to hashing.
             whole: if n <= 1 << 20 {
                 vec![Self::NONE; n]
@@ -465,7 +490,7 @@ impl Places {
 
     fn find(&self, mut i: u32, path: &[u32]) -> Option<u32> {
         while i != Self::NONE {
-            if self.list[i as usize].1.as_slice() == path {
+            if same_path(&self.list[i as usize].1, path) {
                 return Some(i);
             }
             i = self.next[i as usize];
@@ -531,6 +556,130 @@ impl Places {
     }
 }
 
+/// Facts about the ids one function defines, by id: a slot per id from
+/// the function's lowest result id (a module numbers its ids densely, so
+/// this is a load instead of a hash lookup per operand), hashing only for
+/// huge, sparse ids. Each id added gets the next ordinal (its value's
+/// index), so per-id data can also live in plain vectors.
+#[derive(Debug)]
+struct IdMap<T> {
+    index: IdIndex,
+    values: Vec<T>,
+}
+
+#[derive(Debug)]
+enum IdIndex {
+    /// Slot `id - lo` holds the ordinal, or [`IdIndex::NONE`]. The few ids
+    /// outside the range (parameters: compilers number them with the
+    /// function, before its body) are listed in `outside`.
+    Dense {
+        lo: Id,
+        slots: Vec<u32>,
+        outside: Vec<(Id, u32)>,
+    },
+    Sparse(HashMap<Id, u32>),
+}
+
+impl IdIndex {
+    const NONE: u32 = u32::MAX;
+
+    fn find(&self, id: Id) -> Option<u32> {
+        match self {
+            IdIndex::Dense { lo, slots, outside } => {
+                match id.checked_sub(*lo).and_then(|k| slots.get(k as usize)) {
+                    Some(&k) => (k != Self::NONE).then_some(k),
+                    None => outside.iter().find(|(x, _)| *x == id).map(|&(_, k)| k),
+                }
+            }
+            IdIndex::Sparse(m) => m.get(&id).copied(),
+        }
+    }
+
+    /// The ordinal of `id`, given `next` when it is new.
+    fn find_or_add(&mut self, id: Id, next: u32) -> u32 {
+        match self {
+            IdIndex::Dense { lo, slots, outside } => {
+                match id.checked_sub(*lo).and_then(|k| slots.get_mut(k as usize)) {
+                    Some(s) => {
+                        if *s == Self::NONE {
+                            *s = next;
+                        }
+                        *s
+                    }
+                    None => match outside.iter().find(|(x, _)| *x == id) {
+                        Some(&(_, k)) => k,
+                        None => {
+                            outside.push((id, next));
+                            next
+                        }
+                    },
+                }
+            }
+            IdIndex::Sparse(m) => *m.entry(id).or_insert(next),
+        }
+    }
+}
+
+impl<T> IdMap<T> {
+    /// For the ids `lo..=hi`.
+    fn new(lo: Id, hi: Id) -> IdMap<T> {
+        let n = hi.saturating_sub(lo) as usize + 1;
+        let index = if n <= 1 << 20 {
+            IdIndex::Dense {
+                lo,
+                slots: vec![IdIndex::NONE; n],
+                outside: Vec::new(),
+            }
+        } else {
+            IdIndex::Sparse(HashMap::default())
+        };
+        IdMap {
+            index,
+            values: Vec::new(),
+        }
+    }
+
+    fn get(&self, id: &Id) -> Option<&T> {
+        self.values.get(self.index.find(*id)? as usize)
+    }
+
+    fn contains_key(&self, id: &Id) -> bool {
+        self.index.find(*id).is_some()
+    }
+
+    /// The ordinal of `id`: `0..` in the order ids were added.
+    fn ordinal(&self, id: Id) -> Option<usize> {
+        self.index.find(id).map(|k| k as usize)
+    }
+
+    fn len(&self) -> usize {
+        self.values.len()
+    }
+
+    fn insert(&mut self, id: Id, value: T) {
+        let next = self.values.len() as u32;
+        let k = self.index.find_or_add(id, next);
+        if k == next {
+            self.values.push(value);
+        } else {
+            self.values[k as usize] = value;
+        }
+    }
+}
+
+/// A set of the ids one function defines (see [`IdMap`]).
+type IdSet = IdMap<()>;
+
+impl IdSet {
+    fn contains(&self, id: &Id) -> bool {
+        self.contains_key(id)
+    }
+
+    fn add(&mut self, id: Id) {
+        self.insert(id, ());
+    }
+}
+
 /// A pointer into a function-local variable.
 #[derive(Clone, Debug)]
 struct LocalPtr {
@@ -587,16 +736,38 @@ enum Step {
     Other,
 }
 
+/// A piece of one block's backward transfer (see [`FnLiveness::blocks`]).
+#[derive(Debug)]
+enum Segment {
+    /// A run of [`Step::Plain`]s folded into one: kills the places
+    /// `FnLiveness::step_uses[kill]`, then makes `step_uses[gen]` live
+    /// (index lists in the shared pool, not two sets per run).
+    Run {
+        kill: std::ops::Range<u32>,
+        gen: std::ops::Range<u32>,
+    },
+    /// An instruction whose transfer depends on the live set.
+    Inst(usize),
+}
+
 /// Parts are tracked separately up to this many elements per composite.
 const MAX_SPLIT: u32 = 64;
+
+/// Variables possibly written on some path to each block's end.
+struct Defined {
+    /// Per block, as indices into `written`.
+    out: Vec<BitSet>,
+    /// The roots something in the function writes.
+    written: Vec<Id>,
+}
 
 /// Liveness facts of one function.
 pub struct FnLiveness {
     func: usize,
     /// Function-local `OpVariable`s.
-    vars: HashSet<Id>,
+    vars: IdSet,
     /// Pointer ids derived from a local variable or a pointer parameter.
-    roots: HashMap<Id, LocalPtr>,
+    roots: IdMap<LocalPtr>,
     /// For each `OpFunctionCall` (by instruction index), the parts each
     /// pointer argument's callee parameter may read before writing.
     call_reads: HashMap<usize, ExposedParams>,
@@ -608,16 +779,15 @@ pub struct FnLiveness {
     /// The loads of `copies`.
     copy_loads: HashSet<usize>,
     /// SSA values that count as state: defined here, not pointers to locals.
-    ssa: HashSet<Id>,
+    ssa: IdSet,
     /// Live places at each block's end, as indices into `places`.
     live_out: Vec<BitSet>,
     /// Every place met while solving (the live sets' members).
     places: RefCell<Places>,
-    /// Variables possibly written at each block's end.
-    /// (As indices into `written`.)
-    defined_out: Vec<BitSet>,
-    /// The roots something in the function writes, indexed for `defined_out`.
-    written: Vec<Id>,
+    /// Variables possibly written at each block's end (as indices into
+    /// [`Defined::written`]): only asked where a site is, so worked out
+    /// on first use (a callee solved for its parameters never asks).
+    defined: std::cell::OnceCell<Defined>,
     preds: Vec<Vec<usize>>,
     remat: HashMap<Id, bool>,
     /// Variables' rematerialisation as read at an instruction.
@@ -626,9 +796,16 @@ pub struct FnLiveness {
     steps: Vec<Step>,
     /// The places `Step::Plain` reads.
     step_uses: Vec<u32>,
+    /// Each block's backward transfer, last instruction first: the
+    /// fixpoint visits a block with a few word operations per run of
+    /// plain steps instead of stepping every instruction.
+    segments: Vec<Segment>,
+    /// Where each block's segments start in `segments` (one more entry
+    /// than blocks).
+    block_segments: Vec<u32>,
     /// The instructions that define or use each variable, in order (built
     /// on first use).
-    mentions: Option<HashMap<Id, std::rc::Rc<[usize]>>>,
+    mentions: Option<Vec<std::rc::Rc<[usize]>>>,
 }
 
 impl FnLiveness {
@@ -752,6 +929,10 @@ impl FnLiveness {
             w
         };
         let own: Vec<Vec<Vec<u32>>> = (0..n).map(own).collect();
+        // Nothing written here at all: nothing written on every path.
+        if own.iter().all(Vec::is_empty) {
+            return Vec::new();
+        }
         // Forward must-analysis: `None` is "everything" (not reached yet).
         let mut out: Vec<Option<HashSet<Vec<u32>>>> = vec![None; n];
         let mut changed = true;
@@ -809,10 +990,16 @@ impl FnLiveness {
         depth: u32,
     ) -> (FnLiveness, bool) {
         let f = &program.functions[func];
-        let mut vars = HashSet::default();
-        let mut roots: HashMap<Id, LocalPtr> = HashMap::default();
-        // Most results are SSA values: sized once, not grown step by step.
-        let mut ssa = HashSet::with_capacity_and_hasher(f.end + 1 - f.start, Default::default());
+        // The body's ids: the function's own and its parameters' are often
+        // numbered long before it, and would widen the dense tables.
+        let ids = program.insts[f.start..=f.end]
+            .iter()
+            .filter(|i| !matches!(i.class.opcode, Op::Function | Op::FunctionParameter))
+            .filter_map(|i| i.result_id);
+        let (lo, hi) = ids.fold((Id::MAX, 0), |(lo, hi), r| (lo.min(r), hi.max(r)));
+        let mut vars = IdSet::new(lo, hi);
+        let mut roots: IdMap<LocalPtr> = IdMap::new(lo, hi);
+        let mut ssa = IdSet::new(lo, hi);
         for inst in &program.insts[f.start..=f.end] {
             let Some(r) = inst.result_id else { continue };
             if program.is_debug_inst(inst) {
@@ -832,7 +1019,7 @@ impl FnLiveness {
                     );
                 }
                 Op::Variable => {
-                    vars.insert(r);
+                    vars.add(r);
                     roots.insert(
                         r,
                         LocalPtr {
@@ -847,8 +1034,8 @@ impl FnLiveness {
                 | Op::PtrAccessChain
                 | Op::CopyObject
                 | Op::Bitcast => {
-                    let ids: Vec<Id> = id_operands(inst).collect();
-                    match ids.first().and_then(|b| roots.get(b)).cloned() {
+                    let mut ids = id_operands(inst);
+                    match ids.next().and_then(|b| roots.get(&b)).cloned() {
                         Some(mut ptr) => {
                             let chain = matches!(
                                 inst.class.opcode,
@@ -860,7 +1047,7 @@ impl FnLiveness {
                                 ptr.exact = false;
                             }
                             if chain {
-                                for &ix in &ids[1..] {
+                                for ix in ids {
                                     match program.const_u64(ix) {
                                         Some(c) if ptr.exact => ptr.path.push(c as u32),
                                         _ => ptr.exact = false,
@@ -870,13 +1057,13 @@ impl FnLiveness {
                             roots.insert(r, ptr);
                         }
                         None => {
-                            ssa.insert(r);
+                            ssa.add(r);
                         }
                     }
                 }
                 Op::Label | Op::Function => {}
                 _ => {
-                    ssa.insert(r);
+                    ssa.add(r);
                 }
             }
         }
@@ -918,19 +1105,25 @@ impl FnLiveness {
         }
         let mut copies = HashMap::default();
         if !candidates.is_empty() {
-            let mut uses: HashMap<Id, usize> = candidates.iter().map(|c| (c.2, 0)).collect();
+            // Counted by the loaded values' ordinals: a dense lookup per
+            // operand of every instruction, not a hash.
+            let mut loaded: IdSet = IdMap::new(lo, hi);
+            for c in &candidates {
+                loaded.add(c.2);
+            }
+            let mut uses = vec![0usize; loaded.len()];
             for inst in &program.insts[f.start..=f.end] {
                 if program.is_debug_inst(inst) {
                     continue;
                 }
                 for id in id_operands(inst) {
-                    if let Some(n) = uses.get_mut(&id) {
-                        *n += 1;
+                    if let Some(k) = loaded.ordinal(id) {
+                        uses[k] += 1;
                     }
                 }
             }
             for (store, load, v) in candidates {
-                if uses.get(&v) == Some(&1) {
+                if loaded.ordinal(v).map(|k| uses[k]) == Some(1) {
                     copies.insert(store, load);
                 }
             }
@@ -952,10 +1145,6 @@ impl FnLiveness {
                 call_reads.insert(i, e);
             }
         }
-        let ids = program.insts[f.start..=f.end]
-            .iter()
-            .filter_map(|i| i.result_id);
-        let (lo, hi) = ids.fold((Id::MAX, 0), |(lo, hi), r| (lo.min(r), hi.max(r)));
         let mut fl = FnLiveness {
             func,
             vars,
@@ -965,14 +1154,15 @@ impl FnLiveness {
             copies,
             ssa,
             live_out: vec![BitSet::default(); n],
-            places: RefCell::new(Places::new(lo, hi)),
-            defined_out: vec![BitSet::default(); n],
-            written: Vec::new(),
+            places: RefCell::new(Places::new(lo, hi, f.end + 1 - f.start)),
+            defined: std::cell::OnceCell::new(),
             preds,
             remat: HashMap::default(),
             remat_at: HashMap::default(),
             steps: Vec::new(),
             step_uses: Vec::new(),
+            segments: Vec::new(),
+            block_segments: Vec::new(),
             mentions: None,
         };
         fl.prepare_steps(program);
@@ -987,7 +1177,8 @@ impl FnLiveness {
         let f = &program.functions[self.func];
         let places = self.places.get_mut();
         let mut steps = Vec::with_capacity(f.end + 1 - f.start);
-        let mut pool = Vec::new();
+        // About two operands an instruction, and as many run entries.
+        let mut pool = Vec::with_capacity(4 * (f.end + 1 - f.start));
         for at in f.start..=f.end {
             let inst = &program.insts[at];
             let op = inst.class.opcode;
@@ -1033,8 +1224,81 @@ impl FnLiveness {
                 uses: start..pool.len() as u32,
             });
         }
+        // Fold each block's runs of plain steps: stepping back over
+        // "kill d, then make U live" after (kill K, then make G live) is
+        // (kill K ∪ {d}, then make (G − {d}) ∪ U live).
+        let mut segments = Vec::new();
+        let mut block_segments = Vec::with_capacity(f.blocks.len() + 1);
+        // The run being folded, as sets; written to the pool when it ends.
+        let (mut kill, mut gen) = (BitSet::default(), BitSet::default());
+        let mut in_run = false;
+        let end_run = |kill: &mut BitSet,
+                       gen: &mut BitSet,
+                       pool: &mut Vec<u32>,
+                       segments: &mut Vec<Segment>| {
+            let k0 = pool.len() as u32;
+            pool.extend(kill.iter());
+            let g0 = pool.len() as u32;
+            pool.extend(gen.iter());
+            let g1 = pool.len() as u32;
+            segments.push(Segment::Run {
+                kill: k0..g0,
+                gen: g0..g1,
+            });
+            kill.clear();
+            gen.clear();
+        };
+        for block in &f.blocks {
+            block_segments.push(segments.len() as u32);
+            for at in (block.start..=block.end).rev() {
+                match &steps[at - f.start] {
+                    Step::Skip => {}
+                    Step::Plain { def, uses } => {
+                        in_run = true;
+                        if *def != Places::NONE {
+                            kill.insert(*def);
+                            gen.remove(*def);
+                        }
+                        for k in uses.start..uses.end {
+                            gen.insert(pool[k as usize]);
+                        }
+                    }
+                    Step::Other => {
+                        if std::mem::take(&mut in_run) {
+                            end_run(&mut kill, &mut gen, &mut pool, &mut segments);
+                        }
+                        segments.push(Segment::Inst(at));
+                    }
+                }
+            }
+            if std::mem::take(&mut in_run) {
+                end_run(&mut kill, &mut gen, &mut pool, &mut segments);
+            }
+        }
+        block_segments.push(segments.len() as u32);
         self.steps = steps;
         self.step_uses = pool;
+        self.segments = segments;
+        self.block_segments = block_segments;
+    }
+
+    /// Backward transfer of a whole block over the live set (as stepping
+    /// back over each of its instructions).
+    fn block_back(&self, program: &Program, b: usize, live: &mut BitSet) {
+        let range = self.block_segments[b] as usize..self.block_segments[b + 1] as usize;
+        for seg in &self.segments[range] {
+            match seg {
+                Segment::Run { kill, gen } => {
+                    for &k in &self.step_uses[kill.start as usize..kill.end as usize] {
+                        live.remove(k);
+                    }
+                    for &g in &self.step_uses[gen.start as usize..gen.end as usize] {
+                        live.insert(g);
+                    }
+                }
+                Segment::Inst(at) => self.step_back(program, *at, live),
+            }
+        }
     }
 
     fn function<'p>(&self, program: &'p Program) -> &'p Function {
@@ -1094,9 +1358,9 @@ impl FnLiveness {
                     .filter(|&i| live.contains(i))
                     .filter_map(|i| {
                         let q = &places.place(i).1;
-                        if let Some(rest) = q.strip_prefix(dst.path.as_slice()) {
-                            Some(rest.to_vec())
-                        } else if dst.path.starts_with(q) {
+                        if has_prefix(q, &dst.path) {
+                            Some(q[dst.path.len()..].to_vec())
+                        } else if has_prefix(&dst.path, q) {
                             Some(Vec::new())
                         } else {
                             None
@@ -1195,9 +1459,9 @@ impl FnLiveness {
             .filter(|&i| live.contains(i))
             .filter_map(|i| {
                 let q = &places.place(i).1;
-                if q.starts_with(&ptr.path) {
+                if has_prefix(q, &ptr.path) {
                     Some((i, true))
-                } else if ptr.path.starts_with(q) {
+                } else if has_prefix(&ptr.path, q) {
                     Some((i, false))
                 } else {
                     None
@@ -1303,7 +1567,7 @@ impl FnLiveness {
         let mut live_in: Vec<BitSet> = vec![BitSet::default(); n];
         let phi_uses: Vec<BitSet> = {
             let places = &mut *self.places.borrow_mut();
-            phi_uses
+            let mut sets: Vec<BitSet> = phi_uses
                 .iter()
                 .map(|uses| {
                     let mut set = BitSet::default();
@@ -1312,7 +1576,14 @@ impl FnLiveness {
                     }
                     set
                 })
-                .collect()
+                .collect();
+            // Every place met so far fits from the start: the sets copied
+            // from these do not grow word by word in the loop below.
+            let known = places.list.len() as u32;
+            for set in &mut sets {
+                set.reserve_indices(known);
+            }
+            sets
         };
         // A worklist: a block is redone only when a successor's live-in
         // grew (every block once first, last block first), instead of every
@@ -1337,9 +1608,7 @@ impl FnLiveness {
             }
             let mut live = std::mem::take(&mut scratch);
             live.clone_from(&out);
-            for k in (f.blocks[b].start..=f.blocks[b].end).rev() {
-                self.step_back(program, k, &mut live);
-            }
+            self.block_back(program, b, &mut live);
             self.live_out[b] = out;
             if live != live_in[b] {
                 std::mem::swap(&mut live_in[b], &mut live);
@@ -1352,43 +1621,51 @@ impl FnLiveness {
             }
             scratch = live;
         }
-        // Forward: variables possibly written on some path. What each
-        // block writes itself is the same every round.
-        let mut index: HashMap<Id, u32> = HashMap::default();
-        let mut written = Vec::new();
-        let own: Vec<BitSet> = f
-            .blocks
-            .iter()
-            .map(|block| {
-                let mut set = BitSet::default();
-                for inst in &program.insts[block.start..=block.end] {
-                    self.writes(program, inst, |id| {
-                        set.insert(*index.entry(id).or_insert_with(|| {
-                            written.push(id);
-                            written.len() as u32 - 1
-                        }));
-                    });
-                }
-                set
-            })
-            .collect();
-        self.written = written;
-        let mut changed = true;
-        let mut rounds = 0;
-        while changed && rounds < 10_000 {
-            changed = false;
-            rounds += 1;
-            for (b, written) in own.iter().enumerate() {
-                let mut d = written.clone();
-                for &p in &self.preds[b] {
-                    d.union_with(&self.defined_out[p]);
-                }
-                if d != self.defined_out[b] {
-                    self.defined_out[b] = d;
-                    changed = true;
+    }
+
+    /// Variables possibly written on some path to each block's end.
+    fn defined(&self, program: &Program) -> &Defined {
+        self.defined.get_or_init(|| {
+            let f = self.function(program);
+            // What each block writes itself is the same every round.
+            let mut index: HashMap<Id, u32> = HashMap::default();
+            let mut written = Vec::new();
+            let own: Vec<BitSet> = f
+                .blocks
+                .iter()
+                .map(|block| {
+                    let mut set = BitSet::default();
+                    for inst in &program.insts[block.start..=block.end] {
+                        self.writes(program, inst, |id| {
+                            set.insert(*index.entry(id).or_insert_with(|| {
+                                written.push(id);
+                                written.len() as u32 - 1
+                            }));
+                        });
+                    }
+                    set
+                })
+                .collect();
+            let mut out = vec![BitSet::default(); f.blocks.len()];
+            let mut d = BitSet::default();
+            let mut changed = true;
+            let mut rounds = 0;
+            while changed && rounds < 10_000 {
+                changed = false;
+                rounds += 1;
+                for (b, own) in own.iter().enumerate() {
+                    d.clone_from(own);
+                    for &p in &self.preds[b] {
+                        d.union_with(&out[p]);
+                    }
+                    if d != out[b] {
+                        std::mem::swap(&mut out[b], &mut d);
+                        changed = true;
+                    }
                 }
             }
-        }
+            Defined { out, written }
+        })
     }
 
     /// Ids live just after instruction `inst` (SSA values and variables).
@@ -1422,7 +1699,7 @@ impl FnLiveness {
         }
         let outer = paths
             .iter()
-            .filter(|p| !paths.iter().any(|q| q.len() < p.len() && p.starts_with(q)));
+            .filter(|p| !paths.iter().any(|q| q.len() < p.len() && has_prefix(p, q)));
         let mut sum = 0;
         for p in outer {
             let mut t = ty;
@@ -1443,9 +1720,10 @@ impl FnLiveness {
         let Some(b) = f.block_of(inst) else {
             return HashSet::default();
         };
+        let defined = self.defined(program);
         let mut d: HashSet<Id> = HashSet::default();
         for &p in &self.preds[b] {
-            d.extend(self.defined_out[p].iter().map(|i| self.written[i as usize]));
+            d.extend(defined.out[p].iter().map(|i| defined.written[i as usize]));
         }
         for k in f.blocks[b].start..inst {
             self.writes(program, &program.insts[k], |id| {
@@ -1598,7 +1876,7 @@ impl FnLiveness {
             };
             // A variable is read only where it is mentioned: look nowhere else.
             let mentions = if is_var {
-                self.mentions(program).get(&id).cloned()
+                self.mentions(program, id)
             } else {
                 None
             };
@@ -1824,17 +2102,19 @@ impl FnLiveness {
             return r;
         }
         self.remat_at.insert(key.clone(), false);
-        let reaching = self.reaching_writes(program, var, at);
+        // Shared, not copied: the loop below recurses into `self`.
+        let mentions = self.mentions(program, var);
+        let reaching = self.reaching_writes(program, var, at, mentions.as_deref().unwrap_or(&[]));
         let mut ok = true;
         let mut stored: Vec<(Vec<u32>, Id)> = Vec::new();
-        // Shared, not copied: the loop below recurses into `self`.
-        let mentions = self.mentions(program).get(&var).cloned();
         for &i in mentions.iter().flat_map(|m| m.iter()) {
             let inst = &program.insts[i];
-            let ids: Vec<Id> = id_operands(inst).collect();
+            // The operands one by one: a vector of them per mention was a
+            // good part of this function's time.
+            let mut ids = id_operands(inst);
             match inst.class.opcode {
                 Op::Variable => {
-                    if let Some(&init) = ids.first().filter(|_| reaching.contains(&i)) {
+                    if let Some(init) = ids.next().filter(|_| reaching.binary_search(&i).is_ok()) {
                         if !matches!(
                             program.constants.get(&init),
                             Some(Constant::Int(_) | Constant::Float(_) | Constant::Bool(_))
@@ -1847,24 +2127,24 @@ impl FnLiveness {
                     }
                 }
                 // A store that cannot reach `at` does not give the value read there.
-                Op::Store if !reaching.contains(&i) => {}
+                Op::Store if reaching.binary_search(&i).is_err() => {}
                 Op::Store => {
-                    let value = ids.get(1).copied().unwrap_or(0);
-                    let path = ids
-                        .first()
-                        .and_then(|p| self.roots.get(p))
+                    let ptr = ids.next();
+                    let value = ids.next().unwrap_or(0);
+                    let path = ptr
+                        .and_then(|p| self.roots.get(&p))
                         .map(|p| p.path.clone())
                         .unwrap_or_default();
                     let overlaps = parts.is_empty()
                         || parts
                             .iter()
-                            .any(|q| q.starts_with(&path) || path.starts_with(q));
+                            .any(|q| has_prefix(q, &path) || has_prefix(&path, q));
                     if !overlaps {
                         continue;
                     }
-                    let clash = stored
-                        .iter()
-                        .any(|(q, v)| *v != value && (q.starts_with(&path) || path.starts_with(q)));
+                    let clash = stored.iter().any(|(q, v)| {
+                        *v != value && (has_prefix(q, &path) || has_prefix(&path, q))
+                    });
                     if clash || !self.remat_ssa(program, value, depth + 1) {
                         ok = false;
                     }
@@ -1872,10 +2152,7 @@ impl FnLiveness {
                 }
                 Op::Load => {}
                 Op::AccessChain | Op::InBoundsAccessChain | Op::PtrAccessChain => {
-                    if !ids[1..]
-                        .iter()
-                        .all(|&x| self.remat_ssa(program, x, depth + 1))
-                    {
+                    if !ids.skip(1).all(|x| self.remat_ssa(program, x, depth + 1)) {
                         ok = false;
                     }
                 }
@@ -1891,10 +2168,12 @@ impl FnLiveness {
 
     /// The instructions (not debug info) that define a variable or use a
     /// pointer into it, per variable, in order.
-    fn mentions(&mut self, program: &Program) -> &HashMap<Id, std::rc::Rc<[usize]>> {
+    fn mentions(&mut self, program: &Program, var: Id) -> Option<std::rc::Rc<[usize]>> {
         if self.mentions.is_none() {
+            // By the variable's ordinal among the roots (every variable
+            // and pointer parameter is its own root): no hashing per mention.
             let f = &program.functions[self.func];
-            let mut m: HashMap<Id, Vec<usize>> = HashMap::default();
+            let mut m: Vec<Vec<usize>> = vec![Vec::new(); self.roots.len()];
             for i in f.start..=f.end {
                 let inst = &program.insts[i];
                 if program.is_debug_inst(inst) {
@@ -1903,23 +2182,34 @@ impl FnLiveness {
                 let used = id_operands(inst).filter_map(|x| self.root(x));
                 let defined = inst.result_id.filter(|r| self.vars.contains(r));
                 for v in defined.into_iter().chain(used) {
-                    let list = m.entry(v).or_default();
+                    let Some(list) = self.roots.ordinal(v).and_then(|k| m.get_mut(k)) else {
+                        continue;
+                    };
                     if list.last() != Some(&i) {
                         list.push(i);
                     }
                 }
             }
-            self.mentions = Some(m.into_iter().map(|(v, l)| (v, l.into())).collect());
+            self.mentions = Some(m.into_iter().map(Into::into).collect());
         }
-        self.mentions.get_or_insert_with(HashMap::default)
+        let list = self.mentions.as_ref()?.get(self.roots.ordinal(var)?)?;
+        (!list.is_empty()).then(|| list.clone())
     }
 
     /// The writes to `var` (stores, and its `OpVariable` when it has an
     /// initializer) that can give the value read at `at`: walking back from
-    /// `at` along every path, up to a store of the whole variable.
-    fn reaching_writes(&self, program: &Program, var: Id, at: usize) -> HashSet<usize> {
+    /// `at` along every path, up to a store of the whole variable; sorted.
+    /// Only the variable's `mentions` (sorted) can write it: a block is
+    /// searched through those, not instruction by instruction.
+    fn reaching_writes(
+        &self,
+        program: &Program,
+        var: Id,
+        at: usize,
+        mentions: &[usize],
+    ) -> Vec<usize> {
         let f = self.function(program);
-        let mut found = HashSet::default();
+        let mut found = Vec::new();
         let Some(b0) = f.block_of(at) else {
             return found;
         };
@@ -1942,9 +2232,11 @@ impl FnLiveness {
         while let Some((b, last)) = work.pop() {
             let block = &f.blocks[b];
             let mut killed = false;
-            for i in (block.start..last).rev() {
+            let from = mentions.partition_point(|&i| i < block.start);
+            let to = mentions.partition_point(|&i| i < last);
+            for &i in mentions[from..to.max(from)].iter().rev() {
                 if let Some(w) = whole(i) {
-                    found.insert(i);
+                    found.push(i);
                     if w {
                         killed = true;
                         break;
@@ -1958,7 +2250,7 @@ impl FnLiveness {
                 // The entry block holds the variables and their initializers.
                 if let Some(&d) = program.defs.get(&var) {
                     if whole(d) == Some(true) {
-                        found.insert(d);
+                        found.push(d);
                     }
                 }
             }
@@ -1968,6 +2260,8 @@ impl FnLiveness {
                 }
             }
         }
+        found.sort_unstable();
+        found.dedup();
         found
     }
 }
@@ -2017,7 +2311,7 @@ mod tests {
 
     #[test]
     fn places_intern_once_and_list_each_ids_parts() {
-        let mut p = Places::new(10, 20);
+        let mut p = Places::new(10, 20, 4);
         let whole = p.intern(12, &[]);
         assert_eq!(p.intern(12, &[]), whole, "interned once");
         let a = p.intern(12, &[1, 2]);
@@ -2039,10 +2333,83 @@ mod tests {
     }
 
     #[test]
+    fn id_maps_dense_with_parameters_apart_and_sparse() {
+        // A small range is a table; the huge one hashes.
+        for (lo, hi) in [(100, 200), (0, u32::MAX)] {
+            let mut m: IdMap<&str> = IdMap::new(lo, hi);
+            m.insert(150, "a");
+            // Below the body's range, as a parameter numbered before it.
+            m.insert(7, "param");
+            m.insert(150, "b");
+            assert_eq!(m.get(&150), Some(&"b"), "replaced, not added");
+            assert_eq!(m.get(&7), Some(&"param"));
+            assert!(m.contains_key(&7) && !m.contains_key(&151));
+            assert_eq!(m.get(&300), None, "above the range");
+            assert_eq!(m.get(&99), None, "below the range, never added");
+            assert_eq!(
+                (m.ordinal(150), m.ordinal(7), m.ordinal(8), m.len()),
+                (Some(0), Some(1), None, 2)
+            );
+        }
+    }
+
+    #[test]
+    fn folded_blocks_step_like_their_instructions() {
+        // The fixpoint applies each block's folded runs; stepping back over
+        // every instruction must give the same set, from the solved set at
+        // the block's end and from one holding every place met.
+        for rel in [
+            "shaders/reflect_adaptive.hlsl",
+            "shaders/reflect_iterative.wgsl",
+            "fixtures/live/loop_local.rgen.gV.spv",
+        ] {
+            let p = program(rel);
+            let mut runs = 0;
+            for func in 0..p.functions.len() {
+                let fl = FnLiveness::new(&p, func);
+                runs += fl
+                    .segments
+                    .iter()
+                    .filter(|s| matches!(s, Segment::Run { .. }))
+                    .count();
+                let mut all = BitSet::default();
+                for i in 0..fl.places.borrow().list.len() as u32 {
+                    all.insert(i);
+                }
+                let f = &p.functions[func];
+                for (b, block) in f.blocks.iter().enumerate() {
+                    for start in [&fl.live_out[b], &all] {
+                        let mut by_block = start.clone();
+                        fl.block_back(&p, b, &mut by_block);
+                        let mut by_inst = start.clone();
+                        for k in (block.start..=block.end).rev() {
+                            fl.step_back(&p, k, &mut by_inst);
+                        }
+                        assert_eq!(by_block, by_inst, "{rel}: function {func}, block {b}");
+                    }
+                }
+            }
+            assert!(runs > 0, "{rel}: some runs were folded");
+        }
+    }
+
+    #[test]
+    fn path_prefixes() {
+        assert!(has_prefix(&[1, 2, 3], &[1, 2]));
+        assert!(has_prefix(&[1, 2], &[]));
+        assert!(has_prefix(&[1, 2], &[1, 2]));
+        assert!(!has_prefix(&[1, 2], &[1, 2, 3]));
+        assert!(!has_prefix(&[1, 3], &[1, 2]));
+        assert!(same_path(&[4, 5], &[4, 5]));
+        assert!(!same_path(&[4, 5], &[4]) && !same_path(&[4], &[4, 5]));
+        assert!(same_path(&[], &[]));
+    }
+
+    #[test]
     fn places_with_colliding_keys_stay_apart() {
         // A huge id range has no dense table: every place is hashed, and
         // many parts of one variable share chains of the same key space.
-        let mut p = Places::new(0, u32::MAX);
+        let mut p = Places::new(0, u32::MAX, 0);
         let ids: Vec<u32> = (0..200u32)
             .map(|i| p.intern(7, &[i % 10, i / 10]))
             .collect();

@@ -26,14 +26,16 @@ use crate::shader::Language;
 use crate::shader::Stage;
 use rspirv::dr::{Instruction, Operand};
 use spirv::{Op, StorageClass};
-use std::collections::HashMap;
+// Ids hash far faster with Fx than with SipHash, and the analyses look
+// ids up all the time (`defs`, `constants`, `types`); a module's ids are
+// its own, not adversarial input to a hash table.
+type HashMap<K, V> = rustc_hash::FxHashMap<K, V>;
 use std::path::PathBuf;
 
 pub type Id = u32;
 
-/// The Program's maps: keys are small integers, hashed on every lookup the
-/// analyses make, for which SipHash's resistance to chosen keys buys nothing.
-pub type FastMap<K, V> = rustc_hash::FxHashMap<K, V>;
+/// The Program's maps, Fx-hashed as above.
+pub type FastMap<K, V> = HashMap<K, V>;
 
 /// Decorations with their literal operands.
 pub type Decorations = Vec<(spirv::Decoration, Vec<u32>)>;
@@ -393,7 +395,7 @@ impl Program {
         // Every call by callee, indexed once: call chains ask per function.
         struct Calls(HashMap<Id, Vec<usize>>);
         let calls = self.memo.get_or(|| {
-            let mut by_callee: HashMap<Id, Vec<usize>> = HashMap::new();
+            let mut by_callee: HashMap<Id, Vec<usize>> = HashMap::default();
             for (i, inst) in self.insts.iter().enumerate() {
                 if inst.class.opcode != Op::FunctionCall {
                     continue;
@@ -463,18 +465,32 @@ impl Program {
 
     /// Function ids reachable from `root` through `OpFunctionCall`, `root` first.
     pub fn reachable_functions(&self, root: Id) -> Vec<Id> {
-        let mut seen = vec![root];
-        let mut i = 0;
-        while i < seen.len() {
-            if let Some(f) = self.function(seen[i]) {
+        // Each function's callees, in the order of its calls, listed once
+        // per Program: the analyses ask per shader and per entry point, and
+        // scanning every reachable instruction each time added up.
+        struct Callees(HashMap<Id, Vec<Id>>);
+        let callees = self.memo.get_or(|| {
+            let mut by_caller: HashMap<Id, Vec<Id>> = HashMap::default();
+            for f in &self.functions {
+                let mut list = Vec::new();
                 for inst in &self.insts[f.start..=f.end] {
                     if inst.class.opcode == Op::FunctionCall {
                         if let Some(Operand::IdRef(callee)) = inst.operands.first() {
-                            if !seen.contains(callee) {
-                                seen.push(*callee);
-                            }
+                            list.push(*callee);
                         }
                     }
+                }
+                // The first function of an id wins, as `function` finds it.
+                by_caller.entry(f.id).or_insert(list);
+            }
+            Callees(by_caller)
+        });
+        let mut seen = vec![root];
+        let mut i = 0;
+        while i < seen.len() {
+            for callee in callees.0.get(&seen[i]).map_or(&[][..], Vec::as_slice) {
+                if !seen.contains(callee) {
+                    seen.push(*callee);
                 }
             }
             i += 1;
