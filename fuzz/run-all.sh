@@ -7,7 +7,7 @@
 set -uo pipefail
 cd "$(dirname "$0")"
 seconds=${1:-300}
-targets=${TARGETS:-"hlsl_preprocess hlsl_parse hlsl_compile wgsl spirv spirv_gen config pipeline"}
+targets=${TARGETS:-"hlsl_preprocess hlsl_parse hlsl_compile wgsl spirv spirv_decode spirv_gen config pipeline"}
 ./seed.sh >/dev/null
 for t in $targets; do
     log=$(mktemp)

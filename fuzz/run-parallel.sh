@@ -17,7 +17,7 @@ bin=$(realpath "$1")
 seconds=$2
 jobs_spec=$3
 out=$(realpath -m "${4:-/tmp/rtlint-fuzz}")
-targets=${TARGETS:-"hlsl_preprocess hlsl_parse hlsl_compile wgsl spirv spirv_gen config pipeline"}
+targets=${TARGETS:-"hlsl_preprocess hlsl_parse hlsl_compile wgsl spirv spirv_decode spirv_gen config pipeline"}
 mkdir -p "$out"
 ./seed.sh >/dev/null
 

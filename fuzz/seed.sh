@@ -16,6 +16,7 @@ for t in hlsl_preprocess hlsl_parse hlsl_compile; do
 done
 seed wgsl shaders fixtures -name '*.wgsl'
 seed spirv fixtures -name '*.spv'
+seed spirv_decode fixtures -name '*.spv'
 seed config . -path ./target -prune -o -path ./fuzz -prune -o -name 'rtlint.toml'
 seed pipeline shaders fixtures tests -name '*.pipeline.toml'
 # spirv_gen's inputs are generator choices: any bytes make a module.

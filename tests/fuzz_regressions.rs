@@ -47,6 +47,13 @@ fn run(target: &str, data: &[u8]) {
                 }
             }
         }
+        "spirv_decode" => {
+            if let Ok(words) = rtlint::program::words_from_bytes(data, Path::new("fuzz.spv")) {
+                if let Err(e) = rtlint::program::decode::check_against_rspirv(&words) {
+                    panic!("{e}");
+                }
+            }
+        }
         "config" => {
             if let Some(Ok(c)) = text.map(|t| Config::parse(t, Path::new("rtlint.toml"))) {
                 let _ = c.check_rule_names(rtlint::rules::is_selector);

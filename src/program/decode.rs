@@ -397,6 +397,83 @@ fn decoration_params(d: Decoration) -> Option<Params> {
     })
 }
 
+/// The decoder against rspirv's parser on any words (unit tests and the
+/// fuzz target `spirv_decode`): where the decoder gives instructions,
+/// rspirv must parse the module and give the same ones. `Err` says where
+/// they differ.
+pub fn check_against_rspirv(words: &[u32]) -> Result<(), String> {
+    // What `build::parse` checks before it asks the decoder.
+    if words.len() < 5 || words[0] != super::binary::MAGIC {
+        return Ok(());
+    }
+    let Some(offsets) = checked_offsets(words) else {
+        return Ok(());
+    };
+    if offsets
+        .iter()
+        .any(|&at| Op::from_u32(words[at as usize] & 0xffff).is_none())
+    {
+        return Ok(());
+    }
+    let Some(got) = decode(words, &offsets) else {
+        return Ok(());
+    };
+    match rspirv_insts(words) {
+        None => Err("decoded a module rspirv refuses".into()),
+        Some(expected) => match expected.iter().zip(&got).position(|(a, b)| a != b) {
+            Some(k) => Err(format!(
+                "instruction {k}: rspirv {:?}, decoded {:?}",
+                expected[k], got[k]
+            )),
+            None if expected.len() != got.len() => Err(format!(
+                "rspirv {} instructions, decoded {}",
+                expected.len(),
+                got.len()
+            )),
+            None => Ok(()),
+        },
+    }
+}
+
+/// Offsets as `build::parse` checks them first: `None` where a word
+/// count is 0 or runs past the end.
+pub fn checked_offsets(words: &[u32]) -> Option<Vec<u32>> {
+    let mut out = Vec::new();
+    let mut i = 5;
+    while i < words.len() {
+        let count = (words[i] >> 16) as usize;
+        if count == 0 || i + count > words.len() {
+            return None;
+        }
+        out.push(i as u32);
+        i += count;
+    }
+    Some(out)
+}
+
+/// Every instruction as rspirv's parser reads them (`None`: it refuses).
+fn rspirv_insts(words: &[u32]) -> Option<Vec<Instruction>> {
+    struct All(Vec<Instruction>);
+    impl rspirv::binary::Consumer for All {
+        fn initialize(&mut self) -> rspirv::binary::ParseAction {
+            rspirv::binary::ParseAction::Continue
+        }
+        fn finalize(&mut self) -> rspirv::binary::ParseAction {
+            rspirv::binary::ParseAction::Continue
+        }
+        fn consume_header(&mut self, _: rspirv::dr::ModuleHeader) -> rspirv::binary::ParseAction {
+            rspirv::binary::ParseAction::Continue
+        }
+        fn consume_instruction(&mut self, i: Instruction) -> rspirv::binary::ParseAction {
+            self.0.push(i);
+            rspirv::binary::ParseAction::Continue
+        }
+    }
+    let mut all = All(Vec::new());
+    rspirv::binary::parse_words(words, &mut all).ok()?;
+    Some(all.0)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -413,31 +490,6 @@ mod tests {
         }
     }
 
-    fn rspirv_insts(words: &[u32]) -> Option<Vec<Instruction>> {
-        struct All(Vec<Instruction>);
-        impl rspirv::binary::Consumer for All {
-            fn initialize(&mut self) -> rspirv::binary::ParseAction {
-                rspirv::binary::ParseAction::Continue
-            }
-            fn finalize(&mut self) -> rspirv::binary::ParseAction {
-                rspirv::binary::ParseAction::Continue
-            }
-            fn consume_header(
-                &mut self,
-                _: rspirv::dr::ModuleHeader,
-            ) -> rspirv::binary::ParseAction {
-                rspirv::binary::ParseAction::Continue
-            }
-            fn consume_instruction(&mut self, i: Instruction) -> rspirv::binary::ParseAction {
-                self.0.push(i);
-                rspirv::binary::ParseAction::Continue
-            }
-        }
-        let mut all = All(Vec::new());
-        rspirv::binary::parse_words(words, &mut all).ok()?;
-        Some(all.0)
-    }
-
     fn offsets(words: &[u32]) -> Vec<u32> {
         let mut out = Vec::new();
         let mut i = 5;
@@ -446,22 +498,6 @@ mod tests {
             i += (words[i] >> 16).max(1) as usize;
         }
         out
-    }
-
-    /// Offsets as `build::parse` checks them first: `None` where a word
-    /// count is 0 or runs past the end.
-    fn checked_offsets(words: &[u32]) -> Option<Vec<u32>> {
-        let mut out = Vec::new();
-        let mut i = 5;
-        while i < words.len() {
-            let count = (words[i] >> 16) as usize;
-            if count == 0 || i + count > words.len() {
-                return None;
-            }
-            out.push(i as u32);
-            i += count;
-        }
-        Some(out)
     }
 
     /// Damaged modules: wherever the decoder gives instructions, rspirv
