@@ -75,6 +75,22 @@ pub fn parse(words: &[u32], path: &Path, language: Language) -> Result<Program, 
         if Op::from_u32(opcode).is_none() {
             return Err(err(path, format!("unknown opcode {opcode} at word {i}")));
         }
+        // rspirv reads the operands of the operation an `OpSpecConstantOp`
+        // names by that opcode's grammar and panics on one it cannot take
+        // (another `OpSpecConstant*`: found by fuzzing); the spec allows a
+        // fixed list.
+        if opcode == Op::SpecConstantOp as u32 && count >= 4 {
+            let inner = words[i + 3];
+            if !Op::from_u32(inner).is_some_and(spec_constant_op_allows) {
+                return Err(err(
+                    path,
+                    format!(
+                        "OpSpecConstantOp at word {i} performs {}, which OpSpecConstantOp does not allow",
+                        opname(&[inner], 0)
+                    ),
+                ));
+            }
+        }
         offsets.push(i as u32);
         i += count;
     }
@@ -235,6 +251,74 @@ fn valid_utf8_strings(words: &[u32], offsets: &[u32]) -> Option<Vec<u32>> {
         }
     }
     out
+}
+
+/// The operations `OpSpecConstantOp` may perform: the SPIR-V specification's
+/// list for shaders and for kernels together.
+fn spec_constant_op_allows(op: Op) -> bool {
+    use Op::*;
+    matches!(
+        op,
+        SConvert
+            | UConvert
+            | FConvert
+            | SNegate
+            | Not
+            | IAdd
+            | ISub
+            | IMul
+            | UDiv
+            | SDiv
+            | UMod
+            | SRem
+            | SMod
+            | ShiftRightLogical
+            | ShiftRightArithmetic
+            | ShiftLeftLogical
+            | BitwiseOr
+            | BitwiseXor
+            | BitwiseAnd
+            | VectorShuffle
+            | CompositeExtract
+            | CompositeInsert
+            | LogicalOr
+            | LogicalAnd
+            | LogicalNot
+            | LogicalEqual
+            | LogicalNotEqual
+            | Select
+            | IEqual
+            | INotEqual
+            | ULessThan
+            | SLessThan
+            | UGreaterThan
+            | SGreaterThan
+            | ULessThanEqual
+            | SLessThanEqual
+            | UGreaterThanEqual
+            | SGreaterThanEqual
+            | QuantizeToF16
+            | ConvertFToS
+            | ConvertSToF
+            | ConvertFToU
+            | ConvertUToF
+            | ConvertPtrToU
+            | ConvertUToPtr
+            | GenericCastToPtr
+            | PtrCastToGeneric
+            | Bitcast
+            | FNegate
+            | FAdd
+            | FSub
+            | FMul
+            | FDiv
+            | FRem
+            | FMod
+            | AccessChain
+            | InBoundsAccessChain
+            | PtrAccessChain
+            | InBoundsPtrAccessChain
+    )
 }
 
 fn opname(words: &[u32], offset: u32) -> String {
@@ -1145,6 +1229,46 @@ mod tests {
             .unwrap();
         let name = p.type_name(ptr);
         assert!(name.starts_with("ptr<ptr<") && name.contains('…'), "{name}");
+    }
+
+    /// Found by fuzzing: rspirv panicked reading an `OpSpecConstantOp` that
+    /// performs another `OpSpecConstant*`; now an input error naming it, and
+    /// an operation the specification allows still parses.
+    #[test]
+    fn spec_constant_op_performs_only_what_the_spec_allows() {
+        use rspirv::binary::Assemble;
+        let module = |op: Op| {
+            let mut b = rspirv::dr::Builder::new();
+            b.capability(spirv::Capability::Shader);
+            b.memory_model(spirv::AddressingModel::Logical, spirv::MemoryModel::GLSL450);
+            let u = b.type_int(32, 0);
+            let one = b.spec_constant_bit32(u, 1);
+            let mut words = b.module().assemble();
+            // OpSpecConstantOp %u %id <op> %one %one, by hand: rspirv's
+            // builder takes only the operations it knows.
+            let id = words[3];
+            words[3] += 1;
+            words.extend([
+                (6 << 16) | Op::SpecConstantOp as u32,
+                u,
+                id,
+                op as u32,
+                one,
+                one,
+            ]);
+            words
+        };
+        let path = Path::new("t.spv");
+        for bad in [Op::SpecConstant, Op::SpecConstantOp, Op::Constant] {
+            let e = parse(&module(bad), path, Language::Spirv).unwrap_err();
+            assert!(
+                e.to_string().contains(&format!(
+                    "performs Op{bad:?}, which OpSpecConstantOp does not allow"
+                )),
+                "{e}"
+            );
+        }
+        assert!(parse(&module(Op::IAdd), path, Language::Spirv).is_ok());
     }
 
     /// glslang 12 `-gV` gives `main` line 0; such positions, and lines past
