@@ -2054,6 +2054,11 @@ impl FnLiveness {
     }
 
     fn remat_global_ptr(&mut self, program: &Program, ptr: Id, depth: u32) -> bool {
+        // As deep as `remat_ssa` looks; an access chain that is its own base
+        // (invalid, found by fuzzing) recursed until the stack overflowed.
+        if depth > 64 {
+            return false;
+        }
         if let Some(g) = program.globals.iter().find(|g| g.id == ptr) {
             return matches!(
                 g.storage,
