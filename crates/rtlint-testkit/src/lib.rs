@@ -172,6 +172,26 @@ fn hash(w: &[u32]) -> u64 {
     })
 }
 
+/// Turns the Vulkan drivers' shader caches off for this process, so that a
+/// benchmark's repeated pipeline creation compiles each time, as a pipeline
+/// the driver has not seen does (NVIDIA's cache otherwise answers a repeat
+/// from what it kept: the 17 repository pipelines took 125 ms cached and
+/// 2.6 s compiled on the H200; `examples/drv_time.rs`). Call it first in
+/// `main`, before any thread starts. `RTLINT_BENCH_DRIVER_CACHE=1` keeps
+/// the caches; returns whether they are off.
+pub fn driver_caches_off() -> bool {
+    if std::env::var_os("RTLINT_BENCH_DRIVER_CACHE").is_some_and(|v| v != "0") {
+        return false;
+    }
+    for (k, v) in [
+        ("__GL_SHADER_DISK_CACHE", "0"),
+        ("MESA_SHADER_CACHE_DISABLE", "true"),
+    ] {
+        std::env::set_var(k, v);
+    }
+    true
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -222,24 +242,4 @@ mod tests {
         assert_eq!(words_of_bytes(&bytes_of_words(&w)), w);
         assert_eq!(bytes_of_words(&[0x0403_0201]), [1, 2, 3, 4]);
     }
-}
-
-/// Turns the Vulkan drivers' shader caches off for this process, so that a
-/// benchmark's repeated pipeline creation compiles each time, as a pipeline
-/// the driver has not seen does (NVIDIA's cache otherwise answers a repeat
-/// from what it kept: the 17 repository pipelines took 125 ms cached and
-/// 2.6 s compiled on the H200; `examples/drv_time.rs`). Call it first in
-/// `main`, before any thread starts. `RTLINT_BENCH_DRIVER_CACHE=1` keeps
-/// the caches; returns whether they are off.
-pub fn driver_caches_off() -> bool {
-    if std::env::var_os("RTLINT_BENCH_DRIVER_CACHE").is_some_and(|v| v != "0") {
-        return false;
-    }
-    for (k, v) in [
-        ("__GL_SHADER_DISK_CACHE", "0"),
-        ("MESA_SHADER_CACHE_DISABLE", "true"),
-    ] {
-        std::env::set_var(k, v);
-    }
-    true
 }
