@@ -162,16 +162,9 @@ impl Config {
                 e.message().trim().to_string(),
             );
             if let Some(span) = e.span() {
-                let (line, column) = crate::shader::line_col(text, span.start);
-                let (end_line, end_column) = crate::shader::line_col(text, span.end);
+                let at = |offset| crate::shader::line_col(text, offset);
                 err = err.at(
-                    Location {
-                        path: path.to_path_buf(),
-                        line,
-                        column,
-                        end_line,
-                        end_column,
-                    },
+                    Location::between(path, at(span.start), at(span.end)),
                     "here",
                 );
             }

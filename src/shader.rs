@@ -176,6 +176,17 @@ impl Location {
         }
     }
 
+    /// A location from one (line, column) to another.
+    pub fn between(path: impl Into<PathBuf>, start: (u32, u32), end: (u32, u32)) -> Self {
+        Location {
+            path: path.into(),
+            line: start.0,
+            column: start.1,
+            end_line: end.0,
+            end_column: end.1,
+        }
+    }
+
     /// A location spanning `len` columns from `column` on one line.
     pub fn span(path: impl Into<PathBuf>, line: u32, column: u32, len: u32) -> Self {
         Location {

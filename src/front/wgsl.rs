@@ -205,15 +205,7 @@ impl<'a> Lines<'a> {
     fn location(&self, path: &Path, at: usize, name: &str) -> Location {
         let start = at.min(self.source.len());
         let end = (at + name.len()).clamp(start, self.source.len());
-        let (line, column) = self.line_col(start);
-        let (end_line, end_column) = self.line_col(end);
-        Location {
-            path: path.to_path_buf(),
-            line,
-            column,
-            end_line,
-            end_column,
-        }
+        Location::between(path, self.line_col(start), self.line_col(end))
     }
 }
 
@@ -331,15 +323,7 @@ pub fn span_location(path: &Path, source: &str, span: naga::Span) -> Location {
         .map(|r| r.end)
         .unwrap_or(start)
         .clamp(start, source.len());
-    let (line, column) = line_col(source, start);
-    let (end_line, end_column) = line_col(source, end);
-    Location {
-        path: path.to_path_buf(),
-        line,
-        column,
-        end_line,
-        end_column,
-    }
+    Location::between(path, line_col(source, start), line_col(source, end))
 }
 
 #[cfg(test)]
