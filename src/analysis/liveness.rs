@@ -824,7 +824,17 @@ impl FnLiveness {
             memo: HashMap::default(),
             shared: std::mem::take(shared),
         };
-        let (fl, _) = Self::build(program, func, &mut builds, 0);
+        let (fl, exact) = Self::build(program, func, &mut builds, 0);
+        // A caller met later asks what this function does with its pointer
+        // parameters: answered from this build, not by building it again.
+        let f = &program.functions[func];
+        if exact
+            && !builds.shared.exposed.contains_key(&func)
+            && f.params.iter().any(|&p| is_pointer_param(program, p))
+        {
+            let exposed = fl.exposed(program);
+            builds.shared.exposed.insert(func, exposed);
+        }
         *shared = builds.shared;
         fl
     }
@@ -862,15 +872,26 @@ impl FnLiveness {
         }
         builds.memo.insert(func, (unknown, false));
         let (fl, exact) = Self::build(program, func, builds, depth + 1);
+        let exposed = fl.exposed(program);
+        builds.memo.insert(func, (exposed.clone(), exact));
+        if exact {
+            builds.shared.exposed.insert(func, exposed.clone());
+            builds.shared.built.insert(func, fl);
+        }
+        (exposed, exact)
+    }
+
+    /// What this function does with each of its pointer parameters.
+    fn exposed(&self, program: &Program) -> ExposedParams {
+        let f = self.function(program);
         let entry = f.blocks.first().map(|b| b.start);
         let live = entry
-            .map(|i| fl.places_after(program, i))
+            .map(|i| self.places_after(program, i))
             .unwrap_or_default();
-        let exposed: ExposedParams = f
-            .params
+        f.params
             .iter()
             .map(|p| {
-                if !fl.roots.contains_key(p) {
+                if !self.roots.contains_key(p) {
                     return ParamEffect::default();
                 }
                 let reads = live
@@ -880,16 +901,10 @@ impl FnLiveness {
                     .collect();
                 ParamEffect {
                     reads: Some(reads),
-                    writes: fl.written_on_every_path(program, *p),
+                    writes: self.written_on_every_path(program, *p),
                 }
             })
-            .collect();
-        builds.memo.insert(func, (exposed.clone(), exact));
-        if exact {
-            builds.shared.exposed.insert(func, exposed.clone());
-            builds.shared.built.insert(func, fl);
-        }
-        (exposed, exact)
+            .collect()
     }
 
     /// The parts of pointer parameter (or variable) `var` that every path
