@@ -709,8 +709,6 @@ type ExposedParams = Vec<ParamEffect>;
 #[derive(Default)]
 struct Shared {
     exposed: HashMap<usize, ExposedParams>,
-    /// Callees solved exactly on the way, for their own sites.
-    built: HashMap<usize, FnLiveness>,
 }
 
 /// One top-level build: every answer met on the way, exact or not, and
@@ -813,13 +811,9 @@ impl FnLiveness {
         Self::build(program, func, &mut Builds::default(), 0).0
     }
 
-    /// The liveness of function `func`, built once per program: taken from
-    /// `shared` when a callee's build already made it exactly, else built
-    /// as [`FnLiveness::new`] would.
+    /// The liveness of function `func`, built as [`FnLiveness::new`] would,
+    /// reusing (and adding to) the callee answers in `shared`.
     fn shared(program: &Program, func: usize, shared: &mut Shared) -> FnLiveness {
-        if let Some(fl) = shared.built.remove(&func) {
-            return fl;
-        }
         let mut builds = Builds {
             memo: HashMap::default(),
             shared: std::mem::take(shared),
@@ -876,7 +870,6 @@ impl FnLiveness {
         builds.memo.insert(func, (exposed.clone(), exact));
         if exact {
             builds.shared.exposed.insert(func, exposed.clone());
-            builds.shared.built.insert(func, fl);
         }
         (exposed, exact)
     }
@@ -997,7 +990,7 @@ impl FnLiveness {
     }
 
     /// The liveness of `func`, and whether every callee's answer it used
-    /// was exact.
+    /// was exact. Below the top (`depth` > 0) only its variables' parts.
     fn build(
         program: &Program,
         func: usize,
@@ -1005,6 +998,11 @@ impl FnLiveness {
         depth: u32,
     ) -> (FnLiveness, bool) {
         let f = &program.functions[func];
+        // A callee solved for its pointer parameters (`depth` > 0) needs only
+        // the variables' parts: what SSA values are live never changes which
+        // parts are (a load reads its variable whether or not its value is
+        // used), so they are not tracked there at all.
+        let track_ssa = depth == 0;
         // The body's ids: the function's own and its parameters' are often
         // numbered long before it, and would widen the dense tables.
         let ids = program.insts[f.start..=f.end]
@@ -1071,15 +1069,17 @@ impl FnLiveness {
                             }
                             roots.insert(r, ptr);
                         }
-                        None => {
+                        None if track_ssa => {
                             ssa.add(r);
                         }
+                        None => {}
                     }
                 }
                 Op::Label | Op::Function => {}
-                _ => {
+                _ if track_ssa => {
                     ssa.add(r);
                 }
+                _ => {}
             }
         }
         let n = f.blocks.len();
