@@ -565,6 +565,8 @@ impl Places {
 struct IdMap<T> {
     index: IdIndex,
     values: Vec<T>,
+    /// The id of each value, by ordinal.
+    keys: Vec<Id>,
 }
 
 #[derive(Debug)]
@@ -636,6 +638,7 @@ impl<T> IdMap<T> {
         IdMap {
             index,
             values: Vec::new(),
+            keys: Vec::new(),
         }
     }
 
@@ -661,6 +664,7 @@ impl<T> IdMap<T> {
         let k = self.index.find_or_add(id, next);
         if k == next {
             self.values.push(value);
+            self.keys.push(id);
         } else {
             self.values[k as usize] = value;
         }
@@ -759,6 +763,25 @@ struct Defined {
     written: Vec<Id>,
 }
 
+/// The instructions mentioning each root (by its ordinal among
+/// [`FnLiveness::roots`]), in order: one list for all, `start[k]..start[k + 1]`
+/// being root `k`'s (one allocation, not one per root).
+struct Mentions {
+    start: Vec<u32>,
+    list: Vec<usize>,
+}
+
+/// One root's mentions, shared (the recomputation check recurses into the
+/// function's liveness while reading them).
+struct MentionList(std::rc::Rc<Mentions>, std::ops::Range<usize>);
+
+impl std::ops::Deref for MentionList {
+    type Target = [usize];
+    fn deref(&self) -> &[usize] {
+        &self.0.list[self.1.clone()]
+    }
+}
+
 /// Liveness facts of one function.
 pub struct FnLiveness {
     func: usize,
@@ -803,7 +826,7 @@ pub struct FnLiveness {
     block_segments: Vec<u32>,
     /// The instructions that define or use each variable, in order (built
     /// on first use).
-    mentions: Option<Vec<std::rc::Rc<[usize]>>>,
+    mentions: std::cell::OnceCell<std::rc::Rc<Mentions>>,
 }
 
 impl FnLiveness {
@@ -906,9 +929,16 @@ impl FnLiveness {
     fn written_on_every_path(&self, program: &Program, var: Id) -> Vec<Vec<u32>> {
         let f = self.function(program);
         let n = f.blocks.len();
+        // Only an instruction that mentions `var` can write it.
+        let Some(mentions) = self.mentions(program, var) else {
+            return Vec::new();
+        };
         let own = |b: usize| -> Vec<Vec<u32>> {
             let mut w = Vec::new();
-            for i in f.blocks[b].start..=f.blocks[b].end {
+            let block = &f.blocks[b];
+            let from = mentions.partition_point(|&i| i < block.start);
+            let to = mentions.partition_point(|&i| i <= block.end);
+            for &i in &mentions[from..to] {
                 let inst = &program.insts[i];
                 match inst.class.opcode {
                     Op::Store => {
@@ -1178,7 +1208,7 @@ impl FnLiveness {
             step_uses: Vec::new(),
             segments: Vec::new(),
             block_segments: Vec::new(),
-            mentions: None,
+            mentions: std::cell::OnceCell::new(),
         };
         fl.prepare_steps(program);
         fl.solve(program);
@@ -1642,25 +1672,30 @@ impl FnLiveness {
     fn defined(&self, program: &Program) -> &Defined {
         self.defined.get_or_init(|| {
             let f = self.function(program);
-            // What each block writes itself is the same every round.
-            let mut index: HashMap<Id, u32> = HashMap::default();
+            // What each block writes itself is the same every round. Only
+            // variables are asked about, and only an instruction that
+            // mentions one can write it: each variable's mentions, not
+            // every instruction.
             let mut written = Vec::new();
-            let own: Vec<BitSet> = f
-                .blocks
-                .iter()
-                .map(|block| {
-                    let mut set = BitSet::default();
-                    for inst in &program.insts[block.start..=block.end] {
-                        self.writes(program, inst, |id| {
-                            set.insert(*index.entry(id).or_insert_with(|| {
-                                written.push(id);
-                                written.len() as u32 - 1
-                            }));
-                        });
+            let mut own: Vec<BitSet> = vec![BitSet::default(); f.blocks.len()];
+            for &var in &self.vars.keys {
+                let Some(mentions) = self.mentions(program, var) else {
+                    continue;
+                };
+                let k = written.len() as u32;
+                let mut any = false;
+                for &i in mentions.iter() {
+                    let mut hit = false;
+                    self.writes(program, &program.insts[i], |id| hit |= id == var);
+                    if let Some(b) = hit.then(|| block_at(f, i)).flatten() {
+                        own[b].insert(k);
+                        any = true;
                     }
-                    set
-                })
-                .collect();
+                }
+                if any {
+                    written.push(var);
+                }
+            }
             let mut out = vec![BitSet::default(); f.blocks.len()];
             let mut d = BitSet::default();
             let mut changed = true;
@@ -1694,7 +1729,7 @@ impl FnLiveness {
     /// SSA values and parts of variables live just after instruction `inst`.
     fn places_after(&self, program: &Program, inst: usize) -> HashSet<Place> {
         let f = self.function(program);
-        let Some(b) = f.block_of(inst) else {
+        let Some(b) = block_at(f, inst) else {
             return HashSet::default();
         };
         let mut live = self.live_out[b].clone();
@@ -1732,7 +1767,7 @@ impl FnLiveness {
     /// Variables possibly written before instruction `inst`.
     fn defined_before(&self, program: &Program, inst: usize) -> HashSet<Id> {
         let f = self.function(program);
-        let Some(b) = f.block_of(inst) else {
+        let Some(b) = block_at(f, inst) else {
             return HashSet::default();
         };
         let defined = self.defined(program);
@@ -1941,7 +1976,7 @@ impl FnLiveness {
         only: Option<&[usize]>,
     ) -> Option<Location> {
         let f = self.function(program);
-        let b0 = f.block_of(inst)?;
+        let b0 = block_at(f, inst)?;
         let reads = |k: usize| {
             only.is_none_or(|m| m.binary_search(&k).is_ok())
                 && self.reads(program, &program.insts[k], id)
@@ -2188,12 +2223,16 @@ impl FnLiveness {
 
     /// The instructions (not debug info) that define a variable or use a
     /// pointer into it, per variable, in order.
-    fn mentions(&mut self, program: &Program, var: Id) -> Option<std::rc::Rc<[usize]>> {
-        if self.mentions.is_none() {
+    fn mentions(&self, program: &Program, var: Id) -> Option<MentionList> {
+        let all = self.mentions.get_or_init(|| {
             // By the variable's ordinal among the roots (every variable
             // and pointer parameter is its own root): no hashing per mention.
+            // (root ordinal, instruction) pairs in instruction order, then
+            // placed by a counting sort, which keeps that order per root.
             let f = &program.functions[self.func];
-            let mut m: Vec<Vec<usize>> = vec![Vec::new(); self.roots.len()];
+            let n = self.roots.len();
+            let mut pairs: Vec<(u32, usize)> = Vec::new();
+            let mut last = vec![usize::MAX; n];
             for i in f.start..=f.end {
                 let inst = &program.insts[i];
                 if program.is_debug_inst(inst) {
@@ -2202,18 +2241,33 @@ impl FnLiveness {
                 let used = id_operands(inst).filter_map(|x| self.root(x));
                 let defined = inst.result_id.filter(|r| self.vars.contains(r));
                 for v in defined.into_iter().chain(used) {
-                    let Some(list) = self.roots.ordinal(v).and_then(|k| m.get_mut(k)) else {
+                    let Some(k) = self.roots.ordinal(v).filter(|&k| k < n) else {
                         continue;
                     };
-                    if list.last() != Some(&i) {
-                        list.push(i);
+                    if last[k] != i {
+                        last[k] = i;
+                        pairs.push((k as u32, i));
                     }
                 }
             }
-            self.mentions = Some(m.into_iter().map(Into::into).collect());
-        }
-        let list = self.mentions.as_ref()?.get(self.roots.ordinal(var)?)?;
-        (!list.is_empty()).then(|| list.clone())
+            let mut start = vec![0u32; n + 1];
+            for &(k, _) in &pairs {
+                start[k as usize + 1] += 1;
+            }
+            for k in 0..n {
+                start[k + 1] += start[k];
+            }
+            let mut fill = start.clone();
+            let mut list = vec![0usize; pairs.len()];
+            for (k, i) in pairs {
+                list[fill[k as usize] as usize] = i;
+                fill[k as usize] += 1;
+            }
+            std::rc::Rc::new(Mentions { start, list })
+        });
+        let k = self.roots.ordinal(var)?;
+        let range = *all.start.get(k)? as usize..*all.start.get(k + 1)? as usize;
+        (!range.is_empty()).then(|| MentionList(all.clone(), range))
     }
 
     /// The writes to `var` (stores, and its `OpVariable` when it has an
@@ -2230,7 +2284,7 @@ impl FnLiveness {
     ) -> Vec<usize> {
         let f = self.function(program);
         let mut found = Vec::new();
-        let Some(b0) = f.block_of(at) else {
+        let Some(b0) = block_at(f, at) else {
             return found;
         };
         let whole = |i: usize| -> Option<bool> {
@@ -2284,6 +2338,13 @@ impl FnLiveness {
         found.dedup();
         found
     }
+}
+
+/// The block of function `f` holding instruction `inst` (blocks are in
+/// order and disjoint: a binary search, not a scan).
+fn block_at(f: &Function, inst: usize) -> Option<usize> {
+    let b = f.blocks.partition_point(|b| b.start <= inst).checked_sub(1)?;
+    (inst <= f.blocks[b].end).then_some(b)
 }
 
 /// Whether `op` makes a pointer into (or a copy of) its operand: using the
