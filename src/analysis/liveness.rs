@@ -1499,25 +1499,23 @@ impl FnLiveness {
     /// is dead before the write; a live enclosing part stays live only in
     /// the pieces the write does not cover.
     fn kill(&self, program: &Program, places: &mut Places, live: &mut BitSet, ptr: &LocalPtr) {
-        let parts: Vec<(u32, bool)> = places
-            .of(ptr.var)
-            .filter(|&i| live.contains(i))
-            .filter_map(|i| {
-                let q = &places.place(i).1;
-                if has_prefix(q, &ptr.path) {
-                    Some((i, true))
-                } else if has_prefix(&ptr.path, q) {
-                    Some((i, false))
-                } else {
-                    None
-                }
-            })
-            .collect();
-        for (i, inside) in parts {
-            if inside {
-                live.remove(i);
+        // The parts inside go at once; the (rare) enclosing ones are split
+        // after, when the places can be added to: a list only for those.
+        // (A split piece is never inside the part written, so the order
+        // does not matter.)
+        let mut enclosing: Vec<u32> = Vec::new();
+        for i in places.of(ptr.var) {
+            if !live.contains(i) {
                 continue;
             }
+            let q = &places.place(i).1;
+            if has_prefix(q, &ptr.path) {
+                live.remove(i);
+            } else if has_prefix(&ptr.path, q) {
+                enclosing.push(i);
+            }
+        }
+        for i in enclosing {
             let q = places.place(i).1.clone();
             if let Some(pieces) = self.split(program, ptr.var, &q, &ptr.path) {
                 live.remove(i);
