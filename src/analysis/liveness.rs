@@ -1224,6 +1224,10 @@ impl FnLiveness {
         let mut steps = Vec::with_capacity(f.end + 1 - f.start);
         // About two operands an instruction, and as many run entries.
         let mut pool = Vec::with_capacity(4 * (f.end + 1 - f.start));
+        // Every function built asks for its variables' mentions (the
+        // "written before" sets, a parameter's must-writes): gathered in
+        // this walk, not another.
+        let mut mentions = MentionPairs::new(self.roots.len());
         for at in f.start..=f.end {
             let inst = &program.insts[at];
             let op = inst.class.opcode;
@@ -1231,6 +1235,7 @@ impl FnLiveness {
                 steps.push(Step::Skip);
                 continue;
             }
+            mentions.add(&self.roots, &self.vars, at, inst);
             if self.copies.contains_key(&at)
                 || matches!(
                     op,
@@ -1325,6 +1330,7 @@ impl FnLiveness {
         self.step_uses = pool;
         self.segments = segments;
         self.block_segments = block_segments;
+        let _ = self.mentions.set(mentions.finish());
     }
 
     /// Backward transfer of a whole block over the live set (as stepping
@@ -2223,51 +2229,78 @@ impl FnLiveness {
     /// pointer into it, per variable, in order.
     fn mentions(&self, program: &Program, var: Id) -> Option<MentionList> {
         let all = self.mentions.get_or_init(|| {
-            // By the variable's ordinal among the roots (every variable
-            // and pointer parameter is its own root): no hashing per mention.
-            // (root ordinal, instruction) pairs in instruction order, then
-            // placed by a counting sort, which keeps that order per root.
             let f = &program.functions[self.func];
-            let n = self.roots.len();
-            let mut pairs: Vec<(u32, usize)> = Vec::new();
-            let mut last = vec![usize::MAX; n];
+            let mut pairs = MentionPairs::new(self.roots.len());
             for i in f.start..=f.end {
                 let inst = &program.insts[i];
-                if program.is_debug_inst(inst) {
-                    continue;
-                }
-                let used = id_operands(inst).filter_map(|x| self.root(x));
-                let defined = inst.result_id.filter(|r| self.vars.contains(r));
-                for v in defined.into_iter().chain(used) {
-                    let Some(k) = self.roots.ordinal(v).filter(|&k| k < n) else {
-                        continue;
-                    };
-                    if last[k] != i {
-                        last[k] = i;
-                        pairs.push((k as u32, i));
-                    }
+                if !program.is_debug_inst(inst) {
+                    pairs.add(&self.roots, &self.vars, i, inst);
                 }
             }
-            let mut start = vec![0u32; n + 1];
-            for &(k, _) in &pairs {
-                start[k as usize + 1] += 1;
-            }
-            for k in 0..n {
-                start[k + 1] += start[k];
-            }
-            let mut fill = start.clone();
-            let mut list = vec![0usize; pairs.len()];
-            for (k, i) in pairs {
-                list[fill[k as usize] as usize] = i;
-                fill[k as usize] += 1;
-            }
-            std::rc::Rc::new(Mentions { start, list })
+            pairs.finish()
         });
         let k = self.roots.ordinal(var)?;
         let range = *all.start.get(k)? as usize..*all.start.get(k + 1)? as usize;
         (!range.is_empty()).then(|| MentionList(all.clone(), range))
     }
+}
 
+/// The mentions of a function's roots as they are met: (root ordinal,
+/// instruction) pairs in instruction order, then placed by a counting sort,
+/// which keeps that order per root. By the variable's ordinal among the
+/// roots (every variable and pointer parameter is its own root): no
+/// hashing per mention.
+struct MentionPairs {
+    n: usize,
+    pairs: Vec<(u32, usize)>,
+    last: Vec<usize>,
+}
+
+impl MentionPairs {
+    fn new(n: usize) -> MentionPairs {
+        MentionPairs {
+            n,
+            pairs: Vec::new(),
+            last: vec![usize::MAX; n],
+        }
+    }
+
+    /// Instruction `i` (not debug info) of a function with these roots and
+    /// variables.
+    fn add(&mut self, roots: &IdMap<LocalPtr>, vars: &IdSet, i: usize, inst: &Instruction) {
+        let used = id_operands(inst).filter_map(|x| roots.get(&x).map(|p| p.var));
+        let defined = inst.result_id.filter(|r| vars.contains(r));
+        for v in defined.into_iter().chain(used) {
+            let Some(k) = roots.ordinal(v).filter(|&k| k < self.n) else {
+                continue;
+            };
+            if self.last[k] != i {
+                self.last[k] = i;
+                self.pairs.push((k as u32, i));
+            }
+        }
+    }
+
+    fn finish(self) -> std::rc::Rc<Mentions> {
+        let MentionPairs { n, pairs, .. } = self;
+        let mut start = vec![0u32; n + 1];
+        for &(k, _) in &pairs {
+            start[k as usize + 1] += 1;
+        }
+        for k in 0..n {
+            start[k + 1] += start[k];
+        }
+        let mut fill = start.clone();
+        let mut list = vec![0usize; pairs.len()];
+        for (k, i) in pairs {
+            list[fill[k as usize] as usize] = i;
+            fill[k as usize] += 1;
+        }
+        std::rc::Rc::new(Mentions { start, list })
+    }
+}
+
+impl FnLiveness {
     /// The writes to `var` (stores, and its `OpVariable` when it has an
     /// initializer) that can give the value read at `at`: walking back from
     /// `at` along every path, up to a store of the whole variable; sorted.
