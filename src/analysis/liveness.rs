@@ -1227,7 +1227,7 @@ impl FnLiveness {
         // Every function built asks for its variables' mentions (the
         // "written before" sets, a parameter's must-writes): gathered in
         // this walk, not another.
-        let mut mentions = MentionPairs::new(self.roots.len());
+        let mut mentions = MentionPairs::new(self.roots.len(), f.end + 1 - f.start);
         for at in f.start..=f.end {
             let inst = &program.insts[at];
             let op = inst.class.opcode;
@@ -2230,7 +2230,7 @@ impl FnLiveness {
     fn mentions(&self, program: &Program, var: Id) -> Option<MentionList> {
         let all = self.mentions.get_or_init(|| {
             let f = &program.functions[self.func];
-            let mut pairs = MentionPairs::new(self.roots.len());
+            let mut pairs = MentionPairs::new(self.roots.len(), f.end + 1 - f.start);
             for i in f.start..=f.end {
                 let inst = &program.insts[i];
                 if !program.is_debug_inst(inst) {
@@ -2257,16 +2257,19 @@ struct MentionPairs {
 }
 
 impl MentionPairs {
-    fn new(n: usize) -> MentionPairs {
+    /// For `n` roots in a function of `insts` instructions (about as many
+    /// mentions at most, made room for at once).
+    fn new(n: usize, insts: usize) -> MentionPairs {
         MentionPairs {
             n,
-            pairs: Vec::new(),
+            pairs: Vec::with_capacity(if n == 0 { 0 } else { insts }),
             last: vec![usize::MAX; n],
         }
     }
 
     /// Instruction `i` (not debug info) of a function with these roots and
     /// variables.
+    #[inline]
     fn add(&mut self, roots: &IdMap<LocalPtr>, vars: &IdSet, i: usize, inst: &Instruction) {
         let used = id_operands(inst).filter_map(|x| roots.get(&x).map(|p| p.var));
         let defined = inst.result_id.filter(|r| vars.contains(r));
