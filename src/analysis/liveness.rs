@@ -1034,10 +1034,13 @@ impl FnLiveness {
         // used), so they are not tracked there at all.
         let track_ssa = depth == 0;
         // The body's ids: the function's own and its parameters' are often
-        // numbered long before it, and would widen the dense tables.
+        // numbered long before it, and would widen the dense tables; so are
+        // debug-info instructions' (our HLSL compiler numbers them after
+        // every function), which nothing here looks up.
         let ids = program.insts[f.start..=f.end]
             .iter()
             .filter(|i| !matches!(i.class.opcode, Op::Function | Op::FunctionParameter))
+            .filter(|i| !program.is_debug_inst(i))
             .filter_map(|i| i.result_id);
         let (lo, hi) = ids.fold((Id::MAX, 0), |(lo, hi), r| (lo.min(r), hi.max(r)));
         let mut vars = IdSet::new(lo, hi);
