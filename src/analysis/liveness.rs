@@ -1238,8 +1238,7 @@ impl FnLiveness {
                 steps.push(Step::Skip);
                 continue;
             }
-            mentions.add(&self.roots, &self.vars, at, inst);
-            if self.copies.contains_key(&at)
+            let other = self.copies.contains_key(&at)
                 || matches!(
                     op,
                     Op::Store
@@ -1247,34 +1246,52 @@ impl FnLiveness {
                         | Op::CopyMemorySized
                         | Op::FunctionCall
                         | Op::Variable
-                )
-            {
-                steps.push(Step::Other);
-                continue;
-            }
+                );
             // Only SSA values and variables (pointer parameters) are ever
             // places; another result cannot be live.
-            let def = inst
-                .result_id
-                .filter(|r| self.ssa.contains(r) || self.roots.get(r).is_some_and(|p| p.var == *r))
-                .map_or(Places::NONE, |r| places.intern(r, &[]));
-            let start = pool.len() as u32;
-            // A copy's load reads nothing here (the store does), and phi
-            // operands are used on the incoming edge (`solve`).
-            if !(op == Op::Phi || (op == Op::Load && self.copy_loads.contains(&at))) {
-                let derives = derives_pointer(op);
-                for id in id_operands(inst) {
-                    if self.ssa.contains(&id) {
-                        pool.push(places.intern(id, &[]));
-                    }
-                    if let Some(p) = self.roots.get(&id).filter(|_| !derives) {
-                        pool.push(places.intern(p.var, &p.path));
+            let def = match inst.result_id {
+                Some(r) if !other => {
+                    if self.ssa.contains(&r) || self.roots.get(&r).is_some_and(|p| p.var == r) {
+                        places.intern(r, &[])
+                    } else {
+                        Places::NONE
                     }
                 }
+                _ => Places::NONE,
+            };
+            // The operands once, for both the mentions and a plain step's
+            // reads (in that order, as the places are numbered).
+            // A copy's load reads nothing here (the store does), and phi
+            // operands are used on the incoming edge (`solve`).
+            let reads =
+                !other && !(op == Op::Phi || (op == Op::Load && self.copy_loads.contains(&at)));
+            let derives = derives_pointer(op);
+            let start = pool.len() as u32;
+            if let Some(r) = inst.result_id.filter(|r| self.vars.contains(r)) {
+                mentions.add(&self.roots, at, r);
             }
-            steps.push(Step::Plain {
-                def,
-                uses: start..pool.len() as u32,
+            for id in id_operands(inst) {
+                let root = self.roots.get(&id);
+                if let Some(p) = root {
+                    mentions.add(&self.roots, at, p.var);
+                }
+                if !reads {
+                    continue;
+                }
+                if self.ssa.contains(&id) {
+                    pool.push(places.intern(id, &[]));
+                }
+                if let Some(p) = root.filter(|_| !derives) {
+                    pool.push(places.intern(p.var, &p.path));
+                }
+            }
+            steps.push(if other {
+                Step::Other
+            } else {
+                Step::Plain {
+                    def,
+                    uses: start..pool.len() as u32,
+                }
             });
         }
         // Fold each block's runs of plain steps: stepping back over
@@ -2237,7 +2254,7 @@ impl FnLiveness {
             for i in f.start..=f.end {
                 let inst = &program.insts[i];
                 if !program.is_debug_inst(inst) {
-                    pairs.add(&self.roots, &self.vars, i, inst);
+                    pairs.add_inst(&self.roots, &self.vars, i, inst);
                 }
             }
             pairs.finish()
@@ -2272,18 +2289,24 @@ impl MentionPairs {
 
     /// Instruction `i` (not debug info) of a function with these roots and
     /// variables.
-    #[inline]
-    fn add(&mut self, roots: &IdMap<LocalPtr>, vars: &IdSet, i: usize, inst: &Instruction) {
+    fn add_inst(&mut self, roots: &IdMap<LocalPtr>, vars: &IdSet, i: usize, inst: &Instruction) {
         let used = id_operands(inst).filter_map(|x| roots.get(&x).map(|p| p.var));
         let defined = inst.result_id.filter(|r| vars.contains(r));
         for v in defined.into_iter().chain(used) {
-            let Some(k) = roots.ordinal(v).filter(|&k| k < self.n) else {
-                continue;
-            };
-            if self.last[k] != i {
-                self.last[k] = i;
-                self.pairs.push((k as u32, i));
-            }
+            self.add(roots, i, v);
+        }
+    }
+
+    /// That instruction `i` mentions root `v` (its variable, or a pointer
+    /// into it), met in order.
+    #[inline]
+    fn add(&mut self, roots: &IdMap<LocalPtr>, i: usize, v: Id) {
+        let Some(k) = roots.ordinal(v).filter(|&k| k < self.n) else {
+            return;
+        };
+        if self.last[k] != i {
+            self.last[k] = i;
+            self.pairs.push((k as u32, i));
         }
     }
 
