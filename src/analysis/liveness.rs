@@ -1046,6 +1046,10 @@ impl FnLiveness {
         let mut vars = IdSet::new(lo, hi);
         let mut roots: IdMap<LocalPtr> = IdMap::new(lo, hi);
         let mut ssa = IdSet::new(lo, hi);
+        if track_ssa {
+            // About one SSA value an instruction: room made once.
+            ssa.keys.reserve(f.end + 1 - f.start);
+        }
         for inst in &program.insts[f.start..=f.end] {
             let Some(r) = inst.result_id else { continue };
             if program.is_debug_inst(inst) {
