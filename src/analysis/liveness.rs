@@ -2407,7 +2407,10 @@ impl FnLiveness {
 /// The block of function `f` holding instruction `inst` (blocks are in
 /// order and disjoint: a binary search, not a scan).
 fn block_at(f: &Function, inst: usize) -> Option<usize> {
-    let b = f.blocks.partition_point(|b| b.start <= inst).checked_sub(1)?;
+    let b = f
+        .blocks
+        .partition_point(|b| b.start <= inst)
+        .checked_sub(1)?;
     (inst <= f.blocks[b].end).then_some(b)
 }
 
