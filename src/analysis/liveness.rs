@@ -2481,6 +2481,40 @@ mod tests {
     }
 
     #[test]
+    fn mentions_from_the_step_walk_match_a_walk_of_their_own_and_blocks_are_found() {
+        // The mentions are gathered while the steps are prepared; the
+        // lazy path (a walk of their own) must give the same lists, and
+        // the binary search the same block as the scan.
+        for rel in [
+            "shaders/reflect_adaptive.hlsl",
+            "shaders/reflect_glossy.wgsl",
+            "shaders/reflect_hybrid.hlsl",
+            "fixtures/live/loop_local.rgen.gV.spv",
+        ] {
+            let p = program(rel);
+            let mut mentioned = 0;
+            for (func, f) in p.functions.iter().enumerate() {
+                let fl = FnLiveness::new(&p, func);
+                let from_steps = fl.mentions.get().expect("gathered while preparing").clone();
+                let mut own = MentionPairs::new(fl.roots.len(), f.end + 1 - f.start);
+                for i in f.start..=f.end {
+                    if !p.is_debug_inst(&p.insts[i]) {
+                        own.add_inst(&fl.roots, &fl.vars, i, &p.insts[i]);
+                    }
+                }
+                let own = own.finish();
+                assert_eq!(from_steps.start, own.start, "{rel} function {func}");
+                assert_eq!(from_steps.list, own.list, "{rel} function {func}");
+                mentioned += own.list.len();
+                for i in f.start..=f.end {
+                    assert_eq!(block_at(f, i), f.block_of(i), "{rel} instruction {i}");
+                }
+            }
+            assert!(mentioned > 0, "{rel}: no variable mentioned");
+        }
+    }
+
+    #[test]
     fn id_maps_dense_with_parameters_apart_and_sparse() {
         // A small range is a table; the huge one hashes.
         for (lo, hi) in [(100, 200), (0, u32::MAX)] {
