@@ -1268,7 +1268,7 @@ impl FnLiveness {
             // A copy's load reads nothing here (the store does), and phi
             // operands are used on the incoming edge (`solve`).
             let reads =
-                !other && !(op == Op::Phi || (op == Op::Load && self.copy_loads.contains(&at)));
+                !(other || op == Op::Phi || (op == Op::Load && self.copy_loads.contains(&at)));
             let derives = derives_pointer(op);
             let start = pool.len() as u32;
             if let Some(r) = inst.result_id.filter(|r| self.vars.contains(r)) {
