@@ -515,6 +515,29 @@ impl Program {
     /// spans that its SPIR-V writer does not emit), matched through `OpName`.
     pub fn attach_named_decls(&mut self, decls: &[(NamedDecl, Location)]) {
         use NamedDecl as N;
+        // Each name's ids, globals and functions, found once: a lookup per
+        // declaration, not a scan of every name (generated sources declare
+        // thousands of functions).
+        let mut by_name: HashMap<&str, Vec<Id>> = HashMap::default();
+        for (id, n) in &self.names {
+            by_name.entry(n.as_str()).or_default().push(*id);
+        }
+        for ids in by_name.values_mut() {
+            ids.sort_unstable();
+        }
+        let mut globals_named: HashMap<&str, Vec<Id>> = HashMap::default();
+        for g in &self.globals {
+            if let Some(n) = g.name.as_deref() {
+                globals_named.entry(n).or_default().push(g.id);
+            }
+        }
+        let mut functions_named: HashMap<&str, Vec<Id>> = HashMap::default();
+        for f in &self.functions {
+            if let Some(n) = f.name.as_deref() {
+                functions_named.entry(n).or_default().push(f.id);
+            }
+        }
+        let mut decl_pos = std::mem::take(&mut self.decl_pos);
         for (decl, loc) in decls {
             let file = match self.files.iter().position(|f| f.path == loc.path) {
                 Some(i) => i as u32,
@@ -533,51 +556,37 @@ impl Program {
                 end_line: loc.end_line,
                 end_column: loc.end_column,
             };
-            let named = |name: &str| -> Vec<Id> {
-                let mut ids: Vec<Id> = self
-                    .names
-                    .iter()
-                    .filter(|(_, n)| *n == name)
-                    .map(|(id, _)| *id)
-                    .collect();
-                ids.sort_unstable();
-                ids
+            let named = |map: &HashMap<&str, Vec<Id>>, name: &str| -> Vec<Id> {
+                map.get(name).cloned().unwrap_or_default()
             };
             match decl {
                 N::Type(name) => {
-                    for id in named(name) {
+                    for id in named(&by_name, name) {
                         if matches!(self.types.get(&id), Some(Type::Struct { .. })) {
-                            self.decl_pos.insert(Decl::Type(id), pos);
+                            decl_pos.insert(Decl::Type(id), pos);
                         }
                     }
                 }
                 N::Member(name, k) => {
-                    for id in named(name) {
+                    for id in named(&by_name, name) {
                         if matches!(self.types.get(&id), Some(Type::Struct { .. })) {
-                            self.decl_pos.insert(Decl::Member(id, *k), pos);
+                            decl_pos.insert(Decl::Member(id, *k), pos);
                         }
                     }
                 }
                 N::Global(name) => {
-                    for g in self
-                        .globals
-                        .iter()
-                        .filter(|g| g.name.as_deref() == Some(name.as_str()))
-                    {
-                        self.decl_pos.insert(Decl::Var(g.id), pos);
+                    for id in named(&globals_named, name) {
+                        decl_pos.insert(Decl::Var(id), pos);
                     }
                 }
                 N::Function(name) => {
-                    for f in self
-                        .functions
-                        .iter()
-                        .filter(|f| f.name.as_deref() == Some(name.as_str()))
-                    {
-                        self.decl_pos.insert(Decl::Func(f.id), pos);
+                    for id in named(&functions_named, name) {
+                        decl_pos.insert(Decl::Func(id), pos);
                     }
                 }
             }
         }
+        self.decl_pos = decl_pos;
     }
 
     /// A short type name for messages (`vec3<f32>`-neutral: `float3`-like HLSL
