@@ -126,6 +126,7 @@ impl TraceGraph {
 /// Builds the trace graph of a pipeline.
 pub fn trace_graph(pipeline: &Pipeline) -> TraceGraph {
     let mut g = TraceGraph::default();
+    g.nodes.reserve(pipeline.shaders().count());
     for (i, s) in pipeline.raygen.iter().enumerate() {
         g.nodes.push(Node {
             shader: s.clone(),

@@ -348,14 +348,15 @@ pub fn breakdown_with(program: &Program, entry: &str, sites: &[LiveSite]) -> Bre
         if !in_interface(g.id) && program.version >= (1, 4) {
             continue;
         }
-        let size = scalar_size(program, g.ty).unwrap_or(0);
+        // Sized only for the classes counted here.
+        let size = || scalar_size(program, g.ty).unwrap_or(0);
         match g.storage {
             StorageClass::IncomingRayPayloadKHR => {
-                b.incoming_payload = b.incoming_payload.max(size)
+                b.incoming_payload = b.incoming_payload.max(size())
             }
-            StorageClass::HitAttributeKHR => b.hit_attributes = b.hit_attributes.max(size),
+            StorageClass::HitAttributeKHR => b.hit_attributes = b.hit_attributes.max(size()),
             StorageClass::IncomingCallableDataKHR => {
-                b.incoming_callable_data = b.incoming_callable_data.max(size)
+                b.incoming_callable_data = b.incoming_callable_data.max(size())
             }
             _ => {}
         }
@@ -396,8 +397,11 @@ pub fn breakdown_with(program: &Program, entry: &str, sites: &[LiveSite]) -> Bre
         b.live_blocks = b.live_blocks.max(aggregates + call_data);
         b.live_state_total = b.live_state_total.max(site.live_bytes + call_data);
         b.live_state = b.live_state.max(kept);
-        if loops.contain(program, site.chain.first().copied().unwrap_or(site.inst)) {
-            b.loop_live_state = b.loop_live_state.max(kept);
+        // Asked only when it could raise the maximum.
+        if kept > b.loop_live_state
+            && loops.contain(program, site.chain.first().copied().unwrap_or(site.inst))
+        {
+            b.loop_live_state = kept;
         }
     }
     b
@@ -431,13 +435,25 @@ fn other_call_data_live(program: &Program, inst: usize, loops: &Loops) -> (u64, 
     if !matches!(site.kind, SiteKind::TraceRay | SiteKind::ExecuteCallable) {
         return (0, 0);
     }
-    let looped = loops.contain(program, inst);
+    // Only other blocks count: a shader with one payload has none to scan.
+    let others = program.globals.iter().any(|g| {
+        matches!(
+            g.storage,
+            StorageClass::CallableDataKHR | StorageClass::RayPayloadKHR
+        ) && Some(g.id) != site.payload
+    });
+    if !others {
+        return (0, 0);
+    }
+    let mut looped = None;
     let (mut callable, mut payload) = (0, 0);
     for u in loops.call_data(program, site.function) {
         if Some(u.global) == site.payload {
             continue;
         }
-        let stored = u.first_store.is_some_and(|k| k < inst || looped);
+        let stored = u.first_store.is_some_and(|k| {
+            k < inst || *looped.get_or_insert_with(|| loops.contain(program, inst))
+        });
         let read = u.last_load.is_some_and(|k| k > inst);
         if stored && read {
             let size = scalar_size(program, u.ty).unwrap_or(0);
@@ -796,7 +812,8 @@ pub fn stack_report(pipeline: &Pipeline) -> StackReport {
 
 /// [`stack_report`] over a recursion analysis the caller already has.
 pub fn stack_report_with(pipeline: &Pipeline, rec: &RecursionReport) -> StackReport {
-    let mut cache: rustc_hash::FxHashMap<(usize, &str), Breakdown> = Default::default();
+    let mut cache: rustc_hash::FxHashMap<(usize, &str), Breakdown> =
+        rustc_hash::FxHashMap::with_capacity_and_hasher(rec.graph.nodes.len(), Default::default());
     let sites: Vec<_> = pipeline.programs.iter().map(shared_live_bytes).collect();
     let mut shaders = Vec::with_capacity(rec.graph.nodes.len());
     for node in &rec.graph.nodes {

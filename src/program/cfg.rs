@@ -188,9 +188,18 @@ impl FunctionCfgs {
             return &[];
         };
         cell.get_or_init(|| {
-            let idom = self.idom(program, fi);
             let n = f.blocks.len();
             let mut looped = vec![false; n];
+            // Every edge forward in block order: no cycle, so no back edge
+            // (and no dominator tree needed to find none).
+            if f.blocks
+                .iter()
+                .enumerate()
+                .all(|(b, block)| block.succs.iter().all(|&s| s > b))
+            {
+                return looped;
+            }
+            let idom = self.idom(program, fi);
             let preds = self.preds[fi].get_or_init(|| Preds::of(f));
             // Which back edge last visited a block: each loop's body is
             // walked on its own (a body already marked may lead further).
