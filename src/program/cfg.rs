@@ -297,6 +297,7 @@ pub fn call_chains(program: &Program, root: Id, target: Id, max: usize) -> Vec<V
     #[allow(clippy::too_many_arguments)]
     fn up(
         program: &Program,
+        calls: &super::CallIndex,
         max: usize,
         root: Id,
         f: Id,
@@ -315,7 +316,8 @@ pub fn call_chains(program: &Program, root: Id, target: Id, max: usize) -> Vec<V
             return;
         }
         visiting.push(f);
-        for call in program.callers(f) {
+        // The index itself, not `Program::callers`' copy per step.
+        for &call in calls.by_callee.get(&f).map_or(&[][..], Vec::as_slice) {
             let Some(caller) = program
                 .function_of(call)
                 .and_then(|i| program.functions.get(i))
@@ -323,14 +325,22 @@ pub fn call_chains(program: &Program, root: Id, target: Id, max: usize) -> Vec<V
                 continue;
             };
             suffix.push(call);
-            up(program, max, root, caller.id, suffix, out, visiting);
+            up(program, calls, max, root, caller.id, suffix, out, visiting);
             suffix.pop();
         }
         visiting.pop();
     }
     let mut out = Vec::new();
+    if target == root {
+        // `[[]]` without the index.
+        if max > 0 {
+            out.push(Vec::new());
+        }
+        return out;
+    }
     up(
         program,
+        &program.call_index(),
         max,
         root,
         target,
