@@ -201,8 +201,8 @@ fn steps(iters: usize, files: &[PathBuf]) {
     let mut sums = [Duration::ZERO; 8];
     for f in files {
         let text = std::fs::read_to_string(f).unwrap();
-        let (module, info) = rtlint::front::wgsl::parse(&text, f).unwrap();
-        let words = rtlint::front::wgsl::write_spirv(&module, &info, &text, f).unwrap();
+        let (mut module, info) = rtlint::front::wgsl::parse(&text, f).unwrap();
+        let words = rtlint::front::wgsl::write_spirv(&mut module, &info, &text, f).unwrap();
         let decls = rtlint::front::wgsl::declarations(&module, &text, f);
         let d = [
             time(iters, || {
@@ -210,7 +210,7 @@ fn steps(iters: usize, files: &[PathBuf]) {
             }),
             time(iters, || {
                 std::hint::black_box(
-                    rtlint::front::wgsl::write_spirv(&module, &info, &text, f).unwrap(),
+                    rtlint::front::wgsl::write_spirv(&mut module, &info, &text, f).unwrap(),
                 );
             }),
             time(iters, || {

@@ -77,8 +77,8 @@ pub fn compile_input(
     match language {
         Language::Wgsl => {
             let text = text()?;
-            let (module, info) = wgsl::parse(&text, path)?;
-            let words = wgsl::write_spirv(&module, &info, &text, path)?;
+            let (mut module, info) = wgsl::parse(&text, path)?;
+            let words = wgsl::write_spirv(&mut module, &info, &text, path)?;
             Ok(compiled(
                 Language::Wgsl,
                 words,
