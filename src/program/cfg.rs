@@ -350,3 +350,39 @@ pub fn call_chains(program: &Program, root: Id, target: Id, max: usize) -> Vec<V
     );
     out
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::path::Path;
+
+    /// The memo's dominators and loop blocks are `dominators` and the union
+    /// of `natural_loops`, function by function: loops in GLSL, HLSL and
+    /// WGSL output, helpers without one.
+    #[test]
+    fn memo_matches_dominators_and_natural_loops() {
+        let mut loops = 0;
+        for rel in [
+            "fixtures/guards/loop.rgen.g.spv",
+            "fixtures/guards/fresh.hlsl",
+            "fixtures/guards/constructed.wgsl",
+        ] {
+            let path = Path::new(env!("CARGO_MANIFEST_DIR")).join(rel);
+            let lang = crate::shader::Language::from_path(&path).unwrap();
+            let p = crate::front::load(&path, lang).unwrap();
+            let cfgs = function_cfgs(&p);
+            for (fi, f) in p.functions.iter().enumerate() {
+                assert_eq!(cfgs.idom(&p, fi), dominators(f).as_slice(), "{rel} {fi}");
+                let mut want = vec![false; f.blocks.len()];
+                for (_, body) in natural_loops(f) {
+                    loops += 1;
+                    for b in body {
+                        want[b] = true;
+                    }
+                }
+                assert_eq!(cfgs.looped(&p, fi), want.as_slice(), "{rel} {fi}");
+            }
+        }
+        assert!(loops >= 3, "{loops}");
+    }
+}
