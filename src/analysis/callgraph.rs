@@ -126,6 +126,7 @@ impl TraceGraph {
 /// Builds the trace graph of a pipeline.
 pub fn trace_graph(pipeline: &Pipeline) -> TraceGraph {
     let mut g = TraceGraph::default();
+    g.nodes.reserve(pipeline.shaders().count());
     for (i, s) in pipeline.raygen.iter().enumerate() {
         g.nodes.push(Node {
             shader: s.clone(),
@@ -159,11 +160,14 @@ pub fn trace_graph(pipeline: &Pipeline) -> TraceGraph {
     }
     let described = pipeline.described();
     for from in 0..g.nodes.len() {
-        let shader = g.nodes[from].shader.clone();
-        let Some(program) = pipeline.program(&shader) else {
+        let (program_index, entry_function) = {
+            let s = &g.nodes[from].shader;
+            (s.program, s.function)
+        };
+        let Some(program) = pipeline.programs.get(program_index) else {
             continue;
         };
-        let reach = program.reachable_functions(shader.function);
+        let reach = program.reachable_functions(entry_function);
         for site in &program.sites {
             let Some(f) = program.functions.get(site.function) else {
                 continue;
@@ -176,7 +180,7 @@ pub fn trace_graph(pipeline: &Pipeline) -> TraceGraph {
             // operands folded at this shader's call.
             let chains = crate::program::cfg::call_chains(
                 program,
-                shader.function,
+                entry_function,
                 f.id,
                 super::liveness::MAX_CHAINS,
             );
@@ -322,7 +326,7 @@ pub fn trace_graph(pipeline: &Pipeline) -> TraceGraph {
                     from,
                     to,
                     kind,
-                    program: shader.program,
+                    program: program_index,
                     inst: site.inst,
                     location: location.clone(),
                 });

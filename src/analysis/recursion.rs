@@ -12,10 +12,13 @@
 use super::callgraph::{trace_graph, EdgeKind, TraceGraph};
 use crate::diag::Location;
 use crate::pipeline::{DescribedConstant, Pipeline};
-use crate::program::cfg::{call_chains, dominates, dominators, natural_loops, strongly_connected};
+use crate::program::cfg::{
+    call_chains, dominates, dominators, function_cfgs, natural_loops, strongly_connected,
+};
 use crate::program::{Constant, Function, Id, Program, Type};
 use crate::shader::Stage;
 use rspirv::dr::{Instruction, Operand};
+use rustc_hash::{FxHashMap, FxHashSet};
 use spirv::{Op, StorageClass};
 use std::collections::{BTreeMap, HashSet};
 
@@ -187,7 +190,7 @@ pub fn recursion_report(pipeline: &Pipeline) -> RecursionReport {
     let mut adj: Vec<Vec<usize>> = vec![Vec::new(); n];
     // First-seen order, without a scan per edge (a folder's loose pipeline
     // joins every trace to every hit shader).
-    let mut seen = std::collections::HashSet::new();
+    let mut seen = FxHashSet::default();
     for e in graph.traces() {
         if seen.insert((e.from, e.to)) {
             adj[e.from].push(e.to);
@@ -361,7 +364,7 @@ pub fn recursion_report(pipeline: &Pipeline) -> RecursionReport {
     }
     chain.reverse();
     let mut recursive_sites: Vec<RecursiveSite> = Vec::new();
-    let mut listed = std::collections::HashSet::new();
+    let mut listed = FxHashSet::default();
     for e in graph.traces() {
         let stage = graph.nodes[e.from].shader.stage;
         if matches!(stage, Stage::ClosestHit | Stage::Miss) && listed.insert((e.program, e.inst)) {
@@ -481,7 +484,7 @@ enum Source {
 /// write in the module counts).
 fn values_of(program: &Program, place: (Id, Vec<u64>)) -> Vec<Source> {
     let mut out = Vec::new();
-    let mut seen = HashSet::new();
+    let mut seen = FxHashSet::default();
     stored_values(program, &place, &mut out, &mut seen, 0);
     out
 }
@@ -490,7 +493,7 @@ fn stored_values(
     program: &Program,
     place: &(Id, Vec<u64>),
     out: &mut Vec<Source>,
-    seen: &mut HashSet<(Id, Vec<u64>)>,
+    seen: &mut FxHashSet<(Id, Vec<u64>)>,
     depth: u32,
 ) {
     if depth > MAX_RESOLVE || !seen.insert(place.clone()) {
@@ -500,35 +503,13 @@ fn stored_values(
     if let Some(Operand::IdRef(init)) = program.def(*var).and_then(|d| d.operands.get(1)) {
         component(program, *init, path, out, seen, depth + 1);
     }
-    for inst in &program.insts {
-        if program.is_debug_inst(inst) {
-            continue;
-        }
-        let (dst, src_value, src_ptr) = match inst.class.opcode {
-            Op::Store => {
-                let v: Vec<Id> = ids(inst).collect();
-                match v.as_slice() {
-                    [d, s, ..] => (*d, Some(*s), None),
-                    _ => continue,
-                }
-            }
-            Op::CopyMemory | Op::CopyMemorySized => {
-                let v: Vec<Id> = ids(inst).collect();
-                match v.as_slice() {
-                    [d, s, ..] => (*d, None, Some(*s)),
-                    _ => continue,
-                }
-            }
-            _ => continue,
-        };
-        let Some((dv, dp)) = place_of(program, dst, 0) else {
-            continue;
-        };
-        if dv != *var || !path.starts_with(&dp) {
+    let stores = stores_by_var(program);
+    for (dp, src_value, src_ptr) in stores.0.get(var).map_or(&[][..], Vec::as_slice) {
+        if !path.starts_with(dp) {
             continue;
         }
         let rest = &path[dp.len()..];
-        if let Some(value) = src_value {
+        if let Some(value) = *src_value {
             component(program, value, rest, out, seen, depth + 1);
         } else if let Some((sv, mut sp)) = src_ptr.and_then(|p| place_of(program, p, 0)) {
             sp.extend_from_slice(rest);
@@ -537,13 +518,50 @@ fn stored_values(
     }
 }
 
+/// Every `OpStore` and `OpCopyMemory` of a program by the variable it
+/// writes, in module order: the member path written, and the stored value
+/// or the pointer copied from. Listed once per Program (each query for a
+/// place's values scanned every instruction).
+struct StoresByVar(FxHashMap<Id, Vec<StoreTo>>);
+
+type StoreTo = (Vec<u64>, Option<Id>, Option<Id>);
+
+fn stores_by_var(program: &Program) -> std::sync::Arc<StoresByVar> {
+    program.memo.get_or(|| {
+        let mut by_var: FxHashMap<Id, Vec<StoreTo>> = FxHashMap::default();
+        for inst in &program.insts {
+            let (dst, src_value, src_ptr) = match inst.class.opcode {
+                Op::Store => {
+                    let mut v = ids(inst);
+                    match (v.next(), v.next()) {
+                        (Some(d), Some(s)) => (d, Some(s), None),
+                        _ => continue,
+                    }
+                }
+                Op::CopyMemory | Op::CopyMemorySized => {
+                    let mut v = ids(inst);
+                    match (v.next(), v.next()) {
+                        (Some(d), Some(s)) => (d, None, Some(s)),
+                        _ => continue,
+                    }
+                }
+                _ => continue,
+            };
+            if let Some((dv, dp)) = place_of(program, dst, 0) {
+                by_var.entry(dv).or_default().push((dp, src_value, src_ptr));
+            }
+        }
+        StoresByVar(by_var)
+    })
+}
+
 /// The sources of a load from `place`: a local's stored values, else the
 /// read itself.
 fn read_place(
     program: &Program,
     place: (Id, Vec<u64>),
     out: &mut Vec<Source>,
-    seen: &mut HashSet<(Id, Vec<u64>)>,
+    seen: &mut FxHashSet<(Id, Vec<u64>)>,
     depth: u32,
 ) {
     if is_local(program, place.0) {
@@ -559,7 +577,7 @@ fn component(
     value: Id,
     path: &[u64],
     out: &mut Vec<Source>,
-    seen: &mut HashSet<(Id, Vec<u64>)>,
+    seen: &mut FxHashSet<(Id, Vec<u64>)>,
     depth: u32,
 ) {
     if depth > MAX_RESOLVE {
@@ -1078,8 +1096,12 @@ fn relations(program: &Program, cond: Id, want: bool, out: &mut Vec<Rel>, depth:
 
 /// Relations guaranteed to hold at instruction `inst` by the conditional
 /// branches that dominate it.
-fn dominating_relations(program: &Program, f: &Function, inst: usize) -> Vec<(Rel, usize)> {
-    let idom = dominators(f);
+fn dominating_relations(program: &Program, fi: usize, inst: usize) -> Vec<(Rel, usize)> {
+    let Some(f) = program.functions.get(fi) else {
+        return Vec::new();
+    };
+    let cfgs = function_cfgs(program);
+    let idom = cfgs.idom(program, fi);
     let Some(b) = f.block_of(inst) else {
         return Vec::new();
     };
@@ -1098,9 +1120,9 @@ fn dominating_relations(program: &Program, f: &Function, inst: usize) -> Vec<(Re
             if let [cond, t, e, ..] = v.as_slice() {
                 let (tb, eb) = (f.block_by_label(*t), f.block_by_label(*e));
                 if let (Some(tb), Some(eb)) = (tb, eb) {
-                    let want = if tb != eb && dominates(&idom, tb, b) {
+                    let want = if tb != eb && dominates(idom, tb, b) {
                         Some(true)
-                    } else if tb != eb && dominates(&idom, eb, b) {
+                    } else if tb != eb && dominates(idom, eb, b) {
                         Some(false)
                     } else {
                         None
@@ -1153,13 +1175,13 @@ fn recognise_guard(
     let mut seen_counter: Option<String> = None;
     let mut why_not: Option<NoGuard> = None;
     for &p in &points {
-        let Some(f) = program
+        let Some(fi) = program
             .function_of(p)
-            .and_then(|i| program.functions.get(i))
+            .filter(|&i| i < program.functions.len())
         else {
             continue;
         };
-        for (rel, term) in dominating_relations(program, f, p) {
+        for (rel, term) in dominating_relations(program, fi, p) {
             let Some(counter @ Counter::Payload { .. }) = counter_of(program, rel.lhs) else {
                 continue;
             };

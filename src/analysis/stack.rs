@@ -24,7 +24,8 @@ use crate::program::scalar::scalar_size;
 use crate::program::{Program, SiteKind, Type};
 use crate::shader::Stage;
 use spirv::StorageClass;
-use std::collections::{BTreeMap, HashMap};
+use std::collections::BTreeMap;
+use std::sync::OnceLock;
 
 /// The largest pipeline stack measured to run on an NVIDIA H200 (driver
 /// 580.159.04): 14,702 bytes per thread ran and 14,746 lost the device, at
@@ -347,14 +348,15 @@ pub fn breakdown_with(program: &Program, entry: &str, sites: &[LiveSite]) -> Bre
         if !in_interface(g.id) && program.version >= (1, 4) {
             continue;
         }
-        let size = scalar_size(program, g.ty).unwrap_or(0);
+        // Sized only for the classes counted here.
+        let size = || scalar_size(program, g.ty).unwrap_or(0);
         match g.storage {
             StorageClass::IncomingRayPayloadKHR => {
-                b.incoming_payload = b.incoming_payload.max(size)
+                b.incoming_payload = b.incoming_payload.max(size())
             }
-            StorageClass::HitAttributeKHR => b.hit_attributes = b.hit_attributes.max(size),
+            StorageClass::HitAttributeKHR => b.hit_attributes = b.hit_attributes.max(size()),
             StorageClass::IncomingCallableDataKHR => {
-                b.incoming_callable_data = b.incoming_callable_data.max(size)
+                b.incoming_callable_data = b.incoming_callable_data.max(size())
             }
             _ => {}
         }
@@ -372,33 +374,18 @@ pub fn breakdown_with(program: &Program, entry: &str, sites: &[LiveSite]) -> Bre
     ) {
         b.hit_attributes = 0;
     }
+    let loops = Loops::of(program);
     for fid in &reach {
-        let Some(f) = program.function(*fid) else {
-            continue;
-        };
-        for inst in &program.insts[f.start..=f.end] {
-            if inst.class.opcode != spirv::Op::Variable {
-                continue;
-            }
-            let Some(Type::Pointer {
-                storage: StorageClass::Function,
-                pointee,
-            }) = inst.result_type.and_then(|t| program.ty(t))
-            else {
-                continue;
-            };
-            if matches!(program.ty(*pointee), Some(Type::Array { .. })) {
-                b.local_arrays += scalar_size(program, *pointee).unwrap_or(0);
-            }
+        if let Some(fi) = program.function_index(*fid) {
+            b.local_arrays += loops.local_arrays(program, fi);
         }
     }
     // Shader calls only: an inline ray query keeps its state in registers.
-    let mut loops = Loops::default();
     for site in sites
         .iter()
         .filter(|s| s.entry == entry && s.kind != crate::analysis::liveness::LiveSiteKind::RayQuery)
     {
-        let (call_data, payload) = other_call_data_live(program, site.inst, &mut loops);
+        let (call_data, payload) = other_call_data_live(program, site.inst, &loops);
         b.outlived_payloads = b.outlived_payloads.max(payload);
         let kept = site.live_bytes - site.rematerializable_bytes + call_data;
         let aggregates: u64 = site
@@ -410,8 +397,11 @@ pub fn breakdown_with(program: &Program, entry: &str, sites: &[LiveSite]) -> Bre
         b.live_blocks = b.live_blocks.max(aggregates + call_data);
         b.live_state_total = b.live_state_total.max(site.live_bytes + call_data);
         b.live_state = b.live_state.max(kept);
-        if loops.contain(program, site.chain.first().copied().unwrap_or(site.inst)) {
-            b.loop_live_state = b.loop_live_state.max(kept);
+        // Asked only when it could raise the maximum.
+        if kept > b.loop_live_state
+            && loops.contain(program, site.chain.first().copied().unwrap_or(site.inst))
+        {
+            b.loop_live_state = kept;
         }
     }
     b
@@ -438,28 +428,134 @@ fn is_aggregate_variable(program: &Program, id: u32) -> bool {
 /// caller's frame; such a payload cost a few bytes whatever its size.
 /// (GLSL declares both as globals, which live-state analysis does not
 /// count; HLSL's locals are counted there.)
-fn other_call_data_live(program: &Program, inst: usize, loops: &mut Loops) -> (u64, u64) {
-    use spirv::Op;
+fn other_call_data_live(program: &Program, inst: usize, loops: &Loops) -> (u64, u64) {
     let Some(site) = program.sites.iter().find(|s| s.inst == inst) else {
         return (0, 0);
     };
     if !matches!(site.kind, SiteKind::TraceRay | SiteKind::ExecuteCallable) {
         return (0, 0);
     }
-    let Some(f) = program.functions.get(site.function) else {
-        return (0, 0);
-    };
-    let looped = loops.contain(program, inst);
-    let (mut callable, mut payload) = (0, 0);
-    for g in program.globals.iter().filter(|g| {
+    // Only other blocks count: a shader with one payload has none to scan.
+    let others = program.globals.iter().any(|g| {
         matches!(
             g.storage,
             StorageClass::CallableDataKHR | StorageClass::RayPayloadKHR
         ) && Some(g.id) != site.payload
-    }) {
+    });
+    if !others {
+        return (0, 0);
+    }
+    let mut looped = None;
+    let (mut callable, mut payload) = (0, 0);
+    for u in loops.call_data(program, site.function) {
+        if Some(u.global) == site.payload {
+            continue;
+        }
+        let stored = u.first_store.is_some_and(|k| {
+            k < inst || *looped.get_or_insert_with(|| loops.contain(program, inst))
+        });
+        let read = u.last_load.is_some_and(|k| k > inst);
+        if stored && read {
+            let size = scalar_size(program, u.ty).unwrap_or(0);
+            if u.storage == StorageClass::CallableDataKHR {
+                callable += size;
+            } else {
+                payload += size;
+            }
+        }
+    }
+    (callable, payload)
+}
+
+/// Where one function writes and reads a ray payload or callable data
+/// global (through access chains into it): the first store and the last
+/// load, by instruction index.
+struct CallDataUse {
+    global: u32,
+    ty: u32,
+    storage: StorageClass,
+    first_store: Option<usize>,
+    last_load: Option<usize>,
+}
+
+fn call_data_uses(program: &Program, f: &crate::program::Function) -> Vec<CallDataUse> {
+    use spirv::Op;
+    let mut out: Vec<CallDataUse> = program
+        .globals
+        .iter()
+        .filter(|g| {
+            matches!(
+                g.storage,
+                StorageClass::CallableDataKHR | StorageClass::RayPayloadKHR
+            )
+        })
+        .map(|g| CallDataUse {
+            global: g.id,
+            ty: g.ty,
+            storage: g.storage,
+            first_store: None,
+            last_load: None,
+        })
+        .collect();
+    if out.is_empty() || out.len() > 64 {
+        return call_data_uses_one_by_one(program, f, out);
+    }
+    // Pointers into each block within this function, one bit per global,
+    // found in one pass over the function for all of them.
+    let mut into: rustc_hash::FxHashMap<u32, u64> = Default::default();
+    for (k, u) in out.iter().enumerate() {
+        *into.entry(u.global).or_default() |= 1 << k;
+    }
+    for k in f.start..=f.end {
+        let i = &program.insts[k];
+        if !matches!(
+            i.class.opcode,
+            Op::AccessChain | Op::InBoundsAccessChain | Op::Store | Op::Load
+        ) {
+            continue;
+        }
+        let Some(first) = i.operands.iter().find_map(|o| match o {
+            rspirv::dr::Operand::IdRef(id) => Some(*id),
+            _ => None,
+        }) else {
+            continue;
+        };
+        let Some(&bits) = into.get(&first) else {
+            continue;
+        };
+        match i.class.opcode {
+            Op::AccessChain | Op::InBoundsAccessChain => {
+                if let Some(r) = i.result_id {
+                    *into.entry(r).or_default() |= bits;
+                }
+            }
+            op => {
+                for (n, u) in out.iter_mut().enumerate() {
+                    if bits & (1 << n) == 0 {
+                        continue;
+                    }
+                    if op == Op::Store {
+                        u.first_store.get_or_insert(k);
+                    } else {
+                        u.last_load = Some(k);
+                    }
+                }
+            }
+        }
+    }
+    out
+}
+
+/// [`call_data_uses`] a global at a time (more globals than bits).
+fn call_data_uses_one_by_one(
+    program: &Program,
+    f: &crate::program::Function,
+    mut out: Vec<CallDataUse>,
+) -> Vec<CallDataUse> {
+    use spirv::Op;
+    for u in &mut out {
         // Pointers into the block within this function.
-        let mut ptrs = vec![g.id];
-        let (mut stored, mut read) = (false, false);
+        let mut ptrs = vec![u.global];
         for k in f.start..=f.end {
             let i = &program.insts[k];
             let first = i.operands.iter().find_map(|o| match o {
@@ -473,34 +569,45 @@ fn other_call_data_live(program: &Program, inst: usize, loops: &mut Loops) -> (u
                     ptrs.extend(i.result_id);
                 }
                 Op::Store if first.is_some_and(|p| ptrs.contains(&p)) => {
-                    stored |= k < inst || looped;
+                    u.first_store.get_or_insert(k);
                 }
                 Op::Load if first.is_some_and(|p| ptrs.contains(&p)) => {
-                    read |= k > inst;
+                    u.last_load = Some(k);
                 }
                 _ => {}
             }
         }
-        if stored && read {
-            let size = scalar_size(program, g.ty).unwrap_or(0);
-            if g.storage == StorageClass::CallableDataKHR {
-                callable += size;
-            } else {
-                payload += size;
-            }
-        }
     }
-    (callable, payload)
+    out
 }
 
-/// Which blocks of each function lie in a loop, worked out once per
-/// function: natural loops need the dominator tree, and every site asked.
-#[derive(Default)]
-struct Loops(HashMap<usize, Vec<bool>>);
+/// Per function of a program, worked out once (the Program's memo) and
+/// asked per site and per entry point: which blocks lie in a loop (natural
+/// loops need the dominator tree), the bytes of its function-local arrays,
+/// and where it uses payload and callable-data globals.
+struct Loops {
+    cfgs: std::sync::Arc<crate::program::cfg::FunctionCfgs>,
+    facts: std::sync::Arc<FunctionFacts>,
+}
+
+struct FunctionFacts {
+    local_arrays: Vec<OnceLock<u64>>,
+    call_data: Vec<OnceLock<Vec<CallDataUse>>>,
+}
 
 impl Loops {
+    fn of(program: &Program) -> Self {
+        Loops {
+            cfgs: crate::program::cfg::function_cfgs(program),
+            facts: program.memo.get_or(|| FunctionFacts {
+                local_arrays: program.functions.iter().map(|_| OnceLock::new()).collect(),
+                call_data: program.functions.iter().map(|_| OnceLock::new()).collect(),
+            }),
+        }
+    }
+
     /// Whether instruction `inst` lies in a loop of its function.
-    fn contain(&mut self, program: &Program, inst: usize) -> bool {
+    fn contain(&self, program: &Program, inst: usize) -> bool {
         let Some(fi) = program.function_of(inst) else {
             return false;
         };
@@ -510,18 +617,46 @@ impl Loops {
         let Some(block) = f.block_of(inst) else {
             return false;
         };
-        let looped = self.0.entry(fi).or_insert_with(|| {
-            let mut looped = vec![false; f.blocks.len()];
-            for (_, body) in crate::program::cfg::natural_loops(f) {
-                for b in body {
-                    if let Some(x) = looped.get_mut(b) {
-                        *x = true;
-                    }
+        self.cfgs
+            .looped(program, fi)
+            .get(block)
+            .copied()
+            .unwrap_or(false)
+    }
+
+    /// Bytes of the function-local arrays function `fi` declares.
+    fn local_arrays(&self, program: &Program, fi: usize) -> u64 {
+        let (Some(cell), Some(f)) = (self.facts.local_arrays.get(fi), program.functions.get(fi))
+        else {
+            return 0;
+        };
+        *cell.get_or_init(|| {
+            let mut bytes = 0;
+            for inst in &program.insts[f.start..=f.end] {
+                if inst.class.opcode != spirv::Op::Variable {
+                    continue;
+                }
+                let Some(Type::Pointer {
+                    storage: StorageClass::Function,
+                    pointee,
+                }) = inst.result_type.and_then(|t| program.ty(t))
+                else {
+                    continue;
+                };
+                if matches!(program.ty(*pointee), Some(Type::Array { .. })) {
+                    bytes += scalar_size(program, *pointee).unwrap_or(0);
                 }
             }
-            looped
-        });
-        looped.get(block).copied().unwrap_or(false)
+            bytes
+        })
+    }
+
+    /// [`call_data_uses`] of function `fi`.
+    fn call_data(&self, program: &Program, fi: usize) -> &[CallDataUse] {
+        match (self.facts.call_data.get(fi), program.functions.get(fi)) {
+            (Some(cell), Some(f)) => cell.get_or_init(|| call_data_uses(program, f)),
+            _ => &[],
+        }
     }
 }
 
@@ -580,10 +715,10 @@ pub fn exact_call_chain(rec: &RecursionReport, sizes: &[u64]) -> Option<u64> {
         callables: &[Vec<usize>],
         sizes: &[u64],
         v: usize,
-        memo: &mut HashMap<usize, u64>,
+        memo: &mut [Option<u64>],
         depth: usize,
     ) -> u64 {
-        if let Some(&x) = memo.get(&v) {
+        if let Some(x) = memo[v] {
             return x;
         }
         let own = sizes.get(v).copied().unwrap_or(0);
@@ -595,10 +730,10 @@ pub fn exact_call_chain(rec: &RecursionReport, sizes: &[u64]) -> Option<u64> {
             .map(|&to| with_callables(callables, sizes, to, memo, depth + 1))
             .max()
             .unwrap_or(0);
-        memo.insert(v, own + above);
+        memo[v] = Some(own + above);
         own + above
     }
-    let mut memo = HashMap::new();
+    let mut memo = vec![None; n];
     let mut w: Vec<u64> = (0..n)
         .map(|v| with_callables(&callables, sizes, v, &mut memo, 0))
         .collect();
@@ -625,11 +760,25 @@ pub fn exact_call_chain(rec: &RecursionReport, sizes: &[u64]) -> Option<u64> {
     let mut order: Vec<usize> = (0..n).collect();
     // Levels order the acyclic part; nodes of one cycle share its weight.
     order.sort_by_key(|&v| level(v).unwrap_or(u32::MAX));
-    let cycle_of = |v: usize| rec.cycles.iter().find(|c| c.nodes.contains(&v));
+    // The first cycle through each node, and each node's incoming traces,
+    // found once (not a scan of every cycle and edge per node and pass).
+    let mut cycle_of: Vec<Option<usize>> = vec![None; n];
+    for (k, c) in rec.cycles.iter().enumerate() {
+        for &v in &c.nodes {
+            if let Some(slot) = cycle_of.get_mut(v) {
+                slot.get_or_insert(k);
+            }
+        }
+    }
+    let mut into: Vec<Vec<usize>> = vec![Vec::new(); n];
+    for e in g.traces() {
+        into[e.to].push(e.from);
+    }
     for _ in 0..2 {
         for &v in &order {
-            let own = match cycle_of(v) {
-                Some(c) => {
+            let own = match cycle_of[v] {
+                Some(k) => {
+                    let c = &rec.cycles[k];
                     let x = c.extra_levels?;
                     let max_w = c.nodes.iter().map(|&u| w[u]).max().unwrap_or(0);
                     (x + 1) * max_w
@@ -639,13 +788,13 @@ pub fn exact_call_chain(rec: &RecursionReport, sizes: &[u64]) -> Option<u64> {
             let entered = if g.nodes[v].shader.stage == Stage::RayGeneration {
                 Some(0)
             } else {
-                g.traces()
-                    .filter(|e| e.to == v)
-                    .filter(|e| match (cycle_of(e.from), cycle_of(v)) {
-                        (Some(a), Some(b)) => !std::ptr::eq(a, b),
+                into[v]
+                    .iter()
+                    .filter(|&&from| match (cycle_of[from], cycle_of[v]) {
+                        (Some(a), Some(b)) => a != b,
                         _ => true,
                     })
-                    .filter_map(|e| best[e.from])
+                    .filter_map(|&from| best[from])
                     .max()
             };
             if let Some(base) = entered {
@@ -663,13 +812,14 @@ pub fn stack_report(pipeline: &Pipeline) -> StackReport {
 
 /// [`stack_report`] over a recursion analysis the caller already has.
 pub fn stack_report_with(pipeline: &Pipeline, rec: &RecursionReport) -> StackReport {
-    let mut cache: HashMap<(usize, String), Breakdown> = HashMap::new();
+    let mut cache: rustc_hash::FxHashMap<(usize, &str), Breakdown> =
+        rustc_hash::FxHashMap::with_capacity_and_hasher(rec.graph.nodes.len(), Default::default());
     let sites: Vec<_> = pipeline.programs.iter().map(shared_live_bytes).collect();
-    let mut shaders = Vec::new();
+    let mut shaders = Vec::with_capacity(rec.graph.nodes.len());
     for node in &rec.graph.nodes {
         let s = &node.shader;
         let b = cache
-            .entry((s.program, s.entry.clone()))
+            .entry((s.program, s.entry.as_str()))
             .or_insert_with(|| match (pipeline.program(s), sites.get(s.program)) {
                 (Some(p), Some(sites)) => breakdown_with(p, &s.entry, sites),
                 _ => Breakdown::default(),
@@ -680,7 +830,11 @@ pub fn stack_report_with(pipeline: &Pipeline, rec: &RecursionReport) -> StackRep
         shaders.push(ShaderStack {
             entry: s.entry.clone(),
             stage: s.stage,
-            file: s.file.display().to_string(),
+            // As `display()` writes it; a UTF-8 path without the formatter.
+            file: match s.file.to_str() {
+                Some(f) => f.to_owned(),
+                None => s.file.display().to_string(),
+            },
             group,
             model_bytes: full_model(s.stage, &b),
             driver_model_bytes,

@@ -254,78 +254,135 @@ fn find_fn(source: &str, name: &str) -> Option<usize> {
 /// naga's writer finds each `OpLine`'s line by counting the newlines from the
 /// top of the source (`Span::location`), which makes writing quadratic in the
 /// file's length (two thirds of the writer's time on the repository's
-/// shaders). So the writer is handed statement numbers instead of positions:
-/// statement `k`'s span becomes byte `k` of a blank text with no newline
-/// (line 1, column `k + 1`, found by one `memchr`), and the words are put
-/// back afterwards: each `OpLine` gets the line and column naga would have
-/// written for the real span, from a line index, and `OpSource` the real text.
-/// The module's spans are restored before returning.
+/// shaders, and minutes for a 10 MB file). So the writer is handed statement
+/// numbers instead of positions: the `k`th statement of a function gets byte
+/// `k` of a blank text with no newline (line 1, column `k + 1`, found by one
+/// `memchr` over at most the longest function's statement count), and the
+/// words are put back afterwards: each `OpLine` gets the line and column
+/// naga writes for the real span, found from its function (by the name the
+/// writer gives it) and a line index, and `OpSource` the real text. Where a
+/// line cannot be traced back that way (two functions of one name), naga
+/// writes from the real text. The module's spans are restored before
+/// returning.
 pub fn write_spirv(
     module: &mut naga::Module,
     info: &naga::valid::ModuleInfo,
     source: &str,
     path: &Path,
 ) -> Result<Vec<u32>, InputError> {
-    let mut spans = Vec::new();
-    each_statement_span(module, &mut |span| {
-        spans.push(*span);
-        *span = naga::Span::new(spans.len() as u32 - 1, spans.len() as u32 - 1);
-    });
-    let blank = " ".repeat(spans.len() + 1);
-    let words = write_spirv_with(module, info, &blank, path);
-    let mut k = 0;
-    each_statement_span(module, &mut |span| {
-        *span = spans[k];
-        k += 1;
-    });
-    Ok(restore_positions(&words?, source, &spans))
+    match write_coded(module, info, source, path)? {
+        Some(words) => Ok(words),
+        None => write_spirv_with(module, info, source, path),
+    }
 }
 
-/// Calls `f` on the span of every statement of every function, in a fixed
-/// order.
-fn each_statement_span(module: &mut naga::Module, f: &mut impl FnMut(&mut naga::Span)) {
-    fn block(b: &mut naga::Block, f: &mut impl FnMut(&mut naga::Span)) {
+/// [`write_spirv`] through statement numbers; `None` where a line cannot be
+/// traced back.
+fn write_coded(
+    module: &mut naga::Module,
+    info: &naga::valid::ModuleInfo,
+    source: &str,
+    path: &Path,
+) -> Result<Option<Vec<u32>>, InputError> {
+    let mut spans: Vec<Vec<naga::Span>> = Vec::new();
+    each_statement_span(module, &mut |function, span| {
+        if function == spans.len() {
+            spans.push(Vec::new());
+        }
+        let k = spans[function].len() as u32;
+        spans[function].push(*span);
+        *span = naga::Span::new(k, k);
+    });
+    let longest = spans.iter().map(Vec::len).max().unwrap_or(0);
+    let blank = " ".repeat(longest + 1);
+    let coded = write_spirv_with(module, info, &blank, path);
+    each_statement_span(module, &mut |function, span| {
+        *span = spans[function][span.to_range().map_or(0, |r| r.start)];
+    });
+    Ok(restore_positions(
+        &coded?,
+        source,
+        &function_names(module),
+        &spans,
+    ))
+}
+
+/// The functions in the order the writer writes them (the module's
+/// functions, then its entry points), with the name it gives each.
+fn function_names(module: &naga::Module) -> Vec<Option<&str>> {
+    let functions = module.functions.iter().map(|(_, f)| f.name.as_deref());
+    let entries = module
+        .entry_points
+        .iter()
+        .map(|ep| ep.function.name.as_deref());
+    functions.chain(entries).collect()
+}
+
+/// Calls `f` with the function's number (as [`function_names`] counts
+/// them) and the span of each statement it holds, in a fixed order.
+fn each_statement_span(module: &mut naga::Module, f: &mut impl FnMut(usize, &mut naga::Span)) {
+    fn block(n: usize, b: &mut naga::Block, f: &mut impl FnMut(usize, &mut naga::Span)) {
         for (statement, span) in b.span_iter_mut() {
             if let Some(span) = span {
-                f(span);
+                f(n, span);
             }
             match statement {
-                naga::Statement::Block(inner) => block(inner, f),
+                naga::Statement::Block(inner) => block(n, inner, f),
                 naga::Statement::If { accept, reject, .. } => {
-                    block(accept, f);
-                    block(reject, f);
+                    block(n, accept, f);
+                    block(n, reject, f);
                 }
                 naga::Statement::Switch { cases, .. } => {
                     for case in cases {
-                        block(&mut case.body, f);
+                        block(n, &mut case.body, f);
                     }
                 }
                 naga::Statement::Loop {
                     body, continuing, ..
                 } => {
-                    block(body, f);
-                    block(continuing, f);
+                    block(n, body, f);
+                    block(n, continuing, f);
                 }
                 _ => {}
             }
         }
     }
-    for (_, function) in module.functions.iter_mut() {
-        block(&mut function.body, f);
-    }
-    for entry in &mut module.entry_points {
-        block(&mut entry.function.body, f);
+    let functions = module.functions.iter_mut().map(|(_, function)| function);
+    let entries = module.entry_points.iter_mut().map(|ep| &mut ep.function);
+    for (n, function) in functions.chain(entries).enumerate() {
+        // Every function has its number, with statements or without.
+        f(n, &mut naga::Span::default());
+        block(n, &mut function.body, f);
     }
 }
 
 /// The words naga wrote with statement numbers for positions (see
 /// [`write_spirv`]), with each `OpLine` and the `OpSource` text as naga
-/// writes them for `source`.
-fn restore_positions(words: &[u32], source: &str, spans: &[naga::Span]) -> Vec<u32> {
+/// writes them for `source`; `None` where an `OpLine` cannot be traced to
+/// its statement.
+fn restore_positions(
+    words: &[u32],
+    source: &str,
+    names: &[Option<&str>],
+    spans: &[Vec<naga::Span>],
+) -> Option<Vec<u32>> {
     const OP_SOURCE_CONTINUED: u32 = 2;
     const OP_SOURCE: u32 = 3;
+    const OP_NAME: u32 = 5;
     const OP_LINE: u32 = 8;
+    const OP_FUNCTION: u32 = 54;
+    const OP_FUNCTION_END: u32 = 56;
+    let mut by_name: rustc_hash::FxHashMap<&str, usize> = Default::default();
+    for (n, name) in names.iter().enumerate() {
+        if let Some(name) = name {
+            if by_name.insert(name, n).is_some() {
+                return None;
+            }
+        }
+    }
     let lines = Lines::new(source);
+    let mut named: rustc_hash::FxHashMap<u32, usize> = Default::default();
+    let mut function: Option<usize> = None;
     let mut out = Vec::with_capacity(words.len() + source.len() / 4 + 8);
     out.extend_from_slice(&words[..words.len().min(5)]);
     let mut i = 5;
@@ -334,11 +391,26 @@ fn restore_positions(words: &[u32], source: &str, spans: &[naga::Span]) -> Vec<u
         let inst = &words[i..(i + count.max(1)).min(words.len())];
         i += count.max(1);
         match op {
+            OP_NAME if inst.len() > 2 => {
+                let bytes: Vec<u8> = inst[2..].iter().flat_map(|w| w.to_le_bytes()).collect();
+                let text = bytes.split(|&b| b == 0).next().unwrap_or_default();
+                if let Some(&n) = std::str::from_utf8(text).ok().and_then(|t| by_name.get(t)) {
+                    named.insert(inst[1], n);
+                }
+                out.extend_from_slice(inst);
+            }
+            OP_FUNCTION if inst.len() > 2 => {
+                function = named.get(&inst[2]).copied();
+                out.extend_from_slice(inst);
+            }
+            OP_FUNCTION_END => {
+                function = None;
+                out.extend_from_slice(inst);
+            }
             OP_LINE if inst.len() == 4 => {
-                let code = inst[3].wrapping_sub(1) as usize;
-                let start = spans
-                    .get(code)
-                    .map_or(0, |s| s.to_range().map_or(0, |r| r.start).min(source.len()));
+                let code = inst[3].checked_sub(1)? as usize;
+                let span = spans.get(function?)?.get(code)?;
+                let start = span.to_range().map_or(0, |r| r.start).min(source.len());
                 // naga's `Span::location`: the newlines before the start, and
                 // the column in bytes.
                 let line = lines.starts.partition_point(|&s| s <= start);
@@ -353,7 +425,7 @@ fn restore_positions(words: &[u32], source: &str, spans: &[naga::Span]) -> Vec<u
             _ => out.extend_from_slice(inst),
         }
     }
-    out
+    Some(out)
 }
 
 /// `OpSource` with the text, and `OpSourceContinued` for what does not fit,
@@ -498,9 +570,11 @@ mod tests {
                  loop {{ y += 1.0; continuing {{ break if y > 9.0; }} }}\n  return y;\n}}\n"
             )
         };
-        let small = body(0);
+        let entry = "@compute @workgroup_size(1)\nfn main() {\n  var z = g0(1.0);\n  \
+                     if z > 2.0 { z = g0(z); }\n}\n";
+        let small = body(0) + entry;
         let large = format!(
-            "/* {} */\n{}",
+            "/* {} */\n{}{entry}",
             "é".repeat(40_000),
             (0..400).map(body).collect::<String>()
         );
@@ -511,16 +585,18 @@ mod tests {
             let direct = write_spirv_with(&module, &info, &source, path).unwrap();
             let spans_before: Vec<naga::Span> = {
                 let mut v = Vec::new();
-                each_statement_span(&mut module, &mut |s| v.push(*s));
+                each_statement_span(&mut module, &mut |_, s| v.push(*s));
                 v
             };
             assert!(spans_before.len() > 5);
+            let coded = write_coded(&mut module, &info, &source, path).unwrap();
+            assert_eq!(coded.as_ref(), Some(&direct), "traced back, as naga writes");
             assert_eq!(
                 write_spirv(&mut module, &info, &source, path).unwrap(),
                 direct
             );
             let mut after = Vec::new();
-            each_statement_span(&mut module, &mut |s| after.push(*s));
+            each_statement_span(&mut module, &mut |_, s| after.push(*s));
             assert_eq!(after, spans_before, "spans restored");
         }
     }

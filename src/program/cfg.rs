@@ -3,17 +3,61 @@
 
 use super::{Function, Id, Program};
 use std::collections::{HashMap, HashSet};
+use std::sync::{Arc, OnceLock};
+
+/// Each block's predecessors in block order, as one flat list: a `Vec`
+/// per block cost an allocation each, and the analyses ask for many small
+/// functions.
+pub struct Preds {
+    start: Vec<usize>,
+    list: Vec<usize>,
+}
+
+impl Preds {
+    pub fn of(f: &Function) -> Preds {
+        let n = f.blocks.len();
+        let mut start = vec![0usize; n + 1];
+        for block in &f.blocks {
+            for &s in &block.succs {
+                start[s + 1] += 1;
+            }
+        }
+        for b in 0..n {
+            start[b + 1] += start[b];
+        }
+        let mut list = vec![0usize; start[n]];
+        let mut next = start.clone();
+        for (b, block) in f.blocks.iter().enumerate() {
+            for &s in &block.succs {
+                list[next[s]] = b;
+                next[s] += 1;
+            }
+        }
+        Preds { start, list }
+    }
+
+    /// The predecessors of block `b`.
+    pub fn of_block(&self, b: usize) -> &[usize] {
+        &self.list[self.start[b]..self.start[b + 1]]
+    }
+}
 
 /// Immediate dominators by block index (Cooper, Harvey, Kennedy).
 pub fn dominators(f: &Function) -> Vec<Option<usize>> {
+    dominators_with(f, &Preds::of(f))
+}
+
+/// [`dominators`] with the function's predecessors already listed.
+pub fn dominators_with(f: &Function, preds: &Preds) -> Vec<Option<usize>> {
     let n = f.blocks.len();
     if n == 0 {
         return Vec::new();
     }
     // Post-order by an explicit stack: shader CFGs can be large.
-    let mut order = Vec::new();
+    let mut order = Vec::with_capacity(n);
     let mut seen = vec![false; n];
-    let mut stack = vec![(0usize, 0usize)];
+    let mut stack = Vec::with_capacity(n);
+    stack.push((0usize, 0usize));
     seen[0] = true;
     while let Some((b, k)) = stack.pop() {
         match f.blocks[b].succs.get(k) {
@@ -32,12 +76,6 @@ pub fn dominators(f: &Function) -> Vec<Option<usize>> {
     for (i, &b) in order.iter().enumerate() {
         rpo[b] = i;
     }
-    let mut preds = vec![Vec::new(); n];
-    for (b, block) in f.blocks.iter().enumerate() {
-        for &s in &block.succs {
-            preds[s].push(b);
-        }
-    }
     let mut idom: Vec<Option<usize>> = vec![None; n];
     idom[0] = Some(0);
     let mut changed = true;
@@ -45,7 +83,7 @@ pub fn dominators(f: &Function) -> Vec<Option<usize>> {
         changed = false;
         for &b in order.iter().skip(1) {
             let mut new: Option<usize> = None;
-            for &p in &preds[b] {
+            for &p in preds.of_block(b) {
                 if idom[p].is_none() {
                     continue;
                 }
@@ -91,13 +129,8 @@ pub fn dominates(idom: &[Option<usize>], a: usize, mut b: usize) -> bool {
 /// Natural loops of a function: header block and body blocks, one per back
 /// edge target, by header.
 pub fn natural_loops(f: &Function) -> Vec<(usize, HashSet<usize>)> {
-    let idom = dominators(f);
-    let mut preds = vec![Vec::new(); f.blocks.len()];
-    for (b, block) in f.blocks.iter().enumerate() {
-        for &s in &block.succs {
-            preds[s].push(b);
-        }
-    }
+    let preds = Preds::of(f);
+    let idom = dominators_with(f, &preds);
     let mut loops: HashMap<usize, HashSet<usize>> = HashMap::new();
     for (b, block) in f.blocks.iter().enumerate() {
         for &h in &block.succs {
@@ -108,7 +141,7 @@ pub fn natural_loops(f: &Function) -> Vec<(usize, HashSet<usize>)> {
             let mut work = vec![b];
             while let Some(x) = work.pop() {
                 if body.insert(x) {
-                    work.extend(preds[x].iter().copied());
+                    work.extend_from_slice(preds.of_block(x));
                 }
             }
         }
@@ -116,6 +149,84 @@ pub fn natural_loops(f: &Function) -> Vec<(usize, HashSet<usize>)> {
     let mut v: Vec<_> = loops.into_iter().collect();
     v.sort_by_key(|(h, _)| *h);
     v
+}
+
+/// Each function's dominator tree and which of its blocks lie in a loop,
+/// worked out on first use and kept in the Program's memo: the stack model
+/// asks per site and per entry point, the depth guards per trace, and a
+/// helper shared by several shaders was analysed once per shader.
+pub struct FunctionCfgs {
+    preds: Vec<OnceLock<Preds>>,
+    idom: Vec<OnceLock<Vec<Option<usize>>>>,
+    looped: Vec<OnceLock<Vec<bool>>>,
+}
+
+/// The memo of [`FunctionCfgs`] of a program.
+pub fn function_cfgs(program: &Program) -> Arc<FunctionCfgs> {
+    program.memo.get_or(|| FunctionCfgs {
+        preds: program.functions.iter().map(|_| OnceLock::new()).collect(),
+        idom: program.functions.iter().map(|_| OnceLock::new()).collect(),
+        looped: program.functions.iter().map(|_| OnceLock::new()).collect(),
+    })
+}
+
+impl FunctionCfgs {
+    /// [`dominators`] of function `fi` (an index into `program.functions`).
+    pub fn idom(&self, program: &Program, fi: usize) -> &[Option<usize>] {
+        match (self.idom.get(fi), program.functions.get(fi)) {
+            (Some(cell), Some(f)) => {
+                cell.get_or_init(|| dominators_with(f, self.preds[fi].get_or_init(|| Preds::of(f))))
+            }
+            _ => &[],
+        }
+    }
+
+    /// Per block of function `fi`: whether it lies in one of the function's
+    /// [`natural_loops`] (their union, without building each body as a set).
+    pub fn looped(&self, program: &Program, fi: usize) -> &[bool] {
+        let (Some(cell), Some(f)) = (self.looped.get(fi), program.functions.get(fi)) else {
+            return &[];
+        };
+        cell.get_or_init(|| {
+            let n = f.blocks.len();
+            let mut looped = vec![false; n];
+            // Every edge forward in block order: no cycle, so no back edge
+            // (and no dominator tree needed to find none).
+            if f.blocks
+                .iter()
+                .enumerate()
+                .all(|(b, block)| block.succs.iter().all(|&s| s > b))
+            {
+                return looped;
+            }
+            let idom = self.idom(program, fi);
+            let preds = self.preds[fi].get_or_init(|| Preds::of(f));
+            // Which back edge last visited a block: each loop's body is
+            // walked on its own (a body already marked may lead further).
+            let mut visit = vec![usize::MAX; n];
+            let mut edge = 0;
+            let mut work = Vec::new();
+            for (b, block) in f.blocks.iter().enumerate() {
+                for &h in &block.succs {
+                    if !dominates(idom, h, b) {
+                        continue;
+                    }
+                    edge += 1;
+                    looped[h] = true;
+                    visit[h] = edge;
+                    work.push(b);
+                    while let Some(x) = work.pop() {
+                        if visit[x] != edge {
+                            visit[x] = edge;
+                            looped[x] = true;
+                            work.extend_from_slice(preds.of_block(x));
+                        }
+                    }
+                }
+            }
+            looped
+        })
+    }
 }
 
 /// Strongly connected components, sinks first.
@@ -186,6 +297,7 @@ pub fn call_chains(program: &Program, root: Id, target: Id, max: usize) -> Vec<V
     #[allow(clippy::too_many_arguments)]
     fn up(
         program: &Program,
+        calls: &super::CallIndex,
         max: usize,
         root: Id,
         f: Id,
@@ -204,7 +316,8 @@ pub fn call_chains(program: &Program, root: Id, target: Id, max: usize) -> Vec<V
             return;
         }
         visiting.push(f);
-        for call in program.callers(f) {
+        // The index itself, not `Program::callers`' copy per step.
+        for &call in calls.by_callee.get(&f).map_or(&[][..], Vec::as_slice) {
             let Some(caller) = program
                 .function_of(call)
                 .and_then(|i| program.functions.get(i))
@@ -212,14 +325,22 @@ pub fn call_chains(program: &Program, root: Id, target: Id, max: usize) -> Vec<V
                 continue;
             };
             suffix.push(call);
-            up(program, max, root, caller.id, suffix, out, visiting);
+            up(program, calls, max, root, caller.id, suffix, out, visiting);
             suffix.pop();
         }
         visiting.pop();
     }
     let mut out = Vec::new();
+    if target == root {
+        // `[[]]` without the index.
+        if max > 0 {
+            out.push(Vec::new());
+        }
+        return out;
+    }
     up(
         program,
+        &program.call_index(),
         max,
         root,
         target,
@@ -228,4 +349,40 @@ pub fn call_chains(program: &Program, root: Id, target: Id, max: usize) -> Vec<V
         &mut Vec::new(),
     );
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::path::Path;
+
+    /// The memo's dominators and loop blocks are `dominators` and the union
+    /// of `natural_loops`, function by function: loops in GLSL, HLSL and
+    /// WGSL output, helpers without one.
+    #[test]
+    fn memo_matches_dominators_and_natural_loops() {
+        let mut loops = 0;
+        for rel in [
+            "fixtures/guards/loop.rgen.g.spv",
+            "fixtures/guards/fresh.hlsl",
+            "fixtures/guards/constructed.wgsl",
+        ] {
+            let path = Path::new(env!("CARGO_MANIFEST_DIR")).join(rel);
+            let lang = crate::shader::Language::from_path(&path).unwrap();
+            let p = crate::front::load(&path, lang).unwrap();
+            let cfgs = function_cfgs(&p);
+            for (fi, f) in p.functions.iter().enumerate() {
+                assert_eq!(cfgs.idom(&p, fi), dominators(f).as_slice(), "{rel} {fi}");
+                let mut want = vec![false; f.blocks.len()];
+                for (_, body) in natural_loops(f) {
+                    loops += 1;
+                    for b in body {
+                        want[b] = true;
+                    }
+                }
+                assert_eq!(cfgs.looped(&p, fi), want.as_slice(), "{rel} {fi}");
+            }
+        }
+        assert!(loops >= 3, "{loops}");
+    }
 }

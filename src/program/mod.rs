@@ -247,6 +247,13 @@ pub struct Program {
     pub memo: Memo,
 }
 
+/// [`Program::call_index`]: calls by callee (instruction indices) and
+/// callees by calling function, in module order.
+struct CallIndex {
+    by_callee: HashMap<Id, Vec<usize>>,
+    by_caller: HashMap<Id, Vec<Id>>,
+}
+
 /// Results computed once per Program, one per type: the module rules and
 /// the pipeline's stack model both need each shader's live state, and a
 /// Program is not changed once built.
@@ -392,21 +399,45 @@ impl Program {
 
     /// Instruction indices of the `OpFunctionCall`s that call function `f`.
     pub fn callers(&self, f: Id) -> Vec<usize> {
-        // Every call by callee, indexed once: call chains ask per function.
-        struct Calls(HashMap<Id, Vec<usize>>);
-        let calls = self.memo.get_or(|| {
+        self.call_index()
+            .by_callee
+            .get(&f)
+            .cloned()
+            .unwrap_or_default()
+    }
+
+    /// Every call by callee and each function's callees, indexed in one
+    /// pass over the module: call chains ask per function, and the
+    /// analyses ask for reachable functions per shader and per entry point.
+    fn call_index(&self) -> std::sync::Arc<CallIndex> {
+        self.memo.get_or(|| {
             let mut by_callee: HashMap<Id, Vec<usize>> = HashMap::default();
+            let mut calls: Vec<(usize, Id)> = Vec::new();
             for (i, inst) in self.insts.iter().enumerate() {
                 if inst.class.opcode != Op::FunctionCall {
                     continue;
                 }
                 if let Some(Operand::IdRef(x)) = inst.operands.first() {
                     by_callee.entry(*x).or_default().push(i);
+                    calls.push((i, *x));
                 }
             }
-            Calls(by_callee)
-        });
-        calls.0.get(&f).cloned().unwrap_or_default()
+            let mut by_caller: HashMap<Id, Vec<Id>> = HashMap::default();
+            for f in &self.functions {
+                let from = calls.partition_point(|&(i, _)| i < f.start);
+                let list = calls[from..]
+                    .iter()
+                    .take_while(|&&(i, _)| i <= f.end)
+                    .map(|&(_, callee)| callee)
+                    .collect();
+                // The first function of an id wins, as `function` finds it.
+                by_caller.entry(f.id).or_insert(list);
+            }
+            CallIndex {
+                by_callee,
+                by_caller,
+            }
+        })
     }
 
     /// The function (index into `functions`) containing instruction `inst`.
@@ -468,27 +499,12 @@ impl Program {
         // Each function's callees, in the order of its calls, listed once
         // per Program: the analyses ask per shader and per entry point, and
         // scanning every reachable instruction each time added up.
-        struct Callees(HashMap<Id, Vec<Id>>);
-        let callees = self.memo.get_or(|| {
-            let mut by_caller: HashMap<Id, Vec<Id>> = HashMap::default();
-            for f in &self.functions {
-                let mut list = Vec::new();
-                for inst in &self.insts[f.start..=f.end] {
-                    if inst.class.opcode == Op::FunctionCall {
-                        if let Some(Operand::IdRef(callee)) = inst.operands.first() {
-                            list.push(*callee);
-                        }
-                    }
-                }
-                // The first function of an id wins, as `function` finds it.
-                by_caller.entry(f.id).or_insert(list);
-            }
-            Callees(by_caller)
-        });
+        let index = self.call_index();
+        let callees = &index.by_caller;
         let mut seen = vec![root];
         let mut i = 0;
         while i < seen.len() {
-            for callee in callees.0.get(&seen[i]).map_or(&[][..], Vec::as_slice) {
+            for callee in callees.get(&seen[i]).map_or(&[][..], Vec::as_slice) {
                 if !seen.contains(callee) {
                     seen.push(*callee);
                 }
@@ -515,6 +531,29 @@ impl Program {
     /// spans that its SPIR-V writer does not emit), matched through `OpName`.
     pub fn attach_named_decls(&mut self, decls: &[(NamedDecl, Location)]) {
         use NamedDecl as N;
+        // Each name's ids, globals and functions, found once: a lookup per
+        // declaration, not a scan of every name (generated sources declare
+        // thousands of functions).
+        let mut by_name: HashMap<&str, Vec<Id>> = HashMap::default();
+        for (id, n) in &self.names {
+            by_name.entry(n.as_str()).or_default().push(*id);
+        }
+        for ids in by_name.values_mut() {
+            ids.sort_unstable();
+        }
+        let mut globals_named: HashMap<&str, Vec<Id>> = HashMap::default();
+        for g in &self.globals {
+            if let Some(n) = g.name.as_deref() {
+                globals_named.entry(n).or_default().push(g.id);
+            }
+        }
+        let mut functions_named: HashMap<&str, Vec<Id>> = HashMap::default();
+        for f in &self.functions {
+            if let Some(n) = f.name.as_deref() {
+                functions_named.entry(n).or_default().push(f.id);
+            }
+        }
+        let mut decl_pos = std::mem::take(&mut self.decl_pos);
         for (decl, loc) in decls {
             let file = match self.files.iter().position(|f| f.path == loc.path) {
                 Some(i) => i as u32,
@@ -533,51 +572,37 @@ impl Program {
                 end_line: loc.end_line,
                 end_column: loc.end_column,
             };
-            let named = |name: &str| -> Vec<Id> {
-                let mut ids: Vec<Id> = self
-                    .names
-                    .iter()
-                    .filter(|(_, n)| *n == name)
-                    .map(|(id, _)| *id)
-                    .collect();
-                ids.sort_unstable();
-                ids
+            let named = |map: &HashMap<&str, Vec<Id>>, name: &str| -> Vec<Id> {
+                map.get(name).cloned().unwrap_or_default()
             };
             match decl {
                 N::Type(name) => {
-                    for id in named(name) {
+                    for id in named(&by_name, name) {
                         if matches!(self.types.get(&id), Some(Type::Struct { .. })) {
-                            self.decl_pos.insert(Decl::Type(id), pos);
+                            decl_pos.insert(Decl::Type(id), pos);
                         }
                     }
                 }
                 N::Member(name, k) => {
-                    for id in named(name) {
+                    for id in named(&by_name, name) {
                         if matches!(self.types.get(&id), Some(Type::Struct { .. })) {
-                            self.decl_pos.insert(Decl::Member(id, *k), pos);
+                            decl_pos.insert(Decl::Member(id, *k), pos);
                         }
                     }
                 }
                 N::Global(name) => {
-                    for g in self
-                        .globals
-                        .iter()
-                        .filter(|g| g.name.as_deref() == Some(name.as_str()))
-                    {
-                        self.decl_pos.insert(Decl::Var(g.id), pos);
+                    for id in named(&globals_named, name) {
+                        decl_pos.insert(Decl::Var(id), pos);
                     }
                 }
                 N::Function(name) => {
-                    for f in self
-                        .functions
-                        .iter()
-                        .filter(|f| f.name.as_deref() == Some(name.as_str()))
-                    {
-                        self.decl_pos.insert(Decl::Func(f.id), pos);
+                    for id in named(&functions_named, name) {
+                        decl_pos.insert(Decl::Func(id), pos);
                     }
                 }
             }
         }
+        self.decl_pos = decl_pos;
     }
 
     /// A short type name for messages (`vec3<f32>`-neutral: `float3`-like HLSL
