@@ -8,6 +8,10 @@ use naga::back::spv;
 use naga::valid::{Capabilities, ValidationFlags, Validator};
 use std::path::Path;
 
+/// Opcodes of the instructions [`restore_positions`] rewrites.
+const OP_SOURCE_CONTINUED: u32 = 2;
+const OP_SOURCE: u32 = 3;
+
 /// SPIR-V version written for WGSL input: 1.4 is the floor for ray tracing.
 const SPIRV_VERSION: (u8, u8) = (1, 4);
 
@@ -366,8 +370,6 @@ fn restore_positions(
     names: &[Option<&str>],
     spans: &[Vec<naga::Span>],
 ) -> Option<Vec<u32>> {
-    const OP_SOURCE_CONTINUED: u32 = 2;
-    const OP_SOURCE: u32 = 3;
     const OP_NAME: u32 = 5;
     const OP_LINE: u32 = 8;
     const OP_FUNCTION: u32 = 54;
@@ -432,8 +434,6 @@ fn restore_positions(
 /// split as naga splits it: after every 65,535 bytes (at a character
 /// boundary) when the text is longer than that, each piece nul-terminated.
 fn source_instructions(out: &mut Vec<u32>, language: u32, version: u32, file: u32, text: &str) {
-    const OP_SOURCE_CONTINUED: u32 = 2;
-    const OP_SOURCE: u32 = 3;
     let limit = u16::MAX as usize;
     let mut pieces = Vec::new();
     if text.len() > limit {
