@@ -311,6 +311,32 @@ fn write_coded(
     ))
 }
 
+/// Holds [`write_spirv`] to naga's own writer given the text itself: the
+/// same words, through the traced path (for the fuzz target and tests;
+/// `Ok` for a source naga does not accept).
+pub fn check_positions_against_naga(source: &str, path: &Path) -> Result<(), String> {
+    let Ok((mut module, info)) = parse(source, path) else {
+        return Ok(());
+    };
+    let direct = write_spirv_with(&module, &info, source, path).map_err(|e| e.to_string());
+    let coded = write_coded(&mut module, &info, source, path).map_err(|e| e.to_string());
+    match (coded, direct) {
+        (Ok(Some(c)), Ok(d)) if c == d => Ok(()),
+        (Ok(Some(c)), Ok(d)) => Err(format!(
+            "words differ ({} against naga's {}), first at word {}",
+            c.len(),
+            d.len(),
+            c.iter()
+                .zip(&d)
+                .position(|(a, b)| a != b)
+                .unwrap_or(c.len().min(d.len()))
+        )),
+        (Ok(None), _) => Err("an OpLine was not traced back".into()),
+        (Err(a), Err(b)) if a == b => Ok(()),
+        (c, d) => Err(format!("one writer failed: {:?} / {:?}", c.err(), d.err())),
+    }
+}
+
 /// The functions in the order the writer writes them (the module's
 /// functions, then its entry points), with the name it gives each.
 fn function_names(module: &naga::Module) -> Vec<Option<&str>> {
@@ -598,6 +624,34 @@ mod tests {
             let mut after = Vec::new();
             each_statement_span(&mut module, &mut |_, s| after.push(*s));
             assert_eq!(after, spans_before, "spans restored");
+        }
+    }
+
+    /// Every WGSL file of the repository: the traced words are naga's.
+    #[test]
+    fn repository_wgsl_written_as_naga_writes_it() {
+        let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+        let mut files = Vec::new();
+        let mut dirs = vec![
+            root.join("shaders"),
+            root.join("fixtures"),
+            root.join("tests"),
+        ];
+        while let Some(d) = dirs.pop() {
+            for e in std::fs::read_dir(&d).unwrap().flatten() {
+                let p = e.path();
+                if p.is_dir() {
+                    dirs.push(p);
+                } else if p.extension().is_some_and(|x| x == "wgsl") {
+                    files.push(p);
+                }
+            }
+        }
+        assert!(files.len() >= 20, "{} WGSL files", files.len());
+        for f in files {
+            let text = std::fs::read_to_string(&f).unwrap();
+            check_positions_against_naga(&text, &f)
+                .unwrap_or_else(|e| panic!("{}: {e}", f.display()));
         }
     }
 
