@@ -12,8 +12,8 @@
 //!   driver (`vkGetRayTracingShaderGroupStackSizeKHR`), when a device is there,
 //!   with the driver's shader caches off (`RTLINT_BENCH_DRIVER_CACHE=1`
 //!   keeps them: a repeated creation is then a cache lookup).
-//! - scaling: 1..10,000 files and one HLSL file growing 1×..64× (entry
-//!   points, instructions, includes): wall time and peak memory (maxrss of
+//! - scaling: 1..10,000 files, one HLSL and one WGSL file growing 1×..64× (entry
+//!   points, instructions, includes; functions, statements): wall time and peak memory (maxrss of
 //!   the `rtlint` child).
 //! - the result cache (cold against warm) and `--shard`.
 //!
@@ -515,17 +515,28 @@ fn main() {
         biggest = dir;
     }
 
-    // One HLSL file growing: entry points, instructions, includes.
+    // One HLSL file growing: entry points, instructions, includes; one WGSL
+    // file growing in functions and in statements (naga's writer made WGSL
+    // quadratic in the file's length once: docs/performance.md).
     let factors: &[usize] = if quick {
         &[1, 4]
     } else {
         &[1, 2, 4, 8, 16, 32, 64]
     };
-    for shape in ["entry points", "instructions", "includes"] {
+    let shapes = [
+        "entry points",
+        "instructions",
+        "includes",
+        "wgsl functions",
+        "wgsl statements",
+    ];
+    for shape in shapes {
         for &k in factors {
             let dir = scratch(&format!("grow-{}-{k}", shape.replace(' ', "-")));
-            let text = grown_hlsl(shape, k, &dir);
-            let file = dir.join("grown.hlsl");
+            let (text, file) = match shape.strip_prefix("wgsl ") {
+                Some(wgsl_shape) => (grown_wgsl(&root, wgsl_shape, k), dir.join("grown.wgsl")),
+                None => (grown_hlsl(shape, k, &dir), dir.join("grown.hlsl")),
+            };
             std::fs::write(&file, text).unwrap();
             let runs: Vec<(Duration, u64)> = (0..3)
                 .map(|_| {
@@ -635,6 +646,27 @@ fn main() {
 /// An HLSL shader `k` times as big in one way: `k` entry points with a
 /// helper each, one entry point with `k` times the statements, or `k`
 /// included headers (written into `dir`).
+/// The glossy reference shader with `k` × 64 small functions, or with one
+/// function of `k` × 64 statements.
+fn grown_wgsl(root: &Path, shape: &str, k: usize) -> String {
+    let mut s = std::fs::read_to_string(root.join("shaders/reflect_glossy.wgsl")).unwrap();
+    if shape == "functions" {
+        for i in 0..64 * k {
+            let _ = write!(
+                s,
+                "\nfn grown{i}(x: f32) -> f32 {{\n    var y = x;\n    if y > 4.0 {{ y = y * 0.5; }}\n    return y + {i}.0;\n}}\n"
+            );
+        }
+    } else {
+        s.push_str("\nfn grown(x: f32) -> f32 {\n    var y = x;\n");
+        for i in 0..64 * k {
+            let _ = writeln!(s, "    y = y * 0.5 + {i}.0;");
+        }
+        s.push_str("    return y;\n}\n");
+    }
+    s
+}
+
 fn grown_hlsl(shape: &str, k: usize, dir: &Path) -> String {
     let mut s = String::from(
         "RaytracingAccelerationStructure tlas : register(t0);\nRWTexture2D<float4> image : register(u1);\nstruct Payload { float4 color; };\n",
