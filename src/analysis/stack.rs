@@ -497,15 +497,14 @@ fn call_data_uses(program: &Program, f: &crate::program::Function) -> Vec<CallDa
             last_load: None,
         })
         .collect();
-    if out.is_empty() || out.len() > 64 {
-        return call_data_uses_one_by_one(program, f, out);
+    if out.is_empty() {
+        return out;
     }
-    // Pointers into each block within this function, one bit per global,
-    // found in one pass over the function for all of them.
-    let mut into: rustc_hash::FxHashMap<u32, u64> = Default::default();
-    for (k, u) in out.iter().enumerate() {
-        *into.entry(u.global).or_default() |= 1 << k;
-    }
+    // Each pointer into one of these globals within this function, with the
+    // global's place in `out`, found in one pass for all of them: ids are
+    // defined once, so a pointer leads back to one global.
+    let mut into: rustc_hash::FxHashMap<u32, usize> =
+        out.iter().enumerate().map(|(n, u)| (u.global, n)).collect();
     for k in f.start..=f.end {
         let i = &program.insts[k];
         if !matches!(
@@ -520,62 +519,19 @@ fn call_data_uses(program: &Program, f: &crate::program::Function) -> Vec<CallDa
         }) else {
             continue;
         };
-        let Some(&bits) = into.get(&first) else {
+        let Some(&n) = into.get(&first) else {
             continue;
         };
         match i.class.opcode {
             Op::AccessChain | Op::InBoundsAccessChain => {
                 if let Some(r) = i.result_id {
-                    *into.entry(r).or_default() |= bits;
+                    into.insert(r, n);
                 }
             }
-            op => {
-                for (n, u) in out.iter_mut().enumerate() {
-                    if bits & (1 << n) == 0 {
-                        continue;
-                    }
-                    if op == Op::Store {
-                        u.first_store.get_or_insert(k);
-                    } else {
-                        u.last_load = Some(k);
-                    }
-                }
+            Op::Store => {
+                out[n].first_store.get_or_insert(k);
             }
-        }
-    }
-    out
-}
-
-/// [`call_data_uses`] a global at a time (more globals than bits).
-fn call_data_uses_one_by_one(
-    program: &Program,
-    f: &crate::program::Function,
-    mut out: Vec<CallDataUse>,
-) -> Vec<CallDataUse> {
-    use spirv::Op;
-    for u in &mut out {
-        // Pointers into the block within this function.
-        let mut ptrs = vec![u.global];
-        for k in f.start..=f.end {
-            let i = &program.insts[k];
-            let first = i.operands.iter().find_map(|o| match o {
-                rspirv::dr::Operand::IdRef(id) => Some(*id),
-                _ => None,
-            });
-            match i.class.opcode {
-                Op::AccessChain | Op::InBoundsAccessChain
-                    if first.is_some_and(|b| ptrs.contains(&b)) =>
-                {
-                    ptrs.extend(i.result_id);
-                }
-                Op::Store if first.is_some_and(|p| ptrs.contains(&p)) => {
-                    u.first_store.get_or_insert(k);
-                }
-                Op::Load if first.is_some_and(|p| ptrs.contains(&p)) => {
-                    u.last_load = Some(k);
-                }
-                _ => {}
-            }
+            _ => out[n].last_load = Some(k),
         }
     }
     out
