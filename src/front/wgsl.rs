@@ -205,6 +205,14 @@ impl<'a> Lines<'a> {
         (line as u32, column)
     }
 
+    /// The line and the column in bytes of byte `start`, as naga's
+    /// `Span::location` counts them.
+    fn line_byte_col(&self, start: usize) -> (u32, u32) {
+        let start = start.min(self.source.len());
+        let line = self.starts.partition_point(|&s| s <= start);
+        (line as u32, (start - self.starts[line - 1] + 1) as u32)
+    }
+
     /// The location of `name` written at byte `at`.
     fn location(&self, path: &Path, at: usize, name: &str) -> Location {
         let start = at.min(self.source.len());
@@ -288,11 +296,9 @@ fn write_coded(
     source: &str,
     path: &Path,
 ) -> Result<Option<Vec<u32>>, InputError> {
-    let mut spans: Vec<Vec<naga::Span>> = Vec::new();
+    let mut spans: Vec<Vec<naga::Span>> =
+        vec![Vec::new(); module.functions.len() + module.entry_points.len()];
     each_statement_span(module, &mut |function, span| {
-        if function == spans.len() {
-            spans.push(Vec::new());
-        }
         let k = spans[function].len() as u32;
         spans[function].push(*span);
         *span = naga::Span::new(k, k);
@@ -300,8 +306,11 @@ fn write_coded(
     let longest = spans.iter().map(Vec::len).max().unwrap_or(0);
     let blank = " ".repeat(longest + 1);
     let coded = write_spirv_with(module, info, &blank, path);
+    // Back in the order they were taken.
+    let mut next = vec![0; spans.len()];
     each_statement_span(module, &mut |function, span| {
-        *span = spans[function][span.to_range().map_or(0, |r| r.start)];
+        *span = spans[function][next[function]];
+        next[function] += 1;
     });
     Ok(restore_positions(
         &coded?,
@@ -380,8 +389,6 @@ fn each_statement_span(module: &mut naga::Module, f: &mut impl FnMut(usize, &mut
     let functions = module.functions.iter_mut().map(|(_, function)| function);
     let entries = module.entry_points.iter_mut().map(|ep| &mut ep.function);
     for (n, function) in functions.chain(entries).enumerate() {
-        // Every function has its number, with statements or without.
-        f(n, &mut naga::Span::default());
         block(n, &mut function.body, f);
     }
 }
@@ -438,12 +445,8 @@ fn restore_positions(
             OP_LINE if inst.len() == 4 => {
                 let code = inst[3].checked_sub(1)? as usize;
                 let span = spans.get(function?)?.get(code)?;
-                let start = span.to_range().map_or(0, |r| r.start).min(source.len());
-                // naga's `Span::location`: the newlines before the start, and
-                // the column in bytes.
-                let line = lines.starts.partition_point(|&s| s <= start);
-                let column = start - lines.starts[line - 1] + 1;
-                out.extend_from_slice(&[inst[0], inst[1], line as u32, column as u32]);
+                let (line, column) = lines.line_byte_col(span.to_range().map_or(0, |r| r.start));
+                out.extend_from_slice(&[inst[0], inst[1], line, column]);
             }
             OP_SOURCE if inst.len() > 4 => {
                 source_instructions(&mut out, inst[1], inst[2], inst[3], source);
