@@ -20,6 +20,7 @@ use crate::program::cfg::call_chains;
 use crate::program::scalar::scalar_size;
 use crate::program::{Constant, Function, Id, Program, SiteKind, Type};
 use crate::shader::Stage;
+use body::Body;
 use rspirv::dr::{Instruction, Operand};
 use spirv::{Op, StorageClass};
 use std::cell::RefCell;
@@ -30,6 +31,8 @@ use std::collections::VecDeque;
 type HashMap<K, V> = rustc_hash::FxHashMap<K, V>;
 type HashSet<T> = rustc_hash::FxHashSet<T>;
 use std::path::PathBuf;
+
+mod body;
 
 /// What suspends the shader.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Serialize)]
@@ -337,31 +340,22 @@ fn is_pointer_param(program: &Program, id: Id) -> bool {
 }
 
 /// Whether `op` is an atomic, ray-query, group or subgroup operation: one
-/// that does not give the same value when done again. (By name, without
-/// allocating: this is asked for every value whose recomputation is weighed.)
+/// that does not give the same value when done again. (By name: asked for
+/// every value whose recomputation is weighed, so each opcode's answer is
+/// kept once worked out.)
 fn varies(op: Op) -> bool {
-    struct Name([u8; 64], usize);
-    impl std::fmt::Write for Name {
-        fn write_str(&mut self, s: &str) -> std::fmt::Result {
-            let room = self.0.len() - self.1;
-            let n = s.len().min(room);
-            self.0[self.1..self.1 + n].copy_from_slice(&s.as_bytes()[..n]);
-            self.1 += n;
-            Ok(())
-        }
+    thread_local! {
+        static KNOWN: RefCell<HashMap<u32, bool>> = RefCell::default();
     }
-    let mut name = Name([0; 64], 0);
-    let _ = std::fmt::Write::write_fmt(&mut name, format_args!("{op:?}"));
-    let name = &name.0[..name.1];
-    [
-        &b"Atomic"[..],
-        b"RayQuery",
-        b"GroupNonUniform",
-        b"Subgroup",
-        b"Group",
-    ]
-    .iter()
-    .any(|p| name.starts_with(p))
+    if let Some(v) = KNOWN.with(|k| k.borrow().get(&(op as u32)).copied()) {
+        return v;
+    }
+    let name = format!("{op:?}");
+    let v = ["Atomic", "RayQuery", "GroupNonUniform", "Subgroup", "Group"]
+        .iter()
+        .any(|p| name.starts_with(p));
+    KNOWN.with(|k| k.borrow_mut().insert(op as u32, v));
+    v
 }
 
 /// A name for a value: its `OpName`, the variable it was loaded from, or the
@@ -427,6 +421,24 @@ fn has_prefix(path: &[u32], prefix: &[u32]) -> bool {
         k += 1;
     }
     true
+}
+
+/// Calls `f` with path `a` followed by `b`: on the stack when short (a
+/// call's effect on its arguments' parts is joined at every visit of the
+/// fixpoint, which allocated a vector each time).
+fn with_joined<R>(a: &[u32], b: &[u32], f: impl FnOnce(&[u32]) -> R) -> R {
+    const ROOM: usize = 16;
+    let n = a.len() + b.len();
+    if n <= ROOM {
+        let mut buf = [0u32; ROOM];
+        buf[..a.len()].copy_from_slice(a);
+        buf[a.len()..n].copy_from_slice(b);
+        f(&buf[..n])
+    } else {
+        let mut v = a.to_vec();
+        v.extend_from_slice(b);
+        f(&v)
+    }
 }
 
 /// Whether two paths are equal (see [`has_prefix`]).
@@ -685,13 +697,41 @@ impl IdSet {
 }
 
 /// A pointer into a function-local variable.
-#[derive(Clone, Debug)]
+#[derive(Clone, Copy, Debug)]
 struct LocalPtr {
     var: Id,
-    /// Constant indices from the variable, up to the first dynamic one.
-    path: Vec<u32>,
+    /// Constant indices from the variable, up to the first dynamic one:
+    /// `FnLiveness::paths[path.0..path.1]` (one list for the function's
+    /// pointers, not a vector each).
+    path: (u32, u32),
     /// Whether every index was constant (the pointer names exactly `path`).
     exact: bool,
+}
+
+impl LocalPtr {
+    /// The whole of variable (or pointer parameter) `var`.
+    fn whole(var: Id) -> LocalPtr {
+        LocalPtr {
+            var,
+            path: (0, 0),
+            exact: true,
+        }
+    }
+
+    fn path_range(&self) -> std::ops::Range<usize> {
+        self.path.0 as usize..self.path.1 as usize
+    }
+}
+
+/// Whether an instruction is half of a copy between local parts (see
+/// `FnLiveness::copy`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Copy {
+    None,
+    /// The store; the load's instruction index.
+    Store(u32),
+    /// The load (its read is the store's).
+    Load,
 }
 
 /// What a function does with each pointer parameter, as its callers see it.
@@ -704,7 +744,7 @@ struct ParamEffect {
 }
 
 /// Per parameter of a function.
-type ExposedParams = Vec<ParamEffect>;
+type ExposedParams = std::rc::Rc<[ParamEffect]>;
 
 /// What the functions of one program share while their liveness is built:
 /// answers that depend on nothing but the function (see
@@ -713,6 +753,10 @@ type ExposedParams = Vec<ParamEffect>;
 #[derive(Default)]
 struct Shared {
     exposed: HashMap<usize, ExposedParams>,
+    /// Functions built exactly as callees: a site's function or a
+    /// caller on a chain met later takes its build from here (the parts
+    /// are solved the same whichever asks; the SSA values on first use).
+    built: HashMap<usize, FnLiveness>,
 }
 
 /// One top-level build: every answer met on the way, exact or not, and
@@ -757,10 +801,186 @@ const MAX_SPLIT: u32 = 64;
 
 /// Variables possibly written on some path to each block's end.
 struct Defined {
-    /// Per block, as indices into `written`.
+    /// Per block, as indices among the variables something writes.
     out: Vec<BitSet>,
-    /// The roots something in the function writes.
-    written: Vec<Id>,
+    /// Each variable's index there (by its ordinal among the function's
+    /// variables), or [`IdIndex::NONE`] when nothing writes it.
+    slot: Vec<u32>,
+}
+
+/// The SSA values of one function live at each block's end: its values
+/// are those defined in it that are not pointers to its variables or
+/// pointer parameters. Solved apart from the parts, by one kill and one
+/// gen set per block (each value is defined once, so nothing in a block
+/// depends on the live set), in flat word arrays: a row of `words` per
+/// block.
+struct SsaLive {
+    /// Each value's ordinal by id from `lo` (or [`IdIndex::NONE`]), and
+    /// the values numbered outside that range (parameters).
+    lo: Id,
+    slot: Vec<u32>,
+    outside: Vec<(Id, u32)>,
+    /// The id of each ordinal.
+    ids: Vec<Id>,
+    words: usize,
+    live_out: Vec<u64>,
+}
+
+impl SsaLive {
+    fn new(fl: &FnLiveness, program: &Program) -> SsaLive {
+        let f = fl.function(program);
+        let body = &fl.body;
+        let (lo, hi) = (body.lo, body.hi);
+        let span = if hi >= lo { (hi - lo) as usize + 1 } else { 0 };
+        let mut ssa = SsaLive {
+            lo,
+            slot: vec![IdIndex::NONE; span],
+            outside: Vec::new(),
+            ids: Vec::new(),
+            words: 0,
+            live_out: Vec::new(),
+        };
+        for &r in &fl.ssa_ids {
+            let k = ssa.ids.len() as u32;
+            match r.checked_sub(lo).map(|d| d as usize).filter(|&d| d < span) {
+                Some(d) if ssa.slot[d] == IdIndex::NONE => ssa.slot[d] = k,
+                Some(_) => continue,
+                None if ssa.outside.iter().any(|&(x, _)| x == r) => continue,
+                None => ssa.outside.push((r, k)),
+            }
+            ssa.ids.push(r);
+        }
+        let n = f.blocks.len();
+        let w = ssa.ids.len().div_ceil(64);
+        ssa.words = w;
+        // Per block: the values it defines, those it reads before defining
+        // them, and (as its first live-out) those its successors' phis read
+        // on the edge from it.
+        let mut kill = vec![0u64; n * w];
+        let mut gen = vec![0u64; n * w];
+        let mut live_out = vec![0u64; n * w];
+        for (b, block) in f.blocks.iter().enumerate() {
+            let _ = block;
+            let row = b * w..(b + 1) * w;
+            for &i in body.block(b).iter().rev() {
+                let i = i as usize;
+                ssa.step(fl, i, &mut gen[row.clone()], Some(&mut kill[row.clone()]));
+                if body.op(i) == Op::Phi && !body.debug(i) {
+                    for pair in body.ids(i).chunks(2) {
+                        if let [value, pred] = pair {
+                            if let Some(p) = f.block_by_label(*pred) {
+                                if let Some(k) = ssa.ordinal(*value) {
+                                    set(&mut live_out[p * w..(p + 1) * w], k);
+                                }
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        // A worklist, as for the parts (see `FnLiveness::solve`).
+        let mut live_in = vec![0u64; n * w];
+        let mut work: Vec<usize> = (0..n).collect();
+        let mut queued = vec![true; n];
+        let mut steps = 0usize;
+        while let Some(b) = work.pop() {
+            queued[b] = false;
+            steps += 1;
+            if steps > n.saturating_mul(10_000) {
+                break;
+            }
+            for &s in &f.blocks[b].succs {
+                if s < n {
+                    for k in 0..w {
+                        live_out[b * w + k] |= live_in[s * w + k];
+                    }
+                }
+            }
+            let mut changed = false;
+            for k in b * w..(b + 1) * w {
+                let v = gen[k] | (live_out[k] & !kill[k]);
+                changed |= v != live_in[k];
+                live_in[k] = v;
+            }
+            if changed {
+                for &p in &fl.preds[b] {
+                    if !queued[p] {
+                        queued[p] = true;
+                        work.push(p);
+                    }
+                }
+            }
+        }
+        ssa.live_out = live_out;
+        ssa
+    }
+
+    #[inline]
+    fn ordinal(&self, id: Id) -> Option<u32> {
+        let k = match id
+            .checked_sub(self.lo)
+            .and_then(|d| self.slot.get(d as usize))
+        {
+            Some(&k) => k,
+            None => self.outside.iter().find(|&&(x, _)| x == id)?.1,
+        };
+        (k != IdIndex::NONE).then_some(k)
+    }
+
+    /// Steps back over instruction `i`: its result dies (into `kill` too,
+    /// when given), the values it reads live. A phi reads on its edges,
+    /// and a copy's load and store read no value (the copy reads the
+    /// source's parts).
+    #[inline]
+    fn step(&self, fl: &FnLiveness, i: usize, live: &mut [u64], kill: Option<&mut [u64]>) {
+        let body = &fl.body;
+        if body.debug(i) {
+            return;
+        }
+        if let Some(k) = body.result(i).and_then(|r| self.ordinal(r)) {
+            unset(live, k);
+            if let Some(kill) = kill {
+                set(kill, k);
+            }
+        }
+        if body.op(i) == Op::Phi || fl.copy[i - body.start()] != Copy::None {
+            return;
+        }
+        for &id in body.ids(i) {
+            if let Some(k) = self.ordinal(id) {
+                set(live, k);
+            }
+        }
+    }
+
+    /// The values live just after instruction `inst` of block `b`.
+    fn after(&self, fl: &FnLiveness, f: &Function, b: usize, inst: usize) -> Vec<Id> {
+        let w = self.words;
+        let _ = f;
+        let mut live = self.live_out[b * w..(b + 1) * w].to_vec();
+        for &k in fl.body.block_after(b, inst).iter().rev() {
+            self.step(fl, k as usize, &mut live, None);
+        }
+        let mut out = Vec::new();
+        for (k, &word) in live.iter().enumerate() {
+            let mut rest = word;
+            while rest != 0 {
+                out.push(self.ids[k * 64 + rest.trailing_zeros() as usize]);
+                rest &= rest - 1;
+            }
+        }
+        out
+    }
+}
+
+#[inline]
+fn set(words: &mut [u64], k: u32) {
+    words[k as usize / 64] |= 1 << (k % 64);
+}
+
+#[inline]
+fn unset(words: &mut [u64], k: u32) {
+    words[k as usize / 64] &= !(1 << (k % 64));
 }
 
 /// The instructions mentioning each root (by its ordinal among
@@ -782,9 +1002,16 @@ impl std::ops::Deref for MentionList {
     }
 }
 
+/// A variable read at an instruction, in the parts read (sorted).
+type RematKey = (Id, usize, Vec<Vec<u32>>);
+
 /// Liveness facts of one function.
 pub struct FnLiveness {
     func: usize,
+    /// The function's instructions, decoded once.
+    body: Body,
+    /// The constant index paths of `roots`, one after another.
+    paths: Vec<u32>,
     /// Function-local `OpVariable`s.
     vars: IdSet,
     /// Pointer ids derived from a local variable or a pointer parameter.
@@ -794,13 +1021,14 @@ pub struct FnLiveness {
     call_reads: HashMap<usize, ExposedParams>,
     /// `OpLoad`s of a whole local part whose only use is the store right
     /// after them into another local part (a copy, such as glslang's
-    /// copy-in of an `inout` argument), by the store's instruction index:
-    /// the load's index.
-    copies: HashMap<usize, usize>,
-    /// The loads of `copies`.
-    copy_loads: HashSet<usize>,
-    /// SSA values that count as state: defined here, not pointers to locals.
-    ssa: IdSet,
+    /// copy-in of an `inout` argument): per instruction from the
+    /// function's start, the store (with its load's index) and the load.
+    copy: Vec<Copy>,
+    /// The function's SSA values, in the order defined.
+    ssa_ids: Vec<Id>,
+    /// SSA values live at each block's end, solved on first use (only a
+    /// site's function and its callers on a chain ask).
+    ssa: std::cell::OnceCell<SsaLive>,
     /// Live places at each block's end, as indices into `places`.
     live_out: Vec<BitSet>,
     /// Every place met while solving (the live sets' members).
@@ -810,9 +1038,9 @@ pub struct FnLiveness {
     /// on first use (a callee solved for its parameters never asks).
     defined: std::cell::OnceCell<Defined>,
     preds: Vec<Vec<usize>>,
-    remat: HashMap<Id, bool>,
+    remat: RefCell<HashMap<Id, bool>>,
     /// Variables' rematerialisation as read at an instruction.
-    remat_at: HashMap<(Id, usize, Vec<Vec<u32>>), bool>,
+    remat_at: RefCell<HashMap<RematKey, bool>>,
     /// Each instruction's backward transfer (from the function's start).
     steps: Vec<Step>,
     /// The places `Step::Plain` reads.
@@ -830,6 +1058,11 @@ pub struct FnLiveness {
 }
 
 impl FnLiveness {
+    /// The constant indices of `p` from its variable.
+    fn path(&self, p: &LocalPtr) -> &[u32] {
+        &self.paths[p.path_range()]
+    }
+
     pub fn new(program: &Program, func: usize) -> FnLiveness {
         Self::build(program, func, &mut Builds::default(), 0).0
     }
@@ -837,6 +1070,9 @@ impl FnLiveness {
     /// The liveness of function `func`, built as [`FnLiveness::new`] would,
     /// reusing (and adding to) the callee answers in `shared`.
     fn shared(program: &Program, func: usize, shared: &mut Shared) -> FnLiveness {
+        if let Some(fl) = shared.built.remove(&func) {
+            return fl;
+        }
         let mut builds = Builds {
             memo: HashMap::default(),
             shared: std::mem::take(shared),
@@ -876,7 +1112,7 @@ impl FnLiveness {
             return (e.clone(), true);
         }
         let f = &program.functions[func];
-        let unknown: ExposedParams = vec![ParamEffect::default(); f.params.len()];
+        let unknown: ExposedParams = vec![ParamEffect::default(); f.params.len()].into();
         // Without pointer parameters a callee reads and writes nothing of
         // its caller's: no need to solve it for that.
         if !f.params.iter().any(|&p| is_pointer_param(program, p)) {
@@ -893,6 +1129,7 @@ impl FnLiveness {
         builds.memo.insert(func, (exposed.clone(), exact));
         if exact {
             builds.shared.exposed.insert(func, exposed.clone());
+            builds.shared.built.insert(func, fl);
         }
         (exposed, exact)
     }
@@ -902,7 +1139,7 @@ impl FnLiveness {
         let f = self.function(program);
         let entry = f.blocks.first().map(|b| b.start);
         let live = entry
-            .map(|i| self.places_after(program, i))
+            .map(|i| self.parts_after(program, i))
             .unwrap_or_default();
         f.params
             .iter()
@@ -915,6 +1152,8 @@ impl FnLiveness {
                     .filter(|(v, _)| v == p)
                     .map(|(_, path)| path.clone())
                     .collect();
+                // (In the set's order, as before: the order the parts are
+                // interned in at each call.)
                 ParamEffect {
                     reads: Some(reads),
                     writes: self.written_on_every_path(program, *p),
@@ -939,23 +1178,22 @@ impl FnLiveness {
             let from = mentions.partition_point(|&i| i < block.start);
             let to = mentions.partition_point(|&i| i <= block.end);
             for &i in &mentions[from..to] {
-                let inst = &program.insts[i];
-                match inst.class.opcode {
+                match self.body.op(i) {
                     Op::Store => {
-                        let t = id_operands(inst).next().and_then(|t| self.roots.get(&t));
+                        let t = self.body.first(i).and_then(|t| self.roots.get(&t));
                         if let Some(t) = t.filter(|t| t.var == var && t.exact) {
-                            w.push(t.path.clone());
+                            w.push(self.path(t).to_vec());
                         }
                     }
                     Op::FunctionCall => {
-                        for (k, a) in id_operands(inst).enumerate().skip(1) {
-                            let Some(t) = self.roots.get(&a).filter(|t| t.var == var && t.exact)
+                        for (k, a) in self.body.ids(i).iter().enumerate().skip(1) {
+                            let Some(t) = self.roots.get(a).filter(|t| t.var == var && t.exact)
                             else {
                                 continue;
                             };
                             let e = self.call_reads.get(&i).and_then(|e| e.get(k - 1));
                             for x in e.map(|e| e.writes.as_slice()).unwrap_or_default() {
-                                let mut path = t.path.clone();
+                                let mut path = self.path(t).to_vec();
                                 path.extend_from_slice(x);
                                 w.push(path);
                             }
@@ -1028,95 +1266,94 @@ impl FnLiveness {
         depth: u32,
     ) -> (FnLiveness, bool) {
         let f = &program.functions[func];
-        // A callee solved for its pointer parameters (`depth` > 0) needs only
-        // the variables' parts: what SSA values are live never changes which
-        // parts are (a load reads its variable whether or not its value is
-        // used), so they are not tracked there at all.
-        let track_ssa = depth == 0;
-        // The body's ids: the function's own and its parameters' are often
-        // numbered long before it, and would widen the dense tables; so are
-        // debug-info instructions' (our HLSL compiler numbers them after
-        // every function), which nothing here looks up.
-        let ids = program.insts[f.start..=f.end]
-            .iter()
-            .filter(|i| !matches!(i.class.opcode, Op::Function | Op::FunctionParameter))
-            .filter(|i| !program.is_debug_inst(i))
-            .filter_map(|i| i.result_id);
-        let (lo, hi) = ids.fold((Id::MAX, 0), |(lo, hi), r| (lo.min(r), hi.max(r)));
+        // Only the variables' parts are solved here; the SSA values apart,
+        // where a site asks (`SsaLive`): what SSA values are live never
+        // changes which parts are (a load reads its variable whether or not
+        // its value is used), and no part changes which values are.
+        // The body's ids (`Body::lo..=hi`): the function's own and its
+        // parameters' are often numbered long before it, and would widen
+        // the dense tables; so are debug-info instructions' (our HLSL
+        // compiler numbers them after every function), which nothing here
+        // looks up.
+        let body = Body::new(program, f);
+        let (lo, hi) = (body.lo, body.hi);
         let mut vars = IdSet::new(lo, hi);
         let mut roots: IdMap<LocalPtr> = IdMap::new(lo, hi);
-        let mut ssa = IdSet::new(lo, hi);
-        if track_ssa {
-            // About one SSA value an instruction: room made once.
-            ssa.keys.reserve(f.end + 1 - f.start);
-        }
-        for inst in &program.insts[f.start..=f.end] {
-            let Some(r) = inst.result_id else { continue };
-            if program.is_debug_inst(inst) {
-                continue;
+        let mut paths: Vec<u32> = Vec::new();
+        // The results that are no pointers to locals (the SSA values, in
+        // the order defined: see `SsaLive`).
+        let mut ssa_ids: Vec<Id> = Vec::new();
+        // Copies from one local part to another: `%v = OpLoad %a; OpStore %b %v`
+        // with `%v` used nowhere else and nothing between the two.
+        // Candidates first (met in this walk); then the uses of their
+        // loaded values only.
+        let mut candidates: Vec<(usize, usize, Id)> = Vec::new();
+        let mut calls: Vec<usize> = Vec::new();
+        let mut prev: Option<usize> = None;
+        for &i in body.kept() {
+            let i = i as usize;
+            let op = body.op(i);
+            if op == Op::Label {
+                // A copy's load and store lie in one block.
+                prev = None;
             }
-            match inst.class.opcode {
+            if let Some(l) = prev.replace(i) {
+                if body.op(l) == Op::Load && op == Op::Store {
+                    let (ld, st) = (body.ids(l), body.ids(i));
+                    if let (Some(v), Some(&src)) = (body.result(l), ld.first()) {
+                        let exact = |p: Id| roots.get(&p).is_some_and(|r| r.exact);
+                        if st.len() == 2 && st[1] == v && exact(src) && exact(st[0]) {
+                            candidates.push((i, l, v));
+                        }
+                    }
+                }
+            }
+            if op == Op::FunctionCall {
+                calls.push(i);
+            }
+            let Some(r) = body.result(i) else { continue };
+            match op {
                 // A pointer parameter is tracked like a variable (its
                 // contents belong to the caller, which counts them).
-                Op::FunctionParameter if is_pointer_type(program, inst.result_type) => {
-                    roots.insert(
-                        r,
-                        LocalPtr {
-                            var: r,
-                            path: Vec::new(),
-                            exact: true,
-                        },
-                    );
+                Op::FunctionParameter if is_pointer_type(program, program.insts[i].result_type) => {
+                    roots.insert(r, LocalPtr::whole(r));
                 }
                 Op::Variable => {
                     vars.add(r);
-                    roots.insert(
-                        r,
-                        LocalPtr {
-                            var: r,
-                            path: Vec::new(),
-                            exact: true,
-                        },
-                    );
+                    roots.insert(r, LocalPtr::whole(r));
                 }
                 Op::AccessChain
                 | Op::InBoundsAccessChain
                 | Op::PtrAccessChain
                 | Op::CopyObject
                 | Op::Bitcast => {
-                    let mut ids = id_operands(inst);
-                    match ids.next().and_then(|b| roots.get(&b)).cloned() {
+                    let ids = body.ids(i);
+                    match ids.first().and_then(|b| roots.get(b)).copied() {
                         Some(mut ptr) => {
-                            let chain = matches!(
-                                inst.class.opcode,
-                                Op::AccessChain | Op::InBoundsAccessChain
-                            );
-                            if inst.class.opcode == Op::PtrAccessChain
-                                || inst.class.opcode == Op::Bitcast
-                            {
+                            let chain = matches!(op, Op::AccessChain | Op::InBoundsAccessChain);
+                            if op == Op::PtrAccessChain || op == Op::Bitcast {
                                 ptr.exact = false;
                             }
                             if chain {
-                                for ix in ids {
+                                // The base's path, then the constant indices
+                                // (while every index so far is constant).
+                                let from = paths.len() as u32;
+                                paths.extend_from_within(ptr.path_range());
+                                for &ix in &ids[1..] {
                                     match program.const_u64(ix) {
-                                        Some(c) if ptr.exact => ptr.path.push(c as u32),
+                                        Some(c) if ptr.exact => paths.push(c as u32),
                                         _ => ptr.exact = false,
                                     }
                                 }
+                                ptr.path = (from, paths.len() as u32);
                             }
                             roots.insert(r, ptr);
                         }
-                        None if track_ssa => {
-                            ssa.add(r);
-                        }
-                        None => {}
+                        None => ssa_ids.push(r),
                     }
                 }
                 Op::Label | Op::Function => {}
-                _ if track_ssa => {
-                    ssa.add(r);
-                }
-                _ => {}
+                _ => ssa_ids.push(r),
             }
         }
         let n = f.blocks.len();
@@ -1128,34 +1365,9 @@ impl FnLiveness {
                 }
             }
         }
-        // Copies from one local part to another: `%v = OpLoad %a; OpStore %b %v`
-        // with `%v` used nowhere else and nothing between the two.
-        // Candidates first; then the uses of their loaded values only.
-        let mut candidates: Vec<(usize, usize, Id)> = Vec::new();
-        for block in &f.blocks {
-            let mut prev: Option<usize> = None;
-            for i in block.start..=block.end {
-                let inst = &program.insts[i];
-                if program.is_debug_inst(inst) || matches!(inst.class.opcode, Op::Line | Op::NoLine)
-                {
-                    continue;
-                }
-                let Some(l) = prev.replace(i) else { continue };
-                let (load, store) = (&program.insts[l], inst);
-                if load.class.opcode != Op::Load || store.class.opcode != Op::Store {
-                    continue;
-                }
-                let (Some(v), Some(src)) = (load.result_id, id_operands(load).next()) else {
-                    continue;
-                };
-                let ops: Vec<Id> = id_operands(store).collect();
-                let exact = |p: Id| roots.get(&p).is_some_and(|r| r.exact);
-                if ops.len() == 2 && ops[1] == v && exact(src) && exact(ops[0]) {
-                    candidates.push((i, l, v));
-                }
-            }
-        }
-        let mut copies = HashMap::default();
+        // Per instruction: the load a copy's store copies from, or that a
+        // load is a copy's (read at the store).
+        let mut copy = vec![Copy::None; f.end + 1 - f.start];
         if !candidates.is_empty() {
             // Counted by the loaded values' ordinals: a dense lookup per
             // operand of every instruction, not a hash.
@@ -1164,33 +1376,25 @@ impl FnLiveness {
                 loaded.add(c.2);
             }
             let mut uses = vec![0usize; loaded.len()];
-            for inst in &program.insts[f.start..=f.end] {
-                if program.is_debug_inst(inst) {
-                    continue;
-                }
-                for id in id_operands(inst) {
-                    if let Some(k) = loaded.ordinal(id) {
+            for &i in body.kept() {
+                for id in body.ids(i as usize) {
+                    if let Some(k) = loaded.ordinal(*id) {
                         uses[k] += 1;
                     }
                 }
             }
             for (store, load, v) in candidates {
                 if loaded.ordinal(v).map(|k| uses[k]) == Some(1) {
-                    copies.insert(store, load);
+                    copy[store - f.start] = Copy::Store(load as u32);
+                    copy[load - f.start] = Copy::Load;
                 }
             }
         }
         // What each call reads through the pointers it passes.
         let mut call_reads = HashMap::default();
         let mut exact = true;
-        for i in f.start..=f.end {
-            let inst = &program.insts[i];
-            if inst.class.opcode != Op::FunctionCall {
-                continue;
-            }
-            let callee = id_operands(inst)
-                .next()
-                .and_then(|c| program.function_index(c));
+        for i in calls {
+            let callee = body.first(i).and_then(|c| program.function_index(c));
             if let Some(c) = callee {
                 let (e, e_exact) = Self::exposed_params(program, c, builds, depth);
                 exact &= e_exact;
@@ -1199,18 +1403,20 @@ impl FnLiveness {
         }
         let mut fl = FnLiveness {
             func,
+            body,
+            paths,
             vars,
             roots,
             call_reads,
-            copy_loads: copies.values().copied().collect(),
-            copies,
-            ssa,
+            copy,
+            ssa_ids,
+            ssa: std::cell::OnceCell::new(),
             live_out: vec![BitSet::default(); n],
             places: RefCell::new(Places::new(lo, hi, f.end + 1 - f.start)),
             defined: std::cell::OnceCell::new(),
             preds,
-            remat: HashMap::default(),
-            remat_at: HashMap::default(),
+            remat: RefCell::default(),
+            remat_at: RefCell::default(),
             steps: Vec::new(),
             step_uses: Vec::new(),
             segments: Vec::new(),
@@ -1228,21 +1434,19 @@ impl FnLiveness {
     fn prepare_steps(&mut self, program: &Program) {
         let f = &program.functions[self.func];
         let places = self.places.get_mut();
-        let mut steps = Vec::with_capacity(f.end + 1 - f.start);
+        let mut steps = vec![Step::Skip; f.end + 1 - f.start];
         // About two operands an instruction, and as many run entries.
         let mut pool = Vec::with_capacity(4 * (f.end + 1 - f.start));
         // Every function built asks for its variables' mentions (the
         // "written before" sets, a parameter's must-writes): gathered in
         // this walk, not another.
         let mut mentions = MentionPairs::new(self.roots.len(), f.end + 1 - f.start);
-        for at in f.start..=f.end {
-            let inst = &program.insts[at];
-            let op = inst.class.opcode;
-            if program.is_debug_inst(inst) {
-                steps.push(Step::Skip);
-                continue;
-            }
-            let other = self.copies.contains_key(&at)
+        let body = &self.body;
+        for &at in body.kept() {
+            let at = at as usize;
+            let op = body.op(at);
+            let copy = self.copy[at - f.start];
+            let other = matches!(copy, Copy::Store(_))
                 || matches!(
                     op,
                     Op::Store
@@ -1253,9 +1457,10 @@ impl FnLiveness {
                 );
             // Only SSA values and variables (pointer parameters) are ever
             // places; another result cannot be live.
-            let def = match inst.result_id {
+            let result = body.result(at);
+            let def = match result {
                 Some(r) if !other => {
-                    if self.ssa.contains(&r) || self.roots.get(&r).is_some_and(|p| p.var == r) {
+                    if self.roots.get(&r).is_some_and(|p| p.var == r) {
                         places.intern(r, &[])
                     } else {
                         Places::NONE
@@ -1267,14 +1472,13 @@ impl FnLiveness {
             // reads (in that order, as the places are numbered).
             // A copy's load reads nothing here (the store does), and phi
             // operands are used on the incoming edge (`solve`).
-            let reads =
-                !(other || op == Op::Phi || (op == Op::Load && self.copy_loads.contains(&at)));
+            let reads = !(other || op == Op::Phi || copy == Copy::Load);
             let derives = derives_pointer(op);
             let start = pool.len() as u32;
-            if let Some(r) = inst.result_id.filter(|r| self.vars.contains(r)) {
+            if let Some(r) = result.filter(|r| self.vars.contains(r)) {
                 mentions.add(&self.roots, at, r);
             }
-            for id in id_operands(inst) {
+            for &id in body.ids(at) {
                 let root = self.roots.get(&id);
                 if let Some(p) = root {
                     mentions.add(&self.roots, at, p.var);
@@ -1282,72 +1486,71 @@ impl FnLiveness {
                 if !reads {
                     continue;
                 }
-                if self.ssa.contains(&id) {
-                    pool.push(places.intern(id, &[]));
-                }
                 if let Some(p) = root.filter(|_| !derives) {
-                    pool.push(places.intern(p.var, &p.path));
+                    pool.push(places.intern(p.var, &self.paths[p.path_range()]));
                 }
             }
-            steps.push(if other {
+            steps[at - f.start] = if other {
                 Step::Other
             } else {
                 Step::Plain {
                     def,
                     uses: start..pool.len() as u32,
                 }
-            });
+            };
         }
         // Fold each block's runs of plain steps: stepping back over
         // "kill d, then make U live" after (kill K, then make G live) is
         // (kill K ∪ {d}, then make (G − {d}) ∪ U live).
         let mut segments = Vec::new();
         let mut block_segments = Vec::with_capacity(f.blocks.len() + 1);
-        // The run being folded, as sets; written to the pool when it ends.
-        let (mut kill, mut gen) = (BitSet::default(), BitSet::default());
-        let mut in_run = false;
-        let end_run = |kill: &mut BitSet,
-                       gen: &mut BitSet,
+        // The run being folded, as short lists (only the variables' parts
+        // a run reads: most instructions touch none); written to the pool
+        // when it ends, and not at all when empty.
+        let (mut kill, mut gen): (Vec<u32>, Vec<u32>) = (Vec::new(), Vec::new());
+        let end_run = |kill: &mut Vec<u32>,
+                       gen: &mut Vec<u32>,
                        pool: &mut Vec<u32>,
                        segments: &mut Vec<Segment>| {
+            if kill.is_empty() && gen.is_empty() {
+                return;
+            }
             let k0 = pool.len() as u32;
-            pool.extend(kill.iter());
+            pool.append(kill);
             let g0 = pool.len() as u32;
-            pool.extend(gen.iter());
+            pool.append(gen);
             let g1 = pool.len() as u32;
             segments.push(Segment::Run {
                 kill: k0..g0,
                 gen: g0..g1,
             });
-            kill.clear();
-            gen.clear();
         };
-        for block in &f.blocks {
+        for b in 0..f.blocks.len() {
             block_segments.push(segments.len() as u32);
-            for at in (block.start..=block.end).rev() {
+            for &at in self.body.block(b).iter().rev() {
+                let at = at as usize;
                 match &steps[at - f.start] {
                     Step::Skip => {}
                     Step::Plain { def, uses } => {
-                        in_run = true;
                         if *def != Places::NONE {
-                            kill.insert(*def);
-                            gen.remove(*def);
+                            if !kill.contains(def) {
+                                kill.push(*def);
+                            }
+                            gen.retain(|g| g != def);
                         }
-                        for k in uses.start..uses.end {
-                            gen.insert(pool[k as usize]);
+                        for &u in &pool[uses.start as usize..uses.end as usize] {
+                            if !gen.contains(&u) {
+                                gen.push(u);
+                            }
                         }
                     }
                     Step::Other => {
-                        if std::mem::take(&mut in_run) {
-                            end_run(&mut kill, &mut gen, &mut pool, &mut segments);
-                        }
+                        end_run(&mut kill, &mut gen, &mut pool, &mut segments);
                         segments.push(Segment::Inst(at));
                     }
                 }
             }
-            if std::mem::take(&mut in_run) {
-                end_run(&mut kill, &mut gen, &mut pool, &mut segments);
-            }
+            end_run(&mut kill, &mut gen, &mut pool, &mut segments);
         }
         block_segments.push(segments.len() as u32);
         self.steps = steps;
@@ -1401,13 +1604,13 @@ impl FnLiveness {
             }
             _ => {}
         }
-        let inst = &program.insts[at];
-        if program.is_debug_inst(inst) {
+        let body = &self.body;
+        if body.debug(at) {
             return;
         }
         let places = &mut *self.places.borrow_mut();
-        let op = inst.class.opcode;
-        if let Some(r) = inst.result_id {
+        let op = body.op(at);
+        if let Some(r) = body.result(at) {
             if let Some(i) = places.get(r, &[]) {
                 live.remove(i);
             }
@@ -1418,42 +1621,43 @@ impl FnLiveness {
                 }
             }
         }
-        if let Some(&load) = self.copies.get(&at) {
+        let copy = self.copy[at - start];
+        if let Copy::Store(load) = copy {
             // A copy: the parts of the target live after it were the same
             // parts of the source.
-            let mut ops = id_operands(inst);
-            let dst_ptr = ops.next();
-            let src_ptr = id_operands(&program.insts[load]).next();
+            let dst_ptr = body.first(at);
+            let src_ptr = body.first(load as usize);
             if let (Some(dst), Some(src)) = (
                 dst_ptr.and_then(|p| self.roots.get(&p)),
                 src_ptr.and_then(|p| self.roots.get(&p)),
             ) {
+                let dst_path = self.path(dst);
                 let wanted: Vec<Vec<u32>> = places
                     .of(dst.var)
                     .filter(|&i| live.contains(i))
                     .filter_map(|i| {
                         let q = &places.place(i).1;
-                        if has_prefix(q, &dst.path) {
-                            Some(q[dst.path.len()..].to_vec())
-                        } else if has_prefix(&dst.path, q) {
+                        if has_prefix(q, dst_path) {
+                            Some(q[dst_path.len()..].to_vec())
+                        } else if has_prefix(dst_path, q) {
                             Some(Vec::new())
                         } else {
                             None
                         }
                     })
                     .collect();
-                self.kill(program, places, live, dst);
+                self.kill(program, places, live, dst.var, dst_path);
                 for r in wanted {
-                    let mut path = src.path.clone();
-                    path.extend(r);
-                    live.insert(places.intern(src.var, &path));
+                    with_joined(self.path(src), &r, |path| {
+                        live.insert(places.intern(src.var, path));
+                    });
                 }
                 return;
             }
         }
-        if op == Op::Load && self.copy_loads.contains(&at) {
+        if copy == Copy::Load {
             // Its read is the copy's, handled at the store.
-            if let Some(i) = inst.result_id.and_then(|r| places.get(r, &[])) {
+            if let Some(i) = body.result(at).and_then(|r| places.get(r, &[])) {
                 live.remove(i);
             }
             return;
@@ -1462,20 +1666,17 @@ impl FnLiveness {
             // Phi operands are used on the incoming edge, handled by `solve`.
             Op::Phi => return,
             Op::Store | Op::CopyMemory | Op::CopyMemorySized => {
-                if let Some(Operand::IdRef(ptr)) = inst.operands.first() {
-                    if let Some(p) = self.roots.get(ptr).filter(|p| p.exact) {
-                        self.kill(program, places, live, p);
+                if let Some(ptr) = body.first(at) {
+                    if let Some(p) = self.roots.get(&ptr).filter(|p| p.exact) {
+                        self.kill(program, places, live, p.var, self.path(p));
                     }
                 }
             }
             _ => {}
         }
         let derives = derives_pointer(op);
-        for (k, id) in id_operands(inst).enumerate() {
-            if self.ssa.contains(&id) {
-                live.insert(places.intern(id, &[]));
-            }
-            if let Some(p) = self.roots.get(&id) {
+        for (k, id) in body.ids(at).iter().enumerate() {
+            if let Some(p) = self.roots.get(id) {
                 // Deriving a pointer reads nothing; a store's target is
                 // written, not read; anything else may read the variable.
                 let reads = match op {
@@ -1493,64 +1694,63 @@ impl FnLiveness {
                 let effect = (op == Op::FunctionCall && k > 0 && p.exact)
                     .then(|| self.call_reads.get(&at)?.get(k - 1))
                     .flatten();
+                let base = self.path(p);
                 if let Some(e) = effect {
                     for w in &e.writes {
-                        let mut path = p.path.clone();
-                        path.extend_from_slice(w);
-                        self.kill(
-                            program,
-                            places,
-                            live,
-                            &LocalPtr {
-                                var: p.var,
-                                path,
-                                exact: true,
-                            },
-                        );
+                        with_joined(base, w, |path| {
+                            self.kill(program, places, live, p.var, path);
+                        });
                     }
                 }
                 match effect.and_then(|e| e.reads.as_ref()) {
                     Some(parts) => {
                         for q in parts {
-                            let mut path = p.path.clone();
-                            path.extend_from_slice(q);
-                            live.insert(places.intern(p.var, &path));
+                            with_joined(base, q, |path| {
+                                live.insert(places.intern(p.var, path));
+                            });
                         }
                     }
                     None => {
-                        live.insert(places.intern(p.var, &p.path));
+                        live.insert(places.intern(p.var, base));
                     }
                 }
             }
         }
     }
 
-    /// A write of exactly `ptr`'s part: that part and everything inside it
-    /// is dead before the write; a live enclosing part stays live only in
-    /// the pieces the write does not cover.
-    fn kill(&self, program: &Program, places: &mut Places, live: &mut BitSet, ptr: &LocalPtr) {
+    /// A write of exactly part `path` of `var`: that part and everything
+    /// inside it is dead before the write; a live enclosing part stays
+    /// live only in the pieces the write does not cover.
+    fn kill(
+        &self,
+        program: &Program,
+        places: &mut Places,
+        live: &mut BitSet,
+        var: Id,
+        path: &[u32],
+    ) {
         // The parts inside go at once; the (rare) enclosing ones are split
         // after, when the places can be added to: a list only for those.
         // (A split piece is never inside the part written, so the order
         // does not matter.)
         let mut enclosing: Vec<u32> = Vec::new();
-        for i in places.of(ptr.var) {
+        for i in places.of(var) {
             if !live.contains(i) {
                 continue;
             }
             let q = &places.place(i).1;
-            if has_prefix(q, &ptr.path) {
+            if has_prefix(q, path) {
                 live.remove(i);
-            } else if has_prefix(&ptr.path, q) {
+            } else if has_prefix(path, q) {
                 enclosing.push(i);
             }
         }
         for i in enclosing {
             let q = places.place(i).1.clone();
-            if let Some(pieces) = self.split(program, ptr.var, &q, &ptr.path) {
+            if let Some(pieces) = self.split(program, var, &q, path) {
                 live.remove(i);
                 for p in pieces {
-                    live.insert(places.intern(ptr.var, &p));
+                    live.insert(places.intern(var, &p));
                 }
             }
         }
@@ -1594,23 +1794,23 @@ impl FnLiveness {
     /// constant, which is recomputed rather than kept across a call.
     /// (Given to `each` one by one: asked of every instruction, and most
     /// write nothing.)
-    fn writes(&self, program: &Program, inst: &Instruction, each: impl FnMut(Id)) {
-        match inst.class.opcode {
+    fn writes(&self, program: &Program, i: usize, each: impl FnMut(Id)) {
+        let body = &self.body;
+        match body.op(i) {
             Op::Load | Op::AccessChain | Op::InBoundsAccessChain | Op::PtrAccessChain => {}
-            _ if program.is_debug_inst(inst) => {}
-            Op::Variable if inst.operands.len() > 1 => {
-                let constant = matches!(
-                    inst.operands.get(1),
-                    Some(Operand::IdRef(init))
-                        if program.constants.contains_key(init)
-                            || program.spec_constants.contains_key(init)
-                );
+            _ if body.debug(i) => {}
+            Op::Variable if !body.ids(i).is_empty() => {
+                let init = body.ids(i)[0];
+                let constant = program.constants.contains_key(&init)
+                    || program.spec_constants.contains_key(&init);
                 if !constant {
-                    inst.result_id.into_iter().for_each(each);
+                    body.result(i).into_iter().for_each(each);
                 }
             }
-            _ => id_operands(inst)
-                .filter_map(|id| self.root(id))
+            _ => body
+                .ids(i)
+                .iter()
+                .filter_map(|&id| self.root(id))
                 .for_each(each),
         }
     }
@@ -1618,46 +1818,10 @@ impl FnLiveness {
     fn solve(&mut self, program: &Program) {
         let f = self.function(program);
         let n = f.blocks.len();
-        // Phi uses per predecessor block.
-        let mut phi_uses: Vec<Vec<Id>> = vec![Vec::new(); n];
-        for block in &f.blocks {
-            for inst in &program.insts[block.start..=block.end] {
-                if inst.class.opcode != Op::Phi {
-                    continue;
-                }
-                let ids: Vec<Id> = id_operands(inst).collect();
-                for pair in ids.chunks(2) {
-                    if let [value, pred] = pair {
-                        if let Some(p) = f.block_by_label(*pred) {
-                            if self.ssa.contains(value) {
-                                phi_uses[p].push(*value);
-                            }
-                        }
-                    }
-                }
-            }
-        }
         let mut live_in: Vec<BitSet> = vec![BitSet::default(); n];
-        let phi_uses: Vec<BitSet> = {
-            let places = &mut *self.places.borrow_mut();
-            let mut sets: Vec<BitSet> = phi_uses
-                .iter()
-                .map(|uses| {
-                    let mut set = BitSet::default();
-                    for &v in uses {
-                        set.insert(places.intern(v, &[]));
-                    }
-                    set
-                })
-                .collect();
-            // Every place met so far fits from the start: the sets copied
-            // from these do not grow word by word in the loop below.
-            let known = places.list.len() as u32;
-            for set in &mut sets {
-                set.reserve_indices(known);
-            }
-            sets
-        };
+        // Every place met so far fits from the start: the sets do not grow
+        // word by word in the loop below.
+        let known = self.places.get_mut().list.len() as u32;
         // A worklist: a block is redone only when a successor's live-in
         // grew (every block once first, last block first), instead of every
         // block every round until a whole round changes nothing.
@@ -1673,7 +1837,8 @@ impl FnLiveness {
                 break;
             }
             let mut out = std::mem::take(&mut self.live_out[b]);
-            out.clone_from(&phi_uses[b]);
+            out.clear();
+            out.reserve_indices(known);
             for &s in &f.blocks[b].succs {
                 if let Some(li) = live_in.get(s) {
                     out.union_with(li);
@@ -1704,24 +1869,26 @@ impl FnLiveness {
             // variables are asked about, and only an instruction that
             // mentions one can write it: each variable's mentions, not
             // every instruction.
-            let mut written = Vec::new();
+            let mut written = 0u32;
+            let mut slot = vec![IdIndex::NONE; self.vars.keys.len()];
             let mut own: Vec<BitSet> = vec![BitSet::default(); f.blocks.len()];
-            for &var in &self.vars.keys {
+            for (ordinal, &var) in self.vars.keys.iter().enumerate() {
                 let Some(mentions) = self.mentions(program, var) else {
                     continue;
                 };
-                let k = written.len() as u32;
+                let k = written;
                 let mut any = false;
                 for &i in mentions.iter() {
                     let mut hit = false;
-                    self.writes(program, &program.insts[i], |id| hit |= id == var);
+                    self.writes(program, i, |id| hit |= id == var);
                     if let Some(b) = hit.then(|| block_at(f, i)).flatten() {
                         own[b].insert(k);
                         any = true;
                     }
                 }
                 if any {
-                    written.push(var);
+                    slot[ordinal] = k;
+                    written += 1;
                 }
             }
             let mut out = vec![BitSet::default(); f.blocks.len()];
@@ -1742,7 +1909,7 @@ impl FnLiveness {
                     }
                 }
             }
-            Defined { out, written }
+            Defined { out, slot }
         })
     }
 
@@ -1756,13 +1923,29 @@ impl FnLiveness {
 
     /// SSA values and parts of variables live just after instruction `inst`.
     fn places_after(&self, program: &Program, inst: usize) -> HashSet<Place> {
+        let mut out = self.parts_after(program, inst);
+        let f = self.function(program);
+        if let Some(b) = block_at(f, inst) {
+            let ssa = self.ssa.get_or_init(|| SsaLive::new(self, program));
+            out.extend(
+                ssa.after(self, f, b, inst)
+                    .into_iter()
+                    .map(|id| (id, Vec::new())),
+            );
+        }
+        out
+    }
+
+    /// The parts of variables (and pointer parameters) live just after
+    /// instruction `inst`.
+    fn parts_after(&self, program: &Program, inst: usize) -> HashSet<Place> {
         let f = self.function(program);
         let Some(b) = block_at(f, inst) else {
             return HashSet::default();
         };
         let mut live = self.live_out[b].clone();
-        for k in (inst + 1..=f.blocks[b].end).rev() {
-            self.step_back(program, k, &mut live);
+        for &k in self.body.block_after(b, inst).iter().rev() {
+            self.step_back(program, k as usize, &mut live);
         }
         let places = self.places.borrow();
         live.iter().map(|i| places.place(i).clone()).collect()
@@ -1770,7 +1953,7 @@ impl FnLiveness {
 
     /// Bytes of the live parts of variable `var` (of type `ty`): all of it
     /// when the whole is live, else the sum of the outermost live parts.
-    fn live_part_size(program: &Program, ty: Id, paths: &[&Vec<u32>]) -> u64 {
+    fn live_part_size(program: &Program, ty: Id, paths: &[&[u32]]) -> u64 {
         let whole = scalar_size(program, ty).unwrap_or(0);
         if paths.iter().any(|p| p.is_empty()) {
             return whole;
@@ -1792,23 +1975,33 @@ impl FnLiveness {
         sum.min(whole)
     }
 
-    /// Variables possibly written before instruction `inst`.
-    fn defined_before(&self, program: &Program, inst: usize) -> HashSet<Id> {
+    /// Whether variable `var` may be written before instruction `inst`
+    /// (on some path to it): asked only of the live variables, so their
+    /// own writes are looked up, not a set of all built.
+    fn written_before(&self, program: &Program, var: Id, inst: usize) -> bool {
         let f = self.function(program);
         let Some(b) = block_at(f, inst) else {
-            return HashSet::default();
+            return false;
         };
         let defined = self.defined(program);
-        let mut d: HashSet<Id> = HashSet::default();
-        for &p in &self.preds[b] {
-            d.extend(defined.out[p].iter().map(|i| defined.written[i as usize]));
+        let slot = self
+            .vars
+            .ordinal(var)
+            .map_or(IdIndex::NONE, |k| defined.slot[k]);
+        if slot != IdIndex::NONE && self.preds[b].iter().any(|&p| defined.out[p].contains(slot)) {
+            return true;
         }
-        for k in f.blocks[b].start..inst {
-            self.writes(program, &program.insts[k], |id| {
-                d.insert(id);
-            });
-        }
-        d
+        // Only an instruction that mentions `var` can write it.
+        let Some(mentions) = self.mentions(program, var) else {
+            return false;
+        };
+        let from = mentions.partition_point(|&i| i < f.blocks[b].start);
+        let to = mentions.partition_point(|&i| i < inst);
+        mentions[from..to.max(from)].iter().any(|&k| {
+            let mut hit = false;
+            self.writes(program, k, |id| hit |= id == var);
+            hit
+        })
     }
 
     /// The places in this function that call `call` passes for the
@@ -1819,16 +2012,16 @@ impl FnLiveness {
         call: usize,
         params: &[(usize, Vec<u32>)],
     ) -> Vec<Place> {
-        let inst = &program.insts[call];
-        if inst.class.opcode != Op::FunctionCall {
+        let _ = program;
+        if self.body.op(call) != Op::FunctionCall {
             return Vec::new();
         }
-        let args: Vec<Id> = id_operands(inst).skip(1).collect();
+        let args = &self.body.ids(call)[1..];
         params
             .iter()
             .filter_map(|(k, path)| {
                 let root = self.roots.get(args.get(*k)?)?;
-                let mut p = root.path.clone();
+                let mut p = self.path(root).to_vec();
                 if root.exact {
                     p.extend_from_slice(path);
                 }
@@ -1863,18 +2056,27 @@ impl FnLiveness {
         places: &HashSet<Place>,
         described: bool,
     ) -> Vec<LiveValue> {
-        let live: HashSet<Id> = places.iter().map(|(id, _)| *id).collect();
-        let defined = self.defined_before(program, inst);
-        let result = program.insts.get(inst).and_then(|i| i.result_id);
-        let mut ids: Vec<Id> = live
-            .into_iter()
-            .filter(|id| Some(*id) != result)
-            .filter(|id| !self.vars.contains(id) || defined.contains(id))
-            .collect();
-        ids.sort_unstable();
+        // The places by id: each value's parts side by side.
+        let mut by_id: Vec<(Id, &[u32])> =
+            places.iter().map(|(id, p)| (*id, p.as_slice())).collect();
+        by_id.sort_unstable_by_key(|&(id, _)| id);
+        let result = self.body.result(inst);
         let mut out = Vec::new();
-        for id in ids {
+        let mut k = 0;
+        while k < by_id.len() {
+            let id = by_id[k].0;
+            let from = k;
+            while k < by_id.len() && by_id[k].0 == id {
+                k += 1;
+            }
+            let parts = &by_id[from..k];
+            if Some(id) == result {
+                continue;
+            }
             let is_var = self.vars.contains(&id);
+            if is_var && !self.written_before(program, id, inst) {
+                continue;
+            }
             let ty = if is_var {
                 program
                     .def(id)
@@ -1896,21 +2098,13 @@ impl FnLiveness {
                 _ => {}
             }
             let rematerializable = if is_var {
-                let parts: Vec<Vec<u32>> = places
-                    .iter()
-                    .filter(|(v, _)| *v == id)
-                    .map(|(_, p)| p.clone())
-                    .collect();
+                let parts: Vec<Vec<u32>> = parts.iter().map(|(_, p)| p.to_vec()).collect();
                 self.remat_var(program, id, inst, &parts, 0)
             } else {
                 self.remat_ssa(program, id, 0)
             };
             let size = if is_var {
-                let paths: Vec<&Vec<u32>> = places
-                    .iter()
-                    .filter(|(v, _)| *v == id)
-                    .map(|(_, p)| p)
-                    .collect();
+                let paths: Vec<&[u32]> = parts.iter().map(|&(_, p)| p).collect();
                 FnLiveness::live_part_size(program, ty, &paths)
             } else {
                 scalar_size(program, ty).unwrap_or(0)
@@ -1975,22 +2169,24 @@ impl FnLiveness {
         out
     }
 
-    fn reads(&self, program: &Program, inst: &Instruction, id: Id) -> bool {
-        if program.is_debug_inst(inst) {
+    fn reads(&self, i: usize, id: Id) -> bool {
+        let body = &self.body;
+        if body.debug(i) {
             return false;
         }
-        if inst.class.opcode == Op::Phi {
-            return id_operands(inst).step_by(2).any(|x| x == id);
+        let ids = body.ids(i);
+        if body.op(i) == Op::Phi {
+            return ids.iter().step_by(2).any(|&x| x == id);
         }
         if self.vars.contains(&id) {
-            match inst.class.opcode {
+            match body.op(i) {
                 Op::Load | Op::FunctionCall | Op::CopyMemory | Op::ExtInst => {
-                    id_operands(inst).any(|x| self.root(x) == Some(id))
+                    ids.iter().any(|&x| self.root(x) == Some(id))
                 }
                 _ => false,
             }
         } else {
-            id_operands(inst).any(|x| x == id)
+            ids.contains(&id)
         }
     }
 
@@ -2005,10 +2201,8 @@ impl FnLiveness {
     ) -> Option<Location> {
         let f = self.function(program);
         let b0 = block_at(f, inst)?;
-        let reads = |k: usize| {
-            only.is_none_or(|m| m.binary_search(&k).is_ok())
-                && self.reads(program, &program.insts[k], id)
-        };
+        let reads =
+            |k: usize| only.is_none_or(|m| m.binary_search(&k).is_ok()) && self.reads(k, id);
         let mut found = None;
         for k in inst + 1..=f.blocks[b0].end {
             if reads(k) {
@@ -2044,9 +2238,8 @@ impl FnLiveness {
         let f = self.function(program);
         (f.start..=f.end)
             .filter(|&i| {
-                let inst = &program.insts[i];
-                inst.class.opcode == Op::Store
-                    && id_operands(inst).next().and_then(|p| self.root(p)) == Some(var)
+                self.body.op(i) == Op::Store
+                    && self.body.first(i).and_then(|p| self.root(p)) == Some(var)
             })
             .find_map(|i| program.inst_location(i))
             .or_else(|| program.decl_location(crate::program::Decl::Var(var)))
@@ -2054,26 +2247,31 @@ impl FnLiveness {
 
     /// Whether an SSA value can be recomputed after the trace from builtins,
     /// push constants, uniform or storage loads and constants.
-    fn remat_ssa(&mut self, program: &Program, id: Id, depth: u32) -> bool {
+    fn remat_ssa(&self, program: &Program, id: Id, depth: u32) -> bool {
         if program.constants.contains_key(&id) || program.spec_constants.contains_key(&id) {
             return true;
         }
-        if let Some(&r) = self.remat.get(&id) {
+        if let Some(&r) = self.remat.borrow().get(&id) {
             return r;
         }
         let Some(&i) = program.defs.get(&id) else {
             return false;
         };
-        let inst = &program.insts[i];
-        let op = inst.class.opcode;
+        let f = self.function(program);
+        let inside = (f.start..=f.end).contains(&i);
+        let op = if inside {
+            self.body.op(i)
+        } else {
+            program.insts[i].class.opcode
+        };
         if op == Op::Undef {
             return true;
         }
-        if depth > 64 || !(self.function(program).start..=self.function(program).end).contains(&i) {
+        if depth > 64 || !inside {
             return false;
         }
         // Cycles through phis are loop-carried: not recomputable.
-        self.remat.insert(id, false);
+        self.remat.borrow_mut().insert(id, false);
         let r = match op {
             Op::Phi | Op::FunctionCall | Op::FunctionParameter | Op::Variable => false,
             // A clock reads time, and subgroup operations depend on which
@@ -2081,12 +2279,12 @@ impl FnLiveness {
             Op::ReadClockKHR => false,
             _ if varies(op) => false,
             Op::Load => {
-                let ptr = id_operands(inst).next().unwrap_or(0);
+                let ptr = self.body.first(i).unwrap_or(0);
                 match self.root(ptr) {
                     // The caller's value: not known here.
                     Some(v) if !self.vars.contains(&v) => false,
                     Some(v) => {
-                        let part = self.roots.get(&ptr).map(|p| p.path.clone());
+                        let part = self.roots.get(&ptr).map(|p| self.path(p).to_vec());
                         self.remat_var(
                             program,
                             v,
@@ -2103,18 +2301,18 @@ impl FnLiveness {
                     None => self.remat_global_ptr(program, ptr, depth + 1),
                 }
             }
-            _ => {
-                let ids: Vec<Id> = id_operands(inst).collect();
-                ids.into_iter().all(|x| {
-                    // Extended-instruction sets are ids too: they are constant.
-                    matches!(
+            // Extended-instruction sets are ids too: they are constant.
+            // (Asked after the value itself, which is no set but for those:
+            // the set's definition is looked up only then.)
+            _ => self.body.ids(i).iter().all(|&x| {
+                self.remat_ssa(program, x, depth + 1)
+                    || matches!(
                         program.def(x).map(|d| d.class.opcode),
                         Some(Op::ExtInstImport)
-                    ) || self.remat_ssa(program, x, depth + 1)
-                })
-            }
+                    )
+            }),
         };
-        self.remat.insert(id, r);
+        self.remat.borrow_mut().insert(id, r);
         r
     }
 
@@ -2131,7 +2329,7 @@ impl FnLiveness {
         )
     }
 
-    fn remat_global_ptr(&mut self, program: &Program, ptr: Id, depth: u32) -> bool {
+    fn remat_global_ptr(&self, program: &Program, ptr: Id, depth: u32) -> bool {
         // As deep as `remat_ssa` looks; an access chain that is its own base
         // (invalid, found by fuzzing) recursed until the stack overflowed.
         if depth > 64 {
@@ -2171,7 +2369,7 @@ impl FnLiveness {
     /// address. Only writes to the `parts` read count (all of them when
     /// `parts` is empty or holds the whole variable).
     fn remat_var(
-        &mut self,
+        &self,
         program: &Program,
         var: Id,
         at: usize,
@@ -2180,24 +2378,24 @@ impl FnLiveness {
     ) -> bool {
         let mut parts = parts.to_vec();
         parts.sort();
-        let key = (var, at, parts.clone());
-        if let Some(&r) = self.remat_at.get(&key) {
+        let key = (var, at, parts);
+        if let Some(&r) = self.remat_at.borrow().get(&key) {
             return r;
         }
-        self.remat_at.insert(key.clone(), false);
-        // Shared, not copied: the loop below recurses into `self`.
+        self.remat_at.borrow_mut().insert(key.clone(), false);
+        let parts = &key.2;
         let mentions = self.mentions(program, var);
         let reaching = self.reaching_writes(program, var, at, mentions.as_deref().unwrap_or(&[]));
         let mut ok = true;
-        let mut stored: Vec<(Vec<u32>, Id)> = Vec::new();
+        // The paths stored to, as ranges of `self.paths`.
+        let mut stored: Vec<((u32, u32), Id)> = Vec::new();
+        let body = &self.body;
         for &i in mentions.iter().flat_map(|m| m.iter()) {
-            let inst = &program.insts[i];
-            // The operands one by one: a vector of them per mention was a
-            // good part of this function's time.
-            let mut ids = id_operands(inst);
-            match inst.class.opcode {
+            let ids = body.ids(i);
+            match body.op(i) {
                 Op::Variable => {
-                    if let Some(init) = ids.next().filter(|_| reaching.binary_search(&i).is_ok()) {
+                    if let Some(&init) = ids.first().filter(|_| reaching.binary_search(&i).is_ok())
+                    {
                         if !matches!(
                             program.constants.get(&init),
                             Some(Constant::Int(_) | Constant::Float(_) | Constant::Bool(_))
@@ -2206,36 +2404,41 @@ impl FnLiveness {
                         {
                             ok = false;
                         }
-                        stored.push((Vec::new(), init));
+                        stored.push(((0, 0), init));
                     }
                 }
                 // A store that cannot reach `at` does not give the value read there.
                 Op::Store if reaching.binary_search(&i).is_err() => {}
                 Op::Store => {
-                    let ptr = ids.next();
-                    let value = ids.next().unwrap_or(0);
-                    let path = ptr
-                        .and_then(|p| self.roots.get(&p))
-                        .map(|p| p.path.clone())
-                        .unwrap_or_default();
+                    let ptr = ids.first();
+                    let value = ids.get(1).copied().unwrap_or(0);
+                    let range = ptr
+                        .and_then(|p| self.roots.get(p))
+                        .map_or((0, 0), |p| p.path);
+                    let path = &self.paths[range.0 as usize..range.1 as usize];
                     let overlaps = parts.is_empty()
                         || parts
                             .iter()
-                            .any(|q| has_prefix(q, &path) || has_prefix(&path, q));
+                            .any(|q| has_prefix(q, path) || has_prefix(path, q));
                     if !overlaps {
                         continue;
                     }
-                    let clash = stored.iter().any(|(q, v)| {
-                        *v != value && (has_prefix(q, &path) || has_prefix(&path, q))
+                    let clash = stored.iter().any(|&((s, e), v)| {
+                        let q = &self.paths[s as usize..e as usize];
+                        v != value && (has_prefix(q, path) || has_prefix(path, q))
                     });
                     if clash || !self.remat_ssa(program, value, depth + 1) {
                         ok = false;
                     }
-                    stored.push((path, value));
+                    stored.push((range, value));
                 }
                 Op::Load => {}
                 Op::AccessChain | Op::InBoundsAccessChain | Op::PtrAccessChain => {
-                    if !ids.skip(1).all(|x| self.remat_ssa(program, x, depth + 1)) {
+                    if !ids
+                        .iter()
+                        .skip(1)
+                        .all(|&x| self.remat_ssa(program, x, depth + 1))
+                    {
                         ok = false;
                     }
                 }
@@ -2245,7 +2448,7 @@ impl FnLiveness {
                 break;
             }
         }
-        self.remat_at.insert(key, ok);
+        self.remat_at.borrow_mut().insert(key, ok);
         ok
     }
 
@@ -2255,11 +2458,8 @@ impl FnLiveness {
         let all = self.mentions.get_or_init(|| {
             let f = &program.functions[self.func];
             let mut pairs = MentionPairs::new(self.roots.len(), f.end + 1 - f.start);
-            for i in f.start..=f.end {
-                let inst = &program.insts[i];
-                if !program.is_debug_inst(inst) {
-                    pairs.add_inst(&self.roots, &self.vars, i, inst);
-                }
+            for &i in self.body.kept() {
+                pairs.add_inst(&self.roots, &self.vars, &self.body, i as usize);
             }
             pairs.finish()
         });
@@ -2293,9 +2493,12 @@ impl MentionPairs {
 
     /// Instruction `i` (not debug info) of a function with these roots and
     /// variables.
-    fn add_inst(&mut self, roots: &IdMap<LocalPtr>, vars: &IdSet, i: usize, inst: &Instruction) {
-        let used = id_operands(inst).filter_map(|x| roots.get(&x).map(|p| p.var));
-        let defined = inst.result_id.filter(|r| vars.contains(r));
+    fn add_inst(&mut self, roots: &IdMap<LocalPtr>, vars: &IdSet, body: &Body, i: usize) {
+        let used = body
+            .ids(i)
+            .iter()
+            .filter_map(|x| roots.get(x).map(|p| p.var));
+        let defined = body.result(i).filter(|r| vars.contains(r));
         for v in defined.into_iter().chain(used) {
             self.add(roots, i, v);
         }
@@ -2351,15 +2554,15 @@ impl FnLiveness {
         let Some(b0) = block_at(f, at) else {
             return found;
         };
+        let body = &self.body;
         let whole = |i: usize| -> Option<bool> {
-            let inst = &program.insts[i];
-            match inst.class.opcode {
+            match body.op(i) {
                 Op::Store => {
-                    let p = id_operands(inst).next().and_then(|p| self.roots.get(&p))?;
-                    (p.var == var).then_some(p.exact && p.path.is_empty())
+                    let p = body.first(i).and_then(|p| self.roots.get(&p))?;
+                    (p.var == var).then_some(p.exact && p.path.0 == p.path.1)
                 }
-                Op::Variable if inst.result_id == Some(var) => {
-                    (inst.operands.len() > 1).then_some(true)
+                Op::Variable if body.result(i) == Some(var) => {
+                    (!body.ids(i).is_empty()).then_some(true)
                 }
                 _ => None,
             }
@@ -2499,7 +2702,7 @@ mod tests {
                 let mut own = MentionPairs::new(fl.roots.len(), f.end + 1 - f.start);
                 for i in f.start..=f.end {
                     if !p.is_debug_inst(&p.insts[i]) {
-                        own.add_inst(&fl.roots, &fl.vars, i, &p.insts[i]);
+                        own.add_inst(&fl.roots, &fl.vars, &fl.body, i);
                     }
                 }
                 let own = own.finish();
