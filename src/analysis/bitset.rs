@@ -21,6 +21,7 @@ impl Clone for BitSet {
 
 impl BitSet {
     /// Adds `i`; whether it was absent.
+    #[inline]
     pub fn insert(&mut self, i: u32) -> bool {
         let (w, b) = (i as usize / 64, i % 64);
         if w >= self.0.len() {
@@ -32,6 +33,7 @@ impl BitSet {
     }
 
     /// Removes `i`; whether it was present.
+    #[inline]
     pub fn remove(&mut self, i: u32) -> bool {
         let (w, b) = (i as usize / 64, i % 64);
         match self.0.get_mut(w) {
@@ -43,6 +45,7 @@ impl BitSet {
         }
     }
 
+    #[inline]
     pub fn contains(&self, i: u32) -> bool {
         self.0
             .get(i as usize / 64)
@@ -50,6 +53,7 @@ impl BitSet {
     }
 
     /// Adds every index of `other`.
+    #[inline]
     pub fn union_with(&mut self, other: &BitSet) {
         if other.0.len() > self.0.len() {
             self.0.resize(other.0.len(), 0);
@@ -61,6 +65,7 @@ impl BitSet {
 
     /// Makes room for the indices below `n` at once (the words a set
     /// would otherwise grow one insert or union at a time).
+    #[inline]
     pub fn reserve_indices(&mut self, n: u32) {
         let words = (n as usize).div_ceil(64);
         if words > self.0.len() {
@@ -69,6 +74,7 @@ impl BitSet {
     }
 
     /// Removes every index, keeping the words for reuse.
+    #[inline]
     pub fn clear(&mut self) {
         self.0.fill(0);
     }

@@ -192,9 +192,10 @@ pub fn shared_live_bytes(program: &Program) -> SitesForBytes {
 /// The live sites; with `described`, each value's name, type and
 /// positions and the payload's description too.
 fn compute_live_sites(program: &Program, described: bool) -> Vec<LiveSite> {
-    let mut cache: HashMap<usize, FnLiveness> = HashMap::default();
-    let mut shared = Shared::default();
-    let mut out = Vec::new();
+    // Every site along every chain first: then each function is built
+    // knowing the instructions it will be asked about (see `Focus`).
+    let mut jobs: Vec<(&crate::program::RtSite, LiveSiteKind, usize, Vec<usize>)> = Vec::new();
+    let mut asked: HashMap<usize, Vec<usize>> = HashMap::default();
     for site in &program.sites {
         let kind = match site.kind {
             SiteKind::TraceRay => LiveSiteKind::TraceRay,
@@ -202,76 +203,99 @@ fn compute_live_sites(program: &Program, described: bool) -> Vec<LiveSite> {
             SiteKind::RayQuery if site.op == Op::RayQueryProceedKHR => LiveSiteKind::RayQuery,
             _ => continue,
         };
-        for entry in &program.entry_points {
+        for (e, entry) in program.entry_points.iter().enumerate() {
             let Some(g) = program.functions.get(site.function) else {
                 continue;
             };
             for chain in call_chains(program, entry.function, g.id, MAX_CHAINS) {
-                // Levels: the site in its own function, then each call upwards.
-                let mut points = vec![site.inst];
-                points.extend(chain.iter().rev().copied());
-                let mut values: Vec<LiveValue> = Vec::new();
-                let mut seen: HashSet<Id> = HashSet::default();
-                // Parts behind the previous level's pointer parameters that
-                // it still needs after the site: the caller's memory, counted
-                // where the caller passes it.
-                let mut carried: Vec<(usize, Vec<u32>)> = Vec::new();
-                for &p in &points {
-                    let Some(fi) = program.function_of(p) else {
-                        continue;
-                    };
-                    let fl = cache
-                        .entry(fi)
-                        .or_insert_with(|| FnLiveness::shared(program, fi, &mut shared));
-                    let extra = fl.arguments_of(program, p, &carried);
-                    let mut places = fl.places_after(program, p);
-                    places.extend(extra);
-                    for v in fl.live_across(program, p, &places, described) {
-                        if seen.insert(v.id) {
-                            values.push(v);
-                        }
+                for &p in std::iter::once(&site.inst).chain(chain.iter()) {
+                    if let Some(fi) = program.function_of(p) {
+                        asked.entry(fi).or_default().push(p);
                     }
-                    carried = fl.param_parts_across(program, &places);
                 }
-                // The query object is the site's own state, like a payload.
-                values.retain(|v| Some(v.id) != site.payload);
-                // Largest first; what counts before what can be recomputed;
-                // names only break the remaining ties, so a module without
-                // names lists the same shapes in the same order.
-                values.sort_by(|a, b| {
-                    b.size
-                        .cmp(&a.size)
-                        .then(a.rematerializable.cmp(&b.rematerializable))
-                        .then_with(|| a.name.cmp(&b.name))
-                });
-                let location = std::iter::once(site.inst)
-                    .chain(chain.iter().rev().copied())
-                    .find_map(|i| program.inst_location(i));
-                let payload = site
-                    .payload
-                    .filter(|_| described)
-                    .map(|id| payload_info(program, id));
-                out.push(LiveSite {
-                    path: program.path.clone(),
-                    line: location.as_ref().map(|l| l.line),
-                    column: location.as_ref().map(|l| l.column),
-                    entry: entry.name.clone(),
-                    stage: entry.stage,
-                    kind,
-                    live_bytes: values.iter().map(|v| v.size).sum(),
-                    rematerializable_bytes: values
-                        .iter()
-                        .filter(|v| v.rematerializable)
-                        .map(|v| v.size)
-                        .sum(),
-                    payload,
-                    values,
-                    inst: site.inst,
-                    chain,
-                    location,
-                });
+                jobs.push((site, kind, e, chain));
             }
         }
+    }
+    let mut cache: HashMap<usize, FnLiveness> = HashMap::default();
+    let mut shared = Shared::default();
+    let mut out = Vec::new();
+    for (site, kind, e, chain) in jobs {
+        let entry = &program.entry_points[e];
+        // Levels: the site in its own function, then each call upwards.
+        let mut points = vec![site.inst];
+        points.extend(chain.iter().rev().copied());
+        let mut values: Vec<LiveValue> = Vec::new();
+        let mut seen: HashSet<Id> = HashSet::default();
+        // Parts behind the previous level's pointer parameters that
+        // it still needs after the site: the caller's memory, counted
+        // where the caller passes it.
+        let mut carried: Vec<(usize, Vec<u32>)> = Vec::new();
+        for &p in &points {
+            let Some(fi) = program.function_of(p) else {
+                continue;
+            };
+            let fl = cache.entry(fi).or_insert_with(|| {
+                // A function with pointer parameters may be asked
+                // what it does with them too: solved whole, once.
+                let f = &program.functions[fi];
+                let focus = if f.params.iter().any(|&p| is_pointer_param(program, p)) {
+                    Focus::all(program, fi)
+                } else {
+                    Focus::new(program, fi, &asked[&fi])
+                };
+                FnLiveness::shared(program, fi, &mut shared, focus)
+            });
+            let extra = fl.arguments_of(program, p, &carried);
+            let mut places = fl.places_after(program, p);
+            places.extend(extra);
+            // A set: sorted, each place once.
+            places.sort_unstable();
+            places.dedup();
+            for v in fl.live_across(program, p, &places, described) {
+                if seen.insert(v.id) {
+                    values.push(v);
+                }
+            }
+            carried = fl.param_parts_across(program, &places);
+        }
+        // The query object is the site's own state, like a payload.
+        values.retain(|v| Some(v.id) != site.payload);
+        // Largest first; what counts before what can be recomputed;
+        // names only break the remaining ties, so a module without
+        // names lists the same shapes in the same order.
+        values.sort_by(|a, b| {
+            b.size
+                .cmp(&a.size)
+                .then(a.rematerializable.cmp(&b.rematerializable))
+                .then_with(|| a.name.cmp(&b.name))
+        });
+        let location = std::iter::once(site.inst)
+            .chain(chain.iter().rev().copied())
+            .find_map(|i| program.inst_location(i));
+        let payload = site
+            .payload
+            .filter(|_| described)
+            .map(|id| payload_info(program, id));
+        out.push(LiveSite {
+            path: program.path.clone(),
+            line: location.as_ref().map(|l| l.line),
+            column: location.as_ref().map(|l| l.column),
+            entry: entry.name.clone(),
+            stage: entry.stage,
+            kind,
+            live_bytes: values.iter().map(|v| v.size).sum(),
+            rematerializable_bytes: values
+                .iter()
+                .filter(|v| v.rematerializable)
+                .map(|v| v.size)
+                .sum(),
+            payload,
+            values,
+            inst: site.inst,
+            chain,
+            location,
+        });
     }
     out
 }
@@ -409,6 +433,7 @@ fn id_operands(inst: &Instruction) -> impl Iterator<Item = Id> + '_ {
 /// Whether `path` begins with `prefix`. Paths are a few indices long: a
 /// loop, not a `memcmp` call per comparison (which `starts_with` and `==`
 /// make, and which was a sixth of the model's time in `kill`).
+#[inline]
 fn has_prefix(path: &[u32], prefix: &[u32]) -> bool {
     if prefix.len() > path.len() {
         return false;
@@ -495,11 +520,13 @@ impl Places {
         BuildHasherDefault::<rustc_hash::FxHasher>::default().hash_one(path)
     }
 
+    #[inline]
     fn slot(&self, id: Id) -> Option<usize> {
         let k = id.checked_sub(self.lo)? as usize;
         (k < self.whole.len()).then_some(k)
     }
 
+    #[inline]
     fn find(&self, mut i: u32, path: &[u32]) -> Option<u32> {
         while i != Self::NONE {
             if same_path(&self.list[i as usize].1, path) {
@@ -543,6 +570,7 @@ impl Places {
     }
 
     /// The index of place `(id, path)`, if met.
+    #[inline]
     fn get(&self, id: Id, path: &[u32]) -> Option<u32> {
         if path.is_empty() {
             if let Some(k) = self.slot(id) {
@@ -563,6 +591,7 @@ impl Places {
         )
     }
 
+    #[inline]
     fn place(&self, i: u32) -> &Place {
         &self.list[i as usize]
     }
@@ -597,6 +626,7 @@ enum IdIndex {
 impl IdIndex {
     const NONE: u32 = u32::MAX;
 
+    #[inline]
     fn find(&self, id: Id) -> Option<u32> {
         match self {
             IdIndex::Dense { lo, slots, outside } => {
@@ -610,6 +640,7 @@ impl IdIndex {
     }
 
     /// The ordinal of `id`, given `next` when it is new.
+    #[inline]
     fn find_or_add(&mut self, id: Id, next: u32) -> u32 {
         match self {
             IdIndex::Dense { lo, slots, outside } => {
@@ -654,15 +685,18 @@ impl<T> IdMap<T> {
         }
     }
 
+    #[inline]
     fn get(&self, id: &Id) -> Option<&T> {
         self.values.get(self.index.find(*id)? as usize)
     }
 
+    #[inline]
     fn contains_key(&self, id: &Id) -> bool {
         self.index.find(*id).is_some()
     }
 
     /// The ordinal of `id`: `0..` in the order ids were added.
+    #[inline]
     fn ordinal(&self, id: Id) -> Option<usize> {
         self.index.find(id).map(|k| k as usize)
     }
@@ -687,10 +721,12 @@ impl<T> IdMap<T> {
 type IdSet = IdMap<()>;
 
 impl IdSet {
+    #[inline]
     fn contains(&self, id: &Id) -> bool {
         self.contains_key(id)
     }
 
+    #[inline]
     fn add(&mut self, id: Id) {
         self.insert(id, ());
     }
@@ -808,6 +844,47 @@ struct Defined {
     slot: Vec<u32>,
 }
 
+/// The blocks of a function whose liveness a site can see: those reachable
+/// from the blocks of the instructions it is asked about (the sites and the
+/// calls on their chains). What is live after an instruction depends only
+/// on what can run after it, so the other blocks are not solved, and the
+/// callees they call are not asked what they do with their parameters.
+struct Focus {
+    blocks: Vec<bool>,
+    /// Every block (as a callee is solved, for its entry).
+    all: bool,
+}
+
+impl Focus {
+    fn all(program: &Program, func: usize) -> Focus {
+        Focus {
+            blocks: vec![true; program.functions[func].blocks.len()],
+            all: true,
+        }
+    }
+
+    /// Function `func`, asked about the instructions `asked`.
+    fn new(program: &Program, func: usize, asked: &[usize]) -> Focus {
+        let f = &program.functions[func];
+        let mut blocks = vec![false; f.blocks.len()];
+        let mut work: Vec<usize> = asked.iter().filter_map(|&i| block_at(f, i)).collect();
+        while let Some(b) = work.pop() {
+            if std::mem::replace(&mut blocks[b], true) {
+                continue;
+            }
+            work.extend(
+                f.blocks[b]
+                    .succs
+                    .iter()
+                    .copied()
+                    .filter(|&s| s < blocks.len()),
+            );
+        }
+        let all = blocks.iter().all(|&b| b);
+        Focus { blocks, all }
+    }
+}
+
 /// The SSA values of one function live at each block's end: its values
 /// are those defined in it that are not pointers to its variables or
 /// pointer parameters. Solved apart from the parts, by one kill and one
@@ -859,8 +936,7 @@ impl SsaLive {
         let mut kill = vec![0u64; n * w];
         let mut gen = vec![0u64; n * w];
         let mut live_out = vec![0u64; n * w];
-        for (b, block) in f.blocks.iter().enumerate() {
-            let _ = block;
+        for b in (0..n).filter(|&b| fl.focus.blocks[b]) {
             let row = b * w..(b + 1) * w;
             for &i in body.block(b).iter().rev() {
                 let i = i as usize;
@@ -880,8 +956,8 @@ impl SsaLive {
         }
         // A worklist, as for the parts (see `FnLiveness::solve`).
         let mut live_in = vec![0u64; n * w];
-        let mut work: Vec<usize> = (0..n).collect();
-        let mut queued = vec![true; n];
+        let mut work: Vec<usize> = (0..n).filter(|&b| fl.focus.blocks[b]).collect();
+        let mut queued = fl.focus.blocks.clone();
         let mut steps = 0usize;
         while let Some(b) = work.pop() {
             queued[b] = false;
@@ -904,7 +980,7 @@ impl SsaLive {
             }
             if changed {
                 for &p in &fl.preds[b] {
-                    if !queued[p] {
+                    if fl.focus.blocks[p] && !queued[p] {
                         queued[p] = true;
                         work.push(p);
                     }
@@ -1026,6 +1102,8 @@ pub struct FnLiveness {
     copy: Vec<Copy>,
     /// The function's SSA values, in the order defined.
     ssa_ids: Vec<Id>,
+    /// The blocks solved.
+    focus: Focus,
     /// SSA values live at each block's end, solved on first use (only a
     /// site's function and its callers on a chain ask).
     ssa: std::cell::OnceCell<SsaLive>,
@@ -1059,17 +1137,25 @@ pub struct FnLiveness {
 
 impl FnLiveness {
     /// The constant indices of `p` from its variable.
+    #[inline]
     fn path(&self, p: &LocalPtr) -> &[u32] {
         &self.paths[p.path_range()]
     }
 
     pub fn new(program: &Program, func: usize) -> FnLiveness {
-        Self::build(program, func, &mut Builds::default(), 0).0
+        Self::build(
+            program,
+            func,
+            &mut Builds::default(),
+            0,
+            Focus::all(program, func),
+        )
+        .0
     }
 
     /// The liveness of function `func`, built as [`FnLiveness::new`] would,
     /// reusing (and adding to) the callee answers in `shared`.
-    fn shared(program: &Program, func: usize, shared: &mut Shared) -> FnLiveness {
+    fn shared(program: &Program, func: usize, shared: &mut Shared, focus: Focus) -> FnLiveness {
         if let Some(fl) = shared.built.remove(&func) {
             return fl;
         }
@@ -1077,11 +1163,13 @@ impl FnLiveness {
             memo: HashMap::default(),
             shared: std::mem::take(shared),
         };
-        let (fl, exact) = Self::build(program, func, &mut builds, 0);
+        let whole = focus.all;
+        let (fl, exact) = Self::build(program, func, &mut builds, 0, focus);
         // A caller met later asks what this function does with its pointer
         // parameters: answered from this build, not by building it again.
         let f = &program.functions[func];
         if exact
+            && whole
             && !builds.shared.exposed.contains_key(&func)
             && f.params.iter().any(|&p| is_pointer_param(program, p))
         {
@@ -1124,7 +1212,7 @@ impl FnLiveness {
             return (unknown, false);
         }
         builds.memo.insert(func, (unknown, false));
-        let (fl, exact) = Self::build(program, func, builds, depth + 1);
+        let (fl, exact) = Self::build(program, func, builds, depth + 1, Focus::all(program, func));
         let exposed = fl.exposed(program);
         builds.memo.insert(func, (exposed.clone(), exact));
         if exact {
@@ -1264,6 +1352,7 @@ impl FnLiveness {
         func: usize,
         builds: &mut Builds,
         depth: u32,
+        focus: Focus,
     ) -> (FnLiveness, bool) {
         let f = &program.functions[func];
         // Only the variables' parts are solved here; the SSA values apart,
@@ -1279,10 +1368,15 @@ impl FnLiveness {
         let (lo, hi) = (body.lo, body.hi);
         let mut vars = IdSet::new(lo, hi);
         let mut roots: IdMap<LocalPtr> = IdMap::new(lo, hi);
-        let mut paths: Vec<u32> = Vec::new();
+        // Room made once (growing these was a good part of the allocations):
+        // about a pointer and a value an instruction at most.
+        let n_insts = body.kept().len();
+        roots.values.reserve(n_insts);
+        roots.keys.reserve(n_insts);
+        let mut paths: Vec<u32> = Vec::with_capacity(2 * n_insts);
         // The results that are no pointers to locals (the SSA values, in
         // the order defined: see `SsaLive`).
-        let mut ssa_ids: Vec<Id> = Vec::new();
+        let mut ssa_ids: Vec<Id> = Vec::with_capacity(n_insts);
         // Copies from one local part to another: `%v = OpLoad %a; OpStore %b %v`
         // with `%v` used nowhere else and nothing between the two.
         // Candidates first (met in this walk); then the uses of their
@@ -1394,6 +1488,10 @@ impl FnLiveness {
         let mut call_reads = HashMap::default();
         let mut exact = true;
         for i in calls {
+            // A call no site can see past needs no answer from its callee.
+            if !block_at(f, i).is_some_and(|b| focus.blocks[b]) {
+                continue;
+            }
             let callee = body.first(i).and_then(|c| program.function_index(c));
             if let Some(c) = callee {
                 let (e, e_exact) = Self::exposed_params(program, c, builds, depth);
@@ -1410,6 +1508,7 @@ impl FnLiveness {
             call_reads,
             copy,
             ssa_ids,
+            focus,
             ssa: std::cell::OnceCell::new(),
             live_out: vec![BitSet::default(); n],
             places: RefCell::new(Places::new(lo, hi, f.end + 1 - f.start)),
@@ -1583,6 +1682,7 @@ impl FnLiveness {
         &program.functions[self.func]
     }
 
+    #[inline]
     fn root(&self, id: Id) -> Option<Id> {
         self.roots.get(&id).map(|p| p.var)
     }
@@ -1825,8 +1925,8 @@ impl FnLiveness {
         // A worklist: a block is redone only when a successor's live-in
         // grew (every block once first, last block first), instead of every
         // block every round until a whole round changes nothing.
-        let mut work: Vec<usize> = (0..n).collect();
-        let mut queued = vec![true; n];
+        let mut work: Vec<usize> = (0..n).filter(|&b| self.focus.blocks[b]).collect();
+        let mut queued = self.focus.blocks.clone();
         let mut steps = 0usize;
         // Reused for each block's live set, to spare an allocation a visit.
         let mut scratch = BitSet::default();
@@ -1851,7 +1951,7 @@ impl FnLiveness {
             if live != live_in[b] {
                 std::mem::swap(&mut live_in[b], &mut live);
                 for &p in &self.preds[b] {
-                    if !queued[p] {
+                    if self.focus.blocks[p] && !queued[p] {
                         queued[p] = true;
                         work.push(p);
                     }
@@ -1921,11 +2021,22 @@ impl FnLiveness {
             .collect()
     }
 
-    /// SSA values and parts of variables live just after instruction `inst`.
-    fn places_after(&self, program: &Program, inst: usize) -> HashSet<Place> {
-        let mut out = self.parts_after(program, inst);
+    /// SSA values and parts of variables live just after instruction `inst`
+    /// (each once).
+    fn places_after(&self, program: &Program, inst: usize) -> Vec<Place> {
         let f = self.function(program);
-        if let Some(b) = block_at(f, inst) {
+        let Some(b) = block_at(f, inst) else {
+            return Vec::new();
+        };
+        let mut live = self.live_out[b].clone();
+        for &k in self.body.block_after(b, inst).iter().rev() {
+            self.step_back(program, k as usize, &mut live);
+        }
+        let mut out: Vec<Place> = {
+            let places = self.places.borrow();
+            live.iter().map(|i| places.place(i).clone()).collect()
+        };
+        {
             let ssa = self.ssa.get_or_init(|| SsaLive::new(self, program));
             out.extend(
                 ssa.after(self, f, b, inst)
@@ -2032,11 +2143,7 @@ impl FnLiveness {
 
     /// Parts behind this function's pointer parameters among the `places`
     /// live across an instruction, by parameter index.
-    fn param_parts_across(
-        &self,
-        program: &Program,
-        places: &HashSet<Place>,
-    ) -> Vec<(usize, Vec<u32>)> {
+    fn param_parts_across(&self, program: &Program, places: &[Place]) -> Vec<(usize, Vec<u32>)> {
         let f = self.function(program);
         let mut out: Vec<(usize, Vec<u32>)> = places
             .iter()
@@ -2053,7 +2160,7 @@ impl FnLiveness {
         &mut self,
         program: &Program,
         inst: usize,
-        places: &HashSet<Place>,
+        places: &[Place],
         described: bool,
     ) -> Vec<LiveValue> {
         // The places by id: each value's parts side by side.
@@ -2388,7 +2495,8 @@ impl FnLiveness {
         let reaching = self.reaching_writes(program, var, at, mentions.as_deref().unwrap_or(&[]));
         let mut ok = true;
         // The paths stored to, as ranges of `self.paths`.
-        let mut stored: Vec<((u32, u32), Id)> = Vec::new();
+        let mut stored: Vec<((u32, u32), Id)> =
+            Vec::with_capacity(mentions.as_ref().map_or(0, |m| m.len()));
         let body = &self.body;
         for &i in mentions.iter().flat_map(|m| m.iter()) {
             let ids = body.ids(i);
@@ -2609,6 +2717,7 @@ impl FnLiveness {
 
 /// The block of function `f` holding instruction `inst` (blocks are in
 /// order and disjoint: a binary search, not a scan).
+#[inline]
 fn block_at(f: &Function, inst: usize) -> Option<usize> {
     let b = f
         .blocks

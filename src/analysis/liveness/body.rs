@@ -44,8 +44,8 @@ impl Body {
             op: Vec::with_capacity(n),
             result: Vec::with_capacity(n),
             at: Vec::with_capacity(n + 1),
-            // About two id operands an instruction.
-            ids: Vec::with_capacity(2 * n),
+            // At most about three id operands an instruction.
+            ids: Vec::with_capacity(3 * n),
             debug: Vec::with_capacity(n),
             kept: Vec::with_capacity(n),
             block_kept: Vec::with_capacity(f.blocks.len()),
@@ -55,20 +55,22 @@ impl Body {
         for inst in &program.insts[f.start..=f.end] {
             let op = inst.class.opcode;
             b.at.push(b.ids.len() as u32);
-            let mut debug = false;
-            for (k, o) in inst.operands.iter().enumerate() {
-                if let Operand::IdRef(x) = o {
-                    debug |= k == 0 && op == Op::ExtInst && program.debug_sets.contains(x);
-                    b.ids.push(*x);
+            let debug = op == Op::ExtInst
+                && matches!(inst.operands.first(),
+                    Some(Operand::IdRef(x)) if program.debug_sets.contains(x));
+            let r = inst.result_id.unwrap_or(0);
+            // Debug info and positions are read by no pass: no operands kept.
+            if !debug && !matches!(op, Op::Line | Op::NoLine) {
+                b.kept.push((b.start + b.op.len()) as u32);
+                for o in &inst.operands {
+                    if let Operand::IdRef(x) = o {
+                        b.ids.push(*x);
+                    }
                 }
             }
-            let r = inst.result_id.unwrap_or(0);
             if r != 0 && !debug && !matches!(op, Op::Function | Op::FunctionParameter) {
                 b.lo = b.lo.min(r);
                 b.hi = b.hi.max(r);
-            }
-            if !debug && !matches!(op, Op::Line | Op::NoLine) {
-                b.kept.push((b.start + b.op.len()) as u32);
             }
             b.op.push(op);
             b.result.push(r);
@@ -115,7 +117,8 @@ impl Body {
         Some(self.result[i - self.start]).filter(|&r| r != 0)
     }
 
-    /// The id operands of instruction `i`, in order.
+    /// The id operands of instruction `i`, in order (none kept for debug
+    /// info and `OpLine`/`OpNoLine`).
     #[inline]
     pub fn ids(&self, i: usize) -> &[Id] {
         let k = i - self.start;
