@@ -84,6 +84,7 @@ pub fn declarations(
     path: &Path,
 ) -> Vec<(NamedDecl, Location)> {
     let lines = Lines::new(source);
+    let fns = fn_names(source);
     let mut out = Vec::new();
     for (handle, ty) in module.types.iter() {
         let (Some(name), naga::TypeInner::Struct { members, .. }) = (&ty.name, &ty.inner) else {
@@ -135,7 +136,7 @@ pub fn declarations(
         }
     }
     for ep in &module.entry_points {
-        if let Some(at) = find_fn(source, &ep.name) {
+        if let Some(at) = find_fn(source, &fns, &ep.name) {
             out.push((
                 NamedDecl::Function(ep.name.clone()),
                 lines.location(path, at, &ep.name),
@@ -162,7 +163,7 @@ pub fn declarations(
         {
             continue;
         }
-        let Some(start) = find_fn(source, ep) else {
+        let Some(start) = find_fn(source, &fns, ep) else {
             continue;
         };
         let end = source[start..]
@@ -244,20 +245,26 @@ fn find_ident(source: &str, from: usize, to: usize, name: &str) -> Option<usize>
     None
 }
 
-/// Byte offset of the name in `fn name(`.
-fn find_fn(source: &str, name: &str) -> Option<usize> {
+/// Where the word after each `fn` keyword starts, in source order: found
+/// once per file, not once per entry point and argument.
+fn fn_names(source: &str) -> Vec<usize> {
+    let mut out = Vec::new();
     let mut from = 0;
     while let Some(at) = find_ident(source, from, source.len(), "fn") {
         let rest = &source[at + 2..];
-        let trimmed = rest.trim_start();
-        if trimmed.starts_with(name)
-            && !trimmed[name.len()..].starts_with(|c: char| c.is_alphanumeric() || c == '_')
-        {
-            return Some(at + 2 + (rest.len() - trimmed.len()));
-        }
+        out.push(at + 2 + (rest.len() - rest.trim_start().len()));
         from = at + 2;
     }
-    None
+    out
+}
+
+/// Byte offset of the name in `fn name(` (`names` from [`fn_names`]).
+fn find_fn(source: &str, names: &[usize], name: &str) -> Option<usize> {
+    names.iter().copied().find(|&at| {
+        let trimmed = &source[at..];
+        trimmed.starts_with(name)
+            && !trimmed[name.len()..].starts_with(|c: char| c.is_alphanumeric() || c == '_')
+    })
 }
 
 /// Writes the module's SPIR-V with `OpSource` (the WGSL text) and an

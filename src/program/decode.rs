@@ -61,18 +61,43 @@ impl Words<'_> {
         Some(v)
     }
     fn string(&mut self) -> Option<String> {
+        // The terminating word found first, so the bytes are copied once
+        // into a buffer of their size (an embedded source is tens of KB).
         let rest = &self.w[self.at..];
-        let mut bytes = Vec::new();
-        for (k, w) in rest.iter().enumerate() {
-            let b = w.to_le_bytes();
-            if let Some(z) = b.iter().position(|&c| c == 0) {
-                bytes.extend_from_slice(&b[..z]);
-                self.at += k + 1;
-                return String::from_utf8(bytes).ok();
-            }
-            bytes.extend_from_slice(&b);
+        let k = rest.iter().position(|&w| has_zero_byte(w))?;
+        let last = rest[k].to_le_bytes();
+        let z = last.iter().position(|&c| c == 0)?;
+        let mut bytes = Vec::with_capacity(4 * k + z);
+        for w in &rest[..k] {
+            bytes.extend_from_slice(&w.to_le_bytes());
         }
-        None
+        bytes.extend_from_slice(&last[..z]);
+        self.at += k + 1;
+        String::from_utf8(bytes).ok()
+    }
+}
+
+/// Whether one of the word's four bytes is 0.
+fn has_zero_byte(w: u32) -> bool {
+    w.wrapping_sub(0x0101_0101) & !w & 0x8080_8080 != 0
+}
+
+/// Whether the `spirv` crate knows `opcode` (`Op::from_u32`, a long chain
+/// of range tests that cost as much as decoding the instruction),
+/// remembered per opcode for the process.
+pub fn known_opcode(opcode: u16) -> bool {
+    use std::sync::atomic::{AtomicU8, Ordering};
+    // 0: not asked yet, 1: known, 2: unknown.
+    static KNOWN: [AtomicU8; 1 << 16] = [const { AtomicU8::new(0) }; 1 << 16];
+    let slot = &KNOWN[opcode as usize];
+    match slot.load(Ordering::Relaxed) {
+        1 => true,
+        2 => false,
+        _ => {
+            let known = Op::from_u32(u32::from(opcode)).is_some();
+            slot.store(if known { 1 } else { 2 }, Ordering::Relaxed);
+            known
+        }
     }
 }
 

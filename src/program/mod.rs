@@ -18,7 +18,7 @@ pub mod types;
 mod values;
 
 pub use binary::{words_from_bytes, MAGIC};
-pub use build::parse;
+pub use build::{parse, parse_owned};
 pub use types::{ArrayLen, Type};
 
 use crate::diag::Location;
