@@ -320,7 +320,7 @@ fn write_coded(
         next[function] += 1;
     });
     Ok(restore_positions(
-        &coded?,
+        coded?,
         source,
         &function_names(module),
         &spans,
@@ -405,7 +405,7 @@ fn each_statement_span(module: &mut naga::Module, f: &mut impl FnMut(usize, &mut
 /// writes them for `source`; `None` where an `OpLine` cannot be traced to
 /// its statement.
 fn restore_positions(
-    words: &[u32],
+    mut words: Vec<u32>,
     source: &str,
     names: &[Option<&str>],
     spans: &[Vec<naga::Span>],
@@ -425,44 +425,56 @@ fn restore_positions(
     let lines = Lines::new(source);
     let mut named: rustc_hash::FxHashMap<u32, usize> = Default::default();
     let mut function: Option<usize> = None;
-    let mut out = Vec::with_capacity(words.len() + source.len() / 4 + 8);
-    out.extend_from_slice(&words[..words.len().min(5)]);
+    let mut name_bytes: Vec<u8> = Vec::new();
+    // `OpLine`s are mended in place; the `OpSource` (its operands kept
+    // for the real text's) and `OpSourceContinued` ranges are replaced
+    // afterwards, so the rest of the module is copied in a few pieces,
+    // not instruction by instruction.
+    let mut replaced: Vec<(usize, usize, Option<[u32; 3]>)> = Vec::new();
     let mut i = 5;
     while i < words.len() {
         let (count, op) = ((words[i] >> 16) as usize, words[i] & 0xffff);
-        let inst = &words[i..(i + count.max(1)).min(words.len())];
-        i += count.max(1);
+        let end = (i + count.max(1)).min(words.len());
         match op {
-            OP_NAME if inst.len() > 2 => {
-                let bytes: Vec<u8> = inst[2..].iter().flat_map(|w| w.to_le_bytes()).collect();
-                let text = bytes.split(|&b| b == 0).next().unwrap_or_default();
+            OP_NAME if end - i > 2 => {
+                name_bytes.clear();
+                name_bytes.extend(words[i + 2..end].iter().flat_map(|w| w.to_le_bytes()));
+                let text = name_bytes.split(|&b| b == 0).next().unwrap_or_default();
                 if let Some(&n) = std::str::from_utf8(text).ok().and_then(|t| by_name.get(t)) {
-                    named.insert(inst[1], n);
+                    named.insert(words[i + 1], n);
                 }
-                out.extend_from_slice(inst);
             }
-            OP_FUNCTION if inst.len() > 2 => {
-                function = named.get(&inst[2]).copied();
-                out.extend_from_slice(inst);
-            }
-            OP_FUNCTION_END => {
-                function = None;
-                out.extend_from_slice(inst);
-            }
-            OP_LINE if inst.len() == 4 => {
-                let code = inst[3].checked_sub(1)? as usize;
+            OP_FUNCTION if end - i > 2 => function = named.get(&words[i + 2]).copied(),
+            OP_FUNCTION_END => function = None,
+            OP_LINE if end - i == 4 => {
+                let code = words[i + 3].checked_sub(1)? as usize;
                 let span = spans.get(function?)?.get(code)?;
                 let (line, column) = lines.line_byte_col(span.to_range().map_or(0, |r| r.start));
-                out.extend_from_slice(&[inst[0], inst[1], line, column]);
+                words[i + 2] = line;
+                words[i + 3] = column;
             }
-            OP_SOURCE if inst.len() > 4 => {
-                source_instructions(&mut out, inst[1], inst[2], inst[3], source);
+            OP_SOURCE if end - i > 4 => {
+                replaced.push((i, end, Some([words[i + 1], words[i + 2], words[i + 3]])));
             }
-            // The blank text's continuation, replaced with the source's above.
-            OP_SOURCE_CONTINUED => {}
-            _ => out.extend_from_slice(inst),
+            // The blank text's continuation, replaced with the source's.
+            OP_SOURCE_CONTINUED => replaced.push((i, end, None)),
+            _ => {}
         }
+        i = end;
     }
+    if replaced.is_empty() {
+        return Some(words);
+    }
+    let mut out = Vec::with_capacity(words.len() + source.len() / 4 + 8);
+    let mut from = 0;
+    for (start, end, head) in replaced {
+        out.extend_from_slice(&words[from..start]);
+        if let Some([language, version, file]) = head {
+            source_instructions(&mut out, language, version, file, source);
+        }
+        from = end;
+    }
+    out.extend_from_slice(&words[from..]);
     Some(out)
 }
 

@@ -1056,6 +1056,7 @@ impl Builder<'_> {
     /// Splits the instruction stream into functions and blocks with successors.
     fn functions(&mut self) -> Result<(), InputError> {
         let n = self.p.insts.len();
+        let mut labels: FastMap<Id, usize> = FastMap::default();
         let mut i = 0;
         while i < n {
             if self.p.insts[i].class.opcode != Op::Function {
@@ -1103,29 +1104,32 @@ impl Builder<'_> {
             if block_start.is_some() {
                 return Err(self.at(i, "block has no terminator"));
             }
-            // Successors by label.
+            // Successors by label: each label's block found in a map, not
+            // by a search of the function's blocks per branch target.
+            labels.clear();
+            for (k, block) in blocks.iter().enumerate() {
+                labels.entry(block.label).or_insert(k);
+            }
             for b in 0..blocks.len() {
                 let term = &self.p.insts[blocks[b].end];
-                let targets: Vec<Id> = match term.class.opcode {
-                    Op::Branch => id_at(term, 0).into_iter().collect(),
-                    Op::BranchConditional => [id_at(term, 1), id_at(term, 2)]
+                let (branch, cases): ([Option<Id>; 2], &[Operand]) = match term.class.opcode {
+                    Op::Branch => ([id_at(term, 0), None], &[]),
+                    Op::BranchConditional => ([id_at(term, 1), id_at(term, 2)], &[]),
+                    // Every id after the selector: the default and each case's.
+                    Op::Switch => ([None, None], term.operands.get(1..).unwrap_or(&[])),
+                    _ => ([None, None], &[]),
+                };
+                let targets =
+                    branch
                         .into_iter()
                         .flatten()
-                        .collect(),
-                    Op::Switch => term
-                        .operands
-                        .iter()
-                        .enumerate()
-                        .filter_map(|(k, o)| match o {
-                            Operand::IdRef(x) if k != 0 => Some(*x),
+                        .chain(cases.iter().filter_map(|o| match o {
+                            Operand::IdRef(x) => Some(*x),
                             _ => None,
-                        })
-                        .collect(),
-                    _ => Vec::new(),
-                };
+                        }));
                 let mut succs = Vec::new();
                 for t in targets {
-                    match blocks.iter().position(|x| x.label == t) {
+                    match labels.get(&t).copied() {
                         Some(s) => {
                             if !succs.contains(&s) {
                                 succs.push(s)
