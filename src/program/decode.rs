@@ -183,9 +183,16 @@ fn width_of(widths: &[Width], id: u32) -> Width {
 fn instruction(g: Grammar, w: &mut Words, widths: &[Width]) -> Option<Instruction> {
     let mut result_type = None;
     let mut result_id = None;
-    // At most one operand per word, and rarely more than 16 (a string of
-    // many words, such as the embedded source, is one operand).
-    let mut operands = Vec::with_capacity(w.w.len().min(16));
+    // At most one operand per word after the result type and id, and
+    // rarely more than 16 (a string of many words, such as the embedded
+    // source, is one operand).
+    let results = g
+        .operands
+        .iter()
+        .take(2)
+        .filter(|o| matches!(o.kind, K::IdResultType | K::IdResult))
+        .count();
+    let mut operands = Vec::with_capacity(w.w.len().saturating_sub(results).min(16));
     let mut k = 0;
     while k < g.operands.len() {
         let lop = &g.operands[k];
