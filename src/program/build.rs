@@ -1110,8 +1110,8 @@ impl Builder<'_> {
             for (k, block) in blocks.iter().enumerate() {
                 labels.entry(block.label).or_insert(k);
             }
-            for b in 0..blocks.len() {
-                let term = &self.p.insts[blocks[b].end];
+            for block in &mut blocks {
+                let term = &self.p.insts[block.end];
                 let (branch, cases): ([Option<Id>; 2], &[Operand]) = match term.class.opcode {
                     Op::Branch => ([id_at(term, 0), None], &[]),
                     Op::BranchConditional => ([id_at(term, 1), id_at(term, 2)], &[]),
@@ -1137,13 +1137,13 @@ impl Builder<'_> {
                         }
                         None => {
                             return Err(self.at(
-                                blocks[b].end,
+                                block.end,
                                 format!("branch target %{t} is not a block of this function"),
                             ));
                         }
                     }
                 }
-                blocks[b].succs = succs;
+                block.succs = succs;
             }
             self.p.functions.push(Function {
                 id,
