@@ -1338,6 +1338,62 @@ mod tests {
         assert!(parse(&module(Op::IAdd), path, Language::Spirv).is_ok());
     }
 
+    /// Successors by label: each target's block once, in branch order
+    /// (a switch's default first); a target in another function is an
+    /// input error naming it.
+    #[test]
+    fn successors_by_label() {
+        use rspirv::binary::Assemble;
+        use rspirv::dr::Operand as O;
+        let module = |stray: bool| {
+            let mut b = rspirv::dr::Builder::new();
+            b.capability(spirv::Capability::Shader);
+            b.memory_model(spirv::AddressingModel::Logical, spirv::MemoryModel::GLSL450);
+            let void = b.type_void();
+            let boolean = b.type_bool();
+            let u = b.type_int(32, 0);
+            let yes = b.constant_true(boolean);
+            let one = b.constant_bit32(u, 1);
+            let fty = b.type_function(void, []);
+            let elsewhere = b.id();
+            b.begin_function(void, None, spirv::FunctionControl::NONE, fty)
+                .unwrap();
+            let (a, bb, c) = (b.id(), b.id(), b.id());
+            b.begin_block(None).unwrap();
+            b.branch_conditional(yes, a, bb, []).unwrap();
+            b.begin_block(Some(a)).unwrap();
+            b.branch(if stray { elsewhere } else { c }).unwrap();
+            b.begin_block(Some(bb)).unwrap();
+            b.switch(one, c, [(O::LiteralBit32(1), a), (O::LiteralBit32(2), c)])
+                .unwrap();
+            b.begin_block(Some(c)).unwrap();
+            b.ret().unwrap();
+            b.end_function().unwrap();
+            b.begin_function(void, None, spirv::FunctionControl::NONE, fty)
+                .unwrap();
+            b.begin_block(Some(elsewhere)).unwrap();
+            b.ret().unwrap();
+            b.end_function().unwrap();
+            (b.module().assemble(), elsewhere)
+        };
+        let path = Path::new("t.spv");
+        let p = parse(&module(false).0, path, Language::Spirv).unwrap();
+        let succs: Vec<Vec<usize>> = p.functions[0]
+            .blocks
+            .iter()
+            .map(|b| b.succs.clone())
+            .collect();
+        assert_eq!(succs, [vec![1, 2], vec![3], vec![3, 1], vec![]]);
+        let (words, elsewhere) = module(true);
+        let e = parse(&words, path, Language::Spirv).unwrap_err();
+        assert!(
+            e.to_string().contains(&format!(
+                "branch target %{elsewhere} is not a block of this function"
+            )),
+            "{e}"
+        );
+    }
+
     #[test]
     fn line_count_is_lines_count() {
         for t in [

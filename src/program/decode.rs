@@ -532,6 +532,36 @@ mod tests {
         out
     }
 
+    /// The per-opcode table answers as `Op::from_u32` does, asked twice
+    /// (the second answer comes from the table).
+    #[test]
+    fn known_opcode_is_from_u32() {
+        for _ in 0..2 {
+            for w in 0..=u16::MAX {
+                assert_eq!(known_opcode(w), Op::from_u32(u32::from(w)).is_some(), "{w}");
+            }
+        }
+    }
+
+    /// The zero-byte test against the bytes themselves.
+    #[test]
+    fn zero_byte_found_in_any_position() {
+        for w in [
+            0u32,
+            0x0000_0001,
+            0x6162_6300,
+            0x0061_6263,
+            0x6100_6263,
+            0x6162_0063,
+            0x8080_8080,
+            0xffff_ffff,
+            0x0101_0101,
+            0x6162_6364,
+        ] {
+            assert_eq!(has_zero_byte(w), w.to_le_bytes().contains(&0), "{w:#x}");
+        }
+    }
+
     /// Damaged modules: wherever the decoder gives instructions, rspirv
     /// parses the module too and gives the same ones.
     #[test]
