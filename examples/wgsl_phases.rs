@@ -3,7 +3,9 @@
 //! share: `cargo run --release --example wgsl_phases -- [ITERS] [FILE.wgsl...]`
 //! (default: every WGSL file under shaders/ and fixtures/ that loads).
 //! `LOOP=parse|load|rules|check` repeats one phase ITERS times over the
-//! files instead, for a profiler; `STEPS=1` times the steps of reading.
+//! files instead, for a profiler; `STEPS=1` times the steps of reading;
+//! `SEQ=1` times the steps of one `check_input` one after the other inside
+//! each run (each step as cold as `check_input` finds it), so they add up.
 use rtlint::config::Config;
 use rtlint::shader::Language;
 use std::path::{Path, PathBuf};
@@ -94,6 +96,11 @@ fn main() {
                 }
             }
         }
+        return;
+    }
+
+    if std::env::var_os("SEQ").is_some() {
+        in_sequence(iters, &files, &config);
         return;
     }
 
@@ -277,4 +284,65 @@ fn steps(iters: usize, files: &[PathBuf]) {
     for (n, d) in names.iter().zip(sums) {
         println!("{n:>22} {:.3} ms", ms(d));
     }
+}
+
+/// The steps of `check_input` on WGSL, timed in turn within each run
+/// (`SEQ=1`): the per-phase figures above each repeat one phase while it
+/// is hot in the caches, so they sum to less than a check.
+fn in_sequence(iters: usize, files: &[PathBuf], config: &Config) {
+    let names = [
+        "read the file",
+        "naga parse+validate",
+        "naga SPIR-V out (ours around it)",
+        "declarations",
+        "program::parse",
+        "attach_named_decls",
+        "rules",
+        "drop",
+    ];
+    let mut sums = [Duration::ZERO; 8];
+    let mut whole = Duration::ZERO;
+    for f in files {
+        let mut runs: Vec<[Duration; 8]> = Vec::new();
+        for _ in 0..=iters {
+            let mut d = [Duration::ZERO; 8];
+            let mut t = Instant::now();
+            let mut lap = |k: usize, d: &mut [Duration; 8]| {
+                d[k] = t.elapsed();
+                t = Instant::now();
+            };
+            let text = rtlint::front::read_text(f).unwrap();
+            lap(0, &mut d);
+            let (mut module, info) = rtlint::front::wgsl::parse(&text, f).unwrap();
+            lap(1, &mut d);
+            let words = rtlint::front::wgsl::write_spirv(&mut module, &info, &text, f).unwrap();
+            lap(2, &mut d);
+            let decls = rtlint::front::wgsl::declarations(&module, &text, f);
+            drop((module, info, text));
+            lap(3, &mut d);
+            let mut p = rtlint::program::parse_owned(words, f, Language::Wgsl).unwrap();
+            lap(4, &mut d);
+            p.attach_named_decls(&decls);
+            lap(5, &mut d);
+            std::hint::black_box(rtlint::rules::check_program(&p, config));
+            lap(6, &mut d);
+            drop(p);
+            lap(7, &mut d);
+            runs.push(d);
+        }
+        // The first run is the warm-up.
+        let runs = &runs[1..];
+        for (k, sum) in sums.iter_mut().enumerate() {
+            *sum += median(runs.iter().map(|r| r[k]).collect());
+        }
+        whole += median(runs.iter().map(|r| r.iter().sum()).collect());
+    }
+    for (n, d) in names.iter().zip(sums) {
+        println!("{n:>33} {:.3} ms", ms(d));
+    }
+    println!(
+        "{:>33} {:.3} ms (median of the runs' sums)",
+        "one check",
+        ms(whole)
+    );
 }

@@ -287,19 +287,25 @@ impl std::error::Error for InputError {}
 /// Reads a UTF-8 text input; an unreadable or non-UTF-8 file is an input error.
 pub fn read_text(path: &Path) -> Result<String, InputError> {
     let bytes = std::fs::read(path).map_err(|e| io_error(path, &e))?;
-    text_from_bytes(&bytes, path)
+    // The bytes become the text, not a copy of them.
+    String::from_utf8(bytes).map_err(|e| not_utf8(path, e.utf8_error()))
 }
 
 /// Input bytes as UTF-8 text; anything else is an input error.
 pub fn text_from_bytes(bytes: &[u8], path: &Path) -> Result<String, InputError> {
-    String::from_utf8(bytes.to_vec()).map_err(|e| {
-        let offset = e.utf8_error().valid_up_to();
-        InputError::new(
-            InputErrorKind::InvalidUtf8,
-            path,
-            format!("file is not valid UTF-8 (byte offset {offset})"),
-        )
-    })
+    match std::str::from_utf8(bytes) {
+        Ok(text) => Ok(text.to_string()),
+        Err(e) => Err(not_utf8(path, e)),
+    }
+}
+
+fn not_utf8(path: &Path, e: std::str::Utf8Error) -> InputError {
+    let offset = e.valid_up_to();
+    InputError::new(
+        InputErrorKind::InvalidUtf8,
+        path,
+        format!("file is not valid UTF-8 (byte offset {offset})"),
+    )
 }
 
 pub fn io_error(path: &Path, e: &std::io::Error) -> InputError {

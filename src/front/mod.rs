@@ -146,8 +146,9 @@ pub fn load_library(
     language: Language,
     options: &FrontOptions,
 ) -> Result<(crate::program::Program, hlsl::subobject::Subobjects), InputError> {
-    let c = compile_input(path, contents, language, options)?;
-    let mut program = crate::program::parse(&c.words, &c.path, c.language)?;
+    let mut c = compile_input(path, contents, language, options)?;
+    let words = std::mem::take(&mut c.words);
+    let mut program = crate::program::parse_owned(words, &c.path, c.language)?;
     program.attach_named_decls(&c.decls);
     if let Some(scratch) = &c.scratch_source {
         for f in &mut program.files {

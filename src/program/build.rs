@@ -40,6 +40,16 @@ fn err(path: &Path, msg: impl Into<String>) -> InputError {
 /// Parses and checks a module. `language` is the front-end's language; a
 /// `.spv` takes the one its `OpSource` names.
 pub fn parse(words: &[u32], path: &Path, language: Language) -> Result<Program, InputError> {
+    parse_owned(words.to_vec(), path, language)
+}
+
+/// [`parse`], keeping `words` as the Program's copy of the module instead
+/// of copying them.
+pub fn parse_owned(
+    words: Vec<u32>,
+    path: &Path,
+    language: Language,
+) -> Result<Program, InputError> {
     if words.len() < 5 {
         return Err(err(path, "SPIR-V module is shorter than the 5-word header"));
     }
@@ -72,7 +82,7 @@ pub fn parse(words: &[u32], path: &Path, language: Language) -> Result<Program, 
             ));
         }
         let opcode = words[i] & 0xffff;
-        if Op::from_u32(opcode).is_none() {
+        if !super::decode::known_opcode(opcode as u16) {
             return Err(err(path, format!("unknown opcode {opcode} at word {i}")));
         }
         // rspirv reads the operands of the operation an `OpSpecConstantOp`
@@ -101,8 +111,8 @@ pub fn parse(words: &[u32], path: &Path, language: Language) -> Result<Program, 
     // Compilers copy source bytes into strings unchecked (glslang `-g` keeps
     // a Latin-1 comment), and spirv-val accepts that: parse a copy whose
     // strings have each invalid byte replaced by `?`.
-    let cleaned = valid_utf8_strings(words, &offsets);
-    let input = cleaned.as_deref().unwrap_or(words);
+    let cleaned = valid_utf8_strings(&words, &offsets);
+    let input = cleaned.as_deref().unwrap_or(&words);
     if let Some(insts) = super::decode::decode(input, &offsets) {
         let (major, minor) = (
             ((words[1] >> 16) & 0xff) as u8,
@@ -120,17 +130,17 @@ pub fn parse(words: &[u32], path: &Path, language: Language) -> Result<Program, 
             S::OperandExpected(_, n) => format!(
                 "instruction at word {} ({}) is missing operands",
                 at(n),
-                opname(words, at(n))
+                opname(&words, at(n))
             ),
             S::OperandExceeded(_, n) => format!(
                 "instruction at word {} ({}) has more operands than its opcode takes",
                 at(n),
-                opname(words, at(n))
+                opname(&words, at(n))
             ),
             S::TypeUnsupported(_, n) => format!(
                 "instruction at word {} ({}) uses an undeclared or unsupported type",
                 at(n),
-                opname(words, at(n))
+                opname(&words, at(n))
             ),
             S::WordCountZero(_, n) => {
                 format!("instruction at word {} has a word count of 0", at(n))
@@ -150,7 +160,7 @@ pub fn parse(words: &[u32], path: &Path, language: Language) -> Result<Program, 
             path: path.to_path_buf(),
             language,
             version: (major, minor),
-            words: words.to_vec(),
+            words,
             memo: Default::default(),
             insts: c.insts,
             offsets,
@@ -192,12 +202,23 @@ pub fn parse(words: &[u32], path: &Path, language: Language) -> Result<Program, 
 
 /// The word within an instruction where its literal string starts, for the
 /// instructions that carry one.
-fn string_word(op: Op, count: usize) -> Option<usize> {
-    let at = match op {
-        Op::String | Op::Name | Op::ExtInstImport => 2,
-        Op::MemberName | Op::EntryPoint => 3,
-        Op::SourceContinued | Op::SourceExtension | Op::Extension | Op::ModuleProcessed => 1,
-        Op::Source => 4,
+fn string_word(opcode: u32, count: usize) -> Option<usize> {
+    // By number: every instruction is asked, and `Op::from_u32` is slow.
+    const STRING: u32 = Op::String as u32;
+    const NAME: u32 = Op::Name as u32;
+    const EXT_INST_IMPORT: u32 = Op::ExtInstImport as u32;
+    const MEMBER_NAME: u32 = Op::MemberName as u32;
+    const ENTRY_POINT: u32 = Op::EntryPoint as u32;
+    const SOURCE_CONTINUED: u32 = Op::SourceContinued as u32;
+    const SOURCE_EXTENSION: u32 = Op::SourceExtension as u32;
+    const EXTENSION: u32 = Op::Extension as u32;
+    const MODULE_PROCESSED: u32 = Op::ModuleProcessed as u32;
+    const SOURCE: u32 = Op::Source as u32;
+    let at = match opcode {
+        STRING | NAME | EXT_INST_IMPORT => 2,
+        MEMBER_NAME | ENTRY_POINT => 3,
+        SOURCE_CONTINUED | SOURCE_EXTENSION | EXTENSION | MODULE_PROCESSED => 1,
+        SOURCE => 4,
         _ => return None,
     };
     (at < count).then_some(at)
@@ -210,10 +231,7 @@ fn valid_utf8_strings(words: &[u32], offsets: &[u32]) -> Option<Vec<u32>> {
     for &at in offsets {
         let at = at as usize;
         let count = (words[at] >> 16) as usize;
-        let Some(op) = Op::from_u32(words[at] & 0xffff) else {
-            continue;
-        };
-        let Some(k) = string_word(op, count) else {
+        let Some(k) = string_word(words[at] & 0xffff, count) else {
             continue;
         };
         // Plain ASCII up to the terminating zero is valid as it stands: no
@@ -393,10 +411,10 @@ impl Builder<'_> {
             .map(|f| {
                 // glslang `-gV` embeds no text: the file on disk, if any.
                 match &f.text {
-                    Some(t) => Some(t.lines().count()),
+                    Some(t) => Some(line_count(t)),
                     None => std::fs::read_to_string(&f.path)
                         .ok()
-                        .map(|t| t.lines().count()),
+                        .map(|t| line_count(&t)),
                 }
             })
             .collect();
@@ -418,7 +436,17 @@ impl Builder<'_> {
 
     /// Every id used must be defined somewhere in the module and below the bound.
     fn check_ids(&mut self, bound: u32) -> Result<(), InputError> {
-        self.p.defs.reserve(self.p.insts.len());
+        // Which ids are defined, by id where the bound is near the module's
+        // size (ids are dense): a use costs an index, not a hash lookup.
+        let dense = bound as usize <= 4 * self.p.words.len() + 64;
+        let mut defined = vec![false; if dense { bound as usize } else { 0 }];
+        let results = self
+            .p
+            .insts
+            .iter()
+            .filter(|i| i.result_id.is_some())
+            .count();
+        self.p.defs.reserve(results);
         for (i, inst) in self.p.insts.iter().enumerate() {
             if let Some(r) = inst.result_id {
                 if r == 0 || r >= bound {
@@ -429,8 +457,18 @@ impl Builder<'_> {
                 if self.p.defs.insert(r, i).is_some() {
                     return Err(self.at(i, format!("id %{r} is defined twice")));
                 }
+                if dense {
+                    defined[r as usize] = true;
+                }
             }
         }
+        let is_defined = |id: Id| {
+            if dense {
+                defined.get(id as usize).copied().unwrap_or(false)
+            } else {
+                self.p.defs.contains_key(&id)
+            }
+        };
         for (i, inst) in self.p.insts.iter().enumerate() {
             let used = inst
                 .result_type
@@ -442,7 +480,7 @@ impl Builder<'_> {
                     _ => None,
                 }));
             for id in used {
-                if !self.p.defs.contains_key(&id) {
+                if !is_defined(id) {
                     return Err(self.at(i, format!("id %{id} is used but never defined")));
                 }
             }
@@ -497,6 +535,24 @@ impl Builder<'_> {
     /// points, debug info, and the source position of every instruction.
     fn collect(&mut self) -> Result<(), InputError> {
         self.p.locs = vec![None; self.p.insts.len()];
+        // The maps sized once, not grown as they fill.
+        let (mut names, mut member_names, mut decorated, mut types, mut constants) =
+            (0, 0, 0, 0, 0);
+        for inst in &self.p.insts {
+            match inst.class.opcode {
+                Op::Name => names += 1,
+                Op::MemberName => member_names += 1,
+                Op::Decorate => decorated += 1,
+                op if op.is_type() => types += 1,
+                op if op.is_constant() => constants += 1,
+                _ => {}
+            }
+        }
+        self.p.names.reserve(names);
+        self.p.member_names.reserve(member_names);
+        self.p.decorations.reserve(decorated);
+        self.p.types.reserve(types);
+        self.p.constants.reserve(constants);
         // Taken out while read, not cloned per instruction; put back on
         // every path out.
         let insts = std::mem::take(&mut self.p.insts);
@@ -1000,6 +1056,7 @@ impl Builder<'_> {
     /// Splits the instruction stream into functions and blocks with successors.
     fn functions(&mut self) -> Result<(), InputError> {
         let n = self.p.insts.len();
+        let mut labels: FastMap<Id, usize> = FastMap::default();
         let mut i = 0;
         while i < n {
             if self.p.insts[i].class.opcode != Op::Function {
@@ -1047,29 +1104,32 @@ impl Builder<'_> {
             if block_start.is_some() {
                 return Err(self.at(i, "block has no terminator"));
             }
-            // Successors by label.
-            for b in 0..blocks.len() {
-                let term = &self.p.insts[blocks[b].end];
-                let targets: Vec<Id> = match term.class.opcode {
-                    Op::Branch => id_at(term, 0).into_iter().collect(),
-                    Op::BranchConditional => [id_at(term, 1), id_at(term, 2)]
+            // Successors by label: each label's block found in a map, not
+            // by a search of the function's blocks per branch target.
+            labels.clear();
+            for (k, block) in blocks.iter().enumerate() {
+                labels.entry(block.label).or_insert(k);
+            }
+            for block in &mut blocks {
+                let term = &self.p.insts[block.end];
+                let (branch, cases): ([Option<Id>; 2], &[Operand]) = match term.class.opcode {
+                    Op::Branch => ([id_at(term, 0), None], &[]),
+                    Op::BranchConditional => ([id_at(term, 1), id_at(term, 2)], &[]),
+                    // Every id after the selector: the default and each case's.
+                    Op::Switch => ([None, None], term.operands.get(1..).unwrap_or(&[])),
+                    _ => ([None, None], &[]),
+                };
+                let targets =
+                    branch
                         .into_iter()
                         .flatten()
-                        .collect(),
-                    Op::Switch => term
-                        .operands
-                        .iter()
-                        .enumerate()
-                        .filter_map(|(k, o)| match o {
-                            Operand::IdRef(x) if k != 0 => Some(*x),
+                        .chain(cases.iter().filter_map(|o| match o {
+                            Operand::IdRef(x) => Some(*x),
                             _ => None,
-                        })
-                        .collect(),
-                    _ => Vec::new(),
-                };
+                        }));
                 let mut succs = Vec::new();
                 for t in targets {
-                    match blocks.iter().position(|x| x.label == t) {
+                    match labels.get(&t).copied() {
                         Some(s) => {
                             if !succs.contains(&s) {
                                 succs.push(s)
@@ -1077,13 +1137,13 @@ impl Builder<'_> {
                         }
                         None => {
                             return Err(self.at(
-                                blocks[b].end,
+                                block.end,
                                 format!("branch target %{t} is not a block of this function"),
                             ));
                         }
                     }
                 }
-                blocks[b].succs = succs;
+                block.succs = succs;
             }
             self.p.functions.push(Function {
                 id,
@@ -1167,6 +1227,13 @@ fn lit_of(o: &Operand) -> Option<u32> {
         Operand::BuiltIn(b) => Some(*b as u32),
         _ => None,
     }
+}
+
+/// `text.lines().count()`, by counting newlines in one pass (the
+/// embedded source is the whole file).
+fn line_count(text: &str) -> usize {
+    let newlines = text.bytes().filter(|&b| b == b'\n').count();
+    newlines + usize::from(!text.is_empty() && !text.ends_with('\n'))
 }
 
 pub fn is_terminator(op: Op) -> bool {
@@ -1269,6 +1336,79 @@ mod tests {
             );
         }
         assert!(parse(&module(Op::IAdd), path, Language::Spirv).is_ok());
+    }
+
+    /// Successors by label: each target's block once, in branch order
+    /// (a switch's default first); a target in another function is an
+    /// input error naming it.
+    #[test]
+    fn successors_by_label() {
+        use rspirv::binary::Assemble;
+        use rspirv::dr::Operand as O;
+        let module = |stray: bool| {
+            let mut b = rspirv::dr::Builder::new();
+            b.capability(spirv::Capability::Shader);
+            b.memory_model(spirv::AddressingModel::Logical, spirv::MemoryModel::GLSL450);
+            let void = b.type_void();
+            let boolean = b.type_bool();
+            let u = b.type_int(32, 0);
+            let yes = b.constant_true(boolean);
+            let one = b.constant_bit32(u, 1);
+            let fty = b.type_function(void, []);
+            let elsewhere = b.id();
+            b.begin_function(void, None, spirv::FunctionControl::NONE, fty)
+                .unwrap();
+            let (a, bb, c) = (b.id(), b.id(), b.id());
+            b.begin_block(None).unwrap();
+            b.branch_conditional(yes, a, bb, []).unwrap();
+            b.begin_block(Some(a)).unwrap();
+            b.branch(if stray { elsewhere } else { c }).unwrap();
+            b.begin_block(Some(bb)).unwrap();
+            b.switch(one, c, [(O::LiteralBit32(1), a), (O::LiteralBit32(2), c)])
+                .unwrap();
+            b.begin_block(Some(c)).unwrap();
+            b.ret().unwrap();
+            b.end_function().unwrap();
+            b.begin_function(void, None, spirv::FunctionControl::NONE, fty)
+                .unwrap();
+            b.begin_block(Some(elsewhere)).unwrap();
+            b.ret().unwrap();
+            b.end_function().unwrap();
+            (b.module().assemble(), elsewhere)
+        };
+        let path = Path::new("t.spv");
+        let p = parse(&module(false).0, path, Language::Spirv).unwrap();
+        let succs: Vec<Vec<usize>> = p.functions[0]
+            .blocks
+            .iter()
+            .map(|b| b.succs.clone())
+            .collect();
+        assert_eq!(succs, [vec![1, 2], vec![3], vec![3, 1], vec![]]);
+        let (words, elsewhere) = module(true);
+        let e = parse(&words, path, Language::Spirv).unwrap_err();
+        assert!(
+            e.to_string().contains(&format!(
+                "branch target %{elsewhere} is not a block of this function"
+            )),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn line_count_is_lines_count() {
+        for t in [
+            "",
+            "\n",
+            "a",
+            "a\n",
+            "a\nb",
+            "a\r\nb\r\n",
+            "\n\n",
+            "a\n\nb\n",
+            "\r\n\r",
+        ] {
+            assert_eq!(line_count(t), t.lines().count(), "{t:?}");
+        }
     }
 
     /// glslang 12 `-gV` gives `main` line 0; such positions, and lines past

@@ -61,18 +61,43 @@ impl Words<'_> {
         Some(v)
     }
     fn string(&mut self) -> Option<String> {
+        // The terminating word found first, so the bytes are copied once
+        // into a buffer of their size (an embedded source is tens of KB).
         let rest = &self.w[self.at..];
-        let mut bytes = Vec::new();
-        for (k, w) in rest.iter().enumerate() {
-            let b = w.to_le_bytes();
-            if let Some(z) = b.iter().position(|&c| c == 0) {
-                bytes.extend_from_slice(&b[..z]);
-                self.at += k + 1;
-                return String::from_utf8(bytes).ok();
-            }
-            bytes.extend_from_slice(&b);
+        let k = rest.iter().position(|&w| has_zero_byte(w))?;
+        let last = rest[k].to_le_bytes();
+        let z = last.iter().position(|&c| c == 0)?;
+        let mut bytes = Vec::with_capacity(4 * k + z);
+        for w in &rest[..k] {
+            bytes.extend_from_slice(&w.to_le_bytes());
         }
-        None
+        bytes.extend_from_slice(&last[..z]);
+        self.at += k + 1;
+        String::from_utf8(bytes).ok()
+    }
+}
+
+/// Whether one of the word's four bytes is 0.
+fn has_zero_byte(w: u32) -> bool {
+    w.wrapping_sub(0x0101_0101) & !w & 0x8080_8080 != 0
+}
+
+/// Whether the `spirv` crate knows `opcode` (`Op::from_u32`, a long chain
+/// of range tests that cost as much as decoding the instruction),
+/// remembered per opcode for the process.
+pub fn known_opcode(opcode: u16) -> bool {
+    use std::sync::atomic::{AtomicU8, Ordering};
+    // 0: not asked yet, 1: known, 2: unknown.
+    static KNOWN: [AtomicU8; 1 << 16] = [const { AtomicU8::new(0) }; 1 << 16];
+    let slot = &KNOWN[opcode as usize];
+    match slot.load(Ordering::Relaxed) {
+        1 => true,
+        2 => false,
+        _ => {
+            let known = Op::from_u32(u32::from(opcode)).is_some();
+            slot.store(if known { 1 } else { 2 }, Ordering::Relaxed);
+            known
+        }
     }
 }
 
@@ -158,9 +183,16 @@ fn width_of(widths: &[Width], id: u32) -> Width {
 fn instruction(g: Grammar, w: &mut Words, widths: &[Width]) -> Option<Instruction> {
     let mut result_type = None;
     let mut result_id = None;
-    // At most one operand per word, and rarely more than 16 (a string of
-    // many words, such as the embedded source, is one operand).
-    let mut operands = Vec::with_capacity(w.w.len().min(16));
+    // At most one operand per word after the result type and id, and
+    // rarely more than 16 (a string of many words, such as the embedded
+    // source, is one operand).
+    let results = g
+        .operands
+        .iter()
+        .take(2)
+        .filter(|o| matches!(o.kind, K::IdResultType | K::IdResult))
+        .count();
+    let mut operands = Vec::with_capacity(w.w.len().saturating_sub(results).min(16));
     let mut k = 0;
     while k < g.operands.len() {
         let lop = &g.operands[k];
@@ -498,6 +530,36 @@ mod tests {
             i += (words[i] >> 16).max(1) as usize;
         }
         out
+    }
+
+    /// The per-opcode table answers as `Op::from_u32` does, asked twice
+    /// (the second answer comes from the table).
+    #[test]
+    fn known_opcode_is_from_u32() {
+        for _ in 0..2 {
+            for w in 0..=u16::MAX {
+                assert_eq!(known_opcode(w), Op::from_u32(u32::from(w)).is_some(), "{w}");
+            }
+        }
+    }
+
+    /// The zero-byte test against the bytes themselves.
+    #[test]
+    fn zero_byte_found_in_any_position() {
+        for w in [
+            0u32,
+            0x0000_0001,
+            0x6162_6300,
+            0x0061_6263,
+            0x6100_6263,
+            0x6162_0063,
+            0x8080_8080,
+            0xffff_ffff,
+            0x0101_0101,
+            0x6162_6364,
+        ] {
+            assert_eq!(has_zero_byte(w), w.to_le_bytes().contains(&0), "{w:#x}");
+        }
     }
 
     /// Damaged modules: wherever the decoder gives instructions, rspirv

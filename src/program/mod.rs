@@ -18,7 +18,7 @@ pub mod types;
 mod values;
 
 pub use binary::{words_from_bytes, MAGIC};
-pub use build::parse;
+pub use build::{parse, parse_owned};
 pub use types::{ArrayLen, Type};
 
 use crate::diag::Location;
@@ -534,9 +534,12 @@ impl Program {
         // Each name's ids, globals and functions, found once: a lookup per
         // declaration, not a scan of every name (generated sources declare
         // thousands of functions).
+        // Only struct types take a type's or a member's position.
         let mut by_name: HashMap<&str, Vec<Id>> = HashMap::default();
         for (id, n) in &self.names {
-            by_name.entry(n.as_str()).or_default().push(*id);
+            if matches!(self.types.get(id), Some(Type::Struct { .. })) {
+                by_name.entry(n.as_str()).or_default().push(*id);
+            }
         }
         for ids in by_name.values_mut() {
             ids.sort_unstable();
@@ -552,6 +555,9 @@ impl Program {
             if let Some(n) = f.name.as_deref() {
                 functions_named.entry(n).or_default().push(f.id);
             }
+        }
+        fn named<'m>(map: &'m HashMap<&str, Vec<Id>>, name: &str) -> &'m [Id] {
+            map.get(name).map_or(&[], Vec::as_slice)
         }
         let mut decl_pos = std::mem::take(&mut self.decl_pos);
         for (decl, loc) in decls {
@@ -572,31 +578,28 @@ impl Program {
                 end_line: loc.end_line,
                 end_column: loc.end_column,
             };
-            let named = |map: &HashMap<&str, Vec<Id>>, name: &str| -> Vec<Id> {
-                map.get(name).cloned().unwrap_or_default()
-            };
             match decl {
                 N::Type(name) => {
-                    for id in named(&by_name, name) {
+                    for &id in named(&by_name, name) {
                         if matches!(self.types.get(&id), Some(Type::Struct { .. })) {
                             decl_pos.insert(Decl::Type(id), pos);
                         }
                     }
                 }
                 N::Member(name, k) => {
-                    for id in named(&by_name, name) {
+                    for &id in named(&by_name, name) {
                         if matches!(self.types.get(&id), Some(Type::Struct { .. })) {
                             decl_pos.insert(Decl::Member(id, *k), pos);
                         }
                     }
                 }
                 N::Global(name) => {
-                    for id in named(&globals_named, name) {
+                    for &id in named(&globals_named, name) {
                         decl_pos.insert(Decl::Var(id), pos);
                     }
                 }
                 N::Function(name) => {
-                    for id in named(&functions_named, name) {
+                    for &id in named(&functions_named, name) {
                         decl_pos.insert(Decl::Func(id), pos);
                     }
                 }
