@@ -239,6 +239,16 @@ pub fn reached_without(p: &Program, q: &Query, fact: PathFact, at: &[usize]) -> 
     });
     let mut out = Vec::new();
     for (fi, f) in p.functions.iter().enumerate() {
+        // At entry the fact fails only where the query starts afresh.
+        let fresh = match storage {
+            Some(StorageClass::Function) => decl.and_then(|d| p.function_of(d)) == Some(fi),
+            Some(StorageClass::Private) => p.entry_points.iter().any(|e| e.function == f.id),
+            _ => false,
+        };
+        // Asked first: finding the uses below costs a walk of the function.
+        if !fresh {
+            continue;
+        }
         // The uses in this function, and the calls that reach one.
         let here: Vec<usize> = (f.start..=f.end)
             .filter(|&i| {
@@ -260,15 +270,6 @@ pub fn reached_without(p: &Program, q: &Query, fact: PathFact, at: &[usize]) -> 
         if here.is_empty() || f.blocks.is_empty() {
             continue;
         }
-        // At entry the fact fails only where the query starts afresh.
-        let fresh = match storage {
-            Some(StorageClass::Function) => decl.and_then(|d| p.function_of(d)) == Some(fi),
-            Some(StorageClass::Private) => p.entry_points.iter().any(|e| e.function == f.id),
-            _ => false,
-        };
-        if !fresh {
-            continue;
-        }
         let names_query = |id: Id| roots(p, id).contains(&q.var);
         // Transfer over instructions start..=end from state `s`; records misses.
         let step = |s: bool, from: usize, to: usize, misses: Option<&mut Vec<usize>>| -> bool {
@@ -277,7 +278,8 @@ pub fn reached_without(p: &Program, q: &Query, fact: PathFact, at: &[usize]) -> 
             for i in from..=to {
                 let inst = &p.insts[i];
                 let op = inst.class.opcode;
-                if !s && here.contains(&i) {
+                // `here` lists instructions in order.
+                if !s && here.binary_search(&i).is_ok() {
                     if let Some(m) = misses.as_deref_mut() {
                         m.push(i);
                     }

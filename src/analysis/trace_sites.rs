@@ -125,13 +125,17 @@ pub fn depends_on_payload(program: &Program, id: crate::program::Id, chain: &[us
         }
         ptr
     };
-    let mut seen: Vec<(crate::program::Id, usize)> = Vec::new();
+    // Every store's value by the variable its pointer starts from, in the
+    // module's order: found once per Program, not by a scan of every
+    // instruction per local the search loads (quadratic in a module).
+    struct StoresByRoot(crate::program::FastMap<crate::program::Id, Vec<crate::program::Id>>);
+    let mut stores: Option<std::sync::Arc<StoresByRoot>> = None;
+    let mut seen: std::collections::HashSet<(crate::program::Id, usize)> = Default::default();
     let mut work: Vec<(crate::program::Id, usize)> = vec![(id, chain.len())];
     while let Some((v, depth)) = work.pop() {
-        if seen.contains(&(v, depth)) || seen.len() > LIMIT {
+        if seen.len() > LIMIT || !seen.insert((v, depth)) {
             continue;
         }
-        seen.push((v, depth));
         let Some(inst) = program.def(v) else { continue };
         match inst.class.opcode {
             Op::Load => {
@@ -150,17 +154,24 @@ pub fn depends_on_payload(program: &Program, id: crate::program::Id, chain: &[us
                     Some(StorageClass::Function | StorageClass::Private)
                 ) {
                     // Every value stored into the local.
-                    for s in program.insts.iter() {
-                        if s.class.opcode != Op::Store {
-                            continue;
-                        }
-                        if let (Some(Operand::IdRef(p)), Some(Operand::IdRef(val))) =
-                            (s.operands.first(), s.operands.get(1))
-                        {
-                            if root(*p) == var {
-                                work.push((*val, depth));
+                    let stores = stores.get_or_insert_with(|| {
+                        program.memo.get_or(|| {
+                            let mut by_root = crate::program::FastMap::default();
+                            for s in &program.insts {
+                                if s.class.opcode != Op::Store {
+                                    continue;
+                                }
+                                if let (Some(Operand::IdRef(p)), Some(Operand::IdRef(val))) =
+                                    (s.operands.first(), s.operands.get(1))
+                                {
+                                    by_root.entry(root(*p)).or_insert_with(Vec::new).push(*val);
+                                }
                             }
-                        }
+                            StoresByRoot(by_root)
+                        })
+                    });
+                    if let Some(vals) = stores.0.get(&var) {
+                        work.extend(vals.iter().map(|&val| (val, depth)));
                     }
                 }
             }
