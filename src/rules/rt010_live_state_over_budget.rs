@@ -16,9 +16,7 @@ pub const DEFAULT_BUDGET_BYTES: u64 = 64;
 /// (`rtlint live` still lists them).
 pub fn check(program: &Program, sites: &[LiveSite], budget_bytes: u64) -> Vec<Diagnostic> {
     let mut out = Vec::new();
-    for site in sites.iter().filter(|s| {
-        s.path == program.path && s.kind != crate::analysis::liveness::LiveSiteKind::RayQuery
-    }) {
+    for site in reported(program, sites) {
         let kept = site.live_bytes - site.rematerializable_bytes;
         if kept <= budget_bytes {
             continue;
@@ -155,11 +153,28 @@ super::declare_rule! {
 }
 
 fn run(ctx: &super::Context) -> Vec<Diagnostic> {
-    check(
-        ctx.program,
-        &crate::analysis::liveness::live_sites(ctx.program),
-        super::option_u64(ctx.config, &RULE, "budget", ctx.config.live_state_budget),
-    )
+    use crate::analysis::liveness::{shared_live_bytes, shared_live_sites};
+    let budget = super::option_u64(ctx.config, &RULE, "budget", ctx.config.live_state_budget);
+    // The bytes decide whether anything is reported; naming, typing and
+    // placing each value (a third of the liveness time) only for a finding.
+    let bytes = shared_live_bytes(ctx.program);
+    if check_bytes(ctx.program, &bytes, budget) {
+        check(ctx.program, &shared_live_sites(ctx.program), budget)
+    } else {
+        Vec::new()
+    }
+}
+
+/// Whether [`check`] reports anything: the same sites, counted the same way.
+fn check_bytes(program: &Program, sites: &[LiveSite], budget_bytes: u64) -> bool {
+    reported(program, sites).any(|s| s.live_bytes - s.rematerializable_bytes > budget_bytes)
+}
+
+/// The sites [`check`] judges.
+fn reported<'a>(program: &'a Program, sites: &'a [LiveSite]) -> impl Iterator<Item = &'a LiveSite> {
+    sites.iter().filter(|s| {
+        s.path == program.path && s.kind != crate::analysis::liveness::LiveSiteKind::RayQuery
+    })
 }
 
 #[cfg(test)]
@@ -177,6 +192,42 @@ mod tests {
         )
         .unwrap();
         check(&p, &live_sites(&p), budget)
+    }
+
+    /// The rule as `check` runs it (bytes first, descriptions only for a
+    /// finding) reports what judging the described sites reports, at
+    /// budgets on both sides of each site's count.
+    #[test]
+    fn run_reports_what_check_reports() {
+        let mut judged = 0;
+        for rel in [
+            "fixtures/RT010/bad.rgen.spv",
+            "fixtures/RT010/good.rgen.spv",
+            "fixtures/live/seed.rchit.spv",
+            "fixtures/live/classes.rgen.spv",
+            "fixtures/live/classes.wgsl",
+            "fixtures/live/classes.hlsl",
+        ] {
+            let path = Path::new(env!("CARGO_MANIFEST_DIR")).join(rel);
+            let p = load(&path, Language::from_path(&path).unwrap()).unwrap();
+            let sites = live_sites(&p);
+            for budget in [0, 4, 11, 12, 64, 1 << 20] {
+                let mut config = crate::config::Config::default();
+                config.live_state_budget = Some(budget);
+                let fresh = load(&path, Language::from_path(&path).unwrap()).unwrap();
+                let got: Vec<String> = crate::rules::check_program(&fresh, &config)
+                    .into_iter()
+                    .filter(|d| d.code == Some(CODE))
+                    .map(|d| format!("{d:?}"))
+                    .collect();
+                let want: Vec<String> =
+                    check(&p, &sites, budget).iter().map(|d| format!("{d:?}")).collect();
+                judged += want.len();
+                assert_eq!(got, want, "{rel} at budget {budget}");
+            }
+        }
+        // Findings were compared, not only silences.
+        assert!(judged > 0);
     }
 
     #[test]
