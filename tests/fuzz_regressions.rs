@@ -1,9 +1,47 @@
 //! Replays the fuzz regression corpus (`fuzz/regressions/<target>/*`: inputs
 //! that once crashed or hung a `cargo fuzz` target, minimised) through the
 //! same calls as each target in `fuzz/fuzz_targets/`: each must end in a
-//! result or an input error (`spirv_gen`: keep the generator's invariants).
+//! result or an input error (`spirv_gen`: keep the generator's invariants),
+//! without asking for more than [`MAX_ALLOCATION`] at once.
 
 mod common;
+
+use std::alloc::{GlobalAlloc, Layout, System};
+
+/// No single allocation over this while replaying: an input that once ran
+/// the fuzzer out of memory fails here (the process aborts with
+/// "memory allocation of N bytes failed") instead of passing on a machine
+/// with enough of it.
+const MAX_ALLOCATION: usize = 1 << 30;
+
+struct Capped;
+
+unsafe impl GlobalAlloc for Capped {
+    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+        if layout.size() > MAX_ALLOCATION {
+            return std::ptr::null_mut();
+        }
+        System.alloc(layout)
+    }
+    unsafe fn alloc_zeroed(&self, layout: Layout) -> *mut u8 {
+        if layout.size() > MAX_ALLOCATION {
+            return std::ptr::null_mut();
+        }
+        System.alloc_zeroed(layout)
+    }
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+        System.dealloc(ptr, layout)
+    }
+    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
+        if new_size > MAX_ALLOCATION {
+            return std::ptr::null_mut();
+        }
+        System.realloc(ptr, layout, new_size)
+    }
+}
+
+#[global_allocator]
+static ALLOCATOR: Capped = Capped;
 
 use rtlint::config::Config;
 use rtlint::front::hlsl::{compile_source_whole, parse_source, pp::MemLoader, HlslOptions};
