@@ -1020,9 +1020,8 @@ impl SsaLive {
     }
 
     /// The values live just after instruction `inst` of block `b`.
-    fn after(&self, fl: &FnLiveness, f: &Function, b: usize, inst: usize) -> Vec<Id> {
+    fn after(&self, fl: &FnLiveness, b: usize, inst: usize) -> Vec<Id> {
         let w = self.words;
-        let _ = f;
         let mut live = self.live_out[b * w..(b + 1) * w].to_vec();
         for &k in fl.body.block_after(b, inst).iter().rev() {
             self.step(fl, k as usize, &mut live, None);
@@ -2014,42 +2013,41 @@ impl FnLiveness {
     /// SSA values and parts of variables live just after instruction `inst`
     /// (each once).
     fn places_after(&self, program: &Program, inst: usize) -> Vec<Place> {
-        let f = self.function(program);
-        let Some(b) = block_at(f, inst) else {
+        let Some((b, live)) = self.live_parts_after(program, inst) else {
             return Vec::new();
         };
-        let mut live = self.live_out[b].clone();
-        for &k in self.body.block_after(b, inst).iter().rev() {
-            self.step_back(program, k as usize, &mut live);
-        }
         let mut out: Vec<Place> = {
             let places = self.places.borrow();
             live.iter().map(|i| places.place(i).clone()).collect()
         };
-        {
-            let ssa = self.ssa.get_or_init(|| SsaLive::new(self, program));
-            out.extend(
-                ssa.after(self, f, b, inst)
-                    .into_iter()
-                    .map(|id| (id, Vec::new())),
-            );
-        }
+        let ssa = self.ssa.get_or_init(|| SsaLive::new(self, program));
+        out.extend(
+            ssa.after(self, b, inst)
+                .into_iter()
+                .map(|id| (id, Vec::new())),
+        );
         out
     }
 
     /// The parts of variables (and pointer parameters) live just after
     /// instruction `inst`.
     fn parts_after(&self, program: &Program, inst: usize) -> HashSet<Place> {
-        let f = self.function(program);
-        let Some(b) = block_at(f, inst) else {
+        let Some((_, live)) = self.live_parts_after(program, inst) else {
             return HashSet::default();
         };
+        let places = self.places.borrow();
+        live.iter().map(|i| places.place(i).clone()).collect()
+    }
+
+    /// The block of instruction `inst`, and the places of the parts live
+    /// just after it (by index).
+    fn live_parts_after(&self, program: &Program, inst: usize) -> Option<(usize, BitSet)> {
+        let b = block_at(self.function(program), inst)?;
         let mut live = self.live_out[b].clone();
         for &k in self.body.block_after(b, inst).iter().rev() {
             self.step_back(program, k as usize, &mut live);
         }
-        let places = self.places.borrow();
-        live.iter().map(|i| places.place(i).clone()).collect()
+        Some((b, live))
     }
 
     /// Bytes of the live parts of variable `var` (of type `ty`): all of it

@@ -1056,7 +1056,6 @@ impl Builder<'_> {
     /// Splits the instruction stream into functions and blocks with successors.
     fn functions(&mut self) -> Result<(), InputError> {
         let n = self.p.insts.len();
-        let mut labels: FastMap<Id, usize> = FastMap::default();
         let mut i = 0;
         while i < n {
             if self.p.insts[i].class.opcode != Op::Function {
@@ -1104,13 +1103,10 @@ impl Builder<'_> {
             if block_start.is_some() {
                 return Err(self.at(i, "block has no terminator"));
             }
-            // Successors by label: each label's block found in a map, not
-            // by a search of the function's blocks per branch target.
-            labels.clear();
-            for (k, block) in blocks.iter().enumerate() {
-                labels.entry(block.label).or_insert(k);
-            }
-            for block in &mut blocks {
+            // Successors by label (labels are defined once: `check_ids`).
+            let mut f = Function::new(id, self.p.names.get(&id).cloned(), params, start, i, blocks);
+            let mut all_succs = Vec::with_capacity(f.blocks.len());
+            for block in &f.blocks {
                 let term = &self.p.insts[block.end];
                 let (branch, cases): ([Option<Id>; 2], &[Operand]) = match term.class.opcode {
                     Op::Branch => ([id_at(term, 0), None], &[]),
@@ -1129,7 +1125,7 @@ impl Builder<'_> {
                         }));
                 let mut succs = Vec::new();
                 for t in targets {
-                    match labels.get(&t).copied() {
+                    match f.block_by_label(t) {
                         Some(s) => {
                             if !succs.contains(&s) {
                                 succs.push(s)
@@ -1143,16 +1139,12 @@ impl Builder<'_> {
                         }
                     }
                 }
+                all_succs.push(succs);
+            }
+            for (block, succs) in f.blocks.iter_mut().zip(all_succs) {
                 block.succs = succs;
             }
-            self.p.functions.push(Function {
-                id,
-                name: self.p.names.get(&id).cloned(),
-                params,
-                start,
-                end: i,
-                blocks,
-            });
+            self.p.functions.push(f);
             i += 1;
         }
         for e in &self.p.entry_points {

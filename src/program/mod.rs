@@ -121,9 +121,38 @@ pub struct Function {
     pub start: usize,
     pub end: usize,
     pub blocks: Vec<Block>,
+    /// Each block's label with its index, sorted by label: branch targets
+    /// and phi operands are looked up per use, so not by a scan of the
+    /// blocks. Labels are ids, defined once.
+    labels: Vec<(Id, usize)>,
 }
 
 impl Function {
+    pub fn new(
+        id: Id,
+        name: Option<String>,
+        params: Vec<Id>,
+        start: usize,
+        end: usize,
+        blocks: Vec<Block>,
+    ) -> Function {
+        let mut labels: Vec<(Id, usize)> = blocks
+            .iter()
+            .enumerate()
+            .map(|(k, b)| (b.label, k))
+            .collect();
+        labels.sort_unstable();
+        Function {
+            id,
+            name,
+            params,
+            start,
+            end,
+            blocks,
+            labels,
+        }
+    }
+
     /// Index of the block holding instruction `inst`.
     pub fn block_of(&self, inst: usize) -> Option<usize> {
         self.blocks
@@ -132,7 +161,8 @@ impl Function {
     }
 
     pub fn block_by_label(&self, label: Id) -> Option<usize> {
-        self.blocks.iter().position(|b| b.label == label)
+        let k = self.labels.binary_search_by_key(&label, |&(l, _)| l).ok()?;
+        Some(self.labels[k].1)
     }
 }
 
@@ -534,7 +564,8 @@ impl Program {
         // Each name's ids, globals and functions, found once: a lookup per
         // declaration, not a scan of every name (generated sources declare
         // thousands of functions).
-        // Only struct types take a type's or a member's position.
+        // Only struct types take a type's or a member's position, so only
+        // they are listed.
         let mut by_name: HashMap<&str, Vec<Id>> = HashMap::default();
         for (id, n) in &self.names {
             if matches!(self.types.get(id), Some(Type::Struct { .. })) {
@@ -581,16 +612,12 @@ impl Program {
             match decl {
                 N::Type(name) => {
                     for &id in named(&by_name, name) {
-                        if matches!(self.types.get(&id), Some(Type::Struct { .. })) {
-                            decl_pos.insert(Decl::Type(id), pos);
-                        }
+                        decl_pos.insert(Decl::Type(id), pos);
                     }
                 }
                 N::Member(name, k) => {
                     for &id in named(&by_name, name) {
-                        if matches!(self.types.get(&id), Some(Type::Struct { .. })) {
-                            decl_pos.insert(Decl::Member(id, *k), pos);
-                        }
+                        decl_pos.insert(Decl::Member(id, *k), pos);
                     }
                 }
                 N::Global(name) => {
