@@ -1067,8 +1067,9 @@ impl std::ops::Deref for MentionList {
     }
 }
 
-/// A variable read at an instruction, in the parts read (sorted).
-type RematKey = (Id, usize, Vec<Vec<u32>>);
+/// A variable read at an instruction, in the parts read (sorted), each
+/// part as its length then its indices: one vector, not one per part.
+type RematKey = (Id, usize, Vec<u32>);
 
 /// Liveness facts of one function.
 pub struct FnLiveness {
@@ -1108,6 +1109,9 @@ pub struct FnLiveness {
     remat: RefCell<HashMap<Id, bool>>,
     /// Variables' rematerialisation as read at an instruction.
     remat_at: RefCell<HashMap<RematKey, bool>>,
+    /// Vectors a reaching-writes walk reuses (the blocks to visit and
+    /// those seen), instead of two allocations per question.
+    walk: RefCell<(Vec<(usize, usize)>, Vec<bool>)>,
     /// Each instruction's backward transfer (from the function's start).
     steps: Vec<Step>,
     /// The places `Step::Plain` reads.
@@ -1505,6 +1509,7 @@ impl FnLiveness {
             preds,
             remat: RefCell::default(),
             remat_at: RefCell::default(),
+            walk: RefCell::default(),
             steps: Vec::new(),
             step_uses: Vec::new(),
             segments: Vec::new(),
@@ -2154,7 +2159,10 @@ impl FnLiveness {
         // The places by id: each value's parts side by side.
         let mut by_id: Vec<(Id, &[u32])> =
             places.iter().map(|(id, p)| (*id, p.as_slice())).collect();
-        by_id.sort_unstable_by_key(|&(id, _)| id);
+        // (The caller's places come sorted, so each id's parts in order.)
+        if !by_id.is_sorted_by_key(|&(id, _)| id) {
+            by_id.sort_unstable_by_key(|&(id, _)| id);
+        }
         let result = self.body.result(inst);
         let mut out = Vec::new();
         let mut k = 0;
@@ -2193,8 +2201,7 @@ impl FnLiveness {
                 _ => {}
             }
             let rematerializable = if is_var {
-                let parts: Vec<Vec<u32>> = parts.iter().map(|(_, p)| p.to_vec()).collect();
-                self.remat_var(program, id, inst, &parts, 0)
+                self.remat_var(program, id, inst, parts.iter().map(|&(_, p)| p), 0)
             } else {
                 self.remat_ssa(program, id, 0)
             };
@@ -2379,14 +2386,8 @@ impl FnLiveness {
                     // The caller's value: not known here.
                     Some(v) if !self.vars.contains(&v) => false,
                     Some(v) => {
-                        let part = self.roots.get(&ptr).map(|p| self.path(p).to_vec());
-                        self.remat_var(
-                            program,
-                            v,
-                            i,
-                            &part.into_iter().collect::<Vec<_>>(),
-                            depth + 1,
-                        )
+                        let part = self.roots.get(&ptr).map(|p| self.path(p));
+                        self.remat_var(program, v, i, part.into_iter(), depth + 1)
                     }
                     // A buffer_reference pointer is an address computed like
                     // any value: the load is recomputable when it is.
@@ -2463,35 +2464,51 @@ impl FnLiveness {
     /// a value that changed), and nothing else (a call, an atomic) gets its
     /// address. Only writes to the `parts` read count (all of them when
     /// `parts` is empty or holds the whole variable).
-    fn remat_var(
+    fn remat_var<'a>(
         &self,
         program: &Program,
         var: Id,
         at: usize,
-        parts: &[Vec<u32>],
+        parts: impl Iterator<Item = &'a [u32]>,
         depth: u32,
     ) -> bool {
-        let mut parts = parts.to_vec();
-        parts.sort();
-        let key = (var, at, parts);
+        // The parts in order, flattened into the key (see `RematKey`).
+        let mut sorted: Vec<&[u32]> = parts.collect();
+        if !sorted.is_sorted() {
+            sorted.sort();
+        }
+        let mut flat = Vec::with_capacity(sorted.iter().map(|p| p.len() + 1).sum());
+        for p in &sorted {
+            flat.push(p.len() as u32);
+            flat.extend_from_slice(p);
+        }
+        let key = (var, at, flat);
         if let Some(&r) = self.remat_at.borrow().get(&key) {
             return r;
         }
         self.remat_at.borrow_mut().insert(key.clone(), false);
-        let parts = &key.2;
+        let parts = &sorted;
         let mentions = self.mentions(program, var);
         let reaching = self.reaching_writes(program, var, at, mentions.as_deref().unwrap_or(&[]));
+        // Both lists are sorted, and every reaching write is among the
+        // mentions: whether a mention reaches is a walk along `reaching`
+        // beside the mentions, not a binary search each.
+        let mut next = 0;
+        let mut reaches = |i: usize| {
+            while next < reaching.len() && reaching[next] < i {
+                next += 1;
+            }
+            reaching.get(next) == Some(&i)
+        };
         let mut ok = true;
         // The paths stored to, as ranges of `self.paths`.
-        let mut stored: Vec<((u32, u32), Id)> =
-            Vec::with_capacity(mentions.as_ref().map_or(0, |m| m.len()));
+        let mut stored: Vec<((u32, u32), Id)> = Vec::new();
         let body = &self.body;
         for &i in mentions.iter().flat_map(|m| m.iter()) {
             let ids = body.ids(i);
             match body.op(i) {
                 Op::Variable => {
-                    if let Some(&init) = ids.first().filter(|_| reaching.binary_search(&i).is_ok())
-                    {
+                    if let Some(&init) = ids.first().filter(|_| reaches(i)) {
                         if !matches!(
                             program.constants.get(&init),
                             Some(Constant::Int(_) | Constant::Float(_) | Constant::Bool(_))
@@ -2504,7 +2521,7 @@ impl FnLiveness {
                     }
                 }
                 // A store that cannot reach `at` does not give the value read there.
-                Op::Store if reaching.binary_search(&i).is_err() => {}
+                Op::Store if !reaches(i) => {}
                 Op::Store => {
                     let ptr = ids.first();
                     let value = ids.get(1).copied().unwrap_or(0);
@@ -2664,8 +2681,12 @@ impl FnLiveness {
             }
         };
         // (block, last instruction to look at)
-        let mut work: Vec<(usize, usize)> = vec![(b0, at)];
-        let mut seen = vec![false; f.blocks.len()];
+        let mut walk = self.walk.borrow_mut();
+        let (work, seen) = &mut *walk;
+        work.clear();
+        work.push((b0, at));
+        seen.clear();
+        seen.resize(f.blocks.len(), false);
         while let Some((b, last)) = work.pop() {
             let block = &f.blocks[b];
             let mut killed = false;
