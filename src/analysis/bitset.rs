@@ -52,17 +52,6 @@ impl BitSet {
             .is_some_and(|w| w >> (i % 64) & 1 == 1)
     }
 
-    /// Adds every index of `other`.
-    #[inline]
-    pub fn union_with(&mut self, other: &BitSet) {
-        if other.0.len() > self.0.len() {
-            self.0.resize(other.0.len(), 0);
-        }
-        for (a, b) in self.0.iter_mut().zip(&other.0) {
-            *a |= b;
-        }
-    }
-
     /// Makes room for the indices below `n` at once (the words a set
     /// would otherwise grow one insert or union at a time).
     #[inline]
@@ -77,6 +66,36 @@ impl BitSet {
     #[inline]
     pub fn clear(&mut self) {
         self.0.fill(0);
+    }
+
+    /// The words, lowest indices first (flat tables of sets copy them).
+    #[inline]
+    pub fn words(&self) -> &[u64] {
+        &self.0
+    }
+
+    /// Adds every index of a set given as its words.
+    #[inline]
+    pub fn union_words(&mut self, words: &[u64]) {
+        if words.len() > self.0.len() {
+            self.0.resize(words.len(), 0);
+        }
+        for (a, b) in self.0.iter_mut().zip(words) {
+            *a |= b;
+        }
+    }
+
+    /// Whether this set holds exactly the indices of a set given as its
+    /// words (as `==`).
+    #[inline]
+    pub fn same_words(&self, words: &[u64]) -> bool {
+        let (short, long) = if self.0.len() <= words.len() {
+            (&self.0[..], words)
+        } else {
+            (words, &self.0[..])
+        };
+        short.iter().zip(long.iter()).all(|(a, b)| a == b)
+            && long[short.len()..].iter().all(|&w| w == 0)
     }
 
     /// The indices, smallest first.
@@ -184,11 +203,14 @@ mod tests {
         let mut b = BitSet::default();
         b.insert(2);
         b.insert(300);
-        a.union_with(&b);
+        a.union_words(b.words());
         assert_eq!(a.iter().collect::<Vec<_>>(), [1, 2, 300]);
         let mut c = b.clone();
-        c.union_with(&BitSet::default());
+        c.union_words(BitSet::default().words());
         assert_eq!(c, b);
+        // Sets given as words compare as sets do, whatever their length.
+        assert!(b.same_words(c.words()) && !a.same_words(b.words()));
+        assert!(c.same_words(&[4, 0, 0, 0, 0, 1 << 44, 0]) && !c.same_words(&[4]));
         let mut d = BitSet::default();
         d.insert(900);
         d.clone_from(&a);

@@ -842,8 +842,10 @@ const MAX_SPLIT: u32 = 64;
 
 /// Variables possibly written on some path to each block's end.
 struct Defined {
-    /// Per block, as indices among the variables something writes.
-    out: Vec<BitSet>,
+    /// Per block (a row of `w` words each), as indices among the
+    /// variables something writes.
+    out: Vec<u64>,
+    w: usize,
     /// Each variable's index there (by its ordinal among the function's
     /// variables), or [`IdIndex::NONE`] when nothing writes it.
     slot: Vec<u32>,
@@ -887,6 +889,92 @@ impl Focus {
         }
         let all = blocks.iter().all(|&b| b);
         Focus { blocks, all }
+    }
+}
+
+/// Each block's predecessors: `list[start[b]..start[b + 1]]` (one list
+/// for the function, not a vector per block).
+struct Preds {
+    start: Vec<usize>,
+    list: Vec<usize>,
+}
+
+impl Preds {
+    fn new(f: &Function) -> Preds {
+        let n = f.blocks.len();
+        let mut start = vec![0usize; n + 1];
+        for block in &f.blocks {
+            for &s in block.succs.iter().filter(|&&s| s < n) {
+                start[s + 1] += 1;
+            }
+        }
+        for b in 0..n {
+            start[b + 1] += start[b];
+        }
+        let mut fill = start.clone();
+        let mut list = vec![0usize; start[n]];
+        // By block, so each block's predecessors are in order, as before.
+        for (b, block) in f.blocks.iter().enumerate() {
+            for &s in block.succs.iter().filter(|&&s| s < n) {
+                list[fill[s]] = b;
+                fill[s] += 1;
+            }
+        }
+        Preds { start, list }
+    }
+}
+
+impl std::ops::Index<usize> for Preds {
+    type Output = [usize];
+    #[inline]
+    fn index(&self, b: usize) -> &[usize] {
+        &self.list[self.start[b]..self.start[b + 1]]
+    }
+}
+
+/// One bit set per block in a single flat table of `w` words a row
+/// (widened when a set outgrows it): the fixpoint's sets without an
+/// allocation per block.
+#[derive(Debug, Default)]
+struct Rows {
+    n: usize,
+    w: usize,
+    words: Vec<u64>,
+}
+
+impl Rows {
+    fn new(n: usize, w: usize) -> Rows {
+        Rows {
+            n,
+            w,
+            words: vec![0; n * w],
+        }
+    }
+
+    #[inline]
+    fn row(&self, b: usize) -> &[u64] {
+        &self.words[b * self.w..(b + 1) * self.w]
+    }
+
+    /// Row `b` := `words` (no longer than a row), zero-padded.
+    #[inline]
+    fn set_row(&mut self, b: usize, words: &[u64]) {
+        let row = &mut self.words[b * self.w..(b + 1) * self.w];
+        row[..words.len()].copy_from_slice(words);
+        row[words.len()..].fill(0);
+    }
+
+    /// Makes rows at least `w` words wide.
+    fn widen(&mut self, w: usize) {
+        if w <= self.w {
+            return;
+        }
+        let mut words = vec![0; self.n * w];
+        for b in 0..self.n {
+            words[b * w..b * w + self.w].copy_from_slice(self.row(b));
+        }
+        self.words = words;
+        self.w = w;
     }
 }
 
@@ -1098,20 +1186,20 @@ pub struct FnLiveness {
     /// site's function and its callers on a chain ask).
     ssa: std::cell::OnceCell<SsaLive>,
     /// Live places at each block's end, as indices into `places`.
-    live_out: Vec<BitSet>,
+    live_out: Rows,
     /// Every place met while solving (the live sets' members).
     places: RefCell<Places>,
     /// Variables possibly written at each block's end (as indices into
     /// [`Defined::written`]): only asked where a site is, so worked out
     /// on first use (a callee solved for its parameters never asks).
     defined: std::cell::OnceCell<Defined>,
-    preds: Vec<Vec<usize>>,
+    preds: Preds,
     remat: RefCell<HashMap<Id, bool>>,
     /// Variables' rematerialisation as read at an instruction.
     remat_at: RefCell<HashMap<RematKey, bool>>,
     /// Vectors a reaching-writes walk reuses (the blocks to visit and
     /// those seen), instead of two allocations per question.
-    walk: RefCell<(Vec<(usize, usize)>, Vec<bool>)>,
+    walk: RefCell<Walk>,
     /// Each instruction's backward transfer (from the function's start).
     steps: Vec<Step>,
     /// The places `Step::Plain` reads.
@@ -1126,6 +1214,25 @@ pub struct FnLiveness {
     /// The instructions that define or use each variable, in order (built
     /// on first use).
     mentions: std::cell::OnceCell<std::rc::Rc<Mentions>>,
+    /// Each root's mentions by block (made on the first reaching-writes
+    /// walk: only a site's function asks).
+    mention_blocks: std::cell::OnceCell<MentionBlocks>,
+}
+
+/// Each root's mentions grouped by block: `runs[start[k]..start[k + 1]]`
+/// are root `k`'s, each (block, from, to) into its mention list, in order.
+struct MentionBlocks {
+    start: Vec<u32>,
+    runs: Vec<(u32, u32, u32)>,
+}
+
+/// What a reaching-writes walk reuses: the blocks to visit, those seen,
+/// and each block's span of the variable's mentions.
+#[derive(Default)]
+struct Walk {
+    work: Vec<(usize, usize)>,
+    seen: Vec<bool>,
+    span: Vec<(u32, u32)>,
 }
 
 impl FnLiveness {
@@ -1443,15 +1550,7 @@ impl FnLiveness {
                 _ => ssa_ids.push(r),
             }
         }
-        let n = f.blocks.len();
-        let mut preds = vec![Vec::new(); n];
-        for (b, block) in f.blocks.iter().enumerate() {
-            for &s in &block.succs {
-                if let Some(p) = preds.get_mut(s) {
-                    p.push(b);
-                }
-            }
-        }
+        let preds = Preds::new(f);
         // Per instruction: the load a copy's store copies from, or that a
         // load is a copy's (read at the store).
         let mut copy = vec![Copy::None; f.end + 1 - f.start];
@@ -1503,7 +1602,7 @@ impl FnLiveness {
             ssa_ids,
             focus,
             ssa: std::cell::OnceCell::new(),
-            live_out: vec![BitSet::default(); n],
+            live_out: Rows::default(),
             places: RefCell::new(Places::new(lo, hi, f.end + 1 - f.start)),
             defined: std::cell::OnceCell::new(),
             preds,
@@ -1515,6 +1614,7 @@ impl FnLiveness {
             segments: Vec::new(),
             block_segments: Vec::new(),
             mentions: std::cell::OnceCell::new(),
+            mention_blocks: std::cell::OnceCell::new(),
         };
         fl.prepare_steps(program);
         fl.solve(program);
@@ -1912,38 +2012,41 @@ impl FnLiveness {
     fn solve(&mut self, program: &Program) {
         let f = self.function(program);
         let n = f.blocks.len();
-        let mut live_in: Vec<BitSet> = vec![BitSet::default(); n];
-        // Every place met so far fits from the start: the sets do not grow
-        // word by word in the loop below.
-        let known = self.places.get_mut().list.len() as u32;
+        // Every place met so far fits from the start: the rows widen only
+        // when the loop below meets new places (a copy's or a call's parts).
+        let known = self.places.get_mut().list.len();
+        let mut live_in = Rows::new(n, known.div_ceil(64));
+        let mut live_out = Rows::new(n, known.div_ceil(64));
         // A worklist: a block is redone only when a successor's live-in
         // grew (every block once first, last block first), instead of every
         // block every round until a whole round changes nothing.
         let mut work: Vec<usize> = (0..n).filter(|&b| self.focus.blocks[b]).collect();
         let mut queued = self.focus.blocks.clone();
         let mut steps = 0usize;
-        // Reused for each block's live set, to spare an allocation a visit.
-        let mut scratch = BitSet::default();
+        // One live set and one live-out set, reused for every visit.
+        let mut live = BitSet::default();
+        let mut out = BitSet::default();
         while let Some(b) = work.pop() {
             queued[b] = false;
             steps += 1;
             if steps > n.saturating_mul(10_000) {
                 break;
             }
-            let mut out = std::mem::take(&mut self.live_out[b]);
             out.clear();
-            out.reserve_indices(known);
+            out.reserve_indices((live_in.w * 64) as u32);
             for &s in &f.blocks[b].succs {
-                if let Some(li) = live_in.get(s) {
-                    out.union_with(li);
+                if s < n {
+                    out.union_words(live_in.row(s));
                 }
             }
-            let mut live = std::mem::take(&mut scratch);
             live.clone_from(&out);
             self.block_back(program, b, &mut live);
-            self.live_out[b] = out;
-            if live != live_in[b] {
-                std::mem::swap(&mut live_in[b], &mut live);
+            let w = live.words().len().max(out.words().len());
+            live_in.widen(w);
+            live_out.widen(w);
+            live_out.set_row(b, out.words());
+            if !live.same_words(live_in.row(b)) {
+                live_in.set_row(b, live.words());
                 for &p in &self.preds[b] {
                     if self.focus.blocks[p] && !queued[p] {
                         queued[p] = true;
@@ -1951,21 +2054,24 @@ impl FnLiveness {
                     }
                 }
             }
-            scratch = live;
         }
+        self.live_out = live_out;
     }
 
     /// Variables possibly written on some path to each block's end.
     fn defined(&self, program: &Program) -> &Defined {
         self.defined.get_or_init(|| {
             let f = self.function(program);
+            let n = f.blocks.len();
             // What each block writes itself is the same every round. Only
             // variables are asked about, and only an instruction that
             // mentions one can write it: each variable's mentions, not
             // every instruction.
             let mut written = 0u32;
             let mut slot = vec![IdIndex::NONE; self.vars.keys.len()];
-            let mut own: Vec<BitSet> = vec![BitSet::default(); f.blocks.len()];
+            // (block, index) pairs first: the rows' width is the number of
+            // variables written, known only at the end.
+            let mut writes: Vec<(usize, u32)> = Vec::new();
             for (ordinal, &var) in self.vars.keys.iter().enumerate() {
                 let Some(mentions) = self.mentions(program, var) else {
                     continue;
@@ -1976,7 +2082,7 @@ impl FnLiveness {
                     let mut hit = false;
                     self.writes(program, i, |id| hit |= id == var);
                     if let Some(b) = hit.then(|| block_at(f, i)).flatten() {
-                        own[b].insert(k);
+                        writes.push((b, k));
                         any = true;
                     }
                 }
@@ -1985,25 +2091,41 @@ impl FnLiveness {
                     written += 1;
                 }
             }
-            let mut out = vec![BitSet::default(); f.blocks.len()];
-            let mut d = BitSet::default();
-            let mut changed = true;
-            let mut rounds = 0;
-            while changed && rounds < 10_000 {
-                changed = false;
-                rounds += 1;
-                for (b, own) in own.iter().enumerate() {
-                    d.clone_from(own);
-                    for &p in &self.preds[b] {
-                        d.union_with(&out[p]);
+            let w = (written as usize).div_ceil(64);
+            let mut own = vec![0u64; n * w];
+            for (b, k) in writes {
+                set(&mut own[b * w..(b + 1) * w], k);
+            }
+            // Forward, by a worklist over flat rows (a set per block and a
+            // clone per visit before).
+            let mut out = own.clone();
+            let mut work: Vec<usize> = (0..n).rev().collect();
+            let mut queued = vec![true; n];
+            let mut d = vec![0u64; w];
+            let mut steps = 0usize;
+            while let Some(b) = work.pop() {
+                queued[b] = false;
+                steps += 1;
+                if steps > n.saturating_mul(10_000) {
+                    break;
+                }
+                d.copy_from_slice(&own[b * w..(b + 1) * w]);
+                for &p in &self.preds[b] {
+                    for k in 0..w {
+                        d[k] |= out[p * w + k];
                     }
-                    if d != out[b] {
-                        std::mem::swap(&mut out[b], &mut d);
-                        changed = true;
+                }
+                if d[..] != out[b * w..(b + 1) * w] {
+                    out[b * w..(b + 1) * w].copy_from_slice(&d);
+                    for &s in &f.blocks[b].succs {
+                        if s < n && !queued[s] {
+                            queued[s] = true;
+                            work.push(s);
+                        }
                     }
                 }
             }
-            Defined { out, slot }
+            Defined { out, w, slot }
         })
     }
 
@@ -2048,7 +2170,8 @@ impl FnLiveness {
     /// just after it (by index).
     fn live_parts_after(&self, program: &Program, inst: usize) -> Option<(usize, BitSet)> {
         let b = block_at(self.function(program), inst)?;
-        let mut live = self.live_out[b].clone();
+        let mut live = BitSet::default();
+        live.union_words(self.live_out.row(b));
         for &k in self.body.block_after(b, inst).iter().rev() {
             self.step_back(program, k as usize, &mut live);
         }
@@ -2092,7 +2215,12 @@ impl FnLiveness {
             .vars
             .ordinal(var)
             .map_or(IdIndex::NONE, |k| defined.slot[k]);
-        if slot != IdIndex::NONE && self.preds[b].iter().any(|&p| defined.out[p].contains(slot)) {
+        let w = defined.w;
+        if slot != IdIndex::NONE
+            && self.preds[b]
+                .iter()
+                .any(|&p| defined.out[p * w + slot as usize / 64] >> (slot % 64) & 1 == 1)
+        {
             return true;
         }
         // Only an instruction that mentions `var` can write it.
@@ -2680,19 +2808,27 @@ impl FnLiveness {
                 _ => None,
             }
         };
-        // (block, last instruction to look at)
+        // Each block's span of the mentions, looked up as the walk meets
+        // it (two binary searches per block visited were most of the walk).
+        let runs = self.mention_runs(program, var);
         let mut walk = self.walk.borrow_mut();
-        let (work, seen) = &mut *walk;
+        let Walk { work, seen, span } = &mut *walk;
+        span.resize(f.blocks.len(), (0, 0));
+        for &(b, from, to) in runs {
+            span[b as usize] = (from, to);
+        }
+        // (block, last instruction to look at)
         work.clear();
         work.push((b0, at));
         seen.clear();
         seen.resize(f.blocks.len(), false);
         while let Some((b, last)) = work.pop() {
-            let block = &f.blocks[b];
             let mut killed = false;
-            let from = mentions.partition_point(|&i| i < block.start);
-            let to = mentions.partition_point(|&i| i < last);
-            for &i in mentions[from..to.max(from)].iter().rev() {
+            let (from, to) = span[b];
+            for &i in mentions[from as usize..to as usize].iter().rev() {
+                if i >= last {
+                    continue;
+                }
                 if let Some(w) = whole(i) {
                     found.push(i);
                     if w {
@@ -2718,9 +2854,54 @@ impl FnLiveness {
                 }
             }
         }
+        for &(b, _, _) in runs {
+            span[b as usize] = (0, 0);
+        }
         found.sort_unstable();
         found.dedup();
         found
+    }
+
+    /// Root `var`'s mentions by block (see [`MentionBlocks`]).
+    fn mention_runs(&self, program: &Program, var: Id) -> &[(u32, u32, u32)] {
+        let Some(k) = self.roots.ordinal(var) else {
+            return &[];
+        };
+        let mb = self.mention_blocks.get_or_init(|| {
+            let f = self.function(program);
+            // (Every function built gathers its mentions.)
+            let Some(all) = self.mentions.get() else {
+                return MentionBlocks {
+                    start: Vec::new(),
+                    runs: Vec::new(),
+                };
+            };
+            let n = all.start.len().saturating_sub(1);
+            let mut start = Vec::with_capacity(n + 1);
+            let mut runs = Vec::new();
+            for r in 0..n {
+                start.push(runs.len() as u32);
+                let (lo, hi) = (all.start[r] as usize, all.start[r + 1] as usize);
+                let mut j = lo;
+                while j < hi {
+                    let Some(b) = block_at(f, all.list[j]) else {
+                        j += 1;
+                        continue;
+                    };
+                    let from = j;
+                    while j < hi && all.list[j] <= f.blocks[b].end {
+                        j += 1;
+                    }
+                    runs.push((b as u32, (from - lo) as u32, (j - lo) as u32));
+                }
+            }
+            start.push(runs.len() as u32);
+            MentionBlocks { start, runs }
+        });
+        match (mb.start.get(k), mb.start.get(k + 1)) {
+            (Some(&a), Some(&b)) => &mb.runs[a as usize..b as usize],
+            _ => &[],
+        }
     }
 }
 
@@ -2910,7 +3091,9 @@ mod tests {
                 }
                 let f = &p.functions[func];
                 for (b, block) in f.blocks.iter().enumerate() {
-                    for start in [&fl.live_out[b], &all] {
+                    let mut out = BitSet::default();
+                    out.union_words(fl.live_out.row(b));
+                    for start in [&out, &all] {
                         let mut by_block = start.clone();
                         fl.block_back(&p, b, &mut by_block);
                         let mut by_inst = start.clone();
