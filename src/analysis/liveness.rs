@@ -1155,6 +1155,9 @@ impl std::ops::Deref for MentionList {
     }
 }
 
+/// A path stored to (a range of `FnLiveness::paths`) and the value stored.
+type Stored = ((u32, u32), Id);
+
 /// A variable read at an instruction, in the parts read (sorted), each
 /// part as its length then its indices: one vector, not one per part.
 type RematKey = (Id, usize, Vec<u32>);
@@ -1196,7 +1199,13 @@ pub struct FnLiveness {
     preds: Preds,
     remat: RefCell<HashMap<Id, bool>>,
     /// Variables' rematerialisation as read at an instruction.
-    remat_at: RefCell<HashMap<RematKey, bool>>,
+    remat_at: RefCell<HashMap<RematKey, u32>>,
+    /// The answers of `remat_at`, by the slot it gives (so the key is
+    /// moved into the table once, not copied for an answer in progress).
+    remat_ok: RefCell<Vec<bool>>,
+    /// Vectors the recomputability questions reuse (they nest): reaching
+    /// writes, and the paths stored to.
+    spare: RefCell<(Vec<Vec<usize>>, Vec<Vec<Stored>>)>,
     /// Vectors a reaching-writes walk reuses (the blocks to visit and
     /// those seen), instead of two allocations per question.
     walk: RefCell<Walk>,
@@ -1214,15 +1223,16 @@ pub struct FnLiveness {
     /// The instructions that define or use each variable, in order (built
     /// on first use).
     mentions: std::cell::OnceCell<std::rc::Rc<Mentions>>,
-    /// Each root's mentions by block (made on the first reaching-writes
-    /// walk: only a site's function asks).
-    mention_blocks: std::cell::OnceCell<MentionBlocks>,
+    /// The mentions by block of each variable a reaching-writes walk
+    /// asked about (only a site's function asks, about a few variables).
+    mention_blocks: RefCell<MentionBlocks>,
 }
 
-/// Each root's mentions grouped by block: `runs[start[k]..start[k + 1]]`
-/// are root `k`'s, each (block, from, to) into its mention list, in order.
+/// Root `k`'s mentions grouped by block, once asked: `runs[at[k].0..at[k].1]`,
+/// each (block, from, to) into its mention list, in order.
+#[derive(Default)]
 struct MentionBlocks {
-    start: Vec<u32>,
+    at: HashMap<usize, (u32, u32)>,
     runs: Vec<(u32, u32, u32)>,
 }
 
@@ -1608,13 +1618,15 @@ impl FnLiveness {
             preds,
             remat: RefCell::default(),
             remat_at: RefCell::default(),
+            remat_ok: RefCell::default(),
+            spare: RefCell::default(),
             walk: RefCell::default(),
             steps: Vec::new(),
             step_uses: Vec::new(),
             segments: Vec::new(),
             block_segments: Vec::new(),
             mentions: std::cell::OnceCell::new(),
-            mention_blocks: std::cell::OnceCell::new(),
+            mention_blocks: RefCell::default(),
         };
         fl.prepare_steps(program);
         fl.solve(program);
@@ -1635,6 +1647,7 @@ impl FnLiveness {
         // this walk, not another.
         let mut mentions = MentionPairs::new(self.roots.len(), f.end + 1 - f.start);
         let body = &self.body;
+        let mut others = 0;
         for &at in body.kept() {
             let at = at as usize;
             let op = body.op(at);
@@ -1683,6 +1696,7 @@ impl FnLiveness {
                     pool.push(places.intern(p.var, &self.paths[p.path_range()]));
                 }
             }
+            others += other as usize;
             steps[at - f.start] = if other {
                 Step::Other
             } else {
@@ -1695,7 +1709,8 @@ impl FnLiveness {
         // Fold each block's runs of plain steps: stepping back over
         // "kill d, then make U live" after (kill K, then make G live) is
         // (kill K ∪ {d}, then make (G − {d}) ∪ U live).
-        let mut segments = Vec::new();
+        // At most a run before each other step and one at each block's end.
+        let mut segments = Vec::with_capacity(2 * others + f.blocks.len());
         let mut block_segments = Vec::with_capacity(f.blocks.len() + 1);
         // The run being folded, as short lists (only the variables' parts
         // a run reads: most instructions touch none); written to the pool
@@ -2597,27 +2612,50 @@ impl FnLiveness {
         program: &Program,
         var: Id,
         at: usize,
-        parts: impl Iterator<Item = &'a [u32]>,
+        parts: impl Iterator<Item = &'a [u32]> + Clone,
         depth: u32,
     ) -> bool {
-        // The parts in order, flattened into the key (see `RematKey`).
-        let mut sorted: Vec<&[u32]> = parts.collect();
-        if !sorted.is_sorted() {
-            sorted.sort();
-        }
-        let mut flat = Vec::with_capacity(sorted.iter().map(|p| p.len() + 1).sum());
-        for p in &sorted {
+        // The parts in order, flattened into the key (see `RematKey`); the
+        // callers' come sorted.
+        let mut flat = Vec::new();
+        let mut push = |p: &[u32]| {
             flat.push(p.len() as u32);
             flat.extend_from_slice(p);
+        };
+        if parts.clone().is_sorted() {
+            parts.clone().for_each(&mut push);
+        } else {
+            let mut sorted: Vec<&[u32]> = parts.clone().collect();
+            sorted.sort();
+            sorted.into_iter().for_each(&mut push);
         }
         let key = (var, at, flat);
-        if let Some(&r) = self.remat_at.borrow().get(&key) {
-            return r;
+        if let Some(&k) = self.remat_at.borrow().get(&key) {
+            return self.remat_ok.borrow()[k as usize];
         }
-        self.remat_at.borrow_mut().insert(key.clone(), false);
-        let parts = &sorted;
+        // In progress: a question that comes back to itself answers no.
+        let slot = {
+            let mut answers = self.remat_ok.borrow_mut();
+            answers.push(false);
+            answers.len() - 1
+        };
+        self.remat_at.borrow_mut().insert(key, slot as u32);
+        let no_parts = parts.clone().next().is_none();
         let mentions = self.mentions(program, var);
-        let reaching = self.reaching_writes(program, var, at, mentions.as_deref().unwrap_or(&[]));
+        let (mut reaching, mut stored) = {
+            let mut spare = self.spare.borrow_mut();
+            (
+                spare.0.pop().unwrap_or_default(),
+                spare.1.pop().unwrap_or_default(),
+            )
+        };
+        self.reaching_writes(
+            program,
+            var,
+            at,
+            mentions.as_deref().unwrap_or(&[]),
+            &mut reaching,
+        );
         // Both lists are sorted, and every reaching write is among the
         // mentions: whether a mention reaches is a walk along `reaching`
         // beside the mentions, not a binary search each.
@@ -2630,7 +2668,7 @@ impl FnLiveness {
         };
         let mut ok = true;
         // The paths stored to, as ranges of `self.paths`.
-        let mut stored: Vec<((u32, u32), Id)> = Vec::new();
+        stored.clear();
         let body = &self.body;
         for &i in mentions.iter().flat_map(|m| m.iter()) {
             let ids = body.ids(i);
@@ -2657,9 +2695,9 @@ impl FnLiveness {
                         .and_then(|p| self.roots.get(p))
                         .map_or((0, 0), |p| p.path);
                     let path = &self.paths[range.0 as usize..range.1 as usize];
-                    let overlaps = parts.is_empty()
+                    let overlaps = no_parts
                         || parts
-                            .iter()
+                            .clone()
                             .any(|q| has_prefix(q, path) || has_prefix(path, q));
                     if !overlaps {
                         continue;
@@ -2689,7 +2727,10 @@ impl FnLiveness {
                 break;
             }
         }
-        self.remat_at.borrow_mut().insert(key, ok);
+        self.remat_ok.borrow_mut()[slot] = ok;
+        let mut spare = self.spare.borrow_mut();
+        spare.0.push(reaching);
+        spare.1.push(stored);
         ok
     }
 
@@ -2780,7 +2821,7 @@ impl MentionPairs {
 impl FnLiveness {
     /// The writes to `var` (stores, and its `OpVariable` when it has an
     /// initializer) that can give the value read at `at`: walking back from
-    /// `at` along every path, up to a store of the whole variable; sorted.
+    /// `at` along every path, up to a store of the whole variable; sorted, into `found`.
     /// Only the variable's `mentions` (sorted) can write it: a block is
     /// searched through those, not instruction by instruction.
     fn reaching_writes(
@@ -2789,11 +2830,12 @@ impl FnLiveness {
         var: Id,
         at: usize,
         mentions: &[usize],
-    ) -> Vec<usize> {
+        found: &mut Vec<usize>,
+    ) {
         let f = self.function(program);
-        let mut found = Vec::new();
+        found.clear();
         let Some(b0) = block_at(f, at) else {
-            return found;
+            return;
         };
         let body = &self.body;
         let whole = |i: usize| -> Option<bool> {
@@ -2810,7 +2852,8 @@ impl FnLiveness {
         };
         // Each block's span of the mentions, looked up as the walk meets
         // it (two binary searches per block visited were most of the walk).
-        let runs = self.mention_runs(program, var);
+        let mut mb = self.mention_blocks.borrow_mut();
+        let runs = self.mention_runs(&mut mb, program, var, mentions);
         let mut walk = self.walk.borrow_mut();
         let Walk { work, seen, span } = &mut *walk;
         span.resize(f.blocks.len(), (0, 0));
@@ -2859,49 +2902,39 @@ impl FnLiveness {
         }
         found.sort_unstable();
         found.dedup();
-        found
     }
 
-    /// Root `var`'s mentions by block (see [`MentionBlocks`]).
-    fn mention_runs(&self, program: &Program, var: Id) -> &[(u32, u32, u32)] {
+    /// Root `var`'s mentions (`mentions`) by block (see [`MentionBlocks`]),
+    /// grouped on its first question.
+    fn mention_runs<'m>(
+        &self,
+        mb: &'m mut MentionBlocks,
+        program: &Program,
+        var: Id,
+        mentions: &[usize],
+    ) -> &'m [(u32, u32, u32)] {
         let Some(k) = self.roots.ordinal(var) else {
             return &[];
         };
-        let mb = self.mention_blocks.get_or_init(|| {
+        let (a, b) = *mb.at.entry(k).or_insert_with(|| {
             let f = self.function(program);
-            // (Every function built gathers its mentions.)
-            let Some(all) = self.mentions.get() else {
-                return MentionBlocks {
-                    start: Vec::new(),
-                    runs: Vec::new(),
+            let first = mb.runs.len() as u32;
+            let mut j = 0;
+            // Sorted: a binary search only when a mention leaves the block.
+            while j < mentions.len() {
+                let Some(b) = block_at(f, mentions[j]) else {
+                    j += 1;
+                    continue;
                 };
-            };
-            let n = all.start.len().saturating_sub(1);
-            let mut start = Vec::with_capacity(n + 1);
-            let mut runs = Vec::new();
-            for r in 0..n {
-                start.push(runs.len() as u32);
-                let (lo, hi) = (all.start[r] as usize, all.start[r + 1] as usize);
-                let mut j = lo;
-                while j < hi {
-                    let Some(b) = block_at(f, all.list[j]) else {
-                        j += 1;
-                        continue;
-                    };
-                    let from = j;
-                    while j < hi && all.list[j] <= f.blocks[b].end {
-                        j += 1;
-                    }
-                    runs.push((b as u32, (from - lo) as u32, (j - lo) as u32));
+                let from = j;
+                while j < mentions.len() && mentions[j] <= f.blocks[b].end {
+                    j += 1;
                 }
+                mb.runs.push((b as u32, from as u32, j as u32));
             }
-            start.push(runs.len() as u32);
-            MentionBlocks { start, runs }
+            (first, mb.runs.len() as u32)
         });
-        match (mb.start.get(k), mb.start.get(k + 1)) {
-            (Some(&a), Some(&b)) => &mb.runs[a as usize..b as usize],
-            _ => &[],
-        }
+        &mb.runs[a as usize..b as usize]
     }
 }
 
