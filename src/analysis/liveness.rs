@@ -480,7 +480,10 @@ type Place = (Id, Vec<u32>);
 /// a live set is a [`BitSet`] of indices.
 #[derive(Debug, Default)]
 struct Places {
-    list: Vec<Place>,
+    /// Each place's id and path (a range of `paths`: one pool for all,
+    /// not a vector per part).
+    list: Vec<(Id, u32, u32)>,
+    paths: Vec<u32>,
     /// The whole-id place of each id from `lo` on (SSA values, whole
     /// variables): most places, found without hashing.
     whole: Vec<u32>,
@@ -529,7 +532,7 @@ impl Places {
     #[inline]
     fn find(&self, mut i: u32, path: &[u32]) -> Option<u32> {
         while i != Self::NONE {
-            if same_path(&self.list[i as usize].1, path) {
+            if same_path(self.place(i).1, path) {
                 return Some(i);
             }
             i = self.next[i as usize];
@@ -554,7 +557,9 @@ impl Places {
             return i;
         }
         let i = self.list.len() as u32;
-        self.list.push((id, path.to_vec()));
+        let from = self.paths.len() as u32;
+        self.paths.extend_from_slice(path);
+        self.list.push((id, from, self.paths.len() as u32));
         self.next.push(old);
         match slot {
             Some(k) => self.whole[k] = i,
@@ -592,8 +597,9 @@ impl Places {
     }
 
     #[inline]
-    fn place(&self, i: u32) -> &Place {
-        &self.list[i as usize]
+    fn place(&self, i: u32) -> (Id, &[u32]) {
+        let (id, from, to) = self.list[i as usize];
+        (id, &self.paths[from as usize..to as usize])
     }
 }
 
@@ -1845,7 +1851,7 @@ impl FnLiveness {
                     .of(dst.var)
                     .filter(|&i| live.contains(i))
                     .filter_map(|i| {
-                        let q = &places.place(i).1;
+                        let q = places.place(i).1;
                         if has_prefix(q, dst_path) {
                             Some(q[dst_path.len()..].to_vec())
                         } else if has_prefix(dst_path, q) {
@@ -1947,7 +1953,7 @@ impl FnLiveness {
             if !live.contains(i) {
                 continue;
             }
-            let q = &places.place(i).1;
+            let q = places.place(i).1;
             if has_prefix(q, path) {
                 live.remove(i);
             } else if has_prefix(path, q) {
@@ -1955,7 +1961,7 @@ impl FnLiveness {
             }
         }
         for i in enclosing {
-            let q = places.place(i).1.clone();
+            let q = places.place(i).1.to_vec();
             if let Some(pieces) = self.split(program, var, &q, path) {
                 live.remove(i);
                 for p in pieces {
@@ -2160,7 +2166,12 @@ impl FnLiveness {
         };
         let mut out: Vec<Place> = {
             let places = self.places.borrow();
-            live.iter().map(|i| places.place(i).clone()).collect()
+            live.iter()
+                .map(|i| {
+                    let (id, path) = places.place(i);
+                    (id, path.to_vec())
+                })
+                .collect()
         };
         let ssa = self.ssa.get_or_init(|| SsaLive::new(self, program));
         out.extend(
@@ -2178,7 +2189,12 @@ impl FnLiveness {
             return HashSet::default();
         };
         let places = self.places.borrow();
-        live.iter().map(|i| places.place(i).clone()).collect()
+        live.iter()
+            .map(|i| {
+                let (id, path) = places.place(i);
+                (id, path.to_vec())
+            })
+            .collect()
     }
 
     /// The block of instruction `inst`, and the places of the parts live
@@ -2195,14 +2211,18 @@ impl FnLiveness {
 
     /// Bytes of the live parts of variable `var` (of type `ty`): all of it
     /// when the whole is live, else the sum of the outermost live parts.
-    fn live_part_size(program: &Program, ty: Id, paths: &[&[u32]]) -> u64 {
+    fn live_part_size<'a>(
+        program: &Program,
+        ty: Id,
+        paths: impl Iterator<Item = &'a [u32]> + Clone,
+    ) -> u64 {
         let whole = scalar_size(program, ty).unwrap_or(0);
-        if paths.iter().any(|p| p.is_empty()) {
+        if paths.clone().any(|p| p.is_empty()) {
             return whole;
         }
         let outer = paths
-            .iter()
-            .filter(|p| !paths.iter().any(|q| q.len() < p.len() && has_prefix(p, q)));
+            .clone()
+            .filter(|p| !paths.clone().any(|q| q.len() < p.len() && has_prefix(p, q)));
         let mut sum = 0;
         for p in outer {
             let mut t = ty;
@@ -2299,13 +2319,19 @@ impl FnLiveness {
         places: &[Place],
         described: bool,
     ) -> Vec<LiveValue> {
-        // The places by id: each value's parts side by side.
-        let mut by_id: Vec<(Id, &[u32])> =
-            places.iter().map(|(id, p)| (*id, p.as_slice())).collect();
-        // (The caller's places come sorted, so each id's parts in order.)
-        if !by_id.is_sorted_by_key(|&(id, _)| id) {
-            by_id.sort_unstable_by_key(|&(id, _)| id);
-        }
+        // The places by id: each value's parts side by side, in order
+        // (the caller's come sorted; a copy only otherwise).
+        let copy: Vec<Place>;
+        let by_id: &[Place] = if places.is_sorted() {
+            places
+        } else {
+            copy = {
+                let mut v = places.to_vec();
+                v.sort();
+                v
+            };
+            &copy
+        };
         let result = self.body.result(inst);
         let mut out = Vec::new();
         let mut k = 0;
@@ -2344,13 +2370,12 @@ impl FnLiveness {
                 _ => {}
             }
             let rematerializable = if is_var {
-                self.remat_var(program, id, inst, parts.iter().map(|&(_, p)| p), 0)
+                self.remat_var(program, id, inst, parts.iter().map(|(_, p)| &p[..]), 0)
             } else {
                 self.remat_ssa(program, id, 0)
             };
             let size = if is_var {
-                let paths: Vec<&[u32]> = parts.iter().map(|&(_, p)| p).collect();
-                FnLiveness::live_part_size(program, ty, &paths)
+                FnLiveness::live_part_size(program, ty, parts.iter().map(|(_, p)| &p[..]))
             } else {
                 scalar_size(program, ty).unwrap_or(0)
             };
@@ -2617,7 +2642,7 @@ impl FnLiveness {
     ) -> bool {
         // The parts in order, flattened into the key (see `RematKey`); the
         // callers' come sorted.
-        let mut flat = Vec::new();
+        let mut flat = Vec::with_capacity(parts.clone().map(|p| p.len() + 1).sum());
         let mut push = |p: &[u32]| {
             flat.push(p.len() as u32);
             flat.extend_from_slice(p);
@@ -3012,7 +3037,7 @@ mod tests {
         assert_eq!(p.of(12).collect::<Vec<_>>(), [whole, a, b]);
         assert_eq!(p.of(1_000).collect::<Vec<_>>(), [far_part]);
         assert_eq!(p.of(14).count(), 0);
-        assert_eq!(p.place(a), &(12, vec![1, 2]));
+        assert_eq!(p.place(a), (12, &[1, 2][..]));
     }
 
     #[test]
