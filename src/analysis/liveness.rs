@@ -825,7 +825,13 @@ enum Step {
         def: u32,
         uses: std::ops::Range<u32>,
     },
-    /// Stores, copies, calls and variables: worked out each time.
+    /// A store of a value that is no local pointer into exactly part
+    /// `FnLiveness::paths[path.0..path.1]` of `var` (most stores): kills
+    /// that part, reads nothing tracked. The part's places change while
+    /// solving, so the kill is worked out each time, but without the
+    /// lookups of [`Step::Other`].
+    Store { var: Id, path: (u32, u32) },
+    /// Copies, calls, variables and other stores: worked out each time.
     Other,
 }
 
@@ -1376,87 +1382,120 @@ impl FnLiveness {
         let Some(mentions) = self.mentions(program, var) else {
             return Vec::new();
         };
-        let own = |b: usize| -> Vec<Vec<u32>> {
-            let mut w = Vec::new();
-            let block = &f.blocks[b];
-            let from = mentions.partition_point(|&i| i < block.start);
-            let to = mentions.partition_point(|&i| i <= block.end);
-            for &i in &mentions[from..to] {
-                match self.body.op(i) {
-                    Op::Store => {
-                        let t = self.body.first(i).and_then(|t| self.roots.get(&t));
-                        if let Some(t) = t.filter(|t| t.var == var && t.exact) {
-                            w.push(self.path(t).to_vec());
-                        }
-                    }
-                    Op::FunctionCall => {
-                        for (k, a) in self.body.ids(i).iter().enumerate().skip(1) {
-                            let Some(t) = self.roots.get(a).filter(|t| t.var == var && t.exact)
-                            else {
-                                continue;
-                            };
-                            let e = self.call_reads.get(&i).and_then(|e| e.get(k - 1));
-                            for x in e.map(|e| e.writes.as_slice()).unwrap_or_default() {
-                                let mut path = self.path(t).to_vec();
-                                path.extend_from_slice(x);
-                                w.push(path);
-                            }
-                        }
-                    }
-                    _ => {}
+        // Every part written somewhere, once (an index each), and the
+        // (block, index) of each write: the analysis below runs on bit
+        // rows of those indices, not on hash sets of paths per block.
+        let mut parts: Vec<Vec<u32>> = Vec::new();
+        let mut writes: Vec<(usize, usize)> = Vec::new();
+        let mut add = |b: usize, path: &[u32]| {
+            let k = match parts.iter().position(|q| same_path(q, path)) {
+                Some(k) => k,
+                None => {
+                    parts.push(path.to_vec());
+                    parts.len() - 1
                 }
-            }
-            w
+            };
+            writes.push((b, k));
         };
-        let own: Vec<Vec<Vec<u32>>> = (0..n).map(own).collect();
+        for &i in mentions.iter() {
+            let Some(b) = block_at(f, i) else {
+                continue;
+            };
+            match self.body.op(i) {
+                Op::Store => {
+                    let t = self.body.first(i).and_then(|t| self.roots.get(&t));
+                    if let Some(t) = t.filter(|t| t.var == var && t.exact) {
+                        add(b, self.path(t));
+                    }
+                }
+                Op::FunctionCall => {
+                    for (k, a) in self.body.ids(i).iter().enumerate().skip(1) {
+                        let Some(t) = self.roots.get(a).filter(|t| t.var == var && t.exact) else {
+                            continue;
+                        };
+                        let e = self.call_reads.get(&i).and_then(|e| e.get(k - 1));
+                        for x in e.map(|e| e.writes.as_slice()).unwrap_or_default() {
+                            with_joined(self.path(t), x, |path| add(b, path));
+                        }
+                    }
+                }
+                _ => {}
+            }
+        }
         // Nothing written here at all: nothing written on every path.
-        if own.iter().all(Vec::is_empty) {
+        if writes.is_empty() {
             return Vec::new();
         }
-        // Forward must-analysis: `None` is "everything" (not reached yet).
-        let mut out: Vec<Option<HashSet<Vec<u32>>>> = vec![None; n];
+        let w = parts.len().div_ceil(64);
+        let mut own = vec![0u64; n * w];
+        for (b, k) in writes {
+            own[b * w + k / 64] |= 1 << (k % 64);
+        }
+        // Forward must-analysis, in rounds over the blocks in order; an
+        // unreached block's set is "everything".
+        let mut out = vec![0u64; n * w];
+        let mut reached = vec![false; n];
+        let mut set = vec![0u64; w];
         let mut changed = true;
         let mut rounds = 0;
         while changed && rounds < 1000 {
             changed = false;
             rounds += 1;
             for b in 0..n {
-                let mut inset: Option<HashSet<Vec<u32>>> = if b == 0 {
-                    Some(HashSet::default())
-                } else {
-                    None
-                };
+                let mut any = b == 0;
+                set.fill(0);
                 for &p in &self.preds[b] {
-                    if let Some(o) = &out[p] {
-                        inset = Some(match inset {
-                            None => o.clone(),
-                            Some(i) => i.intersection(o).cloned().collect(),
-                        });
+                    if !reached[p] {
+                        continue;
+                    }
+                    let o = &out[p * w..(p + 1) * w];
+                    if any {
+                        set.iter_mut().zip(o).for_each(|(s, o)| *s &= o);
+                    } else {
+                        set.copy_from_slice(o);
+                        any = true;
                     }
                 }
-                let Some(mut set) = inset else { continue };
-                set.extend(own[b].iter().cloned());
-                if out[b].as_ref() != Some(&set) {
-                    out[b] = Some(set);
+                if !any {
+                    continue;
+                }
+                set.iter_mut()
+                    .zip(&own[b * w..(b + 1) * w])
+                    .for_each(|(s, o)| *s |= o);
+                if !reached[b] || out[b * w..(b + 1) * w] != set[..] {
+                    out[b * w..(b + 1) * w].copy_from_slice(&set);
+                    reached[b] = true;
                     changed = true;
                 }
             }
         }
-        let mut must: Option<HashSet<Vec<u32>>> = None;
-        for (block, o) in f.blocks.iter().zip(&out) {
+        // Written on every path to every return (one not reached writes
+        // nothing).
+        let mut must: Option<Vec<u64>> = None;
+        for (b, block) in f.blocks.iter().enumerate() {
             if !matches!(
                 program.insts[block.end].class.opcode,
                 Op::Return | Op::ReturnValue
             ) {
                 continue;
             }
-            let o = o.clone().unwrap_or_default();
-            must = Some(match must {
-                None => o,
-                Some(m) => m.intersection(&o).cloned().collect(),
-            });
+            let o = if reached[b] {
+                &out[b * w..(b + 1) * w]
+            } else {
+                &[][..]
+            };
+            let m = must.get_or_insert_with(|| vec![u64::MAX; w]);
+            for (k, m) in m.iter_mut().enumerate() {
+                *m &= o.get(k).copied().unwrap_or(0);
+            }
         }
-        let mut v: Vec<Vec<u32>> = must.unwrap_or_default().into_iter().collect();
+        let must = must.unwrap_or_default();
+        let mut v: Vec<Vec<u32>> = parts
+            .into_iter()
+            .enumerate()
+            .filter(|(k, _)| must.get(k / 64).is_some_and(|m| m >> (k % 64) & 1 == 1))
+            .map(|(_, p)| p)
+            .collect();
         v.sort();
         v
     }
@@ -1703,7 +1742,21 @@ impl FnLiveness {
                 }
             }
             others += other as usize;
-            steps[at - f.start] = if other {
+            // (The first id operand is the pointer; the others are the
+            // value and any memory-model scope.)
+            let store = (op == Op::Store && copy == Copy::None)
+                .then(|| body.ids(at).split_first())
+                .flatten()
+                .and_then(|(ptr, rest)| {
+                    let p = self.roots.get(ptr).filter(|p| p.exact)?;
+                    (!rest.iter().any(|x| self.roots.contains_key(x))).then_some(p)
+                });
+            steps[at - f.start] = if let Some(p) = store {
+                Step::Store {
+                    var: p.var,
+                    path: p.path,
+                }
+            } else if other {
                 Step::Other
             } else {
                 Step::Plain {
@@ -1758,7 +1811,7 @@ impl FnLiveness {
                             }
                         }
                     }
-                    Step::Other => {
+                    Step::Store { .. } | Step::Other => {
                         end_run(&mut kill, &mut gen, &mut pool, &mut segments);
                         segments.push(Segment::Inst(at));
                     }
@@ -1815,6 +1868,12 @@ impl FnLiveness {
                 for &u in &self.step_uses[uses.start as usize..uses.end as usize] {
                     live.insert(u);
                 }
+                return;
+            }
+            Some(Step::Store { var, path }) => {
+                let places = &mut *self.places.borrow_mut();
+                let path = &self.paths[path.0 as usize..path.1 as usize];
+                self.kill(program, places, live, *var, path);
                 return;
             }
             _ => {}
