@@ -10,22 +10,28 @@
 //! the front-end options. Files the input pulls in (includes, the sources
 //! its debug info names) are known only after compiling: the entry lists
 //! them with a hash of their contents, and a lookup whose listed file
-//! changed, appeared or vanished misses. Entries are written whole to a
-//! temporary file and renamed, so runs sharing the folder (CI shards) never
-//! read half an entry.
+//! changed, appeared or vanished misses.
 //!
-//! Old entries are pruned by age, not by the last run: an entry's
-//! modification time is its last use (a hit refreshes it when it is over a
-//! day old), and at most once a day a run removes entries unused for
-//! [`MAX_AGE`] and temporary files of runs that died. Pruning what the
-//! current run did not use would throw away the other shards' entries
-//! (shards share the folder) and a whole tree's after a run over one
-//! folder; ruff's cache likewise drops files it has not seen for a while.
+//! Entries are kept in packs, one file per input folder and scope (the key's
+//! parts other than the input: build, working directory, config, options),
+//! as ruff keeps one file per package: a pack is written once its folder is
+//! checked, whole to a temporary file and renamed, so runs sharing the
+//! cache (CI shards, which deal out folders whole) never read half of one.
+//!
+//! Old packs are pruned by age, not by the last run: a pack's modification
+//! time is its last use (a read refreshes it when it is over a day old),
+//! and at most once a day a run removes packs unused for [`MAX_AGE`] and
+//! temporary files of runs that died. Pruning what the current run did not
+//! use would throw away the other shards' packs (shards share the folder)
+//! and a whole tree's after a run over one folder; ruff's cache likewise
+//! drops files it has not seen for a while. Within a pack, an entry goes
+//! when the pack is written again and its input no longer exists.
 
 use crate::diag::{Diagnostic, Fix, Label, Severity};
-use std::collections::HashMap;
+use std::collections::{BTreeMap, HashMap, HashSet};
 use std::hash::{Hash, Hasher};
 use std::path::{Path, PathBuf};
+use std::sync::{Arc, Mutex};
 use std::time::{Duration, SystemTime};
 
 /// Where the CLI keeps its cache when neither `--cache-dir` nor
@@ -54,6 +60,7 @@ impl Key {
 }
 
 /// Builds a [`Key`] from parts.
+#[derive(Clone)]
 pub struct KeyBuilder(
     std::collections::hash_map::DefaultHasher,
     std::collections::hash_map::DefaultHasher,
@@ -215,15 +222,76 @@ pub struct Cache {
     dir: PathBuf,
     /// Dependencies' hashes, each computed once a run: many inputs share a
     /// header, and files do not change under a run.
-    deps: std::sync::Mutex<HashMap<PathBuf, Option<String>>>,
+    deps: Mutex<HashMap<PathBuf, Option<String>>>,
+    /// Packs read or written this run and not yet flushed, by pack id.
+    packs: Mutex<HashMap<Key, Arc<Mutex<Pack>>>>,
+}
+
+/// The entries of one folder's inputs (or loose pipelines) under one scope
+/// (build, working directory, config and options), stored as one file.
+///
+/// One file per input made a cold run over 10,000 files spend more time
+/// creating files than checking them (about 0.8 ms of kernel time per new
+/// file on ext4 here: 12.0 s CPU against 3.7 s without the cache); a pack
+/// per folder writes 25 times fewer. Each scope has its own pack, so runs
+/// under different configs do not evict each other's entries.
+#[derive(Debug)]
+struct Pack {
+    /// The folder: an untouched entry whose file is gone is dropped when
+    /// the pack is written again.
+    folder: PathBuf,
+    slots: BTreeMap<String, Slot>,
+    /// Slots looked up or written this run.
+    touched: HashSet<String>,
+    dirty: bool,
+}
+
+/// One entry of a pack: its full key, and the entry as JSON text (parsed
+/// only when a lookup hits).
+#[derive(Debug, serde::Serialize, serde::Deserialize)]
+struct Slot {
+    key: String,
+    entry: Box<serde_json::value::RawValue>,
+}
+
+#[derive(serde::Serialize, serde::Deserialize)]
+struct PackFile {
+    slots: BTreeMap<String, Slot>,
+}
+
+/// The slot of a loose pipeline group (its path is a folder or a file): not
+/// the name of any input's slot.
+fn group_slot(group: &Path) -> String {
+    format!("group {}", group.display())
+}
+
+/// An input's slot: its file name within its folder.
+fn input_slot(path: &Path) -> String {
+    path.file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_else(|| path.display().to_string())
+}
+
+/// An input's folder, as the input names it (its pack's scope holds the
+/// working directory, so a relative folder is unambiguous).
+fn folder_of(path: &Path) -> &Path {
+    named(path.parent().unwrap_or(Path::new("")))
+}
+
+/// A folder as packs name it: the working directory is `.`.
+fn named(folder: &Path) -> &Path {
+    if folder.as_os_str().is_empty() {
+        Path::new(".")
+    } else {
+        folder
+    }
 }
 
 impl Cache {
     /// Opens (and creates) the folder; `None` when it cannot be created, so a
     /// read-only checkout still lints, uncached.
     pub fn open(dir: &Path) -> Option<Cache> {
-        std::fs::create_dir_all(dir.join("files")).ok()?;
-        std::fs::create_dir_all(dir.join("groups")).ok()?;
+        std::fs::create_dir_all(dir.join("packs")).ok()?;
         // As ruff does: the folder ignores itself and says what it is.
         let ignore = dir.join(".gitignore");
         if !ignore.exists() {
@@ -239,25 +307,52 @@ impl Cache {
         Some(Cache {
             dir: dir.to_path_buf(),
             deps: Default::default(),
+            packs: Default::default(),
         })
     }
 
-    fn path(&self, kind: &str, key: Key) -> PathBuf {
-        self.dir.join(kind).join(format!("{}.json", key.hex()))
+    fn pack_path(&self, id: Key) -> PathBuf {
+        self.dir.join("packs").join(format!("{}.json", id.hex()))
     }
 
-    fn read<T: serde::de::DeserializeOwned>(&self, kind: &str, key: Key) -> Option<T> {
+    /// The pack of `folder` under `scope`, read from disk the first time
+    /// this run asks.
+    fn pack(&self, scope: Key, folder: &Path) -> Arc<Mutex<Pack>> {
+        let id = KeyBuilder::default()
+            .add(scope)
+            .add(folder.as_os_str())
+            .finish();
+        let Ok(mut packs) = self.packs.lock() else {
+            return Arc::new(Mutex::new(Pack::empty(folder)));
+        };
+        packs
+            .entry(id)
+            .or_insert_with(|| Arc::new(Mutex::new(self.read_pack(id, folder))))
+            .clone()
+    }
+
+    fn read_pack(&self, id: Key, folder: &Path) -> Pack {
         use std::io::Read;
-        let path = self.path(kind, key);
-        let mut file = std::fs::File::open(&path).ok()?;
-        // One look at the open file: its size, and its time below.
-        let meta = file.metadata().ok()?;
+        let path = self.pack_path(id);
+        let mut pack = Pack::empty(folder);
+        let Ok(mut file) = std::fs::File::open(&path) else {
+            return pack;
+        };
+        let Ok(meta) = file.metadata() else {
+            return pack;
+        };
         let mut bytes = Vec::with_capacity(meta.len() as usize);
-        file.read_to_end(&mut bytes).ok()?;
-        let value = serde_json::from_slice(&bytes).ok()?;
-        // A hit is a use: keep the entry from being pruned.
-        let modified = meta.modified().ok();
-        let old = modified
+        if file.read_to_end(&mut bytes).is_err() {
+            return pack;
+        }
+        let Ok(stored) = serde_json::from_slice::<PackFile>(&bytes) else {
+            return pack;
+        };
+        pack.slots = stored.slots;
+        // Read is use: keep the pack from being pruned.
+        let old = meta
+            .modified()
+            .ok()
             .and_then(|m| SystemTime::now().duration_since(m).ok())
             .is_some_and(|a| a > PRUNE_EVERY);
         if old {
@@ -265,28 +360,60 @@ impl Cache {
                 let _ = f.set_modified(SystemTime::now());
             }
         }
-        Some(value)
+        pack
     }
 
-    fn write<T: serde::Serialize>(&self, kind: &str, key: Key, value: &T) {
-        let Ok(bytes) = serde_json::to_vec(value) else {
+    fn read<T: serde::de::DeserializeOwned>(
+        &self,
+        scope: Key,
+        folder: &Path,
+        slot: String,
+        key: Key,
+    ) -> Option<T> {
+        let pack = self.pack(scope, folder);
+        let text = {
+            let mut pack = pack.lock().ok()?;
+            let found = pack.slots.get(&slot)?;
+            if found.key != key.hex() {
+                return None;
+            }
+            let text = found.entry.get().to_owned();
+            pack.touched.insert(slot);
+            text
+        };
+        serde_json::from_str(&text).ok()
+    }
+
+    fn write<T: serde::Serialize>(
+        &self,
+        scope: Key,
+        folder: &Path,
+        slot: String,
+        key: Key,
+        value: &T,
+    ) {
+        let Ok(entry) = serde_json::value::to_raw_value(value) else {
             return;
         };
-        let path = self.path(kind, key);
-        // Unique per process and thread, renamed into place whole.
-        let tmp = path.with_extension(format!(
-            "{}.{:?}.tmp",
-            std::process::id(),
-            std::thread::current().id()
-        ));
-        if std::fs::write(&tmp, bytes).is_ok() && std::fs::rename(&tmp, &path).is_err() {
-            let _ = std::fs::remove_file(&tmp);
-        }
+        let pack = self.pack(scope, folder);
+        let Ok(mut pack) = pack.lock() else {
+            return;
+        };
+        pack.touched.insert(slot.clone());
+        pack.slots.insert(
+            slot,
+            Slot {
+                key: key.hex(),
+                entry,
+            },
+        );
+        pack.dirty = true;
     }
 
-    /// The entry for `key` whose dependencies are unchanged.
-    pub fn get(&self, key: Key) -> Option<Entry> {
-        let entry: Entry = self.read("files", key)?;
+    /// The entry of input `path` under `scope` for `key`, when its
+    /// dependencies are unchanged.
+    pub fn get(&self, scope: Key, path: &Path, key: Key) -> Option<Entry> {
+        let entry: Entry = self.read(scope, folder_of(path), input_slot(path), key)?;
         entry
             .deps
             .iter()
@@ -307,19 +434,98 @@ impl Cache {
         h
     }
 
-    pub fn put(&self, key: Key, entry: &Entry) {
-        self.write("files", key, entry);
+    /// Stores input `path`'s entry (written when its folder is flushed).
+    pub fn put(&self, scope: Key, path: &Path, key: Key, entry: &Entry) {
+        self.write(scope, folder_of(path), input_slot(path), key, entry);
     }
 
-    pub fn get_group(&self, key: Key) -> Option<GroupEntry> {
-        self.read("groups", key)
+    /// The entry of loose pipeline `group`, whose members are in `folder`.
+    pub fn get_group(
+        &self,
+        scope: Key,
+        folder: &Path,
+        group: &Path,
+        key: Key,
+    ) -> Option<GroupEntry> {
+        self.read(scope, named(folder), group_slot(group), key)
     }
 
-    pub fn put_group(&self, key: Key, entry: &GroupEntry) {
-        self.write("groups", key, entry);
+    pub fn put_group(&self, scope: Key, folder: &Path, group: &Path, key: Key, entry: &GroupEntry) {
+        self.write(scope, named(folder), group_slot(group), key, entry);
     }
 
-    /// Removes entries unused for [`MAX_AGE`] and temporary files of runs
+    /// Writes the packs of `folder` (as inputs name it) that changed, and
+    /// forgets them: call once the run has checked all of that folder.
+    pub fn flush(&self, folder: &Path) {
+        let folder = named(folder);
+        let done: Vec<(Key, Arc<Mutex<Pack>>)> = match self.packs.lock() {
+            Ok(mut packs) => {
+                let ids: Vec<Key> = packs
+                    .iter()
+                    .filter(|(_, p)| p.lock().is_ok_and(|p| p.folder == folder))
+                    .map(|(id, _)| *id)
+                    .collect();
+                ids.into_iter()
+                    .filter_map(|id| packs.remove(&id).map(|p| (id, p)))
+                    .collect()
+            }
+            Err(_) => return,
+        };
+        for (id, pack) in done {
+            self.write_pack(id, &pack);
+        }
+    }
+
+    /// Writes every changed pack: at the end of a run.
+    pub fn flush_all(&self) {
+        let all: Vec<(Key, Arc<Mutex<Pack>>)> = match self.packs.lock() {
+            Ok(mut packs) => packs.drain().collect(),
+            Err(_) => return,
+        };
+        for (id, pack) in all {
+            self.write_pack(id, &pack);
+        }
+    }
+
+    fn write_pack(&self, id: Key, pack: &Mutex<Pack>) {
+        let Ok(mut pack) = pack.lock() else {
+            return;
+        };
+        if !pack.dirty {
+            return;
+        }
+        // Entries of inputs that are gone leave with the next write; the
+        // others stay (a run over part of a folder keeps the rest).
+        let Pack {
+            folder,
+            slots,
+            touched,
+            ..
+        } = &mut *pack;
+        slots.retain(|name, _| {
+            touched.contains(name) || name.starts_with("group ") || folder.join(name).exists()
+        });
+        let file = PackFile {
+            slots: std::mem::take(slots),
+        };
+        let Ok(bytes) = serde_json::to_vec(&file) else {
+            return;
+        };
+        let path = self.pack_path(id);
+        // Unique per process and thread, renamed into place whole: runs
+        // sharing the folder never read half a pack (two runs writing one
+        // pack at once: the last one's stays, the other's entries miss).
+        let tmp = path.with_extension(format!(
+            "{}.{:?}.tmp",
+            std::process::id(),
+            std::thread::current().id()
+        ));
+        if std::fs::write(&tmp, bytes).is_ok() && std::fs::rename(&tmp, &path).is_err() {
+            let _ = std::fs::remove_file(&tmp);
+        }
+    }
+
+    /// Removes packs unused for [`MAX_AGE`] and temporary files of runs
     /// that died, when the last look was over [`PRUNE_EVERY`] ago (a marker
     /// file's time says when). Returns how many files went.
     pub fn prune(&self) -> usize {
@@ -332,7 +538,8 @@ impl Cache {
             return 0;
         }
         let mut removed = 0;
-        for kind in ["files", "groups"] {
+        // `files` and `groups`: one entry per file, as older builds wrote.
+        for kind in ["packs", "files", "groups"] {
             let Ok(dir) = std::fs::read_dir(self.dir.join(kind)) else {
                 continue;
             };
@@ -349,6 +556,17 @@ impl Cache {
             }
         }
         removed
+    }
+}
+
+impl Pack {
+    fn empty(folder: &Path) -> Pack {
+        Pack {
+            folder: folder.to_path_buf(),
+            slots: BTreeMap::new(),
+            touched: HashSet::new(),
+            dirty: false,
+        }
     }
 }
 

@@ -253,6 +253,8 @@ pub fn check_paths(paths: &[PathBuf], options: &Options) -> Report {
                 Vec::new()
             } else {
                 check_group_cached(
+                    dir,
+                    &folder(&inputs.files[members[0]].path),
                     &members,
                     &inputs.files,
                     &mut outcomes,
@@ -263,6 +265,16 @@ pub fn check_paths(paths: &[PathBuf], options: &Options) -> Report {
             });
         }
         pending = waiting;
+        // Folders checked whole (their groups too): their cache packs are
+        // written now, not held to the end of the run.
+        if let Some(cache) = &cache {
+            for (k, input) in chunk.iter().enumerate() {
+                let dir = folder(&input.path);
+                if last_in.get(&dir) == Some(&(ci * CHUNK + k)) {
+                    cache.flush(&dir);
+                }
+            }
+        }
     }
     let pipelines: Vec<Checked> = inputs
         .pipelines
@@ -304,6 +316,7 @@ pub fn check_paths(paths: &[PathBuf], options: &Options) -> Report {
         .collect();
     report.diagnostics = apply_suppressions(diagnostics, &owned, &report.embedded, &own_text);
     if let Some(cache) = &cache {
+        cache.flush_all();
         cache.prune();
     }
     report
@@ -1063,37 +1076,44 @@ struct Outcome {
     suppressions: Option<Option<Vec<crate::suppress::Suppression>>>,
 }
 
-/// The cache key of an input under its config and the options.
+/// The cache keys of an input under its config and the options: its pack's
+/// scope (everything but the input itself) and its own key.
 /// `read`: the file's bytes, when it is not standard input.
-fn input_key(input: &Input, options: &Options, read: Option<&[u8]>) -> Option<crate::cache::Key> {
+fn input_keys(
+    input: &Input,
+    options: &Options,
+    read: Option<&[u8]>,
+) -> Option<(crate::cache::Key, crate::cache::Key)> {
     let bytes = match &input.contents {
         Some(c) => c.as_slice(),
         None => read?,
     };
     let front = front_options(&input.config, options);
     let mut k = crate::cache::base_key();
-    k.add(&input.path)
-        .add(format!("{:?}", input.language))
-        .add_bytes(bytes)
-        .add(format!("{:?}", input.config))
+    k.add(format!("{:?}", input.config))
         .add(format!("{front:?}"));
     // Only GLSL inputs run glslang, so only they ask which one it is.
     if input.language == Language::Glsl {
         k.add(front::glsl::version());
     }
-    Some(k.finish())
+    let scope = k.finish();
+    k.add(&input.path)
+        .add(format!("{:?}", input.language))
+        .add_bytes(bytes);
+    Some((scope, k.finish()))
 }
 
 fn check_cached(input: &Input, options: &Options, cache: Option<&crate::cache::Cache>) -> Outcome {
     let read = cache
         .filter(|_| input.contents.is_none())
         .and_then(|_| std::fs::read(&input.path).ok());
-    let key = cache.and_then(|_| input_key(input, options, read.as_deref()));
+    let keys = cache.and_then(|_| input_keys(input, options, read.as_deref()));
+    let key = keys.map(|(_, k)| k);
     let suppressions = read
         .as_deref()
         .map(|b| std::str::from_utf8(b).ok().map(crate::suppress::parse));
-    if let (Some(cache), Some(key)) = (cache, key) {
-        if let Some(entry) = cache.get(key) {
+    if let (Some(cache), Some((scope, key))) = (cache, keys) {
+        if let Some(entry) = cache.get(scope, &input.path, key) {
             if let Some(diagnostics) = crate::cache::load_all(entry.diagnostics) {
                 return Outcome {
                     suppressions,
@@ -1128,7 +1148,7 @@ fn check_cached(input: &Input, options: &Options, cache: Option<&crate::cache::C
         .program
         .as_ref()
         .and_then(|p| loose_group(p, &c.subobjects));
-    if let (Some(cache), Some(key), Some(_)) = (cache, key, &c.program) {
+    if let (Some(cache), Some((scope, key)), Some(_)) = (cache, keys, &c.program) {
         if let Some(diagnostics) = crate::cache::store_all(&c.diagnostics) {
             // Everything the module names besides the input itself: includes,
             // and sources debug info points at (rules read their text).
@@ -1139,6 +1159,8 @@ fn check_cached(input: &Input, options: &Options, cache: Option<&crate::cache::C
                 .map(|p| (p.clone(), cache.dep_hash(p)))
                 .collect();
             cache.put(
+                scope,
+                &input.path,
                 key,
                 &crate::cache::Entry {
                     deps,
@@ -1166,7 +1188,10 @@ fn check_cached(input: &Input, options: &Options, cache: Option<&crate::cache::C
 
 /// The pipeline rules over one loose group (`members`: indices into
 /// `inputs`), from the cache when every member and the group are cached.
+#[allow(clippy::too_many_arguments)]
 fn check_group_cached(
+    group: &Path,
+    folder: &Path,
     members: &[usize],
     inputs: &[Input],
     outcomes: &mut [Outcome],
@@ -1174,17 +1199,18 @@ fn check_group_cached(
     options: &Options,
     cache: Option<&crate::cache::Cache>,
 ) -> Vec<Diagnostic> {
-    let key = cache.and_then(|_| {
+    let keys = cache.and_then(|_| {
         let mut k = crate::cache::base_key();
-        k.add(format!("{config:?}"));
+        k.add("group").add(format!("{config:?}"));
+        let scope = k.finish();
         for &i in members {
             k.add(&inputs[i].path).add(outcomes[i].key?);
         }
-        Some(k.finish())
+        Some((scope, k.finish()))
     });
-    if let (Some(cache), Some(key)) = (cache, key) {
+    if let (Some(cache), Some((scope, key))) = (cache, keys) {
         if let Some(d) = cache
-            .get_group(key)
+            .get_group(scope, folder, group, key)
             .and_then(|g| crate::cache::load_all(g.diagnostics))
         {
             return d;
@@ -1202,9 +1228,16 @@ fn check_group_cached(
         }
     }
     let out = check_group(programs, config);
-    if let (Some(cache), Some(key), Some(diagnostics)) = (cache, key, crate::cache::store_all(&out))
+    if let (Some(cache), Some((scope, key)), Some(diagnostics)) =
+        (cache, keys, crate::cache::store_all(&out))
     {
-        cache.put_group(key, &crate::cache::GroupEntry { diagnostics });
+        cache.put_group(
+            scope,
+            folder,
+            group,
+            key,
+            &crate::cache::GroupEntry { diagnostics },
+        );
     }
     out
 }

@@ -23,6 +23,11 @@ pub struct Suppression {
 /// Every suppression in `text`.
 pub fn parse(text: &str) -> Vec<Suppression> {
     let mut out = Vec::new();
+    // Most files have neither marker: one search of the whole text each,
+    // not two per line (a sixth of a warm cached run went here).
+    if !text.contains("rtlint") && !text.contains("diagnostic") {
+        return out;
+    }
     let lines: Vec<&str> = text.lines().collect();
     for (i, line) in lines.iter().enumerate() {
         let n = i as u32 + 1;

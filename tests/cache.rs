@@ -26,15 +26,35 @@ fn check(dir: &Path, args: &[&str]) -> Output {
     c.output().unwrap()
 }
 
+/// The cache's pack files (one per folder and scope).
+fn packs(cache: &Path) -> Vec<PathBuf> {
+    let mut v: Vec<PathBuf> = std::fs::read_dir(cache.join("packs"))
+        .map(|d| {
+            d.map(|e| e.unwrap().path())
+                .filter(|p| p.extension().is_some_and(|x| x == "json"))
+                .collect()
+        })
+        .unwrap_or_default();
+    v.sort();
+    v
+}
+
+/// A pack's entries by slot name (an input's file name, or `group PATH`).
+fn slots(pack: &Path) -> serde_json::Map<String, serde_json::Value> {
+    let v: serde_json::Value = serde_json::from_slice(&std::fs::read(pack).unwrap()).unwrap();
+    v["slots"].as_object().unwrap().clone()
+}
+
 /// Cache entries written so far (one per input, one per loose pipeline).
 fn entries(cache: &Path) -> usize {
-    ["files", "groups"]
+    packs(cache).iter().map(|p| slots(p).len()).sum()
+}
+
+/// Entries of inputs (not of loose pipelines).
+fn input_entries(cache: &Path) -> usize {
+    packs(cache)
         .iter()
-        .map(|k| {
-            std::fs::read_dir(cache.join(k))
-                .map(|d| d.count())
-                .unwrap_or(0)
-        })
+        .map(|p| slots(p).keys().filter(|k| !k.starts_with("group ")).count())
         .sum()
 }
 
@@ -175,32 +195,59 @@ fn old_unused_entries_are_pruned_and_used_ones_kept() {
     let cache = d.join("c");
     let args = ["--cache-dir", cache.to_str().unwrap(), "."];
     let cold = check(&d, &args);
-    let used: Vec<PathBuf> = std::fs::read_dir(cache.join("files"))
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .collect();
-    assert_eq!(used.len(), 1);
-    // An entry of a file long gone, a temporary file of a run that died, and
-    // the used entry made old as well.
-    let stale = cache.join("files/00000000000000000000000000000000.json");
-    let tmp = cache.join("files/00000000000000000000000000000001.4242.ThreadId(2).tmp");
+    // One pack for the input, one for its loose pipeline.
+    let used = packs(&cache);
+    assert_eq!(used.len(), 2, "{used:?}");
+    // A pack of a folder long gone, a temporary file of a run that died, and
+    // the used packs made old as well.
+    let stale = cache.join("packs/00000000000000000000000000000000.json");
+    let tmp = cache.join("packs/00000000000000000000000000000001.4242.ThreadId(2).tmp");
     std::fs::copy(&used[0], &stale).unwrap();
     std::fs::write(&tmp, "{").unwrap();
-    for p in [&stale, &tmp, &used[0]] {
+    for p in [&stale, &tmp, &used[0], &used[1]] {
         set_age(p, 40);
     }
     // Pruned less than a day ago: nothing goes yet.
     assert_eq!(text(&check(&d, &args)), text(&cold));
     assert!(stale.exists() && tmp.exists());
-    assert_eq!(age_days(&used[0]), 0, "a hit refreshes its entry");
-    set_age(&used[0], 40);
+    for p in &used {
+        assert_eq!(age_days(p), 0, "a read did not refresh {}", p.display());
+    }
+    for p in &used {
+        set_age(p, 40);
+    }
     set_age(&cache.join("last-prune"), 2);
     let warm = check(&d, &args);
     assert_eq!(text(&warm), text(&cold));
-    assert!(!stale.exists(), "an unused old entry is left");
+    assert!(!stale.exists(), "an unused old pack is left");
     assert!(!tmp.exists(), "a dead run's temporary file is left");
-    assert!(used[0].exists(), "the entry this run used was pruned");
     assert_eq!(age_days(&cache.join("last-prune")), 0);
+}
+
+/// An entry whose input is gone leaves its pack when the pack is written
+/// again; the other inputs' entries stay.
+#[test]
+fn entries_of_deleted_inputs_leave_their_pack() {
+    let d = scratch("gone");
+    std::fs::write(d.join("payload.hlsli"), PAYLOAD).unwrap();
+    std::fs::write(d.join("gen.hlsl"), shader()).unwrap();
+    std::fs::write(d.join("other.hlsl"), shader().replace("Gen", "Other")).unwrap();
+    let cache = d.join("c");
+    let args = ["--cache-dir", cache.to_str().unwrap(), "."];
+    check(&d, &args);
+    assert_eq!(input_entries(&cache), 2);
+    std::fs::remove_file(d.join("other.hlsl")).unwrap();
+    // A run over one file keeps its folder's other entries.
+    std::fs::write(d.join("third.hlsl"), shader().replace("Gen", "Third")).unwrap();
+    check(&d, &["--cache-dir", cache.to_str().unwrap(), "third.hlsl"]);
+    let names: Vec<String> = packs(&cache)
+        .iter()
+        .flat_map(|p| slots(p).keys().cloned().collect::<Vec<_>>())
+        .filter(|k| !k.starts_with("group "))
+        .collect();
+    assert!(names.contains(&"gen.hlsl".to_string()), "{names:?}");
+    assert!(names.contains(&"third.hlsl".to_string()), "{names:?}");
+    assert!(!names.contains(&"other.hlsl".to_string()), "{names:?}");
 }
 
 /// A GLSL input's key holds what `glslangValidator --version` says: another
@@ -240,7 +287,7 @@ fn another_glslang_misses_the_cache() {
             .output()
             .unwrap();
         assert_ne!(o.status.code(), Some(2), "{}", text(&o));
-        std::fs::read_dir(cache.join("files")).unwrap().count()
+        input_entries(&cache)
     };
     assert_eq!(run("11:12.0.0"), 1);
     assert_eq!(run("11:12.0.0"), 1, "the same glslang reads its entry");
@@ -268,16 +315,14 @@ fn a_partly_cached_folder_still_forms_one_pipeline() {
     let cache = d.join("c");
     let args = ["--cache-dir", cache.to_str().unwrap(), "."];
     assert_eq!(text(&check(&d, &args)), text(&whole));
-    // Forget one input's entry: it is compiled again, the others are not.
-    let first = std::fs::read_dir(cache.join("files"))
-        .unwrap()
-        .next()
-        .unwrap()
-        .unwrap()
-        .path();
-    std::fs::remove_file(first).unwrap();
-    for e in std::fs::read_dir(cache.join("groups")).unwrap() {
-        std::fs::remove_file(e.unwrap().path()).unwrap();
+    // Forget one input's entry and the pipeline's: the input is compiled
+    // again, the others are not.
+    for pack in packs(&cache) {
+        let mut kept = slots(&pack);
+        let first_input = kept.keys().find(|k| !k.starts_with("group ")).cloned();
+        kept.retain(|k, _| !k.starts_with("group ") && Some(k) != first_input.as_ref());
+        let v = serde_json::json!({ "slots": kept });
+        std::fs::write(&pack, serde_json::to_vec(&v).unwrap()).unwrap();
     }
     assert_eq!(text(&check(&d, &args)), text(&whole));
     assert_eq!(text(&check(&d, &args)), text(&whole));
