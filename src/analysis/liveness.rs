@@ -1170,6 +1170,10 @@ impl std::ops::Deref for MentionList {
 /// A path stored to (a range of `FnLiveness::paths`) and the value stored.
 type Stored = ((u32, u32), Id);
 
+/// Spare vectors for nested recomputability questions: reaching writes,
+/// and paths stored to.
+type Spare = (Vec<Vec<usize>>, Vec<Vec<Stored>>);
+
 /// A variable read at an instruction, in the parts read (sorted), each
 /// part as its length then its indices: one vector, not one per part.
 type RematKey = (Id, usize, Vec<u32>);
@@ -1217,7 +1221,7 @@ pub struct FnLiveness {
     remat_ok: RefCell<Vec<bool>>,
     /// Vectors the recomputability questions reuse (they nest): reaching
     /// writes, and the paths stored to.
-    spare: RefCell<(Vec<Vec<usize>>, Vec<Vec<Stored>>)>,
+    spare: RefCell<Spare>,
     /// Vectors a reaching-writes walk reuses (the blocks to visit and
     /// those seen), instead of two allocations per question.
     walk: RefCell<Walk>,
