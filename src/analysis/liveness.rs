@@ -844,6 +844,9 @@ enum Segment {
     Run {
         kill: std::ops::Range<u32>,
         gen: std::ops::Range<u32>,
+        /// The run's first instruction (it covers the block's instructions
+        /// from there to the next segment's).
+        from: u32,
     },
     /// An instruction whose transfer depends on the live set.
     Inst(usize),
@@ -1779,10 +1782,12 @@ impl FnLiveness {
         // a run reads: most instructions touch none); written to the pool
         // when it ends, and not at all when empty.
         let (mut kill, mut gen): (Vec<u32>, Vec<u32>) = (Vec::new(), Vec::new());
+        let mut from = 0u32;
         let end_run = |kill: &mut Vec<u32>,
                        gen: &mut Vec<u32>,
                        pool: &mut Vec<u32>,
-                       segments: &mut Vec<Segment>| {
+                       segments: &mut Vec<Segment>,
+                       from: u32| {
             if kill.is_empty() && gen.is_empty() {
                 return;
             }
@@ -1794,6 +1799,7 @@ impl FnLiveness {
             segments.push(Segment::Run {
                 kill: k0..g0,
                 gen: g0..g1,
+                from,
             });
         };
         for b in 0..f.blocks.len() {
@@ -1803,6 +1809,7 @@ impl FnLiveness {
                 match &steps[at - f.start] {
                     Step::Skip => {}
                     Step::Plain { def, uses } => {
+                        from = at as u32;
                         if *def != Places::NONE {
                             if !kill.contains(def) {
                                 kill.push(*def);
@@ -1816,12 +1823,12 @@ impl FnLiveness {
                         }
                     }
                     Step::Store { .. } | Step::Other => {
-                        end_run(&mut kill, &mut gen, &mut pool, &mut segments);
+                        end_run(&mut kill, &mut gen, &mut pool, &mut segments, from);
                         segments.push(Segment::Inst(at));
                     }
                 }
             }
-            end_run(&mut kill, &mut gen, &mut pool, &mut segments);
+            end_run(&mut kill, &mut gen, &mut pool, &mut segments, from);
         }
         block_segments.push(segments.len() as u32);
         self.steps = steps;
@@ -1836,17 +1843,22 @@ impl FnLiveness {
     fn block_back(&self, program: &Program, b: usize, live: &mut BitSet) {
         let range = self.block_segments[b] as usize..self.block_segments[b + 1] as usize;
         for seg in &self.segments[range] {
-            match seg {
-                Segment::Run { kill, gen } => {
-                    for &k in &self.step_uses[kill.start as usize..kill.end as usize] {
-                        live.remove(k);
-                    }
-                    for &g in &self.step_uses[gen.start as usize..gen.end as usize] {
-                        live.insert(g);
-                    }
+            self.segment_back(program, seg, live);
+        }
+    }
+
+    #[inline]
+    fn segment_back(&self, program: &Program, seg: &Segment, live: &mut BitSet) {
+        match seg {
+            Segment::Run { kill, gen, .. } => {
+                for &k in &self.step_uses[kill.start as usize..kill.end as usize] {
+                    live.remove(k);
                 }
-                Segment::Inst(at) => self.step_back(program, *at, live),
+                for &g in &self.step_uses[gen.start as usize..gen.end as usize] {
+                    live.insert(g);
+                }
             }
+            Segment::Inst(at) => self.step_back(program, *at, live),
         }
     }
 
@@ -2263,11 +2275,30 @@ impl FnLiveness {
     /// The block of instruction `inst`, and the places of the parts live
     /// just after it (by index).
     fn live_parts_after(&self, program: &Program, inst: usize) -> Option<(usize, BitSet)> {
-        let b = block_at(self.function(program), inst)?;
+        let f = self.function(program);
+        let b = block_at(f, inst)?;
         let mut live = BitSet::default();
         live.union_words(self.live_out.row(b));
+        // The block's folded segments wholly after `inst` first (a callee's
+        // entry asks about the whole block), then instruction by
+        // instruction below the last one taken.
+        let mut below = f.blocks[b].end + 1;
+        let range = self.block_segments[b] as usize..self.block_segments[b + 1] as usize;
+        for seg in &self.segments[range] {
+            let first = match *seg {
+                Segment::Run { from, .. } => from as usize,
+                Segment::Inst(at) => at,
+            };
+            if first <= inst {
+                break;
+            }
+            self.segment_back(program, seg, &mut live);
+            below = first;
+        }
         for &k in self.body.block_after(b, inst).iter().rev() {
-            self.step_back(program, k as usize, &mut live);
+            if (k as usize) < below {
+                self.step_back(program, k as usize, &mut live);
+            }
         }
         Some((b, live))
     }
@@ -3222,6 +3253,16 @@ mod tests {
                             fl.step_back(&p, k, &mut by_inst);
                         }
                         assert_eq!(by_block, by_inst, "{rel}: function {func}, block {b}");
+                    }
+                    // After each instruction: the segments wholly after
+                    // it, then the rest one by one, as every one by one.
+                    for k in block.start..=block.end {
+                        let mut by_inst = out.clone();
+                        for &i in fl.body.block_after(b, k).iter().rev() {
+                            fl.step_back(&p, i as usize, &mut by_inst);
+                        }
+                        let after = fl.live_parts_after(&p, k).map(|(_, l)| l);
+                        assert_eq!(after, Some(by_inst), "{rel}: function {func}, inst {k}");
                     }
                 }
             }
