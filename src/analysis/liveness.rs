@@ -980,10 +980,15 @@ impl Rows {
     }
 
     /// Makes rows at least `w` words wide.
+    #[inline]
     fn widen(&mut self, w: usize) {
-        if w <= self.w {
-            return;
+        if w > self.w {
+            self.relayout(w);
         }
+    }
+
+    #[cold]
+    fn relayout(&mut self, w: usize) {
         let mut words = vec![0; self.n * w];
         for b in 0..self.n {
             words[b * w..b * w + self.w].copy_from_slice(self.row(b));
@@ -1103,9 +1108,8 @@ impl SsaLive {
     #[inline]
     fn step(&self, fl: &FnLiveness, i: usize, live: &mut [u64], kill: Option<&mut [u64]>) {
         let body = &fl.body;
-        if body.debug(i) {
-            return;
-        }
+        // (Asked only of the instructions the passes read: no debug info.)
+        debug_assert!(!body.debug(i));
         if let Some(k) = body.result(i).and_then(|r| self.ordinal(r)) {
             unset(live, k);
             if let Some(kill) = kill {
@@ -3012,7 +3016,8 @@ impl FnLiveness {
             }
             for &p in &self.preds[b] {
                 if !std::mem::replace(&mut seen[p], true) {
-                    work.push((p, f.blocks[p].end + 1));
+                    // All of it (without reading the block's bounds).
+                    work.push((p, usize::MAX));
                 }
             }
         }
