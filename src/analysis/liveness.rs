@@ -2024,10 +2024,13 @@ impl FnLiveness {
         path: &[u32],
     ) {
         // The parts inside go at once; the (rare) enclosing ones are split
-        // after, when the places can be added to: a list only for those.
-        // (A split piece is never inside the part written, so the order
-        // does not matter.)
-        let mut enclosing: Vec<u32> = Vec::new();
+        // after, when the places can be added to: a short list for those,
+        // on the stack. (A split piece is never inside the part written,
+        // so the order does not matter.)
+        const ROOM: usize = 8;
+        let mut enclosing = [0u32; ROOM];
+        let mut n = 0;
+        let mut more: Vec<u32> = Vec::new();
         for i in places.of(var) {
             if !live.contains(i) {
                 continue;
@@ -2036,30 +2039,40 @@ impl FnLiveness {
             if has_prefix(q, path) {
                 live.remove(i);
             } else if has_prefix(path, q) {
-                enclosing.push(i);
+                if n < ROOM {
+                    enclosing[n] = i;
+                    n += 1;
+                } else {
+                    more.push(i);
+                }
             }
         }
-        for i in enclosing {
-            let q = places.place(i).1.to_vec();
-            if let Some(pieces) = self.split(program, var, &q, path) {
+        for i in enclosing[..n].iter().copied().chain(more) {
+            // (An enclosing part is a prefix of `path`: its length says it.)
+            let outer = &path[..places.place(i).1.len()];
+            if let Some(pieces) = self.split(program, var, outer, path) {
                 live.remove(i);
-                for p in pieces {
-                    live.insert(places.intern(var, &p));
+                // Each piece is `path[..d]` and one sibling index.
+                for (d, j) in pieces {
+                    with_joined(&path[..d], &[j], |p| {
+                        live.insert(places.intern(var, p));
+                    });
                 }
             }
         }
     }
 
     /// The parts of `outer` not inside `inner` (a longer path below it), as
-    /// the siblings met on the way down; `None` when a composite on the way
-    /// has no known, small element count.
+    /// the siblings met on the way down, each `inner[..depth]` and a last
+    /// index (given as the pair); `None` when a composite on the way has no
+    /// known, small element count.
     fn split(
         &self,
         program: &Program,
         var: Id,
         outer: &[u32],
         inner: &[u32],
-    ) -> Option<Vec<Vec<u32>>> {
+    ) -> Option<Vec<(usize, u32)>> {
         let mut ty = program
             .def(var)
             .and_then(|d| d.result_type)
@@ -2073,11 +2086,7 @@ impl FnLiveness {
             if n > MAX_SPLIT {
                 return None;
             }
-            for j in (0..n).filter(|&j| j != inner[depth]) {
-                let mut piece = inner[..depth].to_vec();
-                piece.push(j);
-                out.push(piece);
-            }
+            out.extend((0..n).filter(|&j| j != inner[depth]).map(|j| (depth, j)));
             ty = element_type(program, ty, inner[depth])?;
         }
         Some(out)
