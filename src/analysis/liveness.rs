@@ -2081,13 +2081,13 @@ impl FnLiveness {
             ty = element_type(program, ty, i)?;
         }
         let mut out = Vec::new();
-        for depth in outer.len()..inner.len() {
+        for (depth, &at) in inner.iter().enumerate().skip(outer.len()) {
             let n = element_count(program, ty)?;
             if n > MAX_SPLIT {
                 return None;
             }
-            out.extend((0..n).filter(|&j| j != inner[depth]).map(|j| (depth, j)));
-            ty = element_type(program, ty, inner[depth])?;
+            out.extend((0..n).filter(|&j| j != at).map(|j| (depth, j)));
+            ty = element_type(program, ty, at)?;
         }
         Some(out)
     }
