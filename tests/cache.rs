@@ -250,6 +250,37 @@ fn entries_of_deleted_inputs_leave_their_pack() {
     assert!(!names.contains(&"other.hlsl".to_string()), "{names:?}");
 }
 
+/// A pack that is not what rtlint wrote (cut short, or garbage) is a miss:
+/// the run answers as without the cache and writes the pack again.
+#[test]
+fn a_damaged_pack_is_a_miss() {
+    let d = scratch("damaged");
+    std::fs::write(d.join("payload.hlsli"), PAYLOAD).unwrap();
+    std::fs::write(d.join("gen.hlsl"), shader()).unwrap();
+    let cache = d.join("c");
+    let args = ["--cache-dir", cache.to_str().unwrap(), "."];
+    let uncached = check(&d, &["--no-cache", "."]);
+    check(&d, &args);
+    let n = entries(&cache);
+    for (k, pack) in packs(&cache).iter().enumerate() {
+        let bytes = std::fs::read(pack).unwrap();
+        let damaged = if k % 2 == 0 {
+            bytes[..bytes.len() / 2].to_vec()
+        } else {
+            b"\x00\xffnot json".to_vec()
+        };
+        std::fs::write(pack, damaged).unwrap();
+    }
+    let o = check(&d, &args);
+    assert_eq!(o.status.code(), uncached.status.code(), "{}", text(&o));
+    assert_eq!(text(&o), text(&uncached));
+    assert_eq!(
+        entries(&cache),
+        n,
+        "the damaged packs were not written again"
+    );
+}
+
 /// A GLSL input's key holds what `glslangValidator --version` says: another
 /// glslang misses the cache. (Other languages never run it.)
 #[test]
