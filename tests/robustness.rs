@@ -138,3 +138,63 @@ fn mutated_wgsl_never_panics() {
         assert!(r.is_ok(), "panic on mutated WGSL:\n{src}");
     }
 }
+
+/// WGSL nested as deep as the limits, in one folder run (inputs checked on
+/// worker threads): an operator chain of the deepest accepted length
+/// compiles, one level more is an error at its place, brackets past naga's
+/// parser limit are an error at the deepest bracket, and a long flat list
+/// is not mistaken for nesting. Before, 5,000 unary minuses in one file
+/// overflowed a worker's stack and aborted the whole run.
+#[test]
+fn wgsl_nesting_is_handled_or_refused_at_its_place() {
+    use rtlint::front::wgsl::MAX_EXPRESSION_DEPTH;
+    let d = std::env::temp_dir().join(format!("rtlint-wgsl-nesting-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    let head = "@compute @workgroup_size(1) fn main() { var x: f32 = ";
+    // `=` is one level, each `-` one more.
+    let minus = |n: usize| format!("{head}{}1.0; }}\n", "- ".repeat(n));
+    std::fs::write(d.join("deepest.wgsl"), minus(MAX_EXPRESSION_DEPTH - 1)).unwrap();
+    std::fs::write(d.join("too_deep.wgsl"), minus(MAX_EXPRESSION_DEPTH)).unwrap();
+    std::fs::write(
+        d.join("brackets.wgsl"),
+        format!("{head}{}1.0{}; }}\n", "(".repeat(200), ")".repeat(200)),
+    )
+    .unwrap();
+    let list: Vec<String> = (0..30_000).map(|i| format!("-{i}.5e-3")).collect();
+    std::fs::write(
+        d.join("flat.wgsl"),
+        format!(
+            "const T = array<f32, 30000>({});\n@compute @workgroup_size(1) fn main() {{ var x: f32 = T[3]; }}\n",
+            list.join(", ")
+        ),
+    )
+    .unwrap();
+    let o = common::rtlint()
+        .args(["check", "--no-cache", "--format", "concise"])
+        .arg(&d)
+        .output()
+        .unwrap();
+    let out = String::from_utf8_lossy(&o.stdout).into_owned() + &String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{out}");
+    let errors: Vec<&str> = out.lines().filter(|l| l.contains("error")).collect();
+    // Two errors, each at its place: at the operator that passes the limit
+    // (the `=` is the first level), and at the deepest bracket, the 200th
+    // (the first is in column 54).
+    let col = head.len() + 2 * (MAX_EXPRESSION_DEPTH - 1) + 1;
+    assert!(
+        errors.iter().any(|l| l.contains(&format!("too_deep.wgsl:1:{col}"))
+            && l.contains("nested too deep")),
+        "{out}"
+    );
+    assert!(
+        errors
+            .iter()
+            .any(|l| l.contains("brackets.wgsl:1:253") && l.contains("brackets nested too deep")),
+        "{out}"
+    );
+    assert!(!out.contains("deepest.wgsl"), "{out}");
+    assert!(!out.contains("flat.wgsl"), "{out}");
+    assert!(out.contains("in 4 files"), "{out}");
+    let _ = std::fs::remove_dir_all(&d);
+}

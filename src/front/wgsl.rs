@@ -19,7 +19,176 @@ pub fn parse(
     source: &str,
     path: &Path,
 ) -> Result<(naga::Module, naga::valid::ModuleInfo), InputError> {
-    guard(path, "parse", || parse_unguarded(source, path))
+    deep(source, path, || {
+        guard(path, "parse", || parse_unguarded(source, path))
+    })
+}
+
+/// Deepest expression nesting accepted: naga's lowering recurses once per
+/// level of an operator chain (`a + b + ...`, `- - x`, `a.b.c`), which its
+/// parser does not limit (it does brackets, at 197, and braces, at 126), and
+/// overflowing a stack aborts the whole run. 20,000 levels fit
+/// [`DEEP_STACK`] with room in a debug build.
+pub const MAX_EXPRESSION_DEPTH: usize = 20_000;
+
+/// Above this bound naga runs on a thread of its own with [`DEEP_STACK`];
+/// below, on the caller's (a worker thread's 2 MiB hold it in a debug build).
+const SHALLOW: usize = 128;
+
+const DEEP_STACK: usize = 256 << 20;
+
+/// Runs `f` (naga over `source`) where its recursion fits: refuses a module
+/// nested deeper than [`MAX_EXPRESSION_DEPTH`] at the place it gets there,
+/// and gives a deep one a large stack.
+pub fn deep<T: Send>(
+    source: &str,
+    path: &Path,
+    f: impl FnOnce() -> Result<T, InputError> + Send,
+) -> Result<T, InputError> {
+    let (depth, at) = nesting_bound(source, MAX_EXPRESSION_DEPTH);
+    if depth > MAX_EXPRESSION_DEPTH {
+        let (line, column) = line_col(source, at);
+        let loc = Location::point(path, line, column);
+        return Err(InputError::new(
+            InputErrorKind::WgslParse,
+            path,
+            format!("expression nested too deep (more than {MAX_EXPRESSION_DEPTH} levels of operators and brackets)"),
+        )
+        .at(loc, "nested too deep here"));
+    }
+    if depth <= SHALLOW {
+        return f();
+    }
+    std::thread::scope(|s| {
+        std::thread::Builder::new()
+            .stack_size(DEEP_STACK)
+            .spawn_scoped(s, f)
+            .map_err(|e| {
+                InputError::new(
+                    InputErrorKind::WgslInternal,
+                    path,
+                    format!("cannot start a thread for a deeply nested module: {e}"),
+                )
+            })?
+            .join()
+            .unwrap_or_else(|p| std::panic::resume_unwind(p))
+    })
+}
+
+/// Whether the `.` at `i` is a decimal point: the token before it starts
+/// with a digit (`1.5`, `0x1.8p3`; not `v1.x`).
+fn in_number(b: &[u8], i: usize) -> bool {
+    let mut k = i;
+    while k > 0 && (b[k - 1].is_ascii_alphanumeric() || b[k - 1] == b'_') {
+        k -= 1;
+    }
+    k < i && b[k].is_ascii_digit()
+}
+
+/// An upper bound on the expression nesting of `source` (and the byte where
+/// it first passes `limit`): within a statement, each operator character
+/// adds a level to the bracket it is in, each open bracket a level, and a
+/// comma ends its argument's levels (a long list stays shallow). Comments
+/// are skipped; a decimal point is not an operator.
+pub fn nesting_bound(source: &str, limit: usize) -> (usize, usize) {
+    let n = nesting(source, limit);
+    (n.bound, n.bound_at)
+}
+
+/// What [`nesting_bound`] finds, and where brackets nest deepest.
+struct Nesting {
+    bound: usize,
+    /// Where `bound` first passed the limit.
+    bound_at: usize,
+    /// The first open bracket at the deepest bracket nesting.
+    deepest_bracket: usize,
+}
+
+fn nesting(source: &str, limit: usize) -> Nesting {
+    let b = source.as_bytes();
+    let (mut brackets, mut deepest, mut deepest_at) = (0usize, 0usize, 0usize);
+    // Operators counted in each open bracket (the statement's level first).
+    let mut levels: Vec<usize> = vec![0];
+    let (mut sum, mut max, mut at) = (0usize, 0usize, 0usize);
+    let mut i = 0;
+    while i < b.len() {
+        let c = b[i];
+        match c {
+            b'/' if b.get(i + 1) == Some(&b'/') => {
+                while i < b.len() && b[i] != b'\n' {
+                    i += 1;
+                }
+                continue;
+            }
+            b'/' if b.get(i + 1) == Some(&b'*') => {
+                // Block comments nest in WGSL.
+                let mut open = 0usize;
+                while i < b.len() {
+                    if b[i] == b'/' && b.get(i + 1) == Some(&b'*') {
+                        open += 1;
+                        i += 2;
+                    } else if b[i] == b'*' && b.get(i + 1) == Some(&b'/') {
+                        open -= 1;
+                        i += 2;
+                        if open == 0 {
+                            break;
+                        }
+                    } else {
+                        i += 1;
+                    }
+                }
+                continue;
+            }
+            b';' | b'{' | b'}' => {
+                levels.clear();
+                levels.push(0);
+                sum = 0;
+                brackets = 0;
+            }
+            b'(' | b'[' => {
+                levels.push(0);
+                sum += 1;
+                brackets += 1;
+                if brackets > deepest {
+                    deepest = brackets;
+                    deepest_at = i;
+                }
+            }
+            b')' | b']' => {
+                brackets = brackets.saturating_sub(1);
+                if levels.len() > 1 {
+                    sum -= levels.pop().unwrap_or(0) + 1;
+                }
+            }
+            b',' => {
+                if let Some(last) = levels.last_mut() {
+                    sum -= *last;
+                    *last = 0;
+                }
+            }
+            b'.' if in_number(b, i) => {}
+            b'+' | b'-' | b'*' | b'/' | b'%' | b'&' | b'|' | b'^' | b'!' | b'~' | b'<' | b'>'
+            | b'=' | b'.' => {
+                if let Some(last) = levels.last_mut() {
+                    *last += 1;
+                }
+                sum += 1;
+            }
+            _ => {}
+        }
+        if sum > max {
+            max = sum;
+            if max > limit && at == 0 {
+                at = i;
+            }
+        }
+        i += 1;
+    }
+    Nesting {
+        bound: max,
+        bound_at: at,
+        deepest_bracket: deepest_at,
+    }
 }
 
 /// Runs naga, turning a panic inside it into an input error: rtlint reports
@@ -52,6 +221,17 @@ fn parse_unguarded(
         let mut labels = e.labels();
         if let Some((span, label)) = labels.next() {
             err = err.at(span_location(path, source, span), label);
+        } else if e.notes().any(|n| n.contains("recursion limit")) {
+            // naga's parser stops 200 calls deep (brackets, calls, indexing)
+            // and says so without a position: point at the deepest bracket.
+            let at = nesting(source, usize::MAX).deepest_bracket;
+            let (line, column) = line_col(source, at);
+            err = InputError::new(
+                InputErrorKind::WgslParse,
+                path,
+                "brackets nested too deep for naga's WGSL parser (it stops at 200 levels of brackets, calls and indexing)",
+            )
+            .at(Location::point(path, line, column), "nested too deep here");
         }
         for (span, label) in labels {
             err.0.secondary.push(crate::diag::Label::new(
@@ -622,6 +802,27 @@ pub fn span_location(path: &Path, source: &str, span: naga::Span) -> Location {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The bound counts operator chains, prefixes and brackets, not list
+    /// items, decimal points or comments.
+    #[test]
+    fn nesting_bound_counts_chains_not_lists() {
+        let bound = |s: &str| nesting_bound(s, usize::MAX).0;
+        assert_eq!(bound("let x = a + b + c + d;"), 4);
+        assert_eq!(bound("let x = - - - 1.5;"), 4);
+        assert_eq!(bound("let x = f(a + b, c);"), 3);
+        assert_eq!(bound("let x = array(1.5, -2.5, 3.5, -4.5, 5.5);"), 3);
+        assert_eq!(bound("let x = ((1));"), 3);
+        assert_eq!(bound("let x = v1.x.y;"), 3);
+        assert_eq!(
+            bound("let x = 1; // - - - - - -\n/* + /* + */ + */ let y = 2;"),
+            1
+        );
+        // Statements do not add up.
+        assert_eq!(bound("let x = a + b; let y = c + d;"), 2);
+        // Where it first passes the limit: the third `+`.
+        assert_eq!(nesting_bound("let x = a + b + c + d;", 3), (4, 18));
+    }
 
     /// Statement numbers in, positions back: the same words as naga's writer
     /// given the text itself, including a text long enough for
