@@ -1061,15 +1061,8 @@ impl SsaLive {
         }
         // A worklist, as for the parts (see `FnLiveness::solve`).
         let mut live_in = vec![0u64; n * w];
-        let mut work: Vec<usize> = (0..n).filter(|&b| fl.focus.blocks[b]).collect();
-        let mut queued = fl.focus.blocks.clone();
-        let mut steps = 0usize;
+        let mut work = Worklist::new(n, (0..n).filter(|&b| fl.focus.blocks[b]));
         while let Some(b) = work.pop() {
-            queued[b] = false;
-            steps += 1;
-            if steps > n.saturating_mul(10_000) {
-                break;
-            }
             for &s in &f.blocks[b].succs {
                 if s < n {
                     for k in 0..w {
@@ -1085,8 +1078,7 @@ impl SsaLive {
             }
             if changed {
                 for &p in &fl.preds[b] {
-                    if fl.focus.blocks[p] && !queued[p] {
-                        queued[p] = true;
+                    if fl.focus.blocks[p] {
                         work.push(p);
                     }
                 }
@@ -1142,6 +1134,42 @@ impl SsaLive {
             }
         }
         out
+    }
+}
+
+/// The blocks a fixpoint has still to visit, each queued at most once at a
+/// time (popped last-queued first). It gives up after 10,000 visits per
+/// block: a fixpoint that does not settle is a bug, and a hang is worse
+/// than the answer so far.
+struct Worklist {
+    work: Vec<usize>,
+    queued: Vec<bool>,
+    left: usize,
+}
+
+impl Worklist {
+    fn new(n: usize, first: impl Iterator<Item = usize>) -> Worklist {
+        let mut queued = vec![false; n];
+        let work = first.inspect(|&b| queued[b] = true).collect();
+        Worklist {
+            work,
+            queued,
+            left: n.saturating_mul(10_000),
+        }
+    }
+
+    fn pop(&mut self) -> Option<usize> {
+        let b = self.work.pop()?;
+        self.queued[b] = false;
+        self.left = self.left.checked_sub(1)?;
+        Some(b)
+    }
+
+    fn push(&mut self, b: usize) {
+        if !self.queued[b] {
+            self.queued[b] = true;
+            self.work.push(b);
+        }
     }
 }
 
@@ -2129,18 +2157,11 @@ impl FnLiveness {
         // A worklist: a block is redone only when a successor's live-in
         // grew (every block once first, last block first), instead of every
         // block every round until a whole round changes nothing.
-        let mut work: Vec<usize> = (0..n).filter(|&b| self.focus.blocks[b]).collect();
-        let mut queued = self.focus.blocks.clone();
-        let mut steps = 0usize;
+        let mut work = Worklist::new(n, (0..n).filter(|&b| self.focus.blocks[b]));
         // One live set and one live-out set, reused for every visit.
         let mut live = BitSet::default();
         let mut out = BitSet::default();
         while let Some(b) = work.pop() {
-            queued[b] = false;
-            steps += 1;
-            if steps > n.saturating_mul(10_000) {
-                break;
-            }
             out.clear();
             out.reserve_indices((live_in.w * 64) as u32);
             for &s in &f.blocks[b].succs {
@@ -2157,8 +2178,7 @@ impl FnLiveness {
             if !live.same_words(live_in.row(b)) {
                 live_in.set_row(b, live.words());
                 for &p in &self.preds[b] {
-                    if self.focus.blocks[p] && !queued[p] {
-                        queued[p] = true;
+                    if self.focus.blocks[p] {
                         work.push(p);
                     }
                 }
@@ -2208,16 +2228,9 @@ impl FnLiveness {
             // Forward, by a worklist over flat rows (a set per block and a
             // clone per visit before).
             let mut out = own.clone();
-            let mut work: Vec<usize> = (0..n).rev().collect();
-            let mut queued = vec![true; n];
+            let mut work = Worklist::new(n, (0..n).rev());
             let mut d = vec![0u64; w];
-            let mut steps = 0usize;
             while let Some(b) = work.pop() {
-                queued[b] = false;
-                steps += 1;
-                if steps > n.saturating_mul(10_000) {
-                    break;
-                }
                 d.copy_from_slice(&own[b * w..(b + 1) * w]);
                 for &p in &self.preds[b] {
                     for k in 0..w {
@@ -2227,8 +2240,7 @@ impl FnLiveness {
                 if d[..] != out[b * w..(b + 1) * w] {
                     out[b * w..(b + 1) * w].copy_from_slice(&d);
                     for &s in &f.blocks[b].succs {
-                        if s < n && !queued[s] {
-                            queued[s] = true;
+                        if s < n {
                             work.push(s);
                         }
                     }
