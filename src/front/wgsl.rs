@@ -110,8 +110,25 @@ fn nesting(source: &str, limit: usize) -> Nesting {
     // Operators counted in each open bracket (the statement's level first).
     let mut levels: Vec<usize> = vec![0];
     let (mut sum, mut max, mut at) = (0usize, 0usize, 0usize);
+    // Bytes the scan looks at; the rest (names, numbers, spaces) are
+    // skipped in a tight loop.
+    const fn marks() -> [bool; 256] {
+        let mut t = [false; 256];
+        let s = b"/;{}()[],.+-*%&|^!~<>=";
+        let mut k = 0;
+        while k < s.len() {
+            t[s[k] as usize] = true;
+            k += 1;
+        }
+        t
+    }
+    const MARKED: [bool; 256] = marks();
     let mut i = 0;
     while i < b.len() {
+        if !MARKED[b[i] as usize] {
+            i += 1;
+            continue;
+        }
         let c = b[i];
         match c {
             b'/' if b.get(i + 1) == Some(&b'/') => {
