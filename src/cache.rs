@@ -259,10 +259,14 @@ struct PackFile {
     slots: BTreeMap<String, Slot>,
 }
 
-/// The slot of a loose pipeline group (its path is a folder or a file): not
-/// the name of any input's slot.
+/// How a loose pipeline group's slot name starts (an input's slot is its
+/// file name; were the two names ever equal, the keys still differ, so the
+/// worst is a miss).
+const GROUP_SLOT: &str = "group ";
+
+/// The slot of a loose pipeline group (its path is a folder or a file).
 fn group_slot(group: &Path) -> String {
-    format!("group {}", group.display())
+    format!("{GROUP_SLOT}{}", group.display())
 }
 
 /// An input's slot: its file name within its folder.
@@ -503,7 +507,7 @@ impl Cache {
             ..
         } = &mut *pack;
         slots.retain(|name, _| {
-            touched.contains(name) || name.starts_with("group ") || folder.join(name).exists()
+            touched.contains(name) || name.starts_with(GROUP_SLOT) || folder.join(name).exists()
         });
         let file = PackFile {
             slots: std::mem::take(slots),

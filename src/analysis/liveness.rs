@@ -907,46 +907,6 @@ impl Focus {
     }
 }
 
-/// Each block's predecessors: `list[start[b]..start[b + 1]]` (one list
-/// for the function, not a vector per block).
-struct Preds {
-    start: Vec<usize>,
-    list: Vec<usize>,
-}
-
-impl Preds {
-    fn new(f: &Function) -> Preds {
-        let n = f.blocks.len();
-        let mut start = vec![0usize; n + 1];
-        for block in &f.blocks {
-            for &s in block.succs.iter().filter(|&&s| s < n) {
-                start[s + 1] += 1;
-            }
-        }
-        for b in 0..n {
-            start[b + 1] += start[b];
-        }
-        let mut fill = start.clone();
-        let mut list = vec![0usize; start[n]];
-        // By block, so each block's predecessors are in order, as before.
-        for (b, block) in f.blocks.iter().enumerate() {
-            for &s in block.succs.iter().filter(|&&s| s < n) {
-                list[fill[s]] = b;
-                fill[s] += 1;
-            }
-        }
-        Preds { start, list }
-    }
-}
-
-impl std::ops::Index<usize> for Preds {
-    type Output = [usize];
-    #[inline]
-    fn index(&self, b: usize) -> &[usize] {
-        &self.list[self.start[b]..self.start[b + 1]]
-    }
-}
-
 /// One bit set per block in a single flat table of `w` words a row
 /// (widened when a set outgrows it): the fixpoint's sets without an
 /// allocation per block.
@@ -1247,7 +1207,7 @@ pub struct FnLiveness {
     /// [`Defined::written`]): only asked where a site is, so worked out
     /// on first use (a callee solved for its parameters never asks).
     defined: std::cell::OnceCell<Defined>,
-    preds: Preds,
+    preds: crate::program::cfg::Preds,
     remat: RefCell<HashMap<Id, bool>>,
     /// Variables' rematerialisation as read at an instruction.
     remat_at: RefCell<HashMap<RematKey, u32>>,
@@ -1644,7 +1604,7 @@ impl FnLiveness {
                 _ => ssa_ids.push(r),
             }
         }
-        let preds = Preds::new(f);
+        let preds = crate::program::cfg::Preds::of(f);
         // Per instruction: the load a copy's store copies from, or that a
         // load is a copy's (read at the store).
         let mut copy = vec![Copy::None; f.end + 1 - f.start];
@@ -2264,15 +2224,7 @@ impl FnLiveness {
         let Some((b, live)) = self.live_parts_after(program, inst) else {
             return Vec::new();
         };
-        let mut out: Vec<Place> = {
-            let places = self.places.borrow();
-            live.iter()
-                .map(|i| {
-                    let (id, path) = places.place(i);
-                    (id, path.to_vec())
-                })
-                .collect()
-        };
+        let mut out: Vec<Place> = self.owned_places(&live);
         let ssa = self.ssa.get_or_init(|| SsaLive::new(self, program));
         out.extend(
             ssa.after(self, b, inst)
@@ -2288,6 +2240,11 @@ impl FnLiveness {
         let Some((_, live)) = self.live_parts_after(program, inst) else {
             return HashSet::default();
         };
+        self.owned_places(&live)
+    }
+
+    /// The places of the parts in `live`, as owned (id, path) pairs.
+    fn owned_places<C: FromIterator<Place>>(&self, live: &BitSet) -> C {
         let places = self.places.borrow();
         live.iter()
             .map(|i| {

@@ -40,7 +40,7 @@ const DEEP_STACK: usize = 256 << 20;
 /// Runs `f` (naga over `source`) where its recursion fits: refuses a module
 /// nested deeper than [`MAX_EXPRESSION_DEPTH`] at the place it gets there,
 /// and gives a deep one a large stack.
-pub fn deep<T: Send>(
+fn deep<T: Send>(
     source: &str,
     path: &Path,
     f: impl FnOnce() -> Result<T, InputError> + Send,
@@ -90,7 +90,7 @@ fn in_number(b: &[u8], i: usize) -> bool {
 /// adds a level to the bracket it is in, each open bracket a level, and a
 /// comma ends its argument's levels (a long list stays shallow). Comments
 /// are skipped; a decimal point is not an operator.
-pub fn nesting_bound(source: &str, limit: usize) -> (usize, usize) {
+fn nesting_bound(source: &str, limit: usize) -> (usize, usize) {
     let n = nesting(source, limit);
     (n.bound, n.bound_at)
 }
@@ -913,8 +913,8 @@ mod tests {
         }
     }
 
-    /// The line index gives what scanning from the top gives, at every byte
-    /// (inside multi-byte characters, at `\r\n`, past the end).
+    /// `find_str` answers as `str::find`, for every start and needle,
+    /// multi-byte characters included.
     #[test]
     fn find_str_is_str_find() {
         let hay = "fn f(x: f32) -> f32 { let fé = x; return fé; } // fn éfn";
@@ -931,6 +931,8 @@ mod tests {
         }
     }
 
+    /// The line index gives what scanning from the top gives, at every byte
+    /// (inside multi-byte characters, at `\r\n`, past the end).
     #[test]
     fn line_index_agrees_with_line_col() {
         for source in [

@@ -16,9 +16,14 @@ pub struct Preds {
 impl Preds {
     pub fn of(f: &Function) -> Preds {
         let n = f.blocks.len();
+        // A successor outside the function (which the builder refuses) is
+        // no edge.
+        fn succs(block: &crate::program::Block, n: usize) -> impl Iterator<Item = usize> + '_ {
+            block.succs.iter().copied().filter(move |&s| s < n)
+        }
         let mut start = vec![0usize; n + 1];
         for block in &f.blocks {
-            for &s in &block.succs {
+            for s in succs(block, n) {
                 start[s + 1] += 1;
             }
         }
@@ -28,7 +33,7 @@ impl Preds {
         let mut list = vec![0usize; start[n]];
         let mut next = start.clone();
         for (b, block) in f.blocks.iter().enumerate() {
-            for &s in &block.succs {
+            for s in succs(block, n) {
                 list[next[s]] = b;
                 next[s] += 1;
             }
@@ -38,6 +43,14 @@ impl Preds {
 
     /// The predecessors of block `b`.
     pub fn of_block(&self, b: usize) -> &[usize] {
+        &self[b]
+    }
+}
+
+impl std::ops::Index<usize> for Preds {
+    type Output = [usize];
+    #[inline]
+    fn index(&self, b: usize) -> &[usize] {
         &self.list[self.start[b]..self.start[b + 1]]
     }
 }
