@@ -616,72 +616,73 @@ struct IdMap<T> {
     keys: Vec<Id>,
 }
 
+/// An id's ordinal: slot `id - lo` holds it, or [`IdIndex::NONE`]. The
+/// few ids outside the range (parameters: compilers number them with the
+/// function, before its body) are listed in `outside`; a range too huge
+/// for slots (a module may number its ids sparsely) has none, and hashes.
 #[derive(Debug)]
-enum IdIndex {
-    /// Slot `id - lo` holds the ordinal, or [`IdIndex::NONE`]. The few ids
-    /// outside the range (parameters: compilers number them with the
-    /// function, before its body) are listed in `outside`.
-    Dense {
-        lo: Id,
-        slots: Vec<u32>,
-        outside: Vec<(Id, u32)>,
-    },
-    Sparse(HashMap<Id, u32>),
+struct IdIndex {
+    lo: Id,
+    slots: Vec<u32>,
+    outside: Vec<(Id, u32)>,
+    sparse: Option<Box<HashMap<Id, u32>>>,
 }
 
 impl IdIndex {
     const NONE: u32 = u32::MAX;
 
-    /// For the ids `lo..=hi`: a slot each, unless the range is huge (a
-    /// module may number its ids sparsely), then hashed.
+    /// For the ids `lo..=hi`: a slot each, unless the range is huge.
     fn new(lo: Id, hi: Id) -> IdIndex {
         let n = hi.saturating_sub(lo) as usize + 1;
-        if n <= 1 << 20 {
-            IdIndex::Dense {
-                lo,
-                slots: vec![IdIndex::NONE; n],
-                outside: Vec::new(),
-            }
-        } else {
-            IdIndex::Sparse(HashMap::default())
+        let dense = n <= 1 << 20;
+        IdIndex {
+            lo,
+            slots: if dense {
+                vec![IdIndex::NONE; n]
+            } else {
+                Vec::new()
+            },
+            outside: Vec::new(),
+            sparse: (!dense).then(Box::default),
         }
     }
 
+    /// (The slot lookup is one test: no variant to match first; asked for
+    /// every operand of most passes.)
     #[inline]
     fn find(&self, id: Id) -> Option<u32> {
-        match self {
-            IdIndex::Dense { lo, slots, outside } => {
-                match id.checked_sub(*lo).and_then(|k| slots.get(k as usize)) {
-                    Some(&k) => (k != Self::NONE).then_some(k),
-                    None => outside.iter().find(|(x, _)| *x == id).map(|&(_, k)| k),
-                }
-            }
-            IdIndex::Sparse(m) => m.get(&id).copied(),
+        match self.slots.get(id.wrapping_sub(self.lo) as usize) {
+            Some(&k) => (k != Self::NONE).then_some(k),
+            None => self.find_outside(id),
+        }
+    }
+
+    #[cold]
+    fn find_outside(&self, id: Id) -> Option<u32> {
+        match &self.sparse {
+            Some(m) => m.get(&id).copied(),
+            None => self.outside.iter().find(|(x, _)| *x == id).map(|&(_, k)| k),
         }
     }
 
     /// The ordinal of `id`, given `next` when it is new.
     #[inline]
     fn find_or_add(&mut self, id: Id, next: u32) -> u32 {
-        match self {
-            IdIndex::Dense { lo, slots, outside } => {
-                match id.checked_sub(*lo).and_then(|k| slots.get_mut(k as usize)) {
-                    Some(s) => {
-                        if *s == Self::NONE {
-                            *s = next;
-                        }
-                        *s
-                    }
-                    None => match outside.iter().find(|(x, _)| *x == id) {
-                        Some(&(_, k)) => k,
-                        None => {
-                            outside.push((id, next));
-                            next
-                        }
-                    },
-                }
+        if let Some(s) = self.slots.get_mut(id.wrapping_sub(self.lo) as usize) {
+            if *s == Self::NONE {
+                *s = next;
             }
-            IdIndex::Sparse(m) => *m.entry(id).or_insert(next),
+            return *s;
+        }
+        if let Some(m) = &mut self.sparse {
+            return *m.entry(id).or_insert(next);
+        }
+        match self.outside.iter().find(|(x, _)| *x == id) {
+            Some(&(_, k)) => k,
+            None => {
+                self.outside.push((id, next));
+                next
+            }
         }
     }
 }
@@ -1001,12 +1002,28 @@ impl SsaLive {
         let mut kill = vec![0u64; n * w];
         let mut gen = vec![0u64; n * w];
         let mut live_out = vec![0u64; n * w];
+        // Forward: a value is in a block's gen when the first instruction
+        // of the block that mentions it reads it (as stepping back over
+        // the block would leave it), and in its kill when defined there.
         for b in (0..n).filter(|&b| fl.focus.blocks[b]) {
             let row = b * w..(b + 1) * w;
-            for &i in body.block(b).iter().rev() {
+            let (gen, kill) = (&mut gen[row.clone()], &mut kill[row]);
+            for &i in body.block(b) {
                 let i = i as usize;
-                ssa.step(fl, i, &mut gen[row.clone()], Some(&mut kill[row.clone()]));
-                if body.op(i) == Op::Phi && !body.debug(i) {
+                let op = body.op(i);
+                if op != Op::Phi && fl.copy[i - body.start()] == Copy::None {
+                    for &id in body.ids(i) {
+                        if let Some(k) = ssa.ordinal(id) {
+                            if kill[k as usize / 64] >> (k % 64) & 1 == 0 {
+                                set(gen, k);
+                            }
+                        }
+                    }
+                }
+                if let Some(k) = body.result(i).and_then(|r| ssa.ordinal(r)) {
+                    set(kill, k);
+                }
+                if op == Op::Phi {
                     for pair in body.ids(i).chunks(2) {
                         if let [value, pred] = pair {
                             if let Some(p) = f.block_by_label(*pred) {
@@ -1053,20 +1070,17 @@ impl SsaLive {
         self.index.find(id)
     }
 
-    /// Steps back over instruction `i`: its result dies (into `kill` too,
-    /// when given), the values it reads live. A phi reads on its edges,
+    /// Steps back over instruction `i`: its result dies, the values it
+    /// reads live. A phi reads on its edges,
     /// and a copy's load and store read no value (the copy reads the
     /// source's parts).
     #[inline]
-    fn step(&self, fl: &FnLiveness, i: usize, live: &mut [u64], kill: Option<&mut [u64]>) {
+    fn step(&self, fl: &FnLiveness, i: usize, live: &mut [u64]) {
         let body = &fl.body;
         // (Asked only of the instructions the passes read: no debug info.)
         debug_assert!(!body.debug(i));
         if let Some(k) = body.result(i).and_then(|r| self.ordinal(r)) {
             unset(live, k);
-            if let Some(kill) = kill {
-                set(kill, k);
-            }
         }
         if body.op(i) == Op::Phi || fl.copy[i - body.start()] != Copy::None {
             return;
@@ -1083,7 +1097,7 @@ impl SsaLive {
         let w = self.words;
         let mut live = self.live_out[b * w..(b + 1) * w].to_vec();
         for &k in fl.body.block_after(b, inst).iter().rev() {
-            self.step(fl, k as usize, &mut live, None);
+            self.step(fl, k as usize, &mut live);
         }
         let mut out = Vec::new();
         for (k, &word) in live.iter().enumerate() {
@@ -1173,6 +1187,44 @@ type Spare = (Vec<Vec<usize>>, Vec<Vec<Stored>>);
 /// part as its length then its indices: one vector, not one per part.
 type RematKey = (Id, usize, Vec<u32>);
 
+/// Whether each SSA value is recomputable, once worked out: a byte per id
+/// (the module's ids are dense), hashing only ids past a bound a sparse
+/// module may have.
+#[derive(Default)]
+struct RematMemo {
+    /// 0: not known; 1: no; 2: yes.
+    dense: Vec<u8>,
+    sparse: HashMap<Id, bool>,
+}
+
+impl RematMemo {
+    const DENSE: usize = 1 << 20;
+
+    #[inline]
+    fn get(&self, id: Id) -> Option<bool> {
+        match self.dense.get(id as usize) {
+            Some(0) => None,
+            Some(&v) => Some(v == 2),
+            None if id as usize >= Self::DENSE => self.sparse.get(&id).copied(),
+            None => None,
+        }
+    }
+
+    fn insert(&mut self, id: Id, r: bool) {
+        let k = id as usize;
+        if k >= Self::DENSE {
+            self.sparse.insert(id, r);
+            return;
+        }
+        if k >= self.dense.len() {
+            // Grown in steps, not per id.
+            self.dense
+                .resize((k + 1).next_power_of_two().min(Self::DENSE), 0);
+        }
+        self.dense[k] = 1 + r as u8;
+    }
+}
+
 /// Liveness facts of one function.
 pub struct FnLiveness {
     func: usize,
@@ -1208,7 +1260,7 @@ pub struct FnLiveness {
     /// on first use (a callee solved for its parameters never asks).
     defined: std::cell::OnceCell<Defined>,
     preds: crate::program::cfg::Preds,
-    remat: RefCell<HashMap<Id, bool>>,
+    remat: RefCell<RematMemo>,
     /// Variables' rematerialisation as read at an instruction.
     remat_at: RefCell<HashMap<RematKey, u32>>,
     /// The answers of `remat_at`, by the slot it gives (so the key is
@@ -2594,13 +2646,17 @@ impl FnLiveness {
     /// Whether an SSA value can be recomputed after the trace from builtins,
     /// push constants, uniform or storage loads and constants.
     fn remat_ssa(&self, program: &Program, id: Id, depth: u32) -> bool {
-        if program.constants.contains_key(&id) || program.spec_constants.contains_key(&id) {
-            return true;
-        }
-        if let Some(&r) = self.remat.borrow().get(&id) {
+        // Answers that do not depend on `depth` are kept too (constants,
+        // ids defined outside the function): asked again for every use.
+        if let Some(r) = self.remat.borrow().get(id) {
             return r;
         }
+        if program.constants.contains_key(&id) || program.spec_constants.contains_key(&id) {
+            self.remat.borrow_mut().insert(id, true);
+            return true;
+        }
         let Some(&i) = program.defs.get(&id) else {
+            self.remat.borrow_mut().insert(id, false);
             return false;
         };
         let f = self.function(program);
@@ -2610,10 +2666,11 @@ impl FnLiveness {
         } else {
             program.insts[i].class.opcode
         };
-        if op == Op::Undef {
-            return true;
+        if op == Op::Undef || !inside {
+            self.remat.borrow_mut().insert(id, op == Op::Undef);
+            return op == Op::Undef;
         }
-        if depth > 64 || !inside {
+        if depth > 64 {
             return false;
         }
         // Cycles through phis are loop-carried: not recomputable.
