@@ -653,16 +653,18 @@ impl IdIndex {
     fn find(&self, id: Id) -> Option<u32> {
         match self.slots.get(id.wrapping_sub(self.lo) as usize) {
             Some(&k) => (k != Self::NONE).then_some(k),
-            None => self.find_outside(id),
+            // Most operands are ids from outside the function (constants,
+            // types, globals): a short list, inline.
+            None if self.sparse.is_none() => {
+                self.outside.iter().find(|(x, _)| *x == id).map(|&(_, k)| k)
+            }
+            None => self.find_sparse(id),
         }
     }
 
     #[cold]
-    fn find_outside(&self, id: Id) -> Option<u32> {
-        match &self.sparse {
-            Some(m) => m.get(&id).copied(),
-            None => self.outside.iter().find(|(x, _)| *x == id).map(|&(_, k)| k),
-        }
+    fn find_sparse(&self, id: Id) -> Option<u32> {
+        self.sparse.as_ref()?.get(&id).copied()
     }
 
     /// The ordinal of `id`, given `next` when it is new.
@@ -1399,9 +1401,14 @@ impl FnLiveness {
     fn exposed(&self, program: &Program) -> ExposedParams {
         let f = self.function(program);
         let entry = f.blocks.first().map(|b| b.start);
+        // Read from the live set itself (by place index), not from a hash
+        // set of owned places: the order of a parameter's parts does not
+        // matter to a caller, which makes each of them live.
         let live = entry
-            .map(|i| self.parts_after(program, i))
+            .and_then(|i| self.live_parts_after(program, i))
+            .map(|(_, live)| live)
             .unwrap_or_default();
+        let places = self.places.borrow();
         f.params
             .iter()
             .map(|p| {
@@ -1410,11 +1417,11 @@ impl FnLiveness {
                 }
                 let reads = live
                     .iter()
-                    .filter(|(v, _)| v == p)
-                    .map(|(_, path)| path.clone())
+                    .filter_map(|i| {
+                        let (v, path) = places.place(i);
+                        (v == *p).then(|| path.to_vec())
+                    })
                     .collect();
-                // (In the set's order, as before: the order the parts are
-                // interned in at each call.)
                 ParamEffect {
                     reads: Some(reads),
                     writes: self.written_on_every_path(program, *p),
@@ -2284,15 +2291,6 @@ impl FnLiveness {
                 .map(|id| (id, Vec::new())),
         );
         out
-    }
-
-    /// The parts of variables (and pointer parameters) live just after
-    /// instruction `inst`.
-    fn parts_after(&self, program: &Program, inst: usize) -> HashSet<Place> {
-        let Some((_, live)) = self.live_parts_after(program, inst) else {
-            return HashSet::default();
-        };
-        self.owned_places(&live)
     }
 
     /// The places of the parts in `live`, as owned (id, path) pairs.
