@@ -401,6 +401,16 @@ fn main() {
         peer_ms: Some(ms(naga_floor)),
         rss_kib: None,
     });
+    // What the one-IR design costs before any rule runs: naga's own SPIR-V
+    // writer (with the debug info that carries positions) on top of naga.
+    table.push(Row {
+        section: "wgsl",
+        case: "  of which the front-end alone (naga + its SPIR-V writer)".into(),
+        ours_ms: ms(compiled),
+        peer: "naga".into(),
+        peer_ms: Some(ms(naga_floor)),
+        rss_kib: None,
+    });
     println!(
         "           where the time goes: naga parse+validate {:.3} ms, + SPIR-V out {:.3}, + reading the module {:.3}, rules {:.3}",
         ms(naga_floor),
