@@ -1012,20 +1012,15 @@ impl SsaLive {
             let (gen, kill) = (&mut gen[row.clone()], &mut kill[row]);
             for &i in body.block(b) {
                 let i = i as usize;
-                let op = body.op(i);
-                if op != Op::Phi && fl.copy[i - body.start()] == Copy::None {
-                    for &id in body.ids(i) {
-                        if let Some(k) = ssa.ordinal(id) {
-                            if kill[k as usize / 64] >> (k % 64) & 1 == 0 {
-                                set(gen, k);
-                            }
-                        }
+                for k in ssa.reads(fl, i) {
+                    if kill[k as usize / 64] >> (k % 64) & 1 == 0 {
+                        set(gen, k);
                     }
                 }
                 if let Some(k) = body.result(i).and_then(|r| ssa.ordinal(r)) {
                     set(kill, k);
                 }
-                if op == Op::Phi {
+                if body.op(i) == Op::Phi {
                     for pair in body.ids(i).chunks(2) {
                         if let [value, pred] = pair {
                             if let Some(p) = f.block_by_label(*pred) {
@@ -1084,14 +1079,22 @@ impl SsaLive {
         if let Some(k) = body.result(i).and_then(|r| self.ordinal(r)) {
             unset(live, k);
         }
-        if body.op(i) == Op::Phi || fl.copy[i - body.start()] != Copy::None {
-            return;
+        for k in self.reads(fl, i) {
+            set(live, k);
         }
-        for &id in body.ids(i) {
-            if let Some(k) = self.ordinal(id) {
-                set(live, k);
-            }
-        }
+    }
+
+    /// The values instruction `i` reads, as ordinals: none for a phi (it
+    /// reads on its edges) or a copy's load and store.
+    #[inline]
+    fn reads<'a>(&'a self, fl: &'a FnLiveness, i: usize) -> impl Iterator<Item = u32> + 'a {
+        let body = &fl.body;
+        let ids = if body.op(i) != Op::Phi && fl.copy[i - body.start()] == Copy::None {
+            body.ids(i)
+        } else {
+            &[]
+        };
+        ids.iter().filter_map(|&id| self.ordinal(id))
     }
 
     /// The values live just after instruction `inst` of block `b`.
