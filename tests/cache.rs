@@ -14,6 +14,14 @@ fn scratch(name: &str) -> PathBuf {
     d
 }
 
+/// A scratch folder holding the test shader and the header it includes.
+fn shader_folder(name: &str) -> PathBuf {
+    let d = scratch(name);
+    std::fs::write(d.join("payload.hlsli"), PAYLOAD).unwrap();
+    std::fs::write(d.join("gen.hlsl"), shader()).unwrap();
+    d
+}
+
 fn text(o: &Output) -> String {
     String::from_utf8_lossy(&o.stdout).into_owned() + &String::from_utf8_lossy(&o.stderr)
 }
@@ -68,9 +76,7 @@ fn shader() -> String {
 /// or the command line's rule options invalidates what they touch.
 #[test]
 fn the_cache_is_never_stale() {
-    let d = scratch("stale");
-    std::fs::write(d.join("payload.hlsli"), PAYLOAD).unwrap();
-    std::fs::write(d.join("gen.hlsl"), shader()).unwrap();
+    let d = shader_folder("stale");
     let cache = d.join("c");
     let cache_arg = ["--cache-dir", cache.to_str().unwrap()];
     let run = |extra: &[&str]| {
@@ -189,9 +195,7 @@ fn age_days(path: &Path) -> u64 {
 /// what this run (or another shard) used stays.
 #[test]
 fn old_unused_entries_are_pruned_and_used_ones_kept() {
-    let d = scratch("prune");
-    std::fs::write(d.join("payload.hlsli"), PAYLOAD).unwrap();
-    std::fs::write(d.join("gen.hlsl"), shader()).unwrap();
+    let d = shader_folder("prune");
     let cache = d.join("c");
     let args = ["--cache-dir", cache.to_str().unwrap(), "."];
     let cold = check(&d, &args);
@@ -228,9 +232,7 @@ fn old_unused_entries_are_pruned_and_used_ones_kept() {
 /// again; the other inputs' entries stay.
 #[test]
 fn entries_of_deleted_inputs_leave_their_pack() {
-    let d = scratch("gone");
-    std::fs::write(d.join("payload.hlsli"), PAYLOAD).unwrap();
-    std::fs::write(d.join("gen.hlsl"), shader()).unwrap();
+    let d = shader_folder("gone");
     std::fs::write(d.join("other.hlsl"), shader().replace("Gen", "Other")).unwrap();
     let cache = d.join("c");
     let args = ["--cache-dir", cache.to_str().unwrap(), "."];
@@ -254,9 +256,7 @@ fn entries_of_deleted_inputs_leave_their_pack() {
 /// the run answers as without the cache and writes the pack again.
 #[test]
 fn a_damaged_pack_is_a_miss() {
-    let d = scratch("damaged");
-    std::fs::write(d.join("payload.hlsli"), PAYLOAD).unwrap();
-    std::fs::write(d.join("gen.hlsl"), shader()).unwrap();
+    let d = shader_folder("damaged");
     let cache = d.join("c");
     let args = ["--cache-dir", cache.to_str().unwrap(), "."];
     let uncached = check(&d, &["--no-cache", "."]);
