@@ -167,12 +167,12 @@ pub fn trace_graph(pipeline: &Pipeline) -> TraceGraph {
         let Some(program) = pipeline.programs.get(program_index) else {
             continue;
         };
-        let reach = program.reachable_functions(entry_function);
+        let reach = program.reached_functions(entry_function);
         for site in &program.sites {
             let Some(f) = program.functions.get(site.function) else {
                 continue;
             };
-            if !reach.contains(&f.id) {
+            if !reach[site.function] {
                 continue;
             }
             // A site in a helper (naga wraps every `traceRay` in one per
@@ -184,9 +184,9 @@ pub fn trace_graph(pipeline: &Pipeline) -> TraceGraph {
                 f.id,
                 super::liveness::MAX_CHAINS,
             );
-            let chain = chains.first().cloned().unwrap_or_default();
+            let chain: &[usize] = chains.first().map_or(&[], Vec::as_slice);
             let location = program
-                .location_in(site.inst, &chain)
+                .location_in(site.inst, chain)
                 .or_else(|| program.site_location(site.inst));
             let mut targets: Vec<usize> = Vec::new();
             let kind = match site.kind {
@@ -195,12 +195,9 @@ pub fn trace_graph(pipeline: &Pipeline) -> TraceGraph {
                 _ => continue,
             };
             // Operands the shader's calls agree on; else as the site has them.
-            let per_chain: Vec<_> = chains
-                .iter()
-                .map(|c| program.trace_operands_in(site, c))
-                .collect();
-            let operands = match per_chain.first() {
-                Some(first) if per_chain.iter().all(|o| o == first) => first.or(site.trace),
+            let mut per_chain = chains.iter().map(|c| program.trace_operands_in(site, c));
+            let operands = match per_chain.next() {
+                Some(first) if per_chain.all(|o| o == first) => first.or(site.trace),
                 _ => site.trace,
             };
             if let (EdgeKind::Trace, Some(t)) = (kind, operands) {

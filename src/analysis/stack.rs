@@ -319,16 +319,19 @@ pub fn breakdown(program: &Program, entry: &str) -> Breakdown {
 
 /// [`breakdown`] with the program's live sites already computed.
 pub fn breakdown_with(program: &Program, entry: &str, sites: &[LiveSite]) -> Breakdown {
+    breakdown_in(program, entry, sites, &Loops::of(program))
+}
+
+/// [`breakdown_with`] with the program's [`Loops`] at hand (the stack
+/// report asks once per program, not once per shader).
+fn breakdown_in(program: &Program, entry: &str, sites: &[LiveSite], loops: &Loops) -> Breakdown {
     let mut b = Breakdown::default();
     let Some(e) = program.entry_points.iter().find(|e| e.name == entry) else {
         return b;
     };
-    let reach = program.reachable_functions(e.function);
+    let reach = program.reached_functions(e.function);
     for site in &program.sites {
-        let Some(f) = program.functions.get(site.function) else {
-            continue;
-        };
-        if !reach.contains(&f.id) {
+        if !reach.get(site.function).copied().unwrap_or(false) {
             continue;
         }
         let size = site.payload.map_or(0, |p| global_size(program, p));
@@ -374,9 +377,9 @@ pub fn breakdown_with(program: &Program, entry: &str, sites: &[LiveSite]) -> Bre
     ) {
         b.hit_attributes = 0;
     }
-    let loops = Loops::of(program);
-    for fid in &reach {
-        if let Some(fi) = program.function_index(*fid) {
+    // Once per function id, as the reached ids list them.
+    for (fi, f) in program.functions.iter().enumerate() {
+        if reach[fi] && program.function_index(f.id) == Some(fi) {
             b.local_arrays += loops.local_arrays(program, fi);
         }
     }
@@ -616,9 +619,9 @@ impl Loops {
     }
 }
 
-fn stage_max(shaders: &[(Stage, u64)]) -> StageMax {
+fn stage_max_of(shaders: impl Iterator<Item = (Stage, u64)>) -> StageMax {
     let mut m = StageMax::default();
-    for &(stage, v) in shaders {
+    for (stage, v) in shaders {
         let slot = match stage {
             Stage::RayGeneration => &mut m.raygen,
             Stage::ClosestHit => &mut m.closest_hit,
@@ -635,21 +638,31 @@ fn stage_max(shaders: &[(Stage, u64)]) -> StageMax {
 
 /// The formulas over per-node sizes (indexed like the trace graph's nodes).
 pub fn formulas(pipeline: &Pipeline, rec: &RecursionReport, sizes: &[u64]) -> Formulas {
-    let stages: Vec<(Stage, u64)> = rec
-        .graph
-        .nodes
-        .iter()
-        .zip(sizes)
-        .map(|(n, &s)| (n.shader.stage, s))
-        .collect();
-    let m = stage_max(&stages);
+    formulas_with(pipeline, rec, &ChainShape::of(rec), sizes)
+}
+
+/// [`formulas`] with the graph's shape worked out once for several sets of
+/// sizes (the model's and the driver-comparable ones).
+fn formulas_with(
+    pipeline: &Pipeline,
+    rec: &RecursionReport,
+    shape: &ChainShape,
+    sizes: &[u64],
+) -> Formulas {
+    let m = stage_max_of(
+        rec.graph
+            .nodes
+            .iter()
+            .zip(sizes)
+            .map(|(n, &s)| (n.shader.stage, s)),
+    );
     Formulas {
         stage_max: m,
         vulkan_default: pipeline.max_recursion_depth.map(|d| vulkan_default(&m, d)),
         vulkan_default_required: rec.required_depth.map(|d| vulkan_default(&m, d)),
         dxr_default: pipeline.max_recursion_depth.map(|d| dxr_default(&m, d)),
         dxr_default_required: rec.required_depth.map(|d| dxr_default(&m, d)),
-        exact_call_chain: exact_call_chain(rec, sizes),
+        exact_call_chain: shape.exact_call_chain(rec, sizes),
     }
 }
 
@@ -658,107 +671,216 @@ pub fn formulas(pipeline: &Pipeline, rec: &RecursionReport, sizes: &[u64]) -> Fo
 /// the tracing shader; callables stack on their caller; a bounded cycle
 /// repeats its largest shader once per level it adds.
 pub fn exact_call_chain(rec: &RecursionReport, sizes: &[u64]) -> Option<u64> {
-    let g = &rec.graph;
-    let n = g.nodes.len();
-    // Callable chains on top of each node.
-    // Each node's callable edges, gathered once (not a scan of every edge
-    // per node: a loose pipeline has edges from every trace to every shader).
-    let mut callables: Vec<Vec<usize>> = vec![Vec::new(); n];
-    for e in g.edges.iter().filter(|e| e.kind == EdgeKind::Callable) {
-        callables[e.from].push(e.to);
-    }
-    fn with_callables(
-        callables: &[Vec<usize>],
-        sizes: &[u64],
-        v: usize,
-        memo: &mut [Option<u64>],
-        depth: usize,
-    ) -> u64 {
-        if let Some(x) = memo[v] {
-            return x;
+    ChainShape::of(rec).exact_call_chain(rec, sizes)
+}
+
+/// Lists of node indices, one per node, in one vector.
+struct PerNode {
+    start: Vec<usize>,
+    list: Vec<usize>,
+}
+
+impl PerNode {
+    /// `pairs` as `(node, item)`, each node's items in the order given.
+    fn of(n: usize, pairs: impl Iterator<Item = (usize, usize)> + Clone) -> PerNode {
+        let mut start = vec![0usize; n + 1];
+        for (v, _) in pairs.clone() {
+            start[v + 1] += 1;
         }
-        let own = sizes.get(v).copied().unwrap_or(0);
-        if depth > callables.len() {
-            return own;
+        for v in 0..n {
+            start[v + 1] += start[v];
         }
-        let above = callables[v]
-            .iter()
-            .map(|&to| with_callables(callables, sizes, to, memo, depth + 1))
-            .max()
-            .unwrap_or(0);
-        memo[v] = Some(own + above);
-        own + above
-    }
-    let mut memo = vec![None; n];
-    let mut w: Vec<u64> = (0..n)
-        .map(|v| with_callables(&callables, sizes, v, &mut memo, 0))
-        .collect();
-    // Intersection and any-hit of a procedural group are active together.
-    for v in 0..n {
-        if g.nodes[v].shader.stage != Stage::AnyHit {
-            continue;
+        let mut list = vec![0usize; start[n]];
+        let mut next = start.clone();
+        for (v, x) in pairs {
+            list[next[v]] = x;
+            next[v] += 1;
         }
-        let Slot::HitGroup(gi) = g.nodes[v].slot else {
-            continue;
-        };
-        let is: u64 = (0..n)
-            .filter(|&u| {
-                g.nodes[u].slot == Slot::HitGroup(gi)
-                    && g.nodes[u].shader.stage == Stage::Intersection
-            })
-            .map(|u| w[u])
-            .sum();
-        w[v] += is;
+        PerNode { start, list }
     }
-    // Longest weighted path over trace edges, cycles by their bound.
-    let mut best: Vec<Option<u64>> = vec![None; n];
-    let level = |v: usize| rec.node_level[v];
-    let mut order: Vec<usize> = (0..n).collect();
-    // Levels order the acyclic part; nodes of one cycle share its weight.
-    order.sort_by_key(|&v| level(v).unwrap_or(u32::MAX));
-    // The first cycle through each node, and each node's incoming traces,
-    // found once (not a scan of every cycle and edge per node and pass).
-    let mut cycle_of: Vec<Option<usize>> = vec![None; n];
-    for (k, c) in rec.cycles.iter().enumerate() {
-        for &v in &c.nodes {
-            if let Some(slot) = cycle_of.get_mut(v) {
-                slot.get_or_insert(k);
-            }
-        }
+
+    fn of_node(&self, v: usize) -> &[usize] {
+        &self.list[self.start[v]..self.start[v + 1]]
     }
-    let mut into: Vec<Vec<usize>> = vec![Vec::new(); n];
-    for e in g.traces() {
-        into[e.to].push(e.from);
-    }
-    for _ in 0..2 {
-        for &v in &order {
-            let own = match cycle_of[v] {
-                Some(k) => {
-                    let c = &rec.cycles[k];
-                    let x = c.extra_levels?;
-                    let max_w = c.nodes.iter().map(|&u| w[u]).max().unwrap_or(0);
-                    (x + 1) * max_w
+}
+
+/// What [`exact_call_chain`] needs of the trace graph, independent of the
+/// sizes: worked out once per report, not once per set of sizes, and each
+/// list gathered once (not a scan of every edge or cycle per node: a loose
+/// pipeline has edges from every trace to every shader).
+struct ChainShape {
+    /// Each node's callable edges' targets.
+    callables: PerNode,
+    /// Per any-hit node: the intersection nodes of its hit group.
+    intersections: PerNode,
+    /// Nodes by level: levels order the acyclic part.
+    order: Vec<usize>,
+    /// The first cycle through each node.
+    cycle_of: Vec<Option<usize>>,
+    /// Each node's incoming traces' sources, but those from its own cycle.
+    into: PerNode,
+    /// A node lies on a cycle with no bound.
+    unbounded: bool,
+}
+
+impl ChainShape {
+    fn of(rec: &RecursionReport) -> ChainShape {
+        let g = &rec.graph;
+        let n = g.nodes.len();
+        let callables = PerNode::of(
+            n,
+            g.edges
+                .iter()
+                .filter(|e| e.kind == EdgeKind::Callable)
+                .map(|e| (e.from, e.to)),
+        );
+        let intersections = PerNode::of(
+            n,
+            (0..n)
+                .filter(|&v| g.nodes[v].shader.stage == Stage::AnyHit)
+                .filter_map(|v| match g.nodes[v].slot {
+                    Slot::HitGroup(gi) => Some((v, gi)),
+                    _ => None,
+                })
+                .flat_map(move |(v, gi)| {
+                    (0..n)
+                        .filter(move |&u| {
+                            g.nodes[u].slot == Slot::HitGroup(gi)
+                                && g.nodes[u].shader.stage == Stage::Intersection
+                        })
+                        .map(move |u| (v, u))
+                }),
+        );
+        let mut order: Vec<usize> = (0..n).collect();
+        order.sort_by_key(|&v| rec.node_level[v].unwrap_or(u32::MAX));
+        let mut cycle_of: Vec<Option<usize>> = vec![None; n];
+        for (k, c) in rec.cycles.iter().enumerate() {
+            for &v in &c.nodes {
+                if let Some(slot) = cycle_of.get_mut(v) {
+                    slot.get_or_insert(k);
                 }
-                None => w[v],
-            };
-            let entered = if g.nodes[v].shader.stage == Stage::RayGeneration {
-                Some(0)
-            } else {
-                into[v]
-                    .iter()
-                    .filter(|&&from| match (cycle_of[from], cycle_of[v]) {
-                        (Some(a), Some(b)) => a != b,
-                        _ => true,
-                    })
-                    .filter_map(|&from| best[from])
-                    .max()
-            };
-            if let Some(base) = entered {
-                best[v] = Some(best[v].unwrap_or(0).max(base + own));
             }
         }
+        let into = PerNode::of(
+            n,
+            g.edges
+                .iter()
+                .filter(|e| e.kind == EdgeKind::Trace)
+                .filter(|e| match (cycle_of[e.from], cycle_of[e.to]) {
+                    (Some(a), Some(b)) => a != b,
+                    _ => true,
+                })
+                .map(|e| (e.to, e.from)),
+        );
+        let unbounded = cycle_of
+            .iter()
+            .flatten()
+            .any(|&k| rec.cycles[k].extra_levels.is_none());
+        ChainShape {
+            callables,
+            intersections,
+            order,
+            cycle_of,
+            into,
+            unbounded,
+        }
     }
-    Some(best.iter().flatten().copied().max().unwrap_or(0))
+
+    fn exact_call_chain(&self, rec: &RecursionReport, sizes: &[u64]) -> Option<u64> {
+        let g = &rec.graph;
+        let n = g.nodes.len();
+        if self.unbounded {
+            return None;
+        }
+        // Callable chains on top of each node.
+        fn with_callables(
+            callables: &PerNode,
+            n: usize,
+            sizes: &[u64],
+            v: usize,
+            memo: &mut [Option<u64>],
+            depth: usize,
+        ) -> u64 {
+            if let Some(x) = memo[v] {
+                return x;
+            }
+            let own = sizes.get(v).copied().unwrap_or(0);
+            if depth > n {
+                return own;
+            }
+            let above = callables
+                .of_node(v)
+                .iter()
+                .map(|&to| with_callables(callables, n, sizes, to, memo, depth + 1))
+                .max()
+                .unwrap_or(0);
+            memo[v] = Some(own + above);
+            own + above
+        }
+        let mut memo = vec![None; n];
+        let mut w: Vec<u64> = (0..n)
+            .map(|v| with_callables(&self.callables, n, sizes, v, &mut memo, 0))
+            .collect();
+        // Intersection and any-hit of a procedural group are active together
+        // (intersection nodes are not any-hit nodes: their sums are as built).
+        for v in 0..n {
+            let is: u64 = self.intersections.of_node(v).iter().map(|&u| w[u]).sum();
+            w[v] += is;
+        }
+        // Longest weighted path over trace edges, cycles by their bound.
+        let mut best: Vec<Option<u64>> = vec![None; n];
+        for _ in 0..2 {
+            for &v in &self.order {
+                let own = match self.cycle_of[v] {
+                    Some(k) => {
+                        let c = &rec.cycles[k];
+                        let x = c.extra_levels?;
+                        let max_w = c.nodes.iter().map(|&u| w[u]).max().unwrap_or(0);
+                        (x + 1) * max_w
+                    }
+                    None => w[v],
+                };
+                let entered = if g.nodes[v].shader.stage == Stage::RayGeneration {
+                    Some(0)
+                } else {
+                    self.into
+                        .of_node(v)
+                        .iter()
+                        .filter_map(|&from| best[from])
+                        .max()
+                };
+                if let Some(base) = entered {
+                    best[v] = Some(best[v].unwrap_or(0).max(base + own));
+                }
+            }
+        }
+        Some(best.iter().flatten().copied().max().unwrap_or(0))
+    }
+}
+
+/// `raygen 0`, `miss 1`, `hit group 2`, `callable 0`: [`Slot`]'s `Display`
+/// without the formatter (a string per shader per report).
+fn slot_name(slot: Slot) -> String {
+    let (kind, mut i) = match slot {
+        Slot::Raygen(i) => ("raygen ", i),
+        Slot::Miss(i) => ("miss ", i),
+        Slot::HitGroup(i) => ("hit group ", i),
+        Slot::Callable(i) => ("callable ", i),
+    };
+    let mut digits = [0u8; 20];
+    let mut k = digits.len();
+    loop {
+        k -= 1;
+        digits[k] = b'0' + (i % 10) as u8;
+        i /= 10;
+        if i == 0 {
+            break;
+        }
+    }
+    let mut s = String::with_capacity(kind.len() + digits.len() - k);
+    s.push_str(kind);
+    s.extend(digits[k..].iter().map(|&d| d as char));
+    s
 }
 
 /// `rtlint stack`: the stack figures of a described (or assumed) pipeline.
@@ -771,18 +893,22 @@ pub fn stack_report_with(pipeline: &Pipeline, rec: &RecursionReport) -> StackRep
     let mut cache: rustc_hash::FxHashMap<(usize, &str), Breakdown> =
         rustc_hash::FxHashMap::with_capacity_and_hasher(rec.graph.nodes.len(), Default::default());
     let sites: Vec<_> = pipeline.programs.iter().map(shared_live_bytes).collect();
+    let mut loops: Vec<Option<Loops>> = pipeline.programs.iter().map(|_| None).collect();
     let mut shaders = Vec::with_capacity(rec.graph.nodes.len());
     for node in &rec.graph.nodes {
         let s = &node.shader;
         let b = cache
             .entry((s.program, s.entry.as_str()))
             .or_insert_with(|| match (pipeline.program(s), sites.get(s.program)) {
-                (Some(p), Some(sites)) => breakdown_with(p, &s.entry, sites),
+                (Some(p), Some(sites)) => {
+                    let loops = loops[s.program].get_or_insert_with(|| Loops::of(p));
+                    breakdown_in(p, &s.entry, sites, loops)
+                }
                 _ => Breakdown::default(),
             })
             .clone();
         let driver_model_bytes = driver_model(s.stage, &b);
-        let group = node.slot.to_string();
+        let group = slot_name(node.slot);
         shaders.push(ShaderStack {
             entry: s.entry.clone(),
             stage: s.stage,
@@ -800,8 +926,9 @@ pub fn stack_report_with(pipeline: &Pipeline, rec: &RecursionReport) -> StackRep
     }
     let model_sizes: Vec<u64> = shaders.iter().map(|s| s.model_bytes).collect();
     let driver_sizes: Vec<u64> = shaders.iter().map(|s| s.driver_model_bytes).collect();
-    let model = formulas(pipeline, rec, &model_sizes);
-    let driver_comparable = formulas(pipeline, rec, &driver_sizes);
+    let shape = ChainShape::of(rec);
+    let model = formulas_with(pipeline, rec, &shape, &model_sizes);
+    let driver_comparable = formulas_with(pipeline, rec, &shape, &driver_sizes);
     let recommended = model
         .exact_call_chain
         .or(model.vulkan_default)
@@ -834,7 +961,11 @@ pub fn stack_report_with(pipeline: &Pipeline, rec: &RecursionReport) -> StackRep
         pipeline: pipeline
             .path
             .as_ref()
-            .map(|p| p.display().to_string())
+            // As `display()` writes it; a UTF-8 path without the formatter.
+            .map(|p| match p.to_str() {
+                Some(p) => p.to_owned(),
+                None => p.display().to_string(),
+            })
             .or_else(|| {
                 let lib = pipeline.subobject_library.as_ref()?;
                 Some(format!("{} (DXR subobjects)", lib.display()))
@@ -903,6 +1034,20 @@ mod tests {
 
     fn report(rel: &str) -> StackReport {
         stack_report(&load(&Path::new(env!("CARGO_MANIFEST_DIR")).join(rel)).unwrap())
+    }
+
+    #[test]
+    fn slot_names_as_display_writes_them() {
+        for i in [0, 1, 9, 10, 99, 100, 12_345, usize::MAX] {
+            for slot in [
+                Slot::Raygen(i),
+                Slot::Miss(i),
+                Slot::HitGroup(i),
+                Slot::Callable(i),
+            ] {
+                assert_eq!(slot_name(slot), slot.to_string());
+            }
+        }
     }
 
     #[test]

@@ -330,7 +330,7 @@ pub fn call_chains(program: &Program, root: Id, target: Id, max: usize) -> Vec<V
         }
         visiting.push(f);
         // The index itself, not `Program::callers`' copy per step.
-        for &call in calls.by_callee.get(&f).map_or(&[][..], Vec::as_slice) {
+        for &(_, call) in calls.calls_to(f) {
             let Some(caller) = program
                 .function_of(call)
                 .and_then(|i| program.functions.get(i))

@@ -277,11 +277,33 @@ pub struct Program {
     pub memo: Memo,
 }
 
-/// [`Program::call_index`]: calls by callee (instruction indices) and
-/// callees by calling function, in module order.
-struct CallIndex {
-    by_callee: HashMap<Id, Vec<usize>>,
-    by_caller: HashMap<Id, Vec<Id>>,
+/// [`Program::call_index`]: every call of the module by callee, and each
+/// function's callees by function index, in flat vectors (a module has a
+/// handful of functions: hash maps of them cost more to build than to
+/// search, and reachability walks indices).
+pub(crate) struct CallIndex {
+    /// `(callee, instruction)` of every `OpFunctionCall`, sorted.
+    by_callee: Vec<(Id, usize)>,
+    /// Function `fi`'s callees, in the order of its calls, are
+    /// `callees[callee_start[fi]..callee_start[fi + 1]]`: the callee's id
+    /// and the index of the first function of that id ([`NOT_A_FUNCTION`]
+    /// when none).
+    callee_start: Vec<usize>,
+    callees: Vec<(Id, usize)>,
+    /// Per function: the index of the first function of its id, whose calls
+    /// count for it, as [`Program::function`] finds it.
+    first: Vec<usize>,
+}
+
+const NOT_A_FUNCTION: usize = usize::MAX;
+
+impl CallIndex {
+    /// The `(callee, instruction)` pairs of the calls to `f`, in module order.
+    pub(crate) fn calls_to(&self, f: Id) -> &[(Id, usize)] {
+        let from = self.by_callee.partition_point(|&(c, _)| c < f);
+        let to = from + self.by_callee[from..].partition_point(|&(c, _)| c == f);
+        &self.by_callee[from..to]
+    }
 }
 
 /// Results computed once per Program, one per type: the module rules and
@@ -430,42 +452,61 @@ impl Program {
     /// Instruction indices of the `OpFunctionCall`s that call function `f`.
     pub fn callers(&self, f: Id) -> Vec<usize> {
         self.call_index()
-            .by_callee
-            .get(&f)
-            .cloned()
-            .unwrap_or_default()
+            .calls_to(f)
+            .iter()
+            .map(|&(_, i)| i)
+            .collect()
     }
 
     /// Every call by callee and each function's callees, indexed in one
     /// pass over the module: call chains ask per function, and the
     /// analyses ask for reachable functions per shader and per entry point.
-    fn call_index(&self) -> std::sync::Arc<CallIndex> {
+    pub(crate) fn call_index(&self) -> std::sync::Arc<CallIndex> {
         self.memo.get_or(|| {
-            let mut by_callee: HashMap<Id, Vec<usize>> = HashMap::default();
-            let mut calls: Vec<(usize, Id)> = Vec::new();
+            let mut by_callee: Vec<(Id, usize)> = Vec::new();
             for (i, inst) in self.insts.iter().enumerate() {
-                if inst.class.opcode != Op::FunctionCall {
-                    continue;
-                }
-                if let Some(Operand::IdRef(x)) = inst.operands.first() {
-                    by_callee.entry(*x).or_default().push(i);
-                    calls.push((i, *x));
+                if inst.class.opcode == Op::FunctionCall {
+                    if let Some(Operand::IdRef(x)) = inst.operands.first() {
+                        by_callee.push((*x, i));
+                    }
                 }
             }
-            let mut by_caller: HashMap<Id, Vec<Id>> = HashMap::default();
+            // Function indices by id; the first of an id wins (stable sort).
+            let mut ids: Vec<(Id, usize)> = self
+                .functions
+                .iter()
+                .enumerate()
+                .map(|(k, f)| (f.id, k))
+                .collect();
+            ids.sort_by_key(|&(id, _)| id);
+            ids.dedup_by_key(|&mut (id, _)| id);
+            let index_of = |id: Id| match ids.binary_search_by_key(&id, |&(id, _)| id) {
+                Ok(k) => ids[k].1,
+                Err(_) => NOT_A_FUNCTION,
+            };
+            let first: Vec<usize> = self.functions.iter().map(|f| index_of(f.id)).collect();
+            // Calls in module order, each function's from its range.
+            let mut calls: Vec<(usize, Id)> = by_callee.iter().map(|&(c, i)| (i, c)).collect();
+            calls.sort_unstable();
+            let mut callee_start = Vec::with_capacity(self.functions.len() + 1);
+            let mut callees = Vec::with_capacity(calls.len());
             for f in &self.functions {
+                callee_start.push(callees.len());
                 let from = calls.partition_point(|&(i, _)| i < f.start);
-                let list = calls[from..]
-                    .iter()
-                    .take_while(|&&(i, _)| i <= f.end)
-                    .map(|&(_, callee)| callee)
-                    .collect();
-                // The first function of an id wins, as `function` finds it.
-                by_caller.entry(f.id).or_insert(list);
+                for &(i, c) in &calls[from..] {
+                    if i > f.end {
+                        break;
+                    }
+                    callees.push((c, index_of(c)));
+                }
             }
+            callee_start.push(callees.len());
+            by_callee.sort_unstable();
             CallIndex {
                 by_callee,
-                by_caller,
+                callee_start,
+                callees,
+                first,
             }
         })
     }
@@ -526,22 +567,67 @@ impl Program {
 
     /// Function ids reachable from `root` through `OpFunctionCall`, `root` first.
     pub fn reachable_functions(&self, root: Id) -> Vec<Id> {
-        // Each function's callees, in the order of its calls, listed once
-        // per Program: the analyses ask per shader and per entry point, and
-        // scanning every reachable instruction each time added up.
+        self.reach(root).0
+    }
+
+    /// Per function (index into `functions`): whether `root` reaches it
+    /// through `OpFunctionCall`. The analyses ask per shader and per site;
+    /// a module of one function needs no call index for it.
+    pub fn reached_functions(&self, root: Id) -> Vec<bool> {
+        match self.functions.as_slice() {
+            [only] => vec![only.id == root],
+            _ => self.reach(root).1,
+        }
+    }
+
+    /// [`Program::reachable_functions`] and [`Program::reached_functions`].
+    fn reach(&self, root: Id) -> (Vec<Id>, Vec<bool>) {
         let index = self.call_index();
-        let callees = &index.by_caller;
-        let mut seen = vec![root];
-        let mut i = 0;
-        while i < seen.len() {
-            for callee in callees.get(&seen[i]).map_or(&[][..], Vec::as_slice) {
-                if !seen.contains(callee) {
-                    seen.push(*callee);
+        let n = self.functions.len();
+        // Flags by the first function of each id; ids that name no
+        // function are listed but call nothing.
+        let mut reached = vec![false; n];
+        let mut others: Vec<Id> = Vec::new();
+        let mut ids = vec![root];
+        let mut queue: Vec<usize> = Vec::new();
+        match self.functions.iter().position(|f| f.id == root) {
+            Some(fi) => {
+                reached[fi] = true;
+                queue.push(fi);
+            }
+            None => others.push(root),
+        }
+        let mut k = 0;
+        while k < queue.len() {
+            let fi = queue[k];
+            for &(callee, ci) in &index.callees[index.callee_start[fi]..index.callee_start[fi + 1]]
+            {
+                let new = if ci == NOT_A_FUNCTION {
+                    !others.contains(&callee) && {
+                        others.push(callee);
+                        true
+                    }
+                } else if reached[ci] {
+                    false
+                } else {
+                    reached[ci] = true;
+                    queue.push(ci);
+                    true
+                };
+                if new {
+                    ids.push(callee);
                 }
             }
-            i += 1;
+            k += 1;
         }
-        seen
+        // A later function with a reached function's id is reached too.
+        for k in 0..n {
+            let fi = index.first[k];
+            if fi != k && fi != NOT_A_FUNCTION {
+                reached[k] = reached[fi];
+            }
+        }
+        (ids, reached)
     }
 
     pub fn function(&self, id: Id) -> Option<&Function> {
