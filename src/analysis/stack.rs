@@ -388,7 +388,7 @@ fn breakdown_in(program: &Program, entry: &str, sites: &[LiveSite], loops: &Loop
         .iter()
         .filter(|s| s.entry == entry && s.kind != crate::analysis::liveness::LiveSiteKind::RayQuery)
     {
-        let (call_data, payload) = other_call_data_live(program, site.inst, &loops);
+        let (call_data, payload) = other_call_data_live(program, site.inst, loops);
         b.outlived_payloads = b.outlived_payloads.max(payload);
         let kept = site.live_bytes - site.rematerializable_bytes + call_data;
         let aggregates: u64 = site
