@@ -13,7 +13,7 @@ use super::callgraph::{trace_graph, EdgeKind, TraceGraph};
 use crate::diag::Location;
 use crate::pipeline::{DescribedConstant, Pipeline};
 use crate::program::cfg::{
-    call_chains, dominates, dominators, function_cfgs, natural_loops, strongly_connected,
+    call_chains, components, dominates, dominators, function_cfgs, natural_loops,
 };
 use crate::program::{Constant, Function, Id, Program, Type};
 use crate::shader::Stage;
@@ -187,26 +187,31 @@ impl RecursionReport {
 pub fn recursion_report(pipeline: &Pipeline) -> RecursionReport {
     let graph = trace_graph(pipeline);
     let n = graph.nodes.len();
-    let mut adj: Vec<Vec<usize>> = vec![Vec::new(); n];
-    // First-seen order, without a scan per edge (a folder's loose pipeline
-    // joins every trace to every hit shader).
-    let mut seen = FxHashSet::default();
-    for e in graph.traces() {
-        if seen.insert((e.from, e.to)) {
-            adj[e.from].push(e.to);
-        }
-    }
-    let sccs = strongly_connected(&adj);
+    // Each node's successors once, in first-seen order, without a scan per
+    // edge (a folder's loose pipeline joins every trace to every hit
+    // shader): sorted with each pair's first position, duplicates dropped,
+    // then back in order per node.
+    let mut adj: Vec<(usize, usize, usize)> = graph
+        .traces()
+        .enumerate()
+        .map(|(k, e)| (e.from, e.to, k))
+        .collect();
+    adj.sort_unstable();
+    adj.dedup_by_key(|&mut (from, to, _)| (from, to));
+    adj.sort_unstable_by_key(|&(from, _, k)| (from, k));
+    let adj: Vec<(usize, usize)> = adj.into_iter().map(|(from, to, _)| (from, to)).collect();
+    let sccs = components(n, &adj);
     let mut scc_of = vec![0usize; n];
-    for (c, nodes) in sccs.iter().enumerate() {
-        for &v in nodes {
+    for c in 0..sccs.len() {
+        for &v in sccs.get(c) {
             scc_of[v] = c;
         }
     }
     // Cycles and their bounds.
     let mut extra: Vec<Option<u64>> = vec![Some(0); sccs.len()];
     let mut cycles = Vec::new();
-    for (c, nodes) in sccs.iter().enumerate() {
+    for c in 0..sccs.len() {
+        let nodes = sccs.get(c);
         let cyclic: Vec<_> = graph
             .traces()
             .filter(|e| scc_of[e.from] == c && scc_of[e.to] == c)
@@ -243,7 +248,7 @@ pub fn recursion_report(pipeline: &Pipeline) -> RecursionReport {
         };
         extra[c] = bound;
         cycles.push(Cycle {
-            nodes: nodes.clone(),
+            nodes: nodes.to_vec(),
             sites,
             extra_levels: bound,
         });
@@ -258,7 +263,8 @@ pub fn recursion_report(pipeline: &Pipeline) -> RecursionReport {
     let mut entry = vec![Lv::Unreached; sccs.len()];
     let mut pred: Vec<Option<(usize, usize)>> = vec![None; sccs.len()];
     for c in (0..sccs.len()).rev() {
-        if sccs[c]
+        if sccs
+            .get(c)
             .iter()
             .any(|&v| graph.nodes[v].shader.stage == Stage::RayGeneration)
         {
@@ -345,7 +351,7 @@ pub fn recursion_report(pipeline: &Pipeline) -> RecursionReport {
         }
         let (node, via) = match pred[c] {
             Some((k, _)) => (traces[k].to, traces[k].location.clone()),
-            None => (sccs[c][0], None),
+            None => (sccs.get(c)[0], None),
         };
         let (level, unbounded) = match (entry[c], extra[c]) {
             (Lv::At(l), Some(_)) => (l as u32, false),

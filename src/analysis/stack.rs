@@ -674,51 +674,30 @@ pub fn exact_call_chain(rec: &RecursionReport, sizes: &[u64]) -> Option<u64> {
     ChainShape::of(rec).exact_call_chain(rec, sizes)
 }
 
-/// Lists of node indices, one per node, in one vector.
-struct PerNode {
-    start: Vec<usize>,
-    list: Vec<usize>,
-}
-
-impl PerNode {
-    /// `pairs` as `(node, item)`, each node's items in the order given.
-    fn of(n: usize, pairs: impl Iterator<Item = (usize, usize)> + Clone) -> PerNode {
-        let mut start = vec![0usize; n + 1];
-        for (v, _) in pairs.clone() {
-            start[v + 1] += 1;
-        }
-        for v in 0..n {
-            start[v + 1] += start[v];
-        }
-        let mut list = vec![0usize; start[n]];
-        let mut next = start.clone();
-        for (v, x) in pairs {
-            list[next[v]] = x;
-            next[v] += 1;
-        }
-        PerNode { start, list }
-    }
-
-    fn of_node(&self, v: usize) -> &[usize] {
-        &self.list[self.start[v]..self.start[v + 1]]
-    }
+/// The items of node `v` in `(node, item)` pairs sorted by node.
+fn of_node(pairs: &[(usize, usize)], v: usize) -> &[(usize, usize)] {
+    let from = pairs.partition_point(|&(u, _)| u < v);
+    let to = from + pairs[from..].partition_point(|&(u, _)| u == v);
+    &pairs[from..to]
 }
 
 /// What [`exact_call_chain`] needs of the trace graph, independent of the
 /// sizes: worked out once per report, not once per set of sizes, and each
 /// list gathered once (not a scan of every edge or cycle per node: a loose
-/// pipeline has edges from every trace to every shader).
+/// pipeline has edges from every trace to every shader). Lists are
+/// `(node, item)` pairs sorted by node, in edge order per node: most are
+/// empty, so they cost no allocation.
 struct ChainShape {
-    /// Each node's callable edges' targets.
-    callables: PerNode,
-    /// Per any-hit node: the intersection nodes of its hit group.
-    intersections: PerNode,
+    /// `(caller, callable)` of each callable edge.
+    callables: Vec<(usize, usize)>,
+    /// `(any-hit, intersection)` nodes of one hit group.
+    intersections: Vec<(usize, usize)>,
     /// Nodes by level: levels order the acyclic part.
     order: Vec<usize>,
     /// The first cycle through each node.
     cycle_of: Vec<Option<usize>>,
-    /// Each node's incoming traces' sources, but those from its own cycle.
-    into: PerNode,
+    /// `(target, source)` of each trace edge, but those within a cycle.
+    into: Vec<(usize, usize)>,
     /// A node lies on a cycle with no bound.
     unbounded: bool,
 }
@@ -727,30 +706,26 @@ impl ChainShape {
     fn of(rec: &RecursionReport) -> ChainShape {
         let g = &rec.graph;
         let n = g.nodes.len();
-        let callables = PerNode::of(
-            n,
-            g.edges
-                .iter()
-                .filter(|e| e.kind == EdgeKind::Callable)
-                .map(|e| (e.from, e.to)),
-        );
-        let intersections = PerNode::of(
-            n,
-            (0..n)
-                .filter(|&v| g.nodes[v].shader.stage == Stage::AnyHit)
-                .filter_map(|v| match g.nodes[v].slot {
-                    Slot::HitGroup(gi) => Some((v, gi)),
-                    _ => None,
-                })
-                .flat_map(move |(v, gi)| {
-                    (0..n)
-                        .filter(move |&u| {
-                            g.nodes[u].slot == Slot::HitGroup(gi)
-                                && g.nodes[u].shader.stage == Stage::Intersection
-                        })
-                        .map(move |u| (v, u))
-                }),
-        );
+        let mut callables: Vec<(usize, usize)> = g
+            .edges
+            .iter()
+            .filter(|e| e.kind == EdgeKind::Callable)
+            .map(|e| (e.from, e.to))
+            .collect();
+        // Stable: each node's edges stay in edge order.
+        callables.sort_by_key(|&(v, _)| v);
+        let mut intersections = Vec::new();
+        for v in 0..n {
+            let (Stage::AnyHit, Slot::HitGroup(gi)) = (g.nodes[v].shader.stage, g.nodes[v].slot)
+            else {
+                continue;
+            };
+            for (u, node) in g.nodes.iter().enumerate() {
+                if node.slot == Slot::HitGroup(gi) && node.shader.stage == Stage::Intersection {
+                    intersections.push((v, u));
+                }
+            }
+        }
         let mut order: Vec<usize> = (0..n).collect();
         order.sort_by_key(|&v| rec.node_level[v].unwrap_or(u32::MAX));
         let mut cycle_of: Vec<Option<usize>> = vec![None; n];
@@ -761,17 +736,15 @@ impl ChainShape {
                 }
             }
         }
-        let into = PerNode::of(
-            n,
-            g.edges
-                .iter()
-                .filter(|e| e.kind == EdgeKind::Trace)
-                .filter(|e| match (cycle_of[e.from], cycle_of[e.to]) {
-                    (Some(a), Some(b)) => a != b,
-                    _ => true,
-                })
-                .map(|e| (e.to, e.from)),
-        );
+        let mut into: Vec<(usize, usize)> = g
+            .traces()
+            .filter(|e| match (cycle_of[e.from], cycle_of[e.to]) {
+                (Some(a), Some(b)) => a != b,
+                _ => true,
+            })
+            .map(|e| (e.to, e.from))
+            .collect();
+        into.sort_by_key(|&(v, _)| v);
         let unbounded = cycle_of
             .iter()
             .flatten()
@@ -794,7 +767,7 @@ impl ChainShape {
         }
         // Callable chains on top of each node.
         fn with_callables(
-            callables: &PerNode,
+            callables: &[(usize, usize)],
             n: usize,
             sizes: &[u64],
             v: usize,
@@ -808,10 +781,9 @@ impl ChainShape {
             if depth > n {
                 return own;
             }
-            let above = callables
-                .of_node(v)
+            let above = of_node(callables, v)
                 .iter()
-                .map(|&to| with_callables(callables, n, sizes, to, memo, depth + 1))
+                .map(|&(_, to)| with_callables(callables, n, sizes, to, memo, depth + 1))
                 .max()
                 .unwrap_or(0);
             memo[v] = Some(own + above);
@@ -822,13 +794,14 @@ impl ChainShape {
             .map(|v| with_callables(&self.callables, n, sizes, v, &mut memo, 0))
             .collect();
         // Intersection and any-hit of a procedural group are active together
-        // (intersection nodes are not any-hit nodes: their sums are as built).
-        for v in 0..n {
-            let is: u64 = self.intersections.of_node(v).iter().map(|&u| w[u]).sum();
-            w[v] += is;
+        // (intersection nodes are not any-hit nodes: their weights are final).
+        for &(v, u) in &self.intersections {
+            w[v] += w[u];
         }
-        // Longest weighted path over trace edges, cycles by their bound.
-        let mut best: Vec<Option<u64>> = vec![None; n];
+        // Longest weighted path over trace edges, cycles by their bound (the
+        // memo's vector reused).
+        let best = &mut memo;
+        best.fill(None);
         for _ in 0..2 {
             for &v in &self.order {
                 let own = match self.cycle_of[v] {
@@ -843,10 +816,9 @@ impl ChainShape {
                 let entered = if g.nodes[v].shader.stage == Stage::RayGeneration {
                     Some(0)
                 } else {
-                    self.into
-                        .of_node(v)
+                    of_node(&self.into, v)
                         .iter()
-                        .filter_map(|&from| best[from])
+                        .filter_map(|&(_, from)| best[from])
                         .max()
                 };
                 if let Some(base) = entered {

@@ -214,6 +214,46 @@ impl FunctionCfgs {
             }
             let idom = self.idom(program, fi);
             let preds = self.preds[fi].get_or_init(|| Preds::of(f));
+            // Each block's depth in the dominator tree: an edge is a back
+            // edge when its target is its source's ancestor at the target's
+            // depth, so the walk up stops there, and a target no shallower
+            // than its source (every forward edge of structured code) needs
+            // none. Unreachable blocks have no depth and dominate nothing.
+            const NO_DEPTH: usize = usize::MAX;
+            let mut depth = vec![NO_DEPTH; n];
+            depth[0] = 0;
+            let mut path = Vec::new();
+            for b in 0..n {
+                let mut x = b;
+                while depth[x] == NO_DEPTH && path.len() <= n {
+                    match idom[x] {
+                        Some(p) if p != x => {
+                            path.push(x);
+                            x = p;
+                        }
+                        _ => break,
+                    }
+                }
+                let mut d = depth[x];
+                while let Some(y) = path.pop() {
+                    d = d.saturating_add(1).min(NO_DEPTH);
+                    depth[y] = d;
+                }
+            }
+            let dominates = |h: usize, b: usize| {
+                if h == b {
+                    return true;
+                }
+                let (dh, db) = (depth[h], depth[b]);
+                if dh == NO_DEPTH || db == NO_DEPTH || dh >= db {
+                    return false;
+                }
+                let mut x = b;
+                for _ in dh..db {
+                    x = idom[x].unwrap_or(x);
+                }
+                x == h
+            };
             // Which back edge last visited a block: each loop's body is
             // walked on its own (a body already marked may lead further).
             let mut visit = vec![usize::MAX; n];
@@ -221,7 +261,7 @@ impl FunctionCfgs {
             let mut work = Vec::new();
             for (b, block) in f.blocks.iter().enumerate() {
                 for &h in &block.succs {
-                    if !dominates(idom, h, b) {
+                    if !dominates(h, b) {
                         continue;
                     }
                     edge += 1;
@@ -244,58 +284,95 @@ impl FunctionCfgs {
 
 /// Strongly connected components, sinks first.
 pub fn strongly_connected(adj: &[Vec<usize>]) -> Vec<Vec<usize>> {
+    let edges: Vec<(usize, usize)> = adj
+        .iter()
+        .enumerate()
+        .flat_map(|(v, ws)| ws.iter().map(move |&w| (v, w)))
+        .collect();
+    let c = components(adj.len(), &edges);
+    (0..c.len()).map(|k| c.get(k).to_vec()).collect()
+}
+
+/// [`strongly_connected`] over `(from, to)` edges sorted by `from` (each
+/// node's edges in visiting order), in flat vectors: component `c` is
+/// `members[start[c]..start[c + 1]]`, sorted, sinks first.
+pub struct Components {
+    pub members: Vec<usize>,
+    pub start: Vec<usize>,
+}
+
+impl Components {
+    pub fn len(&self) -> usize {
+        self.start.len() - 1
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    pub fn get(&self, c: usize) -> &[usize] {
+        &self.members[self.start[c]..self.start[c + 1]]
+    }
+}
+
+/// Tarjan's components in the order [`strongly_connected`] gives them,
+/// without a vector per node or per component.
+pub fn components(n: usize, edges: &[(usize, usize)]) -> Components {
+    const NONE: usize = usize::MAX;
     struct T<'a> {
-        adj: &'a [Vec<usize>],
-        index: Vec<Option<usize>>,
-        low: Vec<usize>,
-        on: Vec<bool>,
+        edges: &'a [(usize, usize)],
+        /// Per node: its index, low link and whether it is on the stack.
+        state: Vec<(usize, usize, bool)>,
         stack: Vec<usize>,
         next: usize,
-        out: Vec<Vec<usize>>,
+        out: Components,
     }
     impl T<'_> {
         fn visit(&mut self, v: usize) {
-            self.index[v] = Some(self.next);
-            self.low[v] = self.next;
+            self.state[v] = (self.next, self.next, true);
             self.next += 1;
             self.stack.push(v);
-            self.on[v] = true;
-            for &w in &self.adj[v] {
-                match self.index[w] {
-                    None => {
-                        self.visit(w);
-                        self.low[v] = self.low[v].min(self.low[w]);
-                    }
-                    Some(i) if self.on[w] => self.low[v] = self.low[v].min(i),
-                    _ => {}
+            let from = self.edges.partition_point(|&(u, _)| u < v);
+            let mut k = from;
+            while let Some(&(u, w)) = self.edges.get(k) {
+                if u != v {
+                    break;
+                }
+                k += 1;
+                let (index, _, on) = self.state[w];
+                if index == NONE {
+                    self.visit(w);
+                    self.state[v].1 = self.state[v].1.min(self.state[w].1);
+                } else if on {
+                    self.state[v].1 = self.state[v].1.min(index);
                 }
             }
-            if Some(self.low[v]) == self.index[v] {
-                let mut c = Vec::new();
+            if self.state[v].1 == self.state[v].0 {
+                let first = self.out.members.len();
                 while let Some(w) = self.stack.pop() {
-                    self.on[w] = false;
-                    c.push(w);
+                    self.state[w].2 = false;
+                    self.out.members.push(w);
                     if w == v {
                         break;
                     }
                 }
-                c.sort_unstable();
-                self.out.push(c);
+                self.out.members[first..].sort_unstable();
+                self.out.start.push(self.out.members.len());
             }
         }
     }
-    let n = adj.len();
     let mut t = T {
-        adj,
-        index: vec![None; n],
-        low: vec![0; n],
-        on: vec![false; n],
+        edges,
+        state: vec![(NONE, 0, false); n],
         stack: Vec::new(),
         next: 0,
-        out: Vec::new(),
+        out: Components {
+            members: Vec::with_capacity(n),
+            start: vec![0],
+        },
     };
     for v in 0..n {
-        if t.index[v].is_none() {
+        if t.state[v].0 == NONE {
             t.visit(v);
         }
     }
@@ -368,6 +445,18 @@ pub fn call_chains(program: &Program, root: Id, target: Id, max: usize) -> Vec<V
 mod tests {
     use super::*;
     use std::path::Path;
+
+    /// Tarjan's components, sinks first, each sorted, in both forms.
+    #[test]
+    fn components_sinks_first() {
+        let adj = vec![vec![1], vec![2], vec![1, 3], vec![], vec![4, 0]];
+        let expected = vec![vec![3], vec![1, 2], vec![0], vec![4]];
+        assert_eq!(strongly_connected(&adj), expected);
+        let edges = [(0, 1), (1, 2), (2, 1), (2, 3), (4, 4), (4, 0)];
+        let c = components(5, &edges);
+        let got: Vec<Vec<usize>> = (0..c.len()).map(|k| c.get(k).to_vec()).collect();
+        assert_eq!(got, expected);
+    }
 
     /// The memo's dominators and loop blocks are `dominators` and the union
     /// of `natural_loops`, function by function: loops in GLSL, HLSL and
