@@ -175,25 +175,34 @@ pub fn trace_graph(pipeline: &Pipeline) -> TraceGraph {
             if !reach[site.function] {
                 continue;
             }
-            // A site in a helper (naga wraps every `traceRay` in one per
-            // payload, called from several shaders) is placed and its
-            // operands folded at this shader's call.
-            let chains = crate::program::cfg::call_chains(
-                program,
-                entry_function,
-                f.id,
-                super::liveness::MAX_CHAINS,
-            );
-            let chain: &[usize] = chains.first().map_or(&[], Vec::as_slice);
-            let location = program
-                .location_in(site.inst, chain)
-                .or_else(|| program.site_location(site.inst));
-            let mut targets: Vec<usize> = Vec::new();
             let kind = match site.kind {
                 SiteKind::TraceRay => EdgeKind::Trace,
                 SiteKind::ExecuteCallable => EdgeKind::Callable,
                 _ => continue,
             };
+            // A site in a helper (naga wraps every `traceRay` in one per
+            // payload, called from several shaders) is placed and its
+            // operands folded at this shader's call; one in the shader's
+            // own function has the empty chain (as `call_chains` gives it,
+            // without a vector for it).
+            static OWN: [Vec<usize>; 1] = [Vec::new()];
+            let helper;
+            let chains: &[Vec<usize>] = if f.id == entry_function {
+                &OWN
+            } else {
+                helper = crate::program::cfg::call_chains(
+                    program,
+                    entry_function,
+                    f.id,
+                    super::liveness::MAX_CHAINS,
+                );
+                &helper
+            };
+            let chain: &[usize] = chains.first().map_or(&[], Vec::as_slice);
+            let location = program
+                .location_in(site.inst, chain)
+                .or_else(|| program.site_location(site.inst));
+            let mut targets: Vec<usize> = Vec::new();
             // Operands the shader's calls agree on; else as the site has them.
             let mut per_chain = chains.iter().map(|c| program.trace_operands_in(site, c));
             let operands = match per_chain.next() {
@@ -224,7 +233,8 @@ pub fn trace_graph(pipeline: &Pipeline) -> TraceGraph {
                 let skip_ch = set & FLAG_SKIP_CLOSEST_HIT != 0;
                 let skip_tri = set & FLAG_SKIP_TRIANGLES != 0;
                 let skip_aabb = set & FLAG_SKIP_AABBS != 0;
-                let groups: Vec<usize> =
+                // The groups reached (`None`: all of them).
+                let groups: Option<Vec<usize>> =
                     match (described, const_of(t.sbt_offset), const_of(t.sbt_stride)) {
                         (true, Some(off), Some(stride)) => {
                             let mut v = Vec::new();
@@ -246,21 +256,25 @@ pub fn trace_graph(pipeline: &Pipeline) -> TraceGraph {
                                     }
                                 }
                             }
-                            v
+                            Some(v)
                         }
                         (true, _, _) => {
                             g.assumptions.push(Assumption::DynamicSbtOffset {
                                 at: location.clone(),
                             });
-                            (0..pipeline.hit_groups.len()).collect()
+                            None
                         }
-                        _ => (0..pipeline.hit_groups.len()).collect(),
+                        _ => None,
                     };
                 for (n, node) in g.nodes.iter().enumerate() {
                     let Slot::HitGroup(gi) = node.slot else {
                         continue;
                     };
-                    if !groups.contains(&gi) {
+                    let reached = match &groups {
+                        Some(v) => v.contains(&gi),
+                        None => gi < pipeline.hit_groups.len(),
+                    };
+                    if !reached {
                         continue;
                     }
                     let group_kind = pipeline.hit_groups.get(gi).map(|h| h.kind);
@@ -278,7 +292,8 @@ pub fn trace_graph(pipeline: &Pipeline) -> TraceGraph {
                         targets.push(n);
                     }
                 }
-                let misses: Vec<usize> = match (described, const_of(t.miss_index)) {
+                // The miss shader reached (`None`: all of them).
+                let miss: Option<usize> = match (described, const_of(t.miss_index)) {
                     (true, Some(m)) => {
                         if (m as usize) >= pipeline.miss.len() {
                             g.out_of_range.push((
@@ -289,31 +304,38 @@ pub fn trace_graph(pipeline: &Pipeline) -> TraceGraph {
                                 },
                             ));
                         }
-                        vec![m as usize]
+                        Some(m as usize)
                     }
                     (true, None) => {
                         g.assumptions.push(Assumption::DynamicMissIndex {
                             at: location.clone(),
                         });
-                        (0..pipeline.miss.len()).collect()
+                        None
                     }
-                    _ => (0..pipeline.miss.len()).collect(),
+                    _ => None,
                 };
                 for (n, node) in g.nodes.iter().enumerate() {
-                    if matches!(node.slot, Slot::Miss(m) if misses.contains(&m)) {
+                    let Slot::Miss(m) = node.slot else {
+                        continue;
+                    };
+                    if miss.map_or(m < pipeline.miss.len(), |x| x == m) {
                         targets.push(n);
                     }
                 }
             } else {
-                let callables: Vec<usize> = match (
+                // The callable reached (`None`: all of them).
+                let callable: Option<usize> = match (
                     described,
                     site.sbt_index.as_ref().and_then(|o| const_of(*o)),
                 ) {
-                    (true, Some(c)) => vec![c as usize],
-                    _ => (0..pipeline.callable.len()).collect(),
+                    (true, Some(c)) => Some(c as usize),
+                    _ => None,
                 };
                 for (n, node) in g.nodes.iter().enumerate() {
-                    if matches!(node.slot, Slot::Callable(c) if callables.contains(&c)) {
+                    let Slot::Callable(c) = node.slot else {
+                        continue;
+                    };
+                    if callable.map_or(c < pipeline.callable.len(), |x| x == c) {
                         targets.push(n);
                     }
                 }

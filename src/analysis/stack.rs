@@ -348,10 +348,17 @@ fn breakdown_in(program: &Program, entry: &str, sites: &[LiveSite], loops: &Loop
     // older modules get every global of the class.
     let in_interface = |id: u32| e.interface.is_empty() || e.interface.contains(&id);
     for g in &program.globals {
-        if !in_interface(g.id) && program.version >= (1, 4) {
+        // Only the classes counted here are looked up in the interface and
+        // sized.
+        if !matches!(
+            g.storage,
+            StorageClass::IncomingRayPayloadKHR
+                | StorageClass::HitAttributeKHR
+                | StorageClass::IncomingCallableDataKHR
+        ) || (!in_interface(g.id) && program.version >= (1, 4))
+        {
             continue;
         }
-        // Sized only for the classes counted here.
         let size = || scalar_size(program, g.ty).unwrap_or(0);
         match g.storage {
             StorageClass::IncomingRayPayloadKHR => {
