@@ -25,7 +25,6 @@ use crate::program::{Program, SiteKind, Type};
 use crate::shader::Stage;
 use spirv::StorageClass;
 use std::collections::BTreeMap;
-use std::sync::OnceLock;
 
 /// The largest pipeline stack measured to run on an NVIDIA H200 (driver
 /// 580.159.04): 14,702 bytes per thread ran and 14,746 lost the device, at
@@ -547,28 +546,32 @@ fn call_data_uses(program: &Program, f: &crate::program::Function) -> Vec<CallDa
     out
 }
 
-/// Per function of a program, worked out once (the Program's memo) and
-/// asked per site and per entry point: which blocks lie in a loop (natural
-/// loops need the dominator tree), the bytes of its function-local arrays,
-/// and where it uses payload and callable-data globals.
+/// Per function of a program, worked out once and asked per site and per
+/// entry point: which blocks lie in a loop (natural loops need the
+/// dominator tree: the Program's memo, which the depth guards share), the
+/// bytes of its function-local arrays, and where it uses payload and
+/// callable-data globals (kept for one report: a memo of them cost more
+/// than it saved).
 struct Loops {
     cfgs: std::sync::Arc<crate::program::cfg::FunctionCfgs>,
-    facts: std::sync::Arc<FunctionFacts>,
+    facts: Vec<FunctionFacts>,
 }
 
+#[derive(Default)]
 struct FunctionFacts {
-    local_arrays: Vec<OnceLock<u64>>,
-    call_data: Vec<OnceLock<Vec<CallDataUse>>>,
+    local_arrays: std::cell::OnceCell<u64>,
+    call_data: std::cell::OnceCell<Vec<CallDataUse>>,
 }
 
 impl Loops {
     fn of(program: &Program) -> Self {
         Loops {
             cfgs: crate::program::cfg::function_cfgs(program),
-            facts: program.memo.get_or(|| FunctionFacts {
-                local_arrays: program.functions.iter().map(|_| OnceLock::new()).collect(),
-                call_data: program.functions.iter().map(|_| OnceLock::new()).collect(),
-            }),
+            facts: program
+                .functions
+                .iter()
+                .map(|_| FunctionFacts::default())
+                .collect(),
         }
     }
 
@@ -592,11 +595,10 @@ impl Loops {
 
     /// Bytes of the function-local arrays function `fi` declares.
     fn local_arrays(&self, program: &Program, fi: usize) -> u64 {
-        let (Some(cell), Some(f)) = (self.facts.local_arrays.get(fi), program.functions.get(fi))
-        else {
+        let (Some(facts), Some(f)) = (self.facts.get(fi), program.functions.get(fi)) else {
             return 0;
         };
-        *cell.get_or_init(|| {
+        *facts.local_arrays.get_or_init(|| {
             let mut bytes = 0;
             for inst in &program.insts[f.start..=f.end] {
                 if inst.class.opcode != spirv::Op::Variable {
@@ -619,8 +621,8 @@ impl Loops {
 
     /// [`call_data_uses`] of function `fi`.
     fn call_data(&self, program: &Program, fi: usize) -> &[CallDataUse] {
-        match (self.facts.call_data.get(fi), program.functions.get(fi)) {
-            (Some(cell), Some(f)) => cell.get_or_init(|| call_data_uses(program, f)),
+        match (self.facts.get(fi), program.functions.get(fi)) {
+            (Some(facts), Some(f)) => facts.call_data.get_or_init(|| call_data_uses(program, f)),
             _ => &[],
         }
     }

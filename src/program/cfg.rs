@@ -169,27 +169,35 @@ pub fn natural_loops(f: &Function) -> Vec<(usize, HashSet<usize>)> {
 /// asks per site and per entry point, the depth guards per trace, and a
 /// helper shared by several shaders was analysed once per shader.
 pub struct FunctionCfgs {
-    preds: Vec<OnceLock<Preds>>,
-    idom: Vec<OnceLock<Vec<Option<usize>>>>,
-    looped: Vec<OnceLock<Vec<bool>>>,
+    /// Per function, in one vector.
+    cells: Vec<FunctionCfg>,
+}
+
+#[derive(Default)]
+struct FunctionCfg {
+    preds: OnceLock<Preds>,
+    idom: OnceLock<Vec<Option<usize>>>,
+    looped: OnceLock<Vec<bool>>,
 }
 
 /// The memo of [`FunctionCfgs`] of a program.
 pub fn function_cfgs(program: &Program) -> Arc<FunctionCfgs> {
     program.memo.get_or(|| FunctionCfgs {
-        preds: program.functions.iter().map(|_| OnceLock::new()).collect(),
-        idom: program.functions.iter().map(|_| OnceLock::new()).collect(),
-        looped: program.functions.iter().map(|_| OnceLock::new()).collect(),
+        cells: program
+            .functions
+            .iter()
+            .map(|_| FunctionCfg::default())
+            .collect(),
     })
 }
 
 impl FunctionCfgs {
     /// [`dominators`] of function `fi` (an index into `program.functions`).
     pub fn idom(&self, program: &Program, fi: usize) -> &[Option<usize>] {
-        match (self.idom.get(fi), program.functions.get(fi)) {
-            (Some(cell), Some(f)) => {
-                cell.get_or_init(|| dominators_with(f, self.preds[fi].get_or_init(|| Preds::of(f))))
-            }
+        match (self.cells.get(fi), program.functions.get(fi)) {
+            (Some(cell), Some(f)) => cell
+                .idom
+                .get_or_init(|| dominators_with(f, cell.preds.get_or_init(|| Preds::of(f)))),
             _ => &[],
         }
     }
@@ -197,10 +205,10 @@ impl FunctionCfgs {
     /// Per block of function `fi`: whether it lies in one of the function's
     /// [`natural_loops`] (their union, without building each body as a set).
     pub fn looped(&self, program: &Program, fi: usize) -> &[bool] {
-        let (Some(cell), Some(f)) = (self.looped.get(fi), program.functions.get(fi)) else {
+        let (Some(cell), Some(f)) = (self.cells.get(fi), program.functions.get(fi)) else {
             return &[];
         };
-        cell.get_or_init(|| {
+        cell.looped.get_or_init(|| {
             let n = f.blocks.len();
             let mut looped = vec![false; n];
             // Every edge forward in block order: no cycle, so no back edge
@@ -213,7 +221,7 @@ impl FunctionCfgs {
                 return looped;
             }
             let idom = self.idom(program, fi);
-            let preds = self.preds[fi].get_or_init(|| Preds::of(f));
+            let preds = cell.preds.get_or_init(|| Preds::of(f));
             // Each block's depth in the dominator tree: an edge is a back
             // edge when its target is its source's ancestor at the target's
             // depth, so the walk up stops there, and a target no shallower

@@ -567,7 +567,7 @@ impl Program {
 
     /// Function ids reachable from `root` through `OpFunctionCall`, `root` first.
     pub fn reachable_functions(&self, root: Id) -> Vec<Id> {
-        self.reach(root).0
+        self.reach(root, true).0
     }
 
     /// Per function (index into `functions`): whether `root` reaches it
@@ -576,19 +576,20 @@ impl Program {
     pub fn reached_functions(&self, root: Id) -> Vec<bool> {
         match self.functions.as_slice() {
             [only] => vec![only.id == root],
-            _ => self.reach(root).1,
+            _ => self.reach(root, false).1,
         }
     }
 
-    /// [`Program::reachable_functions`] and [`Program::reached_functions`].
-    fn reach(&self, root: Id) -> (Vec<Id>, Vec<bool>) {
+    /// [`Program::reachable_functions`] (when `list`) and
+    /// [`Program::reached_functions`].
+    fn reach(&self, root: Id, list: bool) -> (Vec<Id>, Vec<bool>) {
         let index = self.call_index();
         let n = self.functions.len();
         // Flags by the first function of each id; ids that name no
         // function are listed but call nothing.
         let mut reached = vec![false; n];
         let mut others: Vec<Id> = Vec::new();
-        let mut ids = vec![root];
+        let mut ids = if list { vec![root] } else { Vec::new() };
         let mut queue: Vec<usize> = Vec::new();
         match self.functions.iter().position(|f| f.id == root) {
             Some(fi) => {
@@ -614,7 +615,7 @@ impl Program {
                     queue.push(ci);
                     true
                 };
-                if new {
+                if new && list {
                     ids.push(callee);
                 }
             }
