@@ -514,8 +514,7 @@ fn call_data_uses(program: &Program, f: &crate::program::Function) -> Vec<CallDa
     // defined once, so a pointer leads back to one global.
     let mut into: rustc_hash::FxHashMap<u32, usize> =
         out.iter().enumerate().map(|(n, u)| (u.global, n)).collect();
-    for k in f.start..=f.end {
-        let i = &program.insts[k];
+    for (k, i) in (f.start..).zip(&program.insts[f.start..=f.end]) {
         if !matches!(
             i.class.opcode,
             Op::AccessChain | Op::InBoundsAccessChain | Op::Store | Op::Load

@@ -590,7 +590,7 @@ impl Program {
         let mut reached = vec![false; n];
         let mut others: Vec<Id> = Vec::new();
         let mut ids = if list { vec![root] } else { Vec::new() };
-        let mut queue: Vec<usize> = Vec::new();
+        let mut queue: Vec<usize> = Vec::with_capacity(n);
         match self.functions.iter().position(|f| f.id == root) {
             Some(fi) => {
                 reached[fi] = true;
