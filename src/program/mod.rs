@@ -277,7 +277,10 @@ pub struct Program {
     pub memo: Memo,
 }
 
-/// [`Program::call_index`]: every call of the module by callee, and each
+/// [`Program::callers`]' calls outside every function.
+struct OutsideCalls(Vec<(Id, usize)>);
+
+/// [`Program::call_index`]: every call in a function by callee, and each
 /// function's callees by function index, in flat vectors (a module has a
 /// handful of functions: hash maps of them cost more to build than to
 /// search, and reachability walks indices).
@@ -451,11 +454,44 @@ impl Program {
 
     /// Instruction indices of the `OpFunctionCall`s that call function `f`.
     pub fn callers(&self, f: Id) -> Vec<usize> {
-        self.call_index()
+        let mut calls: Vec<usize> = self
+            .call_index()
             .calls_to(f)
             .iter()
             .map(|&(_, i)| i)
-            .collect()
+            .collect();
+        let outside = self
+            .memo
+            .get_or(|| OutsideCalls(self.calls_outside_functions()));
+        if !outside.0.is_empty() {
+            calls.extend(outside.0.iter().filter(|&&(c, _)| c == f).map(|&(_, i)| i));
+            calls.sort_unstable();
+        }
+        calls
+    }
+
+    /// `(callee, instruction)` of the calls outside every function (a
+    /// module no validator accepts): only [`Program::callers`] lists them,
+    /// so the call index scans function bodies alone.
+    fn calls_outside_functions(&self) -> Vec<(Id, usize)> {
+        let mut out = Vec::new();
+        let mut from = 0;
+        let gaps = self
+            .functions
+            .iter()
+            .map(|f| (f.start, f.end + 1))
+            .chain(std::iter::once((self.insts.len(), self.insts.len())));
+        for (start, next) in gaps {
+            for (i, inst) in (from..).zip(self.insts.get(from..start).unwrap_or(&[])) {
+                if inst.class.opcode == Op::FunctionCall {
+                    if let Some(Operand::IdRef(x)) = inst.operands.first() {
+                        out.push((*x, i));
+                    }
+                }
+            }
+            from = from.max(next);
+        }
+        out
     }
 
     /// Every call by callee and each function's callees, indexed in one
@@ -463,11 +499,16 @@ impl Program {
     /// analyses ask for reachable functions per shader and per entry point.
     pub(crate) fn call_index(&self) -> std::sync::Arc<CallIndex> {
         self.memo.get_or(|| {
+            // Function bodies only: a call outside every function reaches
+            // nothing (see `calls_outside_functions`).
             let mut by_callee: Vec<(Id, usize)> = Vec::new();
-            for (i, inst) in self.insts.iter().enumerate() {
-                if inst.class.opcode == Op::FunctionCall {
-                    if let Some(Operand::IdRef(x)) = inst.operands.first() {
-                        by_callee.push((*x, i));
+            for f in &self.functions {
+                let body = self.insts.get(f.start..=f.end).unwrap_or(&[]);
+                for (i, inst) in (f.start..).zip(body) {
+                    if inst.class.opcode == Op::FunctionCall {
+                        if let Some(Operand::IdRef(x)) = inst.operands.first() {
+                            by_callee.push((*x, i));
+                        }
                     }
                 }
             }
@@ -831,5 +872,92 @@ mod op_tests {
             ray_query += name.starts_with("RayQuery") as usize;
         }
         assert_eq!(ray_query, 32);
+    }
+}
+
+#[cfg(test)]
+mod call_tests {
+    use super::*;
+    use std::path::Path;
+
+    fn load(rel: &str) -> Program {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join(rel);
+        let lang = crate::shader::Language::from_path(&path).unwrap();
+        crate::front::load(&path, lang).unwrap()
+    }
+
+    /// Every `OpFunctionCall` of the module: `(instruction, callee)`.
+    fn scanned_calls(p: &Program) -> Vec<(usize, Id)> {
+        p.insts
+            .iter()
+            .enumerate()
+            .filter(|(_, i)| i.class.opcode == Op::FunctionCall)
+            .filter_map(|(k, i)| match i.operands.first() {
+                Some(Operand::IdRef(x)) => Some((k, *x)),
+                _ => None,
+            })
+            .collect()
+    }
+
+    /// The call index answers as a scan of the module does: callers in
+    /// module order, reachable functions breadth-first from each entry
+    /// point, and a flag per function; a call outside every function
+    /// (invalid, but readable) is still one of its callee's callers.
+    #[test]
+    fn index_answers_as_a_scan_does() {
+        let mut helpers = 0;
+        for rel in [
+            "fixtures/guards/constructed.wgsl",
+            "fixtures/guards/fresh.hlsl",
+            "fixtures/guards/two_calls.wgsl",
+            "fixtures/guards/loop.rgen.g.spv",
+        ] {
+            let mut p = load(rel);
+            let Some(helper) = p
+                .functions
+                .iter()
+                .map(|f| f.id)
+                .find(|&id| scanned_calls(&p).iter().any(|&(_, c)| c == id))
+            else {
+                continue;
+            };
+            helpers += 1;
+            // An instruction before the first function made a call.
+            let k = p.functions[0].start - 1;
+            p.insts[k] = rspirv::dr::Instruction::new(
+                Op::FunctionCall,
+                Some(1),
+                Some(1),
+                vec![Operand::IdRef(helper)],
+            );
+            let calls = scanned_calls(&p);
+            for f in &p.functions {
+                let want: Vec<usize> = calls
+                    .iter()
+                    .filter(|&&(_, c)| c == f.id)
+                    .map(|&(i, _)| i)
+                    .collect();
+                assert_eq!(p.callers(f.id), want, "{rel} %{}", f.id);
+            }
+            assert_eq!(p.callers(helper).first(), Some(&k), "{rel}");
+            for e in &p.entry_points {
+                let mut want = vec![e.function];
+                let mut n = 0;
+                while n < want.len() {
+                    if let Some(f) = p.function(want[n]) {
+                        for &(i, c) in &calls {
+                            if f.start <= i && i <= f.end && !want.contains(&c) {
+                                want.push(c);
+                            }
+                        }
+                    }
+                    n += 1;
+                }
+                assert_eq!(p.reachable_functions(e.function), want, "{rel} {}", e.name);
+                let flags: Vec<bool> = p.functions.iter().map(|f| want.contains(&f.id)).collect();
+                assert_eq!(p.reached_functions(e.function), flags, "{rel} {}", e.name);
+            }
+        }
+        assert!(helpers >= 2, "{helpers}");
     }
 }
