@@ -484,36 +484,72 @@ struct Places {
     /// not a vector per part).
     list: Vec<(Id, u32, u32)>,
     paths: Vec<u32>,
-    /// The whole-id place of each id from `lo` on (SSA values, whole
-    /// variables): most places, found without hashing.
-    whole: Vec<u32>,
+    /// Each id's slot: `id - lo` for the ids `lo..lo + dense` (SSA values
+    /// and variables), then each of `params` (pointer parameters are
+    /// variables too, numbered apart from the body), then the ids of
+    /// `sparse` (a module numbered too sparsely for slots by id).
     lo: Id,
-    /// Places of other ids, and all parts below a variable: by id and hash
-    /// of the path, `next` chaining the others with the same key (a
-    /// variable split into its elements has many parts).
+    dense: usize,
+    params: Vec<Id>,
+    sparse: HashMap<Id, u32>,
+    /// By slot: the whole id's place, and its first and last part (a
+    /// non-empty path; the others chained through `next_part` in the
+    /// order met): found without hashing.
+    whole: Vec<u32>,
+    part_first: Vec<u32>,
+    part_last: Vec<u32>,
+    next_part: Vec<u32>,
+    /// The parts: by id and hash of the path, `next` chaining the others
+    /// with the same key (a variable split into its elements has many).
     first: HashMap<(Id, u64), u32>,
     next: Vec<u32>,
-    /// Each id's parts (non-empty paths), by index.
-    parts: HashMap<Id, Vec<u32>>,
+}
+
+/// The places of one id: the whole, then its parts (see [`Places::of`]).
+struct PlacesOf<'a> {
+    whole: u32,
+    part: u32,
+    next_part: &'a [u32],
+}
+
+impl Iterator for PlacesOf<'_> {
+    type Item = u32;
+
+    #[inline]
+    fn next(&mut self) -> Option<u32> {
+        if self.whole != Places::NONE {
+            return Some(std::mem::replace(&mut self.whole, Places::NONE));
+        }
+        let i = self.part;
+        if i == Places::NONE {
+            return None;
+        }
+        self.part = self.next_part[i as usize];
+        Some(i)
+    }
 }
 
 impl Places {
     const NONE: u32 = u32::MAX;
 
     /// For the ids `lo..=hi` defined in one function of `insts`
-    /// instructions (about as many places, made room for at once).
-    fn new(lo: Id, hi: Id, insts: usize) -> Places {
+    /// instructions (about as many places, made room for at once) and its
+    /// parameters `params`.
+    fn new(lo: Id, hi: Id, params: &[Id], insts: usize) -> Places {
         let n = hi.saturating_sub(lo) as usize + 1;
+        // A module with huge, sparse ids falls back to hashing.
+        let dense = if n <= 1 << 20 { n } else { 0 };
+        let slots = dense + params.len();
         Places {
             list: Vec::with_capacity(insts),
             next: Vec::with_capacity(insts),
-            // A module with huge, sparse ids falls back to hashing.
-            whole: if n <= 1 << 20 {
-                vec![Self::NONE; n]
-            } else {
-                Vec::new()
-            },
+            next_part: Vec::with_capacity(insts),
+            whole: vec![Self::NONE; slots],
+            part_first: vec![Self::NONE; slots],
+            part_last: vec![Self::NONE; slots],
             lo,
+            dense,
+            params: params.to_vec(),
             ..Places::default()
         }
     }
@@ -525,8 +561,35 @@ impl Places {
 
     #[inline]
     fn slot(&self, id: Id) -> Option<usize> {
-        let k = id.checked_sub(self.lo)? as usize;
-        (k < self.whole.len()).then_some(k)
+        let k = id.wrapping_sub(self.lo) as usize;
+        if k < self.dense {
+            return Some(k);
+        }
+        self.slot_apart(id)
+    }
+
+    #[inline(never)]
+    fn slot_apart(&self, id: Id) -> Option<usize> {
+        if let Some(j) = self.params.iter().position(|&p| p == id) {
+            return Some(self.dense + j);
+        }
+        if self.sparse.is_empty() {
+            return None;
+        }
+        self.sparse.get(&id).map(|&k| k as usize)
+    }
+
+    /// The slot of `id`, made when it has none.
+    fn slot_or_add(&mut self, id: Id) -> usize {
+        if let Some(k) = self.slot(id) {
+            return k;
+        }
+        let k = self.whole.len();
+        self.sparse.insert(id, k as u32);
+        self.whole.push(Self::NONE);
+        self.part_first.push(Self::NONE);
+        self.part_last.push(Self::NONE);
+        k
     }
 
     #[inline]
@@ -542,35 +605,38 @@ impl Places {
 
     /// The index of place `(id, path)`, added when new.
     fn intern(&mut self, id: Id, path: &[u32]) -> u32 {
-        let slot = if path.is_empty() { self.slot(id) } else { None };
-        if let Some(k) = slot {
-            if self.whole[k] != Self::NONE {
-                return self.whole[k];
+        let k = self.slot_or_add(id);
+        if path.is_empty() {
+            if self.whole[k] == Self::NONE {
+                self.whole[k] = self.push(id, path, Self::NONE);
             }
+            return self.whole[k];
         }
         let key = (id, Self::path_hash(path));
-        let old = match slot {
-            Some(_) => Self::NONE,
-            None => self.first.get(&key).copied().unwrap_or(Self::NONE),
-        };
+        let old = self.first.get(&key).copied().unwrap_or(Self::NONE);
         if let Some(i) = self.find(old, path) {
             return i;
         }
+        let i = self.push(id, path, old);
+        // In front of the chain.
+        self.first.insert(key, i);
+        match self.part_last[k] {
+            Self::NONE => self.part_first[k] = i,
+            last => self.next_part[last as usize] = i,
+        }
+        self.part_last[k] = i;
+        i
+    }
+
+    /// A new place, `next` in its hash chain.
+    #[inline]
+    fn push(&mut self, id: Id, path: &[u32], next: u32) -> u32 {
         let i = self.list.len() as u32;
         let from = self.paths.len() as u32;
         self.paths.extend_from_slice(path);
         self.list.push((id, from, self.paths.len() as u32));
-        self.next.push(old);
-        match slot {
-            Some(k) => self.whole[k] = i,
-            // In front of the chain.
-            None => {
-                self.first.insert(key, i);
-            }
-        }
-        if !path.is_empty() {
-            self.parts.entry(id).or_default().push(i);
-        }
+        self.next.push(next);
+        self.next_part.push(Self::NONE);
         i
     }
 
@@ -578,22 +644,25 @@ impl Places {
     #[inline]
     fn get(&self, id: Id, path: &[u32]) -> Option<u32> {
         if path.is_empty() {
-            if let Some(k) = self.slot(id) {
-                return Some(self.whole[k]).filter(|&i| i != Self::NONE);
-            }
+            let k = self.slot(id)?;
+            return Some(self.whole[k]).filter(|&i| i != Self::NONE);
         }
         self.find(*self.first.get(&(id, Self::path_hash(path)))?, path)
     }
 
-    /// Every place of `id` met so far (the whole, then its parts), by index.
-    fn of(&self, id: Id) -> impl Iterator<Item = u32> + '_ {
-        self.get(id, &[]).into_iter().chain(
-            self.parts
-                .get(&id)
-                .map_or(&[][..], Vec::as_slice)
-                .iter()
-                .copied(),
-        )
+    /// Every place of `id` met so far (the whole, then its parts in the
+    /// order met), by index.
+    #[inline]
+    fn of(&self, id: Id) -> PlacesOf<'_> {
+        let (whole, part) = match self.slot(id) {
+            Some(k) => (self.whole[k], self.part_first[k]),
+            None => (Self::NONE, Self::NONE),
+        };
+        PlacesOf {
+            whole,
+            part,
+            next_part: &self.next_part,
+        }
     }
 
     #[inline]
@@ -1719,7 +1788,7 @@ impl FnLiveness {
             focus,
             ssa: std::cell::OnceCell::new(),
             live_out: Rows::default(),
-            places: RefCell::new(Places::new(lo, hi, f.end + 1 - f.start)),
+            places: RefCell::new(Places::new(lo, hi, &f.params, f.end + 1 - f.start)),
             defined: std::cell::OnceCell::new(),
             preds,
             remat: RefCell::default(),
@@ -3154,7 +3223,7 @@ mod tests {
 
     #[test]
     fn places_intern_once_and_list_each_ids_parts() {
-        let mut p = Places::new(10, 20, 4);
+        let mut p = Places::new(10, 20, &[3], 4);
         let whole = p.intern(12, &[]);
         assert_eq!(p.intern(12, &[]), whole, "interned once");
         let a = p.intern(12, &[1, 2]);
@@ -3164,7 +3233,7 @@ mod tests {
         assert_eq!(p.get(12, &[1]), Some(b));
         assert_eq!(p.get(12, &[2]), None);
         assert_eq!(p.get(13, &[]), None);
-        // Ids outside the dense range go through the hash table.
+        // Ids outside the dense range get their slot through a hash table.
         let far = p.intern(5, &[]);
         let far_part = p.intern(1_000, &[0]);
         assert_eq!(p.get(5, &[]), Some(far));
@@ -3173,6 +3242,15 @@ mod tests {
         assert_eq!(p.of(1_000).collect::<Vec<_>>(), [far_part]);
         assert_eq!(p.of(14).count(), 0);
         assert_eq!(p.place(a), (12, &[1, 2][..]));
+        // A parameter (numbered apart from the body) has a slot too; its
+        // parts are listed in the order met.
+        let q1 = p.intern(3, &[4]);
+        let q = p.intern(3, &[]);
+        let q0 = p.intern(3, &[0]);
+        assert_eq!(p.intern(3, &[4]), q1);
+        assert_eq!(p.get(3, &[]), Some(q));
+        assert_eq!(p.get(3, &[0]), Some(q0));
+        assert_eq!(p.of(3).collect::<Vec<_>>(), [q, q1, q0]);
     }
 
     #[test]
@@ -3327,7 +3405,7 @@ mod tests {
     fn places_with_colliding_keys_stay_apart() {
         // A huge id range has no dense table: every place is hashed, and
         // many parts of one variable share chains of the same key space.
-        let mut p = Places::new(0, u32::MAX, 0);
+        let mut p = Places::new(0, u32::MAX, &[], 0);
         let ids: Vec<u32> = (0..200u32)
             .map(|i| p.intern(7, &[i % 10, i / 10]))
             .collect();

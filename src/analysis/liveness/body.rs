@@ -14,16 +14,12 @@ use spirv::Op;
 /// The instructions `start..start + len` of one function.
 pub(super) struct Body {
     start: usize,
-    op: Vec<Op>,
-    /// Result id, 0 for none (SPIR-V ids start at 1).
-    result: Vec<Id>,
-    /// Where each instruction's id operands start in `ids` (one more
-    /// entry than instructions).
-    at: Vec<u32>,
+    /// Each instruction's opcode, result and id operands, side by side
+    /// (one push an instruction while decoding, one cache line to read).
+    /// (One more row than instructions: the last one only ends the
+    /// last instruction's operands.)
+    rows: Vec<Row>,
     ids: Vec<Id>,
-    /// Debug-info instructions (an `OpExtInst` of a set without
-    /// semantics): they neither read nor write.
-    debug: Vec<bool>,
     /// The instructions every pass reads, in order: not debug info, and
     /// no `OpLine`/`OpNoLine` (which neither read nor write, and are
     /// about a fifth of a function compiled with positions).
@@ -36,53 +32,76 @@ pub(super) struct Body {
     pub hi: Id,
 }
 
+/// One instruction.
+#[derive(Clone, Copy)]
+struct Row {
+    op: Op,
+    /// Result id, 0 for none (SPIR-V ids start at 1).
+    result: Id,
+    /// Where its id operands start in `ids` (they end where the next
+    /// instruction's start).
+    from: u32,
+    /// Debug info (an `OpExtInst` of a set without semantics): it
+    /// neither reads nor writes.
+    debug: bool,
+}
+
 impl Body {
     pub fn new(program: &Program, f: &Function) -> Body {
         let n = f.end + 1 - f.start;
-        let mut b = Body {
-            start: f.start,
-            op: Vec::with_capacity(n),
-            result: Vec::with_capacity(n),
-            at: Vec::with_capacity(n + 1),
-            // At most about three id operands an instruction.
-            ids: Vec::with_capacity(3 * n),
-            debug: Vec::with_capacity(n),
-            kept: Vec::with_capacity(n),
-            block_kept: Vec::with_capacity(f.blocks.len()),
-            lo: Id::MAX,
-            hi: 0,
-        };
-        for inst in &program.insts[f.start..=f.end] {
+        let mut rows = Vec::with_capacity(n + 1);
+        // At most about three id operands an instruction.
+        let mut ids = Vec::with_capacity(3 * n);
+        let mut kept = Vec::with_capacity(n);
+        let (mut lo, mut hi) = (Id::MAX, 0);
+        for (k, inst) in program.insts[f.start..=f.end].iter().enumerate() {
             let op = inst.class.opcode;
-            b.at.push(b.ids.len() as u32);
+            let from = ids.len() as u32;
+            let r = inst.result_id.unwrap_or(0);
             let debug = op == Op::ExtInst
                 && matches!(inst.operands.first(),
                     Some(Operand::IdRef(x)) if program.debug_sets.contains(x));
-            let r = inst.result_id.unwrap_or(0);
             // Debug info and positions are read by no pass: no operands kept.
             if !debug && !matches!(op, Op::Line | Op::NoLine) {
-                b.kept.push((b.start + b.op.len()) as u32);
+                kept.push((f.start + k) as u32);
                 for o in &inst.operands {
                     if let Operand::IdRef(x) = o {
-                        b.ids.push(*x);
+                        ids.push(*x);
                     }
                 }
+                if r != 0 && !matches!(op, Op::Function | Op::FunctionParameter) {
+                    lo = lo.min(r);
+                    hi = hi.max(r);
+                }
             }
-            if r != 0 && !debug && !matches!(op, Op::Function | Op::FunctionParameter) {
-                b.lo = b.lo.min(r);
-                b.hi = b.hi.max(r);
-            }
-            b.op.push(op);
-            b.result.push(r);
-            b.debug.push(debug);
+            rows.push(Row {
+                op,
+                result: r,
+                from,
+                debug,
+            });
         }
-        b.at.push(b.ids.len() as u32);
+        rows.push(Row {
+            op: Op::Nop,
+            result: 0,
+            from: ids.len() as u32,
+            debug: false,
+        });
+        let mut block_kept = Vec::with_capacity(f.blocks.len());
         for block in &f.blocks {
-            let from = b.kept.partition_point(|&i| (i as usize) < block.start);
-            let to = b.kept.partition_point(|&i| (i as usize) <= block.end);
-            b.block_kept.push((from as u32, to.max(from) as u32));
+            let from = kept.partition_point(|&i| (i as usize) < block.start);
+            let to = kept.partition_point(|&i| (i as usize) <= block.end);
+            block_kept.push((from as u32, to.max(from) as u32));
         }
-        b
+        Body {
+            start: f.start,
+            rows,
+            ids,
+            kept,
+            block_kept,
+            lo,
+            hi,
+        }
     }
 
     /// The instructions the passes read (see `kept`), by index.
@@ -109,12 +128,12 @@ impl Body {
 
     #[inline]
     pub fn op(&self, i: usize) -> Op {
-        self.op[i - self.start]
+        self.rows[i - self.start].op
     }
 
     #[inline]
     pub fn result(&self, i: usize) -> Option<Id> {
-        Some(self.result[i - self.start]).filter(|&r| r != 0)
+        Some(self.rows[i - self.start].result).filter(|&r| r != 0)
     }
 
     /// The id operands of instruction `i`, in order (none kept for debug
@@ -122,12 +141,12 @@ impl Body {
     #[inline]
     pub fn ids(&self, i: usize) -> &[Id] {
         let k = i - self.start;
-        &self.ids[self.at[k] as usize..self.at[k + 1] as usize]
+        &self.ids[self.rows[k].from as usize..self.rows[k + 1].from as usize]
     }
 
     #[inline]
     pub fn debug(&self, i: usize) -> bool {
-        self.debug[i - self.start]
+        self.rows[i - self.start].debug
     }
 
     /// The first id operand of instruction `i`.
