@@ -800,6 +800,21 @@ impl<T> IdMap<T> {
     }
 }
 
+impl IdMap<LocalPtr> {
+    /// Adds variable (or pointer parameter) `var` as its own root.
+    fn insert_whole(&mut self, var: Id) {
+        let k = self.index.find_or_add(var, self.values.len() as u32);
+        let ptr = LocalPtr::whole(var, k);
+        match self.values.get_mut(k as usize) {
+            Some(v) => *v = ptr,
+            None => {
+                self.values.push(ptr);
+                self.keys.push(var);
+            }
+        }
+    }
+}
+
 /// A set of the ids one function defines (see [`IdMap`]).
 type IdSet = IdMap<()>;
 
@@ -819,6 +834,9 @@ impl IdSet {
 #[derive(Clone, Copy, Debug)]
 struct LocalPtr {
     var: Id,
+    /// The variable's ordinal among the function's roots (its mentions'
+    /// key, found without another lookup).
+    root: u32,
     /// Constant indices from the variable, up to the first dynamic one:
     /// `FnLiveness::paths[path.0..path.1]` (one list for the function's
     /// pointers, not a vector each).
@@ -828,10 +846,11 @@ struct LocalPtr {
 }
 
 impl LocalPtr {
-    /// The whole of variable (or pointer parameter) `var`.
-    fn whole(var: Id) -> LocalPtr {
+    /// The whole of variable (or pointer parameter) `var`, root `root`.
+    fn whole(var: Id, root: u32) -> LocalPtr {
         LocalPtr {
             var,
+            root,
             path: (0, 0),
             exact: true,
         }
@@ -889,7 +908,8 @@ struct Builds {
 /// One instruction's backward transfer, prepared before solving.
 #[derive(Clone, Debug)]
 enum Step {
-    /// Debug info: reads and writes nothing.
+    /// Reads and writes no place: debug info, and every instruction that
+    /// neither mentions a variable nor writes, calls or takes a parameter.
     Skip,
     /// Kills place `def` (or none: [`Places::NONE`]), then makes the places
     /// `FnLiveness::step_uses[uses]` live.
@@ -1649,13 +1669,14 @@ impl FnLiveness {
         // the dense tables; so are debug-info instructions' (our HLSL
         // compiler numbers them after every function), which nothing here
         // looks up.
-        let body = Body::new(program, f);
+        // One walk decodes each instruction and classifies its result.
+        let mut body = Body::begin(program, f);
         let (lo, hi) = (body.lo, body.hi);
         let mut vars = IdSet::new(lo, hi);
         let mut roots: IdMap<LocalPtr> = IdMap::new(lo, hi);
         // Room made once (growing these was a good part of the allocations):
         // about a pointer and a value an instruction at most.
-        let n_insts = body.kept().len();
+        let n_insts = f.end + 1 - f.start;
         roots.values.reserve(n_insts);
         roots.keys.reserve(n_insts);
         let mut paths: Vec<u32> = Vec::with_capacity(2 * n_insts);
@@ -1668,17 +1689,38 @@ impl FnLiveness {
         // loaded values only.
         let mut candidates: Vec<(usize, usize, Id)> = Vec::new();
         let mut calls: Vec<usize> = Vec::new();
+        // The instructions whose backward step can be more than nothing
+        // (see `prepare_steps`): those that store, copy, call, declare a
+        // variable or take a parameter, phis (which may name a pointer
+        // defined further on), and those with a root among their operands,
+        // found here, as each operand is read.
+        let mut touched: Vec<u32> = Vec::with_capacity(n_insts);
         let mut prev: Option<usize> = None;
-        for &i in body.kept() {
-            let i = i as usize;
-            let op = body.op(i);
+        for i in f.start..=f.end {
+            let Some((op, result, from)) = body.push(program, i) else {
+                continue;
+            };
+            let ids = body.ids_from(from);
+            let touches = matches!(
+                op,
+                Op::Store
+                    | Op::CopyMemory
+                    | Op::CopyMemorySized
+                    | Op::FunctionCall
+                    | Op::Variable
+                    | Op::FunctionParameter
+                    | Op::Phi
+            ) || ids.iter().any(|id| roots.contains_key(id));
+            if touches {
+                touched.push(i as u32);
+            }
             if op == Op::Label {
                 // A copy's load and store lie in one block.
                 prev = None;
             }
             if let Some(l) = prev.replace(i) {
                 if body.op(l) == Op::Load && op == Op::Store {
-                    let (ld, st) = (body.ids(l), body.ids(i));
+                    let (ld, st) = (body.ids(l), ids);
                     if let (Some(v), Some(&src)) = (body.result(l), ld.first()) {
                         let exact = |p: Id| roots.get(&p).is_some_and(|r| r.exact);
                         if st.len() == 2 && st[1] == v && exact(src) && exact(st[0]) {
@@ -1690,23 +1732,22 @@ impl FnLiveness {
             if op == Op::FunctionCall {
                 calls.push(i);
             }
-            let Some(r) = body.result(i) else { continue };
+            let Some(r) = result else { continue };
             match op {
                 // A pointer parameter is tracked like a variable (its
                 // contents belong to the caller, which counts them).
                 Op::FunctionParameter if is_pointer_type(program, program.insts[i].result_type) => {
-                    roots.insert(r, LocalPtr::whole(r));
+                    roots.insert_whole(r);
                 }
                 Op::Variable => {
                     vars.add(r);
-                    roots.insert(r, LocalPtr::whole(r));
+                    roots.insert_whole(r);
                 }
                 Op::AccessChain
                 | Op::InBoundsAccessChain
                 | Op::PtrAccessChain
                 | Op::CopyObject
                 | Op::Bitcast => {
-                    let ids = body.ids(i);
                     match ids.first().and_then(|b| roots.get(b)).copied() {
                         Some(mut ptr) => {
                             let chain = matches!(op, Op::AccessChain | Op::InBoundsAccessChain);
@@ -1735,6 +1776,7 @@ impl FnLiveness {
                 _ => ssa_ids.push(r),
             }
         }
+        body.finish(f);
         let preds = crate::program::cfg::Preds::of(f);
         // Per instruction: the load a copy's store copies from, or that a
         // load is a copy's (read at the store).
@@ -1803,15 +1845,16 @@ impl FnLiveness {
             mentions: std::cell::OnceCell::new(),
             mention_blocks: RefCell::default(),
         };
-        fl.prepare_steps(program);
+        fl.prepare_steps(program, &touched);
         fl.solve(program);
         (fl, exact)
     }
 
     /// Prepares the backward transfer of every instruction that only kills
     /// its result and reads its operands (most of them), so the fixpoint
-    /// does no lookups for those.
-    fn prepare_steps(&mut self, program: &Program) {
+    /// does no lookups for those. Only the instructions `touched` (in
+    /// order) can do more than nothing: the others skip.
+    fn prepare_steps(&mut self, program: &Program, touched: &[u32]) {
         let f = &program.functions[self.func];
         let places = self.places.get_mut();
         let mut steps = vec![Step::Skip; f.end + 1 - f.start];
@@ -1823,7 +1866,7 @@ impl FnLiveness {
         let mut mentions = MentionPairs::new(self.roots.len(), f.end + 1 - f.start);
         let body = &self.body;
         let mut others = 0;
-        for &at in body.kept() {
+        for &at in touched {
             let at = at as usize;
             let op = body.op(at);
             let copy = self.copy[at - f.start];
@@ -1839,8 +1882,10 @@ impl FnLiveness {
             // Only SSA values and variables (pointer parameters) are ever
             // places; another result cannot be live.
             let result = body.result(at);
+            // (Only a pointer parameter is its own root and not `other`: a
+            // variable is `other`, a derived pointer's root is its base's.)
             let def = match result {
-                Some(r) if !other => {
+                Some(r) if op == Op::FunctionParameter => {
                     if self.roots.get(&r).is_some_and(|p| p.var == r) {
                         places.intern(r, &[])
                     } else {
@@ -1856,13 +1901,14 @@ impl FnLiveness {
             let reads = !(other || op == Op::Phi || copy == Copy::Load);
             let derives = derives_pointer(op);
             let start = pool.len() as u32;
-            if let Some(r) = result.filter(|r| self.vars.contains(r)) {
+            // (Only an `OpVariable` defines a variable.)
+            if let Some(r) = result.filter(|r| op == Op::Variable && self.vars.contains(r)) {
                 mentions.add(&self.roots, at, r);
             }
             for &id in body.ids(at) {
                 let root = self.roots.get(&id);
                 if let Some(p) = root {
-                    mentions.add(&self.roots, at, p.var);
+                    mentions.add_root(at, p.root);
                 }
                 if !reads {
                     continue;
@@ -1927,7 +1973,7 @@ impl FnLiveness {
         };
         for b in 0..f.blocks.len() {
             block_segments.push(segments.len() as u32);
-            for &at in self.body.block(b).iter().rev() {
+            for &at in Body::in_block(touched, f, b).iter().rev() {
                 let at = at as usize;
                 match &steps[at - f.start] {
                     Step::Skip => {}
@@ -2987,7 +3033,9 @@ impl FnLiveness {
 struct MentionPairs {
     n: usize,
     pairs: Vec<(u32, usize)>,
-    last: Vec<usize>,
+    /// Where the pairs of the instruction met last start (a root is
+    /// listed once per instruction).
+    at: usize,
 }
 
 impl MentionPairs {
@@ -2997,7 +3045,7 @@ impl MentionPairs {
         MentionPairs {
             n,
             pairs: Vec::with_capacity(if n == 0 { 0 } else { insts }),
-            last: vec![usize::MAX; n],
+            at: 0,
         }
     }
 
@@ -3018,17 +3066,31 @@ impl MentionPairs {
     /// into it), met in order.
     #[inline]
     fn add(&mut self, roots: &IdMap<LocalPtr>, i: usize, v: Id) {
-        let Some(k) = roots.ordinal(v).filter(|&k| k < self.n) else {
+        if let Some(k) = roots.ordinal(v) {
+            self.add_root(i, k as u32);
+        }
+    }
+
+    /// That instruction `i` mentions the root of ordinal `k`.
+    #[inline]
+    fn add_root(&mut self, i: usize, k: u32) {
+        if k as usize >= self.n {
             return;
-        };
-        if self.last[k] != i {
-            self.last[k] = i;
-            self.pairs.push((k as u32, i));
+        }
+        // Instructions come in order: only the last one's pairs can hold `k`.
+        if self.pairs.get(self.at).is_none_or(|&(_, j)| j != i) {
+            self.at = self.pairs.len();
+        }
+        if !self.pairs[self.at..].iter().any(|&(q, _)| q == k) {
+            self.pairs.push((k, i));
         }
     }
 
     fn finish(self) -> std::rc::Rc<Mentions> {
         let MentionPairs { n, pairs, .. } = self;
+        // A counting sort: `start[k + 1]` counts root `k`'s mentions, then
+        // (summed) is where root `k + 1`'s start; filling moves each
+        // `start[k]` to the end of root `k`'s, so one shift restores it.
         let mut start = vec![0u32; n + 1];
         for &(k, _) in &pairs {
             start[k as usize + 1] += 1;
@@ -3036,12 +3098,13 @@ impl MentionPairs {
         for k in 0..n {
             start[k + 1] += start[k];
         }
-        let mut fill = start.clone();
         let mut list = vec![0usize; pairs.len()];
         for (k, i) in pairs {
-            list[fill[k as usize] as usize] = i;
-            fill[k as usize] += 1;
+            list[start[k as usize] as usize] = i;
+            start[k as usize] += 1;
         }
+        start.copy_within(0..n, 1);
+        start[0] = 0;
         std::rc::Rc::new(Mentions { start, list })
     }
 }

@@ -16,8 +16,6 @@ pub(super) struct Body {
     start: usize,
     /// Each instruction's opcode, result and id operands, side by side
     /// (one push an instruction while decoding, one cache line to read).
-    /// (One more row than instructions: the last one only ends the
-    /// last instruction's operands.)
     rows: Vec<Row>,
     ids: Vec<Id>,
     /// The instructions every pass reads, in order: not debug info, and
@@ -38,70 +36,110 @@ struct Row {
     op: Op,
     /// Result id, 0 for none (SPIR-V ids start at 1).
     result: Id,
-    /// Where its id operands start in `ids` (they end where the next
-    /// instruction's start).
+    /// Its id operands: `ids[from..from + len]` (an instruction has
+    /// fewer than 2^16 words).
     from: u32,
+    len: u16,
     /// Debug info (an `OpExtInst` of a set without semantics): it
     /// neither reads nor writes.
     debug: bool,
 }
 
 impl Body {
+    /// The body of `f`, decoded whole.
+    #[cfg(test)]
     pub fn new(program: &Program, f: &Function) -> Body {
-        let n = f.end + 1 - f.start;
-        let mut rows = Vec::with_capacity(n + 1);
-        // At most about three id operands an instruction.
-        let mut ids = Vec::with_capacity(3 * n);
-        let mut kept = Vec::with_capacity(n);
-        let (mut lo, mut hi) = (Id::MAX, 0);
-        for (k, inst) in program.insts[f.start..=f.end].iter().enumerate() {
-            let op = inst.class.opcode;
-            let from = ids.len() as u32;
-            let r = inst.result_id.unwrap_or(0);
-            let debug = op == Op::ExtInst
-                && matches!(inst.operands.first(),
-                    Some(Operand::IdRef(x)) if program.debug_sets.contains(x));
-            // Debug info and positions are read by no pass: no operands kept.
-            if !debug && !matches!(op, Op::Line | Op::NoLine) {
-                kept.push((f.start + k) as u32);
-                for o in &inst.operands {
-                    if let Operand::IdRef(x) = o {
-                        ids.push(*x);
-                    }
-                }
-                if r != 0 && !matches!(op, Op::Function | Op::FunctionParameter) {
-                    lo = lo.min(r);
-                    hi = hi.max(r);
-                }
-            }
-            rows.push(Row {
-                op,
-                result: r,
-                from,
-                debug,
-            });
+        let mut b = Body::begin(program, f);
+        for i in f.start..=f.end {
+            b.push(program, i);
         }
-        rows.push(Row {
-            op: Op::Nop,
-            result: 0,
-            from: ids.len() as u32,
-            debug: false,
-        });
-        let mut block_kept = Vec::with_capacity(f.blocks.len());
-        for block in &f.blocks {
-            let from = kept.partition_point(|&i| (i as usize) < block.start);
-            let to = kept.partition_point(|&i| (i as usize) <= block.end);
-            block_kept.push((from as u32, to.max(from) as u32));
+        b.finish(f);
+        b
+    }
+
+    /// An empty body for `f` (its instructions added by [`Body::push`] in
+    /// order, then [`Body::finish`]), with its id range worked out first:
+    /// the tables by id are made before the walk that decodes and
+    /// classifies each instruction fills them.
+    pub fn begin(program: &Program, f: &Function) -> Body {
+        let n = f.end + 1 - f.start;
+        let (mut lo, mut hi) = (Id::MAX, 0);
+        for inst in &program.insts[f.start..=f.end] {
+            let Some(r) = inst.result_id else { continue };
+            let op = inst.class.opcode;
+            if !matches!(op, Op::Function | Op::FunctionParameter) && !is_debug(program, inst) {
+                lo = lo.min(r);
+                hi = hi.max(r);
+            }
         }
         Body {
             start: f.start,
-            rows,
-            ids,
-            kept,
-            block_kept,
+            rows: Vec::with_capacity(n),
+            // At most about three id operands an instruction.
+            ids: Vec::with_capacity(3 * n),
+            kept: Vec::with_capacity(n),
+            block_kept: Vec::new(),
             lo,
             hi,
         }
+    }
+
+    /// Decodes instruction `i` (the next one). For one the passes read,
+    /// its opcode, result and where its id operands start (see
+    /// [`Body::ids_from`]), handed back so the walk that decodes reads
+    /// them from here.
+    #[inline]
+    pub fn push(&mut self, program: &Program, i: usize) -> Option<(Op, Option<Id>, usize)> {
+        let inst = &program.insts[i];
+        let op = inst.class.opcode;
+        let debug = is_debug(program, inst);
+        let from = self.ids.len();
+        // Debug info and positions are read by no pass: no operands kept.
+        let kept = !debug && !matches!(op, Op::Line | Op::NoLine);
+        if kept {
+            self.kept.push(i as u32);
+            for o in &inst.operands {
+                if let Operand::IdRef(x) = o {
+                    self.ids.push(*x);
+                }
+            }
+        }
+        self.rows.push(Row {
+            op,
+            result: inst.result_id.unwrap_or(0),
+            from: from as u32,
+            len: (self.ids.len() - from) as u16,
+            debug,
+        });
+        kept.then_some((op, inst.result_id.filter(|&r| r != 0), from))
+    }
+
+    /// The id operands from `from` on: the last instruction pushed's.
+    #[inline]
+    pub fn ids_from(&self, from: usize) -> &[Id] {
+        &self.ids[from..]
+    }
+
+    /// Ends the body of `f` once every instruction is pushed.
+    pub fn finish(&mut self, f: &Function) {
+        let kept = &self.kept;
+        self.block_kept = f
+            .blocks
+            .iter()
+            .map(|block| {
+                let from = kept.partition_point(|&i| (i as usize) < block.start);
+                let to = kept.partition_point(|&i| (i as usize) <= block.end);
+                (from as u32, to.max(from) as u32)
+            })
+            .collect();
+    }
+
+    /// Those of `kept` in block `b` of `f`, from a sorted list of them.
+    pub fn in_block<'a>(list: &'a [u32], f: &Function, b: usize) -> &'a [u32] {
+        let block = &f.blocks[b];
+        let from = list.partition_point(|&i| (i as usize) < block.start);
+        let to = list.partition_point(|&i| (i as usize) <= block.end);
+        &list[from..to.max(from)]
     }
 
     /// The instructions the passes read (see `kept`), by index.
@@ -140,8 +178,9 @@ impl Body {
     /// info and `OpLine`/`OpNoLine`).
     #[inline]
     pub fn ids(&self, i: usize) -> &[Id] {
-        let k = i - self.start;
-        &self.ids[self.rows[k].from as usize..self.rows[k + 1].from as usize]
+        let row = &self.rows[i - self.start];
+        let from = row.from as usize;
+        &self.ids[from..from + row.len as usize]
     }
 
     #[inline]
@@ -154,4 +193,12 @@ impl Body {
     pub fn first(&self, i: usize) -> Option<Id> {
         self.ids(i).first().copied()
     }
+}
+
+/// Debug info: an `OpExtInst` of a set without semantics.
+#[inline]
+fn is_debug(program: &Program, inst: &rspirv::dr::Instruction) -> bool {
+    inst.class.opcode == Op::ExtInst
+        && matches!(inst.operands.first(),
+            Some(Operand::IdRef(x)) if program.debug_sets.contains(x))
 }
