@@ -480,9 +480,9 @@ type Place = (Id, Vec<u32>);
 /// a live set is a [`BitSet`] of indices.
 #[derive(Debug, Default)]
 struct Places {
-    /// Each place's id and path (a range of `paths`: one pool for all,
-    /// not a vector per part).
-    list: Vec<(Id, u32, u32)>,
+    /// Each place (one table for its fields: one allocation, not one
+    /// per field).
+    list: Vec<PlaceRow>,
     paths: Vec<u32>,
     /// Each id's slot: `id - lo` for the ids `lo..lo + dense` (SSA values
     /// and variables), then each of `params` (pointer parameters are
@@ -495,21 +495,45 @@ struct Places {
     /// By slot: the whole id's place, and its first and last part (a
     /// non-empty path; the others chained through `next_part` in the
     /// order met): found without hashing.
-    whole: Vec<u32>,
-    part_first: Vec<u32>,
-    part_last: Vec<u32>,
-    next_part: Vec<u32>,
+    slots: Vec<Slot>,
     /// The parts: by id and hash of the path, `next` chaining the others
     /// with the same key (a variable split into its elements has many).
     first: HashMap<(Id, u64), u32>,
-    next: Vec<u32>,
+}
+
+/// A place: its id and path (a range of `Places::paths`: one pool for
+/// all, not a vector per part), and the next place in its hash chain and
+/// among its id's parts.
+#[derive(Clone, Copy, Debug)]
+struct PlaceRow {
+    id: Id,
+    from: u32,
+    to: u32,
+    next: u32,
+    next_part: u32,
+}
+
+/// An id's places (see `Places::slots`).
+#[derive(Clone, Copy, Debug)]
+struct Slot {
+    whole: u32,
+    part_first: u32,
+    part_last: u32,
+}
+
+impl Slot {
+    const NONE: Slot = Slot {
+        whole: Places::NONE,
+        part_first: Places::NONE,
+        part_last: Places::NONE,
+    };
 }
 
 /// The places of one id: the whole, then its parts (see [`Places::of`]).
 struct PlacesOf<'a> {
     whole: u32,
     part: u32,
-    next_part: &'a [u32],
+    list: &'a [PlaceRow],
 }
 
 impl Iterator for PlacesOf<'_> {
@@ -524,7 +548,7 @@ impl Iterator for PlacesOf<'_> {
         if i == Places::NONE {
             return None;
         }
-        self.part = self.next_part[i as usize];
+        self.part = self.list[i as usize].next_part;
         Some(i)
     }
 }
@@ -539,14 +563,9 @@ impl Places {
         let n = hi.saturating_sub(lo) as usize + 1;
         // A module with huge, sparse ids falls back to hashing.
         let dense = if n <= 1 << 20 { n } else { 0 };
-        let slots = dense + params.len();
         Places {
             list: Vec::with_capacity(insts),
-            next: Vec::with_capacity(insts),
-            next_part: Vec::with_capacity(insts),
-            whole: vec![Self::NONE; slots],
-            part_first: vec![Self::NONE; slots],
-            part_last: vec![Self::NONE; slots],
+            slots: vec![Slot::NONE; dense + params.len()],
             lo,
             dense,
             params: params.to_vec(),
@@ -584,11 +603,9 @@ impl Places {
         if let Some(k) = self.slot(id) {
             return k;
         }
-        let k = self.whole.len();
+        let k = self.slots.len();
         self.sparse.insert(id, k as u32);
-        self.whole.push(Self::NONE);
-        self.part_first.push(Self::NONE);
-        self.part_last.push(Self::NONE);
+        self.slots.push(Slot::NONE);
         k
     }
 
@@ -598,7 +615,7 @@ impl Places {
             if same_path(self.place(i).1, path) {
                 return Some(i);
             }
-            i = self.next[i as usize];
+            i = self.list[i as usize].next;
         }
         None
     }
@@ -607,10 +624,10 @@ impl Places {
     fn intern(&mut self, id: Id, path: &[u32]) -> u32 {
         let k = self.slot_or_add(id);
         if path.is_empty() {
-            if self.whole[k] == Self::NONE {
-                self.whole[k] = self.push(id, path, Self::NONE);
+            if self.slots[k].whole == Self::NONE {
+                self.slots[k].whole = self.push(id, path, Self::NONE);
             }
-            return self.whole[k];
+            return self.slots[k].whole;
         }
         let key = (id, Self::path_hash(path));
         let old = self.first.get(&key).copied().unwrap_or(Self::NONE);
@@ -620,11 +637,11 @@ impl Places {
         let i = self.push(id, path, old);
         // In front of the chain.
         self.first.insert(key, i);
-        match self.part_last[k] {
-            Self::NONE => self.part_first[k] = i,
-            last => self.next_part[last as usize] = i,
+        match self.slots[k].part_last {
+            Self::NONE => self.slots[k].part_first = i,
+            last => self.list[last as usize].next_part = i,
         }
-        self.part_last[k] = i;
+        self.slots[k].part_last = i;
         i
     }
 
@@ -634,9 +651,13 @@ impl Places {
         let i = self.list.len() as u32;
         let from = self.paths.len() as u32;
         self.paths.extend_from_slice(path);
-        self.list.push((id, from, self.paths.len() as u32));
-        self.next.push(next);
-        self.next_part.push(Self::NONE);
+        self.list.push(PlaceRow {
+            id,
+            from,
+            to: self.paths.len() as u32,
+            next,
+            next_part: Self::NONE,
+        });
         i
     }
 
@@ -645,7 +666,7 @@ impl Places {
     fn get(&self, id: Id, path: &[u32]) -> Option<u32> {
         if path.is_empty() {
             let k = self.slot(id)?;
-            return Some(self.whole[k]).filter(|&i| i != Self::NONE);
+            return Some(self.slots[k].whole).filter(|&i| i != Self::NONE);
         }
         self.find(*self.first.get(&(id, Self::path_hash(path)))?, path)
     }
@@ -654,21 +675,18 @@ impl Places {
     /// order met), by index.
     #[inline]
     fn of(&self, id: Id) -> PlacesOf<'_> {
-        let (whole, part) = match self.slot(id) {
-            Some(k) => (self.whole[k], self.part_first[k]),
-            None => (Self::NONE, Self::NONE),
-        };
+        let slot = self.slot(id).map_or(Slot::NONE, |k| self.slots[k]);
         PlacesOf {
-            whole,
-            part,
-            next_part: &self.next_part,
+            whole: slot.whole,
+            part: slot.part_first,
+            list: &self.list,
         }
     }
 
     #[inline]
     fn place(&self, i: u32) -> (Id, &[u32]) {
-        let (id, from, to) = self.list[i as usize];
-        (id, &self.paths[from as usize..to as usize])
+        let p = &self.list[i as usize];
+        (p.id, &self.paths[p.from as usize..p.to as usize])
     }
 }
 
