@@ -1196,7 +1196,7 @@ impl SsaLive {
     #[inline]
     fn reads<'a>(&'a self, fl: &'a FnLiveness, i: usize) -> impl Iterator<Item = u32> + 'a {
         let body = &fl.body;
-        let ids = if body.op(i) != Op::Phi && fl.copy[i - body.start()] == Copy::None {
+        let ids = if body.op(i) != Op::Phi && fl.copy_at(i) == Copy::None {
             body.ids(i)
         } else {
             &[]
@@ -1354,7 +1354,8 @@ pub struct FnLiveness {
     /// `OpLoad`s of a whole local part whose only use is the store right
     /// after them into another local part (a copy, such as glslang's
     /// copy-in of an `inout` argument): per instruction from the
-    /// function's start, the store (with its load's index) and the load.
+    /// function's start, the store (with its load's index) and the load
+    /// (empty when the function has none: see `copy_at`).
     copy: Vec<Copy>,
     /// The function's SSA values, in the order defined.
     ssa_ids: Vec<Id>,
@@ -1798,7 +1799,8 @@ impl FnLiveness {
         let preds = crate::program::cfg::Preds::of(f);
         // Per instruction: the load a copy's store copies from, or that a
         // load is a copy's (read at the store).
-        let mut copy = vec![Copy::None; f.end + 1 - f.start];
+        // (Empty when there is none: most functions.)
+        let mut copy = Vec::new();
         if !candidates.is_empty() {
             // Counted by the loaded values' ordinals: a dense lookup per
             // operand of every instruction, not a hash.
@@ -1816,6 +1818,7 @@ impl FnLiveness {
             }
             for (store, load, v) in candidates {
                 if loaded.ordinal(v).map(|k| uses[k]) == Some(1) {
+                    copy.resize(f.end + 1 - f.start, Copy::None);
                     copy[store - f.start] = Copy::Store(load as u32);
                     copy[load - f.start] = Copy::Load;
                 }
@@ -1887,7 +1890,7 @@ impl FnLiveness {
         for &at in touched {
             let at = at as usize;
             let op = body.op(at);
-            let copy = self.copy[at - f.start];
+            let copy = self.copy.get(at - f.start).copied().unwrap_or(Copy::None);
             let other = matches!(copy, Copy::Store(_))
                 || matches!(
                     op,
@@ -2049,6 +2052,13 @@ impl FnLiveness {
         }
     }
 
+    /// Whether instruction `i` is half of a copy.
+    #[inline]
+    fn copy_at(&self, i: usize) -> Copy {
+        let k = i - self.body.start();
+        self.copy.get(k).copied().unwrap_or(Copy::None)
+    }
+
     fn function<'p>(&self, program: &'p Program) -> &'p Function {
         &program.functions[self.func]
     }
@@ -2098,7 +2108,7 @@ impl FnLiveness {
                 }
             }
         }
-        let copy = self.copy[at - start];
+        let copy = self.copy_at(at);
         if let Copy::Store(load) = copy {
             // A copy: the parts of the target live after it were the same
             // parts of the source.
