@@ -46,17 +46,6 @@ struct Row {
 }
 
 impl Body {
-    /// The body of `f`, decoded whole.
-    #[cfg(test)]
-    pub fn new(program: &Program, f: &Function) -> Body {
-        let mut b = Body::begin(program, f);
-        for i in f.start..=f.end {
-            b.push(program, i);
-        }
-        b.finish(f);
-        b
-    }
-
     /// An empty body for `f` (its instructions added by [`Body::push`] in
     /// order, then [`Body::finish`]), with its id range worked out first:
     /// the tables by id are made before the walk that decodes and
