@@ -1704,8 +1704,8 @@ impl FnLiveness {
         let mut ssa_ids: Vec<Id> = Vec::with_capacity(n_insts);
         // Copies from one local part to another: `%v = OpLoad %a; OpStore %b %v`
         // with `%v` used nowhere else and nothing between the two.
-        // Candidates first (met in this walk); then the uses of their
-        // loaded values only.
+        // Candidates are met in this walk, which goes on to count the uses
+        // of their loaded values.
         let mut candidates: Vec<(usize, usize, Id)> = Vec::new();
         let mut calls: Vec<usize> = Vec::new();
         // The instructions whose backward step can be more than nothing
@@ -1715,7 +1715,13 @@ impl FnLiveness {
         // found here, as each operand is read.
         let mut touched: Vec<u32> = Vec::with_capacity(n_insts);
         let mut prev: Option<usize> = None;
-        for i in f.start..=f.end {
+        // The candidates' loaded values, and their uses counted as met
+        // (after its load, only a phi can name a value before its
+        // definition: phis are counted at the end).
+        let mut loaded: Option<(IdSet, Vec<usize>)> = None;
+        let mut phis: Vec<usize> = Vec::new();
+        // (An exclusive range: an inclusive one's iterator costs more.)
+        for i in f.start..f.end + 1 {
             let Some((op, result, from)) = body.push(program, i) else {
                 continue;
             };
@@ -1744,7 +1750,20 @@ impl FnLiveness {
                         let exact = |p: Id| roots.get(&p).is_some_and(|r| r.exact);
                         if st.len() == 2 && st[1] == v && exact(src) && exact(st[0]) {
                             candidates.push((i, l, v));
+                            let (set, uses) =
+                                loaded.get_or_insert_with(|| (IdMap::new(lo, hi), Vec::new()));
+                            set.add(v);
+                            uses.resize(set.len(), 0);
                         }
+                    }
+                }
+            }
+            if op == Op::Phi {
+                phis.push(i);
+            } else if let Some((set, uses)) = &mut loaded {
+                for id in ids {
+                    if let Some(k) = set.ordinal(*id) {
+                        uses[k] += 1;
                     }
                 }
             }
@@ -1801,16 +1820,9 @@ impl FnLiveness {
         // load is a copy's (read at the store).
         // (Empty when there is none: most functions.)
         let mut copy = Vec::new();
-        if !candidates.is_empty() {
-            // Counted by the loaded values' ordinals: a dense lookup per
-            // operand of every instruction, not a hash.
-            let mut loaded: IdSet = IdMap::new(lo, hi);
-            for c in &candidates {
-                loaded.add(c.2);
-            }
-            let mut uses = vec![0usize; loaded.len()];
-            for &i in body.kept() {
-                for id in body.ids(i as usize) {
+        if let Some((loaded, mut uses)) = loaded {
+            for &p in &phis {
+                for id in body.ids(p) {
                     if let Some(k) = loaded.ordinal(*id) {
                         uses[k] += 1;
                     }
