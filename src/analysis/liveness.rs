@@ -1247,9 +1247,20 @@ type Stored = ((u32, u32), Id);
 /// and paths stored to.
 type Spare = (Vec<Vec<usize>>, Vec<Vec<Stored>>);
 
-/// A variable read at an instruction, in the parts read (sorted), each
-/// part as its length then its indices: one vector, not one per part.
-type RematKey = (Id, usize, Vec<u32>);
+/// Variables' recomputability as read at an instruction, once asked: per
+/// question, the parts read (sorted, each part as its length then its
+/// indices, `flat[from..to]`: one pool, not a vector per question), the
+/// answer, and the next question about the same variable and instruction
+/// ([`RematAnswers::NONE`]: none). `FnLiveness::remat_at` gives the first.
+#[derive(Default)]
+struct RematAnswers {
+    list: Vec<(u32, u32, bool, u32)>,
+    flat: Vec<u32>,
+}
+
+impl RematAnswers {
+    const NONE: u32 = u32::MAX;
+}
 
 /// Whether each SSA value is recomputable, once worked out: a byte per id
 /// (the module's ids are dense), hashing only ids past a bound a sparse
@@ -1322,10 +1333,10 @@ pub struct FnLiveness {
     preds: crate::program::cfg::Preds,
     remat: RefCell<RematMemo>,
     /// Variables' rematerialisation as read at an instruction.
-    remat_at: RefCell<HashMap<RematKey, u32>>,
+    remat_at: RefCell<HashMap<(Id, usize), u32>>,
     /// The answers of `remat_at`, by the slot it gives (so the key is
     /// moved into the table once, not copied for an answer in progress).
-    remat_ok: RefCell<Vec<bool>>,
+    remat_ok: RefCell<RematAnswers>,
     /// Vectors the recomputability questions reuse (they nest): reaching
     /// writes, and the paths stored to.
     spare: RefCell<Spare>,
@@ -2393,11 +2404,7 @@ impl FnLiveness {
         let Some(mentions) = self.mentions(program, var) else {
             return false;
         };
-        let writes = |k: usize| {
-            let mut hit = false;
-            self.writes(program, k, |id| hit |= id == var);
-            hit
-        };
+        let writes = |k: usize| self.mention_writes(program, k, var);
         let from = mentions.partition_point(|&i| i < f.blocks[b].start);
         let to = mentions.partition_point(|&i| i < inst);
         if mentions[from..to.max(from)].iter().any(|&k| writes(k)) {
@@ -2438,6 +2445,32 @@ impl FnLiveness {
             }
         }
         false
+    }
+
+    /// Whether instruction `i`, which mentions variable `var`, may write it
+    /// (as [`FnLiveness::writes`] says): without looking through its
+    /// operands again, since mentioning `var` is having an operand in it
+    /// (or being its `OpVariable`).
+    #[inline]
+    fn mention_writes(&self, program: &Program, i: usize, var: Id) -> bool {
+        let body = &self.body;
+        match body.op(i) {
+            Op::Load | Op::AccessChain | Op::InBoundsAccessChain | Op::PtrAccessChain => false,
+            _ if body.debug(i) => false,
+            // An initializer, or no write; an odd instruction that defines
+            // `var` as well as mentioning it, looked at in full.
+            Op::Variable => self.writes_var(program, i, var),
+            _ if body.result(i) == Some(var) => self.writes_var(program, i, var),
+            _ => true,
+        }
+    }
+
+    /// Whether instruction `i` may write variable `var` (see
+    /// [`FnLiveness::writes`]).
+    fn writes_var(&self, program: &Program, i: usize, var: Id) -> bool {
+        let mut hit = false;
+        self.writes(program, i, |id| hit |= id == var);
+        hit
     }
 
     /// Adds to `out` the places in this function that call `call` passes
@@ -2796,31 +2829,44 @@ impl FnLiveness {
         parts: impl Iterator<Item = &'a [u32]> + Clone,
         depth: u32,
     ) -> bool {
-        // The parts in order, flattened into the key (see `RematKey`); the
-        // callers' come sorted.
-        let mut flat = Vec::with_capacity(parts.clone().map(|p| p.len() + 1).sum());
-        let mut push = |p: &[u32]| {
-            flat.push(p.len() as u32);
-            flat.extend_from_slice(p);
-        };
-        if parts.clone().is_sorted() {
-            parts.clone().for_each(&mut push);
-        } else {
-            let mut sorted: Vec<&[u32]> = parts.clone().collect();
-            sorted.sort();
-            sorted.into_iter().for_each(&mut push);
-        }
-        let key = (var, at, flat);
-        if let Some(&k) = self.remat_at.borrow().get(&key) {
-            return self.remat_ok.borrow()[k as usize];
-        }
-        // In progress: a question that comes back to itself answers no.
+        // The parts in order, flattened at the end of the pool (see
+        // `RematAnswers`); the callers' come sorted.
         let slot = {
             let mut answers = self.remat_ok.borrow_mut();
-            answers.push(false);
-            answers.len() - 1
+            let RematAnswers { list, flat } = &mut *answers;
+            let from = flat.len();
+            let mut push = |p: &[u32]| {
+                flat.push(p.len() as u32);
+                flat.extend_from_slice(p);
+            };
+            if parts.clone().is_sorted() {
+                parts.clone().for_each(&mut push);
+            } else {
+                let mut sorted: Vec<&[u32]> = parts.clone().collect();
+                sorted.sort();
+                sorted.into_iter().for_each(&mut push);
+            }
+            let to = flat.len();
+            let first = self
+                .remat_at
+                .borrow()
+                .get(&(var, at))
+                .copied()
+                .unwrap_or(RematAnswers::NONE);
+            let mut q = first;
+            while q != RematAnswers::NONE {
+                let (f, t, ok, next) = list[q as usize];
+                if same_path(&flat[f as usize..t as usize], &flat[from..to]) {
+                    flat.truncate(from);
+                    return ok;
+                }
+                q = next;
+            }
+            // In progress: a question that comes back to itself answers no.
+            list.push((from as u32, to as u32, false, first));
+            list.len() - 1
         };
-        self.remat_at.borrow_mut().insert(key, slot as u32);
+        self.remat_at.borrow_mut().insert((var, at), slot as u32);
         let no_parts = parts.clone().next().is_none();
         let mentions = self.mentions(program, var);
         let (mut reaching, mut stored) = {
@@ -2908,7 +2954,7 @@ impl FnLiveness {
                 break;
             }
         }
-        self.remat_ok.borrow_mut()[slot] = ok;
+        self.remat_ok.borrow_mut().list[slot].2 = ok;
         let mut spare = self.spare.borrow_mut();
         spare.0.push(reaching);
         spare.1.push(stored);
