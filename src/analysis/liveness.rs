@@ -379,17 +379,22 @@ fn is_pointer_param(program: &Program, id: Id) -> bool {
 /// every value whose recomputation is weighed, so each opcode's answer is
 /// kept once worked out.)
 fn varies(op: Op) -> bool {
-    thread_local! {
-        static KNOWN: RefCell<HashMap<u32, bool>> = RefCell::default();
-    }
-    if let Some(v) = KNOWN.with(|k| k.borrow().get(&(op as u32)).copied()) {
-        return v;
+    use std::sync::atomic::{AtomicU8, Ordering};
+    // By opcode: 0 not known, 1 no, 2 yes (a load, not a thread-local hash
+    // lookup); opcodes past the table are named each time.
+    static KNOWN: [AtomicU8; 8192] = [const { AtomicU8::new(0) }; 8192];
+    let slot = KNOWN.get(op as usize);
+    match slot.map_or(0, |k| k.load(Ordering::Relaxed)) {
+        0 => {}
+        known => return known == 2,
     }
     let name = format!("{op:?}");
     let v = ["Atomic", "RayQuery", "GroupNonUniform", "Subgroup", "Group"]
         .iter()
         .any(|p| name.starts_with(p));
-    KNOWN.with(|k| k.borrow_mut().insert(op as u32, v));
+    if let Some(k) = slot {
+        k.store(1 + v as u8, Ordering::Relaxed);
+    }
     v
 }
 
@@ -1285,6 +1290,7 @@ impl RematMemo {
         }
     }
 
+    #[inline]
     fn insert(&mut self, id: Id, r: bool) {
         let k = id as usize;
         if k >= Self::DENSE {
