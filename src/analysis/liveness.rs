@@ -195,7 +195,9 @@ fn compute_live_sites(program: &Program, described: bool) -> Vec<LiveSite> {
     // Every site along every chain first: then each function is built
     // knowing the instructions it will be asked about (see `Focus`).
     let mut jobs: Vec<(&crate::program::RtSite, LiveSiteKind, usize, Vec<usize>)> = Vec::new();
-    let mut asked: HashMap<usize, Vec<usize>> = HashMap::default();
+    // By function index (a few functions of a program ask).
+    let mut asked: Vec<Vec<usize>> = Vec::new();
+    asked.resize_with(program.functions.len(), Vec::new);
     for site in &program.sites {
         let kind = match site.kind {
             SiteKind::TraceRay => LiveSiteKind::TraceRay,
@@ -210,54 +212,63 @@ fn compute_live_sites(program: &Program, described: bool) -> Vec<LiveSite> {
             for chain in call_chains(program, entry.function, g.id, MAX_CHAINS) {
                 for &p in std::iter::once(&site.inst).chain(chain.iter()) {
                     if let Some(fi) = program.function_of(p) {
-                        asked.entry(fi).or_default().push(p);
+                        asked[fi].push(p);
                     }
                 }
                 jobs.push((site, kind, e, chain));
             }
         }
     }
-    let mut cache: HashMap<usize, FnLiveness> = HashMap::default();
+    // Each function's liveness once built, by function index: `slot` into
+    // `built` (an option per function moved the large struct around).
+    let mut slot: Vec<u32> = vec![u32::MAX; program.functions.len()];
+    let mut built: Vec<FnLiveness> =
+        Vec::with_capacity(asked.iter().filter(|a| !a.is_empty()).count());
     let mut shared = Shared::default();
     let mut out = Vec::new();
+    // Reused by every level of every site.
+    let mut seen: HashSet<Id> = HashSet::default();
+    let mut places = SitePlaces::default();
+    let mut carried = SitePlaces::default();
     for (site, kind, e, chain) in jobs {
         let entry = &program.entry_points[e];
-        // Levels: the site in its own function, then each call upwards.
-        let mut points = vec![site.inst];
-        points.extend(chain.iter().rev().copied());
         let mut values: Vec<LiveValue> = Vec::new();
-        let mut seen: HashSet<Id> = HashSet::default();
+        seen.clear();
         // Parts behind the previous level's pointer parameters that
         // it still needs after the site: the caller's memory, counted
         // where the caller passes it.
-        let mut carried: Vec<(usize, Vec<u32>)> = Vec::new();
-        for &p in &points {
+        carried.clear();
+        // Levels: the site in its own function, then each call upwards.
+        for p in std::iter::once(site.inst).chain(chain.iter().rev().copied()) {
             let Some(fi) = program.function_of(p) else {
                 continue;
             };
-            let fl = cache.entry(fi).or_insert_with(|| {
-                // A function with pointer parameters may be asked
-                // what it does with them too: solved whole, once.
-                let f = &program.functions[fi];
-                let focus = if f.params.iter().any(|&p| is_pointer_param(program, p)) {
-                    Focus::all(program, fi)
-                } else {
-                    Focus::new(program, fi, &asked[&fi])
-                };
-                FnLiveness::shared(program, fi, &mut shared, focus)
-            });
-            let extra = fl.arguments_of(program, p, &carried);
-            let mut places = fl.places_after(program, p);
-            places.extend(extra);
+            if slot[fi] == u32::MAX {
+                slot[fi] = built.len() as u32;
+                built.push({
+                    // A function with pointer parameters may be asked
+                    // what it does with them too: solved whole, once.
+                    let f = &program.functions[fi];
+                    let focus = if f.params.iter().any(|&p| is_pointer_param(program, p)) {
+                        Focus::all(program, fi)
+                    } else {
+                        Focus::new(program, fi, &asked[fi])
+                    };
+                    FnLiveness::shared(program, fi, &mut shared, focus)
+                });
+            }
+            let fl = &built[slot[fi] as usize];
+            places.clear();
+            fl.places_after(program, p, &mut places);
+            fl.arguments_of(p, &carried, &mut places);
             // A set: sorted, each place once.
-            places.sort_unstable();
-            places.dedup();
-            for v in fl.live_across(program, p, &places, described) {
+            places.sort();
+            fl.live_across(program, p, &places, described, |v| {
                 if seen.insert(v.id) {
                     values.push(v);
                 }
-            }
-            carried = fl.param_parts_across(program, &places);
+            });
+            fl.param_parts_across(program, &places, &mut carried);
         }
         // The query object is the site's own state, like a payload.
         values.retain(|v| Some(v.id) != site.payload);
@@ -368,17 +379,22 @@ fn is_pointer_param(program: &Program, id: Id) -> bool {
 /// every value whose recomputation is weighed, so each opcode's answer is
 /// kept once worked out.)
 fn varies(op: Op) -> bool {
-    thread_local! {
-        static KNOWN: RefCell<HashMap<u32, bool>> = RefCell::default();
-    }
-    if let Some(v) = KNOWN.with(|k| k.borrow().get(&(op as u32)).copied()) {
-        return v;
+    use std::sync::atomic::{AtomicU8, Ordering};
+    // By opcode: 0 not known, 1 no, 2 yes (a load, not a thread-local hash
+    // lookup); opcodes past the table are named each time.
+    static KNOWN: [AtomicU8; 8192] = [const { AtomicU8::new(0) }; 8192];
+    let slot = KNOWN.get(op as usize);
+    match slot.map_or(0, |k| k.load(Ordering::Relaxed)) {
+        0 => {}
+        known => return known == 2,
     }
     let name = format!("{op:?}");
     let v = ["Atomic", "RayQuery", "GroupNonUniform", "Subgroup", "Group"]
         .iter()
         .any(|p| name.starts_with(p));
-    KNOWN.with(|k| k.borrow_mut().insert(op as u32, v));
+    if let Some(k) = slot {
+        k.store(1 + v as u8, Ordering::Relaxed);
+    }
     v
 }
 
@@ -471,10 +487,62 @@ fn same_path(a: &[u32], b: &[u32]) -> bool {
     a.len() == b.len() && has_prefix(a, b)
 }
 
-/// What backward liveness tracks: an SSA value (empty path), or part of a
-/// function-local variable, named by the constant access-chain indices that
-/// reach it from the variable (empty: all of it).
-type Place = (Id, Vec<u32>);
+/// Places live across one level of a site. A place is what backward
+/// liveness tracks: an SSA value (empty path), or part of a function-local
+/// variable, named by the constant access-chain indices that reach it from
+/// the variable (empty: all of it). Kept as (id, path) with the paths
+/// in one pool: reused for every level of every site (each place was a
+/// vector of its own, allocated, sorted and freed per site). Also the
+/// room the per-site questions reuse.
+#[derive(Default)]
+struct SitePlaces {
+    /// Each place's id and path (`paths[from..to]`).
+    list: Vec<(Id, u32, u32)>,
+    paths: Vec<u32>,
+    /// The live parts' set and the SSA values' words (see
+    /// `FnLiveness::places_after`).
+    live: BitSet,
+    words: Vec<u64>,
+}
+
+impl SitePlaces {
+    fn clear(&mut self) {
+        self.list.clear();
+        self.paths.clear();
+    }
+
+    #[inline]
+    fn push(&mut self, id: Id, path: &[u32]) {
+        let from = self.paths.len() as u32;
+        self.paths.extend_from_slice(path);
+        self.list.push((id, from, self.paths.len() as u32));
+    }
+
+    /// Place `(id, a ++ b)`.
+    fn push_joined(&mut self, id: Id, a: &[u32], b: &[u32]) {
+        let from = self.paths.len() as u32;
+        self.paths.extend_from_slice(a);
+        self.paths.extend_from_slice(b);
+        self.list.push((id, from, self.paths.len() as u32));
+    }
+
+    #[inline]
+    fn path(&self, k: usize) -> &[u32] {
+        let (_, from, to) = self.list[k];
+        &self.paths[from as usize..to as usize]
+    }
+
+    /// Sorted by id, then path (as `(Id, Vec<u32>)` sorts), each once: a
+    /// value's parts side by side.
+    fn sort(&mut self) {
+        let paths = &self.paths;
+        let path = |&(_, from, to): &(Id, u32, u32)| &paths[from as usize..to as usize];
+        self.list
+            .sort_unstable_by(|a, b| a.0.cmp(&b.0).then_with(|| path(a).cmp(path(b))));
+        self.list
+            .dedup_by(|a, b| a.0 == b.0 && same_path(path(a), path(b)));
+    }
+}
 
 /// The places one function's liveness has met, each with a dense index:
 /// a live set is a [`BitSet`] of indices.
@@ -965,17 +1033,6 @@ enum Segment {
 /// Parts are tracked separately up to this many elements per composite.
 const MAX_SPLIT: u32 = 64;
 
-/// Variables possibly written on some path to each block's end.
-struct Defined {
-    /// Per block (a row of `w` words each), as indices among the
-    /// variables something writes.
-    out: Vec<u64>,
-    w: usize,
-    /// Each variable's index there (by its ordinal among the function's
-    /// variables), or [`IdIndex::NONE`] when nothing writes it.
-    slot: Vec<u32>,
-}
-
 /// The blocks of a function whose liveness a site can see: those reachable
 /// from the blocks of the instructions it is asked about (the sites and the
 /// calls on their chains). What is live after an instruction depends only
@@ -1204,22 +1261,29 @@ impl SsaLive {
         ids.iter().filter_map(|&id| self.ordinal(id))
     }
 
-    /// The values live just after instruction `inst` of block `b`.
-    fn after(&self, fl: &FnLiveness, b: usize, inst: usize) -> Vec<Id> {
+    /// The values live just after instruction `inst` of block `b`, each
+    /// given to `each` (`live` is room for the set, reused).
+    fn after(
+        &self,
+        fl: &FnLiveness,
+        b: usize,
+        inst: usize,
+        live: &mut Vec<u64>,
+        mut each: impl FnMut(Id),
+    ) {
         let w = self.words;
-        let mut live = self.live_out[b * w..(b + 1) * w].to_vec();
+        live.clear();
+        live.extend_from_slice(&self.live_out[b * w..(b + 1) * w]);
         for &k in fl.body.block_after(b, inst).iter().rev() {
-            self.step(fl, k as usize, &mut live);
+            self.step(fl, k as usize, live);
         }
-        let mut out = Vec::new();
         for (k, &word) in live.iter().enumerate() {
             let mut rest = word;
             while rest != 0 {
-                out.push(self.ids[k * 64 + rest.trailing_zeros() as usize]);
+                each(self.ids[k * 64 + rest.trailing_zeros() as usize]);
                 rest &= rest - 1;
             }
         }
-        out
     }
 }
 
@@ -1295,9 +1359,20 @@ type Stored = ((u32, u32), Id);
 /// and paths stored to.
 type Spare = (Vec<Vec<usize>>, Vec<Vec<Stored>>);
 
-/// A variable read at an instruction, in the parts read (sorted), each
-/// part as its length then its indices: one vector, not one per part.
-type RematKey = (Id, usize, Vec<u32>);
+/// Variables' recomputability as read at an instruction, once asked: per
+/// question, the parts read (sorted, each part as its length then its
+/// indices, `flat[from..to]`: one pool, not a vector per question), the
+/// answer, and the next question about the same variable and instruction
+/// ([`RematAnswers::NONE`]: none). `FnLiveness::remat_at` gives the first.
+#[derive(Default)]
+struct RematAnswers {
+    list: Vec<(u32, u32, bool, u32)>,
+    flat: Vec<u32>,
+}
+
+impl RematAnswers {
+    const NONE: u32 = u32::MAX;
+}
 
 /// Whether each SSA value is recomputable, once worked out: a byte per id
 /// (the module's ids are dense), hashing only ids past a bound a sparse
@@ -1322,6 +1397,7 @@ impl RematMemo {
         }
     }
 
+    #[inline]
     fn insert(&mut self, id: Id, r: bool) {
         let k = id as usize;
         if k >= Self::DENSE {
@@ -1368,17 +1444,13 @@ pub struct FnLiveness {
     live_out: Rows,
     /// Every place met while solving (the live sets' members).
     places: RefCell<Places>,
-    /// Variables possibly written at each block's end (as indices into
-    /// [`Defined::written`]): only asked where a site is, so worked out
-    /// on first use (a callee solved for its parameters never asks).
-    defined: std::cell::OnceCell<Defined>,
     preds: crate::program::cfg::Preds,
     remat: RefCell<RematMemo>,
     /// Variables' rematerialisation as read at an instruction.
-    remat_at: RefCell<HashMap<RematKey, u32>>,
+    remat_at: RefCell<HashMap<(Id, usize), u32>>,
     /// The answers of `remat_at`, by the slot it gives (so the key is
     /// moved into the table once, not copied for an answer in progress).
-    remat_ok: RefCell<Vec<bool>>,
+    remat_ok: RefCell<RematAnswers>,
     /// Vectors the recomputability questions reuse (they nest): reaching
     /// writes, and the paths stored to.
     spare: RefCell<Spare>,
@@ -1405,20 +1477,42 @@ pub struct FnLiveness {
 }
 
 /// Root `k`'s mentions grouped by block, once asked: `runs[at[k].0..at[k].1]`,
-/// each (block, from, to) into its mention list, in order.
+/// each (block, from, to) into its mention list, in order. By the root's
+/// ordinal (`at[k].0 == u32::MAX`: not grouped yet), not hashed.
 #[derive(Default)]
 struct MentionBlocks {
-    at: HashMap<usize, (u32, u32)>,
+    at: Vec<(u32, u32)>,
     runs: Vec<(u32, u32, u32)>,
 }
 
-/// What a reaching-writes walk reuses: the blocks to visit, those seen,
-/// and each block's span of the variable's mentions.
+/// What a walk over blocks reuses: the blocks to visit, each block's span
+/// of the variable's mentions, and per block the stamp of the last walk
+/// that saw it (`seen`) or found a write of the variable in it (`wrote`):
+/// a new stamp per walk instead of clearing a flag per block.
 #[derive(Default)]
 struct Walk {
     work: Vec<(usize, usize)>,
-    seen: Vec<bool>,
+    seen: Vec<u32>,
+    wrote: Vec<u32>,
+    stamp: u32,
     span: Vec<(u32, u32)>,
+}
+
+impl Walk {
+    /// A fresh stamp for a walk over `n` blocks.
+    fn start(&mut self, n: usize) -> u32 {
+        if self.seen.len() < n {
+            self.seen.resize(n, 0);
+            self.wrote.resize(n, 0);
+        }
+        self.stamp = self.stamp.wrapping_add(1);
+        if self.stamp == 0 {
+            self.seen.fill(0);
+            self.wrote.fill(0);
+            self.stamp = 1;
+        }
+        self.stamp
+    }
 }
 
 impl FnLiveness {
@@ -1864,7 +1958,6 @@ impl FnLiveness {
             ssa: std::cell::OnceCell::new(),
             live_out: Rows::default(),
             places: RefCell::new(Places::new(lo, hi, &f.params, f.end + 1 - f.start)),
-            defined: std::cell::OnceCell::new(),
             preds,
             remat: RefCell::default(),
             remat_at: RefCell::default(),
@@ -2364,110 +2457,47 @@ impl FnLiveness {
         self.live_out = live_out;
     }
 
-    /// Variables possibly written on some path to each block's end.
-    fn defined(&self, program: &Program) -> &Defined {
-        self.defined.get_or_init(|| {
-            let f = self.function(program);
-            let n = f.blocks.len();
-            // What each block writes itself is the same every round. Only
-            // variables are asked about, and only an instruction that
-            // mentions one can write it: each variable's mentions, not
-            // every instruction.
-            let mut written = 0u32;
-            let mut slot = vec![IdIndex::NONE; self.vars.keys.len()];
-            // (block, index) pairs first: the rows' width is the number of
-            // variables written, known only at the end.
-            let mut writes: Vec<(usize, u32)> = Vec::new();
-            for (ordinal, &var) in self.vars.keys.iter().enumerate() {
-                let Some(mentions) = self.mentions(program, var) else {
-                    continue;
-                };
-                let k = written;
-                let mut any = false;
-                for &i in mentions.iter() {
-                    let mut hit = false;
-                    self.writes(program, i, |id| hit |= id == var);
-                    if let Some(b) = hit.then(|| block_at(f, i)).flatten() {
-                        writes.push((b, k));
-                        any = true;
-                    }
-                }
-                if any {
-                    slot[ordinal] = k;
-                    written += 1;
-                }
-            }
-            let w = (written as usize).div_ceil(64);
-            let mut own = vec![0u64; n * w];
-            for (b, k) in writes {
-                set(&mut own[b * w..(b + 1) * w], k);
-            }
-            // Forward, by a worklist over flat rows (a set per block and a
-            // clone per visit before).
-            let mut out = own.clone();
-            let mut work = Worklist::new(n, (0..n).rev());
-            let mut d = vec![0u64; w];
-            while let Some(b) = work.pop() {
-                d.copy_from_slice(&own[b * w..(b + 1) * w]);
-                for &p in &self.preds[b] {
-                    for k in 0..w {
-                        d[k] |= out[p * w + k];
-                    }
-                }
-                if d[..] != out[b * w..(b + 1) * w] {
-                    out[b * w..(b + 1) * w].copy_from_slice(&d);
-                    for &s in &f.blocks[b].succs {
-                        if s < n {
-                            work.push(s);
-                        }
-                    }
-                }
-            }
-            Defined { out, w, slot }
-        })
-    }
-
     /// Ids live just after instruction `inst` (SSA values and variables).
     pub fn live_after(&self, program: &Program, inst: usize) -> HashSet<Id> {
-        self.places_after(program, inst)
-            .into_iter()
-            .map(|(id, _)| id)
-            .collect()
+        let mut places = SitePlaces::default();
+        self.places_after(program, inst, &mut places);
+        places.list.iter().map(|&(id, _, _)| id).collect()
     }
 
-    /// SSA values and parts of variables live just after instruction `inst`
-    /// (each once).
-    fn places_after(&self, program: &Program, inst: usize) -> Vec<Place> {
-        let Some((b, live)) = self.live_parts_after(program, inst) else {
-            return Vec::new();
-        };
-        let mut out: Vec<Place> = self.owned_places(&live);
-        let ssa = self.ssa.get_or_init(|| SsaLive::new(self, program));
-        out.extend(
-            ssa.after(self, b, inst)
-                .into_iter()
-                .map(|id| (id, Vec::new())),
-        );
-        out
-    }
-
-    /// The places of the parts in `live`, as owned (id, path) pairs.
-    fn owned_places<C: FromIterator<Place>>(&self, live: &BitSet) -> C {
-        let places = self.places.borrow();
-        live.iter()
-            .map(|i| {
-                let (id, path) = places.place(i);
-                (id, path.to_vec())
-            })
-            .collect()
+    /// Adds the SSA values and parts of variables live just after
+    /// instruction `inst` to `out` (each once).
+    fn places_after(&self, program: &Program, inst: usize, out: &mut SitePlaces) {
+        let mut live = std::mem::take(&mut out.live);
+        if let Some(b) = self.live_parts_into(program, inst, &mut live) {
+            {
+                let places = self.places.borrow();
+                for i in live.iter() {
+                    let (id, path) = places.place(i);
+                    out.push(id, path);
+                }
+            }
+            let ssa = self.ssa.get_or_init(|| SsaLive::new(self, program));
+            let mut words = std::mem::take(&mut out.words);
+            ssa.after(self, b, inst, &mut words, |id| out.push(id, &[]));
+            out.words = words;
+        }
+        out.live = live;
     }
 
     /// The block of instruction `inst`, and the places of the parts live
     /// just after it (by index).
     fn live_parts_after(&self, program: &Program, inst: usize) -> Option<(usize, BitSet)> {
+        let mut live = BitSet::default();
+        let b = self.live_parts_into(program, inst, &mut live)?;
+        Some((b, live))
+    }
+
+    /// The block of instruction `inst`; `live` := the places of the parts
+    /// live just after it (by index).
+    fn live_parts_into(&self, program: &Program, inst: usize, live: &mut BitSet) -> Option<usize> {
         let f = self.function(program);
         let b = block_at(f, inst)?;
-        let mut live = BitSet::default();
+        live.clear();
         live.union_words(self.live_out.row(b));
         // The block's folded segments wholly after `inst` first (a callee's
         // entry asks about the whole block), then instruction by
@@ -2482,15 +2512,15 @@ impl FnLiveness {
             if first <= inst {
                 break;
             }
-            self.segment_back(program, seg, &mut live);
+            self.segment_back(program, seg, live);
             below = first;
         }
         for &k in self.body.block_after(b, inst).iter().rev() {
             if (k as usize) < below {
-                self.step_back(program, k as usize, &mut live);
+                self.step_back(program, k as usize, live);
             }
         }
-        Some((b, live))
+        Some(b)
     }
 
     /// Bytes of the live parts of variable `var` (of type `ty`): all of it
@@ -2522,102 +2552,134 @@ impl FnLiveness {
     }
 
     /// Whether variable `var` may be written before instruction `inst`
-    /// (on some path to it): asked only of the live variables, so their
-    /// own writes are looked up, not a set of all built.
+    /// (on some path to it): asked only of the live variables, so only
+    /// their own writes are looked at. A write earlier in the block, or
+    /// one in a block with a path to it (a walk back over the
+    /// predecessors), not a forward solution for every variable.
     fn written_before(&self, program: &Program, var: Id, inst: usize) -> bool {
         let f = self.function(program);
         let Some(b) = block_at(f, inst) else {
             return false;
         };
-        let defined = self.defined(program);
-        let slot = self
-            .vars
-            .ordinal(var)
-            .map_or(IdIndex::NONE, |k| defined.slot[k]);
-        let w = defined.w;
-        if slot != IdIndex::NONE
-            && self.preds[b]
-                .iter()
-                .any(|&p| defined.out[p * w + slot as usize / 64] >> (slot % 64) & 1 == 1)
-        {
-            return true;
-        }
         // Only an instruction that mentions `var` can write it.
         let Some(mentions) = self.mentions(program, var) else {
             return false;
         };
+        let writes = |k: usize| self.mention_writes(program, k, var);
         let from = mentions.partition_point(|&i| i < f.blocks[b].start);
         let to = mentions.partition_point(|&i| i < inst);
-        mentions[from..to.max(from)].iter().any(|&k| {
-            let mut hit = false;
-            self.writes(program, k, |id| hit |= id == var);
-            hit
-        })
+        if mentions[from..to.max(from)].iter().any(|&k| writes(k)) {
+            return true;
+        }
+        let mut mb = self.mention_blocks.borrow_mut();
+        let runs = self.mention_runs(&mut mb, program, var, &mentions);
+        let mut walk = self.walk.borrow_mut();
+        let stamp = walk.start(f.blocks.len());
+        let Walk {
+            work, seen, wrote, ..
+        } = &mut *walk;
+        let mut any = false;
+        for &(wb, from, to) in runs {
+            if mentions[from as usize..to as usize]
+                .iter()
+                .any(|&k| writes(k))
+            {
+                wrote[wb as usize] = stamp;
+                any = true;
+            }
+        }
+        if !any {
+            return false;
+        }
+        // The blocks with a path to `b`: any of them that writes `var`.
+        work.clear();
+        work.push((b, 0));
+        while let Some((c, _)) = work.pop() {
+            for &p in &self.preds[c] {
+                if seen[p] != stamp {
+                    if wrote[p] == stamp {
+                        return true;
+                    }
+                    seen[p] = stamp;
+                    work.push((p, 0));
+                }
+            }
+        }
+        false
     }
 
-    /// The places in this function that call `call` passes for the
-    /// callee's parameter parts in `params` (parameter index, path).
-    fn arguments_of(
-        &self,
-        program: &Program,
-        call: usize,
-        params: &[(usize, Vec<u32>)],
-    ) -> Vec<Place> {
-        let _ = program;
+    /// Whether instruction `i`, which mentions variable `var`, may write it
+    /// (as [`FnLiveness::writes`] says): without looking through its
+    /// operands again, since mentioning `var` is having an operand in it
+    /// (or being its `OpVariable`).
+    #[inline]
+    fn mention_writes(&self, program: &Program, i: usize, var: Id) -> bool {
+        let body = &self.body;
+        match body.op(i) {
+            Op::Load | Op::AccessChain | Op::InBoundsAccessChain | Op::PtrAccessChain => false,
+            _ if body.debug(i) => false,
+            // An initializer, or no write; an odd instruction that defines
+            // `var` as well as mentioning it, looked at in full.
+            Op::Variable => self.writes_var(program, i, var),
+            _ if body.result(i) == Some(var) => self.writes_var(program, i, var),
+            _ => true,
+        }
+    }
+
+    /// Whether instruction `i` may write variable `var` (see
+    /// [`FnLiveness::writes`]).
+    fn writes_var(&self, program: &Program, i: usize, var: Id) -> bool {
+        let mut hit = false;
+        self.writes(program, i, |id| hit |= id == var);
+        hit
+    }
+
+    /// Adds to `out` the places in this function that call `call` passes
+    /// for the callee's parameter parts in `params` (parameter index, path).
+    fn arguments_of(&self, call: usize, params: &SitePlaces, out: &mut SitePlaces) {
         if self.body.op(call) != Op::FunctionCall {
-            return Vec::new();
+            return;
         }
         let args = &self.body.ids(call)[1..];
-        params
-            .iter()
-            .filter_map(|(k, path)| {
-                let root = self.roots.get(args.get(*k)?)?;
-                let mut p = self.path(root).to_vec();
-                if root.exact {
-                    p.extend_from_slice(path);
-                }
-                Some((root.var, p))
-            })
-            .collect()
+        for (k, &(param, _, _)) in params.list.iter().enumerate() {
+            let Some(root) = args.get(param as usize).and_then(|a| self.roots.get(a)) else {
+                continue;
+            };
+            if root.exact {
+                out.push_joined(root.var, self.path(root), params.path(k));
+            } else {
+                out.push(root.var, self.path(root));
+            }
+        }
     }
 
-    /// Parts behind this function's pointer parameters among the `places`
-    /// live across an instruction, by parameter index.
-    fn param_parts_across(&self, program: &Program, places: &[Place]) -> Vec<(usize, Vec<u32>)> {
+    /// `out` := the parts behind this function's pointer parameters among
+    /// the `places` live across an instruction, by parameter index.
+    fn param_parts_across(&self, program: &Program, places: &SitePlaces, out: &mut SitePlaces) {
         let f = self.function(program);
-        let mut out: Vec<(usize, Vec<u32>)> = places
-            .iter()
-            .filter_map(|(v, path)| Some((f.params.iter().position(|p| p == v)?, path.clone())))
-            .collect();
-        out.sort();
-        out
+        out.clear();
+        for (k, &(v, _, _)) in places.list.iter().enumerate() {
+            if let Some(param) = f.params.iter().position(|&p| p == v) {
+                out.push(param as Id, places.path(k));
+            }
+        }
     }
 
     /// The values among `places` (those live just after instruction
     /// `inst`, with the caller's parts passed to this function) that count
     /// across `inst`; with `described`, named, typed and placed too.
-    pub fn live_across(
-        &mut self,
+    fn live_across(
+        &self,
         program: &Program,
         inst: usize,
-        places: &[Place],
+        places: &SitePlaces,
         described: bool,
-    ) -> Vec<LiveValue> {
+        mut each: impl FnMut(LiveValue),
+    ) {
         // The places by id: each value's parts side by side, in order
-        // (the caller's come sorted; a copy only otherwise).
-        let copy: Vec<Place>;
-        let by_id: &[Place] = if places.is_sorted() {
-            places
-        } else {
-            copy = {
-                let mut v = places.to_vec();
-                v.sort();
-                v
-            };
-            &copy
-        };
+        // (see `SitePlaces::sort`).
+        let by_id = &places.list;
         let result = self.body.result(inst);
-        let mut out = Vec::new();
         let mut k = 0;
         while k < by_id.len() {
             let id = by_id[k].0;
@@ -2625,7 +2687,7 @@ impl FnLiveness {
             while k < by_id.len() && by_id[k].0 == id {
                 k += 1;
             }
-            let parts = &by_id[from..k];
+            let parts = (from..k).map(|j| places.path(j));
             if Some(id) == result {
                 continue;
             }
@@ -2654,12 +2716,12 @@ impl FnLiveness {
                 _ => {}
             }
             let rematerializable = if is_var {
-                self.remat_var(program, id, inst, parts.iter().map(|(_, p)| &p[..]), 0)
+                self.remat_var(program, id, inst, parts.clone(), 0)
             } else {
                 self.remat_ssa(program, id, 0)
             };
             let size = if is_var {
-                FnLiveness::live_part_size(program, ty, parts.iter().map(|(_, p)| &p[..]))
+                FnLiveness::live_part_size(program, ty, parts)
             } else {
                 scalar_size(program, ty).unwrap_or(0)
             };
@@ -2669,7 +2731,7 @@ impl FnLiveness {
                 Storage::Ssa
             };
             if !described {
-                out.push(LiveValue {
+                each(LiveValue {
                     name: String::new(),
                     ty: String::new(),
                     size,
@@ -2707,7 +2769,7 @@ impl FnLiveness {
                 None
             };
             let use_at = self.first_use_after(program, inst, id, mentions.as_deref());
-            out.push(LiveValue {
+            each(LiveValue {
                 name: value_name(program, id, def.as_ref()),
                 ty: program.type_name(ty),
                 size,
@@ -2720,7 +2782,6 @@ impl FnLiveness {
                 use_at,
             });
         }
-        out
     }
 
     fn reads(&self, i: usize, id: Id) -> bool {
@@ -2929,31 +2990,44 @@ impl FnLiveness {
         parts: impl Iterator<Item = &'a [u32]> + Clone,
         depth: u32,
     ) -> bool {
-        // The parts in order, flattened into the key (see `RematKey`); the
-        // callers' come sorted.
-        let mut flat = Vec::with_capacity(parts.clone().map(|p| p.len() + 1).sum());
-        let mut push = |p: &[u32]| {
-            flat.push(p.len() as u32);
-            flat.extend_from_slice(p);
-        };
-        if parts.clone().is_sorted() {
-            parts.clone().for_each(&mut push);
-        } else {
-            let mut sorted: Vec<&[u32]> = parts.clone().collect();
-            sorted.sort();
-            sorted.into_iter().for_each(&mut push);
-        }
-        let key = (var, at, flat);
-        if let Some(&k) = self.remat_at.borrow().get(&key) {
-            return self.remat_ok.borrow()[k as usize];
-        }
-        // In progress: a question that comes back to itself answers no.
+        // The parts in order, flattened at the end of the pool (see
+        // `RematAnswers`); the callers' come sorted.
         let slot = {
             let mut answers = self.remat_ok.borrow_mut();
-            answers.push(false);
-            answers.len() - 1
+            let RematAnswers { list, flat } = &mut *answers;
+            let from = flat.len();
+            let mut push = |p: &[u32]| {
+                flat.push(p.len() as u32);
+                flat.extend_from_slice(p);
+            };
+            if parts.clone().is_sorted() {
+                parts.clone().for_each(&mut push);
+            } else {
+                let mut sorted: Vec<&[u32]> = parts.clone().collect();
+                sorted.sort();
+                sorted.into_iter().for_each(&mut push);
+            }
+            let to = flat.len();
+            let first = self
+                .remat_at
+                .borrow()
+                .get(&(var, at))
+                .copied()
+                .unwrap_or(RematAnswers::NONE);
+            let mut q = first;
+            while q != RematAnswers::NONE {
+                let (f, t, ok, next) = list[q as usize];
+                if same_path(&flat[f as usize..t as usize], &flat[from..to]) {
+                    flat.truncate(from);
+                    return ok;
+                }
+                q = next;
+            }
+            // In progress: a question that comes back to itself answers no.
+            list.push((from as u32, to as u32, false, first));
+            list.len() - 1
         };
-        self.remat_at.borrow_mut().insert(key, slot as u32);
+        self.remat_at.borrow_mut().insert((var, at), slot as u32);
         let no_parts = parts.clone().next().is_none();
         let mentions = self.mentions(program, var);
         let (mut reaching, mut stored) = {
@@ -3041,7 +3115,7 @@ impl FnLiveness {
                 break;
             }
         }
-        self.remat_ok.borrow_mut()[slot] = ok;
+        self.remat_ok.borrow_mut().list[slot].2 = ok;
         let mut spare = self.spare.borrow_mut();
         spare.0.push(reaching);
         spare.1.push(stored);
@@ -3186,16 +3260,19 @@ impl FnLiveness {
         let mut mb = self.mention_blocks.borrow_mut();
         let runs = self.mention_runs(&mut mb, program, var, mentions);
         let mut walk = self.walk.borrow_mut();
-        let Walk { work, seen, span } = &mut *walk;
-        span.resize(f.blocks.len(), (0, 0));
+        let stamp = walk.start(f.blocks.len());
+        let Walk {
+            work, seen, span, ..
+        } = &mut *walk;
+        if span.len() < f.blocks.len() {
+            span.resize(f.blocks.len(), (0, 0));
+        }
         for &(b, from, to) in runs {
             span[b as usize] = (from, to);
         }
         // (block, last instruction to look at)
         work.clear();
         work.push((b0, at));
-        seen.clear();
-        seen.resize(f.blocks.len(), false);
         while let Some((b, last)) = work.pop() {
             let mut killed = false;
             let (from, to) = span[b];
@@ -3223,7 +3300,8 @@ impl FnLiveness {
                 }
             }
             for &p in &self.preds[b] {
-                if !std::mem::replace(&mut seen[p], true) {
+                if seen[p] != stamp {
+                    seen[p] = stamp;
                     // All of it (without reading the block's bounds).
                     work.push((p, usize::MAX));
                 }
@@ -3248,7 +3326,10 @@ impl FnLiveness {
         let Some(k) = self.roots.ordinal(var) else {
             return &[];
         };
-        let (a, b) = *mb.at.entry(k).or_insert_with(|| {
+        if mb.at.len() <= k {
+            mb.at.resize(self.roots.len().max(k + 1), (u32::MAX, 0));
+        }
+        if mb.at[k].0 == u32::MAX {
             let f = self.function(program);
             let first = mb.runs.len() as u32;
             let mut j = 0;
@@ -3264,8 +3345,9 @@ impl FnLiveness {
                 }
                 mb.runs.push((b as u32, from as u32, j as u32));
             }
-            (first, mb.runs.len() as u32)
-        });
+            mb.at[k] = (first, mb.runs.len() as u32);
+        }
+        let (a, b) = mb.at[k];
         &mb.runs[a as usize..b as usize]
     }
 }
