@@ -195,7 +195,9 @@ fn compute_live_sites(program: &Program, described: bool) -> Vec<LiveSite> {
     // Every site along every chain first: then each function is built
     // knowing the instructions it will be asked about (see `Focus`).
     let mut jobs: Vec<(&crate::program::RtSite, LiveSiteKind, usize, Vec<usize>)> = Vec::new();
-    let mut asked: HashMap<usize, Vec<usize>> = HashMap::default();
+    // By function index (a few functions of a program ask).
+    let mut asked: Vec<Vec<usize>> = Vec::new();
+    asked.resize_with(program.functions.len(), Vec::new);
     for site in &program.sites {
         let kind = match site.kind {
             SiteKind::TraceRay => LiveSiteKind::TraceRay,
@@ -210,54 +212,63 @@ fn compute_live_sites(program: &Program, described: bool) -> Vec<LiveSite> {
             for chain in call_chains(program, entry.function, g.id, MAX_CHAINS) {
                 for &p in std::iter::once(&site.inst).chain(chain.iter()) {
                     if let Some(fi) = program.function_of(p) {
-                        asked.entry(fi).or_default().push(p);
+                        asked[fi].push(p);
                     }
                 }
                 jobs.push((site, kind, e, chain));
             }
         }
     }
-    let mut cache: HashMap<usize, FnLiveness> = HashMap::default();
+    // Each function's liveness once built, by function index: `slot` into
+    // `built` (an option per function moved the large struct around).
+    let mut slot: Vec<u32> = vec![u32::MAX; program.functions.len()];
+    let mut built: Vec<FnLiveness> =
+        Vec::with_capacity(asked.iter().filter(|a| !a.is_empty()).count());
     let mut shared = Shared::default();
     let mut out = Vec::new();
+    // Reused by every level of every site.
+    let mut seen: HashSet<Id> = HashSet::default();
+    let mut places = SitePlaces::default();
+    let mut carried = SitePlaces::default();
     for (site, kind, e, chain) in jobs {
         let entry = &program.entry_points[e];
-        // Levels: the site in its own function, then each call upwards.
-        let mut points = vec![site.inst];
-        points.extend(chain.iter().rev().copied());
         let mut values: Vec<LiveValue> = Vec::new();
-        let mut seen: HashSet<Id> = HashSet::default();
+        seen.clear();
         // Parts behind the previous level's pointer parameters that
         // it still needs after the site: the caller's memory, counted
         // where the caller passes it.
-        let mut carried: Vec<(usize, Vec<u32>)> = Vec::new();
-        for &p in &points {
+        carried.clear();
+        // Levels: the site in its own function, then each call upwards.
+        for p in std::iter::once(site.inst).chain(chain.iter().rev().copied()) {
             let Some(fi) = program.function_of(p) else {
                 continue;
             };
-            let fl = cache.entry(fi).or_insert_with(|| {
-                // A function with pointer parameters may be asked
-                // what it does with them too: solved whole, once.
-                let f = &program.functions[fi];
-                let focus = if f.params.iter().any(|&p| is_pointer_param(program, p)) {
-                    Focus::all(program, fi)
-                } else {
-                    Focus::new(program, fi, &asked[&fi])
-                };
-                FnLiveness::shared(program, fi, &mut shared, focus)
-            });
-            let extra = fl.arguments_of(program, p, &carried);
-            let mut places = fl.places_after(program, p);
-            places.extend(extra);
+            if slot[fi] == u32::MAX {
+                slot[fi] = built.len() as u32;
+                built.push({
+                    // A function with pointer parameters may be asked
+                    // what it does with them too: solved whole, once.
+                    let f = &program.functions[fi];
+                    let focus = if f.params.iter().any(|&p| is_pointer_param(program, p)) {
+                        Focus::all(program, fi)
+                    } else {
+                        Focus::new(program, fi, &asked[fi])
+                    };
+                    FnLiveness::shared(program, fi, &mut shared, focus)
+                });
+            }
+            let fl = &built[slot[fi] as usize];
+            places.clear();
+            fl.places_after(program, p, &mut places);
+            fl.arguments_of(p, &carried, &mut places);
             // A set: sorted, each place once.
-            places.sort_unstable();
-            places.dedup();
-            for v in fl.live_across(program, p, &places, described) {
+            places.sort();
+            fl.live_across(program, p, &places, described, |v| {
                 if seen.insert(v.id) {
                     values.push(v);
                 }
-            }
-            carried = fl.param_parts_across(program, &places);
+            });
+            fl.param_parts_across(program, &places, &mut carried);
         }
         // The query object is the site's own state, like a payload.
         values.retain(|v| Some(v.id) != site.payload);
@@ -368,17 +379,22 @@ fn is_pointer_param(program: &Program, id: Id) -> bool {
 /// every value whose recomputation is weighed, so each opcode's answer is
 /// kept once worked out.)
 fn varies(op: Op) -> bool {
-    thread_local! {
-        static KNOWN: RefCell<HashMap<u32, bool>> = RefCell::default();
-    }
-    if let Some(v) = KNOWN.with(|k| k.borrow().get(&(op as u32)).copied()) {
-        return v;
+    use std::sync::atomic::{AtomicU8, Ordering};
+    // By opcode: 0 not known, 1 no, 2 yes (a load, not a thread-local hash
+    // lookup); opcodes past the table are named each time.
+    static KNOWN: [AtomicU8; 8192] = [const { AtomicU8::new(0) }; 8192];
+    let slot = KNOWN.get(op as usize);
+    match slot.map_or(0, |k| k.load(Ordering::Relaxed)) {
+        0 => {}
+        known => return known == 2,
     }
     let name = format!("{op:?}");
     let v = ["Atomic", "RayQuery", "GroupNonUniform", "Subgroup", "Group"]
         .iter()
         .any(|p| name.starts_with(p));
-    KNOWN.with(|k| k.borrow_mut().insert(op as u32, v));
+    if let Some(k) = slot {
+        k.store(1 + v as u8, Ordering::Relaxed);
+    }
     v
 }
 
@@ -471,49 +487,156 @@ fn same_path(a: &[u32], b: &[u32]) -> bool {
     a.len() == b.len() && has_prefix(a, b)
 }
 
-/// What backward liveness tracks: an SSA value (empty path), or part of a
-/// function-local variable, named by the constant access-chain indices that
-/// reach it from the variable (empty: all of it).
-type Place = (Id, Vec<u32>);
+/// Places live across one level of a site. A place is what backward
+/// liveness tracks: an SSA value (empty path), or part of a function-local
+/// variable, named by the constant access-chain indices that reach it from
+/// the variable (empty: all of it). Kept as (id, path) with the paths
+/// in one pool: reused for every level of every site (each place was a
+/// vector of its own, allocated, sorted and freed per site). Also the
+/// room the per-site questions reuse.
+#[derive(Default)]
+struct SitePlaces {
+    /// Each place's id and path (`paths[from..to]`).
+    list: Vec<(Id, u32, u32)>,
+    paths: Vec<u32>,
+    /// The live parts' set and the SSA values' words (see
+    /// `FnLiveness::places_after`).
+    live: BitSet,
+    words: Vec<u64>,
+}
+
+impl SitePlaces {
+    fn clear(&mut self) {
+        self.list.clear();
+        self.paths.clear();
+    }
+
+    #[inline]
+    fn push(&mut self, id: Id, path: &[u32]) {
+        let from = self.paths.len() as u32;
+        self.paths.extend_from_slice(path);
+        self.list.push((id, from, self.paths.len() as u32));
+    }
+
+    /// Place `(id, a ++ b)`.
+    fn push_joined(&mut self, id: Id, a: &[u32], b: &[u32]) {
+        let from = self.paths.len() as u32;
+        self.paths.extend_from_slice(a);
+        self.paths.extend_from_slice(b);
+        self.list.push((id, from, self.paths.len() as u32));
+    }
+
+    #[inline]
+    fn path(&self, k: usize) -> &[u32] {
+        let (_, from, to) = self.list[k];
+        &self.paths[from as usize..to as usize]
+    }
+
+    /// Sorted by id, then path (as `(Id, Vec<u32>)` sorts), each once: a
+    /// value's parts side by side.
+    fn sort(&mut self) {
+        let paths = &self.paths;
+        let path = |&(_, from, to): &(Id, u32, u32)| &paths[from as usize..to as usize];
+        self.list
+            .sort_unstable_by(|a, b| a.0.cmp(&b.0).then_with(|| path(a).cmp(path(b))));
+        self.list
+            .dedup_by(|a, b| a.0 == b.0 && same_path(path(a), path(b)));
+    }
+}
 
 /// The places one function's liveness has met, each with a dense index:
 /// a live set is a [`BitSet`] of indices.
 #[derive(Debug, Default)]
 struct Places {
-    /// Each place's id and path (a range of `paths`: one pool for all,
-    /// not a vector per part).
-    list: Vec<(Id, u32, u32)>,
+    /// Each place (one table for its fields: one allocation, not one
+    /// per field).
+    list: Vec<PlaceRow>,
     paths: Vec<u32>,
-    /// The whole-id place of each id from `lo` on (SSA values, whole
-    /// variables): most places, found without hashing.
-    whole: Vec<u32>,
+    /// Each id's slot: `id - lo` for the ids `lo..lo + dense` (SSA values
+    /// and variables), then each of `params` (pointer parameters are
+    /// variables too, numbered apart from the body), then the ids of
+    /// `sparse` (a module numbered too sparsely for slots by id).
     lo: Id,
-    /// Places of other ids, and all parts below a variable: by id and hash
-    /// of the path, `next` chaining the others with the same key (a
-    /// variable split into its elements has many parts).
+    dense: usize,
+    params: Vec<Id>,
+    sparse: HashMap<Id, u32>,
+    /// By slot: the whole id's place, and its first and last part (a
+    /// non-empty path; the others chained through `next_part` in the
+    /// order met): found without hashing.
+    slots: Vec<Slot>,
+    /// The parts: by id and hash of the path, `next` chaining the others
+    /// with the same key (a variable split into its elements has many).
     first: HashMap<(Id, u64), u32>,
-    next: Vec<u32>,
-    /// Each id's parts (non-empty paths), by index.
-    parts: HashMap<Id, Vec<u32>>,
+}
+
+/// A place: its id and path (a range of `Places::paths`: one pool for
+/// all, not a vector per part), and the next place in its hash chain and
+/// among its id's parts.
+#[derive(Clone, Copy, Debug)]
+struct PlaceRow {
+    id: Id,
+    from: u32,
+    to: u32,
+    next: u32,
+    next_part: u32,
+}
+
+/// An id's places (see `Places::slots`).
+#[derive(Clone, Copy, Debug)]
+struct Slot {
+    whole: u32,
+    part_first: u32,
+    part_last: u32,
+}
+
+impl Slot {
+    const NONE: Slot = Slot {
+        whole: Places::NONE,
+        part_first: Places::NONE,
+        part_last: Places::NONE,
+    };
+}
+
+/// The places of one id: the whole, then its parts (see [`Places::of`]).
+struct PlacesOf<'a> {
+    whole: u32,
+    part: u32,
+    list: &'a [PlaceRow],
+}
+
+impl Iterator for PlacesOf<'_> {
+    type Item = u32;
+
+    #[inline]
+    fn next(&mut self) -> Option<u32> {
+        if self.whole != Places::NONE {
+            return Some(std::mem::replace(&mut self.whole, Places::NONE));
+        }
+        let i = self.part;
+        if i == Places::NONE {
+            return None;
+        }
+        self.part = self.list[i as usize].next_part;
+        Some(i)
+    }
 }
 
 impl Places {
     const NONE: u32 = u32::MAX;
 
     /// For the ids `lo..=hi` defined in one function of `insts`
-    /// instructions (about as many places, made room for at once).
-    fn new(lo: Id, hi: Id, insts: usize) -> Places {
+    /// instructions (about as many places, made room for at once) and its
+    /// parameters `params`.
+    fn new(lo: Id, hi: Id, params: &[Id], insts: usize) -> Places {
         let n = hi.saturating_sub(lo) as usize + 1;
+        // A module with huge, sparse ids falls back to hashing.
+        let dense = if n <= 1 << 20 { n } else { 0 };
         Places {
             list: Vec::with_capacity(insts),
-            next: Vec::with_capacity(insts),
-            // A module with huge, sparse ids falls back to hashing.
-            whole: if n <= 1 << 20 {
-                vec![Self::NONE; n]
-            } else {
-                Vec::new()
-            },
+            slots: vec![Slot::NONE; dense + params.len()],
             lo,
+            dense,
+            params: params.to_vec(),
             ..Places::default()
         }
     }
@@ -525,8 +648,33 @@ impl Places {
 
     #[inline]
     fn slot(&self, id: Id) -> Option<usize> {
-        let k = id.checked_sub(self.lo)? as usize;
-        (k < self.whole.len()).then_some(k)
+        let k = id.wrapping_sub(self.lo) as usize;
+        if k < self.dense {
+            return Some(k);
+        }
+        self.slot_apart(id)
+    }
+
+    #[inline(never)]
+    fn slot_apart(&self, id: Id) -> Option<usize> {
+        if let Some(j) = self.params.iter().position(|&p| p == id) {
+            return Some(self.dense + j);
+        }
+        if self.sparse.is_empty() {
+            return None;
+        }
+        self.sparse.get(&id).map(|&k| k as usize)
+    }
+
+    /// The slot of `id`, made when it has none.
+    fn slot_or_add(&mut self, id: Id) -> usize {
+        if let Some(k) = self.slot(id) {
+            return k;
+        }
+        let k = self.slots.len();
+        self.sparse.insert(id, k as u32);
+        self.slots.push(Slot::NONE);
+        k
     }
 
     #[inline]
@@ -535,42 +683,49 @@ impl Places {
             if same_path(self.place(i).1, path) {
                 return Some(i);
             }
-            i = self.next[i as usize];
+            i = self.list[i as usize].next;
         }
         None
     }
 
     /// The index of place `(id, path)`, added when new.
     fn intern(&mut self, id: Id, path: &[u32]) -> u32 {
-        let slot = if path.is_empty() { self.slot(id) } else { None };
-        if let Some(k) = slot {
-            if self.whole[k] != Self::NONE {
-                return self.whole[k];
+        let k = self.slot_or_add(id);
+        if path.is_empty() {
+            if self.slots[k].whole == Self::NONE {
+                self.slots[k].whole = self.push(id, path, Self::NONE);
             }
+            return self.slots[k].whole;
         }
         let key = (id, Self::path_hash(path));
-        let old = match slot {
-            Some(_) => Self::NONE,
-            None => self.first.get(&key).copied().unwrap_or(Self::NONE),
-        };
+        let old = self.first.get(&key).copied().unwrap_or(Self::NONE);
         if let Some(i) = self.find(old, path) {
             return i;
         }
+        let i = self.push(id, path, old);
+        // In front of the chain.
+        self.first.insert(key, i);
+        match self.slots[k].part_last {
+            Self::NONE => self.slots[k].part_first = i,
+            last => self.list[last as usize].next_part = i,
+        }
+        self.slots[k].part_last = i;
+        i
+    }
+
+    /// A new place, `next` in its hash chain.
+    #[inline]
+    fn push(&mut self, id: Id, path: &[u32], next: u32) -> u32 {
         let i = self.list.len() as u32;
         let from = self.paths.len() as u32;
         self.paths.extend_from_slice(path);
-        self.list.push((id, from, self.paths.len() as u32));
-        self.next.push(old);
-        match slot {
-            Some(k) => self.whole[k] = i,
-            // In front of the chain.
-            None => {
-                self.first.insert(key, i);
-            }
-        }
-        if !path.is_empty() {
-            self.parts.entry(id).or_default().push(i);
-        }
+        self.list.push(PlaceRow {
+            id,
+            from,
+            to: self.paths.len() as u32,
+            next,
+            next_part: Self::NONE,
+        });
         i
     }
 
@@ -578,28 +733,28 @@ impl Places {
     #[inline]
     fn get(&self, id: Id, path: &[u32]) -> Option<u32> {
         if path.is_empty() {
-            if let Some(k) = self.slot(id) {
-                return Some(self.whole[k]).filter(|&i| i != Self::NONE);
-            }
+            let k = self.slot(id)?;
+            return Some(self.slots[k].whole).filter(|&i| i != Self::NONE);
         }
         self.find(*self.first.get(&(id, Self::path_hash(path)))?, path)
     }
 
-    /// Every place of `id` met so far (the whole, then its parts), by index.
-    fn of(&self, id: Id) -> impl Iterator<Item = u32> + '_ {
-        self.get(id, &[]).into_iter().chain(
-            self.parts
-                .get(&id)
-                .map_or(&[][..], Vec::as_slice)
-                .iter()
-                .copied(),
-        )
+    /// Every place of `id` met so far (the whole, then its parts in the
+    /// order met), by index.
+    #[inline]
+    fn of(&self, id: Id) -> PlacesOf<'_> {
+        let slot = self.slot(id).map_or(Slot::NONE, |k| self.slots[k]);
+        PlacesOf {
+            whole: slot.whole,
+            part: slot.part_first,
+            list: &self.list,
+        }
     }
 
     #[inline]
     fn place(&self, i: u32) -> (Id, &[u32]) {
-        let (id, from, to) = self.list[i as usize];
-        (id, &self.paths[from as usize..to as usize])
+        let p = &self.list[i as usize];
+        (p.id, &self.paths[p.from as usize..p.to as usize])
     }
 }
 
@@ -731,6 +886,21 @@ impl<T> IdMap<T> {
     }
 }
 
+impl IdMap<LocalPtr> {
+    /// Adds variable (or pointer parameter) `var` as its own root.
+    fn insert_whole(&mut self, var: Id) {
+        let k = self.index.find_or_add(var, self.values.len() as u32);
+        let ptr = LocalPtr::whole(var, k);
+        match self.values.get_mut(k as usize) {
+            Some(v) => *v = ptr,
+            None => {
+                self.values.push(ptr);
+                self.keys.push(var);
+            }
+        }
+    }
+}
+
 /// A set of the ids one function defines (see [`IdMap`]).
 type IdSet = IdMap<()>;
 
@@ -750,6 +920,9 @@ impl IdSet {
 #[derive(Clone, Copy, Debug)]
 struct LocalPtr {
     var: Id,
+    /// The variable's ordinal among the function's roots (its mentions'
+    /// key, found without another lookup).
+    root: u32,
     /// Constant indices from the variable, up to the first dynamic one:
     /// `FnLiveness::paths[path.0..path.1]` (one list for the function's
     /// pointers, not a vector each).
@@ -759,10 +932,11 @@ struct LocalPtr {
 }
 
 impl LocalPtr {
-    /// The whole of variable (or pointer parameter) `var`.
-    fn whole(var: Id) -> LocalPtr {
+    /// The whole of variable (or pointer parameter) `var`, root `root`.
+    fn whole(var: Id, root: u32) -> LocalPtr {
         LocalPtr {
             var,
+            root,
             path: (0, 0),
             exact: true,
         }
@@ -820,7 +994,8 @@ struct Builds {
 /// One instruction's backward transfer, prepared before solving.
 #[derive(Clone, Debug)]
 enum Step {
-    /// Debug info: reads and writes nothing.
+    /// Reads and writes no place: debug info, and every instruction that
+    /// neither mentions a variable nor writes, calls or takes a parameter.
     Skip,
     /// Kills place `def` (or none: [`Places::NONE`]), then makes the places
     /// `FnLiveness::step_uses[uses]` live.
@@ -857,17 +1032,6 @@ enum Segment {
 
 /// Parts are tracked separately up to this many elements per composite.
 const MAX_SPLIT: u32 = 64;
-
-/// Variables possibly written on some path to each block's end.
-struct Defined {
-    /// Per block (a row of `w` words each), as indices among the
-    /// variables something writes.
-    out: Vec<u64>,
-    w: usize,
-    /// Each variable's index there (by its ordinal among the function's
-    /// variables), or [`IdIndex::NONE`] when nothing writes it.
-    slot: Vec<u32>,
-}
 
 /// The blocks of a function whose liveness a site can see: those reachable
 /// from the blocks of the instructions it is asked about (the sites and the
@@ -1089,7 +1253,7 @@ impl SsaLive {
     #[inline]
     fn reads<'a>(&'a self, fl: &'a FnLiveness, i: usize) -> impl Iterator<Item = u32> + 'a {
         let body = &fl.body;
-        let ids = if body.op(i) != Op::Phi && fl.copy[i - body.start()] == Copy::None {
+        let ids = if body.op(i) != Op::Phi && fl.copy_at(i) == Copy::None {
             body.ids(i)
         } else {
             &[]
@@ -1097,22 +1261,29 @@ impl SsaLive {
         ids.iter().filter_map(|&id| self.ordinal(id))
     }
 
-    /// The values live just after instruction `inst` of block `b`.
-    fn after(&self, fl: &FnLiveness, b: usize, inst: usize) -> Vec<Id> {
+    /// The values live just after instruction `inst` of block `b`, each
+    /// given to `each` (`live` is room for the set, reused).
+    fn after(
+        &self,
+        fl: &FnLiveness,
+        b: usize,
+        inst: usize,
+        live: &mut Vec<u64>,
+        mut each: impl FnMut(Id),
+    ) {
         let w = self.words;
-        let mut live = self.live_out[b * w..(b + 1) * w].to_vec();
+        live.clear();
+        live.extend_from_slice(&self.live_out[b * w..(b + 1) * w]);
         for &k in fl.body.block_after(b, inst).iter().rev() {
-            self.step(fl, k as usize, &mut live);
+            self.step(fl, k as usize, live);
         }
-        let mut out = Vec::new();
         for (k, &word) in live.iter().enumerate() {
             let mut rest = word;
             while rest != 0 {
-                out.push(self.ids[k * 64 + rest.trailing_zeros() as usize]);
+                each(self.ids[k * 64 + rest.trailing_zeros() as usize]);
                 rest &= rest - 1;
             }
         }
-        out
     }
 }
 
@@ -1188,9 +1359,20 @@ type Stored = ((u32, u32), Id);
 /// and paths stored to.
 type Spare = (Vec<Vec<usize>>, Vec<Vec<Stored>>);
 
-/// A variable read at an instruction, in the parts read (sorted), each
-/// part as its length then its indices: one vector, not one per part.
-type RematKey = (Id, usize, Vec<u32>);
+/// Variables' recomputability as read at an instruction, once asked: per
+/// question, the parts read (sorted, each part as its length then its
+/// indices, `flat[from..to]`: one pool, not a vector per question), the
+/// answer, and the next question about the same variable and instruction
+/// ([`RematAnswers::NONE`]: none). `FnLiveness::remat_at` gives the first.
+#[derive(Default)]
+struct RematAnswers {
+    list: Vec<(u32, u32, bool, u32)>,
+    flat: Vec<u32>,
+}
+
+impl RematAnswers {
+    const NONE: u32 = u32::MAX;
+}
 
 /// Whether each SSA value is recomputable, once worked out: a byte per id
 /// (the module's ids are dense), hashing only ids past a bound a sparse
@@ -1215,6 +1397,7 @@ impl RematMemo {
         }
     }
 
+    #[inline]
     fn insert(&mut self, id: Id, r: bool) {
         let k = id as usize;
         if k >= Self::DENSE {
@@ -1247,7 +1430,8 @@ pub struct FnLiveness {
     /// `OpLoad`s of a whole local part whose only use is the store right
     /// after them into another local part (a copy, such as glslang's
     /// copy-in of an `inout` argument): per instruction from the
-    /// function's start, the store (with its load's index) and the load.
+    /// function's start, the store (with its load's index) and the load
+    /// (empty when the function has none: see `copy_at`).
     copy: Vec<Copy>,
     /// The function's SSA values, in the order defined.
     ssa_ids: Vec<Id>,
@@ -1260,17 +1444,13 @@ pub struct FnLiveness {
     live_out: Rows,
     /// Every place met while solving (the live sets' members).
     places: RefCell<Places>,
-    /// Variables possibly written at each block's end (as indices into
-    /// [`Defined::written`]): only asked where a site is, so worked out
-    /// on first use (a callee solved for its parameters never asks).
-    defined: std::cell::OnceCell<Defined>,
     preds: crate::program::cfg::Preds,
     remat: RefCell<RematMemo>,
     /// Variables' rematerialisation as read at an instruction.
-    remat_at: RefCell<HashMap<RematKey, u32>>,
+    remat_at: RefCell<HashMap<(Id, usize), u32>>,
     /// The answers of `remat_at`, by the slot it gives (so the key is
     /// moved into the table once, not copied for an answer in progress).
-    remat_ok: RefCell<Vec<bool>>,
+    remat_ok: RefCell<RematAnswers>,
     /// Vectors the recomputability questions reuse (they nest): reaching
     /// writes, and the paths stored to.
     spare: RefCell<Spare>,
@@ -1297,20 +1477,42 @@ pub struct FnLiveness {
 }
 
 /// Root `k`'s mentions grouped by block, once asked: `runs[at[k].0..at[k].1]`,
-/// each (block, from, to) into its mention list, in order.
+/// each (block, from, to) into its mention list, in order. By the root's
+/// ordinal (`at[k].0 == u32::MAX`: not grouped yet), not hashed.
 #[derive(Default)]
 struct MentionBlocks {
-    at: HashMap<usize, (u32, u32)>,
+    at: Vec<(u32, u32)>,
     runs: Vec<(u32, u32, u32)>,
 }
 
-/// What a reaching-writes walk reuses: the blocks to visit, those seen,
-/// and each block's span of the variable's mentions.
+/// What a walk over blocks reuses: the blocks to visit, each block's span
+/// of the variable's mentions, and per block the stamp of the last walk
+/// that saw it (`seen`) or found a write of the variable in it (`wrote`):
+/// a new stamp per walk instead of clearing a flag per block.
 #[derive(Default)]
 struct Walk {
     work: Vec<(usize, usize)>,
-    seen: Vec<bool>,
+    seen: Vec<u32>,
+    wrote: Vec<u32>,
+    stamp: u32,
     span: Vec<(u32, u32)>,
+}
+
+impl Walk {
+    /// A fresh stamp for a walk over `n` blocks.
+    fn start(&mut self, n: usize) -> u32 {
+        if self.seen.len() < n {
+            self.seen.resize(n, 0);
+            self.wrote.resize(n, 0);
+        }
+        self.stamp = self.stamp.wrapping_add(1);
+        if self.stamp == 0 {
+            self.seen.fill(0);
+            self.wrote.fill(0);
+            self.stamp = 1;
+        }
+        self.stamp
+    }
 }
 
 impl FnLiveness {
@@ -1580,13 +1782,14 @@ impl FnLiveness {
         // the dense tables; so are debug-info instructions' (our HLSL
         // compiler numbers them after every function), which nothing here
         // looks up.
-        let body = Body::new(program, f);
+        // One walk decodes each instruction and classifies its result.
+        let mut body = Body::begin(program, f);
         let (lo, hi) = (body.lo, body.hi);
         let mut vars = IdSet::new(lo, hi);
         let mut roots: IdMap<LocalPtr> = IdMap::new(lo, hi);
         // Room made once (growing these was a good part of the allocations):
         // about a pointer and a value an instruction at most.
-        let n_insts = body.kept().len();
+        let n_insts = f.end + 1 - f.start;
         roots.values.reserve(n_insts);
         roots.keys.reserve(n_insts);
         let mut paths: Vec<u32> = Vec::with_capacity(2 * n_insts);
@@ -1595,49 +1798,88 @@ impl FnLiveness {
         let mut ssa_ids: Vec<Id> = Vec::with_capacity(n_insts);
         // Copies from one local part to another: `%v = OpLoad %a; OpStore %b %v`
         // with `%v` used nowhere else and nothing between the two.
-        // Candidates first (met in this walk); then the uses of their
-        // loaded values only.
+        // Candidates are met in this walk, which goes on to count the uses
+        // of their loaded values.
         let mut candidates: Vec<(usize, usize, Id)> = Vec::new();
         let mut calls: Vec<usize> = Vec::new();
+        // The instructions whose backward step can be more than nothing
+        // (see `prepare_steps`): those that store, copy, call, declare a
+        // variable or take a parameter, phis (which may name a pointer
+        // defined further on), and those with a root among their operands,
+        // found here, as each operand is read.
+        let mut touched: Vec<u32> = Vec::with_capacity(n_insts);
         let mut prev: Option<usize> = None;
-        for &i in body.kept() {
-            let i = i as usize;
-            let op = body.op(i);
+        // The candidates' loaded values, and their uses counted as met
+        // (after its load, only a phi can name a value before its
+        // definition: phis are counted at the end).
+        let mut loaded: Option<(IdSet, Vec<usize>)> = None;
+        let mut phis: Vec<usize> = Vec::new();
+        // (An exclusive range: an inclusive one's iterator costs more.)
+        for i in f.start..f.end + 1 {
+            let Some((op, result, from)) = body.push(program, i) else {
+                continue;
+            };
+            let ids = body.ids_from(from);
+            let touches = matches!(
+                op,
+                Op::Store
+                    | Op::CopyMemory
+                    | Op::CopyMemorySized
+                    | Op::FunctionCall
+                    | Op::Variable
+                    | Op::FunctionParameter
+                    | Op::Phi
+            ) || ids.iter().any(|id| roots.contains_key(id));
+            if touches {
+                touched.push(i as u32);
+            }
             if op == Op::Label {
                 // A copy's load and store lie in one block.
                 prev = None;
             }
             if let Some(l) = prev.replace(i) {
                 if body.op(l) == Op::Load && op == Op::Store {
-                    let (ld, st) = (body.ids(l), body.ids(i));
+                    let (ld, st) = (body.ids(l), ids);
                     if let (Some(v), Some(&src)) = (body.result(l), ld.first()) {
                         let exact = |p: Id| roots.get(&p).is_some_and(|r| r.exact);
                         if st.len() == 2 && st[1] == v && exact(src) && exact(st[0]) {
                             candidates.push((i, l, v));
+                            let (set, uses) =
+                                loaded.get_or_insert_with(|| (IdMap::new(lo, hi), Vec::new()));
+                            set.add(v);
+                            uses.resize(set.len(), 0);
                         }
+                    }
+                }
+            }
+            if op == Op::Phi {
+                phis.push(i);
+            } else if let Some((set, uses)) = &mut loaded {
+                for id in ids {
+                    if let Some(k) = set.ordinal(*id) {
+                        uses[k] += 1;
                     }
                 }
             }
             if op == Op::FunctionCall {
                 calls.push(i);
             }
-            let Some(r) = body.result(i) else { continue };
+            let Some(r) = result else { continue };
             match op {
                 // A pointer parameter is tracked like a variable (its
                 // contents belong to the caller, which counts them).
                 Op::FunctionParameter if is_pointer_type(program, program.insts[i].result_type) => {
-                    roots.insert(r, LocalPtr::whole(r));
+                    roots.insert_whole(r);
                 }
                 Op::Variable => {
                     vars.add(r);
-                    roots.insert(r, LocalPtr::whole(r));
+                    roots.insert_whole(r);
                 }
                 Op::AccessChain
                 | Op::InBoundsAccessChain
                 | Op::PtrAccessChain
                 | Op::CopyObject
                 | Op::Bitcast => {
-                    let ids = body.ids(i);
                     match ids.first().and_then(|b| roots.get(b)).copied() {
                         Some(mut ptr) => {
                             let chain = matches!(op, Op::AccessChain | Op::InBoundsAccessChain);
@@ -1666,20 +1908,15 @@ impl FnLiveness {
                 _ => ssa_ids.push(r),
             }
         }
+        body.finish(f);
         let preds = crate::program::cfg::Preds::of(f);
         // Per instruction: the load a copy's store copies from, or that a
         // load is a copy's (read at the store).
-        let mut copy = vec![Copy::None; f.end + 1 - f.start];
-        if !candidates.is_empty() {
-            // Counted by the loaded values' ordinals: a dense lookup per
-            // operand of every instruction, not a hash.
-            let mut loaded: IdSet = IdMap::new(lo, hi);
-            for c in &candidates {
-                loaded.add(c.2);
-            }
-            let mut uses = vec![0usize; loaded.len()];
-            for &i in body.kept() {
-                for id in body.ids(i as usize) {
+        // (Empty when there is none: most functions.)
+        let mut copy = Vec::new();
+        if let Some((loaded, mut uses)) = loaded {
+            for &p in &phis {
+                for id in body.ids(p) {
                     if let Some(k) = loaded.ordinal(*id) {
                         uses[k] += 1;
                     }
@@ -1687,6 +1924,7 @@ impl FnLiveness {
             }
             for (store, load, v) in candidates {
                 if loaded.ordinal(v).map(|k| uses[k]) == Some(1) {
+                    copy.resize(f.end + 1 - f.start, Copy::None);
                     copy[store - f.start] = Copy::Store(load as u32);
                     copy[load - f.start] = Copy::Load;
                 }
@@ -1719,8 +1957,7 @@ impl FnLiveness {
             focus,
             ssa: std::cell::OnceCell::new(),
             live_out: Rows::default(),
-            places: RefCell::new(Places::new(lo, hi, f.end + 1 - f.start)),
-            defined: std::cell::OnceCell::new(),
+            places: RefCell::new(Places::new(lo, hi, &f.params, f.end + 1 - f.start)),
             preds,
             remat: RefCell::default(),
             remat_at: RefCell::default(),
@@ -1734,15 +1971,16 @@ impl FnLiveness {
             mentions: std::cell::OnceCell::new(),
             mention_blocks: RefCell::default(),
         };
-        fl.prepare_steps(program);
+        fl.prepare_steps(program, &touched);
         fl.solve(program);
         (fl, exact)
     }
 
     /// Prepares the backward transfer of every instruction that only kills
     /// its result and reads its operands (most of them), so the fixpoint
-    /// does no lookups for those.
-    fn prepare_steps(&mut self, program: &Program) {
+    /// does no lookups for those. Only the instructions `touched` (in
+    /// order) can do more than nothing: the others skip.
+    fn prepare_steps(&mut self, program: &Program, touched: &[u32]) {
         let f = &program.functions[self.func];
         let places = self.places.get_mut();
         let mut steps = vec![Step::Skip; f.end + 1 - f.start];
@@ -1754,10 +1992,10 @@ impl FnLiveness {
         let mut mentions = MentionPairs::new(self.roots.len(), f.end + 1 - f.start);
         let body = &self.body;
         let mut others = 0;
-        for &at in body.kept() {
+        for &at in touched {
             let at = at as usize;
             let op = body.op(at);
-            let copy = self.copy[at - f.start];
+            let copy = self.copy.get(at - f.start).copied().unwrap_or(Copy::None);
             let other = matches!(copy, Copy::Store(_))
                 || matches!(
                     op,
@@ -1770,8 +2008,10 @@ impl FnLiveness {
             // Only SSA values and variables (pointer parameters) are ever
             // places; another result cannot be live.
             let result = body.result(at);
+            // (Only a pointer parameter is its own root and not `other`: a
+            // variable is `other`, a derived pointer's root is its base's.)
             let def = match result {
-                Some(r) if !other => {
+                Some(r) if op == Op::FunctionParameter => {
                     if self.roots.get(&r).is_some_and(|p| p.var == r) {
                         places.intern(r, &[])
                     } else {
@@ -1787,13 +2027,14 @@ impl FnLiveness {
             let reads = !(other || op == Op::Phi || copy == Copy::Load);
             let derives = derives_pointer(op);
             let start = pool.len() as u32;
-            if let Some(r) = result.filter(|r| self.vars.contains(r)) {
+            // (Only an `OpVariable` defines a variable.)
+            if let Some(r) = result.filter(|r| op == Op::Variable && self.vars.contains(r)) {
                 mentions.add(&self.roots, at, r);
             }
             for &id in body.ids(at) {
                 let root = self.roots.get(&id);
                 if let Some(p) = root {
-                    mentions.add(&self.roots, at, p.var);
+                    mentions.add_root(at, p.root);
                 }
                 if !reads {
                     continue;
@@ -1858,7 +2099,7 @@ impl FnLiveness {
         };
         for b in 0..f.blocks.len() {
             block_segments.push(segments.len() as u32);
-            for &at in self.body.block(b).iter().rev() {
+            for &at in Body::in_block(touched, f, b).iter().rev() {
                 let at = at as usize;
                 match &steps[at - f.start] {
                     Step::Skip => {}
@@ -1916,6 +2157,13 @@ impl FnLiveness {
         }
     }
 
+    /// Whether instruction `i` is half of a copy.
+    #[inline]
+    fn copy_at(&self, i: usize) -> Copy {
+        let k = i - self.body.start();
+        self.copy.get(k).copied().unwrap_or(Copy::None)
+    }
+
     fn function<'p>(&self, program: &'p Program) -> &'p Function {
         &program.functions[self.func]
     }
@@ -1965,7 +2213,7 @@ impl FnLiveness {
                 }
             }
         }
-        let copy = self.copy[at - start];
+        let copy = self.copy_at(at);
         if let Copy::Store(load) = copy {
             // A copy: the parts of the target live after it were the same
             // parts of the source.
@@ -2209,110 +2457,47 @@ impl FnLiveness {
         self.live_out = live_out;
     }
 
-    /// Variables possibly written on some path to each block's end.
-    fn defined(&self, program: &Program) -> &Defined {
-        self.defined.get_or_init(|| {
-            let f = self.function(program);
-            let n = f.blocks.len();
-            // What each block writes itself is the same every round. Only
-            // variables are asked about, and only an instruction that
-            // mentions one can write it: each variable's mentions, not
-            // every instruction.
-            let mut written = 0u32;
-            let mut slot = vec![IdIndex::NONE; self.vars.keys.len()];
-            // (block, index) pairs first: the rows' width is the number of
-            // variables written, known only at the end.
-            let mut writes: Vec<(usize, u32)> = Vec::new();
-            for (ordinal, &var) in self.vars.keys.iter().enumerate() {
-                let Some(mentions) = self.mentions(program, var) else {
-                    continue;
-                };
-                let k = written;
-                let mut any = false;
-                for &i in mentions.iter() {
-                    let mut hit = false;
-                    self.writes(program, i, |id| hit |= id == var);
-                    if let Some(b) = hit.then(|| block_at(f, i)).flatten() {
-                        writes.push((b, k));
-                        any = true;
-                    }
-                }
-                if any {
-                    slot[ordinal] = k;
-                    written += 1;
-                }
-            }
-            let w = (written as usize).div_ceil(64);
-            let mut own = vec![0u64; n * w];
-            for (b, k) in writes {
-                set(&mut own[b * w..(b + 1) * w], k);
-            }
-            // Forward, by a worklist over flat rows (a set per block and a
-            // clone per visit before).
-            let mut out = own.clone();
-            let mut work = Worklist::new(n, (0..n).rev());
-            let mut d = vec![0u64; w];
-            while let Some(b) = work.pop() {
-                d.copy_from_slice(&own[b * w..(b + 1) * w]);
-                for &p in &self.preds[b] {
-                    for k in 0..w {
-                        d[k] |= out[p * w + k];
-                    }
-                }
-                if d[..] != out[b * w..(b + 1) * w] {
-                    out[b * w..(b + 1) * w].copy_from_slice(&d);
-                    for &s in &f.blocks[b].succs {
-                        if s < n {
-                            work.push(s);
-                        }
-                    }
-                }
-            }
-            Defined { out, w, slot }
-        })
-    }
-
     /// Ids live just after instruction `inst` (SSA values and variables).
     pub fn live_after(&self, program: &Program, inst: usize) -> HashSet<Id> {
-        self.places_after(program, inst)
-            .into_iter()
-            .map(|(id, _)| id)
-            .collect()
+        let mut places = SitePlaces::default();
+        self.places_after(program, inst, &mut places);
+        places.list.iter().map(|&(id, _, _)| id).collect()
     }
 
-    /// SSA values and parts of variables live just after instruction `inst`
-    /// (each once).
-    fn places_after(&self, program: &Program, inst: usize) -> Vec<Place> {
-        let Some((b, live)) = self.live_parts_after(program, inst) else {
-            return Vec::new();
-        };
-        let mut out: Vec<Place> = self.owned_places(&live);
-        let ssa = self.ssa.get_or_init(|| SsaLive::new(self, program));
-        out.extend(
-            ssa.after(self, b, inst)
-                .into_iter()
-                .map(|id| (id, Vec::new())),
-        );
-        out
-    }
-
-    /// The places of the parts in `live`, as owned (id, path) pairs.
-    fn owned_places<C: FromIterator<Place>>(&self, live: &BitSet) -> C {
-        let places = self.places.borrow();
-        live.iter()
-            .map(|i| {
-                let (id, path) = places.place(i);
-                (id, path.to_vec())
-            })
-            .collect()
+    /// Adds the SSA values and parts of variables live just after
+    /// instruction `inst` to `out` (each once).
+    fn places_after(&self, program: &Program, inst: usize, out: &mut SitePlaces) {
+        let mut live = std::mem::take(&mut out.live);
+        if let Some(b) = self.live_parts_into(program, inst, &mut live) {
+            {
+                let places = self.places.borrow();
+                for i in live.iter() {
+                    let (id, path) = places.place(i);
+                    out.push(id, path);
+                }
+            }
+            let ssa = self.ssa.get_or_init(|| SsaLive::new(self, program));
+            let mut words = std::mem::take(&mut out.words);
+            ssa.after(self, b, inst, &mut words, |id| out.push(id, &[]));
+            out.words = words;
+        }
+        out.live = live;
     }
 
     /// The block of instruction `inst`, and the places of the parts live
     /// just after it (by index).
     fn live_parts_after(&self, program: &Program, inst: usize) -> Option<(usize, BitSet)> {
+        let mut live = BitSet::default();
+        let b = self.live_parts_into(program, inst, &mut live)?;
+        Some((b, live))
+    }
+
+    /// The block of instruction `inst`; `live` := the places of the parts
+    /// live just after it (by index).
+    fn live_parts_into(&self, program: &Program, inst: usize, live: &mut BitSet) -> Option<usize> {
         let f = self.function(program);
         let b = block_at(f, inst)?;
-        let mut live = BitSet::default();
+        live.clear();
         live.union_words(self.live_out.row(b));
         // The block's folded segments wholly after `inst` first (a callee's
         // entry asks about the whole block), then instruction by
@@ -2327,15 +2512,15 @@ impl FnLiveness {
             if first <= inst {
                 break;
             }
-            self.segment_back(program, seg, &mut live);
+            self.segment_back(program, seg, live);
             below = first;
         }
         for &k in self.body.block_after(b, inst).iter().rev() {
             if (k as usize) < below {
-                self.step_back(program, k as usize, &mut live);
+                self.step_back(program, k as usize, live);
             }
         }
-        Some((b, live))
+        Some(b)
     }
 
     /// Bytes of the live parts of variable `var` (of type `ty`): all of it
@@ -2367,102 +2552,134 @@ impl FnLiveness {
     }
 
     /// Whether variable `var` may be written before instruction `inst`
-    /// (on some path to it): asked only of the live variables, so their
-    /// own writes are looked up, not a set of all built.
+    /// (on some path to it): asked only of the live variables, so only
+    /// their own writes are looked at. A write earlier in the block, or
+    /// one in a block with a path to it (a walk back over the
+    /// predecessors), not a forward solution for every variable.
     fn written_before(&self, program: &Program, var: Id, inst: usize) -> bool {
         let f = self.function(program);
         let Some(b) = block_at(f, inst) else {
             return false;
         };
-        let defined = self.defined(program);
-        let slot = self
-            .vars
-            .ordinal(var)
-            .map_or(IdIndex::NONE, |k| defined.slot[k]);
-        let w = defined.w;
-        if slot != IdIndex::NONE
-            && self.preds[b]
-                .iter()
-                .any(|&p| defined.out[p * w + slot as usize / 64] >> (slot % 64) & 1 == 1)
-        {
-            return true;
-        }
         // Only an instruction that mentions `var` can write it.
         let Some(mentions) = self.mentions(program, var) else {
             return false;
         };
+        let writes = |k: usize| self.mention_writes(program, k, var);
         let from = mentions.partition_point(|&i| i < f.blocks[b].start);
         let to = mentions.partition_point(|&i| i < inst);
-        mentions[from..to.max(from)].iter().any(|&k| {
-            let mut hit = false;
-            self.writes(program, k, |id| hit |= id == var);
-            hit
-        })
+        if mentions[from..to.max(from)].iter().any(|&k| writes(k)) {
+            return true;
+        }
+        let mut mb = self.mention_blocks.borrow_mut();
+        let runs = self.mention_runs(&mut mb, program, var, &mentions);
+        let mut walk = self.walk.borrow_mut();
+        let stamp = walk.start(f.blocks.len());
+        let Walk {
+            work, seen, wrote, ..
+        } = &mut *walk;
+        let mut any = false;
+        for &(wb, from, to) in runs {
+            if mentions[from as usize..to as usize]
+                .iter()
+                .any(|&k| writes(k))
+            {
+                wrote[wb as usize] = stamp;
+                any = true;
+            }
+        }
+        if !any {
+            return false;
+        }
+        // The blocks with a path to `b`: any of them that writes `var`.
+        work.clear();
+        work.push((b, 0));
+        while let Some((c, _)) = work.pop() {
+            for &p in &self.preds[c] {
+                if seen[p] != stamp {
+                    if wrote[p] == stamp {
+                        return true;
+                    }
+                    seen[p] = stamp;
+                    work.push((p, 0));
+                }
+            }
+        }
+        false
     }
 
-    /// The places in this function that call `call` passes for the
-    /// callee's parameter parts in `params` (parameter index, path).
-    fn arguments_of(
-        &self,
-        program: &Program,
-        call: usize,
-        params: &[(usize, Vec<u32>)],
-    ) -> Vec<Place> {
-        let _ = program;
+    /// Whether instruction `i`, which mentions variable `var`, may write it
+    /// (as [`FnLiveness::writes`] says): without looking through its
+    /// operands again, since mentioning `var` is having an operand in it
+    /// (or being its `OpVariable`).
+    #[inline]
+    fn mention_writes(&self, program: &Program, i: usize, var: Id) -> bool {
+        let body = &self.body;
+        match body.op(i) {
+            Op::Load | Op::AccessChain | Op::InBoundsAccessChain | Op::PtrAccessChain => false,
+            _ if body.debug(i) => false,
+            // An initializer, or no write; an odd instruction that defines
+            // `var` as well as mentioning it, looked at in full.
+            Op::Variable => self.writes_var(program, i, var),
+            _ if body.result(i) == Some(var) => self.writes_var(program, i, var),
+            _ => true,
+        }
+    }
+
+    /// Whether instruction `i` may write variable `var` (see
+    /// [`FnLiveness::writes`]).
+    fn writes_var(&self, program: &Program, i: usize, var: Id) -> bool {
+        let mut hit = false;
+        self.writes(program, i, |id| hit |= id == var);
+        hit
+    }
+
+    /// Adds to `out` the places in this function that call `call` passes
+    /// for the callee's parameter parts in `params` (parameter index, path).
+    fn arguments_of(&self, call: usize, params: &SitePlaces, out: &mut SitePlaces) {
         if self.body.op(call) != Op::FunctionCall {
-            return Vec::new();
+            return;
         }
         let args = &self.body.ids(call)[1..];
-        params
-            .iter()
-            .filter_map(|(k, path)| {
-                let root = self.roots.get(args.get(*k)?)?;
-                let mut p = self.path(root).to_vec();
-                if root.exact {
-                    p.extend_from_slice(path);
-                }
-                Some((root.var, p))
-            })
-            .collect()
+        for (k, &(param, _, _)) in params.list.iter().enumerate() {
+            let Some(root) = args.get(param as usize).and_then(|a| self.roots.get(a)) else {
+                continue;
+            };
+            if root.exact {
+                out.push_joined(root.var, self.path(root), params.path(k));
+            } else {
+                out.push(root.var, self.path(root));
+            }
+        }
     }
 
-    /// Parts behind this function's pointer parameters among the `places`
-    /// live across an instruction, by parameter index.
-    fn param_parts_across(&self, program: &Program, places: &[Place]) -> Vec<(usize, Vec<u32>)> {
+    /// `out` := the parts behind this function's pointer parameters among
+    /// the `places` live across an instruction, by parameter index.
+    fn param_parts_across(&self, program: &Program, places: &SitePlaces, out: &mut SitePlaces) {
         let f = self.function(program);
-        let mut out: Vec<(usize, Vec<u32>)> = places
-            .iter()
-            .filter_map(|(v, path)| Some((f.params.iter().position(|p| p == v)?, path.clone())))
-            .collect();
-        out.sort();
-        out
+        out.clear();
+        for (k, &(v, _, _)) in places.list.iter().enumerate() {
+            if let Some(param) = f.params.iter().position(|&p| p == v) {
+                out.push(param as Id, places.path(k));
+            }
+        }
     }
 
     /// The values among `places` (those live just after instruction
     /// `inst`, with the caller's parts passed to this function) that count
     /// across `inst`; with `described`, named, typed and placed too.
-    pub fn live_across(
-        &mut self,
+    fn live_across(
+        &self,
         program: &Program,
         inst: usize,
-        places: &[Place],
+        places: &SitePlaces,
         described: bool,
-    ) -> Vec<LiveValue> {
+        mut each: impl FnMut(LiveValue),
+    ) {
         // The places by id: each value's parts side by side, in order
-        // (the caller's come sorted; a copy only otherwise).
-        let copy: Vec<Place>;
-        let by_id: &[Place] = if places.is_sorted() {
-            places
-        } else {
-            copy = {
-                let mut v = places.to_vec();
-                v.sort();
-                v
-            };
-            &copy
-        };
+        // (see `SitePlaces::sort`).
+        let by_id = &places.list;
         let result = self.body.result(inst);
-        let mut out = Vec::new();
         let mut k = 0;
         while k < by_id.len() {
             let id = by_id[k].0;
@@ -2470,7 +2687,7 @@ impl FnLiveness {
             while k < by_id.len() && by_id[k].0 == id {
                 k += 1;
             }
-            let parts = &by_id[from..k];
+            let parts = (from..k).map(|j| places.path(j));
             if Some(id) == result {
                 continue;
             }
@@ -2499,12 +2716,12 @@ impl FnLiveness {
                 _ => {}
             }
             let rematerializable = if is_var {
-                self.remat_var(program, id, inst, parts.iter().map(|(_, p)| &p[..]), 0)
+                self.remat_var(program, id, inst, parts.clone(), 0)
             } else {
                 self.remat_ssa(program, id, 0)
             };
             let size = if is_var {
-                FnLiveness::live_part_size(program, ty, parts.iter().map(|(_, p)| &p[..]))
+                FnLiveness::live_part_size(program, ty, parts)
             } else {
                 scalar_size(program, ty).unwrap_or(0)
             };
@@ -2514,7 +2731,7 @@ impl FnLiveness {
                 Storage::Ssa
             };
             if !described {
-                out.push(LiveValue {
+                each(LiveValue {
                     name: String::new(),
                     ty: String::new(),
                     size,
@@ -2552,7 +2769,7 @@ impl FnLiveness {
                 None
             };
             let use_at = self.first_use_after(program, inst, id, mentions.as_deref());
-            out.push(LiveValue {
+            each(LiveValue {
                 name: value_name(program, id, def.as_ref()),
                 ty: program.type_name(ty),
                 size,
@@ -2565,7 +2782,6 @@ impl FnLiveness {
                 use_at,
             });
         }
-        out
     }
 
     fn reads(&self, i: usize, id: Id) -> bool {
@@ -2774,31 +2990,44 @@ impl FnLiveness {
         parts: impl Iterator<Item = &'a [u32]> + Clone,
         depth: u32,
     ) -> bool {
-        // The parts in order, flattened into the key (see `RematKey`); the
-        // callers' come sorted.
-        let mut flat = Vec::with_capacity(parts.clone().map(|p| p.len() + 1).sum());
-        let mut push = |p: &[u32]| {
-            flat.push(p.len() as u32);
-            flat.extend_from_slice(p);
-        };
-        if parts.clone().is_sorted() {
-            parts.clone().for_each(&mut push);
-        } else {
-            let mut sorted: Vec<&[u32]> = parts.clone().collect();
-            sorted.sort();
-            sorted.into_iter().for_each(&mut push);
-        }
-        let key = (var, at, flat);
-        if let Some(&k) = self.remat_at.borrow().get(&key) {
-            return self.remat_ok.borrow()[k as usize];
-        }
-        // In progress: a question that comes back to itself answers no.
+        // The parts in order, flattened at the end of the pool (see
+        // `RematAnswers`); the callers' come sorted.
         let slot = {
             let mut answers = self.remat_ok.borrow_mut();
-            answers.push(false);
-            answers.len() - 1
+            let RematAnswers { list, flat } = &mut *answers;
+            let from = flat.len();
+            let mut push = |p: &[u32]| {
+                flat.push(p.len() as u32);
+                flat.extend_from_slice(p);
+            };
+            if parts.clone().is_sorted() {
+                parts.clone().for_each(&mut push);
+            } else {
+                let mut sorted: Vec<&[u32]> = parts.clone().collect();
+                sorted.sort();
+                sorted.into_iter().for_each(&mut push);
+            }
+            let to = flat.len();
+            let first = self
+                .remat_at
+                .borrow()
+                .get(&(var, at))
+                .copied()
+                .unwrap_or(RematAnswers::NONE);
+            let mut q = first;
+            while q != RematAnswers::NONE {
+                let (f, t, ok, next) = list[q as usize];
+                if same_path(&flat[f as usize..t as usize], &flat[from..to]) {
+                    flat.truncate(from);
+                    return ok;
+                }
+                q = next;
+            }
+            // In progress: a question that comes back to itself answers no.
+            list.push((from as u32, to as u32, false, first));
+            list.len() - 1
         };
-        self.remat_at.borrow_mut().insert(key, slot as u32);
+        self.remat_at.borrow_mut().insert((var, at), slot as u32);
         let no_parts = parts.clone().next().is_none();
         let mentions = self.mentions(program, var);
         let (mut reaching, mut stored) = {
@@ -2886,7 +3115,7 @@ impl FnLiveness {
                 break;
             }
         }
-        self.remat_ok.borrow_mut()[slot] = ok;
+        self.remat_ok.borrow_mut().list[slot].2 = ok;
         let mut spare = self.spare.borrow_mut();
         spare.0.push(reaching);
         spare.1.push(stored);
@@ -2918,7 +3147,9 @@ impl FnLiveness {
 struct MentionPairs {
     n: usize,
     pairs: Vec<(u32, usize)>,
-    last: Vec<usize>,
+    /// Where the pairs of the instruction met last start (a root is
+    /// listed once per instruction).
+    at: usize,
 }
 
 impl MentionPairs {
@@ -2928,7 +3159,7 @@ impl MentionPairs {
         MentionPairs {
             n,
             pairs: Vec::with_capacity(if n == 0 { 0 } else { insts }),
-            last: vec![usize::MAX; n],
+            at: 0,
         }
     }
 
@@ -2949,17 +3180,31 @@ impl MentionPairs {
     /// into it), met in order.
     #[inline]
     fn add(&mut self, roots: &IdMap<LocalPtr>, i: usize, v: Id) {
-        let Some(k) = roots.ordinal(v).filter(|&k| k < self.n) else {
+        if let Some(k) = roots.ordinal(v) {
+            self.add_root(i, k as u32);
+        }
+    }
+
+    /// That instruction `i` mentions the root of ordinal `k`.
+    #[inline]
+    fn add_root(&mut self, i: usize, k: u32) {
+        if k as usize >= self.n {
             return;
-        };
-        if self.last[k] != i {
-            self.last[k] = i;
-            self.pairs.push((k as u32, i));
+        }
+        // Instructions come in order: only the last one's pairs can hold `k`.
+        if self.pairs.get(self.at).is_none_or(|&(_, j)| j != i) {
+            self.at = self.pairs.len();
+        }
+        if !self.pairs[self.at..].iter().any(|&(q, _)| q == k) {
+            self.pairs.push((k, i));
         }
     }
 
     fn finish(self) -> std::rc::Rc<Mentions> {
         let MentionPairs { n, pairs, .. } = self;
+        // A counting sort: `start[k + 1]` counts root `k`'s mentions, then
+        // (summed) is where root `k + 1`'s start; filling moves each
+        // `start[k]` to the end of root `k`'s, so one shift restores it.
         let mut start = vec![0u32; n + 1];
         for &(k, _) in &pairs {
             start[k as usize + 1] += 1;
@@ -2967,12 +3212,13 @@ impl MentionPairs {
         for k in 0..n {
             start[k + 1] += start[k];
         }
-        let mut fill = start.clone();
         let mut list = vec![0usize; pairs.len()];
         for (k, i) in pairs {
-            list[fill[k as usize] as usize] = i;
-            fill[k as usize] += 1;
+            list[start[k as usize] as usize] = i;
+            start[k as usize] += 1;
         }
+        start.copy_within(0..n, 1);
+        start[0] = 0;
         std::rc::Rc::new(Mentions { start, list })
     }
 }
@@ -3014,16 +3260,19 @@ impl FnLiveness {
         let mut mb = self.mention_blocks.borrow_mut();
         let runs = self.mention_runs(&mut mb, program, var, mentions);
         let mut walk = self.walk.borrow_mut();
-        let Walk { work, seen, span } = &mut *walk;
-        span.resize(f.blocks.len(), (0, 0));
+        let stamp = walk.start(f.blocks.len());
+        let Walk {
+            work, seen, span, ..
+        } = &mut *walk;
+        if span.len() < f.blocks.len() {
+            span.resize(f.blocks.len(), (0, 0));
+        }
         for &(b, from, to) in runs {
             span[b as usize] = (from, to);
         }
         // (block, last instruction to look at)
         work.clear();
         work.push((b0, at));
-        seen.clear();
-        seen.resize(f.blocks.len(), false);
         while let Some((b, last)) = work.pop() {
             let mut killed = false;
             let (from, to) = span[b];
@@ -3051,7 +3300,8 @@ impl FnLiveness {
                 }
             }
             for &p in &self.preds[b] {
-                if !std::mem::replace(&mut seen[p], true) {
+                if seen[p] != stamp {
+                    seen[p] = stamp;
                     // All of it (without reading the block's bounds).
                     work.push((p, usize::MAX));
                 }
@@ -3076,7 +3326,10 @@ impl FnLiveness {
         let Some(k) = self.roots.ordinal(var) else {
             return &[];
         };
-        let (a, b) = *mb.at.entry(k).or_insert_with(|| {
+        if mb.at.len() <= k {
+            mb.at.resize(self.roots.len().max(k + 1), (u32::MAX, 0));
+        }
+        if mb.at[k].0 == u32::MAX {
             let f = self.function(program);
             let first = mb.runs.len() as u32;
             let mut j = 0;
@@ -3092,8 +3345,9 @@ impl FnLiveness {
                 }
                 mb.runs.push((b as u32, from as u32, j as u32));
             }
-            (first, mb.runs.len() as u32)
-        });
+            mb.at[k] = (first, mb.runs.len() as u32);
+        }
+        let (a, b) = mb.at[k];
         &mb.runs[a as usize..b as usize]
     }
 }
@@ -3154,7 +3408,7 @@ mod tests {
 
     #[test]
     fn places_intern_once_and_list_each_ids_parts() {
-        let mut p = Places::new(10, 20, 4);
+        let mut p = Places::new(10, 20, &[3], 4);
         let whole = p.intern(12, &[]);
         assert_eq!(p.intern(12, &[]), whole, "interned once");
         let a = p.intern(12, &[1, 2]);
@@ -3164,7 +3418,7 @@ mod tests {
         assert_eq!(p.get(12, &[1]), Some(b));
         assert_eq!(p.get(12, &[2]), None);
         assert_eq!(p.get(13, &[]), None);
-        // Ids outside the dense range go through the hash table.
+        // Ids outside the dense range get their slot through a hash table.
         let far = p.intern(5, &[]);
         let far_part = p.intern(1_000, &[0]);
         assert_eq!(p.get(5, &[]), Some(far));
@@ -3173,6 +3427,15 @@ mod tests {
         assert_eq!(p.of(1_000).collect::<Vec<_>>(), [far_part]);
         assert_eq!(p.of(14).count(), 0);
         assert_eq!(p.place(a), (12, &[1, 2][..]));
+        // A parameter (numbered apart from the body) has a slot too; its
+        // parts are listed in the order met.
+        let q1 = p.intern(3, &[4]);
+        let q = p.intern(3, &[]);
+        let q0 = p.intern(3, &[0]);
+        assert_eq!(p.intern(3, &[4]), q1);
+        assert_eq!(p.get(3, &[]), Some(q));
+        assert_eq!(p.get(3, &[0]), Some(q0));
+        assert_eq!(p.of(3).collect::<Vec<_>>(), [q, q1, q0]);
     }
 
     #[test]
@@ -3327,7 +3590,7 @@ mod tests {
     fn places_with_colliding_keys_stay_apart() {
         // A huge id range has no dense table: every place is hashed, and
         // many parts of one variable share chains of the same key space.
-        let mut p = Places::new(0, u32::MAX, 0);
+        let mut p = Places::new(0, u32::MAX, &[], 0);
         let ids: Vec<u32> = (0..200u32)
             .map(|i| p.intern(7, &[i % 10, i / 10]))
             .collect();

@@ -14,16 +14,10 @@ use spirv::Op;
 /// The instructions `start..start + len` of one function.
 pub(super) struct Body {
     start: usize,
-    op: Vec<Op>,
-    /// Result id, 0 for none (SPIR-V ids start at 1).
-    result: Vec<Id>,
-    /// Where each instruction's id operands start in `ids` (one more
-    /// entry than instructions).
-    at: Vec<u32>,
+    /// Each instruction's opcode, result and id operands, side by side
+    /// (one push an instruction while decoding, one cache line to read).
+    rows: Vec<Row>,
     ids: Vec<Id>,
-    /// Debug-info instructions (an `OpExtInst` of a set without
-    /// semantics): they neither read nor write.
-    debug: Vec<bool>,
     /// The instructions every pass reads, in order: not debug info, and
     /// no `OpLine`/`OpNoLine` (which neither read nor write, and are
     /// about a fifth of a function compiled with positions).
@@ -36,53 +30,105 @@ pub(super) struct Body {
     pub hi: Id,
 }
 
+/// One instruction.
+#[derive(Clone, Copy)]
+struct Row {
+    op: Op,
+    /// Result id, 0 for none (SPIR-V ids start at 1).
+    result: Id,
+    /// Its id operands: `ids[from..from + len]` (an instruction has
+    /// fewer than 2^16 words).
+    from: u32,
+    len: u16,
+    /// Debug info (an `OpExtInst` of a set without semantics): it
+    /// neither reads nor writes.
+    debug: bool,
+}
+
 impl Body {
-    pub fn new(program: &Program, f: &Function) -> Body {
+    /// An empty body for `f` (its instructions added by [`Body::push`] in
+    /// order, then [`Body::finish`]), with its id range worked out first:
+    /// the tables by id are made before the walk that decodes and
+    /// classifies each instruction fills them.
+    pub fn begin(program: &Program, f: &Function) -> Body {
         let n = f.end + 1 - f.start;
-        let mut b = Body {
+        let (mut lo, mut hi) = (Id::MAX, 0);
+        for inst in &program.insts[f.start..=f.end] {
+            let Some(r) = inst.result_id else { continue };
+            let op = inst.class.opcode;
+            if !matches!(op, Op::Function | Op::FunctionParameter) && !is_debug(program, inst) {
+                lo = lo.min(r);
+                hi = hi.max(r);
+            }
+        }
+        Body {
             start: f.start,
-            op: Vec::with_capacity(n),
-            result: Vec::with_capacity(n),
-            at: Vec::with_capacity(n + 1),
+            rows: Vec::with_capacity(n),
             // At most about three id operands an instruction.
             ids: Vec::with_capacity(3 * n),
-            debug: Vec::with_capacity(n),
             kept: Vec::with_capacity(n),
-            block_kept: Vec::with_capacity(f.blocks.len()),
-            lo: Id::MAX,
-            hi: 0,
-        };
-        for inst in &program.insts[f.start..=f.end] {
-            let op = inst.class.opcode;
-            b.at.push(b.ids.len() as u32);
-            let debug = op == Op::ExtInst
-                && matches!(inst.operands.first(),
-                    Some(Operand::IdRef(x)) if program.debug_sets.contains(x));
-            let r = inst.result_id.unwrap_or(0);
-            // Debug info and positions are read by no pass: no operands kept.
-            if !debug && !matches!(op, Op::Line | Op::NoLine) {
-                b.kept.push((b.start + b.op.len()) as u32);
-                for o in &inst.operands {
-                    if let Operand::IdRef(x) = o {
-                        b.ids.push(*x);
-                    }
+            block_kept: Vec::new(),
+            lo,
+            hi,
+        }
+    }
+
+    /// Decodes instruction `i` (the next one). For one the passes read,
+    /// its opcode, result and where its id operands start (see
+    /// [`Body::ids_from`]), handed back so the walk that decodes reads
+    /// them from here.
+    #[inline]
+    pub fn push(&mut self, program: &Program, i: usize) -> Option<(Op, Option<Id>, usize)> {
+        let inst = &program.insts[i];
+        let op = inst.class.opcode;
+        let debug = is_debug(program, inst);
+        let from = self.ids.len();
+        // Debug info and positions are read by no pass: no operands kept.
+        let kept = !debug && !matches!(op, Op::Line | Op::NoLine);
+        if kept {
+            self.kept.push(i as u32);
+            for o in &inst.operands {
+                if let Operand::IdRef(x) = o {
+                    self.ids.push(*x);
                 }
             }
-            if r != 0 && !debug && !matches!(op, Op::Function | Op::FunctionParameter) {
-                b.lo = b.lo.min(r);
-                b.hi = b.hi.max(r);
-            }
-            b.op.push(op);
-            b.result.push(r);
-            b.debug.push(debug);
         }
-        b.at.push(b.ids.len() as u32);
-        for block in &f.blocks {
-            let from = b.kept.partition_point(|&i| (i as usize) < block.start);
-            let to = b.kept.partition_point(|&i| (i as usize) <= block.end);
-            b.block_kept.push((from as u32, to.max(from) as u32));
-        }
-        b
+        self.rows.push(Row {
+            op,
+            result: inst.result_id.unwrap_or(0),
+            from: from as u32,
+            len: (self.ids.len() - from) as u16,
+            debug,
+        });
+        kept.then_some((op, inst.result_id.filter(|&r| r != 0), from))
+    }
+
+    /// The id operands from `from` on: the last instruction pushed's.
+    #[inline]
+    pub fn ids_from(&self, from: usize) -> &[Id] {
+        &self.ids[from..]
+    }
+
+    /// Ends the body of `f` once every instruction is pushed.
+    pub fn finish(&mut self, f: &Function) {
+        let kept = &self.kept;
+        self.block_kept = f
+            .blocks
+            .iter()
+            .map(|block| {
+                let from = kept.partition_point(|&i| (i as usize) < block.start);
+                let to = kept.partition_point(|&i| (i as usize) <= block.end);
+                (from as u32, to.max(from) as u32)
+            })
+            .collect();
+    }
+
+    /// Those of `kept` in block `b` of `f`, from a sorted list of them.
+    pub fn in_block<'a>(list: &'a [u32], f: &Function, b: usize) -> &'a [u32] {
+        let block = &f.blocks[b];
+        let from = list.partition_point(|&i| (i as usize) < block.start);
+        let to = list.partition_point(|&i| (i as usize) <= block.end);
+        &list[from..to.max(from)]
     }
 
     /// The instructions the passes read (see `kept`), by index.
@@ -109,25 +155,26 @@ impl Body {
 
     #[inline]
     pub fn op(&self, i: usize) -> Op {
-        self.op[i - self.start]
+        self.rows[i - self.start].op
     }
 
     #[inline]
     pub fn result(&self, i: usize) -> Option<Id> {
-        Some(self.result[i - self.start]).filter(|&r| r != 0)
+        Some(self.rows[i - self.start].result).filter(|&r| r != 0)
     }
 
     /// The id operands of instruction `i`, in order (none kept for debug
     /// info and `OpLine`/`OpNoLine`).
     #[inline]
     pub fn ids(&self, i: usize) -> &[Id] {
-        let k = i - self.start;
-        &self.ids[self.at[k] as usize..self.at[k + 1] as usize]
+        let row = &self.rows[i - self.start];
+        let from = row.from as usize;
+        &self.ids[from..from + row.len as usize]
     }
 
     #[inline]
     pub fn debug(&self, i: usize) -> bool {
-        self.debug[i - self.start]
+        self.rows[i - self.start].debug
     }
 
     /// The first id operand of instruction `i`.
@@ -135,4 +182,12 @@ impl Body {
     pub fn first(&self, i: usize) -> Option<Id> {
         self.ids(i).first().copied()
     }
+}
+
+/// Debug info: an `OpExtInst` of a set without semantics.
+#[inline]
+fn is_debug(program: &Program, inst: &rspirv::dr::Instruction) -> bool {
+    inst.class.opcode == Op::ExtInst
+        && matches!(inst.operands.first(),
+            Some(Operand::IdRef(x)) if program.debug_sets.contains(x))
 }
