@@ -210,7 +210,7 @@ pub fn recursion_report(pipeline: &Pipeline) -> RecursionReport {
     // Cycles and their bounds.
     let mut extra: Vec<Option<u64>> = vec![Some(0); sccs.len()];
     let mut cycles = Vec::new();
-    for c in 0..sccs.len() {
+    for (c, extra) in extra.iter_mut().enumerate() {
         let nodes = sccs.get(c);
         let cyclic: Vec<_> = graph
             .traces()
@@ -246,7 +246,7 @@ pub fn recursion_report(pipeline: &Pipeline) -> RecursionReport {
         } else {
             None
         };
-        extra[c] = bound;
+        *extra = bound;
         cycles.push(Cycle {
             nodes: nodes.to_vec(),
             sites,

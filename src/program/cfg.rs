@@ -244,7 +244,7 @@ impl FunctionCfgs {
                 }
                 let mut d = depth[x];
                 while let Some(y) = path.pop() {
-                    d = d.saturating_add(1).min(NO_DEPTH);
+                    d = d.saturating_add(1);
                     depth[y] = d;
                 }
             }
