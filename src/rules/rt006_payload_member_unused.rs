@@ -113,6 +113,19 @@ struct RayType {
 
 /// The fields of a payload type: each struct member (or the whole value)
 /// with its offset under the scalar rule and its shape.
+/// [`fields`] of type `ty` in program `k`, worked out once per type (as
+/// [`uses_of`], for a folder's many layouts).
+fn fields_of(
+    memo: &mut std::collections::HashMap<(usize, Id), std::rc::Rc<[(u64, Shape)]>>,
+    pipeline: &crate::pipeline::Pipeline,
+    k: usize,
+    ty: Id,
+) -> std::rc::Rc<[(u64, Shape)]> {
+    memo.entry((k, ty))
+        .or_insert_with(|| fields(&pipeline.programs[k], ty).into())
+        .clone()
+}
+
 fn fields(program: &crate::program::Program, ty: Id) -> Vec<(u64, Shape)> {
     match (program.ty(ty), layout::layout_type(program, ty, "")) {
         (Some(crate::program::Type::Struct { members }), Some(l)) => members
@@ -124,14 +137,27 @@ fn fields(program: &crate::program::Program, ty: Id) -> Vec<(u64, Shape)> {
     }
 }
 
-/// Per-field uses of `var` as `v` sees it: struct members, or the whole.
-fn field_uses(program: &crate::program::Program, v: &View, ty: Id) -> Vec<Access> {
-    let uses = payload_use::variable_use(program, v.entry, v.var);
+/// How `v` uses each member of its variable, asked once per view: in a
+/// folder's loose pipeline the same shader is a caller, callee or alias of
+/// many payload layouts.
+fn uses_of<'m>(
+    memo: &'m mut std::collections::HashMap<(usize, Id, Id), Vec<Access>>,
+    pipeline: &crate::pipeline::Pipeline,
+    v: &View,
+) -> &'m [Access] {
+    memo.entry((v.program, v.entry, v.var)).or_insert_with(|| {
+        payload_use::variable_use(&pipeline.programs[v.program], v.entry, v.var)
+    })
+}
+
+/// Per-field uses (`uses`, from [`uses_of`]) as a variable of type `ty`
+/// sees them: struct members, or the whole.
+fn field_uses(program: &crate::program::Program, uses: &[Access], ty: Id) -> Vec<Access> {
     if matches!(program.ty(ty), Some(crate::program::Type::Struct { .. })) {
-        uses
+        uses.to_vec()
     } else {
         let mut whole = Access::default();
-        for u in uses {
+        for &u in uses {
             whole.merge(u);
         }
         vec![whole]
@@ -246,6 +272,8 @@ fn run(ctx: &super::PipelineContext) -> Vec<Diagnostic> {
             }
         }
     }
+    let mut var_uses = std::collections::HashMap::new();
+    let mut type_fields = std::collections::HashMap::new();
     let mut out = Vec::new();
     for t in &types {
         // Not judged: no shader with this layout is reached, or the traces
@@ -268,11 +296,7 @@ fn run(ctx: &super::PipelineContext) -> Vec<Diagnostic> {
         let n = payload_use::member_count(program, ty);
         let mut uses = vec![Access::default(); n];
         for v in t.callers.iter().chain(t.callees.iter()) {
-            let p = &pipeline.programs[v.program];
-            for (k, a) in payload_use::variable_use(p, v.entry, v.var)
-                .into_iter()
-                .enumerate()
-            {
+            for (k, &a) in uses_of(&mut var_uses, pipeline, v).iter().enumerate() {
                 if let Some(u) = uses.get_mut(k) {
                     u.merge(a);
                 }
@@ -281,15 +305,16 @@ fn run(ctx: &super::PipelineContext) -> Vec<Diagnostic> {
         // Shaders declaring another layout read and write the members that
         // sit where theirs do (a shadow payload that starts like the main
         // one, handed to the same any-hit shader).
-        let own = fields(program, ty);
+        let own = fields_of(&mut type_fields, pipeline, first.program, ty);
         let is_struct_ty = matches!(program.ty(ty), Some(crate::program::Type::Struct { .. }));
         for v in &t.aliases {
             let p = &pipeline.programs[v.program];
             let Some(wty) = var_type(p, v.var) else {
                 continue;
             };
-            let theirs = fields(p, wty);
-            for (j, a) in field_uses(p, v, wty).into_iter().enumerate() {
+            let theirs = fields_of(&mut type_fields, pipeline, v.program, wty);
+            let theirs_uses = uses_of(&mut var_uses, pipeline, v);
+            for (j, a) in field_uses(p, theirs_uses, wty).into_iter().enumerate() {
                 let Some(f) = theirs.get(j) else { continue };
                 if let Some(k) = own.iter().position(|o| *o == *f) {
                     if is_struct_ty {
