@@ -113,10 +113,13 @@ struct RayType {
 
 /// The fields of a payload type: each struct member (or the whole value)
 /// with its offset under the scalar rule and its shape.
+/// Each (program, type)'s [`fields`], shared by the layouts that ask.
+type FieldsMemo = std::collections::HashMap<(usize, Id), std::rc::Rc<[(u64, Shape)]>>;
+
 /// [`fields`] of type `ty` in program `k`, worked out once per type (as
 /// [`uses_of`], for a folder's many layouts).
 fn fields_of(
-    memo: &mut std::collections::HashMap<(usize, Id), std::rc::Rc<[(u64, Shape)]>>,
+    memo: &mut FieldsMemo,
     pipeline: &crate::pipeline::Pipeline,
     k: usize,
     ty: Id,
