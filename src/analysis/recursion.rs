@@ -207,20 +207,31 @@ pub fn recursion_report(pipeline: &Pipeline) -> RecursionReport {
             scc_of[v] = c;
         }
     }
+    // Each component's traces, in the graph's order (with their index
+    // among the traces): those inside it, and those entering it. One pass,
+    // not a scan of every trace per component (a folder's loose pipeline
+    // has hundreds of components and tens of thousands of traces).
+    let traces: Vec<_> = graph.traces().collect();
+    let mut inside: Vec<Vec<usize>> = vec![Vec::new(); sccs.len()];
+    let mut entering: Vec<Vec<usize>> = vec![Vec::new(); sccs.len()];
+    for (k, e) in traces.iter().enumerate() {
+        let (from, to) = (scc_of[e.from], scc_of[e.to]);
+        if from == to {
+            inside[to].push(k);
+        } else {
+            entering[to].push(k);
+        }
+    }
     // Cycles and their bounds.
     let mut extra: Vec<Option<u64>> = vec![Some(0); sccs.len()];
     let mut cycles = Vec::new();
     for (c, extra) in extra.iter_mut().enumerate() {
         let nodes = sccs.get(c);
-        let cyclic: Vec<_> = graph
-            .traces()
-            .filter(|e| scc_of[e.from] == c && scc_of[e.to] == c)
-            .collect();
-        if cyclic.is_empty() {
+        if inside[c].is_empty() {
             continue;
         }
         let mut sites: Vec<CycleSite> = Vec::new();
-        for e in &cyclic {
+        for e in inside[c].iter().map(|&k| traces[k]) {
             if sites
                 .iter()
                 .any(|s| s.program == e.program && s.inst == e.inst)
@@ -270,10 +281,8 @@ pub fn recursion_report(pipeline: &Pipeline) -> RecursionReport {
         {
             entry[c] = Lv::At(0);
         }
-        for (k, e) in graph.traces().enumerate() {
-            if scc_of[e.to] != c || scc_of[e.from] == c {
-                continue;
-            }
+        for &k in &entering[c] {
+            let e = traces[k];
             let from = scc_of[e.from];
             // A guarded trace that closes the cycle stops tracing at the
             // cycle's last level; other traces (shadow rays) leave from it.
