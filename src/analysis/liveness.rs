@@ -1323,6 +1323,17 @@ impl Worklist {
     }
 }
 
+/// Stores, copies, calls and variables: their backward step depends on
+/// the live set, so it is worked out while solving ([`Step::Other`] or
+/// [`Step::Store`]), never folded into a run.
+#[inline]
+fn worked_out_each_time(op: Op) -> bool {
+    matches!(
+        op,
+        Op::Store | Op::CopyMemory | Op::CopyMemorySized | Op::FunctionCall | Op::Variable
+    )
+}
+
 #[inline]
 fn set(words: &mut [u64], k: u32) {
     words[k as usize / 64] |= 1 << (k % 64);
@@ -1820,16 +1831,9 @@ impl FnLiveness {
                 continue;
             };
             let ids = body.ids_from(from);
-            let touches = matches!(
-                op,
-                Op::Store
-                    | Op::CopyMemory
-                    | Op::CopyMemorySized
-                    | Op::FunctionCall
-                    | Op::Variable
-                    | Op::FunctionParameter
-                    | Op::Phi
-            ) || ids.iter().any(|id| roots.contains_key(id));
+            let touches = worked_out_each_time(op)
+                || matches!(op, Op::FunctionParameter | Op::Phi)
+                || ids.iter().any(|id| roots.contains_key(id));
             if touches {
                 touched.push(i as u32);
             }
@@ -1996,15 +2000,7 @@ impl FnLiveness {
             let at = at as usize;
             let op = body.op(at);
             let copy = self.copy.get(at - f.start).copied().unwrap_or(Copy::None);
-            let other = matches!(copy, Copy::Store(_))
-                || matches!(
-                    op,
-                    Op::Store
-                        | Op::CopyMemory
-                        | Op::CopyMemorySized
-                        | Op::FunctionCall
-                        | Op::Variable
-                );
+            let other = matches!(copy, Copy::Store(_)) || worked_out_each_time(op);
             // Only SSA values and variables (pointer parameters) are ever
             // places; another result cannot be live.
             let result = body.result(at);
