@@ -94,6 +94,7 @@ fn run(ctx: &super::PipelineContext) -> Vec<Diagnostic> {
     let mut seen: std::collections::HashSet<(usize, usize)> = std::collections::HashSet::new();
     let mut refused: std::collections::HashSet<(usize, usize, usize)> =
         std::collections::HashSet::new();
+    let mut incoming = std::collections::HashMap::new();
     for e in g.edges.iter().filter(|e| e.kind == EdgeKind::Trace) {
         if seen.contains(&(e.program, e.inst)) || !refused.insert((e.from, e.program, e.inst)) {
             continue;
@@ -123,19 +124,27 @@ fn run(ctx: &super::PipelineContext) -> Vec<Diagnostic> {
         let mut hits: Vec<(usize, u32)> = Vec::new();
         for &to in targets.get(&(e.program, e.inst)).into_iter().flatten() {
             if let Some(n) = g.nodes.get(to) {
-                let same_type = || {
+                let mut same_type = || {
                     let Some(tp) = pipeline.programs.get(n.shader.program) else {
                         return false;
                     };
                     let Some(shape) = &shape else { return true };
-                    payload_use::globals_used(
-                        tp,
-                        n.shader.function,
-                        StorageClass::IncomingRayPayloadKHR,
-                    )
-                    .iter()
-                    .filter_map(|w| tp.globals.iter().find(|g| g.id == *w))
-                    .any(|g| payload_use::shape_of(tp, g.ty) == *shape)
+                    // Each hit shader's incoming layouts once: a folder's
+                    // loose pipeline sends every trace to every hit shader.
+                    incoming
+                        .entry((n.shader.program, n.shader.function))
+                        .or_insert_with(|| {
+                            payload_use::globals_used(
+                                tp,
+                                n.shader.function,
+                                StorageClass::IncomingRayPayloadKHR,
+                            )
+                            .iter()
+                            .filter_map(|w| tp.globals.iter().find(|g| g.id == *w))
+                            .map(|g| payload_use::shape_of(tp, g.ty))
+                            .collect::<Vec<_>>()
+                        })
+                        .contains(shape)
                 };
                 if n.shader.stage == Stage::ClosestHit && same_type() {
                     let key = (n.shader.program, n.shader.function);
