@@ -277,10 +277,7 @@ pub struct Program {
     pub memo: Memo,
 }
 
-/// [`Program::callers`]' calls outside every function.
-struct OutsideCalls(Vec<(Id, usize)>);
-
-/// [`Program::call_index`]: every call in a function by callee, and each
+/// [`Program::call_index`]: every call by callee, and each
 /// function's callees by function index, in flat vectors (a module has a
 /// handful of functions: hash maps of them cost more to build than to
 /// search, and reachability walks indices).
@@ -454,44 +451,11 @@ impl Program {
 
     /// Instruction indices of the `OpFunctionCall`s that call function `f`.
     pub fn callers(&self, f: Id) -> Vec<usize> {
-        let mut calls: Vec<usize> = self
-            .call_index()
+        self.call_index()
             .calls_to(f)
             .iter()
             .map(|&(_, i)| i)
-            .collect();
-        let outside = self
-            .memo
-            .get_or(|| OutsideCalls(self.calls_outside_functions()));
-        if !outside.0.is_empty() {
-            calls.extend(outside.0.iter().filter(|&&(c, _)| c == f).map(|&(_, i)| i));
-            calls.sort_unstable();
-        }
-        calls
-    }
-
-    /// `(callee, instruction)` of the calls outside every function (a
-    /// module no validator accepts): only [`Program::callers`] lists them,
-    /// so the call index scans function bodies alone.
-    fn calls_outside_functions(&self) -> Vec<(Id, usize)> {
-        let mut out = Vec::new();
-        let mut from = 0;
-        let gaps = self
-            .functions
-            .iter()
-            .map(|f| (f.start, f.end + 1))
-            .chain(std::iter::once((self.insts.len(), self.insts.len())));
-        for (start, next) in gaps {
-            for (i, inst) in (from..).zip(self.insts.get(from..start).unwrap_or(&[])) {
-                if inst.class.opcode == Op::FunctionCall {
-                    if let Some(Operand::IdRef(x)) = inst.operands.first() {
-                        out.push((*x, i));
-                    }
-                }
-            }
-            from = from.max(next);
-        }
-        out
+            .collect()
     }
 
     /// Every call by callee and each function's callees, indexed in one
@@ -499,16 +463,13 @@ impl Program {
     /// analyses ask for reachable functions per shader and per entry point.
     pub(crate) fn call_index(&self) -> std::sync::Arc<CallIndex> {
         self.memo.get_or(|| {
-            // Function bodies only: a call outside every function reaches
-            // nothing (see `calls_outside_functions`).
+            // Every call, also one outside every function (a module no
+            // validator accepts): it calls nothing, but it is a caller.
             let mut by_callee: Vec<(Id, usize)> = Vec::new();
-            for f in &self.functions {
-                let body = self.insts.get(f.start..=f.end).unwrap_or(&[]);
-                for (i, inst) in (f.start..).zip(body) {
-                    if inst.class.opcode == Op::FunctionCall {
-                        if let Some(Operand::IdRef(x)) = inst.operands.first() {
-                            by_callee.push((*x, i));
-                        }
+            for (i, inst) in self.insts.iter().enumerate() {
+                if inst.class.opcode == Op::FunctionCall {
+                    if let Some(Operand::IdRef(x)) = inst.operands.first() {
+                        by_callee.push((*x, i));
                     }
                 }
             }
