@@ -1218,8 +1218,12 @@ fn driver_stack_sizes(
 fn driver_stack_sizes_of(p: &rtlint::pipeline::Pipeline) -> Result<u8, String> {
     let ctx = rtlint::vk::Context::new().map_err(|e| e.to_string())?;
     let depth = rtlint::analysis::recursion_report(p).required_depth;
-    let sizes = rtlint::vk::driver_stack_sizes(&ctx, p, depth)
-        .map_err(|e| format!("creating the pipeline on {} failed: {e}", ctx.info().name))?;
+    let sizes = rtlint::vk::driver_stack_sizes(&ctx, p, depth).map_err(|e| match e {
+        rtlint::vk::Error::Unsupported(needs) => {
+            format!("skipped: needs {needs}, which {} lacks", ctx.info().name)
+        }
+        e => format!("creating the pipeline on {} failed: {e}", ctx.info().name),
+    })?;
     let d = DriverSizes {
         device: ctx.info().name.clone(),
         driver: ctx.info().driver.clone(),

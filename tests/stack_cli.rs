@@ -253,7 +253,14 @@ fn driver_creates_every_pipeline_without_a_validation_error() {
     );
     let pipelines = all_descriptions();
     // Textures, samplers and bindless arrays in several sets, in HLSL and GLSL.
-    for name in ["textured_hlsl.pipeline.toml", "bindless.pipeline.toml"] {
+    // A header declaring a runtime array that one stage leaves unused, and a
+    // module reading the shader clock (its extension must be enabled).
+    for name in [
+        "textured_hlsl.pipeline.toml",
+        "bindless.pipeline.toml",
+        "shared_header.pipeline.toml",
+        "shader_clock.pipeline.toml",
+    ] {
         assert!(
             pipelines.iter().any(|p| p.ends_with(name)),
             "{name} is missing"
@@ -430,4 +437,67 @@ fn stack_of_a_library_described_by_its_subobjects() {
     assert!(r["driver"].is_object(), "no driver figures: {r}");
     let assumptions = r["assumptions"].to_string();
     assert!(assumptions.contains("DXR subobjects"), "{assumptions}");
+}
+
+#[test]
+fn driver_names_the_register_shift_for_an_hlsl_collision() {
+    // t0, u0 and b0 on one binding: no layout serves them; the message says
+    // which HLSL register classes collide and which option separates them,
+    // in words (no Rust debug text).
+    let o = rtlint()
+        .args(["stack", "--driver"])
+        .arg(common::root().join("tests/driver/registers.pipeline.toml"))
+        .env("RTLINT_VK_VALIDATION", "1")
+        .output()
+        .unwrap();
+    // The human report goes to stdout, its input errors after it.
+    let stderr =
+        String::from_utf8_lossy(&o.stdout).into_owned() + &String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{stderr}");
+    assert!(
+        stderr.contains("set 0, binding 0 is an acceleration structure for `Scene`"),
+        "{stderr}"
+    );
+    assert!(stderr.contains("a storage image for `Output`"), "{stderr}");
+    assert!(stderr.contains("`-fvk-u-shift N SET`"), "{stderr}");
+    assert!(stderr.contains("`-fvk-t-shift N SET`"), "{stderr}");
+    let error = stderr
+        .lines()
+        .find(|l| l.contains("no pipeline layout"))
+        .unwrap();
+    for debug in ["Fixed(", "Runtime", "×", "StorageImage"] {
+        assert!(!error.contains(debug), "{debug} in {error}");
+    }
+}
+
+#[test]
+fn a_device_without_the_shader_clock_skips_with_what_it_needs() {
+    // The shader-clock fixture needs VK_KHR_shader_clock: with the device's
+    // own answer it is satisfied, with the feature taken away it is named.
+    let Some(ctx) =
+        rtlint_testkit::require("a Vulkan ray-tracing device", rtlint::vk::Context::new())
+    else {
+        return;
+    };
+    let p = rtlint::pipeline::load(
+        &common::root().join("fixtures/pipelines/shader_clock.pipeline.toml"),
+    )
+    .unwrap();
+    let mut info = ctx.info().clone();
+    assert!(info.shader_clock, "lavapipe has VK_KHR_shader_clock");
+    assert_eq!(
+        rtlint::vk::missing_requirements(&p, &info),
+        Vec::<&str>::new()
+    );
+    info.shader_clock = false;
+    assert_eq!(
+        rtlint::vk::missing_requirements(&p, &info),
+        ["VK_KHR_shader_clock (shaderSubgroupClock)"]
+    );
+    info.shader_int64 = false;
+    assert_eq!(
+        rtlint::vk::missing_requirements(&p, &info),
+        // In the order the module declares them (Int64 first).
+        ["shaderInt64", "VK_KHR_shader_clock (shaderSubgroupClock)"]
+    );
 }

@@ -98,6 +98,13 @@ pub struct DeviceInfo {
     pub max_push_constants_size: u32,
     /// `runtimeDescriptorArray` is present and enabled.
     pub runtime_descriptor_array: bool,
+    /// `VK_KHR_shader_clock` with `shaderSubgroupClock` (SPIR-V
+    /// `ShaderClockKHR`, GLSL `clockARB`) is present and enabled;
+    /// `shader_device_clock` when `shaderDeviceClock` is too.
+    pub shader_clock: bool,
+    pub shader_device_clock: bool,
+    /// `shaderFloat64` is present and enabled.
+    pub shader_float64: bool,
 }
 
 /// What timestamp queries on the chosen queue measure: `timestampValidBits`
@@ -461,6 +468,8 @@ fn examine(
     let has_position_fetch = has(vk::KHR_RAY_TRACING_POSITION_FETCH_NAME);
     let mut fir = vk::PhysicalDeviceRayTracingInvocationReorderFeaturesNV::default();
     let has_reorder = has(vk::NV_RAY_TRACING_INVOCATION_REORDER_NAME);
+    let mut fclock = vk::PhysicalDeviceShaderClockFeaturesKHR::default();
+    let has_clock = has(vk::KHR_SHADER_CLOCK_NAME);
     let mut features = vk::PhysicalDeviceFeatures2::default()
         .push_next(&mut f11)
         .push_next(&mut f12)
@@ -472,6 +481,9 @@ fn examine(
     }
     if has_reorder {
         features = features.push_next(&mut fir);
+    }
+    if has_clock {
+        features = features.push_next(&mut fclock);
     }
     // SAFETY: the chain holds only structures of this device's version and extensions.
     unsafe { instance.get_physical_device_features2(physical, &mut features) };
@@ -562,6 +574,9 @@ fn examine(
             max_bound_descriptor_sets: props.limits.max_bound_descriptor_sets,
             max_push_constants_size: props.limits.max_push_constants_size,
             runtime_descriptor_array: f12.runtime_descriptor_array == vk::TRUE,
+            shader_clock: has_clock && fclock.shader_subgroup_clock == vk::TRUE,
+            shader_device_clock: has_clock && fclock.shader_device_clock == vk::TRUE,
+            shader_float64: core.shader_float64 == vk::TRUE,
         },
         optional: OptionalFeatures {
             core: vk::PhysicalDeviceFeatures {
@@ -623,6 +638,10 @@ fn create_device(instance: &ash::Instance, c: &Candidate) -> Result<ash::Device>
     if c.info.invocation_reorder {
         extensions.push(vk::NV_RAY_TRACING_INVOCATION_REORDER_NAME.as_ptr());
     }
+    // Old enough (Vulkan 1.1 era) for every validation layer to know it.
+    if c.info.shader_clock {
+        extensions.push(vk::KHR_SHADER_CLOCK_NAME.as_ptr());
+    }
     let priorities = [1.0f32];
     let queues = [vk::DeviceQueueCreateInfo::default()
         .queue_family_index(c.queue_family)
@@ -681,6 +700,12 @@ fn create_device(instance: &ash::Instance, c: &Candidate) -> Result<ash::Device>
         .ray_tracing_invocation_reorder(true);
     if c.info.invocation_reorder {
         features = features.push_next(&mut fir);
+    }
+    let mut fclock = vk::PhysicalDeviceShaderClockFeaturesKHR::default()
+        .shader_subgroup_clock(true)
+        .shader_device_clock(c.info.shader_device_clock);
+    if c.info.shader_clock {
+        features = features.push_next(&mut fclock);
     }
     let create = vk::DeviceCreateInfo::default()
         .queue_create_infos(&queues)

@@ -22,6 +22,9 @@ pub enum Error {
     Timeout { what: &'static str, millis: u128 },
     /// The caller asked for something the harness or the device cannot do.
     Invalid(String),
+    /// The shaders need a device extension or feature this device lacks
+    /// (the text names them).
+    Unsupported(String),
 }
 
 pub type Result<T> = std::result::Result<T, Error>;
@@ -48,6 +51,7 @@ impl fmt::Display for Error {
                 write!(f, "{what} did not finish within {millis} ms")
             }
             Error::Invalid(msg) => f.write_str(msg),
+            Error::Unsupported(needs) => write!(f, "skipped: needs {needs}"),
         }
     }
 }

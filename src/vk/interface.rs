@@ -72,9 +72,15 @@ impl PipelineInterface {
     }
 }
 
-/// The interface of every ray-tracing shader in the pipeline, merged. Two
-/// shaders that declare one set and binding with different descriptor
-/// types or counts are an error: no layout can serve both.
+/// The interface of every ray-tracing shader in the pipeline, merged the way
+/// an application's pipeline layout serves all its stages: one binding per
+/// set and binding, with the largest count any shader declares (a runtime
+/// array wins: the layout gives it a count of its own), and the stages whose
+/// entry points use it. A global an entry point lists in its interface but
+/// never references (glslang lists every global of a shared header there,
+/// SPIR-V 1.4 and later) does not constrain the binding's type; two shaders
+/// that both use one binding as different descriptor types are an error: no
+/// layout serves both.
 pub fn reflect(pipeline: &Pipeline) -> Result<PipelineInterface, String> {
     let mut shaders: Vec<&ShaderRef> = Vec::new();
     shaders.extend(&pipeline.raygen);
@@ -86,13 +92,17 @@ pub fn reflect(pipeline: &Pipeline) -> Result<PipelineInterface, String> {
     }
     shaders.extend(&pipeline.callable);
     let mut out = PipelineInterface::default();
-    let mut bindings: BTreeMap<(u32, u32), (LayoutBinding, String)> = BTreeMap::new();
+    let mut declared: BTreeMap<(u32, u32), Vec<Declaration>> = BTreeMap::new();
     for s in shaders {
         let Some(program) = pipeline.program(s) else {
             continue;
         };
-        let used = used_globals(program, s);
-        for g in program.globals.iter().filter(|g| used.contains(&g.id)) {
+        let (referenced, listed) = used_globals(program, s);
+        for g in program.globals.iter() {
+            let used = referenced.contains(&g.id);
+            if !used && !listed.contains(&g.id) {
+                continue;
+            }
             let who = format!("{} `{}` ({})", s.stage.as_str(), s.entry, s.file.display());
             match g.storage {
                 C::PushConstant => {
@@ -123,50 +133,134 @@ pub fn reflect(pipeline: &Pipeline) -> Result<PipelineInterface, String> {
                     program.display_name(g.id)
                 ));
             };
-            match bindings.get_mut(&(set, binding)) {
-                Some((b, first)) => {
-                    if b.kind != kind || b.count != count {
-                        return Err(format!(
-                            "set {set}, binding {binding} is {:?} ×{:?} in {first} but {kind:?} ×{count:?} in {who}: no pipeline layout serves both",
-                            b.kind, b.count
-                        ));
-                    }
-                    b.stages.insert(s.stage);
-                }
-                None => {
-                    bindings.insert(
-                        (set, binding),
-                        (
-                            LayoutBinding {
-                                set,
-                                binding,
-                                kind,
-                                count,
-                                stages: BTreeSet::from([s.stage]),
-                            },
-                            who,
-                        ),
-                    );
-                }
-            }
+            let hlsl = program.language == crate::shader::Language::Hlsl;
+            declared
+                .entry((set, binding))
+                .or_default()
+                .push(Declaration {
+                    kind,
+                    count,
+                    used,
+                    stage: s.stage,
+                    who: format!("`{}` in {who}", program.display_name(g.id)),
+                    hlsl,
+                });
         }
     }
-    out.bindings = bindings.into_values().map(|(b, _)| b).collect();
+    for ((set, binding), decls) in declared {
+        out.bindings.push(merge(set, binding, &decls)?);
+    }
     Ok(out)
 }
 
-/// The globals an entry point uses: referenced from a function it reaches,
-/// or listed in its interface.
-fn used_globals(program: &Program, s: &ShaderRef) -> HashSet<Id> {
+/// One shader's declaration of a set and binding.
+struct Declaration {
+    kind: DescriptorKind,
+    count: DescriptorCount,
+    /// Referenced by a function the entry point reaches, not only listed in
+    /// its interface.
+    used: bool,
+    stage: Stage,
+    /// The variable and the shader, for messages.
+    who: String,
+    /// Compiled from HLSL (registers t, s, u, b all map to bindings).
+    hlsl: bool,
+}
+
+/// The layout binding that serves every declaration of one set and binding.
+fn merge(set: u32, binding: u32, decls: &[Declaration]) -> Result<LayoutBinding, String> {
+    // The type: what the shaders that use the binding say; only listed
+    // declarations (unused) follow, and cannot veto it.
+    let used: Vec<&Declaration> = decls.iter().filter(|d| d.used).collect();
+    let decider = used.first().copied().unwrap_or(&decls[0]);
+    if let Some(other) = used.iter().find(|d| d.kind != decider.kind) {
+        let mut message = format!(
+            "set {set}, binding {binding} is {} for {} but {} for {}: no pipeline layout serves both",
+            decider.kind, decider.who, other.kind, other.who
+        );
+        if decider.hlsl || other.hlsl {
+            message.push_str(&format!(
+                "; HLSL registers t, s, u and b of one number share a binding when compiled for Vulkan (as DXC does): \
+                 shift one register class into a range of its own ({} or {}) or declare `[[vk::binding(N, {set})]]`",
+                decider.kind.shift_option(),
+                other.kind.shift_option()
+            ));
+        }
+        return Err(message);
+    }
+    let mut count = DescriptorCount::Fixed(1);
+    let mut stages = BTreeSet::new();
+    for d in decls.iter().filter(|d| d.kind == decider.kind) {
+        count = match (count, d.count) {
+            (DescriptorCount::Runtime, _) | (_, DescriptorCount::Runtime) => {
+                DescriptorCount::Runtime
+            }
+            (DescriptorCount::Fixed(a), DescriptorCount::Fixed(b)) => {
+                DescriptorCount::Fixed(a.max(b))
+            }
+        };
+        if d.used || used.is_empty() {
+            stages.insert(d.stage);
+        }
+    }
+    Ok(LayoutBinding {
+        set,
+        binding,
+        kind: decider.kind,
+        count,
+        stages,
+    })
+}
+
+impl DescriptorKind {
+    /// DXC's register-shift option for the register class this descriptor
+    /// type comes from in HLSL.
+    fn shift_option(self) -> &'static str {
+        use DescriptorKind::*;
+        match self {
+            Sampler => "`-fvk-s-shift N SET`",
+            UniformBuffer => "`-fvk-b-shift N SET`",
+            StorageImage | StorageTexelBuffer => "`-fvk-u-shift N SET`",
+            // Read-only structured and byte-address buffers are t registers
+            // too; a read-write one is u: name both.
+            StorageBuffer => "`-fvk-t-shift N SET` / `-fvk-u-shift N SET`",
+            CombinedImageSampler | SampledImage | UniformTexelBuffer | AccelerationStructure => {
+                "`-fvk-t-shift N SET`"
+            }
+        }
+    }
+}
+
+impl std::fmt::Display for DescriptorKind {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        use DescriptorKind::*;
+        f.write_str(match self {
+            Sampler => "a sampler",
+            CombinedImageSampler => "a combined image sampler",
+            SampledImage => "a sampled image",
+            StorageImage => "a storage image",
+            UniformTexelBuffer => "a uniform texel buffer",
+            StorageTexelBuffer => "a storage texel buffer",
+            UniformBuffer => "a uniform buffer",
+            StorageBuffer => "a storage buffer",
+            AccelerationStructure => "an acceleration structure",
+        })
+    }
+}
+
+/// The globals an entry point references from a function it reaches, and
+/// those it only lists in its interface.
+fn used_globals(program: &Program, s: &ShaderRef) -> (HashSet<Id>, HashSet<Id>) {
     let globals: HashSet<Id> = program.globals.iter().map(|g| g.id).collect();
-    let mut used = HashSet::new();
+    let mut listed = HashSet::new();
     if let Some(e) = program
         .entry_points
         .iter()
         .find(|e| e.name == s.entry && e.stage == s.stage)
     {
-        used.extend(e.interface.iter().copied().filter(|i| globals.contains(i)));
+        listed.extend(e.interface.iter().copied().filter(|i| globals.contains(i)));
     }
+    let mut used = HashSet::new();
     for f in program.reachable_functions(s.function) {
         let Some(f) = program.function(f) else {
             continue;
@@ -181,7 +275,7 @@ fn used_globals(program: &Program, s: &ShaderRef) -> HashSet<Id> {
             }
         }
     }
-    used
+    (used, listed)
 }
 
 /// The descriptor type and count of a resource variable of type `ty`;
@@ -419,6 +513,27 @@ mod tests {
         assert_eq!(i.shader_record_size, 8);
         let env = &i.bindings.last().unwrap().stages;
         assert_eq!(env.iter().copied().collect::<Vec<_>>(), [Stage::Miss]);
+    }
+
+    #[test]
+    fn an_unused_header_array_takes_the_runtime_array_of_the_stage_that_uses_it() {
+        // The raygen lists `indices` (an array of one) without using it; the
+        // closest hit indexes it as a runtime array: one runtime binding,
+        // used by the closest hit only.
+        let i = reflect(&load("fixtures/pipelines/shared_header.pipeline.toml")).unwrap();
+        let b = i.bindings.iter().find(|b| b.binding == 2).unwrap();
+        assert_eq!(b.kind, DescriptorKind::StorageBuffer);
+        assert_eq!(b.count, DescriptorCount::Runtime);
+        assert_eq!(
+            b.stages.iter().copied().collect::<Vec<_>>(),
+            [Stage::ClosestHit]
+        );
+        // The image: used by the raygen, listed by the closest hit.
+        let image = i.bindings.iter().find(|b| b.binding == 1).unwrap();
+        assert_eq!(
+            image.stages.iter().copied().collect::<Vec<_>>(),
+            [Stage::RayGeneration]
+        );
     }
 
     #[test]

@@ -22,6 +22,7 @@
 
 mod accel;
 mod buffer;
+mod capabilities;
 mod child;
 mod context;
 mod descriptors;
@@ -35,6 +36,7 @@ mod validation;
 
 pub use accel::{Aabb, AccelerationStructure, Geometry, Instance, IDENTITY};
 pub use buffer::{bytes_of, Buffer, Pod};
+pub use capabilities::missing as missing_requirements;
 pub use child::{
     run_command, run_in_child, run_in_child_with_timeout, spawn_command, ChildOutcome,
     RunningChild, CHILD_ENV, DEFAULT_CHILD_TIMEOUT,

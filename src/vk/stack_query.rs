@@ -37,6 +37,10 @@ pub fn driver_stack_sizes<'p>(
     pipeline: &'p Pipeline,
     depth: Option<u32>,
 ) -> Result<BTreeMap<(Slot, Stage), u64>> {
+    let needs = super::missing_requirements(pipeline, ctx.info());
+    if !needs.is_empty() {
+        return Err(Error::Unsupported(needs.join(", ")));
+    }
     let modules: Vec<Vec<u32>> = pipeline
         .programs
         .iter()
