@@ -446,7 +446,7 @@ fn driver_names_the_register_shift_for_an_hlsl_collision() {
     // in words (no Rust debug text).
     let o = rtlint()
         .args(["stack", "--driver"])
-        .arg(common::root().join("tests/driver/registers.pipeline.toml"))
+        .arg(common::root().join("tests/pipelines/registers.pipeline.toml"))
         .env("RTLINT_VK_VALIDATION", "1")
         .output()
         .unwrap();
