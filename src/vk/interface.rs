@@ -188,21 +188,25 @@ fn merge(set: u32, binding: u32, decls: &[Declaration]) -> Result<LayoutBinding,
         }
         return Err(message);
     }
-    let mut count = DescriptorCount::Fixed(1);
+    let mut runtime = false;
+    let mut fixed = 1;
     let mut stages = BTreeSet::new();
     for d in decls.iter().filter(|d| d.kind == decider.kind) {
-        count = match (count, d.count) {
-            (DescriptorCount::Runtime, _) | (_, DescriptorCount::Runtime) => {
-                DescriptorCount::Runtime
-            }
-            (DescriptorCount::Fixed(a), DescriptorCount::Fixed(b)) => {
-                DescriptorCount::Fixed(a.max(b))
-            }
-        };
+        match d.count {
+            DescriptorCount::Runtime => runtime = true,
+            DescriptorCount::Fixed(n) => fixed = fixed.max(n),
+        }
         if d.used || used.is_empty() {
             stages.insert(d.stage);
         }
     }
+    // A runtime array takes whatever count the layout gives; the runtime
+    // count the layout uses must still cover a larger fixed array elsewhere.
+    let count = if runtime && fixed <= super::pipeline::RUNTIME_ARRAY_COUNT {
+        DescriptorCount::Runtime
+    } else {
+        DescriptorCount::Fixed(fixed)
+    };
     Ok(LayoutBinding {
         set,
         binding,
@@ -534,6 +538,70 @@ mod tests {
             image.stages.iter().copied().collect::<Vec<_>>(),
             [Stage::RayGeneration]
         );
+    }
+
+    fn decl(kind: DescriptorKind, count: DescriptorCount, used: bool, stage: Stage) -> Declaration {
+        Declaration {
+            kind,
+            count,
+            used,
+            stage,
+            who: "`x` in a shader".into(),
+            hlsl: false,
+        }
+    }
+
+    #[test]
+    fn the_largest_count_serves_every_declaration() {
+        use DescriptorCount::*;
+        use DescriptorKind::*;
+        let m = |d: &[Declaration]| merge(0, 3, d).unwrap();
+        // Fixed arrays: the largest.
+        let b = m(&[
+            decl(SampledImage, Fixed(4), true, Stage::RayGeneration),
+            decl(SampledImage, Fixed(8), true, Stage::ClosestHit),
+        ]);
+        assert_eq!(b.count, Fixed(8));
+        // A runtime array with a small fixed one: a runtime count.
+        let b = m(&[
+            decl(SampledImage, Fixed(4), true, Stage::RayGeneration),
+            decl(SampledImage, Runtime, true, Stage::ClosestHit),
+        ]);
+        assert_eq!(b.count, Runtime);
+        // With a fixed array larger than the runtime count: that many.
+        let b = m(&[
+            decl(SampledImage, Fixed(64), true, Stage::RayGeneration),
+            decl(SampledImage, Runtime, true, Stage::ClosestHit),
+        ]);
+        assert_eq!(b.count, Fixed(64));
+        // An unused declaration of another type neither decides the type nor
+        // adds its stage; one of the same type still counts.
+        let b = m(&[
+            decl(UniformBuffer, Fixed(1), false, Stage::Miss),
+            decl(StorageBuffer, Fixed(2), false, Stage::RayGeneration),
+            decl(StorageBuffer, Fixed(1), true, Stage::ClosestHit),
+        ]);
+        assert_eq!((b.kind, b.count), (StorageBuffer, Fixed(2)));
+        assert_eq!(
+            b.stages.iter().copied().collect::<Vec<_>>(),
+            [Stage::ClosestHit]
+        );
+        // Two uses of different types: an error in words.
+        let e = merge(
+            1,
+            0,
+            &[
+                decl(StorageImage, Fixed(1), true, Stage::RayGeneration),
+                decl(UniformBuffer, Fixed(1), true, Stage::ClosestHit),
+            ],
+        )
+        .unwrap_err();
+        assert!(
+            e.starts_with("set 1, binding 0 is a storage image for"),
+            "{e}"
+        );
+        assert!(e.contains("but a uniform buffer for"), "{e}");
+        assert!(!e.contains("-fvk-"), "not HLSL: {e}");
     }
 
     #[test]

@@ -652,7 +652,7 @@ unsafe fn bind_set(
 }
 
 /// Descriptors a runtime array gets in a reflected layout.
-const RUNTIME_ARRAY_COUNT: u32 = 16;
+pub(crate) const RUNTIME_ARRAY_COUNT: u32 = 16;
 
 fn check_desc(ctx: &Context, desc: &RayTracingPipelineDesc<'_>) -> Result<()> {
     let limits = ctx.shared.info.ray_tracing;
