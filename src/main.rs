@@ -314,15 +314,10 @@ enum Command {
     /// pipeline and prints the driver's stack sizes as JSON.
     #[command(hide = true, name = "driver-stack-sizes")]
     DriverStackSizes {
-        /// A pipeline description.
+        /// The pipeline as the parent loaded it: a description naming the
+        /// SPIR-V of every module (see `driver_description`).
         #[arg(long)]
-        pipeline: Option<PathBuf>,
-        /// An HLSL library whose DXR subobjects describe the pipeline.
-        #[arg(long)]
-        library: Option<PathBuf>,
-        /// Loose shaders, as `LANG:PATH`.
-        #[arg(long)]
-        shader: Vec<String>,
+        pipeline: PathBuf,
     },
     /// Print a rule's documentation.
     Rule {
@@ -380,11 +375,7 @@ fn run(cli: Cli) -> Result<u8, String> {
         ),
         Command::Verify(args) => verify(args),
         Command::Tradeoff(args) => tradeoff(args),
-        Command::DriverStackSizes {
-            pipeline,
-            library,
-            shader,
-        } => driver_stack_sizes(pipeline, library, shader),
+        Command::DriverStackSizes { pipeline } => driver_stack_sizes(pipeline),
         Command::Rules => {
             let mut out = std::io::stdout().lock();
             for r in rtlint::rules::RULES {
@@ -716,28 +707,13 @@ fn stack(
     if driver {
         return Err("--driver needs rtlint built with the `vulkan` feature".into());
     }
-    // The loose shaders, as the child process of `--driver` reloads them.
-    #[cfg_attr(not(feature = "vulkan"), allow(unused_variables))]
-    let loose: Vec<String> = pipelines
-        .last()
-        .filter(|p| p.path.is_none() && p.subobject_library.is_none())
-        .map(|p| {
-            p.programs
-                .iter()
-                .map(|q| {
-                    let lang = Language::from_path(&q.path).unwrap_or(Language::Spirv);
-                    format!("{}:{}", lang.as_str(), q.path.display())
-                })
-                .collect()
-        })
-        .unwrap_or_default();
     let mut reports = Vec::new();
     for p in &pipelines {
         #[allow(unused_mut)]
         let mut r = rtlint::analysis::stack_report(p);
         #[cfg(feature = "vulkan")]
         if driver {
-            match driver_in_child(p, &loose) {
+            match driver_in_child(p) {
                 Ok(d) => {
                     let sizes = d
                         .sizes
@@ -1115,33 +1091,31 @@ const DRIVER_CHILD_TIMEOUT: std::time::Duration = std::time::Duration::from_secs
 /// that crashes or hangs costs that pipeline its driver figures, with a
 /// message, and nothing else. Validation errors (`RTLINT_VK_VALIDATION=1`)
 /// are errors too: the layout rtlint built does not match the shaders.
-fn driver_in_child(
-    p: &rtlint::pipeline::Pipeline,
-    loose: &[String],
-) -> Result<DriverSizes, String> {
+fn driver_in_child(p: &rtlint::pipeline::Pipeline) -> Result<DriverSizes, String> {
     // RTLINT_DRIVER_CHILD names another program to run as the child (the
     // tests use it to stand in for a driver that crashes).
     let exe = match std::env::var_os("RTLINT_DRIVER_CHILD") {
         Some(p) => PathBuf::from(p),
         None => std::env::current_exe().map_err(|e| format!("cannot find rtlint itself: {e}"))?,
     };
+    // The child gets the modules as this process compiled them, whatever
+    // options (includes, defines, register shifts) that took.
+    static RUN: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+    let dir = std::env::temp_dir().join(format!(
+        "rtlint-driver-{}-{}",
+        std::process::id(),
+        RUN.fetch_add(1, std::sync::atomic::Ordering::Relaxed)
+    ));
+    let description = driver_description(p, &dir)
+        .map_err(|e| format!("cannot write the pipeline for the child process: {e}"))?;
     let mut command = std::process::Command::new(exe);
-    command.arg("driver-stack-sizes");
-    match (&p.path, &p.subobject_library) {
-        (Some(path), _) => {
-            command.arg("--pipeline").arg(path);
-        }
-        (None, Some(library)) => {
-            command.arg("--library").arg(library);
-        }
-        (None, None) => {
-            for s in loose {
-                command.arg("--shader").arg(s);
-            }
-        }
-    }
-    let o = rtlint::vk::run_command(command, DRIVER_CHILD_TIMEOUT)
-        .map_err(|e| format!("cannot start a child process: {e}"))?;
+    command
+        .arg("driver-stack-sizes")
+        .arg("--pipeline")
+        .arg(&description);
+    let o = rtlint::vk::run_command(command, DRIVER_CHILD_TIMEOUT);
+    let _ = std::fs::remove_dir_all(&dir);
+    let o = o.map_err(|e| format!("cannot start a child process: {e}"))?;
     let last_line = |t: &str| {
         t.lines()
             .rev()
@@ -1167,7 +1141,16 @@ fn driver_in_child(
         ));
     }
     if !o.success() {
-        return Err(last_line(&o.stderr));
+        // The child names the modules it was given; say the user's files.
+        let mut message = last_line(&o.stderr);
+        for (i, program) in p.programs.iter().enumerate().rev() {
+            let given = dir.join(format!("m{i}.spv"));
+            message = message.replace(
+                &given.display().to_string(),
+                &program.path.display().to_string(),
+            );
+        }
+        return Err(message);
     }
     let d: DriverSizes = serde_json::from_str(&o.stdout)
         .map_err(|e| format!("unreadable answer from the child process: {e}"))?;
@@ -1180,37 +1163,81 @@ fn driver_in_child(
     Ok(d)
 }
 
-/// The child's side of [`driver_in_child`].
-fn driver_stack_sizes(
-    pipeline: Option<PathBuf>,
-    library: Option<PathBuf>,
-    shaders: Vec<String>,
-) -> Result<u8, String> {
-    let p = match (pipeline, library) {
-        (Some(path), _) => rtlint::pipeline::load(&path).map_err(|e| e.0.message.clone())?,
-        (None, Some(path)) => {
-            let (program, subobjects) =
-                rtlint::front::load_library(&path, None, Language::Hlsl, &Default::default())
-                    .map_err(|e| e.0.message.clone())?;
-            rtlint::pipeline::Pipeline::from_subobjects(program, &subobjects)
-                .map_err(|_| format!("`{}` declares no pipeline subobjects", path.display()))?
-        }
-        (None, None) => {
-            let mut programs = Vec::new();
-            for s in &shaders {
-                let (lang, path) = s
-                    .split_once(':')
-                    .ok_or_else(|| format!("`{s}` is not LANG:PATH"))?;
-                let lang =
-                    Language::parse(lang).ok_or_else(|| format!("unknown language `{lang}`"))?;
-                programs.push(
-                    rtlint::front::load(std::path::Path::new(path), lang)
-                        .map_err(|e| e.0.message.clone())?,
-                );
-            }
-            rtlint::pipeline::Pipeline::from_programs(programs)
-        }
+/// Writes the pipeline as a description in `dir`: every module's SPIR-V
+/// (`mN.spv`, as loaded, so the child compiles nothing again), the groups in
+/// their slots' order, and the recursion depth the driver gets (the
+/// declared one, else the one the shaders need).
+fn driver_description(
+    p: &rtlint::pipeline::Pipeline,
+    dir: &std::path::Path,
+) -> std::io::Result<PathBuf> {
+    use std::fmt::Write as _;
+    std::fs::create_dir_all(dir)?;
+    for (i, program) in p.programs.iter().enumerate() {
+        let bytes: Vec<u8> = program.words.iter().flat_map(|w| w.to_le_bytes()).collect();
+        std::fs::write(dir.join(format!("m{i}.spv")), bytes)?;
+    }
+    let shader = |s: &rtlint::pipeline::ShaderRef| {
+        format!(
+            "file = \"m{}.spv\", entry = {}",
+            s.program,
+            toml_string(&s.entry)
+        )
     };
+    let mut t = String::new();
+    let depth = p
+        .max_recursion_depth
+        .or_else(|| rtlint::analysis::recursion_report(p).required_depth);
+    if let Some(d) = depth {
+        let _ = writeln!(t, "max_recursion_depth = {d}");
+    }
+    for (table, list) in [("raygen", &p.raygen), ("miss", &p.miss)] {
+        for s in list {
+            let _ = writeln!(t, "[[{table}]]\n{}", shader(s).replace(", ", "\n"));
+        }
+    }
+    for g in &p.hit_groups {
+        let kind = match g.kind {
+            rtlint::pipeline::HitGroupKind::Triangles => "triangles",
+            rtlint::pipeline::HitGroupKind::Procedural => "procedural",
+        };
+        let _ = writeln!(t, "[[hit_group]]\ntype = \"{kind}\"");
+        for (key, s) in [
+            ("closest_hit", &g.closest_hit),
+            ("any_hit", &g.any_hit),
+            ("intersection", &g.intersection),
+        ] {
+            if let Some(s) = s {
+                let _ = writeln!(t, "{key} = {{ {} }}", shader(s));
+            }
+        }
+    }
+    for s in &p.callable {
+        let _ = writeln!(t, "[[callable]]\n{}", shader(s).replace(", ", "\n"));
+    }
+    let path = dir.join("driver.pipeline.toml");
+    std::fs::write(&path, t)?;
+    Ok(path)
+}
+
+/// A TOML basic string.
+fn toml_string(s: &str) -> String {
+    let mut out = String::from("\"");
+    for c in s.chars() {
+        match c {
+            '"' => out.push_str("\\\""),
+            '\\' => out.push_str("\\\\"),
+            c if c.is_control() => out.push_str(&format!("\\u{:04X}", c as u32)),
+            c => out.push(c),
+        }
+    }
+    out.push('"');
+    out
+}
+
+/// The child's side of [`driver_in_child`].
+fn driver_stack_sizes(pipeline: PathBuf) -> Result<u8, String> {
+    let p = rtlint::pipeline::load(&pipeline).map_err(|e| e.0.message.clone())?;
     driver_stack_sizes_of(&p)
 }
 

@@ -459,6 +459,13 @@ fn driver_names_the_register_shift_for_an_hlsl_collision() {
         "{stderr}"
     );
     assert!(stderr.contains("a storage image for `Output`"), "{stderr}");
+    // The user's file, not the copy the child process was given.
+    assert!(
+        stderr.contains("raygeneration `RayGen` (")
+            && stderr.contains("tests/pipelines/registers.hlsl)"),
+        "{stderr}"
+    );
+    assert!(!stderr.contains("m0.spv"), "{stderr}");
     assert!(stderr.contains("`-fvk-u-shift N SET`"), "{stderr}");
     assert!(stderr.contains("`-fvk-t-shift N SET`"), "{stderr}");
     let error = stderr
