@@ -39,61 +39,40 @@ pub mod subobject;
 pub mod template;
 pub mod types;
 
+mod options;
 mod vocab;
 
 pub use error::{CompileError, ErrorDetails, ErrorKind, Label};
+pub use options::{
+    parse_args, Bindings, HlslOptions, ParsedArgs, Profile, ProfileKind, RegisterBinding, Shift,
+    TargetEnv,
+};
 pub use vocab::{Location, NamedDecl, Stage};
 
 use std::path::{Path, PathBuf};
 
-/// What `rtlint compile` and `rtlint check` pass to the compiler.
-#[derive(Clone, Debug, Default)]
-pub struct HlslOptions {
-    /// `-I` directories, searched in order after the including file's folder.
-    pub include_dirs: Vec<PathBuf>,
-    /// `-D NAME[=VALUE]`; a define without a value is `1`.
-    pub defines: Vec<(String, String)>,
-    /// Compile only this entry point.
-    pub entry: Option<String>,
-    /// The stage of `entry` when it has no `[shader(...)]` (DXC's `-T`).
-    pub stage: Option<Stage>,
-    /// DXC's `-enable-16bit-types`: `half` and the `min16*` types are then
-    /// 16-bit, which this compiler refuses rather than widen.
-    pub enable_16bit_types: bool,
-}
-
-/// Reads a DXC target profile (`ps_6_5`, `cs_6_0`, `lib_6_3`) or a stage name
-/// (`pixel`, `closesthit`, ...). `lib_*` gives `None`: stages come from the
-/// `[shader(...)]` attributes.
+/// Reads a DXC target profile (`ps_6_5`, `cs_6_0`, `lib_6_3`, `lib_6_x`) or
+/// a stage name (`pixel`, `closesthit`, ...). `lib_*` gives `None`: stages
+/// come from the `[shader(...)]` attributes.
 pub fn parse_stage(s: &str) -> Result<Option<Stage>, String> {
     if let Some(stage) = Stage::from_hlsl_name(s) {
         return Ok(Some(stage));
     }
-    let (kind, version) = s
-        .split_once('_')
-        .ok_or_else(|| format!("unknown profile or stage `{s}`"))?;
-    let valid_version = version
-        .split('_')
-        .all(|p| !p.is_empty() && p.chars().all(|c| c.is_ascii_digit()));
-    if !valid_version {
-        return Err(format!("unknown profile `{s}`"));
-    }
-    match kind {
-        "ps" => Ok(Some(Stage::Fragment)),
-        "cs" => Ok(Some(Stage::Compute)),
-        "lib" => Ok(None),
-        "vs" | "gs" | "hs" | "ds" | "ms" | "as" => Err(format!(
-            "not supported: {} shaders (`{s}`)",
-            match kind {
-                "vs" => "vertex",
-                "gs" => "geometry",
-                "hs" => "hull",
-                "ds" => "domain",
-                "ms" => "mesh",
-                _ => "amplification",
-            }
-        )),
-        _ => Err(format!("unknown profile `{s}`")),
+    let profile = Profile::parse(s).ok_or_else(|| match s.contains('_') {
+        true => format!("unknown profile `{s}`"),
+        false => format!("unknown profile or stage `{s}`"),
+    })?;
+    let unsupported = |what: &str| Err(format!("not supported: {what} shaders (`{s}`)"));
+    match profile.kind {
+        ProfileKind::Pixel => Ok(Some(Stage::Fragment)),
+        ProfileKind::Compute => Ok(Some(Stage::Compute)),
+        ProfileKind::Library => Ok(None),
+        ProfileKind::Vertex => unsupported("vertex"),
+        ProfileKind::Geometry => unsupported("geometry"),
+        ProfileKind::Hull => unsupported("hull"),
+        ProfileKind::Domain => unsupported("domain"),
+        ProfileKind::Mesh => unsupported("mesh"),
+        ProfileKind::Amplification => unsupported("amplification"),
     }
 }
 
@@ -108,6 +87,7 @@ fn lowerer<'a>(
         l.forced_entry = Some((e.clone(), s));
     }
     l.sixteen_bit_types = options.enable_16bit_types;
+    l.bindings = options.bindings.clone();
     l
 }
 
@@ -178,8 +158,19 @@ fn parse_with_warnings(
     loader: &mut dyn pp::FileLoader,
     options: &HlslOptions,
 ) -> Result<Parsed, CompileError> {
-    let out = pp::preprocess(path, text, loader, &options.include_dirs, &options.defines)
-        .map_err(|f| f.error.into_compile_error(&f.files, path))?;
+    let predefined = options.predefined_macros();
+    let out = pp::preprocess_with(
+        path,
+        text,
+        loader,
+        &pp::Setup {
+            include_dirs: &options.include_dirs,
+            predefined: &predefined,
+            defines: &options.defines,
+            row_major: options.row_major,
+        },
+    )
+    .map_err(|f| f.error.into_compile_error(&f.files, path))?;
     let items = parse::parse(&out.tokens).map_err(|e| e.into_compile_error(&out.files, path))?;
     let warnings = out
         .warnings

@@ -212,6 +212,8 @@ pub struct Lowerer<'a> {
     pub forced_entry: Option<(String, Stage)>,
     /// `-enable-16bit-types`: `half` and `min16*` are 16-bit (refused).
     pub sixteen_bit_types: bool,
+    /// How registers become descriptor sets and bindings (DXC's options).
+    pub bindings: crate::Bindings,
     /// DXR subobjects the file declares.
     pub subobjects: super::subobject::Subobjects,
     /// Function templates by qualified name (never lowered themselves).
@@ -529,6 +531,7 @@ impl<'a> Lowerer<'a> {
             member_decorations: HashMap::new(),
             physical_addressing: false,
             sixteen_bit_types: false,
+            bindings: crate::Bindings::default(),
             fn_derivs: HashMap::new(),
             nonuniform: HashSet::new(),
             cbuffer_members: HashMap::new(),
