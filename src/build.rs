@@ -46,6 +46,8 @@ pub struct Builder {
     pipelines: Vec<PathBuf>,
     include_dirs: Vec<PathBuf>,
     defines: Vec<(String, String)>,
+    /// DXC options besides `-I`/`-D` ([`Builder::dxc_args`]).
+    hlsl: hlsl::HlslOptions,
     config: Option<PathBuf>,
     deny_warnings: bool,
     emit_spirv: bool,
@@ -86,6 +88,21 @@ impl Builder {
     pub fn define(mut self, name: impl Into<String>, value: impl Into<String>) -> Self {
         self.defines.push((name.into(), value.into()));
         self
+    }
+
+    /// The project's DXC command line (`-fvk-t-shift 1000 all`,
+    /// `-HV 2021`, `-I`, `-D`, ...), read as `rtlint compile` reads it. A bad
+    /// or unknown option is an error naming it.
+    pub fn dxc_args<S: AsRef<str>>(
+        mut self,
+        args: impl IntoIterator<Item = S>,
+    ) -> Result<Self, String> {
+        let args: Vec<String> = args.into_iter().map(|a| a.as_ref().to_string()).collect();
+        let parsed = hlsl::parse_args(&args, &mut self.hlsl)?;
+        match parsed.rest.first() {
+            Some(a) => Err(format!("not a DXC option: `{a}`")),
+            None => Ok(self),
+        }
     }
 
     /// The `rtlint.toml` for every input; by default each file's nearest.
@@ -206,10 +223,18 @@ impl Builder {
             front: front::FrontOptions {
                 include_dirs: self.include_dirs.clone(),
                 defines: self.defines.clone(),
-                ..front::FrontOptions::default()
+                hlsl: self.vulkan_hlsl(),
             },
             ..lint::Options::default()
         }
+    }
+
+    /// The HLSL options: always a Vulkan build, since the output is SPIR-V
+    /// for Vulkan (so RT041 judges register collisions after the shifts).
+    fn vulkan_hlsl(&self) -> hlsl::HlslOptions {
+        let mut o = self.hlsl.clone();
+        o.spirv = true;
+        o
     }
 
     fn execute(&self) -> Run {
@@ -261,24 +286,8 @@ impl Builder {
             run.rerun_files_of(&program);
             if let (true, Some(dir)) = (self.emit_spirv, &out_dir) {
                 // The config's `[hlsl]` folders and defines first, as `check` has them.
-                let hlsl = &input.config.hlsl;
-                let hlsl_options = hlsl::HlslOptions {
-                    enable_16bit_types: hlsl.enable_16bit_types,
-                    include_dirs: hlsl
-                        .include_dirs
-                        .iter()
-                        .chain(&self.include_dirs)
-                        .cloned()
-                        .collect(),
-                    defines: hlsl
-                        .defines
-                        .iter()
-                        .map(|(k, v)| (k.clone(), v.clone()))
-                        .chain(self.defines.iter().cloned())
-                        .collect(),
-                    entry: None,
-                    stage: None,
-                };
+                let front = lint::front_options_for(input, &options);
+                let hlsl_options = front.hlsl_options();
                 if let Err(e) = emit_spirv(input, &program, &hlsl_options, dir, &mut spirv_names) {
                     run.diagnostics.push(*e.0);
                 }

@@ -18,6 +18,24 @@ pub struct SourceOptions {
     /// DXC's `-enable-16bit-types`.
     #[serde(default)]
     pub enable_16bit_types: bool,
+    /// A DXC command line's options (`["-fvk-t-shift", "1000", "all"]`),
+    /// read as `rtlint compile` reads them; checked when the config loads.
+    #[serde(default)]
+    pub args: Vec<String>,
+}
+
+impl SourceOptions {
+    /// The HLSL options `enable-16bit-types` and `args` give (the include
+    /// folders and defines are shared with GLSL and passed apart).
+    pub fn hlsl_options(&self) -> rtlint_hlsl::HlslOptions {
+        let mut o = rtlint_hlsl::HlslOptions {
+            enable_16bit_types: self.enable_16bit_types,
+            ..Default::default()
+        };
+        // Checked at load: an error here cannot happen.
+        let _ = rtlint_hlsl::parse_args(&self.args, &mut o);
+        o
+    }
 }
 
 /// One rule's entry under `[rules]`.
@@ -188,6 +206,26 @@ impl Config {
                     g,
                     format!("invalid glob `{g}`: {}", e.kind()),
                 ));
+            }
+        }
+        let mut scratch = rtlint_hlsl::HlslOptions::default();
+        match rtlint_hlsl::parse_args(&config.hlsl.args, &mut scratch) {
+            Ok(p) if p.rest.is_empty() => {}
+            Ok(p) => {
+                return Err(config_error(
+                    text,
+                    path,
+                    "args",
+                    format!("[hlsl] args: not a DXC option: `{}`", p.rest[0]),
+                ))
+            }
+            Err(e) => {
+                return Err(config_error(
+                    text,
+                    path,
+                    "args",
+                    format!("[hlsl] args: {e}"),
+                ))
             }
         }
         if let Some(dir) = path.parent() {

@@ -284,6 +284,30 @@ impl fmt::Display for InputError {
 
 impl std::error::Error for InputError {}
 
+/// The HLSL compiler's error as rtlint's: the kind picks the name, labels and
+/// notes carry over.
+impl From<rtlint_hlsl::CompileError> for InputError {
+    #[cold]
+    fn from(e: rtlint_hlsl::CompileError) -> Self {
+        use rtlint_hlsl::ErrorKind as K;
+        let e = e.into_details();
+        let kind = match e.kind {
+            K::Invalid | K::Internal => InputErrorKind::HlslError,
+            K::Unsupported => InputErrorKind::HlslUnsupported,
+            K::Unreadable => InputErrorKind::UnreadableFile,
+        };
+        let mut d = Diagnostic::new(Severity::Error, kind.as_str(), &e.file, e.message);
+        d.primary = e.primary.map(|l| Label::new(l.location, l.message));
+        d.secondary = e
+            .secondary
+            .into_iter()
+            .map(|l| Label::new(l.location, l.message))
+            .collect();
+        d.notes = e.notes;
+        InputError(Box::new(d))
+    }
+}
+
 /// Reads a UTF-8 text input; an unreadable or non-UTF-8 file is an input error.
 pub fn read_text(path: &Path) -> Result<String, InputError> {
     let bytes = std::fs::read(path).map_err(|e| io_error(path, &e))?;

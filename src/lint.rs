@@ -372,7 +372,16 @@ pub fn load_library(input: &Input, options: &Options) -> Result<(Program, Subobj
     front::load_library(&input.path, contents, input.language, &front_options)
 }
 
+/// The front-end options `input` is compiled with: its config's `[hlsl]`,
+/// then `options`'.
+pub fn front_options_for(input: &Input, options: &Options) -> FrontOptions {
+    front_options(&input.config, options)
+}
+
+/// The config's `[hlsl]` first, then the command line's options.
 fn front_options(config: &Config, options: &Options) -> FrontOptions {
+    let mut hlsl = config.hlsl.hlsl_options();
+    hlsl.merge(&options.front.hlsl);
     let mut front_options = FrontOptions {
         include_dirs: config.hlsl.include_dirs.clone(),
         defines: config
@@ -381,9 +390,7 @@ fn front_options(config: &Config, options: &Options) -> FrontOptions {
             .iter()
             .map(|(k, v)| (k.clone(), v.clone()))
             .collect(),
-        entry: options.front.entry.clone(),
-        stage: options.front.stage,
-        enable_16bit_types: config.hlsl.enable_16bit_types || options.front.enable_16bit_types,
+        hlsl,
     };
     front_options
         .include_dirs
@@ -398,6 +405,8 @@ fn front_options(config: &Config, options: &Options) -> FrontOptions {
 struct Configs {
     choice: ConfigChoice,
     overrides: Overrides,
+    /// The command line's HLSL options build for Vulkan.
+    vulkan_hlsl: bool,
     by_file: HashMap<PathBuf, Arc<Config>>,
     by_dir: HashMap<PathBuf, Arc<Config>>,
     /// [`Configs::for_file`]'s answers by the folder as written: a walk
@@ -411,6 +420,7 @@ impl Configs {
         Configs {
             choice: options.config.clone(),
             overrides: options.overrides.clone(),
+            vulkan_hlsl: options.front.hlsl.spirv,
             by_file: HashMap::new(),
             by_dir: HashMap::new(),
             by_parent: HashMap::new(),
@@ -480,6 +490,11 @@ impl Configs {
         config.deny_warnings |= o.deny_warnings;
         if let Some(a) = o.analysis {
             config.analysis = a;
+        }
+        // A DXC command line that builds for Vulkan (`-spirv`, `-fvk-*`, in
+        // `[hlsl] args` or on the command line) says what RT041's option says.
+        if self.vulkan_hlsl || config.hlsl.hlsl_options().spirv {
+            config.set_option("RT041", "vulkan", toml::Value::Boolean(true));
         }
         let c = Arc::new(config);
         self.by_file.insert(key, c.clone());

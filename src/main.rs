@@ -35,27 +35,6 @@ struct Common {
     /// Treat every named file as this language.
     #[arg(long, value_enum)]
     lang: Option<LangArg>,
-    /// Include directory for HLSL and GLSL sources.
-    #[arg(short = 'I', value_name = "DIR")]
-    include: Vec<PathBuf>,
-    /// Define a macro for HLSL and GLSL sources: NAME or NAME=VALUE.
-    #[arg(short = 'D', value_name = "NAME[=VALUE]")]
-    define: Vec<String>,
-    /// HLSL: only this entry point.
-    #[arg(short = 'E', long = "entry", value_name = "NAME")]
-    entry: Option<String>,
-    /// HLSL: the entry point's stage when it has no `[shader(...)]`: a DXC
-    /// profile (`ps_6_5`, `cs_6_5`, `lib_6_3`) or a stage name.
-    #[arg(
-        short = 'T',
-        long = "stage",
-        value_name = "PROFILE",
-        requires = "entry"
-    )]
-    stage: Option<String>,
-    /// HLSL: DXC's `-enable-16bit-types` (`half` is then 16-bit).
-    #[arg(long = "enable-16bit-types")]
-    enable_16bit_types: bool,
     /// The name standard input (`-`) is linted under; its extension picks the language.
     #[arg(long, value_name = "PATH")]
     stdin_filename: Option<PathBuf>,
@@ -271,29 +250,12 @@ enum Command {
     Compile {
         /// The HLSL file.
         file: PathBuf,
-        /// Compile only this entry point.
-        #[arg(short = 'E', long = "entry")]
-        entry: Option<String>,
-        /// The entry point's stage when it has no `[shader(...)]`: a DXC
-        /// profile (`ps_6_5`, `cs_6_5`, `lib_6_3`) or a stage name (`pixel`).
-        #[arg(
-            short = 'T',
-            long = "stage",
-            value_name = "PROFILE",
-            requires = "entry"
-        )]
-        stage: Option<String>,
-        /// Include directory (searched after the including file's folder).
-        #[arg(short = 'I', value_name = "DIR")]
-        include: Vec<PathBuf>,
-        /// Define a macro: NAME or NAME=VALUE.
-        #[arg(short = 'D', value_name = "NAME[=VALUE]")]
-        define: Vec<String>,
-        /// DXC's `-enable-16bit-types` (`half` is then 16-bit).
-        #[arg(long = "enable-16bit-types")]
-        enable_16bit_types: bool,
+        /// Say which DXC options change nothing here.
+        #[arg(short, long)]
+        verbose: bool,
         /// Output: a `.spv` file (one entry point, or with --whole every entry
-        /// point in one module), or a directory for one module per entry point.
+        /// point in one module), or a directory for one module per entry point
+        /// (DXC's `-Fo FILE` too).
         #[arg(short = 'o', long = "output")]
         output: PathBuf,
         /// One module holding every entry point.
@@ -326,8 +288,102 @@ enum Command {
     },
 }
 
+/// DXC's options, read from the command line before clap reads the rest:
+/// DXC spells them with one dash and some take two or four values
+/// (`-fvk-t-shift 1000 all`), which clap cannot express.
+struct Dxc {
+    options: rtlint::front::hlsl::HlslOptions,
+    notes: Vec<String>,
+}
+
+static DXC: std::sync::OnceLock<Dxc> = std::sync::OnceLock::new();
+
+fn dxc() -> &'static Dxc {
+    DXC.get_or_init(|| Dxc {
+        options: Default::default(),
+        notes: Vec::new(),
+    })
+}
+
+/// `--verbose`: the DXC options accepted without effect.
+fn dxc_notes() {
+    for n in &dxc().notes {
+        eprintln!("note: {n}");
+    }
+}
+
+/// The subcommands that compile HLSL read a DXC command line among their
+/// arguments: `-T`, `-E`, `-I`, `-D`, `-HV`, `-fvk-*-shift`, ... (the
+/// `rtlint_hlsl::parse_args` reader); what it does not know goes to clap.
+/// `--entry`/`--stage` are rtlint's long names for `-E`/`-T`, and
+/// `--enable-16bit-types` is taken for DXC's `-enable-16bit-types`.
+fn take_dxc_args(argv: Vec<std::ffi::OsString>) -> Result<Vec<std::ffi::OsString>, String> {
+    const HLSL_COMMANDS: &[&str] = &["check", "live", "stack", "layout", "compile"];
+    let Some(sub) = argv
+        .iter()
+        .skip(1)
+        .position(|a| !a.to_string_lossy().starts_with('-'))
+        .map(|i| i + 1)
+    else {
+        return Ok(argv);
+    };
+    let command = argv[sub].to_string_lossy().into_owned();
+    if !HLSL_COMMANDS.contains(&command.as_str()) {
+        return Ok(argv);
+    }
+    // An argument that is not UTF-8 (a path) stands in as NUL and its
+    // index (no argument can hold a NUL), and comes back unchanged.
+    let mut args = Vec::new();
+    for (i, a) in argv[sub + 1..].iter().enumerate() {
+        let a = match a.to_str() {
+            Some(s) => s.to_string(),
+            None => format!("\0{i}"),
+        };
+        args.push(match a.as_str() {
+            "--entry" => "-E".to_string(),
+            "--stage" => "-T".to_string(),
+            "--enable-16bit-types" => "-enable-16bit-types".to_string(),
+            _ => match (a.strip_prefix("--entry="), a.strip_prefix("--stage=")) {
+                (Some(e), _) => format!("-E{e}"),
+                (_, Some(t)) => format!("-T{t}"),
+                _ => a,
+            },
+        });
+    }
+    let mut options = rtlint::front::hlsl::HlslOptions::default();
+    let parsed = rtlint::front::hlsl::parse_args(&args, &mut options)?;
+    let mut out: Vec<std::ffi::OsString> = argv[..=sub].to_vec();
+    for a in parsed.rest {
+        match a.strip_prefix('\0').and_then(|i| i.parse::<usize>().ok()) {
+            Some(i) => out.push(argv[sub + 1 + i].clone()),
+            None => out.push(a.into()),
+        }
+    }
+    let mut notes = parsed.notes;
+    if let Some(o) = parsed.output {
+        if command == "compile" {
+            out.push("-o".into());
+            out.push(o.into());
+        } else {
+            notes.push(format!(
+                "-Fo {}: ignored by `rtlint {command}`",
+                o.display()
+            ));
+        }
+    }
+    let _ = DXC.set(Dxc { options, notes });
+    Ok(out)
+}
+
 fn main() -> ExitCode {
-    let cli = match Cli::try_parse() {
+    let argv = match take_dxc_args(std::env::args_os().collect()) {
+        Ok(a) => a,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return ExitCode::from(2);
+        }
+    };
+    let cli = match Cli::try_parse_from(argv) {
         Ok(c) => c,
         Err(e) => {
             let _ = e.print();
@@ -360,19 +416,15 @@ fn run(cli: Cli) -> Result<u8, String> {
         Command::Layout { common, format } => layout(common, format),
         Command::Compile {
             file,
-            entry,
-            stage,
-            include,
-            define,
-            enable_16bit_types,
+            verbose,
             output,
             whole,
-        } => compile(
-            file,
-            hlsl_options(entry, stage, include, define, enable_16bit_types),
-            output,
-            whole,
-        ),
+        } => {
+            if verbose {
+                dxc_notes();
+            }
+            compile(file, dxc().options.clone(), output, whole)
+        }
         Command::Verify(args) => verify(args),
         Command::Tradeoff(args) => tradeoff(args),
         Command::DriverStackSizes { pipeline } => driver_stack_sizes(pipeline),
@@ -424,33 +476,23 @@ fn options(common: &Common) -> Result<lint::Options, String> {
     Ok(lint::Options {
         config,
         language: common.lang.map(LangArg::language),
-        front: rtlint::front::FrontOptions {
-            include_dirs: common.include.clone(),
-            defines: common.define.iter().map(|d| split_define(d)).collect(),
-            entry: common.entry.clone(),
-            stage: match common
-                .stage
-                .as_deref()
-                .map(rtlint::front::hlsl::parse_stage)
-            {
-                Some(Ok(s)) => s,
-                Some(Err(e)) => return Err(format!("-T: {e}")),
-                None => None,
-            },
-            enable_16bit_types: common.enable_16bit_types,
+        front: {
+            if common.verbose {
+                dxc_notes();
+            }
+            // `-I`/`-D` are shared with GLSL; the rest is HLSL's alone.
+            let mut hlsl = dxc().options.clone();
+            rtlint::front::FrontOptions {
+                include_dirs: std::mem::take(&mut hlsl.include_dirs),
+                defines: std::mem::take(&mut hlsl.defines),
+                hlsl,
+            }
         },
         respect_gitignore: !common.no_gitignore,
         stdin,
         stdin_filename: common.stdin_filename.clone(),
         ..lint::Options::default()
     })
-}
-
-fn split_define(d: &str) -> (String, String) {
-    match d.split_once('=') {
-        Some((n, v)) => (n.to_string(), v.to_string()),
-        None => (d.to_string(), "1".to_string()),
-    }
 }
 
 fn check(args: CheckArgs) -> Result<u8, String> {
@@ -815,43 +857,13 @@ fn print_report(
     Ok(if problems.is_empty() { 0 } else { 2 })
 }
 
-/// `rtlint compile`'s HLSL options; `Err` is a bad `-T`.
-fn hlsl_options(
-    entry: Option<String>,
-    stage: Option<String>,
-    include: Vec<PathBuf>,
-    define: Vec<String>,
-    enable_16bit_types: bool,
-) -> Result<rtlint::front::hlsl::HlslOptions, String> {
-    use rtlint::front::hlsl;
-    let stage = stage
-        .as_deref()
-        .map(hlsl::parse_stage)
-        .transpose()?
-        .flatten();
-    Ok(hlsl::HlslOptions {
-        stage,
-        include_dirs: include,
-        defines: define.iter().map(|d| split_define(d)).collect(),
-        entry,
-        enable_16bit_types,
-    })
-}
-
 fn compile(
     file: PathBuf,
-    options: Result<rtlint::front::hlsl::HlslOptions, String>,
+    options: rtlint::front::hlsl::HlslOptions,
     output: PathBuf,
     whole: bool,
 ) -> Result<u8, String> {
     use rtlint::front::hlsl;
-    let options = match options {
-        Ok(o) => o,
-        Err(e) => {
-            eprintln!("error: -T: {e}");
-            return Ok(2);
-        }
-    };
     let write = |path: &std::path::Path, words: &[u32]| -> Result<(), String> {
         let bytes: Vec<u8> = words.iter().flat_map(|w| w.to_le_bytes()).collect();
         std::fs::write(path, bytes).map_err(|e| format!("cannot write {}: {e}", path.display()))

@@ -133,3 +133,153 @@ fn compile_errors_name_file_and_position() {
     assert!(err.contains("bad.hlsl:2:13"), "{err}");
     assert!(!d.join("b.spv").exists());
 }
+
+/// (set, binding) of a variable named `name` in a module.
+fn binding_of(words: &[u32], name: &str) -> (Option<u32>, Option<u32>) {
+    let p = rtlint::program::parse(
+        words,
+        std::path::Path::new("m.spv"),
+        rtlint::shader::Language::Spirv,
+    )
+    .unwrap();
+    let g = p
+        .globals
+        .iter()
+        .find(|g| g.name.as_deref() == Some(name))
+        .unwrap_or_else(|| panic!("no global {name}"));
+    (g.set, g.binding)
+}
+
+/// A DXC command line, pasted as a project's build writes it: no-op flags,
+/// `-Fo`, the target environment and the register shifts. The shifts land
+/// where DXC's documentation puts them.
+#[test]
+fn a_dxc_command_line_is_accepted_unchanged() {
+    let d = scratch("dxc");
+    let out = d.join("rt.spv");
+    let o = rtlint()
+        .args([
+            "compile",
+            "-spirv",
+            "-T",
+            "lib_6_3",
+            "-HV",
+            "2021",
+            "-fspv-target-env=vulkan1.2",
+            "-fvk-t-shift",
+            "1000",
+            "all",
+            "-fvk-u-shift",
+            "2000",
+            "all",
+            "-fvk-b-shift",
+            "3000",
+            "0",
+            "-O3",
+            "-Zi",
+            "-Qembed_debug",
+            "-fcgl",
+            "-Vd",
+            "-fspv-debug=vulkan-with-source",
+            "-fvk-use-dx-position-w",
+            "-Fo",
+        ])
+        .arg(&out)
+        .args(["fixtures/RT041/good_d3d12_only.hlsl", "--whole", "-v"])
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(0), "{err}");
+    assert!(
+        err.contains("note: -O3: accepted, changes nothing here"),
+        "{err}"
+    );
+    let words = common::read_words(&out);
+    assert_eq!(binding_of(&words, "scene"), (Some(0), Some(1000)));
+    assert_eq!(binding_of(&words, "colors"), (Some(0), Some(1001)));
+    assert_eq!(binding_of(&words, "output"), (Some(0), Some(2000)));
+    assert_eq!(binding_of(&words, "Camera"), (Some(0), Some(3001)));
+
+    // A bad value is an error naming the option, exit code 2.
+    let o = rtlint()
+        .args(["compile", "-fvk-t-shift", "ten", "all", "x.hlsl", "-o"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("-fvk-t-shift: expected a number"));
+}
+
+/// RT041 reads Vulkan intent from the DXC options: `-spirv` alone checks the
+/// D3D12-style registers (t0 and u0 collide), shifts that separate the
+/// classes leave nothing to report, and `[hlsl] args` says the same.
+#[test]
+fn rt041_judges_collisions_after_the_shifts() {
+    let check = |args: &[&str]| {
+        let o = rtlint()
+            .arg("check")
+            .args(args)
+            .args([
+                "--select",
+                "RT041",
+                "--no-config",
+                "fixtures/RT041/good_d3d12_only.hlsl",
+            ])
+            .output()
+            .unwrap();
+        String::from_utf8_lossy(&o.stdout).into_owned()
+    };
+    assert!(
+        !check(&[]).contains("RT041"),
+        "D3D12-only HLSL without options"
+    );
+    let spirv = check(&["-spirv"]);
+    assert!(spirv.contains("RT041"), "{spirv}");
+    let shifted = check(&[
+        "-spirv",
+        "-fvk-t-shift",
+        "100",
+        "0",
+        "-fvk-u-shift",
+        "200",
+        "0",
+    ]);
+    assert!(!shifted.contains("RT041"), "{shifted}");
+    // Shifting only one class keeps one collision: t1 (colors) and b1 (Camera).
+    let partly = check(&["-fvk-u-shift", "200", "0"]);
+    assert!(
+        partly.contains("RT041") && partly.contains("Camera"),
+        "{partly}"
+    );
+
+    let d = scratch("config-args");
+    std::fs::copy("fixtures/RT041/good_d3d12_only.hlsl", d.join("a.hlsl")).unwrap();
+    std::fs::write(
+        d.join("rtlint.toml"),
+        "[hlsl]\nargs = [\"-spirv\", \"-fvk-u-shift\", \"200\", \"all\"]\n",
+    )
+    .unwrap();
+    let o = rtlint()
+        .args(["check", "--select", "RT041"])
+        .arg(d.join("a.hlsl"))
+        .output()
+        .unwrap();
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(out.contains("RT041") && out.contains("Camera"), "{out}");
+    std::fs::write(
+        d.join("rtlint.toml"),
+        "[hlsl]\nargs = [\"-fvk-u-shift\", \"x\", \"all\"]\n",
+    )
+    .unwrap();
+    let o = rtlint()
+        .args(["check"])
+        .arg(d.join("a.hlsl"))
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(2));
+    let out = String::from_utf8_lossy(&o.stdout).into_owned() + &String::from_utf8_lossy(&o.stderr);
+    assert!(
+        out.contains("[hlsl] args: -fvk-u-shift: expected a number"),
+        "{out}"
+    );
+}

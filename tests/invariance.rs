@@ -381,7 +381,10 @@ fn analyses_do_not_depend_on_debug_info() {
         let language = Language::from_path(path).unwrap();
         // The 16-bit test shaders are written for -enable-16bit-types.
         let options = rtlint::front::FrontOptions {
-            enable_16bit_types: path.to_string_lossy().ends_with("half.hlsl"),
+            hlsl: rtlint::front::hlsl::HlslOptions {
+                enable_16bit_types: path.to_string_lossy().ends_with("half.hlsl"),
+                ..Default::default()
+            },
             ..Default::default()
         };
         let c = rtlint::front::compile_input(path, None, language, &options)

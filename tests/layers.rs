@@ -3,6 +3,10 @@
 //! import against the direction, or on a rule that imports another rule.
 //! Unit-test modules (`#[cfg(test)]`) are exempt: tests may load fixtures
 //! through the front-ends and render through reports.
+//!
+//! The HLSL compiler is not in this scan: it is its own crate
+//! (`crates/rtlint-hlsl`), so Cargo refuses any use of rtlint from it. The
+//! last test here checks that its manifest keeps it that way.
 
 use std::path::{Path, PathBuf};
 
@@ -192,4 +196,38 @@ fn the_checker_finds_imports() {
     let stripped = &code[..code.find("#[cfg(test)]").unwrap()];
     let found = crate_modules(stripped);
     assert_eq!(found, ["front", "config", "report", "vk"]);
+}
+
+/// The HLSL compiler's boundary is Cargo's: its manifest names no rtlint
+/// crate and no path dependency, so nothing of rtlint can be imported there.
+#[test]
+fn the_hlsl_crate_depends_on_nothing_of_rtlint() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let manifest: toml::Table = std::fs::read_to_string(root.join("crates/rtlint-hlsl/Cargo.toml"))
+        .unwrap()
+        .parse()
+        .unwrap();
+    let mut tables = vec![&manifest];
+    if let Some(t) = manifest.get("target").and_then(|t| t.as_table()) {
+        tables.extend(t.values().filter_map(|v| v.as_table()));
+    }
+    let mut deps = Vec::new();
+    for t in tables {
+        for kind in ["dependencies", "dev-dependencies", "build-dependencies"] {
+            if let Some(d) = t.get(kind).and_then(|d| d.as_table()) {
+                deps.extend(d.iter());
+            }
+        }
+    }
+    assert!(
+        deps.iter().any(|(n, _)| *n == "rspirv"),
+        "the scan sees the deps"
+    );
+    for (name, spec) in deps {
+        assert!(!name.starts_with("rtlint"), "rtlint-hlsl depends on {name}");
+        let path = spec.as_table().and_then(|t| t.get("path"));
+        assert!(path.is_none(), "rtlint-hlsl has a path dependency: {name}");
+    }
+    // And rtlint uses it, not a copy: the sources are gone from src/.
+    assert!(!src().join("front/hlsl").exists());
 }

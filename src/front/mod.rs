@@ -38,12 +38,23 @@ pub struct FrontOptions {
     pub include_dirs: Vec<PathBuf>,
     /// `-D NAME=VALUE` (HLSL and GLSL).
     pub defines: Vec<(String, String)>,
-    /// HLSL: compile only this entry point (`-E`).
-    pub entry: Option<String>,
-    /// HLSL: the stage of `entry` when it has no `[shader(...)]` (`-T`).
-    pub stage: Option<crate::shader::Stage>,
-    /// HLSL: DXC's `-enable-16bit-types`.
-    pub enable_16bit_types: bool,
+    /// The rest of a DXC command line (`-E`, `-T`, register shifts, ...):
+    /// the one HLSL options type, whose own `-I`/`-D` lists come after the
+    /// shared ones above. [`FrontOptions::hlsl_options`] puts them together.
+    pub hlsl: hlsl::HlslOptions,
+}
+
+impl FrontOptions {
+    /// What the HLSL compiler is given: the shared `-I`/`-D`, then the rest.
+    pub fn hlsl_options(&self) -> hlsl::HlslOptions {
+        let mut o = hlsl::HlslOptions {
+            include_dirs: self.include_dirs.clone(),
+            defines: self.defines.clone(),
+            ..hlsl::HlslOptions::default()
+        };
+        o.merge(&self.hlsl);
+        o
+    }
 }
 
 /// Reads and compiles one file to SPIR-V.
@@ -95,13 +106,7 @@ pub fn compile_input(
         }
         Language::Hlsl => {
             let text = text()?;
-            let hlsl_options = hlsl::HlslOptions {
-                include_dirs: options.include_dirs.clone(),
-                defines: options.defines.clone(),
-                entry: options.entry.clone(),
-                stage: options.stage,
-                enable_16bit_types: options.enable_16bit_types,
-            };
+            let hlsl_options = options.hlsl_options();
             let m =
                 hlsl::compile_source_whole(path, &text, &mut hlsl::pp::FsLoader, &hlsl_options)?;
             let mut c = compiled(Language::Hlsl, m.words, m.decls);

@@ -72,14 +72,8 @@ pub enum Decl {
 
 /// A declaration named in source, matched to SPIR-V ids through `OpName`:
 /// how front-ends hand over declaration positions the module's own debug
-/// info lacks (see [`Program::attach_named_decls`]).
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub enum NamedDecl {
-    Type(String),
-    Member(String, u32),
-    Global(String),
-    Function(String),
-}
+/// info lacks (see [`Program::attach_named_decls`]). The HLSL compiler's type.
+pub use rtlint_hlsl::NamedDecl;
 
 #[derive(Clone, Debug)]
 pub struct EntryPoint {

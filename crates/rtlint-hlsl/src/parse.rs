@@ -344,7 +344,7 @@ impl<'t> Parser<'t> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::front::hlsl::lex::lex;
+    use crate::lex::lex;
 
     fn items(s: &str) -> Vec<Item> {
         parse(&lex(s, 0).unwrap()).unwrap()

@@ -7,7 +7,7 @@
 
 use super::ast::{Expr, ExprKind};
 use super::error::{Error, Pos, Result};
-use crate::shader::Location;
+use crate::vocab::Location;
 
 /// Which subobject a declaration is, by its type name.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -33,9 +33,8 @@ use super::error::{Error, Pos, Result};
 use super::parse::split_numeric;
 use super::subobject;
 use super::types::*;
-use crate::diag::Location;
-use crate::program::NamedDecl;
-pub use crate::shader::Stage;
+pub use crate::vocab::Stage;
+use crate::vocab::{Location, NamedDecl};
 use rspirv::dr::{self, Builder, InsertPoint, Instruction, Operand};
 use spirv::{BuiltIn, Capability, Decoration, Op, StorageClass, Word as Id};
 use std::collections::{BTreeSet, HashMap, HashSet};
@@ -213,6 +212,8 @@ pub struct Lowerer<'a> {
     pub forced_entry: Option<(String, Stage)>,
     /// `-enable-16bit-types`: `half` and `min16*` are 16-bit (refused).
     pub sixteen_bit_types: bool,
+    /// How registers become descriptor sets and bindings (DXC's options).
+    pub bindings: crate::Bindings,
     /// DXR subobjects the file declares.
     pub subobjects: super::subobject::Subobjects,
     /// Function templates by qualified name (never lowered themselves).
@@ -530,6 +531,7 @@ impl<'a> Lowerer<'a> {
             member_decorations: HashMap::new(),
             physical_addressing: false,
             sixteen_bit_types: false,
+            bindings: crate::Bindings::default(),
             fn_derivs: HashMap::new(),
             nonuniform: HashSet::new(),
             cbuffer_members: HashMap::new(),

@@ -1,8 +1,32 @@
-//! HLSL front-end: preprocess → lex → parse → type-check and emit SPIR-V.
+//! A pure-Rust HLSL → SPIR-V compiler for ray-tracing shaders: DXR
+//! libraries and subobjects, inline ray queries, compute and pixel shaders.
+//! It follows DXC's documented HLSL → SPIR-V mapping for Vulkan, and writes
+//! SPIR-V 1.4 with positions (`OpLine`) and
+//! `NonSemantic.Shader.DebugInfo.100` declarations.
 //!
-//! The shape follows naga's WGSL front-end: stages pass plain data along, and
-//! internal errors (a position and a message) become an [`InputError`] in one
-//! place at this module's boundary. See `docs/hlsl.md` for what is supported.
+//! ```no_run
+//! use rtlint_hlsl::{compile_file, HlslOptions};
+//!
+//! let module = compile_file("rt.hlsl".as_ref(), &HlslOptions::default())?;
+//! for (name, stage) in &module.entries {
+//!     println!("{name}: {}", stage.as_str());
+//! }
+//! # Ok::<(), rtlint_hlsl::CompileError>(())
+//! ```
+//!
+//! [`compile`] gives one module per entry point, [`compile_file`] one module
+//! with all of them plus declaration positions and DXR subobjects;
+//! [`compile_source`] and [`compile_source_whole`] take the text and a
+//! [`pp::FileLoader`] for includes. [`HlslOptions`] is what a DXC command
+//! line says. An error is a [`CompileError`] (kind, message, file, line and
+//! column); HLSL outside the supported subset is refused with
+//! `not supported: ...` at its position, never miscompiled.
+//!
+//! Stages: [`pp`] (preprocessor, on tokens) → [`lex`] → [`parse`] →
+//! [`template`] (instances of the templates used) → lowering (type checking
+//! and SPIR-V emission) → words. The stages pass plain data along, as in
+//! naga's WGSL front-end; internal errors (a position and a message) become
+//! a [`CompileError`] in one place at this crate's boundary.
 
 pub mod ast;
 pub mod attrs;
@@ -15,61 +39,40 @@ pub mod subobject;
 pub mod template;
 pub mod types;
 
-pub use crate::shader::Stage;
+mod options;
+mod vocab;
 
-use crate::diag::{InputError, InputErrorKind};
-use crate::program::NamedDecl;
-use crate::shader::Location;
+pub use error::{CompileError, ErrorDetails, ErrorKind, Label};
+pub use options::{
+    parse_args, Bindings, HlslOptions, ParsedArgs, Profile, ProfileKind, RegisterBinding, Shift,
+    TargetEnv,
+};
+pub use vocab::{Location, NamedDecl, Stage};
+
 use std::path::{Path, PathBuf};
 
-/// What `rtlint compile` and `rtlint check` pass to the compiler.
-#[derive(Clone, Debug, Default)]
-pub struct HlslOptions {
-    /// `-I` directories, searched in order after the including file's folder.
-    pub include_dirs: Vec<PathBuf>,
-    /// `-D NAME[=VALUE]`; a define without a value is `1`.
-    pub defines: Vec<(String, String)>,
-    /// Compile only this entry point.
-    pub entry: Option<String>,
-    /// The stage of `entry` when it has no `[shader(...)]` (DXC's `-T`).
-    pub stage: Option<Stage>,
-    /// DXC's `-enable-16bit-types`: `half` and the `min16*` types are then
-    /// 16-bit, which this compiler refuses rather than widen.
-    pub enable_16bit_types: bool,
-}
-
-/// Reads a DXC target profile (`ps_6_5`, `cs_6_0`, `lib_6_3`) or a stage name
-/// (`pixel`, `closesthit`, ...). `lib_*` gives `None`: stages come from the
-/// `[shader(...)]` attributes.
+/// Reads a DXC target profile (`ps_6_5`, `cs_6_0`, `lib_6_3`, `lib_6_x`) or
+/// a stage name (`pixel`, `closesthit`, ...). `lib_*` gives `None`: stages
+/// come from the `[shader(...)]` attributes.
 pub fn parse_stage(s: &str) -> Result<Option<Stage>, String> {
     if let Some(stage) = Stage::from_hlsl_name(s) {
         return Ok(Some(stage));
     }
-    let (kind, version) = s
-        .split_once('_')
-        .ok_or_else(|| format!("unknown profile or stage `{s}`"))?;
-    let valid_version = version
-        .split('_')
-        .all(|p| !p.is_empty() && p.chars().all(|c| c.is_ascii_digit()));
-    if !valid_version {
-        return Err(format!("unknown profile `{s}`"));
-    }
-    match kind {
-        "ps" => Ok(Some(Stage::Fragment)),
-        "cs" => Ok(Some(Stage::Compute)),
-        "lib" => Ok(None),
-        "vs" | "gs" | "hs" | "ds" | "ms" | "as" => Err(format!(
-            "not supported: {} shaders (`{s}`)",
-            match kind {
-                "vs" => "vertex",
-                "gs" => "geometry",
-                "hs" => "hull",
-                "ds" => "domain",
-                "ms" => "mesh",
-                _ => "amplification",
-            }
-        )),
-        _ => Err(format!("unknown profile `{s}`")),
+    let profile = Profile::parse(s).ok_or_else(|| match s.contains('_') {
+        true => format!("unknown profile `{s}`"),
+        false => format!("unknown profile or stage `{s}`"),
+    })?;
+    let unsupported = |what: &str| Err(format!("not supported: {what} shaders (`{s}`)"));
+    match profile.kind {
+        ProfileKind::Pixel => Ok(Some(Stage::Fragment)),
+        ProfileKind::Compute => Ok(Some(Stage::Compute)),
+        ProfileKind::Library => Ok(None),
+        ProfileKind::Vertex => unsupported("vertex"),
+        ProfileKind::Geometry => unsupported("geometry"),
+        ProfileKind::Hull => unsupported("hull"),
+        ProfileKind::Domain => unsupported("domain"),
+        ProfileKind::Mesh => unsupported("mesh"),
+        ProfileKind::Amplification => unsupported("amplification"),
     }
 }
 
@@ -84,6 +87,7 @@ fn lowerer<'a>(
         l.forced_entry = Some((e.clone(), s));
     }
     l.sixteen_bit_types = options.enable_16bit_types;
+    l.bindings = options.bindings.clone();
     l
 }
 
@@ -111,15 +115,15 @@ pub struct CompiledModule {
 }
 
 /// Compiles each entry point of `path` into its own module.
-pub fn compile(path: &Path, options: &HlslOptions) -> Result<Vec<CompiledEntry>, InputError> {
-    let text = crate::front::read_text(path)?;
+pub fn compile(path: &Path, options: &HlslOptions) -> Result<Vec<CompiledEntry>, CompileError> {
+    let text = read_source(path)?;
     let mut loader = pp::FsLoader;
     compile_source(path, &text, &mut loader, options)
 }
 
 /// Compiles every entry point of `path` into one module (what `rtlint check` reads).
-pub fn compile_file(path: &Path, options: &HlslOptions) -> Result<CompiledModule, InputError> {
-    let text = crate::front::read_text(path)?;
+pub fn compile_file(path: &Path, options: &HlslOptions) -> Result<CompiledModule, CompileError> {
+    let text = read_source(path)?;
     let mut loader = pp::FsLoader;
     compile_source_whole(path, &text, &mut loader, options)
 }
@@ -130,7 +134,7 @@ pub fn parse_source(
     text: &str,
     loader: &mut dyn pp::FileLoader,
     options: &HlslOptions,
-) -> Result<(Vec<ast::Item>, Vec<PathBuf>), InputError> {
+) -> Result<(Vec<ast::Item>, Vec<PathBuf>), CompileError> {
     with_stack(|| parse_source_inner(path, text, loader, options))
 }
 
@@ -139,7 +143,7 @@ fn parse_source_inner(
     text: &str,
     loader: &mut dyn pp::FileLoader,
     options: &HlslOptions,
-) -> Result<(Vec<ast::Item>, Vec<PathBuf>), InputError> {
+) -> Result<(Vec<ast::Item>, Vec<PathBuf>), CompileError> {
     parse_with_warnings(path, text, loader, options).map(|(items, files, _)| (items, files))
 }
 
@@ -153,10 +157,21 @@ fn parse_with_warnings(
     text: &str,
     loader: &mut dyn pp::FileLoader,
     options: &HlslOptions,
-) -> Result<Parsed, InputError> {
-    let out = pp::preprocess(path, text, loader, &options.include_dirs, &options.defines)
-        .map_err(|f| f.error.into_input_error(&f.files, path))?;
-    let items = parse::parse(&out.tokens).map_err(|e| e.into_input_error(&out.files, path))?;
+) -> Result<Parsed, CompileError> {
+    let predefined = options.predefined_macros();
+    let out = pp::preprocess_with(
+        path,
+        text,
+        loader,
+        &pp::Setup {
+            include_dirs: &options.include_dirs,
+            predefined: &predefined,
+            defines: &options.defines,
+            row_major: options.row_major,
+        },
+    )
+    .map_err(|f| f.error.into_compile_error(&f.files, path))?;
+    let items = parse::parse(&out.tokens).map_err(|e| e.into_compile_error(&out.files, path))?;
     let warnings = out
         .warnings
         .iter()
@@ -180,10 +195,10 @@ fn entry_indices(
     path: &Path,
     files: &[PathBuf],
     options: &HlslOptions,
-) -> Result<Vec<(usize, String, Stage)>, InputError> {
+) -> Result<Vec<(usize, String, Stage)>, CompileError> {
     let entries = lowerer
         .declare()
-        .map_err(|e| e.into_input_error(files, path))?;
+        .map_err(|e| e.into_compile_error(files, path))?;
     let all: Vec<(usize, String, Stage)> = entries
         .into_iter()
         .enumerate()
@@ -200,7 +215,7 @@ fn entry_indices(
                 "no entry points: mark one with [shader(\"...\")] or [numthreads(...)], or name it with its stage (-E main -T ps_6_5)".to_string()
             }
         };
-        return Err(InputError::new(InputErrorKind::HlslError, path, msg));
+        return Err(CompileError::whole(ErrorKind::Invalid, path, msg));
     }
     Ok(picked)
 }
@@ -208,14 +223,16 @@ fn entry_indices(
 /// Runs `f` on a thread with a large stack: parsing and lowering recurse
 /// over the syntax tree, whose depth the input controls (up to the parser's
 /// nesting limit), and debug builds use big frames.
-fn with_stack<T: Send>(f: impl FnOnce() -> Result<T, InputError> + Send) -> Result<T, InputError> {
+fn with_stack<T: Send>(
+    f: impl FnOnce() -> Result<T, CompileError> + Send,
+) -> Result<T, CompileError> {
     std::thread::scope(|s| {
         std::thread::Builder::new()
             .stack_size(64 << 20)
             .spawn_scoped(s, f)
             .map_err(|e| {
-                InputError::new(
-                    InputErrorKind::HlslError,
+                CompileError::whole(
+                    ErrorKind::Invalid,
                     Path::new(""),
                     format!("cannot start the compiler thread: {e}"),
                 )
@@ -230,7 +247,7 @@ pub fn compile_source(
     text: &str,
     loader: &mut dyn pp::FileLoader,
     options: &HlslOptions,
-) -> Result<Vec<CompiledEntry>, InputError> {
+) -> Result<Vec<CompiledEntry>, CompileError> {
     with_stack(|| compile_source_inner(path, text, loader, options))
 }
 
@@ -285,7 +302,7 @@ fn compile_source_inner(
     text: &str,
     loader: &mut dyn pp::FileLoader,
     options: &HlslOptions,
-) -> Result<Vec<CompiledEntry>, InputError> {
+) -> Result<Vec<CompiledEntry>, CompileError> {
     let (mut items, files, warnings) = parse_with_warnings(path, text, loader, options)?;
     instantiate_templates(&mut items, &files, options);
     let mut probe = lowerer(&items, &files, options);
@@ -294,13 +311,14 @@ fn compile_source_inner(
     for (_, name, stage) in picked {
         // A fresh module per entry point, holding only what it reaches.
         let mut l = lowerer(&items, &files, options);
-        l.declare().map_err(|e| e.into_input_error(&files, path))?;
-        let k = l.entry_function(&name).ok_or_else(|| {
-            InputError::new(InputErrorKind::HlslError, path, "entry point vanished")
-        })?;
+        l.declare()
+            .map_err(|e| e.into_compile_error(&files, path))?;
+        let k = l
+            .entry_function(&name)
+            .ok_or_else(|| CompileError::whole(ErrorKind::Invalid, path, "entry point vanished"))?;
         let (words, _) = l
             .finish(&[k])
-            .map_err(|e| e.into_input_error(&files, path))?;
+            .map_err(|e| e.into_compile_error(&files, path))?;
         out.push(CompiledEntry {
             name,
             stage,
@@ -316,7 +334,7 @@ pub fn compile_source_whole(
     text: &str,
     loader: &mut dyn pp::FileLoader,
     options: &HlslOptions,
-) -> Result<CompiledModule, InputError> {
+) -> Result<CompiledModule, CompileError> {
     with_stack(|| compile_source_whole_inner(path, text, loader, options))
 }
 
@@ -325,7 +343,7 @@ fn compile_source_whole_inner(
     text: &str,
     loader: &mut dyn pp::FileLoader,
     options: &HlslOptions,
-) -> Result<CompiledModule, InputError> {
+) -> Result<CompiledModule, CompileError> {
     let (mut items, files, warnings) = parse_with_warnings(path, text, loader, options)?;
     instantiate_templates(&mut items, &files, options);
     let mut l = lowerer(&items, &files, options);
@@ -337,12 +355,33 @@ fn compile_source_whole_inner(
     let subobjects = std::mem::take(&mut l.subobjects);
     let (words, decls) = l
         .finish(&ks)
-        .map_err(|e| e.into_input_error(&files, path))?;
+        .map_err(|e| e.into_compile_error(&files, path))?;
     Ok(CompiledModule {
         words,
         entries: picked.into_iter().map(|(_, n, s)| (n, s)).collect(),
         decls,
         subobjects,
         warnings,
+    })
+}
+
+/// Reads a source file.
+pub fn read_source(path: &Path) -> Result<String, CompileError> {
+    let bytes = std::fs::read(path).map_err(|e| {
+        CompileError::whole(
+            ErrorKind::Unreadable,
+            path,
+            format!("cannot read file: {e}"),
+        )
+    })?;
+    String::from_utf8(bytes).map_err(|e| {
+        CompileError::whole(
+            ErrorKind::Unreadable,
+            path,
+            format!(
+                "file is not valid UTF-8 (byte offset {})",
+                e.utf8_error().valid_up_to()
+            ),
+        )
     })
 }

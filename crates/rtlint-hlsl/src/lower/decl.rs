@@ -705,31 +705,9 @@ impl<'a> Lowerer<'a> {
 
     pub(super) fn declare_globals(&mut self) -> Result<()> {
         let items = self.items;
-        // Explicit bindings first, so automatic ones avoid them.
+        // DXC's first two passes (`[[vk::binding]]`, then registers with the
+        // options' mapping) before the third, so automatic ones avoid them.
         let mut used: HashSet<(u32, u32)> = HashSet::new();
-        let explicit = |attrs: &[Attr],
-                        reg: &Option<Register>,
-                        this: &mut Self|
-         -> Result<Option<(u32, u32)>> {
-            for a in attrs {
-                if a.name == "vk::binding" {
-                    let b = a
-                        .args
-                        .first()
-                        .map(|e| this.const_int(e))
-                        .transpose()?
-                        .unwrap_or(0) as u32;
-                    let s = a
-                        .args
-                        .get(1)
-                        .map(|e| this.const_int(e))
-                        .transpose()?
-                        .unwrap_or(0) as u32;
-                    return Ok(Some((s, b)));
-                }
-            }
-            Ok(reg.as_ref().and_then(|r| Some((r.space, r.index?))))
-        };
         for item in items {
             let (attrs, reg) = match item {
                 Item::Var(v) => (&v.attrs, &v.register),
@@ -738,11 +716,11 @@ impl<'a> Lowerer<'a> {
                 } => (attrs, register),
                 _ => continue,
             };
-            if let Some(sb) = explicit(attrs, reg, self)? {
+            // Errors wait for the declaration: this one may not be a resource.
+            if let Ok(Some(sb)) = self.explicit_binding(attrs, reg) {
                 used.insert(sb);
             }
         }
-        let mut next_auto = 0u32;
         let mut globals_members: Vec<&VarDecl> = Vec::new();
         for item in items {
             // Extensions and capabilities a declaration names: an
@@ -764,15 +742,12 @@ impl<'a> Lowerer<'a> {
                     register,
                     members,
                 } => {
-                    let binding = match explicit(attrs, register, self)? {
+                    let binding = match self.explicit_binding(attrs, register)? {
                         Some(sb) => Some(sb),
                         None if attrs.iter().any(|a| a.name == "vk::push_constant") => None,
-                        None => Some(match register {
-                            Some(Register {
-                                index: None, space, ..
-                            }) => self.auto_binding_in(&mut used, *space),
-                            _ => self.auto_binding(&mut used, &mut next_auto),
-                        }),
+                        None => {
+                            Some(self.implicit_binding(&mut used, register, Some('b'), *pos)?)
+                        }
                     };
                     no_ext_decorate(attrs, "a `cbuffer`")?;
                     let members: Vec<&VarDecl> = members.iter().collect();
@@ -794,7 +769,7 @@ impl<'a> Lowerer<'a> {
                     // A namespace's or struct's names are in scope in its initializers.
                     let scope = v.name.rsplit_once("::").map(|(n, _)| format!("{n}::"));
                     let saved = std::mem::replace(&mut self.f.cur_ns, scope.unwrap_or_default());
-                    let r = self.declare_global_var(v, &mut used, &mut next_auto);
+                    let r = self.declare_global_var(v, &mut used);
                     self.f.cur_ns = saved;
                     r?;
                     self.ext_decorate_global(v)?;
@@ -805,12 +780,25 @@ impl<'a> Lowerer<'a> {
         if let Some(first) = globals_members.first() {
             // Plain globals live in the implicit `$Globals` constant buffer, as in DXC.
             let pos = first.pos;
-            let binding = self.auto_binding(&mut used, &mut next_auto);
+            let b = &self.bindings;
+            let binding = match b.bind_globals {
+                // As in DXC: where it is told, shifted only as `-fvk-auto-shift-bindings`
+                // shifts a `b` register, and not counted as used.
+                Some((binding, set)) => {
+                    let shift = if b.auto_shift { b.shift('b', set) } else { 0 };
+                    (set, binding + shift)
+                }
+                None if !b.bind_register.is_empty() => return Err(Error::new(
+                    pos,
+                    "-fvk-bind-register requires Globals buffer to be bound with -fvk-bind-globals",
+                )),
+                None => self.implicit_binding(&mut used, &None, Some('b'), pos)?,
+            };
             self.declare_cbuffer(&[], "$Globals", pos, Some(binding), &globals_members)?;
         }
         // The descriptor heaps' bindings (used only if the heaps are).
-        let resources = self.auto_binding(&mut used, &mut next_auto);
-        let samplers = self.auto_binding(&mut used, &mut next_auto);
+        let resources = next_binding(&mut used, 0, 0);
+        let samplers = next_binding(&mut used, 0, 0);
         self.heap_bindings = (resources, samplers);
         Ok(())
     }
@@ -945,30 +933,76 @@ impl<'a> Lowerer<'a> {
         Ok(())
     }
 
-    /// The next free binding in set `space`.
-    pub(super) fn auto_binding_in(
+    /// DXC's first two passes for one declaration: `[[vk::binding(b, s)]]`,
+    /// else `register(xN, spaceM)` mapped by `-fvk-bind-register` or
+    /// shifted by `-fvk-x-shift`. `None` for a binding the third pass picks.
+    pub(super) fn explicit_binding(
         &mut self,
-        used: &mut HashSet<(u32, u32)>,
-        space: u32,
-    ) -> (u32, u32) {
-        let mut b = 0;
-        while used.contains(&(space, b)) {
-            b += 1;
+        attrs: &[Attr],
+        reg: &Option<Register>,
+    ) -> Result<Option<(u32, u32)>> {
+        if let Some(a) = attrs.iter().find(|a| a.name == "vk::binding") {
+            let b = a
+                .args
+                .first()
+                .map(|e| self.const_int(e))
+                .transpose()?
+                .unwrap_or(0) as u32;
+            let s = match a.args.get(1) {
+                Some(e) => self.const_int(e)? as u32,
+                None => self.bindings.default_space,
+            };
+            return Ok(Some((s, b)));
         }
-        used.insert((space, b));
-        (space, b)
+        let Some(r) = reg else {
+            return Ok(None);
+        };
+        // `register(cN)` places a constant in `$Globals`, not a resource.
+        let Some(index) = r.index.filter(|_| r.class != 'c') else {
+            return Ok(None);
+        };
+        let b = &self.bindings;
+        if !b.bind_register.is_empty() {
+            return match b.bound_register(r.class, index, r.space) {
+                Some(sb) => Ok(Some(sb)),
+                None => Err(Error::new(
+                    r.pos,
+                    format!(
+                        "missing -fvk-bind-register for resource: register({}{index}, space{})",
+                        r.class, r.space
+                    ),
+                )),
+            };
+        }
+        Ok(Some((r.space, index + b.shift(r.class, r.space))))
     }
 
-    pub(super) fn auto_binding(
+    /// DXC's third pass for one resource without a binding: the next free
+    /// binding of its space (`register(spaceM)`) or of the default set,
+    /// from the shift of `class` with `-fvk-auto-shift-bindings`.
+    pub(super) fn implicit_binding(
         &mut self,
         used: &mut HashSet<(u32, u32)>,
-        next: &mut u32,
-    ) -> (u32, u32) {
-        while used.contains(&(0, *next)) {
-            *next += 1;
+        reg: &Option<Register>,
+        class: Option<char>,
+        pos: Pos,
+    ) -> Result<(u32, u32)> {
+        let b = &self.bindings;
+        if !b.bind_register.is_empty() {
+            return Err(Error::new(
+                pos,
+                "-fvk-bind-register requires register annotations on all resources",
+            ));
         }
-        used.insert((0, *next));
-        (0, *next)
+        let space = match reg {
+            Some(r) => r.space,
+            None => b.default_space,
+        };
+        let start = match class {
+            Some(c) if b.auto_shift => b.shift(c, space),
+            _ => 0,
+        };
+        Ok(next_binding(used, space, start))
     }
 
     /// Layout and storage class of a cbuffer / ConstantBuffer by its attributes.
@@ -1153,7 +1187,6 @@ impl<'a> Lowerer<'a> {
         &mut self,
         v: &'a VarDecl,
         used: &mut HashSet<(u32, u32)>,
-        next: &mut u32,
     ) -> Result<()> {
         let t = self.resolve_ty(&v.ty, "")?;
         if let Ty::StructuredBuffer(e, _) = &t {
@@ -1188,34 +1221,15 @@ impl<'a> Lowerer<'a> {
             self.loc(v.pos, v.name.len() as u32),
         ));
         if t.is_resource() {
-            let binding = match v.attrs.iter().find(|a| a.name == "vk::binding") {
-                Some(a) => {
-                    let b = a
-                        .args
-                        .first()
-                        .map(|e| self.const_int(e))
-                        .transpose()?
-                        .unwrap_or(0) as u32;
-                    let s = a
-                        .args
-                        .get(1)
-                        .map(|e| self.const_int(e))
-                        .transpose()?
-                        .unwrap_or(0) as u32;
-                    Some((s, b))
-                }
-                None => match &v.register {
-                    Some(Register {
-                        index: Some(i),
-                        space,
-                        ..
-                    }) => Some((*space, *i)),
-                    Some(Register {
-                        index: None, space, ..
-                    }) => Some(self.auto_binding_in(used, *space)),
-                    None if v.attrs.iter().any(|a| a.name == "vk::push_constant") => None,
-                    None => Some(self.auto_binding(used, next)),
-                },
+            let binding = match self.explicit_binding(&v.attrs, &v.register)? {
+                Some(sb) => Some(sb),
+                None if v.attrs.iter().any(|a| a.name == "vk::push_constant") => None,
+                None => Some(self.implicit_binding(
+                    used,
+                    &v.register,
+                    implicit_register_class(&t),
+                    v.pos,
+                )?),
             };
             let var = self.resource_var(&t, &v.attrs, binding, &v.name)?;
             let shown = match &t {
@@ -1491,4 +1505,30 @@ fn is_ext_builtin(a: &Attr) -> bool {
         a.name.as_str(),
         "vk::ext_builtin_input" | "vk::ext_builtin_output"
     )
+}
+
+/// The next free binding of `set` from `start` (DXC's "next available
+/// binding number").
+fn next_binding(used: &mut HashSet<(u32, u32)>, set: u32, start: u32) -> (u32, u32) {
+    let mut b = start;
+    while used.contains(&(set, b)) {
+        b += 1;
+    }
+    used.insert((set, b));
+    (set, b)
+}
+
+/// The register class DXC infers from a resource's type for
+/// `-fvk-auto-shift-bindings`; none for an acceleration structure.
+fn implicit_register_class(t: &Ty) -> Option<char> {
+    match t {
+        Ty::Array(e, _) | Ty::RtArray(e) => implicit_register_class(e),
+        Ty::Texture { rw: true, .. } | Ty::StructuredBuffer(_, true) | Ty::ByteAddress(true) => {
+            Some('u')
+        }
+        Ty::Texture { .. } | Ty::StructuredBuffer(..) | Ty::ByteAddress(_) => Some('t'),
+        Ty::Sampler | Ty::SamplerCmp => Some('s'),
+        Ty::ConstantBuffer(_) => Some('b'),
+        _ => None,
+    }
 }

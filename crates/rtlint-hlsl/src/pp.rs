@@ -65,11 +65,8 @@ pub const PACK_COLUMN_MAJOR: &str = "#pragma pack_matrix(column_major)";
 const EXPANSION_BUDGET: usize = 2_000_000;
 
 impl<'a> Preprocessor<'a> {
-    pub fn new(
-        loader: &'a mut dyn FileLoader,
-        include_dirs: &[PathBuf],
-        defines: &[(String, String)],
-    ) -> Result<Self> {
+    pub fn new(loader: &'a mut dyn FileLoader, setup: &Setup) -> Result<Self> {
+        let (include_dirs, defines) = (setup.include_dirs, setup.defines);
         let mut pp = Preprocessor {
             loader,
             include_dirs: include_dirs.to_vec(),
@@ -82,16 +79,9 @@ impl<'a> Preprocessor<'a> {
             warnings: Vec::new(),
         };
         // What DXC defines when it compiles for Vulkan (`-spirv`), before the
-        // user's `-D`s (which may replace them). Shader model 6.5: what this
-        // compiler implements.
-        let predefined = [
-            ("__spirv__", "1"),
-            ("__hlsl_dx_compiler", "1"),
-            ("__HLSL_VERSION", "2021"),
-            ("__SHADER_TARGET_MAJOR", "6"),
-            ("__SHADER_TARGET_MINOR", "5"),
-        ];
-        for (name, value) in predefined {
+        // user's `-D`s (which may replace them).
+        for (name, value) in setup.predefined {
+            let name = *name;
             // Plain numbers: no file of their own (nothing in them can fail).
             let body = lex(value, 0)?
                 .into_iter()
@@ -452,6 +442,20 @@ pub struct Failure {
 }
 
 /// Preprocesses `text` (the contents of `path`).
+/// What the preprocessor starts from.
+pub struct Setup<'o> {
+    /// `-I`, searched after the including file's folder.
+    pub include_dirs: &'o [PathBuf],
+    /// The compiler's own macros (`__spirv__`, ...), before `defines`.
+    pub predefined: &'o [(&'o str, String)],
+    /// `-D NAME=VALUE`.
+    pub defines: &'o [(String, String)],
+    /// `-Zpr`: matrices are row-major until a `#pragma pack_matrix` says otherwise.
+    pub row_major: bool,
+}
+
+/// Preprocesses `text` with DXC's predefined macros for a library target
+/// and the given `-I` and `-D`.
 pub fn preprocess(
     path: &Path,
     text: &str,
@@ -459,7 +463,24 @@ pub fn preprocess(
     include_dirs: &[PathBuf],
     defines: &[(String, String)],
 ) -> std::result::Result<Output, Box<Failure>> {
-    let pp = match Preprocessor::new(loader, include_dirs, defines) {
+    let predefined = crate::HlslOptions::default().predefined_macros();
+    let setup = Setup {
+        include_dirs,
+        predefined: &predefined,
+        defines,
+        row_major: false,
+    };
+    preprocess_with(path, text, loader, &setup)
+}
+
+/// Preprocesses `text` as `setup` says.
+pub fn preprocess_with(
+    path: &Path,
+    text: &str,
+    loader: &mut dyn FileLoader,
+    setup: &Setup,
+) -> std::result::Result<Output, Box<Failure>> {
+    let pp = match Preprocessor::new(loader, setup) {
         Ok(p) => p,
         Err(error) => {
             return Err(Box::new(Failure {
@@ -471,6 +492,17 @@ pub fn preprocess(
     // The file table is needed to render an error, so keep it on failure.
     let mut pp = pp;
     match pp.file(path, text, None) {
+        Ok(()) if setup.row_major && !pp.out.is_empty() => {
+            // `-Zpr` is a `#pragma pack_matrix(row_major)` before the first token.
+            let mut t = pp.out[0].clone();
+            t.tok = Tok::Punct(PACK_ROW_MAJOR);
+            pp.out.insert(0, t);
+            Ok(Output {
+                tokens: pp.out,
+                files: pp.files,
+                warnings: pp.warnings,
+            })
+        }
         Ok(()) => Ok(Output {
             tokens: pp.out,
             files: pp.files,

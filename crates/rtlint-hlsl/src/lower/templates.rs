@@ -4,7 +4,7 @@
 
 use super::calls::Arg;
 use super::*;
-use crate::front::hlsl::template::Instance;
+use crate::template::Instance;
 
 /// A concrete template argument.
 #[derive(Clone, Debug, PartialEq)]
