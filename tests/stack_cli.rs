@@ -508,3 +508,40 @@ fn a_device_without_the_shader_clock_skips_with_what_it_needs() {
         ["shaderInt64", "VK_KHR_shader_clock (shaderSubgroupClock)"]
     );
 }
+
+#[test]
+fn driver_takes_the_register_shifts_the_shaders_were_compiled_with() {
+    // DXC's shifts on the command line reach the driver: the child process
+    // gets the modules as `stack` compiled them. With u and b shifted the
+    // pipeline is created with no validation error; with u alone the
+    // collision that remains (t0 and b0) names the option that fixes it.
+    let file = common::root().join("tests/pipelines/registers.hlsl");
+    let run = |shifts: &[&str]| {
+        let o = rtlint()
+            .args(["stack", "--driver", "--format", "json"])
+            .args(shifts)
+            .arg(&file)
+            .env("RTLINT_VK_VALIDATION", "1")
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8_lossy(&o.stderr).into_owned();
+        let v: serde_json::Value =
+            serde_json::from_slice(&o.stdout).unwrap_or_else(|e| panic!("{e}: {stderr}"));
+        (o.status.code(), v, stderr)
+    };
+    let (code, v, stderr) = run(&["-fvk-u-shift", "10", "all", "-fvk-b-shift", "20", "all"]);
+    assert_eq!(code, Some(0), "{v}{stderr}");
+    assert!(!stderr.contains("validation"), "{stderr}");
+    assert_eq!(v["errors"].as_array().map(Vec::len), Some(0), "{v}");
+    assert!(v["pipelines"][0]["driver"].is_object(), "{v}");
+
+    let (code, v, _) = run(&["-fvk-u-shift", "10", "all"]);
+    assert_eq!(code, Some(2), "{v}");
+    let message = v["errors"][0]["message"].as_str().unwrap();
+    assert!(
+        message.contains("an acceleration structure for `Scene`")
+            && message.contains("a uniform buffer for `Camera`"),
+        "{message}"
+    );
+    assert!(message.contains("`-fvk-b-shift N SET`"), "{message}");
+}
