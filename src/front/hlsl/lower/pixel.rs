@@ -280,7 +280,7 @@ impl<'a> Lowerer<'a> {
                     .decorate(var, Decoration::Location, [Operand::LiteralBit32(n)]);
                 self.b.name(var, format!("{prefix}{sem}"));
                 // Vulkan: integer fragment inputs are not interpolated.
-                let integer = matches!(ty.scalar(), Some(ScalarKind::Int | ScalarKind::Uint));
+                let integer = system_values::integer_ty(ty);
                 if dir == Dir::In && (integer || mods.nointerp) {
                     self.b.decorate(var, Decoration::Flat, []);
                 }
