@@ -320,3 +320,13 @@ fn texel_buffers_of_16_bit_floats_are_refused() {
     )
     .unwrap_or_else(|e| panic!("{e}"));
 }
+
+#[test]
+fn a_pixel_input_semantic_is_used_once() {
+    let src = "struct In {\n    float4 a : SV_Position;\n    float4 b : SV_Position;\n};\n\
+               float4 main(In i) : SV_Target { return i.a + i.b; }\n";
+    assert_eq!(
+        error(src, Some("ps_6_0"), false),
+        "3:16: input semantic `SV_Position` used more than once\n  2:16: first used here"
+    );
+}
