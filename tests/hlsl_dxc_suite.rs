@@ -168,6 +168,25 @@ fn inline_spirv_built_ins_declare_their_capabilities() {
     assert!(extensions(&w).contains(&"SPV_EXT_shader_stencil_export".to_string()));
     let sample_id = builtin_var(&w, BuiltIn::SampleId);
     assert!(decorations(&w, sample_id).contains(&(Decoration::Flat as u32)));
+    // Flat written by the source too: once.
+    let src = "[[vk::ext_decorate(/* Flat */ 14)]]\n[[vk::ext_builtin_input(18)]]\n\
+               static const int sample_id;\n\
+               float4 main() : SV_Target { return float4(sample_id, 0, 0, 1); }\n";
+    let mut loader = MemLoader([(PathBuf::from("main.hlsl"), src.to_string())].into());
+    let e = hlsl::compile_source(
+        Path::new("main.hlsl"),
+        src,
+        &mut loader,
+        &options(Some("main"), Some("ps_6_0"), false),
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
+    let w = &e[0].words;
+    validate(w, "inline_builtins_flat_twice");
+    let flats = decorations(w, builtin_var(w, BuiltIn::SampleId))
+        .into_iter()
+        .filter(|d| *d == Decoration::Flat as u32)
+        .count();
+    assert_eq!(flats, 1);
 }
 
 #[test]

@@ -147,7 +147,14 @@ impl Lowerer<'_> {
         }
         vars.sort_by_key(|(v, d)| (*v, *d as u32));
         for (var, d) in vars {
-            if done.insert((var, d as u32)) {
+            // `[[vk::ext_decorate]]` may have written it already: a second
+            // one is invalid.
+            let written = self.b.module_ref().annotations.iter().any(|i| {
+                i.class.opcode == Op::Decorate
+                    && i.operands.first() == Some(&Operand::IdRef(var))
+                    && i.operands.get(1) == Some(&Operand::Decoration(d))
+            });
+            if done.insert((var, d as u32)) && !written {
                 self.b.decorate(var, d, []);
             }
         }
