@@ -349,3 +349,52 @@ fn a_pixel_input_semantic_is_used_once() {
         "3:16: input semantic `SV_Position` used more than once\n  2:16: first used here"
     );
 }
+
+/// Offsets of a struct's members, by member index.
+fn member_offsets(words: &[u32], struct_name: &str) -> Vec<u32> {
+    let id = named(words, struct_name);
+    let mut offsets: Vec<(u32, u32)> = instructions(words)
+        .into_iter()
+        .filter(|(op, ops)| {
+            *op == Op::MemberDecorate as u32 && ops[0] == id && ops[2] == Decoration::Offset as u32
+        })
+        .map(|(_, ops)| (ops[1], ops[3]))
+        .collect();
+    offsets.sort_unstable();
+    offsets.into_iter().map(|(_, o)| o).collect()
+}
+
+#[test]
+fn push_constant_structs_are_push_constant_blocks() {
+    let w = compile(
+        "push_constant_struct.hlsl",
+        Some("main"),
+        Some("ps_6_2"),
+        true,
+    );
+    validate(&w, "push_constant_struct");
+    // The variable is in PushConstant storage, and nothing is in $Globals.
+    let push = named(&w, "push");
+    let class = instructions(&w)
+        .into_iter()
+        .find(|(op, ops)| *op == Op::Variable as u32 && ops[1] == push)
+        .map(|(_, ops)| ops[2]);
+    assert_eq!(class, Some(spirv::StorageClass::PushConstant as u32));
+    assert!(!instructions(&w)
+        .iter()
+        .any(|(op, ops)| *op == Op::Name as u32 && string_at(&ops[1..]) == "type.$Globals"));
+    // Laid out as a push-constant block (as DXC lays it out): the 16-bit
+    // members packed, the float4 after the 32-byte nested struct.
+    assert_eq!(member_offsets(&w, "Light"), vec![0, 2, 8]);
+    assert_eq!(member_offsets(&w, "type.Push"), vec![0, 32]);
+    assert!(capabilities(&w).contains(&(Capability::StoragePushConstant16 as u32)));
+    // Other types cannot be push constants.
+    assert_eq!(
+        error(
+            "[[vk::push_constant]]\nfloat4 tint;\nfloat4 main() : SV_Target { return tint; }\n",
+            Some("ps_6_0"),
+            false
+        ),
+        "1:3: `[[vk::push_constant]]` applies to a variable of struct or `ConstantBuffer<T>` type"
+    );
+}

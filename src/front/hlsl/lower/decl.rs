@@ -900,11 +900,13 @@ impl<'a> Lowerer<'a> {
     }
 
     /// Whether a global belongs in `$Globals`: not static, groupshared, a
-    /// resource or a specialization constant.
+    /// resource, a push-constant block or a specialization constant.
     pub(super) fn in_implicit_globals(&mut self, v: &VarDecl) -> Result<bool> {
         if v.mods.is_static
             || v.mods.groupshared
-            || v.attrs.iter().any(|a| a.name == "vk::constant_id")
+            || v.attrs
+                .iter()
+                .any(|a| a.name == "vk::constant_id" || a.name == "vk::push_constant")
         {
             return Ok(false);
         }
@@ -1182,6 +1184,19 @@ impl<'a> Lowerer<'a> {
         next: &mut u32,
     ) -> Result<()> {
         let t = self.resolve_ty(&v.ty, "")?;
+        // `[[vk::push_constant]] S pc;` is DXC's push-constant block, the
+        // same as `[[vk::push_constant]] ConstantBuffer<S> pc;`.
+        let t = match (t, v.attrs.iter().find(|a| a.name == "vk::push_constant")) {
+            (Ty::Struct(k), Some(_)) if v.dims.is_empty() => Ty::ConstantBuffer(k),
+            (t @ Ty::ConstantBuffer(_), _) | (t, None) => t,
+            (_, Some(a)) => {
+                return Err(Error::new(
+                    a.pos,
+                    "`[[vk::push_constant]]` applies to a variable of struct or `ConstantBuffer<T>` type",
+                )
+                .len(a.name.len() as u32))
+            }
+        };
         if let Ty::StructuredBuffer(e, _) = &t {
             if matches!(**e, Ty::Mat(..)) && v.mods.row_major {
                 return Err(unsupported(
