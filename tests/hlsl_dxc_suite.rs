@@ -398,3 +398,22 @@ fn push_constant_structs_are_push_constant_blocks() {
         "1:3: `[[vk::push_constant]]` applies to a variable of struct or `ConstantBuffer<T>` type"
     );
 }
+
+#[test]
+fn globally_coherent_resources_are_coherent() {
+    let w = compile(
+        "globally_coherent.hlsl",
+        Some("main"),
+        Some("cs_6_0"),
+        false,
+    );
+    validate(&w, "globally_coherent");
+    let coherent = Decoration::Coherent as u32;
+    for name in ["counters", "flags", "image"] {
+        assert!(
+            decorations(&w, named(&w, name)).contains(&coherent),
+            "`{name}` is globallycoherent but not Coherent"
+        );
+    }
+    assert!(!decorations(&w, named(&w, "results")).contains(&coherent));
+}

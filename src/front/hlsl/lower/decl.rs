@@ -1274,6 +1274,11 @@ impl<'a> Lowerer<'a> {
                 },
             };
             let var = self.resource_var(&t, &v.attrs, binding, &v.name)?;
+            // Writes are seen by every invocation of the dispatch, not only
+            // the workgroup (GLSL450 memory model: the Coherent decoration).
+            if v.mods.globally_coherent {
+                self.b.decorate(var, Decoration::Coherent, []);
+            }
             let shown = match &t {
                 Ty::ConstantBuffer(k) => Ty::Struct(*k),
                 other => other.clone(),
