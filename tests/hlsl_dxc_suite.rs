@@ -316,7 +316,7 @@ fn a_built_in_input_cannot_be_redefined_as_an_output() {
                float4 main() : SV_Target { return float4(groups, 1); }\n";
     assert_eq!(
         error(src, Some("ps_6_0"), false),
-        "4:14: built-in NumWorkgroups (24) is already declared as an input; it cannot be redefined as an output\n  2:20: first declared here"
+        "4:14: built-in `NumWorkgroups` (24) is already declared as an input; it cannot be redefined as an output\n  2:20: first declared here"
     );
 }
 

@@ -48,7 +48,7 @@ impl<'a> Lowerer<'a> {
             let e = Error::new(
                 v.pos,
                 format!(
-                    "built-in {bi:?} ({n}) is already declared as an {}; it cannot be redefined as an {}",
+                    "built-in `{bi:?}` ({n}) is already declared as an {}; it cannot be redefined as an {}",
                     if output { "input" } else { "output" },
                     if output { "output" } else { "input" }
                 ),
