@@ -599,6 +599,11 @@ const NOT_RUN: &[(&str, &str)] = &[
     ),
     ("include", "a folder of include files"),
     (
+        "dxc_suite",
+        "a folder of shaders for what DXC's test suite found (pixel shaders, \
+         decorations, capabilities): tests/hlsl_dxc_suite.rs checks them",
+    ),
+    (
         "rayquery_return.hlsl",
         "a function returning a ray query: tests/hlsl_compile.rs checks the call",
     ),

@@ -51,6 +51,8 @@ pub struct Mods {
     pub centroid: bool,
     pub sample: bool,
     pub noperspective: bool,
+    /// `globallycoherent` (a resource: `Coherent`).
+    pub globally_coherent: bool,
 }
 
 #[derive(Clone, Debug)]

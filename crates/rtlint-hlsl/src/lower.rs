@@ -198,6 +198,9 @@ pub struct Lowerer<'a> {
     caps: HashSet<Capability>,
     exts: HashSet<String>,
     builtins: HashMap<BuiltIn, Id>,
+    /// Every built-in variable (read by a system value or declared with
+    /// inline SPIR-V), for the decorations its readers' stages need.
+    builtin_vars: HashMap<Id, system_values::BuiltinVar>,
     rt_vars: HashMap<(StorageClass, Ty), Id>,
     next_location: HashMap<StorageClass, u32>,
     fn_used: HashMap<usize, BTreeSet<Id>>,
@@ -491,6 +494,7 @@ impl<'a> Lowerer<'a> {
             caps,
             exts: HashSet::new(),
             builtins: HashMap::new(),
+            builtin_vars: HashMap::new(),
             rt_vars: HashMap::new(),
             next_location: HashMap::new(),
             fn_used: HashMap::new(),
@@ -691,6 +695,7 @@ impl<'a> Lowerer<'a> {
             }
         }
         self.check_recursion()?;
+        let mut decorated = HashSet::new();
         for &e in entries {
             let sig = self.funcs[e].clone();
             let Some(stage) = sig.stage else { continue };
@@ -714,6 +719,7 @@ impl<'a> Lowerer<'a> {
                 entry_id = *w;
                 vars.extend(io.iter().copied());
             }
+            self.decorate_builtin_inputs(stage, &vars, &mut decorated);
             let vars: Vec<Id> = vars.into_iter().collect();
             self.b.entry_point(
                 stage.model().expect("HLSL stages have an execution model"),
@@ -748,6 +754,7 @@ impl<'a> Lowerer<'a> {
                 self.ray_tracing_caps();
             }
         }
+        self.acceleration_structure_caps();
         let mut debug = self.emit_debug_info();
         let mut module = self.b.module();
         if self.physical_addressing {

@@ -99,10 +99,9 @@ impl<'a> Lowerer<'a> {
                 self.b.type_runtime_array(eid)
             }
             Ty::Struct(k) => self.struct_type(*k, layout, false)?,
-            Ty::Accel => {
-                self.ray_tracing_caps();
-                self.b.type_acceleration_structure_khr()
-            }
+            // Its capability is chosen once the stages are known
+            // (`acceleration_structure_caps`).
+            Ty::Accel => self.b.type_acceleration_structure_khr(),
             Ty::RayQuery(_) => {
                 self.cap(Capability::RayQueryKHR);
                 self.ext("SPV_KHR_ray_query");
@@ -208,6 +207,25 @@ impl<'a> Lowerer<'a> {
     pub(super) fn ray_tracing_caps(&mut self) {
         self.cap(Capability::RayTracingKHR);
         self.ext("SPV_KHR_ray_tracing");
+    }
+
+    /// An acceleration structure type needs ray-tracing pipelines or ray
+    /// queries: in a module without ray-tracing stages that is ray queries,
+    /// so that a device with only VK_KHR_ray_query runs it (as DXC chooses).
+    pub(super) fn acceleration_structure_caps(&mut self) {
+        let has_type = self
+            .b
+            .module_ref()
+            .types_global_values
+            .iter()
+            .any(|i| i.class.opcode == Op::TypeAccelerationStructureKHR);
+        let covered = [Capability::RayTracingKHR, Capability::RayQueryKHR]
+            .iter()
+            .any(|c| self.caps.contains(c));
+        if has_type && !covered {
+            self.cap(Capability::RayQueryKHR);
+            self.ext("SPV_KHR_ray_query");
+        }
     }
 
     pub(super) fn struct_type(&mut self, k: u32, layout: Layout, block: bool) -> Result<Id> {

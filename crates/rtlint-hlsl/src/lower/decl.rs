@@ -119,6 +119,7 @@ impl<'a> Lowerer<'a> {
             }
             let mut stage = None;
             let mut numthreads = [1, 1, 1];
+            let mut has_numthreads = false;
             for a in &f.attrs {
                 match a.name.as_str() {
                     "shader" => {
@@ -136,6 +137,7 @@ impl<'a> Lowerer<'a> {
                         for (n, e) in a.args.iter().enumerate() {
                             numthreads[n] = self.const_int(e)? as u32;
                         }
+                        has_numthreads = true;
                         stage.get_or_insert(Stage::Compute);
                     }
                     _ => {}
@@ -189,6 +191,19 @@ impl<'a> Lowerer<'a> {
                 // prototype may carry the default values.
                 protos.push(f);
                 continue;
+            }
+            // DXC refuses a compute entry point without a workgroup size
+            // rather than assume 1 x 1 x 1 (a prototype may leave it to the
+            // definition).
+            if stage == Some(Stage::Compute) && !has_numthreads {
+                return Err(Error::new(
+                    f.pos,
+                    format!(
+                        "compute entry point `{}` needs a [numthreads(X, Y, Z)] attribute",
+                        f.name
+                    ),
+                )
+                .len(f.name.len() as u32));
             }
             let proto = protos
                 .iter()
@@ -608,6 +623,17 @@ impl<'a> Lowerer<'a> {
                         ))
                     }
                 };
+                // DXC's rule for Vulkan: a texel buffer's elements are not
+                // 16-bit floats (textures of them are read as 32-bit images).
+                if dim == Dim::Buffer && sc == ScalarKind::Half {
+                    return Err(Error::new(
+                        t.pos,
+                        format!(
+                            "`{name}` of 16-bit floats: a Vulkan texel buffer's sampled type is at least 32 bits (use `float` elements)"
+                        ),
+                    )
+                    .len(name.len() as u32));
+                }
                 Ty::Texture {
                     dim,
                     sc,
@@ -862,11 +888,13 @@ impl<'a> Lowerer<'a> {
     }
 
     /// Whether a global belongs in `$Globals`: not static, groupshared, a
-    /// resource or a specialization constant.
+    /// resource, a push-constant block or a specialization constant.
     pub(super) fn in_implicit_globals(&mut self, v: &VarDecl) -> Result<bool> {
         if v.mods.is_static
             || v.mods.groupshared
-            || v.attrs.iter().any(|a| a.name == "vk::constant_id")
+            || v.attrs
+                .iter()
+                .any(|a| a.name == "vk::constant_id" || a.name == "vk::push_constant")
         {
             return Ok(false);
         }
@@ -1189,6 +1217,19 @@ impl<'a> Lowerer<'a> {
         used: &mut HashSet<(u32, u32)>,
     ) -> Result<()> {
         let t = self.resolve_ty(&v.ty, "")?;
+        // `[[vk::push_constant]] S pc;` is DXC's push-constant block, the
+        // same as `[[vk::push_constant]] ConstantBuffer<S> pc;`.
+        let t = match (t, v.attrs.iter().find(|a| a.name == "vk::push_constant")) {
+            (Ty::Struct(k), Some(_)) if v.dims.is_empty() => Ty::ConstantBuffer(k),
+            (t @ Ty::ConstantBuffer(_), _) | (t, None) => t,
+            (_, Some(a)) => {
+                return Err(Error::new(
+                    a.pos,
+                    "`[[vk::push_constant]]` applies to a variable of struct or `ConstantBuffer<T>` type",
+                )
+                .len(a.name.len() as u32))
+            }
+        };
         if let Ty::StructuredBuffer(e, _) = &t {
             if matches!(**e, Ty::Mat(..)) && v.mods.row_major {
                 return Err(unsupported(
@@ -1221,6 +1262,21 @@ impl<'a> Lowerer<'a> {
             self.loc(v.pos, v.name.len() as u32),
         ));
         if t.is_resource() {
+            let mut dims = 0;
+            let mut inner = &t;
+            while let Ty::Array(e, _) | Ty::RtArray(e) = inner {
+                dims += 1;
+                inner = e;
+            }
+            if dims > 1 {
+                // Vulkan: a descriptor variable is one resource or a
+                // one-dimensional array of them.
+                return Err(unsupported(
+                    v.pos,
+                    "arrays of arrays of resources (a Vulkan descriptor array has one dimension: declare `a[N * M]` and index `a[i * M + j]`)",
+                )
+                .len(v.name.len() as u32));
+            }
             let binding = match self.explicit_binding(&v.attrs, &v.register)? {
                 Some(sb) => Some(sb),
                 None if v.attrs.iter().any(|a| a.name == "vk::push_constant") => None,
@@ -1232,6 +1288,11 @@ impl<'a> Lowerer<'a> {
                 )?),
             };
             let var = self.resource_var(&t, &v.attrs, binding, &v.name)?;
+            // Writes are seen by every invocation of the dispatch, not only
+            // the workgroup (GLSL450 memory model: the Coherent decoration).
+            if v.mods.globally_coherent {
+                self.b.decorate(var, Decoration::Coherent, []);
+            }
             let shown = match &t {
                 Ty::ConstantBuffer(k) => Ty::Struct(*k),
                 other => other.clone(),

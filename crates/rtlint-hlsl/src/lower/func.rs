@@ -384,6 +384,15 @@ impl<'a> Lowerer<'a> {
                     .decorate(var, Decoration::BuiltIn, [Operand::BuiltIn(bi)]);
                 self.b.name(var, format!("{bi:?}"));
                 self.builtins.insert(bi, var);
+                self.builtin_vars.insert(
+                    var,
+                    system_values::BuiltinVar {
+                        builtin: bi,
+                        class: StorageClass::Input,
+                        integer: system_values::integer_ty(t),
+                        declared: None,
+                    },
+                );
                 var
             }
         };

@@ -39,7 +39,35 @@ impl<'a> Lowerer<'a> {
             .ok()
             .and_then(BuiltIn::from_u32)
             .ok_or_else(|| Error::new(e.pos, format!("unknown SPIR-V built-in {n}")))?;
-        let req = self.ext_requirements(&v.attrs)?;
+        // DXC's rule: one built-in is an input or an output, not both.
+        if let Some(prev) = self
+            .builtin_vars
+            .values()
+            .find(|b| b.builtin == bi && b.class != class && b.declared.is_some())
+        {
+            let e = Error::new(
+                v.pos,
+                format!(
+                    "built-in `{bi:?}` ({n}) is already declared as an {}; it cannot be redefined as an {}",
+                    if output { "input" } else { "output" },
+                    if output { "output" } else { "input" }
+                ),
+            )
+            .len(v.name.len() as u32);
+            return Err(match prev.declared {
+                Some(p) => e.secondary(p, "first declared here"),
+                None => e,
+            });
+        }
+        let mut req = self.ext_requirements(&v.attrs)?;
+        // The capability the SPIR-V grammar gives the built-in (any one of
+        // those it lists; the first one Vulkan has, unless one is named).
+        let caps = Operand::BuiltIn(bi).required_capabilities();
+        if !caps.iter().any(|c| req.1.contains(c)) {
+            if let Some(c) = caps.into_iter().find(|c| kernel_only(*c).is_none()) {
+                req.1.push(c);
+            }
+        }
         let t = self.resolve_ty(&v.ty, "")?;
         let t = self.apply_dims(t, &v.dims, v.pos, false)?;
         if t.is_resource() || (matches!(t, Ty::RtArray(_)) || t.is_opaque()) {
@@ -55,6 +83,15 @@ impl<'a> Lowerer<'a> {
         self.b
             .decorate(var, Decoration::BuiltIn, [Operand::BuiltIn(bi)]);
         self.global_reqs.insert(var, req);
+        self.builtin_vars.insert(
+            var,
+            super::system_values::BuiltinVar {
+                builtin: bi,
+                class,
+                integer: super::system_values::integer_ty(&t),
+                declared: Some(v.pos),
+            },
+        );
         self.global_decls
             .push((var, v.name.clone(), t.clone(), v.pos));
         self.globals.insert(

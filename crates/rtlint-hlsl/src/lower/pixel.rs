@@ -19,6 +19,8 @@ struct Io {
     next_input: u32,
     /// Whether input locations come from `[[vk::location]]` (set by the first input).
     explicit: Option<bool>,
+    /// Built-in inputs taken, with where their semantic was written.
+    builtins: HashMap<BuiltIn, Pos>,
 }
 
 impl<'a> Lowerer<'a> {
@@ -242,6 +244,17 @@ impl<'a> Lowerer<'a> {
                 ));
             }
         };
+        if let Some((bi, _)) = &builtin {
+            // DXC's rule: one built-in input per entry point.
+            if let Some(first) = io.builtins.insert(*bi, spos) {
+                return Err(Error::new(
+                    spos,
+                    format!("input semantic `{sem}` used more than once"),
+                )
+                .len(sem_len)
+                .secondary(first, "first used here"));
+            }
+        }
         if let Some(n) = location {
             let d = (dir == Dir::Out) as usize;
             if let Some(other) = io.taken[d].insert(n, sem.clone()) {
@@ -280,7 +293,7 @@ impl<'a> Lowerer<'a> {
                     .decorate(var, Decoration::Location, [Operand::LiteralBit32(n)]);
                 self.b.name(var, format!("{prefix}{sem}"));
                 // Vulkan: integer fragment inputs are not interpolated.
-                let integer = matches!(ty.scalar(), Some(ScalarKind::Int | ScalarKind::Uint));
+                let integer = system_values::integer_ty(ty);
                 if dir == Dir::In && (integer || mods.nointerp) {
                     self.b.decorate(var, Decoration::Flat, []);
                 }

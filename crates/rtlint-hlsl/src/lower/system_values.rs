@@ -82,6 +82,85 @@ pub(super) const SYSTEM_VALUES: &[SystemValue] = &[
     transposed("WorldToObject", BuiltIn::WorldToObjectKHR),
 ];
 
+/// A built-in variable of the module: which built-in, in which storage
+/// class, whether it holds integers, and where the source declared it
+/// (`vk::ext_builtin_*`; `None` when a system value or intrinsic reads it).
+pub(super) struct BuiltinVar {
+    pub(super) builtin: BuiltIn,
+    pub(super) class: StorageClass,
+    pub(super) integer: bool,
+    pub(super) declared: Option<Pos>,
+}
+
+/// Built-ins whose value can change when a ray-tracing invocation is
+/// resumed on another subgroup or SM after a trace or call: Vulkan wants
+/// them `Volatile` in ray-generation, intersection, any-hit, closest-hit,
+/// miss and callable shaders (SPIRV-Tools' spread-volatile-semantics pass
+/// applies the same list).
+const RESCHEDULED: &[BuiltIn] = &[
+    BuiltIn::SubgroupSize,
+    BuiltIn::SubgroupLocalInvocationId,
+    BuiltIn::SubgroupEqMask,
+    BuiltIn::SubgroupGeMask,
+    BuiltIn::SubgroupGtMask,
+    BuiltIn::SubgroupLeMask,
+    BuiltIn::SubgroupLtMask,
+    BuiltIn::SMIDNV,
+    BuiltIn::WarpIDNV,
+];
+
+/// Whether a value of `t` is integer (or holds integers): a pixel-shader
+/// input of it is not interpolated.
+pub(super) fn integer_ty(t: &Ty) -> bool {
+    use ScalarKind::*;
+    match t {
+        Ty::ScalarKind(s) | Ty::Vec(s, _) | Ty::Mat(s, ..) => {
+            matches!(s, Int16 | Uint16 | Int | Uint | Int64 | Uint64)
+        }
+        Ty::Array(e, _) => integer_ty(e),
+        _ => false,
+    }
+}
+
+impl Lowerer<'_> {
+    /// The decorations Vulkan asks of the built-in inputs an entry point of
+    /// `stage` reads (`interface`): `Flat` on integer inputs of a pixel
+    /// shader (VUID-StandaloneSpirv-Flat-04744), `Volatile` on
+    /// `RESCHEDULED` ones in the ray-tracing stages. `done` holds what
+    /// earlier entry points of the module already decorated.
+    pub(super) fn decorate_builtin_inputs(
+        &mut self,
+        stage: Stage,
+        interface: &BTreeSet<Id>,
+        done: &mut HashSet<(Id, u32)>,
+    ) {
+        let mut vars: Vec<(Id, Decoration)> = Vec::new();
+        for (&var, b) in &self.builtin_vars {
+            if b.class != StorageClass::Input || !interface.contains(&var) {
+                continue;
+            }
+            if stage == Stage::Fragment && b.integer {
+                vars.push((var, Decoration::Flat));
+            } else if stage.is_ray_tracing() && RESCHEDULED.contains(&b.builtin) {
+                vars.push((var, Decoration::Volatile));
+            }
+        }
+        vars.sort_by_key(|(v, d)| (*v, *d as u32));
+        for (var, d) in vars {
+            // `[[vk::ext_decorate]]` may have written it already: a second
+            // one is invalid.
+            let written = self.b.module_ref().annotations.iter().any(|i| {
+                i.class.opcode == Op::Decorate
+                    && i.operands.first() == Some(&Operand::IdRef(var))
+                    && i.operands.get(1) == Some(&Operand::Decoration(d))
+            });
+            if done.insert((var, d as u32)) && !written {
+                self.b.decorate(var, d, []);
+            }
+        }
+    }
+}
+
 pub(super) fn system_value(name: &str) -> Option<&'static SystemValue> {
     SYSTEM_VALUES.iter().find(|s| s.name == name)
 }

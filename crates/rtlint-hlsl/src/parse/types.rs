@@ -117,9 +117,9 @@ impl<'t> Parser<'t> {
                 Some("centroid") => m.centroid = true,
                 Some("sample") => m.sample = true,
                 Some("noperspective") => m.noperspective = true,
+                Some("globallycoherent") => m.globally_coherent = true,
                 Some(
-                    "inline" | "export" | "extern" | "volatile" | "linear" | "snorm" | "unorm"
-                    | "globallycoherent",
+                    "inline" | "export" | "extern" | "volatile" | "linear" | "snorm" | "unorm",
                 ) => {}
                 _ => return m,
             }
