@@ -283,3 +283,56 @@ fn rt041_judges_collisions_after_the_shifts() {
         "{out}"
     );
 }
+
+/// Windows-1252 bytes in the main file and in a header, as `rtlint check`
+/// and `rtlint compile` read them: accepted, and an error after them is at
+/// its line and column with its line of source shown.
+#[test]
+fn windows_1252_sources_through_the_command_line() {
+    let d = scratch("cp1252");
+    std::fs::write(
+        d.join("h.hlsli"),
+        b"// the light\x92s colour\r\nfloat Shade() { return 0.5; }\r\n",
+    )
+    .unwrap();
+    std::fs::write(
+        d.join("main.hlsl"),
+        b"// caf\xe9 \x96 \x93main\x94\r\n#include \"h.hlsli\"\r\nRWStructuredBuffer<float> o : register(u0);\r\n[numthreads(1, 1, 1)] void main() { o[0] = Shade(); }\r\n",
+    )
+    .unwrap();
+    let o = rtlint()
+        .arg("check")
+        .arg(d.join("main.hlsl"))
+        .output()
+        .unwrap();
+    let out = String::from_utf8_lossy(&o.stdout).into_owned() + &String::from_utf8_lossy(&o.stderr);
+    assert!(matches!(o.status.code(), Some(0 | 1)), "{out}");
+    let o = rtlint()
+        .args(["compile", "-T", "cs_6_0"])
+        .arg(d.join("main.hlsl"))
+        .arg("-o")
+        .arg(d.join("m.spv"))
+        .output()
+        .unwrap();
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+
+    std::fs::write(
+        d.join("bad.hlsl"),
+        b"/* \x92\x92 */ float Shade() { return nope; }\r\n[numthreads(1, 1, 1)] void main() { Shade(); }\r\n",
+    )
+    .unwrap();
+    let o = rtlint()
+        .arg("check")
+        .arg(d.join("bad.hlsl"))
+        .output()
+        .unwrap();
+    let out = String::from_utf8_lossy(&o.stdout).into_owned() + &String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{out}");
+    assert!(out.contains("bad.hlsl:1:33"), "{out}");
+    assert!(out.contains("return nope;"), "the line is shown: {out}");
+}

@@ -101,11 +101,11 @@ fn meant_for_vulkan(ctx: &Context) -> bool {
     }
     // The sources debug info names, and the input itself (a module without
     // debug info names none).
-    let own = std::fs::read_to_string(&p.path).unwrap_or_default();
+    let own = crate::shader::read_source_text(&p.path).unwrap_or_default();
     std::iter::once(own)
         .chain(p.files.iter().map(|f| match &f.text {
             Some(t) => t.clone(),
-            None => std::fs::read_to_string(&f.path).unwrap_or_default(),
+            None => crate::shader::read_source_text(&f.path).unwrap_or_default(),
         }))
         .any(|text| {
             // Code, not a comment that mentions Vulkan.

@@ -112,6 +112,9 @@ pub fn lex(src: &str, file: u32) -> Result<Vec<Token>, Error> {
                 if b[i] == b'\\' && b.get(i + 1) == Some(&b'\n') {
                     i += 1;
                     line += 1;
+                } else if b[i] == b'\\' && b[i + 1..].starts_with(b"\r\n") {
+                    i += 2;
+                    line += 1;
                 }
                 i += 1;
             }
@@ -134,7 +137,8 @@ pub fn lex(src: &str, file: u32) -> Result<Vec<Token>, Error> {
                 if b[i] == b'\n' {
                     line += 1;
                     col = 1;
-                } else {
+                } else if b[i] & 0xc0 != 0x80 {
+                    // Columns count characters: not UTF-8 continuation bytes.
                     col += 1;
                 }
                 i += 1;
