@@ -255,9 +255,10 @@ enum Command {
         verbose: bool,
         /// Output: a `.spv` file (one entry point, or with --whole every entry
         /// point in one module), or a directory for one module per entry point
-        /// (DXC's `-Fo FILE` too).
+        /// (DXC's `-Fo FILE` too). Without it the file is compiled and
+        /// nothing is written (a check).
         #[arg(short = 'o', long = "output")]
-        output: PathBuf,
+        output: Option<PathBuf>,
         /// One module holding every entry point.
         #[arg(long)]
         whole: bool,
@@ -428,7 +429,13 @@ fn run(cli: Cli) -> Result<u8, String> {
             if verbose {
                 dxc_notes();
             }
-            compile(file, dxc().options.clone(), output, whole)
+            // `-T lib_6_x` without `-E`, as DXC reads it: the whole library.
+            let o = &dxc().options;
+            let library = o
+                .profile
+                .is_some_and(|p| p.kind == rtlint::front::hlsl::ProfileKind::Library);
+            let whole = whole || (library && o.entry.is_none());
+            compile(file, o.clone(), output, whole)
         }
         Command::Verify(args) => verify(args),
         Command::Tradeoff(args) => tradeoff(args),
@@ -884,7 +891,7 @@ fn print_report(
 fn compile(
     file: PathBuf,
     options: rtlint::front::hlsl::HlslOptions,
-    output: PathBuf,
+    output: Option<PathBuf>,
     whole: bool,
 ) -> Result<u8, String> {
     use rtlint::front::hlsl;
@@ -904,8 +911,17 @@ fn compile(
                 for w in &m.warnings {
                     eprintln!("{w}");
                 }
-                write(&output, &m.words)?;
-                eprintln!("{}: {} entry points", output.display(), m.entries.len());
+                match &output {
+                    Some(output) => {
+                        write(output, &m.words)?;
+                        eprintln!("{}: {} entry points", output.display(), m.entries.len());
+                    }
+                    None => eprintln!(
+                        "{}: {} entry points compiled (no -o: nothing written)",
+                        file.display(),
+                        m.entries.len()
+                    ),
+                }
                 Ok(0)
             }
             Err(e) => report(e),
@@ -921,6 +937,15 @@ fn compile(
     for w in &entries[0].warnings {
         eprintln!("{w}");
     }
+    let Some(output) = output else {
+        let names: Vec<&str> = entries.iter().map(|e| e.name.as_str()).collect();
+        eprintln!(
+            "{}: {} compiled (no -o: nothing written)",
+            file.display(),
+            names.join(", ")
+        );
+        return Ok(0);
+    };
     if output.is_dir() {
         for e in &entries {
             let path = output.join(format!("{}.spv", e.name));

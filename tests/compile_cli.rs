@@ -336,3 +336,45 @@ fn windows_1252_sources_through_the_command_line() {
     assert!(out.contains("bad.hlsl:1:33"), "{out}");
     assert!(out.contains("return nope;"), "the line is shown: {out}");
 }
+
+/// `-T lib_6_x` without `-E` is the whole library in one module, as DXC
+/// writes it; without `-o`/`-Fo` the file is compiled and nothing written.
+#[test]
+fn a_library_profile_without_an_entry_is_the_whole_library() {
+    let d = scratch("lib");
+    let out = d.join("lib.spv");
+    let o = rtlint()
+        .args([
+            "compile",
+            "-T",
+            "lib_6_3",
+            "tests/hlsl/pipeline.hlsl",
+            "-Fo",
+        ])
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    let p = rtlint::program::parse(
+        &common::read_words(&out),
+        &out,
+        rtlint::shader::Language::Spirv,
+    )
+    .unwrap();
+    assert_eq!(p.entry_points.len(), 4);
+    let o = rtlint()
+        .args(["compile", "-T", "lib_6_x", "tests/hlsl/pipeline.hlsl"])
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(0), "{err}");
+    assert!(
+        err.contains("4 entry points compiled (no -o: nothing written)"),
+        "{err}"
+    );
+}

@@ -248,6 +248,16 @@ const NO_OP_FLAGS: &[&str] = &[
     "-WX",
     "-no-warnings",
     "-nologo",
+    "-all-resources-bound",
+    "-res-may-alias",
+    "-Gfa",
+    "-Gfp",
+    "-Vi",
+    "-H",
+    "-Cc",
+    "-No",
+    "-Ni",
+    "-Lx",
     "-fspv-reflect",
     "-fspv-preserve-interface",
     "-fvk-use-dx-position-w",
@@ -301,7 +311,8 @@ pub fn parse_args(args: &[String], options: &mut HlslOptions) -> Result<ParsedAr
         };
         let at = i;
         let args_i = |k: usize| args.get(at + k).cloned();
-        if NO_OP_FLAGS.contains(&a) {
+        if NO_OP_FLAGS.contains(&a) || (a.starts_with("-W") && a.len() > 2) {
+            // `-Wall`, `-Wno-conversion`, ...: warnings this compiler does not give.
             out.notes
                 .push(format!("{a}: accepted, changes nothing here"));
         } else if let Some(n) = NO_OP_WITH_VALUE.iter().find(|n| a.starts_with(**n)) {

@@ -77,3 +77,15 @@ fn a_spliced_comment_with_crlf() {
         b"// not code \\\r\nfloat Shade() { return nope; }\r\nfloat Shade() { return 1.0; }\r\n";
     compile(&project("splice", header)).unwrap();
 }
+
+/// An apostrophe in the text of a skipped `#error` (`Can't`) is no
+/// character literal: it compiles, as with DXC; one in code is an error at
+/// its position.
+#[test]
+fn an_apostrophe_in_a_skipped_directive() {
+    let header = b"#if 0\r\n#error Can't happen\r\n#endif\r\nfloat Shade() { return 1.0; }\r\n";
+    compile(&project("apostrophe", header)).unwrap();
+    let header = b"float Shade() { return 'ab'; }\r\n";
+    let e = compile(&project("apostrophe-code", header)).unwrap_err();
+    assert!(e.contains("header.hlsli:1:24: "), "{e}");
+}
