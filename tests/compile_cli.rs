@@ -230,11 +230,11 @@ fn rt041_judges_collisions_after_the_shifts() {
         String::from_utf8_lossy(&o.stdout).into_owned()
     };
     assert!(
-        !check(&[]).contains("RT041"),
+        !check(&[]).contains("warning[RT041]"),
         "D3D12-only HLSL without options"
     );
     let spirv = check(&["-spirv"]);
-    assert!(spirv.contains("RT041"), "{spirv}");
+    assert!(spirv.contains("warning[RT041]"), "{spirv}");
     let shifted = check(&[
         "-spirv",
         "-fvk-t-shift",
@@ -244,11 +244,11 @@ fn rt041_judges_collisions_after_the_shifts() {
         "200",
         "0",
     ]);
-    assert!(!shifted.contains("RT041"), "{shifted}");
+    assert!(!shifted.contains("warning[RT041]"), "{shifted}");
     // Shifting only one class keeps one collision: t1 (colors) and b1 (Camera).
     let partly = check(&["-fvk-u-shift", "200", "0"]);
     assert!(
-        partly.contains("RT041") && partly.contains("Camera"),
+        partly.contains("warning[RT041]") && partly.contains("Camera"),
         "{partly}"
     );
 
@@ -265,7 +265,10 @@ fn rt041_judges_collisions_after_the_shifts() {
         .output()
         .unwrap();
     let out = String::from_utf8_lossy(&o.stdout);
-    assert!(out.contains("RT041") && out.contains("Camera"), "{out}");
+    assert!(
+        out.contains("warning[RT041]") && out.contains("Camera"),
+        "{out}"
+    );
     std::fs::write(
         d.join("rtlint.toml"),
         "[hlsl]\nargs = [\"-fvk-u-shift\", \"x\", \"all\"]\n",
