@@ -213,8 +213,10 @@ struct TradeoffArgs {
 #[derive(Subcommand)]
 enum Command {
     /// Lint shaders and report best-practice violations.
+    #[command(after_help = DXC_HELP)]
     Check(Box<CheckArgs>),
     /// Values kept alive across each trace, callable and ray-query site.
+    #[command(after_help = DXC_HELP)]
     Live {
         #[command(flatten)]
         common: Common,
@@ -223,6 +225,7 @@ enum Command {
     },
     /// Recursion depth and stack size of a described pipeline (or of loose
     /// shaders, assuming every trace reaches every shader).
+    #[command(after_help = DXC_HELP)]
     Stack {
         #[command(flatten)]
         common: Common,
@@ -240,6 +243,7 @@ enum Command {
         format: ReportFormat,
     },
     /// Print payload, attribute and shader-record layouts with the best member order.
+    #[command(after_help = DXC_HELP)]
     Layout {
         #[command(flatten)]
         common: Common,
@@ -247,6 +251,7 @@ enum Command {
         format: ReportFormat,
     },
     /// Compile HLSL to SPIR-V with rtlint's own compiler.
+    #[command(after_help = DXC_HELP)]
     Compile {
         /// The HLSL file.
         file: PathBuf,
@@ -293,6 +298,21 @@ enum Command {
         code: String,
     },
 }
+
+/// The DXC options the HLSL commands read (clap does not see them).
+const DXC_HELP: &str = "\
+HLSL: DXC's options, as a build passes them (docs/hlsl.md lists them all):
+  -I DIR, -D NAME[=VALUE]   include folder, define (HLSL and GLSL)
+  -E NAME (--entry)         only this entry point
+  -T PROFILE (--stage)      ps_6_x, cs_6_x, lib_6_x or a stage name
+  -HV 2016|2018|2021|202x   language version (__HLSL_VERSION)
+  -enable-16bit-types       16-bit half and min16 types
+  -Zpr, -Zpc                default matrix packing
+  -fspv-target-env=ENV      target environment (__SPIRV_*_VERSION__)
+  -fvk-{b,t,u,s}-shift N SPACE|all, -fvk-bind-register xN SPACE BINDING SET,
+  -fvk-bind-globals BINDING SET, -fvk-auto-shift-bindings, -auto-binding-space N
+                            register to descriptor set and binding, as DXC maps them
+  -spirv, -O3, -Zi, ...     accepted without effect (-v lists them)";
 
 /// DXC's options, read from the command line before clap reads the rest:
 /// DXC spells them with one dash and some take two or four values
