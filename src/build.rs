@@ -645,6 +645,35 @@ mod tests {
 
     /// The cbuffer rule at its trickiest: a float after an array shares the
     /// array's last row, and so does one after a float3x3.
+    /// The build's output is Vulkan: RT041 checks D3D12-style registers
+    /// without any `vk::` sign, and judges them after `dxc_args`' shifts.
+    #[test]
+    fn hlsl_is_a_vulkan_build_with_the_dxc_shifts() {
+        let shader = "fixtures/RT041/good_d3d12_only.hlsl";
+        let dir = scratch("vk");
+        let config = dir.join("rtlint.toml");
+        std::fs::write(&config, "select = [\"RT041\"]\n").unwrap();
+        let rt041 = |lines: &str| {
+            lines
+                .lines()
+                .filter(|l| l.starts_with("cargo:warning=") && l.contains("RT041"))
+                .count()
+        };
+        let (lines, _) = run(Builder::new().shaders(shader).config(&config).out_dir(&dir));
+        assert_eq!(rt041(&lines), 2, "{lines}");
+        let shifted = Builder::new()
+            .shaders(shader)
+            .config(&config)
+            .dxc_args(["-fvk-t-shift", "100", "all", "-fvk-u-shift", "200", "all"])
+            .unwrap()
+            .out_dir(scratch("vk-shifted"));
+        let (lines, _) = run(shifted);
+        assert_eq!(rt041(&lines), 0, "{lines}");
+        let bad = Builder::new().dxc_args(["-fvk-t-shift", "x", "all"]);
+        assert!(bad.unwrap_err().contains("-fvk-t-shift"));
+        assert!(Builder::new().dxc_args(["shader.hlsl"]).is_err());
+    }
+
     #[test]
     fn cbuffer_follows_declared_offsets_with_split_last_elements() {
         let out = scratch("cbuffer");

@@ -312,24 +312,30 @@ impl From<rtlint_hlsl::CompileError> for InputError {
 pub fn read_text(path: &Path) -> Result<String, InputError> {
     let bytes = std::fs::read(path).map_err(|e| io_error(path, &e))?;
     // The bytes become the text, not a copy of them.
-    String::from_utf8(bytes).map_err(|e| not_utf8(path, e.utf8_error()))
+    String::from_utf8(bytes).map_err(|e| not_utf8(path, e.as_bytes(), e.utf8_error()))
 }
 
 /// Input bytes as UTF-8 text; anything else is an input error.
 pub fn text_from_bytes(bytes: &[u8], path: &Path) -> Result<String, InputError> {
     match std::str::from_utf8(bytes) {
         Ok(text) => Ok(text.to_string()),
-        Err(e) => Err(not_utf8(path, e)),
+        Err(e) => Err(not_utf8(path, bytes, e)),
     }
 }
 
-fn not_utf8(path: &Path, e: std::str::Utf8Error) -> InputError {
+/// Where the first byte that is not UTF-8 is, as an editor counts: line and
+/// column (in characters) of the valid text before it.
+fn not_utf8(path: &Path, bytes: &[u8], e: std::str::Utf8Error) -> InputError {
     let offset = e.valid_up_to();
+    let valid = std::str::from_utf8(&bytes[..offset]).unwrap_or_default();
+    let (line, column) = crate::shader::line_col(valid, offset);
+    let byte = bytes.get(offset).copied().unwrap_or_default();
     InputError::new(
         InputErrorKind::InvalidUtf8,
         path,
-        format!("file is not valid UTF-8 (byte offset {offset})"),
+        format!("file is not valid UTF-8: byte 0x{byte:02x} at line {line}, column {column}"),
     )
+    .at(Location::point(path, line, column), "not UTF-8")
 }
 
 pub fn io_error(path: &Path, e: &std::io::Error) -> InputError {

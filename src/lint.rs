@@ -897,8 +897,7 @@ fn apply_suppressions(
             let parsed = match known.get(*path) {
                 Some(Some(list)) => Some(list.clone()),
                 Some(None) => embedded.get(*path).map(|t| crate::suppress::parse(t)),
-                None => std::fs::read_to_string(path)
-                    .ok()
+                None => crate::shader::read_source_text(path)
                     .as_deref()
                     .or_else(|| embedded.get(*path).copied())
                     .map(crate::suppress::parse),

@@ -213,8 +213,10 @@ struct TradeoffArgs {
 #[derive(Subcommand)]
 enum Command {
     /// Lint shaders and report best-practice violations.
+    #[command(after_help = DXC_HELP)]
     Check(Box<CheckArgs>),
     /// Values kept alive across each trace, callable and ray-query site.
+    #[command(after_help = DXC_HELP)]
     Live {
         #[command(flatten)]
         common: Common,
@@ -223,6 +225,7 @@ enum Command {
     },
     /// Recursion depth and stack size of a described pipeline (or of loose
     /// shaders, assuming every trace reaches every shader).
+    #[command(after_help = DXC_HELP)]
     Stack {
         #[command(flatten)]
         common: Common,
@@ -240,6 +243,7 @@ enum Command {
         format: ReportFormat,
     },
     /// Print payload, attribute and shader-record layouts with the best member order.
+    #[command(after_help = DXC_HELP)]
     Layout {
         #[command(flatten)]
         common: Common,
@@ -247,6 +251,7 @@ enum Command {
         format: ReportFormat,
     },
     /// Compile HLSL to SPIR-V with rtlint's own compiler.
+    #[command(after_help = DXC_HELP)]
     Compile {
         /// The HLSL file.
         file: PathBuf,
@@ -255,9 +260,10 @@ enum Command {
         verbose: bool,
         /// Output: a `.spv` file (one entry point, or with --whole every entry
         /// point in one module), or a directory for one module per entry point
-        /// (DXC's `-Fo FILE` too).
+        /// (DXC's `-Fo FILE` too). Without it the file is compiled and
+        /// nothing is written (a check).
         #[arg(short = 'o', long = "output")]
-        output: PathBuf,
+        output: Option<PathBuf>,
         /// One module holding every entry point.
         #[arg(long)]
         whole: bool,
@@ -287,6 +293,21 @@ enum Command {
         code: String,
     },
 }
+
+/// The DXC options the HLSL commands read (clap does not see them).
+const DXC_HELP: &str = "\
+HLSL: DXC's options, as a build passes them (docs/hlsl.md lists them all):
+  -I DIR, -D NAME[=VALUE]   include folder, define (HLSL and GLSL)
+  -E NAME (--entry)         only this entry point
+  -T PROFILE (--stage)      ps_6_x, cs_6_x, lib_6_x or a stage name
+  -HV 2016|2018|2021|202x   language version (__HLSL_VERSION)
+  -enable-16bit-types       16-bit half and min16 types
+  -Zpr, -Zpc                default matrix packing
+  -fspv-target-env=ENV      target environment (__SPIRV_*_VERSION__)
+  -fvk-{b,t,u,s}-shift N SPACE|all, -fvk-bind-register xN SPACE BINDING SET,
+  -fvk-bind-globals BINDING SET, -fvk-auto-shift-bindings, -auto-binding-space N
+                            register to descriptor set and binding, as DXC maps them
+  -spirv, -O3, -Zi, ...     accepted without effect (-v lists them)";
 
 /// DXC's options, read from the command line before clap reads the rest:
 /// DXC spells them with one dash and some take two or four values
@@ -423,7 +444,13 @@ fn run(cli: Cli) -> Result<u8, String> {
             if verbose {
                 dxc_notes();
             }
-            compile(file, dxc().options.clone(), output, whole)
+            // `-T lib_6_x` without `-E`, as DXC reads it: the whole library.
+            let o = &dxc().options;
+            let library = o
+                .profile
+                .is_some_and(|p| p.kind == rtlint::front::hlsl::ProfileKind::Library);
+            let whole = whole || (library && o.entry.is_none());
+            compile(file, o.clone(), output, whole)
         }
         Command::Verify(args) => verify(args),
         Command::Tradeoff(args) => tradeoff(args),
@@ -860,7 +887,7 @@ fn print_report(
 fn compile(
     file: PathBuf,
     options: rtlint::front::hlsl::HlslOptions,
-    output: PathBuf,
+    output: Option<PathBuf>,
     whole: bool,
 ) -> Result<u8, String> {
     use rtlint::front::hlsl;
@@ -880,8 +907,17 @@ fn compile(
                 for w in &m.warnings {
                     eprintln!("{w}");
                 }
-                write(&output, &m.words)?;
-                eprintln!("{}: {} entry points", output.display(), m.entries.len());
+                match &output {
+                    Some(output) => {
+                        write(output, &m.words)?;
+                        eprintln!("{}: {} entry points", output.display(), m.entries.len());
+                    }
+                    None => eprintln!(
+                        "{}: {} entry points compiled (no -o: nothing written)",
+                        file.display(),
+                        m.entries.len()
+                    ),
+                }
                 Ok(0)
             }
             Err(e) => report(e),
@@ -897,6 +933,15 @@ fn compile(
     for w in &entries[0].warnings {
         eprintln!("{w}");
     }
+    let Some(output) = output else {
+        let names: Vec<&str> = entries.iter().map(|e| e.name.as_str()).collect();
+        eprintln!(
+            "{}: {} compiled (no -o: nothing written)",
+            file.display(),
+            names.join(", ")
+        );
+        return Ok(0);
+    };
     if output.is_dir() {
         for e in &entries {
             let path = output.join(format!("{}.spv", e.name));

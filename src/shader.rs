@@ -49,6 +49,14 @@ impl Language {
 
 pub use rtlint_hlsl::{Location, Stage};
 
+/// A source file's text for what reads it after the compile (snippets,
+/// suppression comments, declarations): any bytes, read as the HLSL
+/// compiler reads them (a header may be Windows-1252); `None` when it
+/// cannot be read.
+pub fn read_source_text(path: &Path) -> Option<String> {
+    std::fs::read(path).ok().map(rtlint_hlsl::decode_source)
+}
+
 /// The 1-based line and column (in characters) of a byte offset in `source`.
 pub fn line_col(source: &str, offset: usize) -> (u32, u32) {
     let mut offset = offset.min(source.len());

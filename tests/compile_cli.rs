@@ -230,11 +230,11 @@ fn rt041_judges_collisions_after_the_shifts() {
         String::from_utf8_lossy(&o.stdout).into_owned()
     };
     assert!(
-        !check(&[]).contains("RT041"),
+        !check(&[]).contains("warning[RT041]"),
         "D3D12-only HLSL without options"
     );
     let spirv = check(&["-spirv"]);
-    assert!(spirv.contains("RT041"), "{spirv}");
+    assert!(spirv.contains("warning[RT041]"), "{spirv}");
     let shifted = check(&[
         "-spirv",
         "-fvk-t-shift",
@@ -244,11 +244,11 @@ fn rt041_judges_collisions_after_the_shifts() {
         "200",
         "0",
     ]);
-    assert!(!shifted.contains("RT041"), "{shifted}");
+    assert!(!shifted.contains("warning[RT041]"), "{shifted}");
     // Shifting only one class keeps one collision: t1 (colors) and b1 (Camera).
     let partly = check(&["-fvk-u-shift", "200", "0"]);
     assert!(
-        partly.contains("RT041") && partly.contains("Camera"),
+        partly.contains("warning[RT041]") && partly.contains("Camera"),
         "{partly}"
     );
 
@@ -265,7 +265,10 @@ fn rt041_judges_collisions_after_the_shifts() {
         .output()
         .unwrap();
     let out = String::from_utf8_lossy(&o.stdout);
-    assert!(out.contains("RT041") && out.contains("Camera"), "{out}");
+    assert!(
+        out.contains("warning[RT041]") && out.contains("Camera"),
+        "{out}"
+    );
     std::fs::write(
         d.join("rtlint.toml"),
         "[hlsl]\nargs = [\"-fvk-u-shift\", \"x\", \"all\"]\n",
@@ -281,5 +284,100 @@ fn rt041_judges_collisions_after_the_shifts() {
     assert!(
         out.contains("[hlsl] args: -fvk-u-shift: expected a number"),
         "{out}"
+    );
+}
+
+/// Windows-1252 bytes in the main file and in a header, as `rtlint check`
+/// and `rtlint compile` read them: accepted, and an error after them is at
+/// its line and column with its line of source shown.
+#[test]
+fn windows_1252_sources_through_the_command_line() {
+    let d = scratch("cp1252");
+    std::fs::write(
+        d.join("h.hlsli"),
+        b"// the light\x92s colour\r\nfloat Shade() { return 0.5; }\r\n",
+    )
+    .unwrap();
+    std::fs::write(
+        d.join("main.hlsl"),
+        b"// caf\xe9 \x96 \x93main\x94\r\n#include \"h.hlsli\"\r\nRWStructuredBuffer<float> o : register(u0);\r\n[numthreads(1, 1, 1)] void main() { o[0] = Shade(); }\r\n",
+    )
+    .unwrap();
+    let o = rtlint()
+        .arg("check")
+        .arg(d.join("main.hlsl"))
+        .output()
+        .unwrap();
+    let out = String::from_utf8_lossy(&o.stdout).into_owned() + &String::from_utf8_lossy(&o.stderr);
+    assert!(matches!(o.status.code(), Some(0 | 1)), "{out}");
+    let o = rtlint()
+        .args(["compile", "-T", "cs_6_0"])
+        .arg(d.join("main.hlsl"))
+        .arg("-o")
+        .arg(d.join("m.spv"))
+        .output()
+        .unwrap();
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+
+    std::fs::write(
+        d.join("bad.hlsl"),
+        b"/* \x92\x92 */ float Shade() { return nope; }\r\n[numthreads(1, 1, 1)] void main() { Shade(); }\r\n",
+    )
+    .unwrap();
+    let o = rtlint()
+        .arg("check")
+        .arg(d.join("bad.hlsl"))
+        .output()
+        .unwrap();
+    let out = String::from_utf8_lossy(&o.stdout).into_owned() + &String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{out}");
+    assert!(out.contains("bad.hlsl:1:33"), "{out}");
+    assert!(out.contains("return nope;"), "the line is shown: {out}");
+}
+
+/// `-T lib_6_x` without `-E` is the whole library in one module, as DXC
+/// writes it; without `-o`/`-Fo` the file is compiled and nothing written.
+#[test]
+fn a_library_profile_without_an_entry_is_the_whole_library() {
+    let d = scratch("lib");
+    let out = d.join("lib.spv");
+    let o = rtlint()
+        .args([
+            "compile",
+            "-T",
+            "lib_6_3",
+            "tests/hlsl/pipeline.hlsl",
+            "-Fo",
+        ])
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    let p = rtlint::program::parse(
+        &common::read_words(&out),
+        &out,
+        rtlint::shader::Language::Spirv,
+    )
+    .unwrap();
+    assert_eq!(p.entry_points.len(), 4);
+    let o = rtlint()
+        .args(["compile", "-T", "lib_6_x", "tests/hlsl/pipeline.hlsl"])
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(0), "{err}");
+    assert!(
+        err.contains("4 entry points compiled (no -o: nothing written)"),
+        "{err}"
     );
 }

@@ -105,7 +105,11 @@ pub fn compile_input(
             Ok(compiled(Language::Spirv, words, Vec::new()))
         }
         Language::Hlsl => {
-            let text = text()?;
+            // Any bytes, as DXC reads them (Windows-1252, a BOM, UTF-16).
+            let text = match contents {
+                Some(bytes) => hlsl::decode_source(bytes.to_vec()),
+                None => hlsl::read_source(path)?,
+            };
             let hlsl_options = options.hlsl_options();
             let m =
                 hlsl::compile_source_whole(path, &text, &mut hlsl::pp::FsLoader, &hlsl_options)?;

@@ -412,9 +412,7 @@ impl Builder<'_> {
                 // glslang `-gV` embeds no text: the file on disk, if any.
                 match &f.text {
                     Some(t) => Some(line_count(t)),
-                    None => std::fs::read_to_string(&f.path)
-                        .ok()
-                        .map(|t| line_count(&t)),
+                    None => crate::shader::read_source_text(&f.path).map(|t| line_count(&t)),
                 }
             })
             .collect();

@@ -134,7 +134,7 @@ pub fn fill(program: &mut Program) {
         .filter_map(|(i, f)| {
             f.text
                 .clone()
-                .or_else(|| std::fs::read_to_string(&f.path).ok())
+                .or_else(|| crate::shader::read_source_text(&f.path))
                 .map(|t| (i as u32, t))
         })
         .collect();
@@ -237,7 +237,7 @@ fn add_included(program: &mut Program, texts: &mut Vec<(u32, String)>) {
             if program.files.iter().any(|f| f.path == path) {
                 continue;
             }
-            let Ok(included) = std::fs::read_to_string(&path) else {
+            let Some(included) = crate::shader::read_source_text(&path) else {
                 continue;
             };
             program.files.push(super::SourceFile { path, text: None });

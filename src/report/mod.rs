@@ -94,7 +94,7 @@ impl Sources {
         todo.dedup();
         let texts: Vec<Option<String>> = todo
             .par_iter()
-            .map(|p| std::fs::read_to_string(p).ok())
+            .map(|p| crate::shader::read_source_text(p))
             .collect();
         for (p, text) in todo.into_iter().zip(texts) {
             let text = text.or_else(|| self.embedded.get(p).cloned());
@@ -109,9 +109,8 @@ impl Sources {
 
     pub fn text(&mut self, path: &Path) -> Option<&str> {
         if !self.cache.contains_key(path) {
-            let text = std::fs::read_to_string(path)
-                .ok()
-                .or_else(|| self.embedded.get(path).cloned());
+            let text =
+                crate::shader::read_source_text(path).or_else(|| self.embedded.get(path).cloned());
             self.cache.insert(path.to_path_buf(), text);
         }
         self.cache.get(path).and_then(|t| t.as_deref())

@@ -268,12 +268,12 @@ impl<'a> Context<'a> {
                 let read;
                 let text = match &f.text {
                     Some(t) => t,
-                    None => match std::fs::read_to_string(&f.path) {
-                        Ok(t) => {
+                    None => match crate::shader::read_source_text(&f.path) {
+                        Some(t) => {
                             read = t;
                             &read
                         }
-                        Err(_) => continue,
+                        None => continue,
                     },
                 };
                 for (li, line) in text.lines().enumerate() {

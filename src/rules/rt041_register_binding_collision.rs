@@ -54,18 +54,21 @@ super::declare_rule! {
     /// different classes never collide, so an HLSL source is checked only when
     /// it shows it is meant for Vulkan: a `vk::` attribute or intrinsic
     /// (`[[vk::binding]]`, `[[vk::push_constant]]`, `vk::RawBufferLoad`, …)
-    /// in the file or its headers, or the option `vulkan = true` for builds
-    /// that compile plain HLSL with `-spirv`. A SPIR-V module compiled from
-    /// HLSL is a Vulkan build and always checked. (Measured: all 47 findings on
-    /// public HLSL without such a sign were D3D12-only code;
-    /// `docs/rules-precision.md`.)
+    /// in the file or its headers, a DXC command line that builds for Vulkan
+    /// (`-spirv`, any `-fspv-*` or `-fvk-*` option, given to `rtlint` or in
+    /// `[hlsl] args`), or the option `vulkan = true`. The build API
+    /// (`rtlint::build`), whose output is SPIR-V for Vulkan, always checks. A
+    /// SPIR-V module compiled from HLSL is a Vulkan build and always checked.
+    /// The collision is judged after the command line's register mapping
+    /// (`-fvk-t-shift 1000 all` separates `t0` from `u0`), since rtlint
+    /// compiles with it. (Measured: all 47 findings on public HLSL without
+    /// such a sign were D3D12-only code; `docs/rules-precision.md`.)
     ///
     /// ## Options
     ///
     /// - `vulkan` (default `false`): check HLSL sources that show no sign of
-    ///   Vulkan too: set it when a build compiles plain HLSL with `-spirv` and
-    ///   no `-fvk-*-shift` options (with shifts the classes do not collide,
-    ///   and rtlint cannot see the options).
+    ///   Vulkan too. Passing the build's DXC options (`-spirv`, its
+    ///   `-fvk-*-shift`s) to `rtlint` or in `[hlsl] args` sets it.
     ///
     /// ## References
     ///
@@ -101,11 +104,11 @@ fn meant_for_vulkan(ctx: &Context) -> bool {
     }
     // The sources debug info names, and the input itself (a module without
     // debug info names none).
-    let own = std::fs::read_to_string(&p.path).unwrap_or_default();
+    let own = crate::shader::read_source_text(&p.path).unwrap_or_default();
     std::iter::once(own)
         .chain(p.files.iter().map(|f| match &f.text {
             Some(t) => t.clone(),
-            None => std::fs::read_to_string(&f.path).unwrap_or_default(),
+            None => crate::shader::read_source_text(&f.path).unwrap_or_default(),
         }))
         .any(|text| {
             // Code, not a comment that mentions Vulkan.

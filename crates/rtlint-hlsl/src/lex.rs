@@ -112,6 +112,9 @@ pub fn lex(src: &str, file: u32) -> Result<Vec<Token>, Error> {
                 if b[i] == b'\\' && b.get(i + 1) == Some(&b'\n') {
                     i += 1;
                     line += 1;
+                } else if b[i] == b'\\' && b[i + 1..].starts_with(b"\r\n") {
+                    i += 2;
+                    line += 1;
                 }
                 i += 1;
             }
@@ -134,7 +137,8 @@ pub fn lex(src: &str, file: u32) -> Result<Vec<Token>, Error> {
                 if b[i] == b'\n' {
                     line += 1;
                     col = 1;
-                } else {
+                } else if b[i] & 0xc0 != 0x80 {
+                    // Columns count characters: not UTF-8 continuation bytes.
                     col += 1;
                 }
                 i += 1;
@@ -187,7 +191,11 @@ pub fn lex(src: &str, file: u32) -> Result<Vec<Token>, Error> {
                 i += 3;
                 Tok::Int(b[start + 1] as u64, false)
             } else {
-                return Err(Error::unsupported(pos, "character literal"));
+                // A lone apostrophe, as in `#error Can't ...` in a skipped
+                // block: a token of its own, as clang lexes it; the parser
+                // refuses it if it reaches code.
+                i += 1;
+                Tok::Punct("'")
             }
         } else {
             let rest = &src[i..];
@@ -222,6 +230,16 @@ pub fn lex(src: &str, file: u32) -> Result<Vec<Token>, Error> {
 /// Reads a number literal at the start of `b`: returns the token and its length.
 fn lex_number(b: &[u8]) -> Option<(Tok, usize)> {
     let mut i = 0;
+    // Binary literals (`0b0101u`), which DXC accepts as clang does.
+    if b.len() > 2 && b[0] == b'0' && matches!(b[1], b'b' | b'B') && matches!(b[2], b'0' | b'1') {
+        let mut j = 2;
+        while j < b.len() && matches!(b[j], b'0' | b'1') {
+            j += 1;
+        }
+        let v = u64::from_str_radix(std::str::from_utf8(&b[2..j]).ok()?, 2).ok()?;
+        let (u, long, n) = int_suffix(&b[j..]);
+        return Some((int_token(v, u, long), j + n));
+    }
     if b.len() > 1 && b[0] == b'0' && (b[1] == b'x' || b[1] == b'X') {
         i = 2;
         let s = i;
@@ -389,6 +407,10 @@ mod tests {
         assert_eq!(
             kinds(".5 1. 3h"),
             vec![Tok::Float(0.5), Tok::Float(1.0), Tok::Float(3.0)]
+        );
+        assert_eq!(
+            kinds("0b01u 0B110 0b1ll"),
+            vec![Tok::Int(1, true), Tok::Int(6, false), Tok::Long(1, false)]
         );
     }
 

@@ -40,6 +40,7 @@ pub mod template;
 pub mod types;
 
 mod options;
+mod text;
 mod vocab;
 
 pub use error::{CompileError, ErrorDetails, ErrorKind, Label};
@@ -47,6 +48,7 @@ pub use options::{
     parse_args, Bindings, HlslOptions, ParsedArgs, Profile, ProfileKind, RegisterBinding, Shift,
     TargetEnv,
 };
+pub use text::decode_source;
 pub use vocab::{Location, NamedDecl, Stage};
 
 use std::path::{Path, PathBuf};
@@ -365,7 +367,7 @@ fn compile_source_whole_inner(
     })
 }
 
-/// Reads a source file.
+/// Reads a source file as DXC reads it: any bytes (see [`decode_source`]).
 pub fn read_source(path: &Path) -> Result<String, CompileError> {
     let bytes = std::fs::read(path).map_err(|e| {
         CompileError::whole(
@@ -374,14 +376,5 @@ pub fn read_source(path: &Path) -> Result<String, CompileError> {
             format!("cannot read file: {e}"),
         )
     })?;
-    String::from_utf8(bytes).map_err(|e| {
-        CompileError::whole(
-            ErrorKind::Unreadable,
-            path,
-            format!(
-                "file is not valid UTF-8 (byte offset {})",
-                e.utf8_error().valid_up_to()
-            ),
-        )
-    })
+    Ok(decode_source(bytes))
 }

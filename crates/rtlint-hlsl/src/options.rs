@@ -248,6 +248,16 @@ const NO_OP_FLAGS: &[&str] = &[
     "-WX",
     "-no-warnings",
     "-nologo",
+    "-all-resources-bound",
+    "-res-may-alias",
+    "-Gfa",
+    "-Gfp",
+    "-Vi",
+    "-H",
+    "-Cc",
+    "-No",
+    "-Ni",
+    "-Lx",
     "-fspv-reflect",
     "-fspv-preserve-interface",
     "-fvk-use-dx-position-w",
@@ -287,13 +297,36 @@ pub fn parse_args(args: &[String], options: &mut HlslOptions) -> Result<ParsedAr
     let mut saw_shift = false;
     while i < args.len() {
         let a = args[i].as_str();
-        // `/T` is DXC's Windows spelling of `-T`.
+        // DXC's Windows spellings (`/T ps_6_0`, `/D X=1`), taken only whole:
+        // `/Data` may as well be a file.
+        const SLASHED: &[&str] = &[
+            "T",
+            "E",
+            "I",
+            "D",
+            "Fo",
+            "HV",
+            "Zi",
+            "Zpr",
+            "Zpc",
+            "Od",
+            "O0",
+            "O1",
+            "O2",
+            "O3",
+            "Vd",
+            "WX",
+            "Qembed_debug",
+            "Ges",
+            "Gis",
+            "nologo",
+        ];
         let a_owned;
         if a == "-spirv" || a.starts_with("-fspv-") || a.starts_with("-fvk-") || a == "-vkbr" {
             options.spirv = true;
         }
         let a = match a.strip_prefix('/') {
-            Some(r) if r.starts_with(|c: char| c.is_ascii_uppercase()) && !r.contains('/') => {
+            Some(r) if SLASHED.contains(&r) => {
                 a_owned = format!("-{r}");
                 a_owned.as_str()
             }
@@ -301,7 +334,8 @@ pub fn parse_args(args: &[String], options: &mut HlslOptions) -> Result<ParsedAr
         };
         let at = i;
         let args_i = |k: usize| args.get(at + k).cloned();
-        if NO_OP_FLAGS.contains(&a) {
+        if NO_OP_FLAGS.contains(&a) || (a.starts_with("-W") && a.len() > 2) {
+            // `-Wall`, `-Wno-conversion`, ...: warnings this compiler does not give.
             out.notes
                 .push(format!("{a}: accepted, changes nothing here"));
         } else if let Some(n) = NO_OP_WITH_VALUE.iter().find(|n| a.starts_with(**n)) {
@@ -590,6 +624,14 @@ mod tests {
         assert_eq!((b.shift('u', 2), b.shift('b', 0)), (0, 0));
         assert!(b.auto_shift);
         assert_eq!(b.bind_globals, Some((5, 2)));
+    }
+
+    #[test]
+    fn windows_spellings_and_paths() {
+        let (o, p) = parse("/T ps_6_0 /E main /D X=1 /Zi /Data /Engine.hlsl").unwrap();
+        assert_eq!(o.entry.as_deref(), Some("main"));
+        assert_eq!(o.defines, [("X".into(), "1".into())]);
+        assert_eq!(p.rest, ["/Data", "/Engine.hlsl"]);
     }
 
     #[test]

@@ -190,3 +190,68 @@ fn a_remaining_collision_is_kept() {
     let b = bindings("-fvk-t-shift 0 0", SHADER).unwrap();
     assert_eq!(at(&b, "texture1"), at(&b, "cbuffer1"));
 }
+
+/// DXC's predefined macros follow `-T`, `-HV`, `-fspv-target-env` and
+/// `-enable-16bit-types`; `-Zpr` makes matrices row-major by default. Each
+/// value is checked by a `#error` that fires when it is wrong.
+#[test]
+fn predefined_macros_and_matrix_packing() {
+    let shader = r#"
+#if __SHADER_TARGET_STAGE != __SHADER_STAGE_COMPUTE || __SHADER_STAGE_COMPUTE != 5
+#error stage
+#endif
+#if __SHADER_TARGET_MAJOR != 6 || __SHADER_TARGET_MINOR != 2
+#error target
+#endif
+#if __HLSL_VERSION != 2018 || !defined(__spirv__) || !defined(__hlsl_dx_compiler)
+#error version
+#endif
+#if __SPIRV_MAJOR_VERSION__ != 1 || __SPIRV_MINOR_VERSION__ != 5
+#error spirv
+#endif
+#if __DXC_VERSION_MAJOR != 1 || __SHADER_STAGE_LIBRARY != 6 || __SHADER_STAGE_PIXEL != 0
+#error dxc
+#endif
+#ifdef __HLSL_ENABLE_16_BIT
+#error sixteen
+#endif
+cbuffer C : register(b0) { float4x4 m; };
+RWStructuredBuffer<float4> output : register(u0);
+[numthreads(1, 1, 1)]
+void main() { output[0] = mul(m, float4(1, 2, 3, 4)); }
+"#;
+    let line = "-T cs_6_2 -E main -HV 2018 -fspv-target-env=vulkan1.2";
+    bindings(line, shader).unwrap();
+    let e = bindings(&format!("{line} -enable-16bit-types"), shader).unwrap_err();
+    assert!(e.contains("sixteen"), "{e}");
+    let e = bindings(
+        "-T cs_6_2 -E main -HV 2021 -fspv-target-env=vulkan1.2",
+        shader,
+    )
+    .unwrap_err();
+    assert!(e.contains("version"), "{e}");
+    let e = bindings("-T lib_6_x -fspv-target-env=vulkan1.2 -HV 2018", shader).unwrap_err();
+    assert!(e.contains("stage"), "{e}");
+
+    // -Zpr: the cbuffer's matrix is HLSL row-major, which SPIR-V calls ColMajor
+    // (OpMemberDecorate ... 5); without it HLSL column-major, SPIR-V RowMajor (4).
+    let decorations = |args: &str| {
+        let mut options = HlslOptions::default();
+        let args: Vec<String> = args.split_whitespace().map(String::from).collect();
+        parse_args(&args, &mut options).unwrap();
+        let mut loader = MemLoader::default();
+        let m = compile_source_whole(Path::new("b.hlsl"), shader, &mut loader, &options).unwrap();
+        let mut found = Vec::new();
+        let mut at = 5;
+        while at < m.words.len() {
+            let (count, op) = ((m.words[at] >> 16) as usize, m.words[at] & 0xffff);
+            if op == 72 && matches!(m.words[at + 3], 4 | 5) {
+                found.push(m.words[at + 3]);
+            }
+            at += count.max(1);
+        }
+        found
+    };
+    assert_eq!(decorations(&format!("{line} -Zpr")), [5]);
+    assert_eq!(decorations(line), [4]);
+}

@@ -17,7 +17,7 @@ pub struct FsLoader;
 
 impl FileLoader for FsLoader {
     fn read(&mut self, path: &Path) -> Option<String> {
-        std::fs::read_to_string(path).ok()
+        std::fs::read(path).ok().map(crate::decode_source)
     }
 
     fn list(&mut self, dir: &Path) -> Vec<String> {
