@@ -260,35 +260,21 @@ impl Builder {
             };
             run.rerun_files_of(&program);
             if let (true, Some(dir)) = (self.emit_spirv, &out_dir) {
-                // The config's `[hlsl]` folders and defines first, as `check` has them.
-                let hlsl = &input.config.hlsl;
-                let hlsl_options = hlsl::HlslOptions {
-                    enable_16bit_types: hlsl.enable_16bit_types,
-                    include_dirs: hlsl
-                        .include_dirs
-                        .iter()
-                        .chain(&self.include_dirs)
-                        .cloned()
-                        .collect(),
-                    defines: hlsl
-                        .defines
-                        .iter()
-                        .map(|(k, v)| (k.clone(), v.clone()))
-                        .chain(self.defines.iter().cloned())
-                        .collect(),
-                    entry: None,
-                    stage: None,
-                };
+                // The same compile options as `check` used for this input.
+                let mut front = lint::front_options(&input.config, &options);
+                front.entry = None;
+                front.stage = None;
+                let hlsl_options = front.hlsl();
                 if let Err(e) = emit_spirv(input, &program, &hlsl_options, dir, &mut spirv_names) {
                     run.diagnostics.push(*e.0);
                 }
             }
             programs.push(program);
         }
-        for p in &report.pipelines {
+        for (p, config) in &inputs.pipelines {
             run.rerun(p);
             // The shaders a description names, wherever they are.
-            if let Ok(pipeline) = crate::pipeline::load(p) {
+            if let Ok(pipeline) = lint::load_pipeline(p, config, &options) {
                 for program in &pipeline.programs {
                     run.rerun(&program.path);
                     run.rerun_files_of(program);

@@ -151,7 +151,7 @@ pub fn check_paths(paths: &[PathBuf], options: &Options) -> Report {
     let descriptions: Vec<Vec<PathBuf>> = inputs
         .pipelines
         .iter()
-        .map(|(p, _)| described_shaders(p))
+        .map(|(p, config)| described_shaders(p, config, options))
         .collect();
     if let Some(shard) = options.shard {
         keep_shard(&mut inputs, &descriptions, shard);
@@ -279,7 +279,7 @@ pub fn check_paths(paths: &[PathBuf], options: &Options) -> Report {
     let pipelines: Vec<Checked> = inputs
         .pipelines
         .par_iter()
-        .map(|(p, config)| check_pipeline(p, config))
+        .map(|(p, config)| check_pipeline(p, config, options))
         .collect();
     for c in pipelines {
         diagnostics.extend(c.diagnostics);
@@ -372,7 +372,24 @@ pub fn load_library(input: &Input, options: &Options) -> Result<(Program, Subobj
     front::load_library(&input.path, contents, input.language, &front_options)
 }
 
-fn front_options(config: &Config, options: &Options) -> FrontOptions {
+/// Loads a pipeline description, compiling the shaders it names with the
+/// same include directories and defines as every other input.
+pub fn load_pipeline(
+    path: &Path,
+    config: &Config,
+    options: &Options,
+) -> Result<crate::pipeline::Pipeline, InputError> {
+    let mut front = front_options(config, options);
+    // The description names each entry point and its stage itself.
+    front.entry = None;
+    front.stage = None;
+    crate::pipeline::load_with(path, &front)
+}
+
+/// The one set of compile options of an input: the config's `[hlsl]`
+/// include directories and defines, then the command line's (or the build
+/// API's).
+pub fn front_options(config: &Config, options: &Options) -> FrontOptions {
     let mut front_options = FrontOptions {
         include_dirs: config.hlsl.include_dirs.clone(),
         defines: config
@@ -828,8 +845,8 @@ fn drop_ignored(diagnostics: &mut Vec<Diagnostic>, ignored: &[&str]) {
 }
 
 /// Loads a pipeline description and runs the pipeline rules on it.
-pub fn check_pipeline(path: &Path, config: &Config) -> Checked {
-    match crate::pipeline::load(path) {
+pub fn check_pipeline(path: &Path, config: &Config, options: &Options) -> Checked {
+    match load_pipeline(path, config, options) {
         Ok(pipeline) => {
             let ctx = crate::rules::PipelineContext::new(&pipeline, config);
             let mut diagnostics = crate::rules::check_pipeline(&ctx);
@@ -966,8 +983,8 @@ fn apply_suppressions(
 
 /// The shader files a pipeline description uses (nothing when it cannot be
 /// read: `check_pipeline` reports that).
-pub fn described_shaders(path: &Path) -> Vec<PathBuf> {
-    crate::pipeline::load(path)
+pub fn described_shaders(path: &Path, config: &Config, options: &Options) -> Vec<PathBuf> {
+    load_pipeline(path, config, options)
         .map(|p| p.programs.iter().map(|p| canonical(&p.path)).collect())
         .unwrap_or_default()
 }

@@ -609,8 +609,11 @@ struct Loaded {
     programs: Vec<rtlint::program::Program>,
     /// The DXR subobjects of each program (empty but for HLSL libraries).
     subobjects: Vec<rtlint::front::hlsl::subobject::Subobjects>,
-    pipelines: Vec<PathBuf>,
+    /// Each description with its config.
+    pipelines: Vec<(PathBuf, std::sync::Arc<rtlint::config::Config>)>,
     problems: Vec<Diagnostic>,
+    /// How the inputs were read: descriptions compile their shaders alike.
+    options: lint::Options,
 }
 
 fn load(common: &Common) -> Result<Loaded, String> {
@@ -631,8 +634,9 @@ fn load(common: &Common) -> Result<Loaded, String> {
     Ok(Loaded {
         programs,
         subobjects,
-        pipelines: inputs.pipelines.into_iter().map(|(p, _)| p).collect(),
+        pipelines: inputs.pipelines,
         problems,
+        options,
     })
 }
 
@@ -682,11 +686,12 @@ fn stack(
         subobjects,
         pipelines: descriptions,
         mut problems,
+        options,
     } = load(&common)?;
     let mut pipelines = Vec::new();
     let mut described = Vec::new();
-    for p in &descriptions {
-        match rtlint::pipeline::load(p) {
+    for (p, config) in &descriptions {
+        match lint::load_pipeline(p, config, &options) {
             Ok(p) => {
                 described.extend(p.programs.iter().map(|q| canonical(&q.path)));
                 pipelines.push(p)

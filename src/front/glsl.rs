@@ -73,9 +73,11 @@ pub fn compile(
         .arg("-g")
         .arg("-o")
         .arg(&output);
-    if let Some(parent) = path.parent().filter(|p| !p.as_os_str().is_empty()) {
-        cmd.arg(format!("-I{}", parent.display()));
-    }
+    // glslang looks beside the file it reads (the scratch copy), so the
+    // shader's own folder is named first, absolute: `a.rchit`, `./a.rchit`
+    // and standard input under `--stdin-filename a.rchit` have the current
+    // folder as theirs.
+    cmd.arg(format!("-I{}", own_folder(path).display()));
     for d in &options.include_dirs {
         cmd.arg(format!("-I{}", d.display()));
     }
@@ -100,6 +102,17 @@ pub fn compile(
     };
     let _ = std::fs::remove_dir_all(&dir);
     result.map(|w| (w, Some(input)))
+}
+
+/// The folder `path` is in, absolute (the current folder for a bare name).
+fn own_folder(path: &Path) -> PathBuf {
+    let parent = path.parent().unwrap_or(Path::new(""));
+    let parent = if parent.as_os_str().is_empty() {
+        Path::new(".")
+    } else {
+        parent
+    };
+    std::path::absolute(parent).unwrap_or_else(|_| parent.to_path_buf())
 }
 
 /// A private scratch folder for one compilation.

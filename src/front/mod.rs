@@ -46,6 +46,19 @@ pub struct FrontOptions {
     pub enable_16bit_types: bool,
 }
 
+impl FrontOptions {
+    /// The HLSL compiler's share of the options.
+    pub fn hlsl(&self) -> hlsl::HlslOptions {
+        hlsl::HlslOptions {
+            include_dirs: self.include_dirs.clone(),
+            defines: self.defines.clone(),
+            entry: self.entry.clone(),
+            stage: self.stage,
+            enable_16bit_types: self.enable_16bit_types,
+        }
+    }
+}
+
 /// Reads and compiles one file to SPIR-V.
 pub fn compile_path(path: &Path, language: Language) -> Result<Compiled, InputError> {
     compile_input(path, None, language, &FrontOptions::default())
@@ -95,15 +108,8 @@ pub fn compile_input(
         }
         Language::Hlsl => {
             let text = text()?;
-            let hlsl_options = hlsl::HlslOptions {
-                include_dirs: options.include_dirs.clone(),
-                defines: options.defines.clone(),
-                entry: options.entry.clone(),
-                stage: options.stage,
-                enable_16bit_types: options.enable_16bit_types,
-            };
             let m =
-                hlsl::compile_source_whole(path, &text, &mut hlsl::pp::FsLoader, &hlsl_options)?;
+                hlsl::compile_source_whole(path, &text, &mut hlsl::pp::FsLoader, &options.hlsl())?;
             let mut c = compiled(Language::Hlsl, m.words, m.decls);
             c.subobjects = m.subobjects;
             Ok(c)
