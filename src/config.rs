@@ -121,6 +121,11 @@ pub struct Config {
     /// Languages for other file extensions: `rgen = "hlsl"`.
     #[serde(default)]
     pub languages: BTreeMap<String, String>,
+    /// GLSL stages of files whose extension names none, by glob relative to
+    /// this file's folder: `"shaders/*.glsl" = "rchit"` (glslang's stage
+    /// names).
+    #[serde(default)]
+    pub stages: BTreeMap<String, String>,
     /// Rules to run instead of the default set: codes, names or groups.
     #[serde(default)]
     pub select: Option<Vec<String>>,
@@ -180,7 +185,12 @@ impl Config {
         config.rule_keys = selectors
             .map(|k| (k.clone(), find_location(text, path, k)))
             .collect();
-        for g in config.exclude.iter().chain(config.per_file_ignores.keys()) {
+        for g in config
+            .exclude
+            .iter()
+            .chain(config.per_file_ignores.keys())
+            .chain(config.stages.keys())
+        {
             if let Err(e) = globset::Glob::new(g) {
                 return Err(config_error(
                     text,
@@ -203,7 +213,20 @@ impl Config {
                     text,
                     path,
                     lang,
-                    format!("unknown language `{lang}` for extension `{ext}` (expected hlsl, wgsl or spirv)"),
+                    format!("unknown language `{lang}` for extension `{ext}` (expected hlsl, wgsl, glsl or spirv)"),
+                ));
+            }
+        }
+        for (glob, stage) in &config.stages {
+            if !crate::shader::GLSL_STAGES.contains(&stage.as_str()) {
+                return Err(config_error(
+                    text,
+                    path,
+                    stage,
+                    format!(
+                        "unknown GLSL stage `{stage}` for `{glob}` (expected one of {})",
+                        crate::shader::GLSL_STAGES.join(", ")
+                    ),
                 ));
             }
         }
@@ -356,6 +379,22 @@ impl Config {
             }
         }
         Ok(())
+    }
+
+    /// The GLSL stage `[stages]` gives `path` (glslang's name: `rchit`).
+    pub fn stage_for(&self, path: &Path) -> Option<&str> {
+        if self.stages.is_empty() {
+            return None;
+        }
+        let rel = self.relative(path);
+        self.stages
+            .iter()
+            .find(|(g, _)| {
+                globset::Glob::new(g)
+                    .map(|g| g.compile_matcher().is_match(&rel))
+                    .unwrap_or(false)
+            })
+            .map(|(_, s)| s.as_str())
     }
 
     /// The language configured for a path's extension.

@@ -367,7 +367,7 @@ pub fn load(input: &Input, options: &Options) -> Result<Program, InputError> {
 
 /// [`load`], also giving the DXR subobjects an HLSL library declares.
 pub fn load_library(input: &Input, options: &Options) -> Result<(Program, Subobjects), InputError> {
-    let front_options = front_options(&input.config, options);
+    let front_options = input_options(input, options);
     let contents = input.contents.as_deref().map(|v| v.as_slice());
     front::load_library(&input.path, contents, input.language, &front_options)
 }
@@ -383,7 +383,18 @@ pub fn load_pipeline(
     // The description names each entry point and its stage itself.
     front.entry = None;
     front.stage = None;
+    front.glsl_stage = None;
     crate::pipeline::load_with(path, &front)
+}
+
+/// [`front_options`] for one input, with the GLSL stage `[stages]` gives
+/// its path when the command line gives none.
+fn input_options(input: &Input, options: &Options) -> FrontOptions {
+    let mut front = front_options(&input.config, options);
+    if front.glsl_stage.is_none() {
+        front.glsl_stage = input.config.stage_for(&input.path).map(str::to_string);
+    }
+    front
 }
 
 /// The one set of compile options of an input: the config's `[hlsl]`
@@ -401,6 +412,7 @@ pub fn front_options(config: &Config, options: &Options) -> FrontOptions {
         entry: options.front.entry.clone(),
         stage: options.front.stage,
         enable_16bit_types: config.hlsl.enable_16bit_types || options.front.enable_16bit_types,
+        glsl_stage: options.front.glsl_stage.clone(),
     };
     front_options
         .include_dirs
@@ -591,7 +603,8 @@ fn collect(paths: &[PathBuf], options: &Options, configs: &mut Configs) -> Input
             .language
             .or_else(|| config.language_for(p))
             .or_else(|| language_from_name(p))
-            .or_else(|| ray_query_glsl(p))
+            .or_else(|| glsl_by_stage(p, &config, options.front.glsl_stage.is_some()))
+            .or_else(|| ray_query_glsl(p, &config, options))
         {
             Some(language) => inputs.files.push(Input {
                 path: p.clone(),
@@ -602,7 +615,7 @@ fn collect(paths: &[PathBuf], options: &Options, configs: &mut Configs) -> Input
             None => inputs.errors.push(InputError::new(
                 InputErrorKind::UnknownLanguage,
                 p,
-                "cannot tell the shader language from the file extension; pass --lang or map the extension under [languages] in rtlint.toml",
+                "cannot tell the shader language from the file extension; pass --lang (and --stage for GLSL) or map the extension under [languages] in rtlint.toml",
             )),
         }
     }
@@ -700,6 +713,13 @@ fn walk(
             if !inputs.pipelines.iter().any(|(q, _)| *q == p) {
                 inputs.pipelines.push((p, config));
             }
+        } else if let Some(language) = glsl_by_stage(&p, &config, false) {
+            inputs.files.push(Input {
+                path: p,
+                language,
+                config,
+                contents: None,
+            });
         } else if p
             .extension()
             .is_some_and(|e| e.eq_ignore_ascii_case("hlsli"))
@@ -714,7 +734,7 @@ fn walk(
             .language_for(&p)
             .or_else(|| language_from_name(&p))
             .or_else(|| options.language.filter(|_| is_shader_like(&p)))
-            .or_else(|| ray_query_glsl(&p))
+            .or_else(|| ray_query_glsl(&p, &config, options))
         {
             inputs.files.push(Input {
                 path: p,
@@ -759,17 +779,60 @@ fn language_from_name(p: &Path) -> Option<Language> {
     })
 }
 
-/// A GLSL compute, fragment or other stage that uses ray queries.
-fn ray_query_glsl(p: &Path) -> Option<Language> {
+/// GLSL, for a file given a stage: by `[stages]` in its config, or by
+/// `--stage` (`named`: the user named the file).
+fn glsl_by_stage(p: &Path, config: &Config, named: bool) -> Option<Language> {
+    (named || config.stage_for(p).is_some()).then_some(Language::Glsl)
+}
+
+/// A GLSL compute, fragment or other stage that uses ray queries, in its
+/// own text or in a file it includes (searched as glslang does: the
+/// including file's folder, then the include directories).
+fn ray_query_glsl(p: &Path, config: &Config, options: &Options) -> Option<Language> {
     let ext = front::glsl::stage_extension(p)?;
     if !front::glsl::RAY_QUERY_EXTENSIONS.contains(&ext) {
         return None;
     }
-    let text = std::fs::read(p).ok()?;
+    let dirs: Vec<PathBuf> = front_options(config, options).include_dirs;
+    let mut seen = HashSet::new();
+    mentions_ray_query(p, &dirs, &mut seen).then_some(Language::Glsl)
+}
+
+fn mentions_ray_query(p: &Path, dirs: &[PathBuf], seen: &mut HashSet<PathBuf>) -> bool {
+    // A header included twice (or in a cycle) is read once.
+    if seen.len() > 256 || !seen.insert(canonical(p)) {
+        return false;
+    }
+    let Ok(text) = std::fs::read(p) else {
+        return false;
+    };
     let needle = b"rayQueryEXT";
-    text.windows(needle.len())
-        .any(|w| w == needle)
-        .then_some(Language::Glsl)
+    if text.windows(needle.len()).any(|w| w == needle) {
+        return true;
+    }
+    let own = p.parent().unwrap_or(Path::new(""));
+    String::from_utf8_lossy(&text).lines().any(|line| {
+        let Some(rest) = line.trim_start().strip_prefix('#') else {
+            return false;
+        };
+        let Some(rest) = rest.trim_start().strip_prefix("include") else {
+            return false;
+        };
+        let rest = rest.trim();
+        let name = match rest.chars().next() {
+            Some('"') => rest[1..].split('"').next(),
+            Some('<') => rest[1..].split('>').next(),
+            _ => None,
+        };
+        let Some(name) = name.filter(|n| !n.is_empty()) else {
+            return false;
+        };
+        std::iter::once(own)
+            .chain(dirs.iter().map(PathBuf::as_path))
+            .map(|d| d.join(name))
+            .find(|c| c.is_file())
+            .is_some_and(|c| mentions_ray_query(&c, dirs, seen))
+    })
 }
 
 pub fn is_pipeline(p: &Path) -> bool {
@@ -1105,7 +1168,7 @@ fn input_keys(
         Some(c) => c.as_slice(),
         None => read?,
     };
-    let front = front_options(&input.config, options);
+    let front = input_options(input, options);
     let mut k = crate::cache::base_key();
     k.add(format!("{:?}", input.config))
         .add(format!("{front:?}"));

@@ -44,14 +44,11 @@ struct Common {
     /// HLSL: only this entry point.
     #[arg(short = 'E', long = "entry", value_name = "NAME")]
     entry: Option<String>,
-    /// HLSL: the entry point's stage when it has no `[shader(...)]`: a DXC
-    /// profile (`ps_6_5`, `cs_6_5`, `lib_6_3`) or a stage name.
-    #[arg(
-        short = 'T',
-        long = "stage",
-        value_name = "PROFILE",
-        requires = "entry"
-    )]
+    /// GLSL: the stage of files whose extension names none (`rgen`, `rchit`,
+    /// `rmiss`, `rahit`, `rint`, `rcall`, `comp`, …). HLSL (with -E): the
+    /// entry point's stage when it has no `[shader(...)]`, a DXC profile
+    /// (`ps_6_5`, `cs_6_5`, `lib_6_3`) or a stage name.
+    #[arg(short = 'T', long = "stage", value_name = "STAGE")]
     stage: Option<String>,
     /// HLSL: DXC's `-enable-16bit-types` (`half` is then 16-bit).
     #[arg(long = "enable-16bit-types")]
@@ -437,22 +434,33 @@ fn options(common: &Common) -> Result<lint::Options, String> {
             include_dirs: common.include.clone(),
             defines: common.define.iter().map(|d| split_define(d)).collect(),
             entry: common.entry.clone(),
-            stage: match common
-                .stage
-                .as_deref()
-                .map(rtlint::front::hlsl::parse_stage)
-            {
-                Some(Ok(s)) => s,
-                Some(Err(e)) => return Err(format!("-T: {e}")),
-                None => None,
+            stage: match (common.stage.as_deref(), &common.entry) {
+                (Some(s), Some(_)) if !is_glsl_stage(s) => {
+                    rtlint::front::hlsl::parse_stage(s).map_err(|e| format!("--stage: {e}"))?
+                }
+                (Some(s), None) if !is_glsl_stage(s) => {
+                    return Err(format!(
+                        "--stage `{s}`: a GLSL stage is one of {}; an HLSL profile or stage also needs -E ENTRY",
+                        rtlint::shader::GLSL_STAGES.join(", ")
+                    ))
+                }
+                _ => None,
             },
             enable_16bit_types: common.enable_16bit_types,
+            glsl_stage: common
+                .stage
+                .clone()
+                .filter(|s| is_glsl_stage(s)),
         },
         respect_gitignore: !common.no_gitignore,
         stdin,
         stdin_filename: common.stdin_filename.clone(),
         ..lint::Options::default()
     })
+}
+
+fn is_glsl_stage(s: &str) -> bool {
+    rtlint::shader::GLSL_STAGES.contains(&s)
 }
 
 fn split_define(d: &str) -> (String, String) {

@@ -197,3 +197,115 @@ void Hit(inout Payload p, in BuiltInTriangleIntersectionAttributes a) { p.color 
         assert_eq!(o.status.code(), Some(0), "{cmd}: {}", text(&o));
     }
 }
+
+const RAY_QUERY_HEADER: &str = "#extension GL_EXT_ray_query : require
+layout(binding = 0) uniform accelerationStructureEXT scene;
+float visible(vec3 o) {
+    rayQueryEXT q;
+    rayQueryInitializeEXT(q, scene, gl_RayFlagsTerminateOnFirstHitEXT, 0xFF, o, 0.0, vec3(0, 1, 0), 10.0);
+    while (rayQueryProceedEXT(q)) {}
+    return rayQueryGetIntersectionTypeEXT(q, true) == gl_RayQueryCommittedIntersectionNoneEXT ? 1.0 : 0.0;
+}
+";
+
+const RAY_QUERY_COMP: &str = "#version 460
+#extension GL_GOOGLE_include_directive : require
+#include \"rq.glsl\"
+layout(local_size_x = 8) in;
+layout(binding = 1) buffer Out { float v[]; } outv;
+void main() { outv.v[gl_GlobalInvocationID.x] = visible(vec3(gl_GlobalInvocationID)); }
+";
+
+/// Item 4: a `.comp` whose `rayQueryEXT` sits in an included file is a
+/// ray-query shader, named or found in a folder.
+#[test]
+fn glsl_ray_query_in_an_included_file() {
+    if !tool("glslangValidator") {
+        return;
+    }
+    let d = scratch("rq-include");
+    write(&d, "lib/rq.glsl", RAY_QUERY_HEADER);
+    write(&d, "shade.comp", RAY_QUERY_COMP);
+    write(
+        &d,
+        "plain.comp",
+        "#version 460\nlayout(local_size_x = 8) in;\nvoid main() {}\n",
+    );
+    let o = run_in(&d, &["check", "shade.comp", "-I", "lib"]);
+    let t = text(&o);
+    assert_eq!(o.status.code(), Some(0), "{t}");
+    assert!(t.contains("in 1 file"), "{t}");
+    // In a walk: linted; the compute shader without ray queries is not.
+    let o = run_in(&d, &["check", ".", "-I", "lib", "--verbose"]);
+    let t = text(&o);
+    assert_eq!(o.status.code(), Some(0), "{t}");
+    assert!(t.contains("skipped plain.comp"), "{t}");
+    assert!(!t.contains("skipped shade.comp"), "{t}");
+    assert!(t.contains("in 1 file"), "{t}");
+}
+
+/// Item 4: the stage of a GLSL file whose extension names none comes from
+/// `--stage` or `[stages]`; without one the error says how to give it
+/// (not glslang's usage text).
+#[test]
+fn glsl_stage_from_the_command_line_or_the_config() {
+    if !tool("glslangValidator") {
+        return;
+    }
+    let d = scratch("stage");
+    write(&d, "common.glsl", GLSL_HEADER);
+    write(&d, "hit.x", GLSL_HIT);
+    write(&d, "rtlint.toml", "[languages]\nx = \"glsl\"\n");
+    let o = run_in(&d, &["check", "hit.x"]);
+    let t = text(&o);
+    assert_eq!(o.status.code(), Some(2), "{t}");
+    assert!(t.contains("cannot tell the GLSL stage of `hit.x`"), "{t}");
+    assert!(t.contains("--stage") && t.contains("[stages]"), "{t}");
+    assert!(!t.contains("Usage"), "{t}");
+    // `--stage`.
+    let o = run_in(&d, &["check", "hit.x", "--stage", "rchit"]);
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o));
+    // `[stages]`, named and in a walk.
+    write(&d, "rtlint.toml", "[stages]\n\"*.x\" = \"rchit\"\n");
+    let o = run_in(&d, &["check", "hit.x"]);
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o));
+    let o = run_in(&d, &["check", ".", "--verbose"]);
+    let t = text(&o);
+    assert_eq!(o.status.code(), Some(0), "{t}");
+    assert!(
+        t.contains("in 1 file") && !t.contains("skipped hit.x"),
+        "{t}"
+    );
+    // An unknown stage, and an unknown language, list what is allowed.
+    write(&d, "rtlint.toml", "[stages]\n\"*.x\" = \"closest\"\n");
+    let t = text(&run_in(&d, &["check", "hit.x"]));
+    assert!(
+        t.contains("unknown GLSL stage `closest`") && t.contains("rchit"),
+        "{t}"
+    );
+    write(&d, "rtlint.toml", "[languages]\nx = \"glsl2\"\n");
+    let t = text(&run_in(&d, &["check", "hit.x"]));
+    assert!(t.contains("hlsl, wgsl, glsl or spirv"), "{t}");
+    // An HLSL profile without an entry point is refused, with the GLSL names.
+    let o = run_in(&d, &["check", "hit.x", "--stage", "ps_6_5"]);
+    assert_eq!(o.status.code(), Some(2), "{}", text(&o));
+    assert!(text(&o).contains("rchit"), "{}", text(&o));
+}
+
+/// Item 15: an input error without a position does not blame debug info
+/// (a missing path, a description, a config are not modules).
+#[test]
+fn positionless_input_errors_say_no_more_than_they_know() {
+    let d = scratch("positionless");
+    write(&d, "empty.pipeline.toml", "max_recursion_depth = 1\n");
+    for args in [
+        &["check", "nope.rgen"][..],
+        &["check", "empty.pipeline.toml"],
+    ] {
+        let o = run_in(&d, args);
+        let t = text(&o);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {t}");
+        assert!(!t.contains("debug info"), "{args:?}: {t}");
+        assert!(t.contains(&format!("= in {}", args[1])), "{args:?}: {t}");
+    }
+}

@@ -59,7 +59,21 @@ pub fn compile(
     text: &[u8],
     options: &FrontOptions,
 ) -> Result<(Vec<u32>, Option<PathBuf>), InputError> {
-    let ext = stage_extension(path).unwrap_or("glsl");
+    let ext = match options.glsl_stage.as_deref().or_else(|| stage_extension(path)) {
+        Some(ext) => ext,
+        // glslang would print its usage text.
+        None => {
+            return Err(InputError::new(
+                InputErrorKind::UnknownLanguage,
+                path,
+                format!(
+                    "cannot tell the GLSL stage of `{}`: name it with a stage extension (`.rchit`, or `name.rchit.glsl`), pass --stage, or give it under [stages] in rtlint.toml (one of {})",
+                    path.display(),
+                    crate::shader::GLSL_STAGES.join(", ")
+                ),
+            ))
+        }
+    };
     let dir = tempdir(path)?;
     // glslang reads a file: the text goes into one named like the input, so
     // the stage still follows from the extension.

@@ -44,6 +44,9 @@ pub struct FrontOptions {
     pub stage: Option<crate::shader::Stage>,
     /// HLSL: DXC's `-enable-16bit-types`.
     pub enable_16bit_types: bool,
+    /// GLSL: the stage (glslang's name, `rchit`) of a file whose extension
+    /// names none (`--stage`, or `[stages]` in rtlint.toml).
+    pub glsl_stage: Option<String>,
 }
 
 impl FrontOptions {
