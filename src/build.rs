@@ -178,7 +178,7 @@ impl Builder {
             .iter()
             .filter(|d| said_failing.insert(one_line(d)))
             .filter(|d| {
-                d.code.is_none()
+                d.is_input_error()
                     || d.severity == Severity::Error
                     || (outcome.deny_warnings && d.severity == Severity::Warning)
             })

@@ -84,6 +84,12 @@ pub struct Diagnostic {
 }
 
 impl Diagnostic {
+    /// An input error: no rule's finding, and not a note about an input
+    /// (a header nothing includes).
+    pub fn is_input_error(&self) -> bool {
+        self.code.is_none() && self.severity != Severity::Note
+    }
+
     pub fn new(
         severity: Severity,
         name: &'static str,
@@ -197,6 +203,9 @@ pub enum InputErrorKind {
     HlslUnsupported,
     /// glslang rejects the GLSL.
     GlslError,
+    /// an HLSL file declares no entry point: a header when another linted
+    /// file includes it (then dropped), else reported as a note.
+    NoEntryPoint,
     /// `stack --driver`: the device could not create the pipeline (the
     /// driver failed or crashed, or the validation layer objected).
     DriverFailed,
@@ -219,6 +228,7 @@ impl InputErrorKind {
         InputErrorKind::HlslUnsupported,
         InputErrorKind::GlslError,
         InputErrorKind::DriverFailed,
+        InputErrorKind::NoEntryPoint,
     ];
 
     pub fn as_str(self) -> &'static str {
@@ -238,6 +248,7 @@ impl InputErrorKind {
             InputErrorKind::HlslUnsupported => "hlsl-unsupported",
             InputErrorKind::GlslError => "glsl-error",
             InputErrorKind::DriverFailed => "driver-failed",
+            InputErrorKind::NoEntryPoint => "no-entry-point",
         }
     }
 }
@@ -288,24 +299,33 @@ impl std::error::Error for InputError {}
 pub fn read_text(path: &Path) -> Result<String, InputError> {
     let bytes = std::fs::read(path).map_err(|e| io_error(path, &e))?;
     // The bytes become the text, not a copy of them.
-    String::from_utf8(bytes).map_err(|e| not_utf8(path, e.utf8_error()))
+    String::from_utf8(bytes).map_err(|e| not_utf8(path, e.as_bytes(), e.utf8_error()))
 }
 
 /// Input bytes as UTF-8 text; anything else is an input error.
 pub fn text_from_bytes(bytes: &[u8], path: &Path) -> Result<String, InputError> {
     match std::str::from_utf8(bytes) {
         Ok(text) => Ok(text.to_string()),
-        Err(e) => Err(not_utf8(path, e)),
+        Err(e) => Err(not_utf8(path, bytes, e)),
     }
 }
 
-fn not_utf8(path: &Path, e: std::str::Utf8Error) -> InputError {
+/// The first bad byte by line and column (what an editor shows), not by
+/// offset.
+fn not_utf8(path: &Path, bytes: &[u8], e: std::str::Utf8Error) -> InputError {
     let offset = e.valid_up_to();
+    // Everything before the bad byte is valid UTF-8.
+    let before = std::str::from_utf8(&bytes[..offset]).unwrap_or_default();
+    let (line, column) = crate::shader::line_col(before, offset);
     InputError::new(
         InputErrorKind::InvalidUtf8,
         path,
-        format!("file is not valid UTF-8 (byte offset {offset})"),
+        format!(
+            "file is not valid UTF-8: byte 0x{:02x} at line {line}, column {column}",
+            bytes[offset]
+        ),
     )
+    .at(Location::point(path, line, column), "not UTF-8")
 }
 
 pub fn io_error(path: &Path, e: &std::io::Error) -> InputError {
@@ -343,6 +363,7 @@ mod tests {
                 "hlsl-unsupported",
                 "glsl-error",
                 "driver-failed",
+                "no-entry-point",
             ]
         );
         for (i, a) in names.iter().enumerate() {

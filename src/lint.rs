@@ -125,7 +125,7 @@ pub struct Report {
 impl Report {
     /// 0 clean, 1 findings at the failing level, 2 input errors.
     pub fn exit_code(&self) -> u8 {
-        if self.diagnostics.iter().any(|d| d.code.is_none()) {
+        if self.diagnostics.iter().any(Diagnostic::is_input_error) {
             2
         } else if self.diagnostics.iter().any(|d| {
             d.severity == Severity::Error || (self.deny_warnings && d.severity == Severity::Warning)
@@ -276,6 +276,7 @@ pub fn check_paths(paths: &[PathBuf], options: &Options) -> Report {
             }
         }
     }
+    settle_headers(&mut diagnostics, owned.iter());
     let pipelines: Vec<Checked> = inputs
         .pipelines
         .par_iter()
@@ -370,6 +371,35 @@ pub fn load_library(input: &Input, options: &Options) -> Result<(Program, Subobj
     let front_options = input_options(input, options);
     let contents = input.contents.as_deref().map(|v| v.as_slice());
     front::load_library(&input.path, contents, input.language, &front_options)
+}
+
+/// An HLSL file without an entry point is a header: when a file another
+/// input read (`included`) is one, its error goes (its contents were linted
+/// through its includers); otherwise the error becomes a note, since a
+/// header nothing includes is no input error.
+pub fn settle_headers<'a>(
+    diagnostics: &mut Vec<Diagnostic>,
+    included: impl Iterator<Item = &'a PathBuf>,
+) {
+    let no_entry = InputErrorKind::NoEntryPoint.as_str();
+    if !diagnostics.iter().any(|d| d.name == no_entry) {
+        return;
+    }
+    let included: HashSet<PathBuf> = included.map(|p| canonical(p)).collect();
+    diagnostics.retain_mut(|d| {
+        if d.name != no_entry || d.code.is_some() {
+            return true;
+        }
+        if included.contains(&canonical(&d.file)) {
+            return false;
+        }
+        d.severity = Severity::Note;
+        d.message = "no entry point, and no linted file includes it: nothing to lint".into();
+        d.help = Some(
+            "mark an entry point with [shader(\"...\")] or [numthreads(...)], or lint the shaders that include it".into(),
+        );
+        true
+    });
 }
 
 /// Loads a pipeline description, compiling the shaders it names with the

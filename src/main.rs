@@ -639,6 +639,12 @@ fn load(common: &Common) -> Result<Loaded, String> {
             Err(InputError(d)) => problems.push(*d),
         }
     }
+    lint::settle_headers(
+        &mut problems,
+        programs
+            .iter()
+            .flat_map(|p| p.files.iter().map(|f| &f.path)),
+    );
     Ok(Loaded {
         programs,
         subobjects,
@@ -849,7 +855,11 @@ fn print_report(
         Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => return Ok(0),
         Err(e) => return Err(format!("cannot write output: {e}")),
     }
-    Ok(if problems.is_empty() { 0 } else { 2 })
+    Ok(if problems.iter().any(Diagnostic::is_input_error) {
+        2
+    } else {
+        0
+    })
 }
 
 /// `rtlint compile`'s HLSL options; `Err` is a bad `-T`.

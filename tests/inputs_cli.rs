@@ -309,3 +309,54 @@ fn positionless_input_errors_say_no_more_than_they_know() {
         assert!(t.contains(&format!("= in {}", args[1])), "{args:?}: {t}");
     }
 }
+
+/// Item 3: a `.hlsl` file without an entry point that another linted file
+/// includes is a header, linted through its includer; one that nothing
+/// includes gets a note, not an input error.
+#[test]
+fn hlsl_headers_without_entry_points() {
+    let d = scratch("hlsl-header");
+    write(
+        &d,
+        "common.hlsl",
+        "struct Payload { float4 color; };\nfloat3 Tint() { return float3(1, 0, 0); }\n",
+    );
+    write(
+        &d,
+        "hit.hlsl",
+        "#include \"common.hlsl\"
+[shader(\"closesthit\")]
+void Hit(inout Payload p, in BuiltInTriangleIntersectionAttributes a) { p.color = float4(Tint(), 1); }
+",
+    );
+    for args in [
+        &["check", "."][..],
+        &["check", "hit.hlsl", "common.hlsl"],
+        &["stack", "."],
+    ] {
+        let o = run_in(&d, args);
+        let t = text(&o);
+        assert_eq!(o.status.code(), Some(0), "{args:?}: {t}");
+        assert!(!t.contains("entry point"), "{args:?}: {t}");
+    }
+    write(&d, "lonely.hlsl", "float Lonely() { return 1; }\n");
+    for args in [
+        &["check", "."][..],
+        &["check", "lonely.hlsl"],
+        &["stack", "."],
+    ] {
+        let o = run_in(&d, args);
+        let t = text(&o);
+        assert_eq!(o.status.code(), Some(0), "{args:?}: {t}");
+        assert!(t.contains("note: no entry point"), "{args:?}: {t}");
+        assert!(t.contains("lonely.hlsl"), "{args:?}: {t}");
+    }
+    let o = run_in(&d, &["check", ".", "--format", "json"]);
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(v["summary"]["input_errors"], 0, "{v}");
+    assert_eq!(v["diagnostics"][0]["severity"], "note", "{v}");
+    assert_eq!(v["diagnostics"][0]["name"], "no-entry-point", "{v}");
+    // An entry point asked for by name and missing is still an error.
+    let o = run_in(&d, &["check", "hit.hlsl", "-E", "Nope", "-T", "closesthit"]);
+    assert_eq!(o.status.code(), Some(2), "{}", text(&o));
+}

@@ -194,13 +194,18 @@ fn entry_indices(
         None => all,
     };
     if picked.is_empty() {
-        let msg = match &options.entry {
-            Some(name) => format!("no entry point named `{name}`"),
-            None => {
-                "no entry points: mark one with [shader(\"...\")] or [numthreads(...)], or name it with its stage (-E main -T ps_6_5)".to_string()
-            }
-        };
-        return Err(InputError::new(InputErrorKind::HlslError, path, msg));
+        return Err(match &options.entry {
+            Some(name) => InputError::new(
+                InputErrorKind::HlslError,
+                path,
+                format!("no entry point named `{name}`"),
+            ),
+            None => InputError::new(
+                InputErrorKind::NoEntryPoint,
+                path,
+                "no entry points: mark one with [shader(\"...\")] or [numthreads(...)], or name it with its stage (-E main -T ps_6_5)",
+            ),
+        });
     }
     Ok(picked)
 }
