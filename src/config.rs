@@ -21,17 +21,48 @@ pub struct SourceOptions {
 }
 
 /// One rule's entry under `[rules]`.
-#[derive(Clone, Debug, PartialEq, serde::Deserialize)]
-#[serde(untagged)]
+#[derive(Clone, Debug, PartialEq)]
 pub enum RuleSetting {
     Level(Level),
     Table {
-        #[serde(default)]
         level: Option<Level>,
         /// The rule's own options; the rule says which it reads.
-        #[serde(flatten)]
         options: BTreeMap<String, toml::Value>,
     },
+}
+
+/// By hand: serde's untagged enums answer a bad value with "did not match
+/// any variant of untagged enum RuleSetting"; a user needs the levels.
+impl<'de> serde::Deserialize<'de> for RuleSetting {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        use serde::de::Error;
+        let level = |v: &toml::Value| -> Result<Level, D::Error> {
+            match v.as_str() {
+                Some("allow") => Ok(Level::Allow),
+                Some("warn") => Ok(Level::Warn),
+                Some("error") => Ok(Level::Error),
+                Some(other) => Err(D::Error::custom(format!(
+                    "unknown level `{other}`: expected \"allow\", \"warn\" or \"error\""
+                ))),
+                None => Err(D::Error::custom(
+                    "a rule's level is \"allow\", \"warn\" or \"error\"",
+                )),
+            }
+        };
+        match toml::Value::deserialize(d)? {
+            v @ toml::Value::String(_) => level(&v).map(RuleSetting::Level),
+            toml::Value::Table(mut t) => {
+                let level = t.remove("level").map(|v| level(&v)).transpose()?;
+                Ok(RuleSetting::Table {
+                    level,
+                    options: t.into_iter().collect(),
+                })
+            }
+            _ => Err(D::Error::custom(
+                "expected a level (\"allow\", \"warn\" or \"error\") or a table of the rule's options",
+            )),
+        }
+    }
 }
 
 impl RuleSetting {

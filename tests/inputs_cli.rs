@@ -360,3 +360,41 @@ void Hit(inout Payload p, in BuiltInTriangleIntersectionAttributes a) { p.color 
     let o = run_in(&d, &["check", "hit.hlsl", "-E", "Nope", "-T", "closesthit"]);
     assert_eq!(o.status.code(), Some(2), "{}", text(&o));
 }
+
+/// Item 15: a bad rule level in rtlint.toml lists the allowed values, not
+/// serde's "untagged enum RuleSetting".
+#[test]
+fn bad_rule_level_lists_the_levels() {
+    let d = scratch("level");
+    write(&d, "lonely.hlsl", "float Lonely() { return 1; }\n");
+    for setting in [
+        "RT001 = \"loud\"",
+        "[rules.RT001]\nlevel = \"loud\"",
+        "RT001 = 3",
+    ] {
+        write(&d, "rtlint.toml", &format!("[rules]\n{setting}\n"));
+        let o = run_in(&d, &["check", "lonely.hlsl"]);
+        let t = text(&o);
+        assert_eq!(o.status.code(), Some(2), "{setting}: {t}");
+        assert!(
+            t.contains("\"allow\", \"warn\" or \"error\""),
+            "{setting}: {t}"
+        );
+        assert!(
+            !t.contains("untagged") && !t.contains("RuleSetting"),
+            "{setting}: {t}"
+        );
+        assert!(
+            t.contains("rtlint.toml:2:") || t.contains("rtlint.toml:3:"),
+            "{setting}: {t}"
+        );
+    }
+    // A table with a level and the rule's options still reads.
+    write(
+        &d,
+        "rtlint.toml",
+        "[rules.RT001]\nlevel = \"error\"\nbudget = 8\n",
+    );
+    let o = run_in(&d, &["check", "lonely.hlsl"]);
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o));
+}
