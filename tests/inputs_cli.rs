@@ -398,3 +398,54 @@ fn bad_rule_level_lists_the_levels() {
     let o = run_in(&d, &["check", "lonely.hlsl"]);
     assert_eq!(o.status.code(), Some(0), "{}", text(&o));
 }
+
+const WGSL_OVERRIDES: &str = "enable wgpu_ray_query;
+override max_dist: f32 = 100.0;
+override samples: u32;
+@group(0) @binding(0) var acc: acceleration_structure;
+@group(0) @binding(1) var<storage, read_write> out: array<f32>;
+@compute @workgroup_size(8)
+fn main(@builtin(global_invocation_id) id: vec3<u32>) {
+    var rq: ray_query;
+    rayQueryInitialize(&rq, acc, RayDesc(0u, 0xFFu, 0.0, max_dist, vec3<f32>(0.0), vec3<f32>(0.0, 1.0, 0.0)));
+    rayQueryProceed(&rq);
+    let hit = rayQueryGetCommittedIntersection(&rq);
+    out[id.x] = hit.t * f32(samples);
+}
+";
+
+/// Item 5: WGSL `override`s are evaluated as a pipeline would: `-D` (or the
+/// config's defines) by name, else the default; one with neither is an
+/// error at its declaration. Findings keep their lines.
+#[test]
+fn wgsl_overrides_take_defaults_or_defines() {
+    let d = scratch("overrides");
+    write(&d, "rq.wgsl", WGSL_OVERRIDES);
+    let o = run_in(&d, &["check", "rq.wgsl"]);
+    let t = text(&o);
+    assert_eq!(o.status.code(), Some(2), "{t}");
+    assert!(t.contains("override `samples` has no default value"), "{t}");
+    assert!(t.contains("rq.wgsl:3:10"), "{t}");
+    let o = run_in(
+        &d,
+        &[
+            "check",
+            "rq.wgsl",
+            "-D",
+            "samples=4",
+            "--select",
+            "RT062",
+            "--format",
+            "concise",
+        ],
+    );
+    let t = text(&o);
+    assert_eq!(o.status.code(), Some(0), "{t}");
+    assert!(t.contains("rq.wgsl:10:5: warning[RT062]"), "{t}");
+    write(&d, "rtlint.toml", "[hlsl.defines]\nsamples = \"2\"\n");
+    let o = run_in(&d, &["check", "rq.wgsl"]);
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o));
+    let o = run_in(&d, &["check", "rq.wgsl", "-D", "samples=many"]);
+    assert_eq!(o.status.code(), Some(2), "{}", text(&o));
+    assert!(text(&o).contains("`many` is not a number"), "{}", text(&o));
+}

@@ -93,7 +93,12 @@ pub fn compile_input(
     match language {
         Language::Wgsl => {
             let text = text()?;
-            let (mut module, info) = wgsl::parse(&text, path)?;
+            let (mut module, mut info) = wgsl::parse(&text, path)?;
+            if let Some((m, i)) =
+                wgsl::apply_overrides(&module, &info, &text, &options.defines, path)?
+            {
+                (module, info) = (m, i);
+            }
             let words = wgsl::write_spirv(&mut module, &info, &text, path)?;
             Ok(compiled(
                 Language::Wgsl,
