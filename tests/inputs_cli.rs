@@ -449,3 +449,77 @@ fn wgsl_overrides_take_defaults_or_defines() {
     assert_eq!(o.status.code(), Some(2), "{}", text(&o));
     assert!(text(&o).contains("`many` is not a number"), "{}", text(&o));
 }
+
+const COMPOSED_LIB: &str = "#define_import_path my::rays
+enable wgpu_ray_query;
+
+const MAX_T: f32 = 100.0;
+
+fn up() -> vec3<f32> {
+    return vec3<f32>(0.0, 1.0, 0.0);
+}
+";
+
+const COMPOSED_SHADER: &str = "enable wgpu_ray_query;
+#import my::rays::{MAX_T, up}
+
+@group(0) @binding(0) var acc: acceleration_structure;
+@group(0) @binding(1) var<storage, read_write> out: array<f32>;
+
+@compute @workgroup_size(8)
+fn main(@builtin(global_invocation_id) id: vec3<u32>) {
+    var rq: ray_query;
+#ifdef OPAQUE
+    let flags = 1u;
+#else
+    let flags = 0u;
+#endif
+    rayQueryInitialize(&rq, acc, RayDesc(flags, 0xFFu, 0.0, MAX_T, vec3<f32>(0.0), up()));
+    rayQueryProceed(&rq);
+    out[id.x] = rayQueryGetCommittedIntersection(&rq).t;
+}
+";
+
+/// Item 5: WGSL written for naga_oil (`#import`, `#define_import_path`,
+/// `#ifdef`) is composed with the modules found beside it or under `-I`,
+/// with `-D` as shader defs; findings land on the shader's own lines.
+#[test]
+fn wgsl_composed_with_naga_oil() {
+    let d = scratch("compose");
+    write(&d, "lib/rays.wgsl", COMPOSED_LIB);
+    write(&d, "shaders/shade.wgsl", COMPOSED_SHADER);
+    let args = ["--select", "RT062", "--format", "concise"];
+    let o = run_in(
+        &d,
+        &[&["check", "shaders/shade.wgsl", "-I", "lib"][..], &args].concat(),
+    );
+    let t = text(&o);
+    assert_eq!(o.status.code(), Some(0), "{t}");
+    assert!(t.contains("shaders/shade.wgsl:16:5: warning[RT062]"), "{t}");
+    // The `#ifdef` branch a define picks: an opaque ray, no finding.
+    let o = run_in(
+        &d,
+        &[
+            &["check", "shaders/shade.wgsl", "-I", "lib", "-D", "OPAQUE"][..],
+            &args,
+        ]
+        .concat(),
+    );
+    let t = text(&o);
+    assert_eq!(o.status.code(), Some(0), "{t}");
+    assert!(!t.contains("RT062"), "{t}");
+    // Found beside the shader (below its folder) as well.
+    std::fs::rename(d.join("lib"), d.join("shaders/lib")).unwrap();
+    let o = run_in(
+        &d.join("shaders"),
+        &[&["check", "shade.wgsl"][..], &args].concat(),
+    );
+    let t = text(&o);
+    assert!(t.contains("shade.wgsl:16:5: warning[RT062]"), "{t}");
+    // A module nobody provides: an error naming the import.
+    std::fs::remove_dir_all(d.join("shaders/lib")).unwrap();
+    let o = run_in(&d, &["check", "shaders/shade.wgsl"]);
+    let t = text(&o);
+    assert_eq!(o.status.code(), Some(2), "{t}");
+    assert!(t.contains("my::rays"), "{t}");
+}

@@ -2,6 +2,8 @@
 //! (`OpString`/`OpLine`, or `NonSemantic.Shader.DebugInfo.100`) leads back to the
 //! original source.
 
+#[cfg(feature = "naga-oil")]
+pub mod compose;
 pub mod glsl;
 pub mod hlsl;
 pub mod wgsl;
@@ -93,7 +95,8 @@ pub fn compile_input(
     match language {
         Language::Wgsl => {
             let text = text()?;
-            let (mut module, mut info) = wgsl::parse(&text, path)?;
+            let (mut module, mut info) =
+                wgsl::parse_composed(&text, path, &options.include_dirs, &options.defines)?;
             if let Some((m, i)) =
                 wgsl::apply_overrides(&module, &info, &text, &options.defines, path)?
             {

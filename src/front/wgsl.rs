@@ -319,6 +319,61 @@ fn guard<T>(
     })
 }
 
+/// Whether `source` uses naga_oil's preprocessor directives.
+pub fn is_composable(source: &str) -> bool {
+    source.lines().any(|l| {
+        let l = l.trim_start();
+        l.strip_prefix('#').is_some_and(|d| {
+            let d = d.trim_start();
+            [
+                "import",
+                "define_import_path",
+                "ifdef",
+                "ifndef",
+                "if ",
+                "else",
+                "endif",
+                "define ",
+            ]
+            .iter()
+            .any(|k| d.starts_with(k))
+        })
+    })
+}
+
+/// WGSL written for composition (`#import`, `#ifdef`…): composed by
+/// naga_oil from the modules in `include_dirs` and the file's folder, with
+/// `defines`; then validated as [`parse`] does. Other WGSL: [`parse`].
+pub fn parse_composed(
+    source: &str,
+    path: &Path,
+    include_dirs: &[std::path::PathBuf],
+    defines: &[(String, String)],
+) -> Result<(naga::Module, naga::valid::ModuleInfo), InputError> {
+    if !is_composable(source) {
+        return parse(source, path);
+    }
+    #[cfg(not(feature = "naga-oil"))]
+    {
+        let _ = (include_dirs, defines);
+        Err(InputError::new(
+            InputErrorKind::UnsupportedLanguage,
+            path,
+            "this WGSL is written for naga_oil composition (`#import`, `#ifdef`): build rtlint with the `naga-oil` feature",
+        ))
+    }
+    #[cfg(feature = "naga-oil")]
+    deep(source, path, || {
+        guard(path, "compose", || {
+            let module = super::compose::compose(source, path, include_dirs, defines)?;
+            let info = Validator::new(ValidationFlags::all(), Capabilities::all())
+                .validate(&module)
+                .map_err(|e| validation_error(path, source, &e))?;
+            Ok((module, info))
+        })
+    })
+}
+
 fn parse_unguarded(
     source: &str,
     path: &Path,
