@@ -523,3 +523,78 @@ fn wgsl_composed_with_naga_oil() {
     assert_eq!(o.status.code(), Some(2), "{t}");
     assert!(t.contains("my::rays"), "{t}");
 }
+
+/// Item 16: a trace written over several lines is reported on the line its
+/// name is on and spans the call; GLSL positions (glslang `-g` has no
+/// columns) get one in every format; HLSL trace regions have a width.
+#[test]
+fn trace_positions_start_at_the_call_and_have_a_width() {
+    if !tool("glslangValidator") {
+        return;
+    }
+    let d = scratch("positions");
+    write(
+        &d,
+        "gen.rgen",
+        "#version 460
+#extension GL_EXT_ray_tracing : require
+struct Payload { vec4 a; vec4 b; vec4 c; vec4 d; vec4 e; };
+layout(binding = 0) uniform accelerationStructureEXT scene;
+layout(location = 0) rayPayloadEXT Payload p;
+void main() {
+    traceRayEXT(scene, 0, 0xFF, 0, 1, 0,
+                vec3(0.0), 0.0,
+                vec3(0.0, 0.0, 1.0), 100.0,
+                0);
+}
+",
+    );
+    let o = run_in(&d, &["live", "gen.rgen"]);
+    let t = text(&o);
+    assert!(t.starts_with("gen.rgen:7:5: trace_ray"), "{t}");
+    let o = run_in(&d, &["check", "gen.rgen", "--format", "sarif"]);
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let region = &v["runs"][0]["results"][0]["relatedLocations"][0]["physicalLocation"]["region"];
+    assert_eq!(region["startLine"], 7, "{region}");
+    assert_eq!(region["startColumn"], 5, "{region}");
+    assert_eq!(region["endLine"], 10, "{region}");
+    assert_eq!(region["endColumn"], 19, "{region}");
+    // A GLSL line without a column from glslang, in concise output.
+    let o = rtlint()
+        .args([
+            "check",
+            "fixtures/RT010/bad.rgen",
+            "--format",
+            "concise",
+            "--select",
+            "RT010",
+        ])
+        .output()
+        .unwrap();
+    assert!(
+        text(&o).contains("fixtures/RT010/bad.rgen:19:5: warning[RT010]"),
+        "{}",
+        text(&o)
+    );
+    // An HLSL trace's region is the call, not a point.
+    let o = rtlint()
+        .args([
+            "check",
+            "fixtures/RT030/bad.hlsl",
+            "--format",
+            "json",
+            "--select",
+            "RT030",
+        ])
+        .output()
+        .unwrap();
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let f = &v["diagnostics"][0];
+    assert_eq!(f["code"], "RT030", "{v}");
+    assert_eq!(
+        (f["line"].as_u64(), f["end_line"].as_u64()),
+        (Some(30), Some(30)),
+        "{f}"
+    );
+    assert!(f["end_column"].as_u64() > f["column"].as_u64(), "{f}");
+}
