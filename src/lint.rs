@@ -396,7 +396,7 @@ pub fn settle_headers<'a>(
         d.severity = Severity::Note;
         d.message = "no entry point, and no linted file includes it: nothing to lint".into();
         d.help = Some(
-            "mark an entry point with [shader(\"...\")] or [numthreads(...)], or lint the shaders that include it".into(),
+            "mark an entry point with [shader(\"...\")] or [numthreads(...)], name one with its stage (-E main -T ps_6_5), or lint the shaders that include it".into(),
         );
         true
     });

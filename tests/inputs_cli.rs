@@ -598,3 +598,59 @@ void main() {
     );
     assert!(f["end_column"].as_u64() > f["column"].as_u64(), "{f}");
 }
+
+/// Item 16: RT010's "defined here" labels sit under the variable, and
+/// `rtlint live` names an HLSL traced payload by its variable.
+#[test]
+fn hlsl_live_values_and_payloads_by_their_names() {
+    let d = scratch("live-names");
+    write(
+        &d,
+        "gen.hlsl",
+        "struct Payload { float4 color; };
+RaytracingAccelerationStructure scene : register(t0);
+RWTexture2D<float4> img : register(u0);
+cbuffer C : register(b0) { uint n; };
+Texture2D<float4> tex : register(t1);
+SamplerState smp : register(s0);
+[shader(\"raygeneration\")]
+void Gen() {
+    float4 acc = float4(0, 0, 0, 0);
+    for (uint i = 0; i < n; i++) {
+        acc += tex.SampleLevel(smp, float2(i, 0), 0);
+    }
+    float3 dir = normalize(acc.xyz);
+    RayDesc ray = { float3(0, 0, 0), 0.001, dir, 100.0 };
+    Payload primary = { float4(0, 0, 0, 0) };
+    TraceRay(scene, RAY_FLAG_NONE, 0xFF, 0, 1, 0, ray, primary);
+    img[DispatchRaysIndex().xy] = primary.color * acc + float4(dir, 1);
+}
+",
+    );
+    write(&d, "rtlint.toml", "[rules.RT010]\nbudget = 8\n");
+    let o = run_in(
+        &d,
+        &["check", "gen.hlsl", "--select", "RT010", "--format", "json"],
+    );
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let labels = v["diagnostics"][0]["labels"]
+        .as_array()
+        .cloned()
+        .unwrap_or_default();
+    let at = |name: &str| {
+        labels
+            .iter()
+            .find(|l| {
+                l["message"]
+                    .as_str()
+                    .unwrap_or("")
+                    .starts_with(&format!("`{name}`"))
+            })
+            .map(|l| (l["line"].as_u64(), l["column"].as_u64()))
+    };
+    assert_eq!(at("acc"), Some((Some(9), Some(12))), "{v}");
+    assert_eq!(at("dir"), Some((Some(13), Some(12))), "{v}");
+    let o = run_in(&d, &["live", "gen.hlsl"]);
+    let t = text(&o);
+    assert!(t.contains("payload `primary`: Payload"), "{t}");
+}

@@ -53,6 +53,54 @@ pub(super) fn refine(p: &mut Program) {
     }
 }
 
+impl Program {
+    /// Where `name` is on the line of `at` (its definition there, `name =`,
+    /// before any other use), as a span of the name: a value's label sits
+    /// under the variable, not under the call that computes it.
+    pub fn name_location(
+        &self,
+        at: &crate::diag::Location,
+        name: &str,
+    ) -> Option<crate::diag::Location> {
+        let file = self.files.iter().find(|f| f.path == at.path)?;
+        let text = match &file.text {
+            Some(t) => std::borrow::Cow::Borrowed(t.as_str()),
+            None => std::borrow::Cow::Owned(std::fs::read_to_string(&file.path).ok()?),
+        };
+        let line = text.lines().nth((at.line as usize).checked_sub(1)?)?;
+        let code = line.split("//").next().unwrap_or(line);
+        let word = |c: char| c.is_alphanumeric() || c == '_';
+        let mut found: Vec<usize> = Vec::new();
+        let mut from = 0;
+        while let Some(i) = code[from..].find(name) {
+            let s = from + i;
+            from = s + name.len();
+            let before = code[..s].chars().next_back().is_none_or(|c| !word(c));
+            let after = code[from..].chars().next().is_none_or(|c| !word(c));
+            if before && after && !name.is_empty() {
+                found.push(s);
+            }
+        }
+        let defines = |&s: &usize| {
+            let rest = code[s + name.len()..].trim_start();
+            let rest = rest.trim_start_matches(['+', '-', '*', '/', '|', '&', '^', '%']);
+            rest.starts_with('=') && !rest.starts_with("==")
+        };
+        let s = found
+            .iter()
+            .copied()
+            .find(defines)
+            .or_else(|| found.first().copied())?;
+        let col = code[..s].chars().count() as u32 + 1;
+        Some(crate::diag::Location::span(
+            at.path.clone(),
+            at.line,
+            col,
+            name.chars().count() as u32,
+        ))
+    }
+}
+
 /// A position without a column: from the line's first to its last
 /// character that is not blank.
 fn whole_line(text: &[&str], pos: &mut SrcPos) {
