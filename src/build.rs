@@ -700,6 +700,39 @@ mod tests {
         let _ = std::fs::remove_dir_all(&out);
     }
 
+    /// `.include_dir()` and `.define()` reach the shaders a pipeline
+    /// description names, as they reach every other input.
+    #[test]
+    fn include_dirs_and_defines_reach_described_shaders() {
+        let dir = scratch("described");
+        std::fs::create_dir_all(dir.join("inc")).unwrap();
+        std::fs::create_dir_all(dir.join("shaders")).unwrap();
+        std::fs::write(
+            dir.join("inc/common.hlsli"),
+            "struct Payload { float4 color; };\n",
+        )
+        .unwrap();
+        std::fs::write(
+            dir.join("shaders/gen.hlsl"),
+            "#include \"common.hlsli\"\n#ifndef COLOR\n#error COLOR is not defined\n#endif\nRaytracingAccelerationStructure scene : register(t0);\n[shader(\"raygeneration\")]\nvoid Gen() {\n    RayDesc ray = { float3(0, 0, 0), 0.0, float3(0, 0, 1), 100.0 };\n    Payload p = { float4(0, 0, 0, COLOR) };\n    TraceRay(scene, 0, 0xFF, 0, 1, 0, ray, p);\n}\n",
+        )
+        .unwrap();
+        std::fs::write(
+            dir.join("shaders/scene.pipeline.toml"),
+            "max_recursion_depth = 1\n[[raygen]]\nfile = \"gen.hlsl\"\nentry = \"Gen\"\n",
+        )
+        .unwrap();
+        let (_, r) = run(Builder::new()
+            .shaders(dir.join("shaders"))
+            .include_dir(dir.join("inc"))
+            .define("COLOR", "1")
+            .out_dir(&dir));
+        r.unwrap();
+        // Without them the description's shader fails: the test is not empty.
+        let (_, r) = run(Builder::new().shaders(dir.join("shaders")).out_dir(&dir));
+        assert!(r.is_err());
+    }
+
     #[test]
     fn bad_hlsl_fails_with_file_and_position() {
         let dir = scratch("bad");
