@@ -195,7 +195,7 @@ impl Builder {
             .iter()
             .filter(|d| said_failing.insert(one_line(d)))
             .filter(|d| {
-                d.code.is_none()
+                d.is_input_error()
                     || d.severity == Severity::Error
                     || (outcome.deny_warnings && d.severity == Severity::Warning)
             })
@@ -224,6 +224,7 @@ impl Builder {
                 include_dirs: self.include_dirs.clone(),
                 defines: self.defines.clone(),
                 hlsl: self.vulkan_hlsl(),
+                glsl_stage: None,
             },
             ..lint::Options::default()
         }
@@ -294,10 +295,10 @@ impl Builder {
             }
             programs.push(program);
         }
-        for p in &report.pipelines {
+        for (p, config) in &inputs.pipelines {
             run.rerun(p);
             // The shaders a description names, wherever they are.
-            if let Ok(pipeline) = crate::pipeline::load(p) {
+            if let Ok(pipeline) = lint::load_pipeline(p, config, &options) {
                 for program in &pipeline.programs {
                     run.rerun(&program.path);
                     run.rerun_files_of(program);
@@ -750,6 +751,39 @@ mod tests {
             "{text}"
         );
         let _ = std::fs::remove_dir_all(&out);
+    }
+
+    /// `.include_dir()` and `.define()` reach the shaders a pipeline
+    /// description names, as they reach every other input.
+    #[test]
+    fn include_dirs_and_defines_reach_described_shaders() {
+        let dir = scratch("described");
+        std::fs::create_dir_all(dir.join("inc")).unwrap();
+        std::fs::create_dir_all(dir.join("shaders")).unwrap();
+        std::fs::write(
+            dir.join("inc/common.hlsli"),
+            "struct Payload { float4 color; };\n",
+        )
+        .unwrap();
+        std::fs::write(
+            dir.join("shaders/gen.hlsl"),
+            "#include \"common.hlsli\"\n#ifndef COLOR\n#error COLOR is not defined\n#endif\nRaytracingAccelerationStructure scene : register(t0);\n[shader(\"raygeneration\")]\nvoid Gen() {\n    RayDesc ray = { float3(0, 0, 0), 0.0, float3(0, 0, 1), 100.0 };\n    Payload p = { float4(0, 0, 0, COLOR) };\n    TraceRay(scene, 0, 0xFF, 0, 1, 0, ray, p);\n}\n",
+        )
+        .unwrap();
+        std::fs::write(
+            dir.join("shaders/scene.pipeline.toml"),
+            "max_recursion_depth = 1\n[[raygen]]\nfile = \"gen.hlsl\"\nentry = \"Gen\"\n",
+        )
+        .unwrap();
+        let (_, r) = run(Builder::new()
+            .shaders(dir.join("shaders"))
+            .include_dir(dir.join("inc"))
+            .define("COLOR", "1")
+            .out_dir(&dir));
+        r.unwrap();
+        // Without them the description's shader fails: the test is not empty.
+        let (_, r) = run(Builder::new().shaders(dir.join("shaders")).out_dir(&dir));
+        assert!(r.is_err());
     }
 
     #[test]

@@ -39,17 +39,48 @@ impl SourceOptions {
 }
 
 /// One rule's entry under `[rules]`.
-#[derive(Clone, Debug, PartialEq, serde::Deserialize)]
-#[serde(untagged)]
+#[derive(Clone, Debug, PartialEq)]
 pub enum RuleSetting {
     Level(Level),
     Table {
-        #[serde(default)]
         level: Option<Level>,
         /// The rule's own options; the rule says which it reads.
-        #[serde(flatten)]
         options: BTreeMap<String, toml::Value>,
     },
+}
+
+/// By hand: serde's untagged enums answer a bad value with "did not match
+/// any variant of untagged enum RuleSetting"; a user needs the levels.
+impl<'de> serde::Deserialize<'de> for RuleSetting {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        use serde::de::Error;
+        let level = |v: &toml::Value| -> Result<Level, D::Error> {
+            match v.as_str() {
+                Some("allow") => Ok(Level::Allow),
+                Some("warn") => Ok(Level::Warn),
+                Some("error") => Ok(Level::Error),
+                Some(other) => Err(D::Error::custom(format!(
+                    "unknown level `{other}`: expected \"allow\", \"warn\" or \"error\""
+                ))),
+                None => Err(D::Error::custom(
+                    "a rule's level is \"allow\", \"warn\" or \"error\"",
+                )),
+            }
+        };
+        match toml::Value::deserialize(d)? {
+            v @ toml::Value::String(_) => level(&v).map(RuleSetting::Level),
+            toml::Value::Table(mut t) => {
+                let level = t.remove("level").map(|v| level(&v)).transpose()?;
+                Ok(RuleSetting::Table {
+                    level,
+                    options: t.into_iter().collect(),
+                })
+            }
+            _ => Err(D::Error::custom(
+                "expected a level (\"allow\", \"warn\" or \"error\") or a table of the rule's options",
+            )),
+        }
+    }
 }
 
 impl RuleSetting {
@@ -139,6 +170,11 @@ pub struct Config {
     /// Languages for other file extensions: `rgen = "hlsl"`.
     #[serde(default)]
     pub languages: BTreeMap<String, String>,
+    /// GLSL stages of files whose extension names none, by glob relative to
+    /// this file's folder: `"shaders/*.glsl" = "rchit"` (glslang's stage
+    /// names).
+    #[serde(default)]
+    pub stages: BTreeMap<String, String>,
     /// Rules to run instead of the default set: codes, names or groups.
     #[serde(default)]
     pub select: Option<Vec<String>>,
@@ -198,7 +234,12 @@ impl Config {
         config.rule_keys = selectors
             .map(|k| (k.clone(), find_location(text, path, k)))
             .collect();
-        for g in config.exclude.iter().chain(config.per_file_ignores.keys()) {
+        for g in config
+            .exclude
+            .iter()
+            .chain(config.per_file_ignores.keys())
+            .chain(config.stages.keys())
+        {
             if let Err(e) = globset::Glob::new(g) {
                 return Err(config_error(
                     text,
@@ -241,7 +282,20 @@ impl Config {
                     text,
                     path,
                     lang,
-                    format!("unknown language `{lang}` for extension `{ext}` (expected hlsl, wgsl or spirv)"),
+                    format!("unknown language `{lang}` for extension `{ext}` (expected hlsl, wgsl, glsl or spirv)"),
+                ));
+            }
+        }
+        for (glob, stage) in &config.stages {
+            if !crate::shader::GLSL_STAGES.contains(&stage.as_str()) {
+                return Err(config_error(
+                    text,
+                    path,
+                    stage,
+                    format!(
+                        "unknown GLSL stage `{stage}` for `{glob}` (expected one of {})",
+                        crate::shader::GLSL_STAGES.join(", ")
+                    ),
                 ));
             }
         }
@@ -394,6 +448,22 @@ impl Config {
             }
         }
         Ok(())
+    }
+
+    /// The GLSL stage `[stages]` gives `path` (glslang's name: `rchit`).
+    pub fn stage_for(&self, path: &Path) -> Option<&str> {
+        if self.stages.is_empty() {
+            return None;
+        }
+        let rel = self.relative(path);
+        self.stages
+            .iter()
+            .find(|(g, _)| {
+                globset::Glob::new(g)
+                    .map(|g| g.compile_matcher().is_match(&rel))
+                    .unwrap_or(false)
+            })
+            .map(|(_, s)| s.as_str())
     }
 
     /// The language configured for a path's extension.

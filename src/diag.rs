@@ -84,6 +84,12 @@ pub struct Diagnostic {
 }
 
 impl Diagnostic {
+    /// An input error: no rule's finding, and not a note about an input
+    /// (a header nothing includes).
+    pub fn is_input_error(&self) -> bool {
+        self.code.is_none() && self.severity != Severity::Note
+    }
+
     pub fn new(
         severity: Severity,
         name: &'static str,
@@ -197,6 +203,9 @@ pub enum InputErrorKind {
     HlslUnsupported,
     /// glslang rejects the GLSL.
     GlslError,
+    /// an HLSL file declares no entry point: a header when another linted
+    /// file includes it (then dropped), else reported as a note.
+    NoEntryPoint,
     /// `stack --driver`: the device could not create the pipeline (the
     /// driver failed or crashed, or the validation layer objected).
     DriverFailed,
@@ -219,6 +228,7 @@ impl InputErrorKind {
         InputErrorKind::HlslUnsupported,
         InputErrorKind::GlslError,
         InputErrorKind::DriverFailed,
+        InputErrorKind::NoEntryPoint,
     ];
 
     pub fn as_str(self) -> &'static str {
@@ -238,6 +248,7 @@ impl InputErrorKind {
             InputErrorKind::HlslUnsupported => "hlsl-unsupported",
             InputErrorKind::GlslError => "glsl-error",
             InputErrorKind::DriverFailed => "driver-failed",
+            InputErrorKind::NoEntryPoint => "no-entry-point",
         }
     }
 }
@@ -295,6 +306,7 @@ impl From<rtlint_hlsl::CompileError> for InputError {
             K::Invalid | K::Internal => InputErrorKind::HlslError,
             K::Unsupported => InputErrorKind::HlslUnsupported,
             K::Unreadable => InputErrorKind::UnreadableFile,
+            K::NoEntryPoint => InputErrorKind::NoEntryPoint,
         };
         let mut d = Diagnostic::new(Severity::Error, kind.as_str(), &e.file, e.message);
         d.primary = e.primary.map(|l| Label::new(l.location, l.message));
@@ -373,6 +385,7 @@ mod tests {
                 "hlsl-unsupported",
                 "glsl-error",
                 "driver-failed",
+                "no-entry-point",
             ]
         );
         for (i, a) in names.iter().enumerate() {

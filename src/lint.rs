@@ -125,7 +125,7 @@ pub struct Report {
 impl Report {
     /// 0 clean, 1 findings at the failing level, 2 input errors.
     pub fn exit_code(&self) -> u8 {
-        if self.diagnostics.iter().any(|d| d.code.is_none()) {
+        if self.diagnostics.iter().any(Diagnostic::is_input_error) {
             2
         } else if self.diagnostics.iter().any(|d| {
             d.severity == Severity::Error || (self.deny_warnings && d.severity == Severity::Warning)
@@ -151,7 +151,7 @@ pub fn check_paths(paths: &[PathBuf], options: &Options) -> Report {
     let descriptions: Vec<Vec<PathBuf>> = inputs
         .pipelines
         .iter()
-        .map(|(p, _)| described_shaders(p))
+        .map(|(p, config)| described_shaders(p, config, options))
         .collect();
     if let Some(shard) = options.shard {
         keep_shard(&mut inputs, &descriptions, shard);
@@ -276,10 +276,11 @@ pub fn check_paths(paths: &[PathBuf], options: &Options) -> Report {
             }
         }
     }
+    settle_headers(&mut diagnostics, owned.iter());
     let pipelines: Vec<Checked> = inputs
         .pipelines
         .par_iter()
-        .map(|(p, config)| check_pipeline(p, config))
+        .map(|(p, config)| check_pipeline(p, config, options))
         .collect();
     for c in pipelines {
         diagnostics.extend(c.diagnostics);
@@ -367,19 +368,75 @@ pub fn load(input: &Input, options: &Options) -> Result<Program, InputError> {
 
 /// [`load`], also giving the DXR subobjects an HLSL library declares.
 pub fn load_library(input: &Input, options: &Options) -> Result<(Program, Subobjects), InputError> {
-    let front_options = front_options(&input.config, options);
+    let front_options = input_options(input, options);
     let contents = input.contents.as_deref().map(|v| v.as_slice());
     front::load_library(&input.path, contents, input.language, &front_options)
 }
 
 /// The front-end options `input` is compiled with: its config's `[hlsl]`,
-/// then `options`'.
+/// then `options`', and the GLSL stage `[stages]` gives its path.
 pub fn front_options_for(input: &Input, options: &Options) -> FrontOptions {
-    front_options(&input.config, options)
+    input_options(input, options)
 }
 
-/// The config's `[hlsl]` first, then the command line's options.
-fn front_options(config: &Config, options: &Options) -> FrontOptions {
+/// An HLSL file without an entry point is a header: when a file another
+/// input read (`included`) is one, its error goes (its contents were linted
+/// through its includers); otherwise the error becomes a note, since a
+/// header nothing includes is no input error.
+pub fn settle_headers<'a>(
+    diagnostics: &mut Vec<Diagnostic>,
+    included: impl Iterator<Item = &'a PathBuf>,
+) {
+    let no_entry = InputErrorKind::NoEntryPoint.as_str();
+    if !diagnostics.iter().any(|d| d.name == no_entry) {
+        return;
+    }
+    let included: HashSet<PathBuf> = included.map(|p| canonical(p)).collect();
+    diagnostics.retain_mut(|d| {
+        if d.name != no_entry || d.code.is_some() {
+            return true;
+        }
+        if included.contains(&canonical(&d.file)) {
+            return false;
+        }
+        d.severity = Severity::Note;
+        d.message = "no entry point, and no linted file includes it: nothing to lint".into();
+        d.help = Some(
+            "mark an entry point with [shader(\"...\")] or [numthreads(...)], name one with its stage (-E main -T ps_6_5), or lint the shaders that include it".into(),
+        );
+        true
+    });
+}
+
+/// Loads a pipeline description, compiling the shaders it names with the
+/// same include directories and defines as every other input.
+pub fn load_pipeline(
+    path: &Path,
+    config: &Config,
+    options: &Options,
+) -> Result<crate::pipeline::Pipeline, InputError> {
+    let mut front = front_options(config, options);
+    // The description names each entry point and its stage itself.
+    front.hlsl.entry = None;
+    front.hlsl.stage = None;
+    front.glsl_stage = None;
+    crate::pipeline::load_with(path, &front)
+}
+
+/// [`front_options`] for one input, with the GLSL stage `[stages]` gives
+/// its path when the command line gives none.
+fn input_options(input: &Input, options: &Options) -> FrontOptions {
+    let mut front = front_options(&input.config, options);
+    if front.glsl_stage.is_none() {
+        front.glsl_stage = input.config.stage_for(&input.path).map(str::to_string);
+    }
+    front
+}
+
+/// The one set of compile options of an input: the config's `[hlsl]`
+/// include directories and defines, then the command line's (or the build
+/// API's).
+pub fn front_options(config: &Config, options: &Options) -> FrontOptions {
     let mut hlsl = config.hlsl.hlsl_options();
     hlsl.merge(&options.front.hlsl);
     let mut front_options = FrontOptions {
@@ -391,6 +448,7 @@ fn front_options(config: &Config, options: &Options) -> FrontOptions {
             .map(|(k, v)| (k.clone(), v.clone()))
             .collect(),
         hlsl,
+        glsl_stage: options.front.glsl_stage.clone(),
     };
     front_options
         .include_dirs
@@ -589,7 +647,8 @@ fn collect(paths: &[PathBuf], options: &Options, configs: &mut Configs) -> Input
             .language
             .or_else(|| config.language_for(p))
             .or_else(|| language_from_name(p))
-            .or_else(|| ray_query_glsl(p))
+            .or_else(|| glsl_by_stage(p, &config, options.front.glsl_stage.is_some()))
+            .or_else(|| ray_query_glsl(p, &config, options))
         {
             Some(language) => inputs.files.push(Input {
                 path: p.clone(),
@@ -600,7 +659,7 @@ fn collect(paths: &[PathBuf], options: &Options, configs: &mut Configs) -> Input
             None => inputs.errors.push(InputError::new(
                 InputErrorKind::UnknownLanguage,
                 p,
-                "cannot tell the shader language from the file extension; pass --lang or map the extension under [languages] in rtlint.toml",
+                "cannot tell the shader language from the file extension; pass --lang (and --stage for GLSL) or map the extension under [languages] in rtlint.toml",
             )),
         }
     }
@@ -698,6 +757,13 @@ fn walk(
             if !inputs.pipelines.iter().any(|(q, _)| *q == p) {
                 inputs.pipelines.push((p, config));
             }
+        } else if let Some(language) = glsl_by_stage(&p, &config, false) {
+            inputs.files.push(Input {
+                path: p,
+                language,
+                config,
+                contents: None,
+            });
         } else if p
             .extension()
             .is_some_and(|e| e.eq_ignore_ascii_case("hlsli"))
@@ -712,7 +778,7 @@ fn walk(
             .language_for(&p)
             .or_else(|| language_from_name(&p))
             .or_else(|| options.language.filter(|_| is_shader_like(&p)))
-            .or_else(|| ray_query_glsl(&p))
+            .or_else(|| ray_query_glsl(&p, &config, options))
         {
             inputs.files.push(Input {
                 path: p,
@@ -757,17 +823,60 @@ fn language_from_name(p: &Path) -> Option<Language> {
     })
 }
 
-/// A GLSL compute, fragment or other stage that uses ray queries.
-fn ray_query_glsl(p: &Path) -> Option<Language> {
+/// GLSL, for a file given a stage: by `[stages]` in its config, or by
+/// `--stage` (`named`: the user named the file).
+fn glsl_by_stage(p: &Path, config: &Config, named: bool) -> Option<Language> {
+    (named || config.stage_for(p).is_some()).then_some(Language::Glsl)
+}
+
+/// A GLSL compute, fragment or other stage that uses ray queries, in its
+/// own text or in a file it includes (searched as glslang does: the
+/// including file's folder, then the include directories).
+fn ray_query_glsl(p: &Path, config: &Config, options: &Options) -> Option<Language> {
     let ext = front::glsl::stage_extension(p)?;
     if !front::glsl::RAY_QUERY_EXTENSIONS.contains(&ext) {
         return None;
     }
-    let text = std::fs::read(p).ok()?;
+    let dirs: Vec<PathBuf> = front_options(config, options).include_dirs;
+    let mut seen = HashSet::new();
+    mentions_ray_query(p, &dirs, &mut seen).then_some(Language::Glsl)
+}
+
+fn mentions_ray_query(p: &Path, dirs: &[PathBuf], seen: &mut HashSet<PathBuf>) -> bool {
+    // A header included twice (or in a cycle) is read once.
+    if seen.len() > 256 || !seen.insert(canonical(p)) {
+        return false;
+    }
+    let Ok(text) = std::fs::read(p) else {
+        return false;
+    };
     let needle = b"rayQueryEXT";
-    text.windows(needle.len())
-        .any(|w| w == needle)
-        .then_some(Language::Glsl)
+    if text.windows(needle.len()).any(|w| w == needle) {
+        return true;
+    }
+    let own = p.parent().unwrap_or(Path::new(""));
+    String::from_utf8_lossy(&text).lines().any(|line| {
+        let Some(rest) = line.trim_start().strip_prefix('#') else {
+            return false;
+        };
+        let Some(rest) = rest.trim_start().strip_prefix("include") else {
+            return false;
+        };
+        let rest = rest.trim();
+        let name = match rest.chars().next() {
+            Some('"') => rest[1..].split('"').next(),
+            Some('<') => rest[1..].split('>').next(),
+            _ => None,
+        };
+        let Some(name) = name.filter(|n| !n.is_empty()) else {
+            return false;
+        };
+        std::iter::once(own)
+            .chain(dirs.iter().map(PathBuf::as_path))
+            .map(|d| d.join(name))
+            .find(|c| c.is_file())
+            .is_some_and(|c| mentions_ray_query(&c, dirs, seen))
+    })
 }
 
 pub fn is_pipeline(p: &Path) -> bool {
@@ -843,8 +952,8 @@ fn drop_ignored(diagnostics: &mut Vec<Diagnostic>, ignored: &[&str]) {
 }
 
 /// Loads a pipeline description and runs the pipeline rules on it.
-pub fn check_pipeline(path: &Path, config: &Config) -> Checked {
-    match crate::pipeline::load(path) {
+pub fn check_pipeline(path: &Path, config: &Config, options: &Options) -> Checked {
+    match load_pipeline(path, config, options) {
         Ok(pipeline) => {
             let ctx = crate::rules::PipelineContext::new(&pipeline, config);
             let mut diagnostics = crate::rules::check_pipeline(&ctx);
@@ -980,8 +1089,8 @@ fn apply_suppressions(
 
 /// The shader files a pipeline description uses (nothing when it cannot be
 /// read: `check_pipeline` reports that).
-pub fn described_shaders(path: &Path) -> Vec<PathBuf> {
-    crate::pipeline::load(path)
+pub fn described_shaders(path: &Path, config: &Config, options: &Options) -> Vec<PathBuf> {
+    load_pipeline(path, config, options)
         .map(|p| p.programs.iter().map(|p| canonical(&p.path)).collect())
         .unwrap_or_default()
 }
@@ -1102,7 +1211,7 @@ fn input_keys(
         Some(c) => c.as_slice(),
         None => read?,
     };
-    let front = front_options(&input.config, options);
+    let front = input_options(input, options);
     let mut k = crate::cache::base_key();
     k.add(format!("{:?}", input.config))
         .add(format!("{front:?}"));

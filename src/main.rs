@@ -315,6 +315,8 @@ HLSL: DXC's options, as a build passes them (docs/hlsl.md lists them all):
 struct Dxc {
     options: rtlint::front::hlsl::HlslOptions,
     notes: Vec<String>,
+    /// `--stage`/`-T` given a GLSL stage name.
+    glsl_stage: Option<String>,
 }
 
 static DXC: std::sync::OnceLock<Dxc> = std::sync::OnceLock::new();
@@ -323,6 +325,7 @@ fn dxc() -> &'static Dxc {
     DXC.get_or_init(|| Dxc {
         options: Default::default(),
         notes: Vec::new(),
+        glsl_stage: None,
     })
 }
 
@@ -355,11 +358,33 @@ fn take_dxc_args(argv: Vec<std::ffi::OsString>) -> Result<Vec<std::ffi::OsString
     // An argument that is not UTF-8 (a path) stands in as NUL and its
     // index (no argument can hold a NUL), and comes back unchanged.
     let mut args = Vec::new();
-    for (i, a) in argv[sub + 1..].iter().enumerate() {
+    // `--stage`/`-T` with a GLSL stage name (`rchit`) is the stage of GLSL
+    // files whose extension names none, not a DXC profile.
+    let mut glsl_stage = None;
+    let mut skip = false;
+    let rest = &argv[sub + 1..];
+    for (i, a) in rest.iter().enumerate() {
+        if std::mem::take(&mut skip) {
+            continue;
+        }
         let a = match a.to_str() {
             Some(s) => s.to_string(),
             None => format!("\0{i}"),
         };
+        let next = rest.get(i + 1).and_then(|n| n.to_str());
+        let attached = a.strip_prefix("--stage=").or_else(|| a.strip_prefix("-T"));
+        match (a.as_str(), next, attached) {
+            ("--stage" | "-T", Some(n), _) if is_glsl_stage(n) => {
+                glsl_stage = Some(n.to_string());
+                skip = true;
+                continue;
+            }
+            (_, _, Some(v)) if is_glsl_stage(v) => {
+                glsl_stage = Some(v.to_string());
+                continue;
+            }
+            _ => {}
+        }
         args.push(match a.as_str() {
             "--entry" => "-E".to_string(),
             "--stage" => "-T".to_string(),
@@ -392,7 +417,11 @@ fn take_dxc_args(argv: Vec<std::ffi::OsString>) -> Result<Vec<std::ffi::OsString
             ));
         }
     }
-    let _ = DXC.set(Dxc { options, notes });
+    let _ = DXC.set(Dxc {
+        options,
+        notes,
+        glsl_stage,
+    });
     Ok(out)
 }
 
@@ -513,6 +542,7 @@ fn options(common: &Common) -> Result<lint::Options, String> {
                 include_dirs: std::mem::take(&mut hlsl.include_dirs),
                 defines: std::mem::take(&mut hlsl.defines),
                 hlsl,
+                glsl_stage: dxc().glsl_stage.clone(),
             }
         },
         respect_gitignore: !common.no_gitignore,
@@ -520,6 +550,10 @@ fn options(common: &Common) -> Result<lint::Options, String> {
         stdin_filename: common.stdin_filename.clone(),
         ..lint::Options::default()
     })
+}
+
+fn is_glsl_stage(s: &str) -> bool {
+    rtlint::shader::GLSL_STAGES.contains(&s)
 }
 
 fn check(args: CheckArgs) -> Result<u8, String> {
@@ -669,8 +703,11 @@ struct Loaded {
     programs: Vec<rtlint::program::Program>,
     /// The DXR subobjects of each program (empty but for HLSL libraries).
     subobjects: Vec<rtlint::front::hlsl::subobject::Subobjects>,
-    pipelines: Vec<PathBuf>,
+    /// Each description with its config.
+    pipelines: Vec<(PathBuf, std::sync::Arc<rtlint::config::Config>)>,
     problems: Vec<Diagnostic>,
+    /// How the inputs were read: descriptions compile their shaders alike.
+    options: lint::Options,
 }
 
 fn load(common: &Common) -> Result<Loaded, String> {
@@ -688,11 +725,18 @@ fn load(common: &Common) -> Result<Loaded, String> {
             Err(InputError(d)) => problems.push(*d),
         }
     }
+    lint::settle_headers(
+        &mut problems,
+        programs
+            .iter()
+            .flat_map(|p| p.files.iter().map(|f| &f.path)),
+    );
     Ok(Loaded {
         programs,
         subobjects,
-        pipelines: inputs.pipelines.into_iter().map(|(p, _)| p).collect(),
+        pipelines: inputs.pipelines,
         problems,
+        options,
     })
 }
 
@@ -742,11 +786,12 @@ fn stack(
         subobjects,
         pipelines: descriptions,
         mut problems,
+        options,
     } = load(&common)?;
     let mut pipelines = Vec::new();
     let mut described = Vec::new();
-    for p in &descriptions {
-        match rtlint::pipeline::load(p) {
+    for (p, config) in &descriptions {
+        match lint::load_pipeline(p, config, &options) {
             Ok(p) => {
                 described.extend(p.programs.iter().map(|q| canonical(&q.path)));
                 pipelines.push(p)
@@ -881,7 +926,11 @@ fn print_report(
         Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => return Ok(0),
         Err(e) => return Err(format!("cannot write output: {e}")),
     }
-    Ok(if problems.is_empty() { 0 } else { 2 })
+    Ok(if problems.iter().any(Diagnostic::is_input_error) {
+        2
+    } else {
+        0
+    })
 }
 
 fn compile(

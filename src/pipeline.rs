@@ -375,13 +375,32 @@ struct RawHitGroup {
 
 /// Reads a description and loads every shader it names.
 pub fn load(path: &Path) -> Result<Pipeline, InputError> {
+    load_with(path, &front::FrontOptions::default())
+}
+
+/// [`load`], compiling the shaders with `options` (include directories,
+/// defines), as every other input of the run is.
+pub fn load_with(path: &Path, options: &front::FrontOptions) -> Result<Pipeline, InputError> {
     let text = front::read_text(path)?;
-    parse(&text, path)
+    parse_with(&text, path, options)
 }
 
 /// Parses a description; shader files are relative to `path`'s folder.
 pub fn parse(text: &str, path: &Path) -> Result<Pipeline, InputError> {
-    let cx = Cx { text, path };
+    parse_with(text, path, &front::FrontOptions::default())
+}
+
+/// [`parse`], compiling the shaders with `options`.
+pub fn parse_with(
+    text: &str,
+    path: &Path,
+    options: &front::FrontOptions,
+) -> Result<Pipeline, InputError> {
+    let cx = Cx {
+        text,
+        path,
+        options,
+    };
     let raw: RawPipeline = toml::from_str(text).map_err(|e| {
         let err = InputError::new(
             InputErrorKind::InvalidPipeline,
@@ -506,6 +525,8 @@ pub fn parse(text: &str, path: &Path) -> Result<Pipeline, InputError> {
 struct Cx<'a> {
     text: &'a str,
     path: &'a Path,
+    /// How the shaders it names are compiled.
+    options: &'a front::FrontOptions,
 }
 
 impl Cx<'_> {
@@ -575,8 +596,8 @@ impl Loader<'_> {
         let index = match self.programs.iter().position(|p| p.path == file) {
             Some(i) => i,
             None => {
-                let (program, subobjects) =
-                    front::load_library(&file, None, lang, &Default::default()).map_err(|e| {
+                let (program, subobjects) = front::load_library(&file, None, lang, cx.options)
+                    .map_err(|e| {
                         e.with_note(format!(
                             "the pipeline description names this file at {here}"
                         ))

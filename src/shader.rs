@@ -47,6 +47,13 @@ impl Language {
     }
 }
 
+/// The GLSL stages glslang knows by name (its `-S` values and the file
+/// extensions it reads them from) that rtlint lints: the ray-tracing stages,
+/// and the others when they use ray queries.
+pub const GLSL_STAGES: &[&str] = &[
+    "rgen", "rchit", "rmiss", "rahit", "rint", "rcall", "comp", "frag", "vert", "mesh", "task",
+];
+
 pub use rtlint_hlsl::{Location, Stage};
 
 /// A source file's text for what reads it after the compile (snippets,

@@ -146,13 +146,9 @@ fn bad_wgsl() {
         &["valid.wgsl:", "invalid WGSL module"],
     );
     std::fs::write(d.join("utf8.wgsl"), b"fn f() {}\n\xff\xfe").unwrap();
-    assert_input_error(
-        &d.join("utf8.wgsl"),
-        &[
-            "utf8.wgsl:2:1",
-            "not valid UTF-8: byte 0xff at line 2, column 1",
-        ],
-    );
+    let t = assert_input_error(&d.join("utf8.wgsl"), &["UTF-8", "line 2, column 1"]);
+    assert!(t.contains("utf8.wgsl:2:1"), "{t}");
+    assert!(!t.contains("offset"), "{t}");
 }
 
 #[test]

@@ -59,7 +59,21 @@ pub fn compile(
     text: &[u8],
     options: &FrontOptions,
 ) -> Result<(Vec<u32>, Option<PathBuf>), InputError> {
-    let ext = stage_extension(path).unwrap_or("glsl");
+    let ext = match options.glsl_stage.as_deref().or_else(|| stage_extension(path)) {
+        Some(ext) => ext,
+        // glslang would print its usage text.
+        None => {
+            return Err(InputError::new(
+                InputErrorKind::UnknownLanguage,
+                path,
+                format!(
+                    "cannot tell the GLSL stage of `{}`: name it with a stage extension (`.rchit`, or `name.rchit.glsl`), pass --stage, or give it under [stages] in rtlint.toml (one of {})",
+                    path.display(),
+                    crate::shader::GLSL_STAGES.join(", ")
+                ),
+            ))
+        }
+    };
     let dir = tempdir(path)?;
     // glslang reads a file: the text goes into one named like the input, so
     // the stage still follows from the extension.
@@ -73,9 +87,11 @@ pub fn compile(
         .arg("-g")
         .arg("-o")
         .arg(&output);
-    if let Some(parent) = path.parent().filter(|p| !p.as_os_str().is_empty()) {
-        cmd.arg(format!("-I{}", parent.display()));
-    }
+    // glslang looks beside the file it reads (the scratch copy), so the
+    // shader's own folder is named first, absolute: `a.rchit`, `./a.rchit`
+    // and standard input under `--stdin-filename a.rchit` have the current
+    // folder as theirs.
+    cmd.arg(format!("-I{}", own_folder(path).display()));
     for d in &options.include_dirs {
         cmd.arg(format!("-I{}", d.display()));
     }
@@ -100,6 +116,17 @@ pub fn compile(
     };
     let _ = std::fs::remove_dir_all(&dir);
     result.map(|w| (w, Some(input)))
+}
+
+/// The folder `path` is in, absolute (the current folder for a bare name).
+fn own_folder(path: &Path) -> PathBuf {
+    let parent = path.parent().unwrap_or(Path::new(""));
+    let parent = if parent.as_os_str().is_empty() {
+        Path::new(".")
+    } else {
+        parent
+    };
+    std::path::absolute(parent).unwrap_or_else(|_| parent.to_path_buf())
 }
 
 /// A private scratch folder for one compilation.

@@ -2,6 +2,8 @@
 //! (`OpString`/`OpLine`, or `NonSemantic.Shader.DebugInfo.100`) leads back to the
 //! original source.
 
+#[cfg(feature = "naga-oil")]
+pub mod compose;
 pub mod glsl;
 pub mod hlsl;
 pub mod wgsl;
@@ -42,6 +44,9 @@ pub struct FrontOptions {
     /// the one HLSL options type, whose own `-I`/`-D` lists come after the
     /// shared ones above. [`FrontOptions::hlsl_options`] puts them together.
     pub hlsl: hlsl::HlslOptions,
+    /// GLSL: the stage (glslang's name, `rchit`) of a file whose extension
+    /// names none (`--stage`, or `[stages]` in rtlint.toml).
+    pub glsl_stage: Option<String>,
 }
 
 impl FrontOptions {
@@ -88,7 +93,13 @@ pub fn compile_input(
     match language {
         Language::Wgsl => {
             let text = text()?;
-            let (mut module, info) = wgsl::parse(&text, path)?;
+            let (mut module, mut info) =
+                wgsl::parse_composed(&text, path, &options.include_dirs, &options.defines)?;
+            if let Some((m, i)) =
+                wgsl::apply_overrides(&module, &info, &text, &options.defines, path)?
+            {
+                (module, info) = (m, i);
+            }
             let words = wgsl::write_spirv(&mut module, &info, &text, path)?;
             Ok(compiled(
                 Language::Wgsl,

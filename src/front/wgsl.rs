@@ -24,6 +24,96 @@ pub fn parse(
     })
 }
 
+/// Gives every pipeline-overridable constant (`override`) a value, as a
+/// pipeline does before naga can write SPIR-V: the value of a `-D NAME=VALUE`
+/// (or `[hlsl.defines]`) naming the override (by name, or by its `@id`),
+/// else its default. An override with neither is an input error, since any
+/// value rtlint chose could be wrong. `None`: the module has none.
+pub fn apply_overrides(
+    module: &naga::Module,
+    info: &naga::valid::ModuleInfo,
+    source: &str,
+    defines: &[(String, String)],
+    path: &Path,
+) -> Result<Option<(naga::Module, naga::valid::ModuleInfo)>, InputError> {
+    if module.overrides.is_empty() {
+        return Ok(None);
+    }
+    let mut constants = naga::back::PipelineConstants::default();
+    for (_, o) in module.overrides.iter() {
+        let key = match o.id {
+            Some(id) => id.to_string(),
+            None => o.name.clone().unwrap_or_default(),
+        };
+        let given = defines
+            .iter()
+            .rev()
+            .find(|(n, _)| *n == key || o.name.as_deref() == Some(n.as_str()));
+        let name = o.name.as_deref().unwrap_or(&key);
+        match given {
+            Some((_, v)) => {
+                let value = match v.trim() {
+                    "true" => 1.0,
+                    "false" => 0.0,
+                    t => t.parse::<f64>().map_err(|_| {
+                        InputError::new(
+                            InputErrorKind::WgslValidation,
+                            path,
+                            format!("override `{name}`: `{v}` is not a number or boolean"),
+                        )
+                    })?,
+                };
+                constants.insert(key, value);
+            }
+            None if o.init.is_none() => {
+                let err = InputError::new(
+                    InputErrorKind::WgslValidation,
+                    path,
+                    format!(
+                        "override `{name}` has no default value: give it one with -D {name}=VALUE (or under [hlsl.defines] in rtlint.toml)"
+                    ),
+                );
+                return Err(match override_location(source, name, path) {
+                    Some(l) => err.at(l, "declared here"),
+                    None => err,
+                });
+            }
+            None => {}
+        }
+    }
+    guard(path, "evaluate the overrides of", || {
+        naga::back::pipeline_constants::process_overrides(module, info, None, &constants)
+            .map(|(m, i)| Some((m.into_owned(), i.into_owned())))
+            .map_err(|e| {
+                InputError::new(
+                    InputErrorKind::WgslValidation,
+                    path,
+                    format!("cannot evaluate the module's overrides: {e}"),
+                )
+            })
+    })
+}
+
+/// Where an override is declared: naga keeps no span for it, so its name
+/// after `override` in the text.
+fn override_location(text: &str, name: &str, path: &Path) -> Option<Location> {
+    let mut from = 0;
+    while let Some(i) = text[from..].find("override") {
+        let at = from + i + "override".len();
+        let rest = &text[at..];
+        let trimmed = rest.trim_start();
+        if trimmed.starts_with(name)
+            && !trimmed[name.len()..].starts_with(|c: char| c.is_alphanumeric() || c == '_')
+        {
+            let start = at + (rest.len() - trimmed.len());
+            let (line, col) = line_col(text, start);
+            return Some(Location::span(path, line, col, name.chars().count() as u32));
+        }
+        from = at;
+    }
+    None
+}
+
 /// Deepest expression nesting accepted: naga's lowering recurses once per
 /// level of an operator chain (`a + b + ...`, `- - x`, `a.b.c`), which its
 /// parser does not limit (it does brackets, at 197, and braces, at 126), and
@@ -226,6 +316,61 @@ fn guard<T>(
             path,
             format!("naga failed to {what} this module (internal error: {msg})"),
         ))
+    })
+}
+
+/// Whether `source` uses naga_oil's preprocessor directives.
+pub fn is_composable(source: &str) -> bool {
+    source.lines().any(|l| {
+        let l = l.trim_start();
+        l.strip_prefix('#').is_some_and(|d| {
+            let d = d.trim_start();
+            [
+                "import",
+                "define_import_path",
+                "ifdef",
+                "ifndef",
+                "if ",
+                "else",
+                "endif",
+                "define ",
+            ]
+            .iter()
+            .any(|k| d.starts_with(k))
+        })
+    })
+}
+
+/// WGSL written for composition (`#import`, `#ifdef`…): composed by
+/// naga_oil from the modules in `include_dirs` and the file's folder, with
+/// `defines`; then validated as [`parse`] does. Other WGSL: [`parse`].
+pub fn parse_composed(
+    source: &str,
+    path: &Path,
+    include_dirs: &[std::path::PathBuf],
+    defines: &[(String, String)],
+) -> Result<(naga::Module, naga::valid::ModuleInfo), InputError> {
+    if !is_composable(source) {
+        return parse(source, path);
+    }
+    #[cfg(not(feature = "naga-oil"))]
+    {
+        let _ = (include_dirs, defines);
+        Err(InputError::new(
+            InputErrorKind::UnsupportedLanguage,
+            path,
+            "this WGSL is written for naga_oil composition (`#import`, `#ifdef`): build rtlint with the `naga-oil` feature",
+        ))
+    }
+    #[cfg(feature = "naga-oil")]
+    deep(source, path, || {
+        guard(path, "compose", || {
+            let module = super::compose::compose(source, path, include_dirs, defines)?;
+            let info = Validator::new(ValidationFlags::all(), Capabilities::all())
+                .validate(&module)
+                .map_err(|e| validation_error(path, source, &e))?;
+            Ok((module, info))
+        })
     })
 }
 

@@ -196,6 +196,7 @@ pub fn parse_owned(
     b.link_debug_composites();
     b.drop_impossible_positions();
     b.sites();
+    super::callpos::refine(&mut b.p);
     super::textdecl::fill(&mut b.p);
     Ok(b.p)
 }

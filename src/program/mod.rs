@@ -8,6 +8,7 @@
 
 mod binary;
 mod build;
+mod callpos;
 pub mod cfg;
 pub mod debug;
 pub mod decode;

@@ -89,11 +89,16 @@ fn render_chunk(
             }
         }
         if d.primary.is_none() {
-            let what = d
-                .subject
-                .as_deref()
-                .unwrap_or("no source position in debug info");
-            cs.notes.push(format!("in {}: {what}", d.file.display()));
+            // Only a finding in a module lacks a position for want of debug
+            // info; an input error (a config, a missing path) has none to give.
+            match (d.subject.as_deref(), d.code) {
+                (Some(what), _) => cs.notes.push(format!("in {}: {what}", d.file.display())),
+                (None, Some(_)) => cs.notes.push(format!(
+                    "in {}: no source position in debug info",
+                    d.file.display()
+                )),
+                (None, None) => cs.notes.push(format!("in {}", d.file.display())),
+            }
         }
         for u in unplaced {
             cs.notes.push(format!("at {u}"));

@@ -55,7 +55,7 @@ impl Summary {
                 Severity::Warning => s.warnings += 1,
                 Severity::Note => s.notes += 1,
             }
-            if d.code.is_none() {
+            if d.is_input_error() {
                 s.input_errors += 1;
             }
         }

@@ -78,7 +78,7 @@ pub fn render(diagnostics: &[Diagnostic]) -> String {
         .filter(|d| d.code.is_none())
         .map(|d| {
             json!({
-                "level": "error",
+                "level": if d.is_input_error() { "error" } else { "note" },
                 "message": { "text": d.message },
                 "descriptor": { "id": d.name },
                 "locations": [location(d)],

@@ -39,8 +39,14 @@ pub fn check(program: &Program, sites: &[LiveSite], budget_bytes: u64) -> Vec<Di
         .with_subject(site.entry.clone())
         .with_primary(site.location.clone(), format!("{kept} bytes kept across this call"));
         for v in site.values.iter().filter(|v| !v.rematerializable).take(4) {
+            // Under the variable's name where the line has it.
+            let def = v.def.as_ref().map(|at| {
+                program
+                    .name_location(at, &v.name)
+                    .unwrap_or_else(|| at.clone())
+            });
             d = d.with_secondary(
-                v.def.clone(),
+                def,
                 format!("`{}` ({}, {} bytes) defined here", v.name, v.ty, v.size),
             );
         }

@@ -35,6 +35,15 @@ pub enum DescriptorCount {
     Runtime,
 }
 
+impl std::fmt::Display for DescriptorCount {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            DescriptorCount::Fixed(n) => write!(f, "{n}"),
+            DescriptorCount::Runtime => f.write_str("a runtime array"),
+        }
+    }
+}
+
 /// One binding of the reflected layout.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct LayoutBinding {
@@ -440,6 +449,34 @@ mod tests {
 
     fn load(rel: &str) -> Pipeline {
         crate::pipeline::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join(rel)).unwrap()
+    }
+
+    /// A user reads the conflict in words, not Rust's debug text.
+    #[test]
+    fn conflicting_bindings_are_told_without_debug_text() {
+        let dir = std::env::temp_dir().join(format!("rtlint-iface-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let gen = dir.join("gen.hlsl");
+        let hit = dir.join("hit.hlsl");
+        std::fs::write(
+            &gen,
+            "RaytracingAccelerationStructure s : register(t0, space1);\nRWTexture2D<float4> img : register(u0);\nstruct P { float4 c; };\n[shader(\"raygeneration\")] void G() { RayDesc r = { float3(0,0,0), 0, float3(0,0,1), 1 }; P p = { float4(0,0,0,0) }; TraceRay(s, 0, 0xFF, 0, 1, 0, r, p); img[uint2(0,0)] = p.c; }\n",
+        )
+        .unwrap();
+        std::fs::write(
+            &hit,
+            "RWStructuredBuffer<float4> buf[] : register(u0);\nstruct P { float4 c; };\n[shader(\"closesthit\")] void H(inout P p, BuiltInTriangleIntersectionAttributes a) { p.c = buf[0][0]; }\n",
+        )
+        .unwrap();
+        let programs = [&gen, &hit]
+            .iter()
+            .map(|p| crate::front::load(p, crate::shader::Language::Hlsl).unwrap())
+            .collect();
+        let e = reflect(&Pipeline::from_programs(programs)).unwrap_err();
+        let _ = std::fs::remove_dir_all(&dir);
+        assert!(e.contains("binding 0"), "{e}");
+        assert!(e.contains("× 1") && e.contains("a runtime array"), "{e}");
+        assert!(!e.contains("Fixed") && !e.contains("Runtime"), "{e}");
     }
 
     #[test]

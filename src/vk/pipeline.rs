@@ -670,8 +670,8 @@ fn check_groups(desc: &RayTracingPipelineDesc<'_>) -> Result<()> {
         match desc.stages.get(i as usize) {
             Some(s) if allowed.contains(&s.stage) => Ok(()),
             Some(s) => Err(Error::Invalid(format!(
-                "{what} refers to stage {i}, a {:?} stage",
-                s.stage
+                "{what} refers to stage {i}, a {} stage",
+                s.stage.as_str()
             ))),
             None => Err(Error::Invalid(format!(
                 "{what} refers to stage {i}, but there are {} stages",

@@ -26,6 +26,9 @@ pub enum Kind {
     Internal,
     /// The main file could not be read.
     Unreadable,
+    /// The file declares no entry point (and none was named): a header, when
+    /// another file includes it.
+    NoEntryPoint,
 }
 
 /// The public name of [`Kind`].

@@ -211,13 +211,14 @@ fn entry_indices(
         None => all,
     };
     if picked.is_empty() {
-        let msg = match &options.entry {
-            Some(name) => format!("no entry point named `{name}`"),
-            None => {
-                "no entry points: mark one with [shader(\"...\")] or [numthreads(...)], or name it with its stage (-E main -T ps_6_5)".to_string()
-            }
+        let (kind, msg) = match &options.entry {
+            Some(name) => (ErrorKind::Invalid, format!("no entry point named `{name}`")),
+            None => (
+                ErrorKind::NoEntryPoint,
+                "no entry points: mark one with [shader(\"...\")] or [numthreads(...)], or name it with its stage (-E main -T ps_6_5)".to_string(),
+            ),
         };
-        return Err(CompileError::whole(ErrorKind::Invalid, path, msg));
+        return Err(CompileError::whole(kind, path, msg));
     }
     Ok(picked)
 }

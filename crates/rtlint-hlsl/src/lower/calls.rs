@@ -935,7 +935,7 @@ impl<'a> Lowerer<'a> {
         if !matches!(t, Ty::Struct(_)) {
             return Err(Error::new(args[7].pos, "the ray payload must be a struct"));
         }
-        let var = self.rt_var(StorageClass::RayPayloadKHR, &t)?;
+        let var = self.rt_var_named(StorageClass::RayPayloadKHR, &t, Some(&args[7]))?;
         let v = self.read(&p)?;
         self.b.store(var, v.id, None, [])?;
         let a = self.b.load(at, None, accel.id, None, [])?;

@@ -319,6 +319,18 @@ impl<'a> Lowerer<'a> {
 
     /// The ray-tracing interface variable of `class` for type `t` (one per type).
     pub(super) fn rt_var(&mut self, class: StorageClass, t: &Ty) -> Result<Id> {
+        self.rt_var_named(class, t, None)
+    }
+
+    /// [`Self::rt_var`]; a payload variable made now is named after `arg`
+    /// when it is a variable (`rtlint live` names payloads by what the
+    /// source traces), else `payload`.
+    pub(super) fn rt_var_named(
+        &mut self,
+        class: StorageClass,
+        t: &Ty,
+        arg: Option<&Expr>,
+    ) -> Result<Id> {
         self.ray_tracing_caps();
         let key = (class, t.clone());
         let var = match self.rt_vars.get(&key) {
@@ -327,12 +339,15 @@ impl<'a> Lowerer<'a> {
                 let tid = self.ty_id(t)?;
                 let pty = self.b.type_pointer(None, class, tid);
                 let var = self.global_var(pty, class, None);
-                let name = match class {
-                    StorageClass::RayPayloadKHR => "payload",
-                    StorageClass::IncomingRayPayloadKHR => "incoming.payload",
-                    StorageClass::HitAttributeKHR => "hit.attributes",
-                    StorageClass::CallableDataKHR => "callable.data",
-                    _ => "incoming.callable.data",
+                let name = match (class, arg.map(|e| &e.kind)) {
+                    (StorageClass::RayPayloadKHR, Some(ExprKind::Ident(n))) => n.as_str(),
+                    _ => match class {
+                        StorageClass::RayPayloadKHR => "payload",
+                        StorageClass::IncomingRayPayloadKHR => "incoming.payload",
+                        StorageClass::HitAttributeKHR => "hit.attributes",
+                        StorageClass::CallableDataKHR => "callable.data",
+                        _ => "incoming.callable.data",
+                    },
                 };
                 self.b.name(var, name);
                 if matches!(

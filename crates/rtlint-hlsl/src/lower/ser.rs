@@ -127,7 +127,7 @@ impl<'a> Lowerer<'a> {
         if !matches!(t, Ty::Struct(_)) {
             return Err(Error::new(e.pos, "the ray payload must be a struct"));
         }
-        let var = self.rt_var(StorageClass::RayPayloadKHR, &t)?;
+        let var = self.rt_var_named(StorageClass::RayPayloadKHR, &t, Some(e))?;
         let v = self.read(&p)?;
         self.b.store(var, v.id, None, [])?;
         Ok((var, p, t))
