@@ -175,11 +175,14 @@ fn run(ctx: &super::PipelineContext) -> Vec<Diagnostic> {
     let pipeline = ctx.pipeline;
     let graph = &ctx.recursion.graph;
     let mut types: Vec<RayType> = Vec::new();
-    // Each shader's incoming payloads, once: a folder's loose pipeline joins
-    // every trace to every hit shader.
-    let mut incoming: std::collections::HashMap<(usize, Id), Vec<Id>> =
-        std::collections::HashMap::new();
-    for e in graph.edges.iter().filter(|e| e.kind == EdgeKind::Trace) {
+    // Shaders the SBT selects whose payload differs count as aliases (code
+    // that reads a shared prefix of two payloads).
+    for e in graph
+        .edges
+        .iter()
+        .chain(&graph.mismatched)
+        .filter(|e| e.kind == EdgeKind::Trace)
+    {
         let Some(program) = pipeline.programs.get(e.program) else {
             continue;
         };
@@ -243,28 +246,16 @@ fn run(ctx: &super::PipelineContext) -> Vec<Diagnostic> {
         ) {
             continue;
         }
-        let Some(tp) = pipeline.programs.get(to.shader.program) else {
-            continue;
-        };
-        let used = incoming
-            .entry((to.shader.program, to.shader.function))
-            .or_insert_with(|| {
-                payload_use::globals_used(
-                    tp,
-                    to.shader.function,
-                    StorageClass::IncomingRayPayloadKHR,
-                )
-            });
-        for &w in used.iter() {
-            let Some(g) = tp.globals.iter().find(|g| g.id == w) else {
-                continue;
-            };
+        for w in graph
+            .payloads
+            .incoming_known(to.shader.program, to.shader.function)
+        {
             let callee = View {
                 program: to.shader.program,
                 entry: to.shader.function,
-                var: w,
+                var: w.var,
             };
-            let list = if payload_use::shape_of(tp, g.ty) == t.shape {
+            let list = if w.shape == t.shape {
                 t.hit_reached |= to.shader.stage == Stage::ClosestHit;
                 &mut t.callees
             } else {
