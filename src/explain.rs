@@ -184,9 +184,10 @@ impl fmt::Display for Assumption {
             Assumption::NoDeclaredDepth => {
                 f.write_str("no declared depth: default formulas use the required depth only")
             }
-            Assumption::UnboundedRecursion(why) => write!(
+            Assumption::UnboundedRecursion { why, at: l } => write!(
                 f,
-                "recursion is unbounded at compile time ({why}): no exact call-chain value"
+                "recursion is unbounded at compile time: the trace{} closes a cycle and {why}; no exact call-chain value",
+                at(l)
             ),
             Assumption::InitialValueAssumed { counter } => write!(
                 f,

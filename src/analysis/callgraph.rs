@@ -41,7 +41,11 @@ pub enum Assumption {
     /// No declared depth: the default formulas use the required depth only.
     NoDeclaredDepth,
     /// Recursion with no bound known at compile time, and why.
-    UnboundedRecursion(super::recursion::NoGuard),
+    UnboundedRecursion {
+        why: super::recursion::NoGuard,
+        /// The trace that closes the cycle without a bound.
+        at: Option<Location>,
+    },
     /// A depth counter with no constant initial value: 0 was assumed.
     InitialValueAssumed { counter: String },
     /// A trace or callable taken to reach a shader whose incoming payload

@@ -601,11 +601,17 @@ pub fn visibility_traces(pipeline: &Pipeline, graph: &TraceGraph) -> Vec<Visibil
         }
         // Without a description, a trace that can run closest-hit shaders
         // but reaches none may be missing its own (a shader of the folder
-        // that could not be read): do not judge it.
+        // that could not be read): do not judge it, unless the folder has
+        // closest-hit shaders, none takes this payload, and a miss shader
+        // does (a shadow ray type, whose hit group often has no closest hit).
         let skips_closest_hit = flags & flags::SKIP_CLOSEST_HIT != 0;
+        let own_miss = pipeline.hit_groups.iter().any(|g| g.closest_hit.is_some())
+            && t.targets
+                .iter()
+                .any(|&n| graph.nodes[n].shader.stage == Stage::Miss);
         if !visibility
             || !any_writer
-            || (!pipeline.described() && !skips_closest_hit && closest_hits.is_empty())
+            || (!pipeline.described() && !skips_closest_hit && closest_hits.is_empty() && !own_miss)
         {
             continue;
         }

@@ -141,6 +141,22 @@ pub fn human(r: &StackReport) -> String {
     }
     let _ = writeln!(s);
     match r.recommended {
+        Some(v) if r.assumed_depth.is_some() => {
+            let d = r.assumed_depth.unwrap_or_default();
+            let whose = if r.declared_depth == Some(d) {
+                "the declared depth"
+            } else {
+                "the device's limit"
+            };
+            let _ = writeln!(
+                s,
+                "recommended (conditional): vkCmdSetRayTracingPipelineStackSizeKHR(cmd, {v}) / SetPipelineStackSize({v})"
+            );
+            let _ = writeln!(
+                s,
+                "  assumes the recursion stops within depth {d} ({whose}): no bound is known at compile time, so a deeper recursion needs more"
+            );
+        }
         Some(v) => {
             let _ = writeln!(
                 s,
