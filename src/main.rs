@@ -243,7 +243,8 @@ enum Command {
         format: ReportFormat,
     },
     /// Recursion depth and stack size of a described pipeline (or of loose
-    /// shaders, assuming every trace reaches every shader).
+    /// shaders, assuming every trace reaches every shader whose incoming
+    /// payload matches its own).
     Stack {
         #[command(flatten)]
         common: Common,

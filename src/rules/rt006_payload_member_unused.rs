@@ -21,13 +21,15 @@ super::declare_rule! {
     /// payload has the same layout. It reports a member that no shader reads, or
     /// that no shader writes. Only the shaders the pipeline uses are modelled:
     /// those of the description, or, without one, the shaders of a folder under
-    /// the assumption that every trace reaches every shader. A payload is not
+    /// the assumption that every trace reaches every shader whose incoming
+    /// payload matches its own. A payload is not
     /// judged when its traces reach no shader with its layout, or when they can
     /// run a closest-hit shader and none with its layout is in the pipeline (a
-    /// folder whose hit shader did not compile). A reached shader that declares
-    /// another layout reads and writes the members that sit at the same offset
-    /// with the same shape (a shadow payload that starts like the main one,
-    /// handed to the main payload's any-hit shader).
+    /// folder whose hit shader did not compile). A shader the trace's SBT
+    /// operands select that declares another layout is not reached, but its
+    /// members that sit at the same offset with the same shape still count as
+    /// read and written (a shadow payload that starts like the main one, handed
+    /// to the main payload's any-hit shader, as public code does).
     ///
     /// A member is read where a load reaches it through an access chain from the
     /// payload variable, written where a store does. Loading or storing the whole

@@ -94,7 +94,10 @@ super::declare_rule! {
     /// description gives under `[constants]`. A cycle is bounded when each trace
     /// closing it is dominated by a comparison of a depth counter carried in the
     /// payload with such a bound and the traced payload's counter grows by a
-    /// constant. The note says what was found instead.
+    /// constant. The message names the trace that closes the cycle without a
+    /// bound, and the note says what was found instead. `rtlint stack` then
+    /// recommends a stack only on the condition that the recursion stops
+    /// within the declared depth (else the device's limit) and says so.
     ///
     /// Without a `*.pipeline.toml` (loose shaders, or a library described by
     /// its DXR subobjects) a bound read from a push constant or uniform is

@@ -82,7 +82,7 @@ fn run(ctx: &super::PipelineContext) -> Vec<Diagnostic> {
     let g = &ctx.recursion.graph;
     let mut out = Vec::new();
     // Per program and per trace, computed once: an undescribed pipeline has
-    // an edge from every trace to every hit group.
+    // an edge from every trace to every hit group that takes its payload.
     let reorder: Vec<bool> = pipeline.programs.iter().map(reorders).collect();
     let mut targets: std::collections::HashMap<(usize, usize), Vec<usize>> =
         std::collections::HashMap::new();
