@@ -495,16 +495,20 @@ fn group_admits(
     let Some(group) = pipeline.hit_groups.get(gi) else {
         return Admit::Yes;
     };
-    let mut incoming = Vec::new();
-    for s in [&group.closest_hit, &group.any_hit].into_iter().flatten() {
-        incoming.extend_from_slice(payloads.incoming(
-            &pipeline.programs,
-            s.program,
-            s.function,
-            s.stage,
-        ));
+    let shaders = [&group.closest_hit, &group.any_hit];
+    for s in shaders.into_iter().flatten() {
+        payloads.incoming(&pipeline.programs, s.program, s.function, s.stage);
     }
-    admit(traced, &incoming)
+    // Borrowed, not copied: a folder's loose pipeline asks once per trace
+    // and group.
+    let payloads = &*payloads;
+    admit(
+        traced,
+        shaders
+            .into_iter()
+            .flatten()
+            .flat_map(|s| payloads.incoming_known(s.program, s.function)),
+    )
 }
 
 /// A constant operand; a specialization constant counts with its default.

@@ -273,6 +273,26 @@ pub fn recursion_report(pipeline: &Pipeline) -> RecursionReport {
         At(u64),
         Unbounded,
     }
+    // A trace leaving a bounded cycle that the cycle's one counter guards
+    // too runs only from the levels the guard allows (once per site).
+    let exit_of = |e: &super::callgraph::Edge| -> Option<u64> {
+        let cy = cycles.iter().find(|cy| cy.nodes.contains(&e.from))?;
+        let guards: Vec<&Guard> = cy
+            .sites
+            .iter()
+            .filter_map(|s| s.guard.as_ref().ok())
+            .collect();
+        let g = guards.iter().max_by_key(|g| g.traces)?;
+        if guards.len() != cy.sites.len()
+            || guards
+                .iter()
+                .any(|o| o.key != g.key || o.step != g.step || o.initial != g.initial)
+        {
+            return None;
+        }
+        exit_levels(pipeline, &graph, e.from, e.inst, g)
+    };
+    let mut exit_memo: FxHashMap<(usize, usize), Option<u64>> = FxHashMap::default();
     let mut entry = vec![Lv::Unreached; sccs.len()];
     let mut pred: Vec<Option<(usize, usize)>> = vec![None; sccs.len()];
     for c in (0..sccs.len()).rev() {
@@ -297,22 +317,13 @@ pub fn recursion_report(pipeline: &Pipeline) -> RecursionReport {
             });
             // A trace leaving a bounded cycle that the cycle's one counter
             // guards too runs only from the levels the guard allows.
-            let guarded_exit = || {
-                let cy = cycles.iter().find(|cy| cy.nodes.contains(&e.from))?;
-                let guards: Vec<&Guard> = cy
-                    .sites
-                    .iter()
-                    .filter_map(|s| s.guard.as_ref().ok())
-                    .collect();
-                let g = guards.iter().max_by_key(|g| g.traces)?;
-                if guards.len() != cy.sites.len()
-                    || guards
-                        .iter()
-                        .any(|o| o.key != g.key || o.step != g.step || o.initial != g.initial)
-                {
-                    return None;
+            let mut guarded_exit = || {
+                if let Some(&k) = exit_memo.get(&(e.from, e.inst)) {
+                    return k;
                 }
-                exit_levels(pipeline, &graph, e.from, e.inst, g)
+                let k = exit_of(e);
+                exit_memo.insert((e.from, e.inst), k);
+                k
             };
             let top = match (entry[from], extra[from]) {
                 (Lv::At(_), Some(0)) if closes_cycle => Lv::Unreached,

@@ -196,17 +196,17 @@ fn run(ctx: &super::PipelineContext) -> Vec<Diagnostic> {
             continue;
         };
         let Some(var) = site.payload else { continue };
-        let Some(global) = program
+        if !program
             .globals
             .iter()
-            .find(|g| g.id == var && g.storage == StorageClass::RayPayloadKHR)
-        else {
-            continue;
-        };
-        let shape = payload_use::shape_of(program, global.ty);
-        if !shape.is_sized() {
+            .any(|g| g.id == var && g.storage == StorageClass::RayPayloadKHR)
+        {
             continue;
         }
+        // The traced payload's shape as the reach analysis took it (sized).
+        let Some(shape) = graph.payloads.traced_known(e.program, e.inst).cloned() else {
+            continue;
+        };
         let (Some(from), Some(to)) = (graph.nodes.get(e.from), graph.nodes.get(e.to)) else {
             continue;
         };
