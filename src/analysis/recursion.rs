@@ -1766,6 +1766,29 @@ mod tests {
         }
     }
 
+    /// A shadow ray guarded by the reflection's own counter leaves the
+    /// cycle only from the levels that guard allows (the shape of
+    /// Microsoft's procedural-geometry sample): GLSL with the shadow guard
+    /// in a helper and the reflection's inline, from 1 to 3, and HLSL with
+    /// both in helpers, from 0 to 3. Without that rule both needed 4.
+    #[test]
+    fn exit_guarded_by_the_cycle_counter() {
+        for v in ["g", "gV"] {
+            let p = loose(&[
+                &format!("fixtures/guards/shared.rgen.{v}.spv"),
+                &format!("fixtures/guards/shared.rchit.{v}.spv"),
+                &format!("fixtures/guards/shared.rmiss.{v}.spv"),
+                &format!("fixtures/guards/shared_shadow.rmiss.{v}.spv"),
+            ]);
+            let r = recursion_report(&p);
+            assert_eq!(r.required_depth, Some(3), "{v}");
+            let g = r.cycles[0].sites[0].guard.as_ref().unwrap();
+            assert_eq!((g.initial, g.bound, g.traces), (1, 3, 2), "{v}");
+        }
+        let r = recursion_report(&loose(&["fixtures/guards/shared_counter.hlsl"]));
+        assert_eq!(r.required_depth, Some(3));
+    }
+
     /// HLSL through rtlint: the traced payload is a fresh local written field
     /// by field from the incoming one (`next.depth = payload.depth + 1`);
     /// the shadow ray's flags sit in a local (skip closest hit: no cycle).
