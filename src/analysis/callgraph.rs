@@ -595,6 +595,31 @@ mod tests {
         ));
     }
 
+    /// A callable reaches only the callables whose incoming data has its
+    /// data's type; the other is selected by nothing (no edge, no
+    /// assumption) and kept as a mismatched edge.
+    #[test]
+    fn callables_by_data_type() {
+        let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/reach/callable");
+        let programs = ["caller.rgen.spv", "sky.rcall.spv", "counter.rcall.spv"]
+            .iter()
+            .map(|f| crate::front::load(&dir.join(f), crate::shader::Language::Spirv).unwrap())
+            .collect();
+        let g = trace_graph(&Pipeline::from_programs(programs));
+        let to: Vec<_> = g
+            .edges
+            .iter()
+            .map(|e| g.nodes[e.to].shader.file.clone())
+            .collect();
+        assert_eq!(to, [dir.join("sky.rcall.spv")], "{:?}", g.edges);
+        assert_eq!(g.mismatched.len(), 1);
+        assert_eq!(
+            g.nodes[g.mismatched[0].to].shader.file,
+            dir.join("counter.rcall.spv")
+        );
+        assert_eq!(g.assumptions, [Assumption::Undescribed]);
+    }
+
     #[test]
     fn instances_any_hit_and_opaque_geometry() {
         let mut p = pipeline("fixtures/pipelines/procedural.pipeline.toml");
