@@ -132,6 +132,13 @@ pub fn human(r: &StackReport) -> String {
                 formula_text(&f.stage_max, d)
             );
         }
+        if let Some(d) = r.assumed_depth.filter(|&d| r.declared_depth != Some(d)) {
+            let _ = writeln!(
+                s,
+                "  Vulkan/DXR default, assumed depth {d}: {}",
+                formula_text(&f.stage_max, d)
+            );
+        }
         let _ = writeln!(s, "  exact call-chain maximum: {}", opt(f.exact_call_chain));
     };
     block("full model", &r.model);
