@@ -595,6 +595,31 @@ mod tests {
         ));
     }
 
+    /// With a description the payload removes edges the SBT allows: the
+    /// shadow trace's record (hit group 1) made a copy of the radiance group
+    /// selects a closest hit that takes another payload.
+    #[test]
+    fn description_edges_removed_by_payload() {
+        let mut p = pipeline("fixtures/reach/scene.pipeline.toml");
+        p.hit_groups[1] = p.hit_groups[0].clone();
+        let g = trace_graph(&p);
+        let shadow_hit = |e: &Edge| {
+            g.nodes[e.from].shader.stage == Stage::ClosestHit
+                && g.nodes[e.to].shader.stage == Stage::ClosestHit
+                && g.nodes[e.to].slot == Slot::HitGroup(1)
+        };
+        assert!(!g.edges.iter().any(shadow_hit), "{:?}", g.edges);
+        // Once from each of the two nodes of the closest hit (groups 0, 1).
+        assert_eq!(g.mismatched.iter().filter(|e| shadow_hit(e)).count(), 2);
+        // The reflection still reaches group 0 and nothing had to be assumed.
+        assert!(g
+            .edges
+            .iter()
+            .any(|e| g.nodes[e.from].shader.stage == Stage::ClosestHit
+                && g.nodes[e.to].slot == Slot::HitGroup(0)));
+        assert!(g.assumptions.is_empty(), "{:?}", g.assumptions);
+    }
+
     /// A callable reaches only the callables whose incoming data has its
     /// data's type; the other is selected by nothing (no edge, no
     /// assumption) and kept as a mismatched edge.
