@@ -144,6 +144,18 @@ impl fmt::Display for NoLoopBound {
     }
 }
 
+impl fmt::Display for crate::analysis::reach::Ambiguity {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        use crate::analysis::reach::Ambiguity;
+        f.write_str(match self {
+            Ambiguity::TracedPayloadUnknown => "its payload is not a declared variable, so it is taken to reach every shader it can select",
+            Ambiguity::TracedPayloadUnsized => "its payload type has no defined size, so it is taken to reach every shader it can select",
+            Ambiguity::IncomingUnsized => "it is taken to reach a shader whose incoming payload type has no defined size",
+            Ambiguity::NoMissTakesPayload => "no miss shader given takes its payload; its level is counted with the miss shaders it can select",
+        })
+    }
+}
+
 /// ` at file:line:col`, or nothing.
 fn at(l: &Option<crate::shader::Location>) -> String {
     l.as_ref().map(|l| format!(" at {l}")).unwrap_or_default()
@@ -153,11 +165,12 @@ impl fmt::Display for Assumption {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
             Assumption::Undescribed => f.write_str(
-                "no pipeline description: every trace may reach every hit group and miss shader",
+                "no pipeline description: every trace may reach every hit group and miss shader whose incoming payload matches its own",
             ),
             Assumption::FromSubobjects => f.write_str(
-                "pipeline described by DXR subobjects, which do not give the shader table's order: every trace may reach every hit group and miss shader",
+                "pipeline described by DXR subobjects, which do not give the shader table's order: every trace may reach every hit group and miss shader whose incoming payload matches its own",
             ),
+            Assumption::PayloadUnmatched { at: l, why } => write!(f, "trace{}: {why}", at(l)),
             Assumption::DynamicSbtOffset { at: l } => write!(
                 f,
                 "trace{} has a SBT offset or stride unknown at compile time: it may reach every hit group",
@@ -171,9 +184,10 @@ impl fmt::Display for Assumption {
             Assumption::NoDeclaredDepth => {
                 f.write_str("no declared depth: default formulas use the required depth only")
             }
-            Assumption::UnboundedRecursion(why) => write!(
+            Assumption::UnboundedRecursion { why, at: l } => write!(
                 f,
-                "recursion is unbounded at compile time ({why}): no exact call-chain value"
+                "recursion is unbounded at compile time: the trace{} closes a cycle and {why}; no exact call-chain value",
+                at(l)
             ),
             Assumption::InitialValueAssumed { counter } => write!(
                 f,

@@ -286,7 +286,8 @@ pub fn check_paths(paths: &[PathBuf], options: &Options) -> Report {
         diagnostics.extend(c.diagnostics);
     }
     // Shaders no description uses still get the pipeline rules, under the
-    // assumption that every trace reaches every shader.
+    // assumption that every trace reaches every shader that takes its
+    // payload.
     for (_, _, found) in groups {
         diagnostics.extend(found.into_iter().flatten());
     }

@@ -224,7 +224,8 @@ enum Command {
         format: ReportFormat,
     },
     /// Recursion depth and stack size of a described pipeline (or of loose
-    /// shaders, assuming every trace reaches every shader).
+    /// shaders, assuming every trace reaches every shader whose incoming
+    /// payload matches its own).
     #[command(after_help = DXC_HELP)]
     Stack {
         #[command(flatten)]

@@ -545,3 +545,177 @@ fn driver_takes_the_register_shifts_the_shaders_were_compiled_with() {
     );
     assert!(message.contains("`-fvk-b-shift N SET`"), "{message}");
 }
+
+/// `rtlint check --format concise` lines (`path:line: level[CODE] …`).
+fn concise(args: &[&str]) -> Vec<String> {
+    let o = rtlint()
+        .args(["check", "--format", "concise"])
+        .args(args)
+        .output()
+        .unwrap();
+    String::from_utf8_lossy(&o.stdout)
+        .lines()
+        .filter(|l| l.contains("[RT"))
+        .map(str::to_owned)
+        .collect()
+}
+
+/// Issue 26: a closest hit that reflects while `payload.depth < 3` and
+/// traces an unflagged shadow ray with its own payload. A trace reaches only
+/// the shaders whose incoming payload matches its own, so the shadow ray
+/// does not close a cycle through the radiance closest hit: the loose
+/// folder, the DXR subobjects and the description all need depth 5 (hits at
+/// levels 1–4, the deepest one's shadow miss at 5), and the loose and
+/// subobject forms never recommend less than the description.
+#[test]
+fn reach_by_payload_gives_one_depth_in_every_form() {
+    let glsl: Vec<String> = ["camera.rgen", "radiance.rchit", "sky.rmiss", "shadow.rmiss"]
+        .iter()
+        .map(|f| format!("fixtures/reach/glsl/{f}.spv"))
+        .collect();
+    let glsl: Vec<&str> = glsl.iter().map(String::as_str).collect();
+    let described = |p: &str| json(&["stack", "--format", "json", p])["pipelines"][0].clone();
+    for (forms, description) in [
+        (
+            vec![
+                vec!["fixtures/reach/loose.hlsl"],
+                vec!["fixtures/reach/library.hlsl"],
+            ],
+            "fixtures/reach/scene.pipeline.toml",
+        ),
+        (vec![glsl.clone()], "fixtures/reach/glsl.pipeline.toml"),
+    ] {
+        let d = described(description);
+        assert_eq!(d["required_depth"], 5, "{description}");
+        assert_eq!(d["declared_depth"], 5, "{description}");
+        let floor = d["recommended"].as_u64().unwrap();
+        for inputs in forms {
+            let mut args = vec!["stack", "--format", "json"];
+            args.extend(&inputs);
+            let r = json(&args)["pipelines"][0].clone();
+            assert_eq!(r["required_depth"], 5, "{inputs:?}");
+            assert!(r["assumed_depth"].is_null(), "{inputs:?}");
+            let rec = r["recommended"].as_u64().unwrap();
+            assert!(rec >= floor, "{inputs:?}: {rec} < {floor}");
+            let chain = r["depth_chain"].as_str().unwrap();
+            assert!(chain.ends_with("at level 5"), "{chain}");
+        }
+    }
+    // The findings: RT020 on the reflection only, RT030 on the shadow ray
+    // (it only records hit or miss and lacks AcceptFirstHit), RT021 where a
+    // description declares less than 5.
+    for (inputs, reflection, shadow) in [
+        (
+            vec!["fixtures/reach/loose.hlsl"],
+            "scene.hlsli:37",
+            "scene.hlsli:31",
+        ),
+        (glsl.clone(), "radiance.rchit:21", "radiance.rchit:16"),
+    ] {
+        let mut args = vec!["--select", "RT020,RT021,RT030"];
+        args.extend(&inputs);
+        let lines = concise(&args);
+        let at = |code: &str, place: &str| {
+            lines
+                .iter()
+                .filter(|l| l.contains(code) && l.contains(place))
+                .count()
+        };
+        assert_eq!(at("[RT020]", reflection), 1, "{lines:#?}");
+        assert_eq!(at("[RT020]", shadow), 0, "{lines:#?}");
+        assert_eq!(at("[RT030]", shadow), 1, "{lines:#?}");
+        assert_eq!(at("[RT021]", ""), 0, "no declared depth: {lines:#?}");
+    }
+    let lines = concise(&["--select", "RT021", "fixtures/reach/shallow.pipeline.toml"]);
+    assert_eq!(lines.len(), 1, "{lines:#?}");
+    assert!(
+        lines[0].contains("needs recursion depth 5, above the declared 3"),
+        "{lines:#?}"
+    );
+}
+
+/// A shadow ray guarded by the reflection's own depth counter, in helpers
+/// that return early at the maximum (as Microsoft's procedural-geometry
+/// sample writes it): the deepest hit traces nothing, so the declared 3 is
+/// enough and RT021 stays silent.
+#[test]
+fn shadow_ray_guarded_by_the_reflection_counter() {
+    let r = json(&[
+        "stack",
+        "--format",
+        "json",
+        "fixtures/guards/shared_counter.hlsl",
+    ])["pipelines"][0]
+        .clone();
+    assert_eq!(r["declared_depth"], 3);
+    assert_eq!(r["required_depth"], 3);
+    assert!(concise(&["--select", "RT021", "fixtures/guards/shared_counter.hlsl"]).is_empty());
+}
+
+/// Recursion without a bound known at compile time: the recommendation is
+/// conditional on the depth it assumes (the declared one, else the device's
+/// limit) and never the smaller figure alone; the note and RT024 name the
+/// trace that closes the cycle.
+#[test]
+fn unbounded_recursion_gives_a_conditional_recommendation() {
+    let r = json(&[
+        "stack",
+        "--format",
+        "json",
+        "fixtures/RT024/bad.pipeline.toml",
+    ])["pipelines"][0]
+        .clone();
+    assert!(r["required_depth"].is_null());
+    assert_eq!(r["assumed_depth"], 5);
+    assert_eq!(r["recommended"], r["model"]["vulkan_default"]);
+    let text = |args: &[&str]| {
+        let o = rtlint().args(args).output().unwrap();
+        String::from_utf8_lossy(&o.stdout).into_owned()
+    };
+    let t = text(&["stack", "fixtures/RT024/bad.pipeline.toml"]);
+    assert!(t.contains("recommended (conditional): "), "{t}");
+    assert!(
+        t.contains("assumes the recursion stops within depth 5 (the declared depth)"),
+        "{t}"
+    );
+    assert!(
+        t.contains("the trace at fixtures/pipelines/recursive/reflect.rchit:26 closes a cycle"),
+        "{t}"
+    );
+    // No declared depth: the device's limit (31) is assumed, and the
+    // recommendation covers it.
+    let r = json(&[
+        "stack",
+        "--format",
+        "json",
+        "fixtures/guards/two_calls.wgsl",
+    ])["pipelines"][0]
+        .clone();
+    assert!(r["required_depth"].is_null());
+    assert_eq!(r["assumed_depth"], 31);
+    let m = &r["model"]["stage_max"];
+    let at31 = m["raygen"].as_u64().unwrap()
+        + m["closest_hit"]
+            .as_u64()
+            .unwrap()
+            .max(m["miss"].as_u64().unwrap())
+            .max(m["intersection"].as_u64().unwrap() + m["any_hit"].as_u64().unwrap())
+        + 30 * m["closest_hit"]
+            .as_u64()
+            .unwrap()
+            .max(m["miss"].as_u64().unwrap())
+        + 2 * m["callable"].as_u64().unwrap();
+    assert!(r["recommended"].as_u64().unwrap() >= at31, "{r}");
+    let t = text(&["stack", "fixtures/guards/two_calls.wgsl"]);
+    assert!(
+        t.contains("assumes the recursion stops within depth 31 (the device's limit)"),
+        "{t}"
+    );
+    let lines = concise(&["--select", "RT024", "fixtures/RT024/bad.pipeline.toml"]);
+    assert!(
+        lines.iter().any(|l| l.contains(
+            "is unbounded at compile time: the trace at fixtures/pipelines/recursive/reflect.rchit:26 has no depth bound"
+        )),
+        "{lines:#?}"
+    );
+}

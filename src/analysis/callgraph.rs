@@ -8,6 +8,7 @@
 //! target and the graph says so. Constant ray flags prune targets: skipping
 //! closest-hit shaders, opaque rays (no any-hit), culled triangles or AABBs.
 
+use super::reach::{admit, Admit, Ambiguity, Payloads};
 use crate::diag::Location;
 pub use crate::pipeline::Slot;
 use crate::pipeline::{HitGroupKind, Pipeline, ShaderRef};
@@ -40,9 +41,19 @@ pub enum Assumption {
     /// No declared depth: the default formulas use the required depth only.
     NoDeclaredDepth,
     /// Recursion with no bound known at compile time, and why.
-    UnboundedRecursion(super::recursion::NoGuard),
+    UnboundedRecursion {
+        why: super::recursion::NoGuard,
+        /// The trace that closes the cycle without a bound.
+        at: Option<Location>,
+    },
     /// A depth counter with no constant initial value: 0 was assumed.
     InitialValueAssumed { counter: String },
+    /// A trace or callable taken to reach a shader whose incoming payload
+    /// could not be compared with its own.
+    PayloadUnmatched {
+        at: Option<Location>,
+        why: super::reach::Ambiguity,
+    },
     /// The driver's numbers come from this device.
     Driver { device: String, driver: String },
     /// The recommended stack was below what the driver's own numbers need
@@ -67,6 +78,12 @@ impl Assumption {
                 at.is_none(),
                 at.as_ref().map(|l| l.to_string()).unwrap_or_default(),
                 1,
+            ),
+            Assumption::PayloadUnmatched { at, .. } => (
+                1,
+                at.is_none(),
+                at.as_ref().map(|l| l.to_string()).unwrap_or_default(),
+                2,
             ),
             _ => (2, false, String::new(), 0),
         }
@@ -101,6 +118,10 @@ pub struct Edge {
     pub program: usize,
     pub inst: usize,
     pub location: Option<Location>,
+    /// Kept only so that the trace's level counts: no miss shader given
+    /// takes the trace's payload, this one included. Rules that judge what
+    /// the reached shaders do leave it out.
+    pub fallback: bool,
 }
 
 #[derive(Clone, Debug, Default)]
@@ -111,6 +132,13 @@ pub struct TraceGraph {
     pub assumptions: Vec<Assumption>,
     /// Sites selecting a group or miss shader the pipeline does not have.
     pub out_of_range: Vec<(Option<Location>, OutOfRange)>,
+    /// The traced and incoming payloads reach was decided by.
+    pub payloads: Payloads,
+    /// Sites and the shaders their SBT operands and flags select but whose
+    /// incoming payload differs from theirs: not reached (the languages
+    /// require the same type), kept for rules about mismatched payloads and
+    /// for code that reads a shared prefix of two payloads.
+    pub mismatched: Vec<Edge>,
 }
 
 impl TraceGraph {
@@ -159,6 +187,7 @@ pub fn trace_graph(pipeline: &Pipeline) -> TraceGraph {
         g.assumptions.push(Assumption::Undescribed);
     }
     let described = pipeline.described();
+    let mut payloads = Payloads::default();
     for from in 0..g.nodes.len() {
         let (program_index, entry_function) = {
             let s = &g.nodes[from].shader;
@@ -203,6 +232,9 @@ pub fn trace_graph(pipeline: &Pipeline) -> TraceGraph {
                 .location_in(site.inst, chain)
                 .or_else(|| program.site_location(site.inst));
             let mut targets: Vec<usize> = Vec::new();
+            // Selected by the SBT but not taking this payload.
+            let mut mismatched: Vec<usize> = Vec::new();
+            let mut fallback: Vec<usize> = Vec::new();
             // Operands the shader's calls agree on; else as the site has them.
             let mut per_chain = chains.iter().map(|c| program.trace_operands_in(site, c));
             let operands = match per_chain.next() {
@@ -292,6 +324,30 @@ pub fn trace_graph(pipeline: &Pipeline) -> TraceGraph {
                         targets.push(n);
                     }
                 }
+                // Of those, the groups whose shaders take this payload.
+                let traced = payloads.traced(&pipeline.programs, program_index, site.inst);
+                let mut admitted: Vec<(usize, Admit)> = Vec::new();
+                targets.retain(|&n| {
+                    let Slot::HitGroup(gi) = g.nodes[n].slot else {
+                        return true;
+                    };
+                    let a = match admitted.iter().find(|(k, _)| *k == gi) {
+                        Some(&(_, a)) => a,
+                        None => {
+                            let a = group_admits(pipeline, &mut payloads, gi, &traced);
+                            admitted.push((gi, a));
+                            a
+                        }
+                    };
+                    if !a.reaches() {
+                        mismatched.push(n);
+                    }
+                    a.reaches()
+                });
+                let mut why = admitted.iter().find_map(|(_, a)| match a {
+                    Admit::Assumed(w) => Some(*w),
+                    _ => None,
+                });
                 // The miss shader reached (`None`: all of them).
                 let miss: Option<usize> = match (described, const_of(t.miss_index)) {
                     (true, Some(m)) => {
@@ -314,15 +370,53 @@ pub fn trace_graph(pipeline: &Pipeline) -> TraceGraph {
                     }
                     _ => None,
                 };
+                let mut refused = Vec::new();
                 for (n, node) in g.nodes.iter().enumerate() {
                     let Slot::Miss(m) = node.slot else {
                         continue;
                     };
-                    if miss.map_or(m < pipeline.miss.len(), |x| x == m) {
-                        targets.push(n);
+                    if !miss.map_or(m < pipeline.miss.len(), |x| x == m) {
+                        continue;
+                    }
+                    let s = &node.shader;
+                    match admit(
+                        &traced,
+                        payloads.incoming(&pipeline.programs, s.program, s.function, s.stage),
+                    ) {
+                        Admit::No => refused.push(n),
+                        a => {
+                            if let Admit::Assumed(w) = a {
+                                why.get_or_insert(w);
+                            }
+                            targets.push(n);
+                        }
                     }
                 }
+                // A trace runs a hit group or a miss shader; the trace itself
+                // takes a recursion level whatever it runs. When no miss
+                // shader given takes its payload, the one it runs is missing
+                // (a folder without the shadow miss) or mismatched: keep the
+                // candidates so the level counts, and say so.
+                if !refused.is_empty()
+                    && !targets
+                        .iter()
+                        .any(|&n| matches!(g.nodes[n].slot, Slot::Miss(_)))
+                {
+                    fallback.extend_from_slice(&refused);
+                    targets.extend(refused);
+                    why.get_or_insert(Ambiguity::NoMissTakesPayload);
+                } else {
+                    mismatched.extend(refused);
+                }
+                if let Some(why) = why {
+                    g.assumptions.push(Assumption::PayloadUnmatched {
+                        at: location.clone(),
+                        why,
+                    });
+                }
             } else {
+                let traced = payloads.traced(&pipeline.programs, program_index, site.inst);
+                let mut why = None;
                 // The callable reached (`None`: all of them).
                 let callable: Option<usize> = match (
                     described,
@@ -335,9 +429,28 @@ pub fn trace_graph(pipeline: &Pipeline) -> TraceGraph {
                     let Slot::Callable(c) = node.slot else {
                         continue;
                     };
-                    if callable.map_or(c < pipeline.callable.len(), |x| x == c) {
-                        targets.push(n);
+                    if !callable.map_or(c < pipeline.callable.len(), |x| x == c) {
+                        continue;
                     }
+                    let s = &node.shader;
+                    match admit(
+                        &traced,
+                        payloads.incoming(&pipeline.programs, s.program, s.function, s.stage),
+                    ) {
+                        Admit::No => mismatched.push(n),
+                        a => {
+                            if let Admit::Assumed(w) = a {
+                                why.get_or_insert(w);
+                            }
+                            targets.push(n);
+                        }
+                    }
+                }
+                if let Some(why) = why {
+                    g.assumptions.push(Assumption::PayloadUnmatched {
+                        at: location.clone(),
+                        why,
+                    });
                 }
             }
             for to in targets {
@@ -348,13 +461,54 @@ pub fn trace_graph(pipeline: &Pipeline) -> TraceGraph {
                     program: program_index,
                     inst: site.inst,
                     location: location.clone(),
+                    fallback: fallback.contains(&to),
+                });
+            }
+            for to in mismatched {
+                g.mismatched.push(Edge {
+                    from,
+                    to,
+                    kind,
+                    program: program_index,
+                    inst: site.inst,
+                    location: location.clone(),
+                    fallback: false,
                 });
             }
         }
     }
     g.assumptions.sort_by_key(Assumption::sort_key);
     g.assumptions.dedup();
+    g.payloads = payloads;
     g
+}
+
+/// Whether hit group `gi` takes payload `traced`: one of its closest-hit
+/// and any-hit shaders declares a matching incoming payload, or none
+/// declares one (an intersection shader alone takes no payload).
+fn group_admits(
+    pipeline: &Pipeline,
+    payloads: &mut Payloads,
+    gi: usize,
+    traced: &Result<super::layout::Shape, super::reach::Ambiguity>,
+) -> Admit {
+    let Some(group) = pipeline.hit_groups.get(gi) else {
+        return Admit::Yes;
+    };
+    let shaders = [&group.closest_hit, &group.any_hit];
+    for s in shaders.into_iter().flatten() {
+        payloads.incoming(&pipeline.programs, s.program, s.function, s.stage);
+    }
+    // Borrowed, not copied: a folder's loose pipeline asks once per trace
+    // and group.
+    let payloads = &*payloads;
+    admit(
+        traced,
+        shaders
+            .into_iter()
+            .flatten()
+            .flat_map(|s| payloads.incoming_known(s.program, s.function)),
+    )
 }
 
 /// A constant operand; a specialization constant counts with its default.
@@ -427,9 +581,68 @@ mod tests {
             .collect();
         let g = trace_graph(&Pipeline::from_programs(programs));
         // The shadow ray still skips the closest hit; the miss index is not
-        // resolved without a description.
+        // resolved without a description. The folder lacks the radiance
+        // miss shader: the raygen's trace keeps the shadow miss as its
+        // candidate (its level counts) and says so.
         assert_eq!(g.edges.len(), 3);
-        assert_eq!(g.assumptions.len(), 1);
+        assert_eq!(g.assumptions.len(), 2);
+        assert!(matches!(
+            g.assumptions[1],
+            Assumption::PayloadUnmatched {
+                why: crate::analysis::reach::Ambiguity::NoMissTakesPayload,
+                ..
+            }
+        ));
+    }
+
+    /// With a description the payload removes edges the SBT allows: the
+    /// shadow trace's record (hit group 1) made a copy of the radiance group
+    /// selects a closest hit that takes another payload.
+    #[test]
+    fn description_edges_removed_by_payload() {
+        let mut p = pipeline("fixtures/reach/scene.pipeline.toml");
+        p.hit_groups[1] = p.hit_groups[0].clone();
+        let g = trace_graph(&p);
+        let shadow_hit = |e: &Edge| {
+            g.nodes[e.from].shader.stage == Stage::ClosestHit
+                && g.nodes[e.to].shader.stage == Stage::ClosestHit
+                && g.nodes[e.to].slot == Slot::HitGroup(1)
+        };
+        assert!(!g.edges.iter().any(shadow_hit), "{:?}", g.edges);
+        // Once from each of the two nodes of the closest hit (groups 0, 1).
+        assert_eq!(g.mismatched.iter().filter(|e| shadow_hit(e)).count(), 2);
+        // The reflection still reaches group 0 and nothing had to be assumed.
+        assert!(g
+            .edges
+            .iter()
+            .any(|e| g.nodes[e.from].shader.stage == Stage::ClosestHit
+                && g.nodes[e.to].slot == Slot::HitGroup(0)));
+        assert!(g.assumptions.is_empty(), "{:?}", g.assumptions);
+    }
+
+    /// A callable reaches only the callables whose incoming data has its
+    /// data's type; the other is selected by nothing (no edge, no
+    /// assumption) and kept as a mismatched edge.
+    #[test]
+    fn callables_by_data_type() {
+        let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/reach/callable");
+        let programs = ["caller.rgen.spv", "sky.rcall.spv", "counter.rcall.spv"]
+            .iter()
+            .map(|f| crate::front::load(&dir.join(f), crate::shader::Language::Spirv).unwrap())
+            .collect();
+        let g = trace_graph(&Pipeline::from_programs(programs));
+        let to: Vec<_> = g
+            .edges
+            .iter()
+            .map(|e| g.nodes[e.to].shader.file.clone())
+            .collect();
+        assert_eq!(to, [dir.join("sky.rcall.spv")], "{:?}", g.edges);
+        assert_eq!(g.mismatched.len(), 1);
+        assert_eq!(
+            g.nodes[g.mismatched[0].to].shader.file,
+            dir.join("counter.rcall.spv")
+        );
+        assert_eq!(g.assumptions, [Assumption::Undescribed]);
     }
 
     #[test]

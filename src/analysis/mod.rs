@@ -8,6 +8,7 @@ pub mod liveness;
 pub mod payload_use;
 pub mod rayquery;
 pub mod rays;
+pub mod reach;
 pub mod recursion;
 pub mod stack;
 pub mod trace_sites;

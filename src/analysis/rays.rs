@@ -469,40 +469,6 @@ fn member_path(program: &Program, ptr: Id) -> Vec<u32> {
     first.map(|f| vec![f]).unwrap_or_default()
 }
 
-/// A structural signature of a type, for matching a caller's payload with
-/// a callee's.
-pub fn signature(program: &Program, ty: Id) -> String {
-    fn go(p: &Program, ty: Id, depth: u32) -> String {
-        if depth > 16 {
-            return "?".into();
-        }
-        match p.ty(ty) {
-            Some(Type::Bool) => "b".into(),
-            Some(Type::Int { width, signed }) => {
-                format!("{}{width}", if *signed { "i" } else { "u" })
-            }
-            Some(Type::Float { width }) => format!("f{width}"),
-            Some(Type::Vector { elem, count }) => format!("v{count}{}", go(p, *elem, depth + 1)),
-            Some(Type::Matrix { column, columns }) => {
-                format!("m{columns}{}", go(p, *column, depth + 1))
-            }
-            Some(Type::Array { elem, len }) => {
-                format!("a{}{}", len.value().unwrap_or(0), go(p, *elem, depth + 1))
-            }
-            Some(Type::Struct { members }) => format!(
-                "s({})",
-                members
-                    .iter()
-                    .map(|m| go(p, *m, depth + 1))
-                    .collect::<Vec<_>>()
-                    .join(",")
-            ),
-            _ => "?".into(),
-        }
-    }
-    go(program, ty, 0)
-}
-
 /// A trace whose every reachable shader can only record hit or miss.
 #[derive(Clone, Debug)]
 pub struct VisibilityTrace {
@@ -529,12 +495,17 @@ pub struct TraceTargets {
     pub targets: Vec<usize>,
 }
 
-/// The trace edges of a graph grouped by site and caller.
+/// The trace edges of a graph grouped by site and caller (without the
+/// fallback edges that only count a level).
 pub fn trace_targets(graph: &TraceGraph) -> Vec<TraceTargets> {
     let mut out: Vec<TraceTargets> = Vec::new();
     // (from, program, inst) → index in `out`, which keeps first-seen order.
     let mut index = std::collections::HashMap::new();
-    for e in graph.edges.iter().filter(|e| e.kind == EdgeKind::Trace) {
+    for e in graph
+        .edges
+        .iter()
+        .filter(|e| e.kind == EdgeKind::Trace && !e.fallback)
+    {
         match index.get(&(e.from, e.program, e.inst)) {
             Some(&i) => {
                 let t: &mut TraceTargets = &mut out[i];
@@ -579,9 +550,9 @@ pub fn trace_payload_ty(program: &Program, inst: usize) -> Option<Id> {
     }
 }
 
-/// Traces of a pipeline that are visibility tests. Without a description,
-/// a shader whose incoming payload differs in type from the trace's is not
-/// taken as reachable (the driver could not pass it that payload).
+/// Traces of a pipeline that are visibility tests, over the shaders each
+/// reaches (the reach analysis leaves out those whose incoming payload
+/// differs from the trace's).
 pub fn visibility_traces(pipeline: &Pipeline, graph: &TraceGraph) -> Vec<VisibilityTrace> {
     let mut out = Vec::new();
     // Per shader, not per trace and target: a folder's loose pipeline joins
@@ -596,7 +567,6 @@ pub fn visibility_traces(pipeline: &Pipeline, graph: &TraceGraph) -> Vec<Visibil
             continue;
         };
         let payload_ty = trace_payload_ty(program, t.inst);
-        let sig = payload_ty.map(|ty| signature(program, ty));
         let mut written = BTreeSet::new();
         let mut closest_hits = Vec::new();
         let mut recording = 0;
@@ -611,15 +581,6 @@ pub fn visibility_traces(pipeline: &Pipeline, graph: &TraceGraph) -> Vec<Visibil
             let u = uses
                 .entry((node.shader.program, node.shader.function))
                 .or_insert_with(|| payload_use(callee, node.shader.function));
-            if !pipeline.described() {
-                let matches = match (&sig, u.ty) {
-                    (Some(s), Some(ty)) => signature(callee, ty) == *s,
-                    _ => true,
-                };
-                if !matches {
-                    continue;
-                }
-            }
             if node.shader.stage == Stage::Intersection {
                 continue;
             }
@@ -640,11 +601,17 @@ pub fn visibility_traces(pipeline: &Pipeline, graph: &TraceGraph) -> Vec<Visibil
         }
         // Without a description, a trace that can run closest-hit shaders
         // but reaches none may be missing its own (a shader of the folder
-        // that could not be read): do not judge it.
+        // that could not be read): do not judge it, unless the folder has
+        // closest-hit shaders, none takes this payload, and a miss shader
+        // does (a shadow ray type, whose hit group often has no closest hit).
         let skips_closest_hit = flags & flags::SKIP_CLOSEST_HIT != 0;
+        let own_miss = pipeline.hit_groups.iter().any(|g| g.closest_hit.is_some())
+            && t.targets
+                .iter()
+                .any(|&n| graph.nodes[n].shader.stage == Stage::Miss);
         if !visibility
             || !any_writer
-            || (!pipeline.described() && !skips_closest_hit && closest_hits.is_empty())
+            || (!pipeline.described() && !skips_closest_hit && closest_hits.is_empty() && !own_miss)
         {
             continue;
         }

@@ -118,6 +118,8 @@ pub struct Guard {
     /// How many times the cycle can trace in one chain.
     pub traces: u64,
     pub location: Option<Location>,
+    /// The incoming payload variable and member path of the counter.
+    pub key: (Id, Vec<u64>),
 }
 
 /// One trace site that closes a cycle.
@@ -271,6 +273,26 @@ pub fn recursion_report(pipeline: &Pipeline) -> RecursionReport {
         At(u64),
         Unbounded,
     }
+    // A trace leaving a bounded cycle that the cycle's one counter guards
+    // too runs only from the levels the guard allows (once per site).
+    let exit_of = |e: &super::callgraph::Edge| -> Option<u64> {
+        let cy = cycles.iter().find(|cy| cy.nodes.contains(&e.from))?;
+        let guards: Vec<&Guard> = cy
+            .sites
+            .iter()
+            .filter_map(|s| s.guard.as_ref().ok())
+            .collect();
+        let g = guards.iter().max_by_key(|g| g.traces)?;
+        if guards.len() != cy.sites.len()
+            || guards
+                .iter()
+                .any(|o| o.key != g.key || o.step != g.step || o.initial != g.initial)
+        {
+            return None;
+        }
+        exit_levels(pipeline, &graph, e.from, e.inst, g)
+    };
+    let mut exit_memo: FxHashMap<(usize, usize), Option<u64>> = FxHashMap::default();
     let mut entry = vec![Lv::Unreached; sccs.len()];
     let mut pred: Vec<Option<(usize, usize)>> = vec![None; sccs.len()];
     for c in (0..sccs.len()).rev() {
@@ -293,10 +315,24 @@ pub fn recursion_report(pipeline: &Pipeline) -> RecursionReport {
                         .iter()
                         .any(|s| s.program == e.program && s.inst == e.inst)
             });
+            // A trace leaving a bounded cycle that the cycle's one counter
+            // guards too runs only from the levels the guard allows.
+            let mut guarded_exit = || {
+                if let Some(&k) = exit_memo.get(&(e.from, e.inst)) {
+                    return k;
+                }
+                let k = exit_of(e);
+                exit_memo.insert((e.from, e.inst), k);
+                k
+            };
             let top = match (entry[from], extra[from]) {
                 (Lv::At(_), Some(0)) if closes_cycle => Lv::Unreached,
                 (Lv::At(l), Some(x)) if closes_cycle => Lv::At(l + x),
-                (Lv::At(l), Some(x)) => Lv::At(l + x + 1),
+                (Lv::At(l), Some(x)) => match guarded_exit() {
+                    Some(0) => Lv::Unreached,
+                    Some(k) => Lv::At(l + k.min(x + 1)),
+                    None => Lv::At(l + x + 1),
+                },
                 (Lv::Unreached, _) => Lv::Unreached,
                 _ => Lv::Unbounded,
             };
@@ -1239,12 +1275,73 @@ fn recognise_guard(
                 location: program
                     .inst_location(term)
                     .or_else(|| program.site_location(term)),
+                key: (counter_var(&counter), path.clone()),
             });
         }
     }
     Err(why_not.unwrap_or(NoGuard::NoComparison {
         counter: seen_counter,
     }))
+}
+
+fn counter_var(c: &Counter) -> Id {
+    let (Counter::Payload { var, .. } | Counter::Var { var, .. }) = c;
+    *var
+}
+
+/// How many of a bounded cycle's levels a trace that leaves it (a shadow
+/// ray) runs from, when the cycle's own counter guards it too: the samples
+/// write `if (payload.depth < MAX)` before the shadow ray as before the
+/// reflection. `None` when no such guard dominates the trace (it may run
+/// at every level). The cycle is entered with the counter at `g.initial`
+/// and each level adds `g.step`.
+fn exit_levels(
+    pipeline: &Pipeline,
+    graph: &TraceGraph,
+    node: usize,
+    site_inst: usize,
+    g: &Guard,
+) -> Option<u64> {
+    let shader = &graph.nodes[node].shader;
+    let program = pipeline.program(shader)?;
+    let site = program.sites.iter().find(|s| s.inst == site_inst)?;
+    let f = program.functions.get(site.function)?;
+    let chains = call_chains(program, shader.function, f.id, super::liveness::MAX_CHAINS);
+    let mut points = vec![site_inst];
+    if let Some(chain) = chains.first() {
+        points.extend(chain.iter().rev().copied());
+    }
+    let mut fewest: Option<u64> = None;
+    for &p in &points {
+        let Some(fi) = program
+            .function_of(p)
+            .filter(|&i| i < program.functions.len())
+        else {
+            continue;
+        };
+        for (rel, _) in dominating_relations(program, fi, p) {
+            let Some(counter @ Counter::Payload { .. }) = counter_of(program, rel.lhs) else {
+                continue;
+            };
+            let Counter::Payload { var, path } = &counter else {
+                continue;
+            };
+            if (*var, path) != (g.key.0, &g.key.1) {
+                continue;
+            }
+            let Ok((bound, _)) = bound_of(program, rel.rhs, &pipeline.constants) else {
+                continue;
+            };
+            let limit = if rel.strict { bound } else { bound + 1 };
+            let levels = if limit <= g.initial {
+                0
+            } else {
+                ((limit - g.initial) as u64).div_ceil(g.step as u64)
+            };
+            fewest = Some(fewest.map_or(levels, |f| f.min(levels)));
+        }
+    }
+    fewest
 }
 
 /// By how much the traced payload's copy of the counter exceeds the
@@ -1667,6 +1764,29 @@ mod tests {
                 "{v}"
             );
         }
+    }
+
+    /// A shadow ray guarded by the reflection's own counter leaves the
+    /// cycle only from the levels that guard allows (the shape of
+    /// Microsoft's procedural-geometry sample): GLSL with the shadow guard
+    /// in a helper and the reflection's inline, from 1 to 3, and HLSL with
+    /// both in helpers, from 0 to 3. Without that rule both needed 4.
+    #[test]
+    fn exit_guarded_by_the_cycle_counter() {
+        for v in ["g", "gV"] {
+            let p = loose(&[
+                &format!("fixtures/guards/shared.rgen.{v}.spv"),
+                &format!("fixtures/guards/shared.rchit.{v}.spv"),
+                &format!("fixtures/guards/shared.rmiss.{v}.spv"),
+                &format!("fixtures/guards/shared_shadow.rmiss.{v}.spv"),
+            ]);
+            let r = recursion_report(&p);
+            assert_eq!(r.required_depth, Some(3), "{v}");
+            let g = r.cycles[0].sites[0].guard.as_ref().unwrap();
+            assert_eq!((g.initial, g.bound, g.traces), (1, 3, 2), "{v}");
+        }
+        let r = recursion_report(&loose(&["fixtures/guards/shared_counter.hlsl"]));
+        assert_eq!(r.required_depth, Some(3));
     }
 
     /// HLSL through rtlint: the traced payload is a fresh local written field

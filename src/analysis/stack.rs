@@ -119,6 +119,11 @@ pub struct StackReport {
     /// What to pass to `vkCmdSetRayTracingPipelineStackSizeKHR` /
     /// `SetPipelineStackSize`.
     pub recommended: Option<u64>,
+    /// When no bound on the recursion is known at compile time: the depth
+    /// the recommendation assumes (the declared depth, else the device's
+    /// limit). The recommendation then holds only while the recursion stays
+    /// within it.
+    pub assumed_depth: Option<u32>,
     /// Full-model formulas (live state and arrays included).
     pub model: Formulas,
     /// The same formulas over the driver-comparable sizes.
@@ -148,6 +153,18 @@ pub fn dxr_default(m: &StageMax, depth: u32) -> u64 {
         + m.closest_hit.max(m.miss).max(m.intersection + m.any_hit) * d.min(1)
         + m.closest_hit.max(m.miss) * d.saturating_sub(1)
         + 2 * m.callable
+}
+
+/// The stack to recommend from one set of formulas: the exact call chain
+/// (else the default formula at the declared depth); with the recursion
+/// unbounded at compile time, the default formula at the depth assumed,
+/// never the declared-depth figure alone, which may be too small.
+fn recommendation(f: &Formulas, assumed_depth: Option<u32>) -> Option<u64> {
+    match assumed_depth {
+        Some(d) => Some(vulkan_default(&f.stage_max, d)),
+        None => f.exact_call_chain.or(f.vulkan_default),
+    }
+    .map(|v| align(v, 16))
 }
 
 fn align(v: u64, a: u64) -> u64 {
@@ -909,22 +926,29 @@ pub fn stack_report_with(pipeline: &Pipeline, rec: &RecursionReport) -> StackRep
     let shape = ChainShape::of(rec);
     let model = formulas_with(pipeline, rec, &shape, &model_sizes);
     let driver_comparable = formulas_with(pipeline, rec, &shape, &driver_sizes);
-    let recommended = model
-        .exact_call_chain
-        .or(model.vulkan_default)
-        .map(|v| align(v, 16));
+    let assumed_depth = match rec.required_depth {
+        Some(_) => None,
+        None => Some(
+            pipeline
+                .max_recursion_depth
+                .unwrap_or(pipeline.device_max_recursion_depth),
+        ),
+    };
+    let recommended = recommendation(&model, assumed_depth);
     let mut assumptions = rec.graph.assumptions.clone();
     if pipeline.max_recursion_depth.is_none() {
         assumptions.push(Assumption::NoDeclaredDepth);
     }
     if let Some(c) = rec.unbounded_cycle() {
-        let why = c
-            .sites
-            .iter()
-            .find_map(|s| s.guard.as_ref().err())
+        let site = c.sites.iter().find(|s| s.guard.is_err());
+        let why = site
+            .and_then(|s| s.guard.as_ref().err())
             .cloned()
             .unwrap_or(NoGuard::NoComparison { counter: None });
-        assumptions.push(Assumption::UnboundedRecursion(why));
+        assumptions.push(Assumption::UnboundedRecursion {
+            why,
+            at: site.and_then(|s| s.location.clone()),
+        });
     }
     for c in &rec.cycles {
         for s in &c.sites {
@@ -961,6 +985,7 @@ pub fn stack_report_with(pipeline: &Pipeline, rec: &RecursionReport) -> StackRep
         dxr_default_required: model.dxr_default_required,
         exact_call_chain: model.exact_call_chain,
         recommended,
+        assumed_depth,
         model,
         driver_comparable,
         driver: None,
@@ -992,8 +1017,7 @@ pub fn attach_driver(
         let f = formulas(pipeline, &rec, &sizes);
         // Never recommend less than the driver's own numbers require: an
         // explicit stack below the real call chain hangs the GPU.
-        if let Some(needed) = f.exact_call_chain.or(f.vulkan_default) {
-            let needed = align(needed, 16);
+        if let Some(needed) = recommendation(&f, report.assumed_depth) {
             if report.recommended.is_some_and(|r| r < needed) {
                 report.assumptions.push(Assumption::RecommendationRaised {
                     from: report.recommended.unwrap_or(0),

@@ -132,6 +132,13 @@ pub fn human(r: &StackReport) -> String {
                 formula_text(&f.stage_max, d)
             );
         }
+        if let Some(d) = r.assumed_depth.filter(|&d| r.declared_depth != Some(d)) {
+            let _ = writeln!(
+                s,
+                "  Vulkan/DXR default, assumed depth {d}: {}",
+                formula_text(&f.stage_max, d)
+            );
+        }
         let _ = writeln!(s, "  exact call-chain maximum: {}", opt(f.exact_call_chain));
     };
     block("full model", &r.model);
@@ -141,6 +148,22 @@ pub fn human(r: &StackReport) -> String {
     }
     let _ = writeln!(s);
     match r.recommended {
+        Some(v) if r.assumed_depth.is_some() => {
+            let d = r.assumed_depth.unwrap_or_default();
+            let whose = if r.declared_depth == Some(d) {
+                "the declared depth"
+            } else {
+                "the device's limit"
+            };
+            let _ = writeln!(
+                s,
+                "recommended (conditional): vkCmdSetRayTracingPipelineStackSizeKHR(cmd, {v}) / SetPipelineStackSize({v})"
+            );
+            let _ = writeln!(
+                s,
+                "  assumes the recursion stops within depth {d} ({whose}): no bound is known at compile time, so a deeper recursion needs more"
+            );
+        }
         Some(v) => {
             let _ = writeln!(
                 s,

@@ -21,13 +21,15 @@ super::declare_rule! {
     /// payload has the same layout. It reports a member that no shader reads, or
     /// that no shader writes. Only the shaders the pipeline uses are modelled:
     /// those of the description, or, without one, the shaders of a folder under
-    /// the assumption that every trace reaches every shader. A payload is not
+    /// the assumption that every trace reaches every shader whose incoming
+    /// payload matches its own. A payload is not
     /// judged when its traces reach no shader with its layout, or when they can
     /// run a closest-hit shader and none with its layout is in the pipeline (a
-    /// folder whose hit shader did not compile). A reached shader that declares
-    /// another layout reads and writes the members that sit at the same offset
-    /// with the same shape (a shadow payload that starts like the main one,
-    /// handed to the main payload's any-hit shader).
+    /// folder whose hit shader did not compile). A shader the trace's SBT
+    /// operands select that declares another layout is not reached, but its
+    /// members that sit at the same offset with the same shape still count as
+    /// read and written (a shadow payload that starts like the main one, handed
+    /// to the main payload's any-hit shader, as public code does).
     ///
     /// A member is read where a load reaches it through an access chain from the
     /// payload variable, written where a store does. Loading or storing the whole
@@ -175,11 +177,14 @@ fn run(ctx: &super::PipelineContext) -> Vec<Diagnostic> {
     let pipeline = ctx.pipeline;
     let graph = &ctx.recursion.graph;
     let mut types: Vec<RayType> = Vec::new();
-    // Each shader's incoming payloads, once: a folder's loose pipeline joins
-    // every trace to every hit shader.
-    let mut incoming: std::collections::HashMap<(usize, Id), Vec<Id>> =
-        std::collections::HashMap::new();
-    for e in graph.edges.iter().filter(|e| e.kind == EdgeKind::Trace) {
+    // Shaders the SBT selects whose payload differs count as aliases (code
+    // that reads a shared prefix of two payloads).
+    for e in graph
+        .edges
+        .iter()
+        .chain(&graph.mismatched)
+        .filter(|e| e.kind == EdgeKind::Trace)
+    {
         let Some(program) = pipeline.programs.get(e.program) else {
             continue;
         };
@@ -191,17 +196,17 @@ fn run(ctx: &super::PipelineContext) -> Vec<Diagnostic> {
             continue;
         };
         let Some(var) = site.payload else { continue };
-        let Some(global) = program
+        if !program
             .globals
             .iter()
-            .find(|g| g.id == var && g.storage == StorageClass::RayPayloadKHR)
-        else {
-            continue;
-        };
-        let shape = payload_use::shape_of(program, global.ty);
-        if !shape.is_sized() {
+            .any(|g| g.id == var && g.storage == StorageClass::RayPayloadKHR)
+        {
             continue;
         }
+        // The traced payload's shape as the reach analysis took it (sized).
+        let Some(shape) = graph.payloads.traced_known(e.program, e.inst).cloned() else {
+            continue;
+        };
         let (Some(from), Some(to)) = (graph.nodes.get(e.from), graph.nodes.get(e.to)) else {
             continue;
         };
@@ -243,28 +248,16 @@ fn run(ctx: &super::PipelineContext) -> Vec<Diagnostic> {
         ) {
             continue;
         }
-        let Some(tp) = pipeline.programs.get(to.shader.program) else {
-            continue;
-        };
-        let used = incoming
-            .entry((to.shader.program, to.shader.function))
-            .or_insert_with(|| {
-                payload_use::globals_used(
-                    tp,
-                    to.shader.function,
-                    StorageClass::IncomingRayPayloadKHR,
-                )
-            });
-        for &w in used.iter() {
-            let Some(g) = tp.globals.iter().find(|g| g.id == w) else {
-                continue;
-            };
+        for w in graph
+            .payloads
+            .incoming_known(to.shader.program, to.shader.function)
+        {
             let callee = View {
                 program: to.shader.program,
                 entry: to.shader.function,
-                var: w,
+                var: w.var,
             };
-            let list = if payload_use::shape_of(tp, g.ty) == t.shape {
+            let list = if w.shape == t.shape {
                 t.hit_reached |= to.shader.stage == Stage::ClosestHit;
                 &mut t.callees
             } else {

@@ -63,8 +63,12 @@ pub fn check(pipeline: &Pipeline, rec: &RecursionReport) -> Vec<Diagnostic> {
                     NAME,
                     &file,
                     format!(
-                        "recursion through {} is unbounded at compile time",
-                        names.join(", ")
+                        "recursion through {} is unbounded at compile time: the trace{} has no depth bound",
+                        names.join(", "),
+                        site.location
+                            .as_ref()
+                            .map(|l| format!(" at {l}"))
+                            .unwrap_or_default()
                     ),
                 )
                 .with_code(CODE)
@@ -90,7 +94,10 @@ super::declare_rule! {
     /// description gives under `[constants]`. A cycle is bounded when each trace
     /// closing it is dominated by a comparison of a depth counter carried in the
     /// payload with such a bound and the traced payload's counter grows by a
-    /// constant. The note says what was found instead.
+    /// constant. The message names the trace that closes the cycle without a
+    /// bound, and the note says what was found instead. `rtlint stack` then
+    /// recommends a stack only on the condition that the recursion stops
+    /// within the declared depth (else the device's limit) and says so.
     ///
     /// Without a `*.pipeline.toml` (loose shaders, or a library described by
     /// its DXR subobjects) a bound read from a push constant or uniform is
@@ -181,9 +188,13 @@ mod tests {
             "loop around a trace in `main` has no bound known at compile time"
         );
         assert_eq!(d[0].notes[0], "no exit compares a counter with a bound");
-        assert_eq!(
-            d[1].message,
-            "recursion through closesthit `main` (hit group 0) is unbounded at compile time"
+        // The message names the trace that makes the depth unbounded.
+        assert!(
+            d[1].message.starts_with(
+                "recursion through closesthit `main` (hit group 0) is unbounded at compile time: the trace at "
+            ) && d[1].message.ends_with("fixtures/pipelines/recursive/reflect.rchit:26 has no depth bound"),
+            "{}",
+            d[1].message
         );
         assert!(
             d[1].notes[0].contains("pushConst.maxDepth"),

@@ -33,8 +33,10 @@ pub fn check(pipeline: &Pipeline, stack: &StackReport, limit_bytes: u64) -> Vec<
     .with_note(
         "on an NVIDIA H200 (driver 580.159.04) a pipeline stack of 14,746 bytes per thread lost the device at the first trace and 14,702 ran; a stack set below what the call chain needs hung the GPU",
     );
+    // A recommendation conditional on an assumed depth is no call chain.
     let help = match stack
         .recommended
+        .filter(|_| stack.assumed_depth.is_none())
         .or(stack.driver_comparable.exact_call_chain)
     {
         Some(v) => {
@@ -175,6 +177,17 @@ mod tests {
         assert_eq!(
             d[0].help.as_deref(),
             Some("set the stack explicitly: vkCmdSetRayTracingPipelineStackSizeKHR(cmd, 2176) or SetPipelineStackSize(2176)")
+        );
+        // Without the bound the recursion is unbounded: the recommendation
+        // is conditional on the declared depth, no call chain's need.
+        p.constants.remove("pushConst.maxDepth");
+        let r = stack_report(&p);
+        assert_eq!(r.assumed_depth, Some(31));
+        let d = check(&p, &r, DEFAULT_LIMIT_BYTES);
+        assert!(
+            !d[0].notes.iter().any(|n| n.contains("deepest call chain")),
+            "{:?}",
+            d[0].notes
         );
     }
 }

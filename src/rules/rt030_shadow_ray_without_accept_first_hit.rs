@@ -13,8 +13,12 @@ super::declare_rule! {
     /// (`gl_RayFlagsTerminateOnFirstHitEXT`, `RAY_FLAG_ACCEPT_FIRST_HIT_AND_END_SEARCH`, WGSL `RAY_FLAG_TERMINATE_ON_FIRST_HIT`, 0x4).
     ///
     /// Without a pipeline description every trace may reach every shader of
-    /// its folder (or file); a shader whose incoming payload has another type
-    /// than the trace's payload is not counted.
+    /// its folder (or file) whose incoming payload has the trace's payload
+    /// type (the reach analysis; `docs/pipeline.md`). A trace that may run a
+    /// closest-hit shader but reaches none is judged only when the folder has
+    /// closest-hit shaders and a miss shader that takes its payload (a shadow
+    /// ray type whose hit group has no closest hit); otherwise its own closest
+    /// hit may be missing from the folder.
     ///
     /// ## Why is this bad?
     ///

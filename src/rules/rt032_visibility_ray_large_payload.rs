@@ -54,18 +54,16 @@ fn check(ctx: &PipelineContext) -> Vec<Diagnostic> {
     let mut reported = super::Reported::default();
     let g = &ctx.recursion.graph;
     let visibility = rays::visibility_traces(ctx.pipeline, g);
-    // Payload types that other traces use for more than a hit flag.
-    let shared: Vec<String> = rays::trace_targets(g)
+    // Payload types (by the reach analysis's shape) that other traces use
+    // for more than a hit flag.
+    let shared: Vec<&crate::analysis::layout::Shape> = rays::trace_targets(g)
         .iter()
         .filter(|t| {
             !visibility
                 .iter()
                 .any(|v| v.program == t.program && v.inst == t.inst)
         })
-        .filter_map(|t| {
-            let program = ctx.pipeline.programs.get(t.program)?;
-            rays::trace_payload_ty(program, t.inst).map(|ty| rays::signature(program, ty))
-        })
+        .filter_map(|t| g.payloads.traced_known(t.program, t.inst))
         .collect();
     for v in visibility {
         let Some(program) = ctx.pipeline.programs.get(v.program) else {
@@ -80,7 +78,11 @@ fn check(ctx: &PipelineContext) -> Vec<Diagnostic> {
         let Some(size) = scalar_size(program, ty) else {
             continue;
         };
-        if !shared.contains(&rays::signature(program, ty)) {
+        if !g
+            .payloads
+            .traced_known(v.program, v.inst)
+            .is_some_and(|s| shared.contains(&s))
+        {
             continue;
         }
         // At most one member written, and not the whole payload.

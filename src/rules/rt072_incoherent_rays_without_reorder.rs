@@ -2,9 +2,7 @@
 //! several closest-hit shaders and never reorders threads.
 
 use crate::analysis::callgraph::EdgeKind;
-use crate::analysis::payload_use;
 use crate::analysis::trace_sites::is_bounce_from;
-use spirv::StorageClass;
 use crate::diag::Diagnostic;
 use crate::shader::Stage;
 
@@ -84,7 +82,7 @@ fn run(ctx: &super::PipelineContext) -> Vec<Diagnostic> {
     let g = &ctx.recursion.graph;
     let mut out = Vec::new();
     // Per program and per trace, computed once: an undescribed pipeline has
-    // an edge from every trace to every hit group.
+    // an edge from every trace to every hit group that takes its payload.
     let reorder: Vec<bool> = pipeline.programs.iter().map(reorders).collect();
     let mut targets: std::collections::HashMap<(usize, usize), Vec<usize>> =
         std::collections::HashMap::new();
@@ -94,7 +92,6 @@ fn run(ctx: &super::PipelineContext) -> Vec<Diagnostic> {
     let mut seen: std::collections::HashSet<(usize, usize)> = std::collections::HashSet::new();
     let mut refused: std::collections::HashSet<(usize, usize, usize)> =
         std::collections::HashSet::new();
-    let mut incoming = std::collections::HashMap::new();
     for e in g.edges.iter().filter(|e| e.kind == EdgeKind::Trace) {
         if seen.contains(&(e.program, e.inst)) || !refused.insert((e.from, e.program, e.inst)) {
             continue;
@@ -111,46 +108,15 @@ fn run(ctx: &super::PipelineContext) -> Vec<Diagnostic> {
         if reorder[e.program] || !is_bounce_from(program, from.shader.function, e.inst) {
             continue;
         }
-        // The traced payload's layout: hit shaders declared with another one
-        // belong to another ray type (a shadow ray's).
-        let shape = program
-            .sites
-            .iter()
-            .find(|s| s.inst == e.inst)
-            .and_then(|s| s.payload)
-            .and_then(|v| program.globals.iter().find(|g| g.id == v))
-            .map(|g| payload_use::shape_of(program, g.ty));
-        // Distinct closest-hit shaders this trace can reach.
+        // Distinct closest-hit shaders this trace can reach (the reach
+        // analysis already left out those declared with another payload,
+        // a shadow ray's).
         let mut hits: Vec<(usize, u32)> = Vec::new();
         for &to in targets.get(&(e.program, e.inst)).into_iter().flatten() {
             if let Some(n) = g.nodes.get(to) {
-                let mut same_type = || {
-                    let Some(tp) = pipeline.programs.get(n.shader.program) else {
-                        return false;
-                    };
-                    let Some(shape) = &shape else { return true };
-                    // Each hit shader's incoming layouts once: a folder's
-                    // loose pipeline sends every trace to every hit shader.
-                    incoming
-                        .entry((n.shader.program, n.shader.function))
-                        .or_insert_with(|| {
-                            payload_use::globals_used(
-                                tp,
-                                n.shader.function,
-                                StorageClass::IncomingRayPayloadKHR,
-                            )
-                            .iter()
-                            .filter_map(|w| tp.globals.iter().find(|g| g.id == *w))
-                            .map(|g| payload_use::shape_of(tp, g.ty))
-                            .collect::<Vec<_>>()
-                        })
-                        .contains(shape)
-                };
-                if n.shader.stage == Stage::ClosestHit && same_type() {
-                    let key = (n.shader.program, n.shader.function);
-                    if !hits.contains(&key) {
-                        hits.push(key);
-                    }
+                let key = (n.shader.program, n.shader.function);
+                if n.shader.stage == Stage::ClosestHit && !hits.contains(&key) {
+                    hits.push(key);
                 }
             }
         }
