@@ -120,6 +120,9 @@ pub struct Report {
     pub embedded: Vec<(PathBuf, String)>,
     /// Warnings fail the run (any config or the command line said so).
     pub deny_warnings: bool,
+    /// Shader files and descriptions of the whole set, before `--shard`
+    /// kept one part: an empty shard of a non-empty set is not an empty run.
+    pub all_inputs: usize,
 }
 
 impl Report {
@@ -140,6 +143,12 @@ impl Report {
     pub fn is_empty(&self) -> bool {
         self.files.is_empty() && self.pipelines.is_empty()
     }
+
+    /// Nothing was linted because the paths hold nothing to lint (not
+    /// because this shard's part of a non-empty set is empty).
+    pub fn found_nothing(&self) -> bool {
+        self.is_empty() && self.all_inputs == 0
+    }
 }
 
 /// Lints `paths` (files, folders, or `-` for standard input).
@@ -153,6 +162,7 @@ pub fn check_paths(paths: &[PathBuf], options: &Options) -> Report {
         .iter()
         .map(|(p, _)| described_shaders(p))
         .collect();
+    let all_inputs = inputs.files.len() + inputs.pipelines.len();
     if let Some(shard) = options.shard {
         keep_shard(&mut inputs, &descriptions, shard);
     }
@@ -162,6 +172,7 @@ pub fn check_paths(paths: &[PathBuf], options: &Options) -> Report {
         files: inputs.files.iter().map(|i| i.path.clone()).collect(),
         pipelines: inputs.pipelines.iter().map(|(p, _)| p.clone()).collect(),
         skipped: inputs.skipped.clone(),
+        all_inputs,
         ..Report::default()
     };
     // A config that cannot be read is reported once, by the first shard.

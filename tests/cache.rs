@@ -506,3 +506,45 @@ fn fast_analysis_leaves_out_the_dataflow_rules() {
     assert_eq!(o.status.code(), Some(2), "{}", text(&o));
     assert!(text(&o).contains("rtlint.toml:1"), "{}", text(&o));
 }
+
+/// A project with one folder on a four-shard CI matrix: the shards without
+/// files succeed, also under `--deny-warnings`; paths with nothing to lint
+/// still fail it.
+#[test]
+fn an_empty_shard_of_a_non_empty_set_succeeds() {
+    let d = scratch("empty-shard");
+    std::fs::create_dir_all(d.join("s")).unwrap();
+    std::fs::write(
+        d.join("s/gen.rgen"),
+        "#version 460\n#extension GL_EXT_ray_tracing : require\nvoid main() {}\n",
+    )
+    .unwrap();
+    std::fs::create_dir_all(d.join("nothing")).unwrap();
+    let mut empty = 0;
+    for k in 1..=4 {
+        let shard = format!("{k}/4");
+        let o = rtlint()
+            .current_dir(&d)
+            .args([
+                "check",
+                "--no-cache",
+                "--deny-warnings",
+                "--shard",
+                &shard,
+                "s",
+            ])
+            .output()
+            .unwrap();
+        assert_eq!(o.status.code(), Some(0), "{shard}: {}", text(&o));
+        if text(&o).contains("this shard got none of the 1 input;") {
+            empty += 1;
+        }
+    }
+    assert_eq!(empty, 3);
+    let o = check(
+        &d,
+        &["--no-cache", "--deny-warnings", "--shard", "2/4", "nothing"],
+    );
+    assert_eq!(o.status.code(), Some(2), "{}", text(&o));
+    assert!(text(&o).contains("no files to lint"), "{}", text(&o));
+}
