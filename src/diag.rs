@@ -197,6 +197,8 @@ pub enum InputErrorKind {
     HlslUnsupported,
     /// glslang rejects the GLSL.
     GlslError,
+    /// a suppression in a shader names no rule, code or group.
+    InvalidSuppression,
     /// `stack --driver`: the device could not create the pipeline (the
     /// driver failed or crashed, or the validation layer objected).
     DriverFailed,
@@ -219,6 +221,7 @@ impl InputErrorKind {
         InputErrorKind::HlslUnsupported,
         InputErrorKind::GlslError,
         InputErrorKind::DriverFailed,
+        InputErrorKind::InvalidSuppression,
     ];
 
     pub fn as_str(self) -> &'static str {
@@ -238,6 +241,7 @@ impl InputErrorKind {
             InputErrorKind::HlslUnsupported => "hlsl-unsupported",
             InputErrorKind::GlslError => "glsl-error",
             InputErrorKind::DriverFailed => "driver-failed",
+            InputErrorKind::InvalidSuppression => "invalid-suppression",
         }
     }
 }
@@ -343,6 +347,7 @@ mod tests {
                 "hlsl-unsupported",
                 "glsl-error",
                 "driver-failed",
+                "invalid-suppression",
             ]
         );
         for (i, a) in names.iter().enumerate() {

@@ -8,7 +8,7 @@ use crate::diag::{Diagnostic, InputError, InputErrorKind, Severity};
 use crate::front::hlsl::subobject::Subobjects;
 use crate::front::{self, FrontOptions};
 use crate::program::Program;
-use crate::shader::Language;
+use crate::shader::{Language, Location};
 use rayon::prelude::*;
 use std::collections::{BTreeMap, HashMap, HashSet};
 use std::path::{Path, PathBuf};
@@ -943,6 +943,27 @@ fn apply_suppressions(
         }
         if !allowed {
             kept.push(d);
+        }
+    }
+    // Selectors that name nothing, in the files this run linted: input
+    // errors, as unknown selectors in rtlint.toml are.
+    for (path, _) in owned {
+        for (s, _) in files.get(path.as_path()).into_iter().flatten() {
+            for (sel, &(column, len)) in s.selectors.iter().zip(&s.spans) {
+                if !crate::rules::is_selector(sel) {
+                    let e = InputError::new(
+                        InputErrorKind::InvalidSuppression,
+                        path,
+                        format!("suppression names unknown rule or group `{sel}`"),
+                    )
+                    .at(
+                        Location::span(path, s.line, column, len),
+                        "not a rule code, name or group",
+                    )
+                    .with_note("`rtlint rules` lists the codes, names and groups");
+                    kept.push(*e.0);
+                }
+            }
         }
     }
     // Unused suppressions, in the files this run linted.

@@ -116,6 +116,76 @@ fn wgsl_filters_and_comments_suppress() {
     );
 }
 
+/// An HLSL raygen tracing two 48-byte payloads declared on lines 1 and 2.
+const TWO_FAT_HLSL: &str = "struct Fat { float4 a; float4 b; float4 c; };\n\
+struct Big { float4 a; float4 b; float4 c; };\n\
+RaytracingAccelerationStructure tlas : register(t0);\n\
+RWTexture2D<float4> image : register(u1);\n\
+[shader(\"raygeneration\")]\n\
+void Gen()\n\
+{\n\
+    RayDesc ray;\n\
+    ray.Origin = float3(0.0, 0.0, 0.0);\n\
+    ray.Direction = float3(0.0, 0.0, 1.0);\n\
+    ray.TMin = 0.001;\n\
+    ray.TMax = 10.0;\n\
+    Fat p = (Fat)0;\n\
+    Big q = (Big)0;\n\
+    TraceRay(tlas, RAY_FLAG_FORCE_OPAQUE, 0xFF, 0, 1, 0, ray, p);\n\
+    TraceRay(tlas, RAY_FLAG_FORCE_OPAQUE, 0xFF, 0, 1, 0, ray, q);\n\
+    image[DispatchRaysIndex().xy] = p.a + q.a;\n\
+}\n";
+
+/// A suppression after code covers its own line only; one alone on its line
+/// covers the next; a selector that names nothing is an input error at the
+/// name, in comments and in WGSL filters alike.
+#[test]
+fn suppressions_cover_their_line_and_unknown_selectors_are_errors() {
+    let d = scratch("suppress-lines");
+    let end_of_line = TWO_FAT_HLSL.replacen("};\n", "}; // rtlint: allow(RT001)\n", 1);
+    std::fs::write(d.join("eol.hlsl"), &end_of_line).unwrap();
+    std::fs::write(
+        d.join("above.hlsl"),
+        TWO_FAT_HLSL.replacen("struct Big", "// rtlint: allow(RT001)\nstruct Big", 1),
+    )
+    .unwrap();
+    let o = check_in(&d, &["--no-cache", "eol.hlsl", "above.hlsl"]);
+    assert_eq!(
+        findings(&o),
+        [
+            "above.hlsl:1:8: warning[RT001]",
+            "eol.hlsl:2:8: warning[RT001]"
+        ],
+        "{}",
+        text(&o)
+    );
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o));
+
+    std::fs::write(
+        d.join("unknown.hlsl"),
+        end_of_line.replace("allow(RT001)", "allow(RT999, RT001)"),
+    )
+    .unwrap();
+    std::fs::write(
+        d.join("unknown.wgsl"),
+        FAT_WGSL.replacen(";\n", ";\ndiagnostic(off, rtlint.no_such_rule);\n", 1),
+    )
+    .unwrap();
+    let o = check_in(&d, &["--no-cache", "unknown.hlsl", "unknown.wgsl"]);
+    let t = text(&o);
+    assert_eq!(o.status.code(), Some(2), "{t}");
+    assert!(
+        t.contains("unknown.hlsl:1:64: error[invalid-suppression] suppression names unknown rule or group `RT999`"),
+        "{t}"
+    );
+    assert!(
+        t.contains("unknown.wgsl:2:24: error[invalid-suppression]"),
+        "{t}"
+    );
+    // The known selector beside the unknown one still applies.
+    assert!(!t.contains("unknown.hlsl:1:8"), "{t}");
+}
+
 /// A GLSL raygen with the same 48-byte payload; the suppression names the
 /// rule by name on the line above.
 const FAT_GLSL: &str = "#version 460\n\
