@@ -372,3 +372,28 @@ fn github_and_sarif_formats() {
         4
     );
 }
+
+/// What `cargo install` builds is lean: the release profile keeps no debug
+/// info (an 80 MB binary with it); profiling has its own profile with line
+/// tables, and the docs that profile name it.
+#[test]
+fn the_release_profile_is_lean_and_profiling_has_its_own() {
+    let manifest: toml::Table =
+        toml::from_str(&std::fs::read_to_string(common::root().join("Cargo.toml")).unwrap())
+            .unwrap();
+    let profiles = manifest["profile"].as_table().unwrap();
+    let release = profiles["release"].as_table().unwrap();
+    let off = |v: Option<&toml::Value>| match v {
+        None => true,
+        Some(toml::Value::Boolean(b)) => !b,
+        Some(toml::Value::Integer(n)) => *n == 0,
+        Some(toml::Value::String(s)) => s == "none",
+        Some(_) => false,
+    };
+    assert!(off(release.get("debug")), "{release:?}");
+    let profiling = profiles["profiling"].as_table().unwrap();
+    assert_eq!(profiling["inherits"].as_str(), Some("release"));
+    assert!(!off(profiling.get("debug")), "{profiling:?}");
+    let perf = std::fs::read_to_string(common::root().join("docs/performance.md")).unwrap();
+    assert!(perf.contains("--profile profiling"));
+}
