@@ -190,7 +190,9 @@ struct VerifyArgs {
     /// The folder holding `verify.toml`, the shaders and `scenes/`.
     #[arg(long, default_value = "shaders")]
     shaders: PathBuf,
-    /// Where the tables (CSV, Markdown) and the images of failed cases go.
+    /// Where the tables (CSV, Markdown) and the images go: each case's GPU
+    /// image, multi-pass cases' path pictures, and for a failed case the CPU
+    /// image and the difference.
     #[arg(long, default_value = "target/verify")]
     out: PathBuf,
     /// Use the first ray-tracing device whose name contains this text.
@@ -294,7 +296,8 @@ enum Command {
         #[arg(long = "enable-16bit-types")]
         enable_16bit_types: bool,
         /// Output: a `.spv` file (one entry point, or with --whole every entry
-        /// point in one module), or a directory for one module per entry point.
+        /// point in one module), or a directory for one module per entry point
+        /// (`-o DIR/`: created when missing).
         #[arg(short = 'o', long = "output")]
         output: PathBuf,
         /// One module holding every entry point.
@@ -304,9 +307,9 @@ enum Command {
     /// Run the reference reflection shaders on the Vulkan device and
     /// compare each image with the CPU reference renderer.
     Verify(VerifyArgs),
-    /// Sweep the reference shaders' knobs (bounces, rays per pixel, t_max,
-    /// roughness cut-off, half resolution, ray origins) and measure GPU time
-    /// against error.
+    /// Sweep the reference shaders' knobs (bounces, spp, tmax, rough_cutoff,
+    /// half_res, ssr, tolerance, min_paths, max_paths, origin; docs/tradeoff.md
+    /// says what each sets) and measure GPU time against error.
     Tradeoff(TradeoffArgs),
     /// List every rule.
     Rules,
@@ -388,18 +391,28 @@ fn run(cli: Cli) -> Result<u8, String> {
         } => driver_stack_sizes(pipeline, library, shader),
         Command::Rules => {
             let mut out = std::io::stdout().lock();
-            for r in rtlint::rules::RULES {
-                let level = if r.group.on_by_default() {
+            let level = |r: &rtlint::rules::Rule| {
+                if r.group.on_by_default() {
                     r.level.as_str()
                 } else {
                     "off"
-                };
+                }
+            };
+            // Columns as wide as their longest entry: names grow.
+            let rules = rtlint::rules::RULES;
+            let width = |f: &dyn Fn(&rtlint::rules::Rule) -> usize| {
+                rules.iter().map(|r| f(r)).max().unwrap_or(0)
+            };
+            let name_w = width(&|r| r.name.len());
+            let level_w = width(&|r| level(r).len());
+            let group_w = width(&|r| r.group.as_str().len());
+            for r in rules {
                 let _ = writeln!(
                     out,
-                    "{}  {:<28} {:<8} {:<12} {}",
+                    "{}  {:<name_w$}  {:<level_w$}  {:<group_w$}  {}",
                     r.code,
                     r.name,
-                    level,
+                    level(r),
                     r.group.as_str(),
                     r.summary
                 );
@@ -919,7 +932,11 @@ fn compile(
     for w in &entries[0].warnings {
         eprintln!("{w}");
     }
-    if output.is_dir() {
+    // `-o dir/` names a folder, which is created when missing.
+    let folder = output.is_dir() || output.as_os_str().to_string_lossy().ends_with(['/', '\\']);
+    if folder {
+        std::fs::create_dir_all(&output)
+            .map_err(|e| format!("cannot create {}: {e}", output.display()))?;
         for e in &entries {
             let path = output.join(format!("{}.spv", e.name));
             write(&path, &e.words)?;

@@ -133,3 +133,23 @@ fn compile_errors_name_file_and_position() {
     assert!(err.contains("bad.hlsl:2:13"), "{err}");
     assert!(!d.join("b.spv").exists());
 }
+
+/// `-o newdir/` names a folder that does not exist yet: it is created.
+#[test]
+fn a_missing_output_folder_is_created() {
+    let d = scratch("newdir").join("new/sub");
+    let o = rtlint()
+        .args(["compile", "tests/hlsl/pipeline.hlsl", "-o"])
+        .arg(format!("{}/", d.display()))
+        .output()
+        .unwrap();
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    for entry in ["RayGen", "Miss", "ShadowMiss", "ClosestHit"] {
+        assert!(d.join(format!("{entry}.spv")).is_file(), "{entry}");
+    }
+}
