@@ -142,7 +142,9 @@ struct CheckArgs {
     /// Exit 0 even when findings fail the run (input errors still exit 2).
     #[arg(long)]
     exit_zero: bool,
-    /// Count findings per rule instead of listing them.
+    /// Count findings per rule instead of listing them, in the format's own
+    /// shape (JSON `statistics`, SARIF run properties, a GitHub notice and
+    /// job summary).
     #[arg(long)]
     statistics: bool,
     /// Print findings only: no summary line, no notes.
@@ -575,8 +577,32 @@ fn emit(
             .filter(|d| d.code.is_none())
             .cloned()
             .collect();
-        write!(out, "{}", report::statistics(diagnostics))?;
-        report::human::render(&errors, sources, out)?;
+        match args.format {
+            CheckFormat::Human | CheckFormat::Concise => {
+                write!(out, "{}", report::statistics(diagnostics))?;
+                report::human::render(&errors, sources, out)?;
+            }
+            CheckFormat::Json => writeln!(
+                out,
+                "{}",
+                report::json::render_statistics(diagnostics, summary)
+            )?,
+            CheckFormat::Sarif => {
+                writeln!(out, "{}", report::sarif::render_statistics(diagnostics))?
+            }
+            CheckFormat::Github => {
+                let (notice, table) = report::github_statistics(diagnostics);
+                write!(out, "{notice}{}", report::github(&errors))?;
+                // The job's summary page, when run as a GitHub step.
+                if let Some(path) = std::env::var_os("GITHUB_STEP_SUMMARY") {
+                    let mut f = std::fs::OpenOptions::new()
+                        .create(true)
+                        .append(true)
+                        .open(path)?;
+                    f.write_all(table.as_bytes())?;
+                }
+            }
+        }
         return Ok(());
     }
     match args.format {

@@ -744,3 +744,53 @@ fn sixteen_bit_types_follow_the_flag_and_the_config() {
     assert!(!compile(&[]));
     assert!(compile(&["--enable-16bit-types"]));
 }
+
+/// `--statistics` speaks each format: JSON's `statistics`, SARIF's run
+/// properties (also through `-o x.sarif`), a GitHub notice and job summary;
+/// the counts are those of the findings a plain run lists.
+#[test]
+fn statistics_in_every_format() {
+    let d = scratch("statistics");
+    std::fs::write(d.join("a.wgsl"), FAT_WGSL).unwrap();
+    std::fs::write(d.join("b.wgsl"), FAT_WGSL).unwrap();
+    let plain = check_in(&d, &["--no-cache", "."]);
+    let listed = findings(&plain).len();
+    assert_eq!(listed, 2, "{}", text(&plain));
+    let run = |args: &[&str]| {
+        rtlint()
+            .current_dir(&d)
+            .args(["check", "--no-cache", "--statistics"])
+            .args(args)
+            .arg(".")
+            .env("GITHUB_STEP_SUMMARY", d.join("summary.md"))
+            .output()
+            .unwrap()
+    };
+    let o = run(&["--format", "json"]);
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).expect("JSON");
+    assert_eq!(v["statistics"][0]["code"], "RT001", "{v}");
+    assert_eq!(v["statistics"][0]["count"], listed, "{v}");
+    assert_eq!(v["diagnostics"].as_array().unwrap().len(), 0, "{v}");
+
+    let o = run(&["--format", "sarif", "-o", "x.sarif"]);
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o));
+    let v: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(d.join("x.sarif")).unwrap()).expect("SARIF");
+    assert_eq!(v["version"], "2.1.0");
+    let run0 = &v["runs"][0];
+    assert_eq!(run0["results"].as_array().unwrap().len(), 0);
+    assert_eq!(run0["properties"]["statistics"][0]["ruleId"], "RT001");
+    assert_eq!(run0["properties"]["statistics"][0]["count"], listed);
+
+    let o = run(&["--format", "github"]);
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert_eq!(
+        out,
+        format!("::notice title=rtlint statistics::{listed} RT001 payload-over-budget\n")
+    );
+    let summary = std::fs::read_to_string(d.join("summary.md")).unwrap();
+    assert!(
+        summary.contains(&format!("| {listed} | RT001 | payload-over-budget |")),
+        "{summary}"
+    );
+}
