@@ -189,9 +189,10 @@ enum AnalysisArg {
 /// `rtlint verify`.
 #[derive(clap::Args, Clone)]
 struct VerifyArgs {
-    /// The folder holding `verify.toml`, the shaders and `scenes/`.
-    #[arg(long, default_value = "shaders")]
-    shaders: PathBuf,
+    /// The folder holding `verify.toml`, the shaders and `scenes/`
+    /// [default: the reference shaders built into rtlint].
+    #[arg(long, value_name = "DIR")]
+    shaders: Option<PathBuf>,
     /// Where the tables (CSV, Markdown) and the images go: each case's GPU
     /// image, multi-pass cases' path pictures, and for a failed case the CPU
     /// image and the difference.
@@ -215,9 +216,10 @@ struct VerifyArgs {
 /// `rtlint tradeoff`.
 #[derive(clap::Args, Clone)]
 struct TradeoffArgs {
-    /// The folder holding `verify.toml`, the shaders and `scenes/`.
-    #[arg(long, default_value = "shaders")]
-    shaders: PathBuf,
+    /// The folder holding `verify.toml`, the shaders and `scenes/`
+    /// [default: the reference shaders built into rtlint].
+    #[arg(long, value_name = "DIR")]
+    shaders: Option<PathBuf>,
     /// Where the CSV, Markdown table, SVG plot and PNGs go.
     #[arg(long, default_value = "target/tradeoff")]
     out: PathBuf,
@@ -747,8 +749,8 @@ fn stack(
     // the pipeline they describe.
     let mut loose_programs = Vec::new();
     for (program, s) in programs.into_iter().zip(subobjects) {
+        // Its description's pipeline already has it.
         if described.contains(&canonical(&program.path)) {
-            loose_programs.push(program);
             continue;
         }
         match rtlint::pipeline::Pipeline::from_subobjects(program, &s) {
@@ -756,37 +758,42 @@ fn stack(
             Err(program) => loose_programs.push(*program),
         }
     }
-    let programs = loose_programs;
-    // Loose shaders: one conservative pipeline over all of them.
-    if !programs.is_empty() {
+    // Loose shaders: one conservative pipeline per folder, as `check`
+    // groups them (shaders in different folders are not one pipeline).
+    let mut folders: Vec<(PathBuf, Vec<rtlint::program::Program>)> = Vec::new();
+    for program in loose_programs {
+        let dir = program.path.parent().map(canonical).unwrap_or_default();
+        match folders.iter_mut().find(|(d, _)| *d == dir) {
+            Some((_, list)) => list.push(program),
+            None => folders.push((dir, vec![program])),
+        }
+    }
+    for (_, programs) in folders {
         pipelines.push(rtlint::pipeline::Pipeline::from_programs(programs));
     }
     #[cfg(not(feature = "vulkan"))]
     if driver {
         return Err("--driver needs rtlint built with the `vulkan` feature".into());
     }
-    // The loose shaders, as the child process of `--driver` reloads them.
+    // A loose pipeline's shaders, as the child process of `--driver`
+    // reloads them.
     #[cfg_attr(not(feature = "vulkan"), allow(unused_variables))]
-    let loose: Vec<String> = pipelines
-        .last()
-        .filter(|p| p.path.is_none() && p.subobject_library.is_none())
-        .map(|p| {
-            p.programs
-                .iter()
-                .map(|q| {
-                    let lang = Language::from_path(&q.path).unwrap_or(Language::Spirv);
-                    format!("{}:{}", lang.as_str(), q.path.display())
-                })
-                .collect()
-        })
-        .unwrap_or_default();
+    let loose_of = |p: &rtlint::pipeline::Pipeline| -> Vec<String> {
+        p.programs
+            .iter()
+            .map(|q| {
+                let lang = Language::from_path(&q.path).unwrap_or(Language::Spirv);
+                format!("{}:{}", lang.as_str(), q.path.display())
+            })
+            .collect()
+    };
     let mut reports = Vec::new();
     for p in &pipelines {
         #[allow(unused_mut)]
         let mut r = rtlint::analysis::stack_report(p);
         #[cfg(feature = "vulkan")]
         if driver {
-            match driver_in_child(p, &loose) {
+            match driver_in_child(p, &loose_of(p)) {
                 Ok(d) => {
                     let sizes = d
                         .sizes
@@ -842,7 +849,15 @@ fn stack(
             .collect::<Vec<_>>()
             .join("\n")
     };
-    print_report(format, json, human, &problems)
+    // A declared depth below the deepest chain fails on the device (RT021
+    // is an error): CI should fail too.
+    let too_shallow = reports
+        .iter()
+        .any(|r| report::stack::raise_depth_to(r).is_some());
+    Ok(match print_report(format, json, human, &problems)? {
+        0 if too_shallow => 1,
+        code => code,
+    })
 }
 
 /// Prints a report as JSON (with the input errors under `errors`) or text
@@ -993,12 +1008,16 @@ fn tradeoff(_: TradeoffArgs) -> Result<u8, String> {
 #[cfg(feature = "vulkan")]
 fn tradeoff(args: TradeoffArgs) -> Result<u8, String> {
     use rtlint::{tradeoff, verify};
+    let shaders = match &args.shaders {
+        Some(dir) => dir.clone(),
+        None => verify::bundled::folder()?,
+    };
     if let Some(child) = &args.child {
         let [setting, image] = child.as_slice() else {
             return Err("--child takes a setting and an image path".into());
         };
         return match tradeoff::child_main(
-            &args.shaders,
+            &shaders,
             &args.scene,
             args.quick,
             setting,
@@ -1015,7 +1034,7 @@ fn tradeoff(args: TradeoffArgs) -> Result<u8, String> {
         let mut c = std::process::Command::new(&exe);
         c.arg("tradeoff")
             .arg("--shaders")
-            .arg(&args.shaders)
+            .arg(&shaders)
             .arg("--scene")
             .arg(&args.scene)
             .arg("--child")
@@ -1030,7 +1049,7 @@ fn tradeoff(args: TradeoffArgs) -> Result<u8, String> {
         c
     };
     let options = tradeoff::Options {
-        shaders: args.shaders.clone(),
+        shaders: shaders.clone(),
         out: args.out.clone(),
         scene: args.scene.clone(),
         quick: args.quick,
@@ -1073,12 +1092,16 @@ fn verify(_: VerifyArgs) -> Result<u8, String> {
 #[cfg(feature = "vulkan")]
 fn verify(args: VerifyArgs) -> Result<u8, String> {
     use rtlint::verify;
+    let shaders = match &args.shaders {
+        Some(dir) => dir.clone(),
+        None => verify::bundled::folder()?,
+    };
     if let Some(child) = &args.child {
         let [case, image] = child.as_slice() else {
             return Err("--child takes a case and an image path".into());
         };
         return match verify::child_main(
-            &args.shaders,
+            &shaders,
             case,
             std::path::Path::new(image),
             args.device.as_deref(),
@@ -1093,7 +1116,7 @@ fn verify(args: VerifyArgs) -> Result<u8, String> {
         let mut c = std::process::Command::new(&exe);
         c.arg("verify")
             .arg("--shaders")
-            .arg(&args.shaders)
+            .arg(&shaders)
             .arg("--child")
             .arg(case)
             .arg(image);
@@ -1103,7 +1126,7 @@ fn verify(args: VerifyArgs) -> Result<u8, String> {
         c
     };
     let options = verify::Options {
-        shaders: args.shaders.clone(),
+        shaders: shaders.clone(),
         out: args.out.clone(),
         filter: args.filter.clone(),
         extremes: args.extremes,

@@ -152,8 +152,13 @@ fn quick_sweep_writes_a_true_front_and_error_falls_with_rays_per_pixel() {
     drop(ctx);
     let out = std::env::temp_dir().join(format!("rtlint-tradeoff-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&out);
+    // From a folder with no `shaders/`, as an installed binary runs: the
+    // reference shaders come from the binary.
+    let elsewhere =
+        std::env::temp_dir().join(format!("rtlint-tradeoff-cwd-{}", std::process::id()));
+    std::fs::create_dir_all(&elsewhere).unwrap();
     let o = common::rtlint()
-        .current_dir(common::root())
+        .current_dir(&elsewhere)
         .args(["tradeoff", "--quick", "--out"])
         .arg(&out)
         .output()
