@@ -305,8 +305,27 @@ pub fn check_paths(paths: &[PathBuf], options: &Options) -> Report {
         || inputs.pipelines.iter().any(|(_, c)| c.deny_warnings);
     let mut seen = HashSet::new();
     // The same finding from several modules (a struct in a shared header)
-    // once; a finding without a position belongs to its own input.
+    // once. A finding without a position belongs to its own input, and two
+    // alike there are two places (two traces of a module without debug
+    // info): the n-th of them is told from the (n+1)-th.
+    let mut alike: HashMap<(Option<&str>, &str, String, PathBuf, Option<String>), usize> =
+        HashMap::new();
     diagnostics.retain(|d| {
+        let nth = if d.primary.is_none() {
+            let n = alike
+                .entry((
+                    d.code,
+                    d.name,
+                    d.message.clone(),
+                    d.file.clone(),
+                    d.subject.clone(),
+                ))
+                .or_insert(0);
+            *n += 1;
+            *n
+        } else {
+            0
+        };
         seen.insert((
             d.code,
             d.name,
@@ -314,6 +333,7 @@ pub fn check_paths(paths: &[PathBuf], options: &Options) -> Report {
             d.primary.as_ref().map(|l| l.location.clone()),
             d.primary.is_none().then(|| d.file.clone()),
             d.subject.clone(),
+            nth,
         ))
     });
     let mut owned: Vec<PathBuf> = owned.into_iter().collect();

@@ -794,3 +794,55 @@ fn statistics_in_every_format() {
         "{summary}"
     );
 }
+
+/// Two traces with the same invalid interval in a module without debug
+/// info: two findings, not one (they are two places, even without lines).
+#[test]
+fn alike_findings_without_positions_stay_apart() {
+    let d = scratch("alike");
+    let src = d.join("two.rgen");
+    std::fs::write(
+        &src,
+        "#version 460\n#extension GL_EXT_ray_tracing : require\n\
+layout(location = 0) rayPayloadEXT vec4 p;\n\
+layout(binding = 0) uniform accelerationStructureEXT tlas;\n\
+layout(binding = 1, rgba8) uniform image2D img;\n\
+void main() {\n\
+    traceRayEXT(tlas, 0, 0xFF, 0, 1, 0, vec3(0.0), 10.0, vec3(0.0, 0.0, 1.0), 1.0, 0);\n\
+    vec4 a = p;\n\
+    traceRayEXT(tlas, 0, 0xFF, 0, 1, 0, vec3(1.0), 10.0, vec3(0.0, 0.0, 1.0), 1.0, 0);\n\
+    imageStore(img, ivec2(gl_LaunchIDEXT.xy), p + a);\n\
+}\n",
+    )
+    .unwrap();
+    let compiled = Command::new("glslangValidator")
+        .args(["-V", "--target-env", "vulkan1.2", "-o"])
+        .arg(d.join("two.spv"))
+        .arg(&src)
+        .output()
+        .map_err(|e| e.to_string())
+        .and_then(|g| {
+            if g.status.success() {
+                Ok(())
+            } else {
+                Err(text(&g))
+            }
+        });
+    if require("glslangValidator", compiled).is_none() {
+        return;
+    }
+    let o = check_in(&d, &["--no-cache", "--select", "RT035", "two.spv"]);
+    assert_eq!(
+        findings(&o),
+        ["two.spv: error[RT035]", "two.spv: error[RT035]"],
+        "{}",
+        text(&o)
+    );
+    let o = check_in(&d, &["--no-cache", "--select", "RT035", "two.rgen"]);
+    assert_eq!(
+        findings(&o),
+        ["two.rgen:7: error[RT035]", "two.rgen:9: error[RT035]"],
+        "{}",
+        text(&o)
+    );
+}
