@@ -153,6 +153,9 @@ impl Report {
 
 /// Lints `paths` (files, folders, or `-` for standard input).
 pub fn check_paths(paths: &[PathBuf], options: &Options) -> Report {
+    // Compiled GLSL is kept beside the results: a description's shaders
+    // are compiled again each run otherwise (its pipeline is not cached).
+    front::glsl::use_module_cache(options.cache.as_ref().map(|c| c.join("modules")));
     let mut configs = Configs::new(options);
     let mut inputs = collect(paths, options, &mut configs);
     // Shaders a description uses are checked with it (on the description's
@@ -308,8 +311,9 @@ pub fn check_paths(paths: &[PathBuf], options: &Options) -> Report {
     // once. A finding without a position belongs to its own input, and two
     // alike there are two places (two traces of a module without debug
     // info): the n-th of them is told from the (n+1)-th.
-    let mut alike: HashMap<(Option<&str>, &str, String, PathBuf, Option<String>), usize> =
-        HashMap::new();
+    // (code, name, message, input, subject) → how many seen so far.
+    type Alike<'a> = (Option<&'a str>, &'a str, String, PathBuf, Option<String>);
+    let mut alike: HashMap<Alike, usize> = HashMap::new();
     diagnostics.retain(|d| {
         let nth = if d.primary.is_none() {
             let n = alike
