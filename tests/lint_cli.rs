@@ -846,3 +846,49 @@ void main() {\n\
         text(&o)
     );
 }
+
+/// A struct in a header two `-g` modules include is one finding at the
+/// header, also when the header is found twice (the copy beside the
+/// modules and the original their debug info names): the copies' identical
+/// declarations are one place, not an ambiguity that loses the position
+/// and gives one finding per module.
+#[test]
+fn a_header_struct_in_g_modules_is_reported_once() {
+    let d = scratch("g-header");
+    std::fs::create_dir_all(d.join("src")).unwrap();
+    std::fs::create_dir_all(d.join("out")).unwrap();
+    let header = "struct Fat { vec4 a; vec4 b; vec4 c; };\n";
+    std::fs::write(d.join("src/fat.glsl"), header).unwrap();
+    std::fs::write(d.join("out/fat.glsl"), header).unwrap();
+    for (name, origin) in [("a", "0.0"), ("b", "1.0")] {
+        std::fs::write(
+            d.join(format!("src/{name}.rgen")),
+            format!("#version 460\n#extension GL_EXT_ray_tracing : require\n#extension GL_GOOGLE_include_directive : require\n#include \"fat.glsl\"\nlayout(location = 0) rayPayloadEXT Fat p;\nlayout(binding = 0) uniform accelerationStructureEXT tlas;\nlayout(binding = 1, rgba8) uniform image2D img;\nvoid main() {{\n    traceRayEXT(tlas, 0, 0xFF, 0, 1, 0, vec3({origin}), 0.001, vec3(0.0, 0.0, 1.0), 100.0, 0);\n    imageStore(img, ivec2(gl_LaunchIDEXT.xy), p.a);\n}}\n"),
+        )
+        .unwrap();
+        let g = Command::new("glslangValidator")
+            .current_dir(&d)
+            .args(["-V", "--target-env", "vulkan1.2", "-g", "-o"])
+            .arg(format!("out/{name}.spv"))
+            .arg(format!("src/{name}.rgen"))
+            .output()
+            .map_err(|e| e.to_string())
+            .and_then(|g| {
+                if g.status.success() {
+                    Ok(())
+                } else {
+                    Err(text(&g))
+                }
+            });
+        if require("glslangValidator", g).is_none() {
+            return;
+        }
+    }
+    let o = check_in(&d, &["--no-cache", "--select", "RT001", "out"]);
+    assert_eq!(
+        findings(&o),
+        ["out/fat.glsl:1:8: warning[RT001]"],
+        "{}",
+        text(&o)
+    );
+}
