@@ -306,15 +306,27 @@ pub fn check_paths(paths: &[PathBuf], options: &Options) -> Report {
     report.deny_warnings = options.overrides.deny_warnings
         || inputs.files.iter().any(|i| i.config.deny_warnings)
         || inputs.pipelines.iter().any(|(_, c)| c.deny_warnings);
-    let mut seen = HashSet::new();
-    // The same finding from several modules (a struct in a shared header)
-    // once. A finding without a position belongs to its own input, and two
-    // alike there are two places (two traces of a module without debug
-    // info): the n-th of them is told from the (n+1)-th.
+    // The same finding from several modules (a struct or a trace in a
+    // shared header) once, with the evidence of each: the secondary labels
+    // (each includer's trace) of the copies are added to the one kept. A
+    // finding without a position belongs to its own input, and two alike
+    // there are two places (two traces of a module without debug info): the
+    // n-th of them is told from the (n+1)-th.
+    type Same = (
+        Option<&'static str>,
+        &'static str,
+        String,
+        Option<crate::shader::Location>,
+        Option<PathBuf>,
+        Option<String>,
+        usize,
+    );
+    let mut kept_at: HashMap<Same, usize> = HashMap::new();
     // (code, name, message, input, subject) → how many seen so far.
     type Alike<'a> = (Option<&'a str>, &'a str, String, PathBuf, Option<String>);
     let mut alike: HashMap<Alike, usize> = HashMap::new();
-    diagnostics.retain(|d| {
+    let mut merged: Vec<Diagnostic> = Vec::with_capacity(diagnostics.len());
+    for d in diagnostics {
         let nth = if d.primary.is_none() {
             let n = alike
                 .entry((
@@ -330,7 +342,7 @@ pub fn check_paths(paths: &[PathBuf], options: &Options) -> Report {
         } else {
             0
         };
-        seen.insert((
+        let key = (
             d.code,
             d.name,
             d.message.clone(),
@@ -338,8 +350,22 @@ pub fn check_paths(paths: &[PathBuf], options: &Options) -> Report {
             d.primary.is_none().then(|| d.file.clone()),
             d.subject.clone(),
             nth,
-        ))
-    });
+        );
+        match kept_at.get(&key) {
+            Some(&k) => {
+                for l in d.secondary {
+                    if !merged[k].secondary.contains(&l) {
+                        merged[k].secondary.push(l);
+                    }
+                }
+            }
+            None => {
+                kept_at.insert(key, merged.len());
+                merged.push(d);
+            }
+        }
+    }
+    let diagnostics = merged;
     let mut owned: Vec<PathBuf> = owned.into_iter().collect();
     owned.sort();
     let owned: Vec<(PathBuf, Arc<Config>)> = owned

@@ -892,3 +892,78 @@ fn a_header_struct_in_g_modules_is_reported_once() {
         text(&o)
     );
 }
+
+/// A payload struct in a GLSL header two shaders include: one finding (one
+/// SARIF result, one annotation) at the header, listing both includers'
+/// traces as evidence.
+#[test]
+fn a_glsl_header_finding_lists_every_includer() {
+    let d = scratch("glsl-header");
+    std::fs::write(
+        d.join("fat.glsl"),
+        "struct Fat { vec4 a; vec4 b; vec4 c; };\n",
+    )
+    .unwrap();
+    for (name, origin) in [("a", "0.0"), ("b", "1.0")] {
+        std::fs::write(
+            d.join(format!("{name}.rgen")),
+            format!("#version 460\n#extension GL_EXT_ray_tracing : require\n#extension GL_GOOGLE_include_directive : require\n#include \"fat.glsl\"\nlayout(location = 0) rayPayloadEXT Fat p;\nlayout(binding = 0) uniform accelerationStructureEXT tlas;\nlayout(binding = 1, rgba8) uniform image2D img;\nvoid main() {{\n    traceRayEXT(tlas, 0, 0xFF, 0, 1, 0, vec3({origin}), 0.001, vec3(0.0, 0.0, 1.0), 100.0, 0);\n    imageStore(img, ivec2(gl_LaunchIDEXT.xy), p.a);\n}}\n"),
+        )
+        .unwrap();
+    }
+    let have = Command::new("glslangValidator")
+        .arg("--version")
+        .output()
+        .map(|_| ())
+        .map_err(|e| e.to_string());
+    if require("glslangValidator", have).is_none() {
+        return;
+    }
+    let o = rtlint()
+        .current_dir(d.parent().unwrap())
+        .args([
+            "check",
+            "--no-cache",
+            "--select",
+            "RT001",
+            "--format",
+            "sarif",
+        ])
+        .arg(d.file_name().unwrap())
+        .output()
+        .unwrap();
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).expect("SARIF");
+    let results = v["runs"][0]["results"].as_array().unwrap();
+    assert_eq!(results.len(), 1, "{v}");
+    let related: Vec<String> = results[0]["relatedLocations"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|l| {
+            let uri = l["physicalLocation"]["artifactLocation"]["uri"]
+                .as_str()
+                .unwrap();
+            uri.rsplit('/').next().unwrap().to_string()
+        })
+        .collect();
+    assert_eq!(related, ["a.rgen", "b.rgen"], "{v}");
+    let o = rtlint()
+        .current_dir(d.parent().unwrap())
+        .args([
+            "check",
+            "--no-cache",
+            "--select",
+            "RT001",
+            "--format",
+            "github",
+        ])
+        .arg(d.file_name().unwrap())
+        .output()
+        .unwrap();
+    assert_eq!(
+        String::from_utf8_lossy(&o.stdout).lines().count(),
+        1,
+        "{}",
+        text(&o)
+    );
+}
