@@ -118,7 +118,8 @@ impl Builder {
     }
 
     /// Writes one SPIR-V module per entry point into the output folder as
-    /// `<file stem>.<entry>.spv`; a `.spv` input is copied as it is.
+    /// `<file stem>.<entry>.spv` (HLSL, WGSL), a GLSL shader as `<file
+    /// name>.spv` (`shadow.rmiss.spv`); a `.spv` input is copied as it is.
     pub fn emit_spirv(mut self) -> Self {
         self.emit_spirv = true;
         self
@@ -204,8 +205,26 @@ impl Builder {
         if failing.is_empty() {
             Ok(())
         } else {
+            // The other shaders' findings go with the failure too: cargo
+            // shows a failed script's output as a block, and a reader of
+            // the error should not have to dig the warnings out of it.
+            let also: Vec<String> = outcome
+                .diagnostics
+                .iter()
+                .filter(|d| d.code.is_some() && !failing.contains(d))
+                .map(one_line)
+                .collect::<BTreeSet<_>>()
+                .into_iter()
+                .collect();
             let mut sources = outcome.sources;
-            Err(Error::new(failing, &mut sources))
+            let mut e = Error::new(failing, &mut sources);
+            if !also.is_empty() {
+                e.rendered.push_str("also found (not failing the build):\n");
+                for l in also {
+                    e.rendered.push_str(&format!("  {l}\n"));
+                }
+            }
+            Err(e)
         }
     }
 
@@ -305,6 +324,15 @@ impl Builder {
                 }
             }
         }
+        let mut written: BTreeSet<PathBuf> = spirv_names.keys().map(PathBuf::from).collect();
+        if let Some(file) = &self.layouts {
+            written.insert(file.clone());
+        }
+        if let Some(dir) = &out_dir {
+            if let Err(e) = forget_old_outputs(dir, &written) {
+                run.diagnostics.push(*e.0);
+            }
+        }
         if let (Some(file), Some(dir)) = (&self.layouts, &out_dir) {
             let options = layouts::Options {
                 glam: !self.no_glam,
@@ -321,6 +349,34 @@ impl Builder {
         }
         run
     }
+}
+
+/// The list of files rtlint wrote into the output folder, one per line.
+const OUTPUTS: &str = "rtlint-outputs.txt";
+
+/// Removes what an earlier run wrote into `dir` and this run does not (the
+/// SPIR-V of a deleted shader), then records this run's files. Only files
+/// rtlint listed are ever removed: the folder is shared with the rest of the
+/// build script.
+fn forget_old_outputs(dir: &Path, written: &BTreeSet<PathBuf>) -> Result<(), InputError> {
+    let list = dir.join(OUTPUTS);
+    if let Ok(old) = std::fs::read_to_string(&list) {
+        for name in old.lines().map(Path::new) {
+            // Names rtlint wrote are plain relative paths; anything else in
+            // the list was not written by it.
+            let plain = name
+                .components()
+                .all(|c| matches!(c, std::path::Component::Normal(_)));
+            if plain && !name.as_os_str().is_empty() && !written.contains(name) {
+                let _ = std::fs::remove_file(dir.join(name));
+            }
+        }
+    }
+    let text: String = written
+        .iter()
+        .map(|p| format!("{}\n", p.display()))
+        .collect();
+    write_if_changed(&list, text.as_bytes())
 }
 
 /// `path` relative to the current folder when it is inside it: cargo runs
@@ -417,14 +473,16 @@ fn emit_spirv(
             }
             out
         }
-        // glslang writes one entry point per file.
+        // glslang writes one entry point per file, always `main`: the file
+        // name with its stage extension tells the modules apart
+        // (`shadow.rmiss` and `shadow.rahit` → `shadow.rmiss.spv`,
+        // `shadow.rahit.spv`).
         Language::Glsl => {
-            let entry = program
-                .entry_points
-                .first()
-                .map(|e| e.name.as_str())
-                .unwrap_or("main");
-            vec![(format!("{stem}.{entry}.spv"), program.words.clone())]
+            let name = path
+                .file_name()
+                .map(|s| s.to_string_lossy().into_owned())
+                .unwrap_or_default();
+            vec![(format!("{name}.spv"), program.words.clone())]
         }
         // A module as it is, under its own name.
         Language::Spirv => {

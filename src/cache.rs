@@ -542,15 +542,16 @@ impl Cache {
             return 0;
         }
         let mut removed = 0;
-        // `files` and `groups`: one entry per file, as older builds wrote.
-        for kind in ["packs", "files", "groups"] {
+        // `files` and `groups`: one entry per file, as older builds wrote;
+        // `modules`: compiled GLSL (`front::glsl`), recompiled when pruned.
+        for kind in ["packs", "files", "groups", "modules"] {
             let Ok(dir) = std::fs::read_dir(self.dir.join(kind)) else {
                 continue;
             };
             for e in dir.flatten() {
                 let path = e.path();
                 let limit = match path.extension().and_then(|x| x.to_str()) {
-                    Some("json") => MAX_AGE,
+                    Some("json" | "spv" | "deps") => MAX_AGE,
                     Some("tmp") => TMP_AGE,
                     _ => continue,
                 };

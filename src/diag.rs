@@ -206,6 +206,8 @@ pub enum InputErrorKind {
     /// an HLSL file declares no entry point: a header when another linted
     /// file includes it (then dropped), else reported as a note.
     NoEntryPoint,
+    /// a suppression in a shader names no rule, code or group.
+    InvalidSuppression,
     /// `stack --driver`: the device could not create the pipeline (the
     /// driver failed or crashed, or the validation layer objected).
     DriverFailed,
@@ -229,6 +231,7 @@ impl InputErrorKind {
         InputErrorKind::GlslError,
         InputErrorKind::DriverFailed,
         InputErrorKind::NoEntryPoint,
+        InputErrorKind::InvalidSuppression,
     ];
 
     pub fn as_str(self) -> &'static str {
@@ -249,6 +252,7 @@ impl InputErrorKind {
             InputErrorKind::GlslError => "glsl-error",
             InputErrorKind::DriverFailed => "driver-failed",
             InputErrorKind::NoEntryPoint => "no-entry-point",
+            InputErrorKind::InvalidSuppression => "invalid-suppression",
         }
     }
 }
@@ -386,6 +390,7 @@ mod tests {
                 "glsl-error",
                 "driver-failed",
                 "no-entry-point",
+                "invalid-suppression",
             ]
         );
         for (i, a) in names.iter().enumerate() {

@@ -8,7 +8,7 @@ use crate::diag::{Diagnostic, InputError, InputErrorKind, Severity};
 use crate::front::hlsl::subobject::Subobjects;
 use crate::front::{self, FrontOptions};
 use crate::program::Program;
-use crate::shader::Language;
+use crate::shader::{Language, Location};
 use rayon::prelude::*;
 use std::collections::{BTreeMap, HashMap, HashSet};
 use std::path::{Path, PathBuf};
@@ -120,6 +120,9 @@ pub struct Report {
     pub embedded: Vec<(PathBuf, String)>,
     /// Warnings fail the run (any config or the command line said so).
     pub deny_warnings: bool,
+    /// Shader files and descriptions of the whole set, before `--shard`
+    /// kept one part: an empty shard of a non-empty set is not an empty run.
+    pub all_inputs: usize,
 }
 
 impl Report {
@@ -140,10 +143,19 @@ impl Report {
     pub fn is_empty(&self) -> bool {
         self.files.is_empty() && self.pipelines.is_empty()
     }
+
+    /// Nothing was linted because the paths hold nothing to lint (not
+    /// because this shard's part of a non-empty set is empty).
+    pub fn found_nothing(&self) -> bool {
+        self.is_empty() && self.all_inputs == 0
+    }
 }
 
 /// Lints `paths` (files, folders, or `-` for standard input).
 pub fn check_paths(paths: &[PathBuf], options: &Options) -> Report {
+    // Compiled GLSL is kept beside the results: a description's shaders
+    // are compiled again each run otherwise (its pipeline is not cached).
+    front::glsl::use_module_cache(options.cache.as_ref().map(|c| c.join("modules")));
     let mut configs = Configs::new(options);
     let mut inputs = collect(paths, options, &mut configs);
     // Shaders a description uses are checked with it (on the description's
@@ -153,6 +165,7 @@ pub fn check_paths(paths: &[PathBuf], options: &Options) -> Report {
         .iter()
         .map(|(p, config)| described_shaders(p, config, options))
         .collect();
+    let all_inputs = inputs.files.len() + inputs.pipelines.len();
     if let Some(shard) = options.shard {
         keep_shard(&mut inputs, &descriptions, shard);
     }
@@ -162,6 +175,7 @@ pub fn check_paths(paths: &[PathBuf], options: &Options) -> Report {
         files: inputs.files.iter().map(|i| i.path.clone()).collect(),
         pipelines: inputs.pipelines.iter().map(|(p, _)| p.clone()).collect(),
         skipped: inputs.skipped.clone(),
+        all_inputs,
         ..Report::default()
     };
     // A config that cannot be read is reported once, by the first shard.
@@ -294,19 +308,66 @@ pub fn check_paths(paths: &[PathBuf], options: &Options) -> Report {
     report.deny_warnings = options.overrides.deny_warnings
         || inputs.files.iter().any(|i| i.config.deny_warnings)
         || inputs.pipelines.iter().any(|(_, c)| c.deny_warnings);
-    let mut seen = HashSet::new();
-    // The same finding from several modules (a struct in a shared header)
-    // once; a finding without a position belongs to its own input.
-    diagnostics.retain(|d| {
-        seen.insert((
+    // The same finding from several modules (a struct or a trace in a
+    // shared header) once, with the evidence of each: the secondary labels
+    // (each includer's trace) of the copies are added to the one kept. A
+    // finding without a position belongs to its own input, and two alike
+    // there are two places (two traces of a module without debug info): the
+    // n-th of them is told from the (n+1)-th.
+    type Same = (
+        Option<&'static str>,
+        &'static str,
+        String,
+        Option<crate::shader::Location>,
+        Option<PathBuf>,
+        Option<String>,
+        usize,
+    );
+    let mut kept_at: HashMap<Same, usize> = HashMap::new();
+    // (code, name, message, input, subject) → how many seen so far.
+    type Alike<'a> = (Option<&'a str>, &'a str, String, PathBuf, Option<String>);
+    let mut alike: HashMap<Alike, usize> = HashMap::new();
+    let mut merged: Vec<Diagnostic> = Vec::with_capacity(diagnostics.len());
+    for d in diagnostics {
+        let nth = if d.primary.is_none() {
+            let n = alike
+                .entry((
+                    d.code,
+                    d.name,
+                    d.message.clone(),
+                    d.file.clone(),
+                    d.subject.clone(),
+                ))
+                .or_insert(0);
+            *n += 1;
+            *n
+        } else {
+            0
+        };
+        let key = (
             d.code,
             d.name,
             d.message.clone(),
             d.primary.as_ref().map(|l| l.location.clone()),
             d.primary.is_none().then(|| d.file.clone()),
             d.subject.clone(),
-        ))
-    });
+            nth,
+        );
+        match kept_at.get(&key) {
+            Some(&k) => {
+                for l in d.secondary {
+                    if !merged[k].secondary.contains(&l) {
+                        merged[k].secondary.push(l);
+                    }
+                }
+            }
+            None => {
+                kept_at.insert(key, merged.len());
+                merged.push(d);
+            }
+        }
+    }
+    let diagnostics = merged;
     let mut owned: Vec<PathBuf> = owned.into_iter().collect();
     owned.sort();
     let owned: Vec<(PathBuf, Arc<Config>)> = owned
@@ -1056,6 +1117,27 @@ fn apply_suppressions(
         }
         if !allowed {
             kept.push(d);
+        }
+    }
+    // Selectors that name nothing, in the files this run linted: input
+    // errors, as unknown selectors in rtlint.toml are.
+    for (path, _) in owned {
+        for (s, _) in files.get(path.as_path()).into_iter().flatten() {
+            for (sel, &(column, len)) in s.selectors.iter().zip(&s.spans) {
+                if !crate::rules::is_selector(sel) {
+                    let e = InputError::new(
+                        InputErrorKind::InvalidSuppression,
+                        path,
+                        format!("suppression names unknown rule or group `{sel}`"),
+                    )
+                    .at(
+                        Location::span(path, s.line, column, len),
+                        "not a rule code, name or group",
+                    )
+                    .with_note("`rtlint rules` lists the codes, names and groups");
+                    kept.push(*e.0);
+                }
+            }
         }
     }
     // Unused suppressions, in the files this run linted.

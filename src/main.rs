@@ -114,13 +114,16 @@ struct CheckArgs {
     /// Ray payloads above this many bytes are reported (RT001).
     #[arg(long)]
     payload_budget: Option<u64>,
-    /// Warnings fail the run (exit 1) too, and so does finding no file to lint.
+    /// Warnings fail the run (exit 1) too, and so does finding no file to
+    /// lint (exit 2; an empty shard of a non-empty set is not that).
     #[arg(long)]
     deny_warnings: bool,
     /// Exit 0 even when findings fail the run (input errors still exit 2).
     #[arg(long)]
     exit_zero: bool,
-    /// Count findings per rule instead of listing them.
+    /// Count findings per rule instead of listing them, in the format's own
+    /// shape (JSON `statistics`, SARIF run properties, a GitHub notice and
+    /// job summary).
     #[arg(long)]
     statistics: bool,
     /// Print findings only: no summary line, no notes.
@@ -165,10 +168,13 @@ enum AnalysisArg {
 /// `rtlint verify`.
 #[derive(clap::Args, Clone)]
 struct VerifyArgs {
-    /// The folder holding `verify.toml`, the shaders and `scenes/`.
-    #[arg(long, default_value = "shaders")]
-    shaders: PathBuf,
-    /// Where the tables (CSV, Markdown) and the images of failed cases go.
+    /// The folder holding `verify.toml`, the shaders and `scenes/`
+    /// [default: the reference shaders built into rtlint].
+    #[arg(long, value_name = "DIR")]
+    shaders: Option<PathBuf>,
+    /// Where the tables (CSV, Markdown) and the images go: each case's GPU
+    /// image, multi-pass cases' path pictures, and for a failed case the CPU
+    /// image and the difference.
     #[arg(long, default_value = "target/verify")]
     out: PathBuf,
     /// Use the first ray-tracing device whose name contains this text.
@@ -189,9 +195,10 @@ struct VerifyArgs {
 /// `rtlint tradeoff`.
 #[derive(clap::Args, Clone)]
 struct TradeoffArgs {
-    /// The folder holding `verify.toml`, the shaders and `scenes/`.
-    #[arg(long, default_value = "shaders")]
-    shaders: PathBuf,
+    /// The folder holding `verify.toml`, the shaders and `scenes/`
+    /// [default: the reference shaders built into rtlint].
+    #[arg(long, value_name = "DIR")]
+    shaders: Option<PathBuf>,
     /// Where the CSV, Markdown table, SVG plot and PNGs go.
     #[arg(long, default_value = "target/tradeoff")]
     out: PathBuf,
@@ -261,8 +268,8 @@ enum Command {
         verbose: bool,
         /// Output: a `.spv` file (one entry point, or with --whole every entry
         /// point in one module), or a directory for one module per entry point
-        /// (DXC's `-Fo FILE` too). Without it the file is compiled and
-        /// nothing is written (a check).
+        /// (DXC's `-Fo FILE` too; `-o DIR/` is created when missing). Without
+        /// it the file is compiled and nothing is written (a check).
         #[arg(short = 'o', long = "output")]
         output: Option<PathBuf>,
         /// One module holding every entry point.
@@ -272,9 +279,9 @@ enum Command {
     /// Run the reference reflection shaders on the Vulkan device and
     /// compare each image with the CPU reference renderer.
     Verify(VerifyArgs),
-    /// Sweep the reference shaders' knobs (bounces, rays per pixel, t_max,
-    /// roughness cut-off, half resolution, ray origins) and measure GPU time
-    /// against error.
+    /// Sweep the reference shaders' knobs (bounces, spp, tmax, rough_cutoff,
+    /// half_res, ssr, tolerance, min_paths, max_paths, origin; docs/tradeoff.md
+    /// says what each sets) and measure GPU time against error.
     Tradeoff(TradeoffArgs),
     /// List every rule.
     Rules,
@@ -487,18 +494,28 @@ fn run(cli: Cli) -> Result<u8, String> {
         Command::DriverStackSizes { pipeline } => driver_stack_sizes(pipeline),
         Command::Rules => {
             let mut out = std::io::stdout().lock();
-            for r in rtlint::rules::RULES {
-                let level = if r.group.on_by_default() {
+            let level = |r: &rtlint::rules::Rule| {
+                if r.group.on_by_default() {
                     r.level.as_str()
                 } else {
                     "off"
-                };
+                }
+            };
+            // Columns as wide as their longest entry: names grow.
+            let rules = rtlint::rules::RULES;
+            let width = |f: &dyn Fn(&rtlint::rules::Rule) -> usize| {
+                rules.iter().map(|r| f(r)).max().unwrap_or(0)
+            };
+            let name_w = width(&|r| r.name.len());
+            let level_w = width(&|r| level(r).len());
+            let group_w = width(&|r| r.group.as_str().len());
+            for r in rules {
                 let _ = writeln!(
                     out,
-                    "{}  {:<28} {:<8} {:<12} {}",
+                    "{}  {:<name_w$}  {:<level_w$}  {:<group_w$}  {}",
                     r.code,
                     r.name,
-                    level,
+                    level(r),
                     r.group.as_str(),
                     r.summary
                 );
@@ -622,11 +639,20 @@ fn check(args: CheckArgs) -> Result<u8, String> {
         Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => return Ok(0),
         Err(e) => return Err(format!("cannot write output: {e}")),
     }
-    if report.is_empty() {
+    if report.found_nothing() {
         eprintln!("warning: no files to lint");
         if args.deny_warnings {
             return Ok(2);
         }
+    } else if report.is_empty() && !args.quiet {
+        // The other shards have the files: a small project on a wide CI
+        // matrix is not an error.
+        let n = report.all_inputs;
+        eprintln!(
+            "note: this shard got none of the {n} input{}; the other shards check {}",
+            if n == 1 { "" } else { "s" },
+            if n == 1 { "it" } else { "them" }
+        );
     }
     let code = report.exit_code();
     Ok(if args.exit_zero && code == 1 { 0 } else { code })
@@ -647,8 +673,32 @@ fn emit(
             .filter(|d| d.code.is_none())
             .cloned()
             .collect();
-        write!(out, "{}", report::statistics(diagnostics))?;
-        report::human::render(&errors, sources, out)?;
+        match args.format {
+            CheckFormat::Human | CheckFormat::Concise => {
+                write!(out, "{}", report::statistics(diagnostics))?;
+                report::human::render(&errors, sources, out)?;
+            }
+            CheckFormat::Json => writeln!(
+                out,
+                "{}",
+                report::json::render_statistics(diagnostics, summary)
+            )?,
+            CheckFormat::Sarif => {
+                writeln!(out, "{}", report::sarif::render_statistics(diagnostics))?
+            }
+            CheckFormat::Github => {
+                let (notice, table) = report::github_statistics(diagnostics);
+                write!(out, "{notice}{}", report::github(&errors))?;
+                // The job's summary page, when run as a GitHub step.
+                if let Some(path) = std::env::var_os("GITHUB_STEP_SUMMARY") {
+                    let mut f = std::fs::OpenOptions::new()
+                        .create(true)
+                        .append(true)
+                        .open(path)?;
+                    f.write_all(table.as_bytes())?;
+                }
+            }
+        }
         return Ok(());
     }
     match args.format {
@@ -804,8 +854,8 @@ fn stack(
     // the pipeline they describe.
     let mut loose_programs = Vec::new();
     for (program, s) in programs.into_iter().zip(subobjects) {
+        // Its description's pipeline already has it.
         if described.contains(&canonical(&program.path)) {
-            loose_programs.push(program);
             continue;
         }
         match rtlint::pipeline::Pipeline::from_subobjects(program, &s) {
@@ -813,9 +863,17 @@ fn stack(
             Err(program) => loose_programs.push(*program),
         }
     }
-    let programs = loose_programs;
-    // Loose shaders: one conservative pipeline over all of them.
-    if !programs.is_empty() {
+    // Loose shaders: one conservative pipeline per folder, as `check`
+    // groups them (shaders in different folders are not one pipeline).
+    let mut folders: Vec<(PathBuf, Vec<rtlint::program::Program>)> = Vec::new();
+    for program in loose_programs {
+        let dir = program.path.parent().map(canonical).unwrap_or_default();
+        match folders.iter_mut().find(|(d, _)| *d == dir) {
+            Some((_, list)) => list.push(program),
+            None => folders.push((dir, vec![program])),
+        }
+    }
+    for (_, programs) in folders {
         pipelines.push(rtlint::pipeline::Pipeline::from_programs(programs));
     }
     #[cfg(not(feature = "vulkan"))]
@@ -884,7 +942,15 @@ fn stack(
             .collect::<Vec<_>>()
             .join("\n")
     };
-    print_report(format, json, human, &problems)
+    // A declared depth below the deepest chain fails on the device (RT021
+    // is an error): CI should fail too.
+    let too_shallow = reports
+        .iter()
+        .any(|r| report::stack::raise_depth_to(r).is_some());
+    Ok(match print_report(format, json, human, &problems)? {
+        0 if too_shallow => 1,
+        code => code,
+    })
 }
 
 /// Prints a report as JSON (with the input errors under `errors`) or text
@@ -992,7 +1058,11 @@ fn compile(
         );
         return Ok(0);
     };
-    if output.is_dir() {
+    // `-o dir/` names a folder, which is created when missing.
+    let folder = output.is_dir() || output.as_os_str().to_string_lossy().ends_with(['/', '\\']);
+    if folder {
+        std::fs::create_dir_all(&output)
+            .map_err(|e| format!("cannot create {}: {e}", output.display()))?;
         for e in &entries {
             let path = output.join(format!("{}.spv", e.name));
             write(&path, &e.words)?;
@@ -1023,12 +1093,16 @@ fn tradeoff(_: TradeoffArgs) -> Result<u8, String> {
 #[cfg(feature = "vulkan")]
 fn tradeoff(args: TradeoffArgs) -> Result<u8, String> {
     use rtlint::{tradeoff, verify};
+    let shaders = match &args.shaders {
+        Some(dir) => dir.clone(),
+        None => verify::bundled::folder()?,
+    };
     if let Some(child) = &args.child {
         let [setting, image] = child.as_slice() else {
             return Err("--child takes a setting and an image path".into());
         };
         return match tradeoff::child_main(
-            &args.shaders,
+            &shaders,
             &args.scene,
             args.quick,
             setting,
@@ -1045,7 +1119,7 @@ fn tradeoff(args: TradeoffArgs) -> Result<u8, String> {
         let mut c = std::process::Command::new(&exe);
         c.arg("tradeoff")
             .arg("--shaders")
-            .arg(&args.shaders)
+            .arg(&shaders)
             .arg("--scene")
             .arg(&args.scene)
             .arg("--child")
@@ -1060,7 +1134,7 @@ fn tradeoff(args: TradeoffArgs) -> Result<u8, String> {
         c
     };
     let options = tradeoff::Options {
-        shaders: args.shaders.clone(),
+        shaders: shaders.clone(),
         out: args.out.clone(),
         scene: args.scene.clone(),
         quick: args.quick,
@@ -1103,12 +1177,16 @@ fn verify(_: VerifyArgs) -> Result<u8, String> {
 #[cfg(feature = "vulkan")]
 fn verify(args: VerifyArgs) -> Result<u8, String> {
     use rtlint::verify;
+    let shaders = match &args.shaders {
+        Some(dir) => dir.clone(),
+        None => verify::bundled::folder()?,
+    };
     if let Some(child) = &args.child {
         let [case, image] = child.as_slice() else {
             return Err("--child takes a case and an image path".into());
         };
         return match verify::child_main(
-            &args.shaders,
+            &shaders,
             case,
             std::path::Path::new(image),
             args.device.as_deref(),
@@ -1123,7 +1201,7 @@ fn verify(args: VerifyArgs) -> Result<u8, String> {
         let mut c = std::process::Command::new(&exe);
         c.arg("verify")
             .arg("--shaders")
-            .arg(&args.shaders)
+            .arg(&shaders)
             .arg("--child")
             .arg(case)
             .arg(image);
@@ -1133,7 +1211,7 @@ fn verify(args: VerifyArgs) -> Result<u8, String> {
         c
     };
     let options = verify::Options {
-        shaders: args.shaders.clone(),
+        shaders: shaders.clone(),
         out: args.out.clone(),
         filter: args.filter.clone(),
         extremes: args.extremes,

@@ -1,6 +1,6 @@
 //! Suppressions written in the shader source: `// rtlint: allow(RT001)` or
-//! `// rtlint: allow(payload-over-budget, reason = "...")` on the finding's
-//! line or the line above, in HLSL, WGSL and GLSL alike (a GLSL-compiled
+//! `// rtlint: allow(payload-over-budget, reason = "...")` at the end of the
+//! finding's line or alone on the line above, in HLSL, WGSL and GLSL alike (a GLSL-compiled
 //! module finds them through the source it embeds); and WGSL's own
 //! `diagnostic(off, rtlint.payload_over_budget)`, as a directive (the whole
 //! file) or an `@diagnostic` attribute (the item it stands on).
@@ -16,6 +16,9 @@ pub struct Suppression {
     pub covers: (u32, u32),
     /// The codes, names or groups it allows.
     pub selectors: Vec<String>,
+    /// Each selector's 1-based column and length in characters (where an
+    /// unknown one is reported).
+    pub spans: Vec<(u32, u32)>,
     /// The reason given, if any.
     pub reason: Option<String>,
 }
@@ -43,11 +46,18 @@ pub fn parse(text: &str) -> Vec<Suppression> {
                     .and_then(|r| r.rfind(')').map(|e| &r[..e]))
                 {
                     let (selectors, reason) = split_args(args);
+                    // After code it speaks of its own line; alone on its
+                    // line, of the next one too.
+                    let alone = line[..c].trim().is_empty();
+                    // `args` is a slice of `line`: its byte offset there.
+                    let args_at = args.as_ptr() as usize - line.as_ptr() as usize;
+                    let spans = spans_in(line, args_at, &selectors);
                     out.push(Suppression {
                         line: n,
                         column: (line[..c + 2 + at].chars().count() + 1) as u32,
-                        covers: (n, n + 1),
+                        covers: (n, if alone { n + 1 } else { n }),
                         selectors,
+                        spans,
                         reason,
                     });
                 }
@@ -79,11 +89,16 @@ pub fn parse(text: &str) -> Vec<Suppression> {
             } else {
                 (1, u32::MAX)
             };
+            let name_at = from + code[from..].find(rule).unwrap_or(0);
             out.push(Suppression {
                 line: n,
                 column: (code[..start].chars().count() + 1) as u32,
                 covers,
                 selectors: vec![rule.replace('_', "-")],
+                spans: vec![(
+                    (code[..name_at].chars().count() + 1) as u32,
+                    rule.chars().count() as u32,
+                )],
                 reason: None,
             });
         }
@@ -108,6 +123,22 @@ fn split_args(args: &str) -> (Vec<String>, Option<String>) {
         .map(String::from)
         .collect();
     (selectors, reason)
+}
+
+/// Columns and lengths of `selectors` in `line`, searched in order from
+/// byte `from`.
+fn spans_in(line: &str, mut from: usize, selectors: &[String]) -> Vec<(u32, u32)> {
+    selectors
+        .iter()
+        .map(|sel| {
+            let at = line[from..].find(sel.as_str()).map_or(from, |k| from + k);
+            from = at + sel.len();
+            (
+                (line[..at].chars().count() + 1) as u32,
+                sel.chars().count() as u32,
+            )
+        })
+        .collect()
 }
 
 /// The last line of the item that starts at line index `i`: the line of the
@@ -145,7 +176,12 @@ mod tests {
         assert_eq!(s.len(), 1);
         assert_eq!(s[0].selectors, ["RT001", "member-straddles-row"]);
         assert_eq!(s[0].reason.as_deref(), Some("legacy"));
-        assert_eq!((s[0].line, s[0].column, s[0].covers), (1, 16, (1, 2)));
+        // At the end of a line of code: that line only.
+        assert_eq!((s[0].line, s[0].column, s[0].covers), (1, 16, (1, 1)));
+        assert_eq!(s[0].spans, [(30, 5), (37, 20)]);
+        // Alone on its line: that line and the next.
+        let s = parse("  // rtlint: allow(RT001)\nstruct P { float x; };\n");
+        assert_eq!(s[0].covers, (1, 2));
         assert!(parse("// rtlint: deny(RT001)\n// rtlint allow(RT001)\n").is_empty());
     }
 
@@ -158,6 +194,7 @@ mod tests {
         assert_eq!(s[0].covers, (1, u32::MAX));
         assert_eq!(s[1].selectors, ["payload-packing-waste"]);
         assert_eq!(s[1].covers, (3, 6));
+        assert_eq!(s[1].spans, [(25, 21)]);
         // Other filters are naga's business.
         assert!(parse("diagnostic(off, derivative_uniformity);\n").is_empty());
         assert!(parse("@diagnostic(warning, rtlint.x) fn f() {}\n").is_empty());

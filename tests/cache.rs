@@ -506,3 +506,126 @@ fn fast_analysis_leaves_out_the_dataflow_rules() {
     assert_eq!(o.status.code(), Some(2), "{}", text(&o));
     assert!(text(&o).contains("rtlint.toml:1"), "{}", text(&o));
 }
+
+/// A project with one folder on a four-shard CI matrix: the shards without
+/// files succeed, also under `--deny-warnings`; paths with nothing to lint
+/// still fail it.
+#[test]
+fn an_empty_shard_of_a_non_empty_set_succeeds() {
+    let d = scratch("empty-shard");
+    std::fs::create_dir_all(d.join("s")).unwrap();
+    std::fs::write(
+        d.join("s/gen.rgen"),
+        "#version 460\n#extension GL_EXT_ray_tracing : require\nvoid main() {}\n",
+    )
+    .unwrap();
+    std::fs::create_dir_all(d.join("nothing")).unwrap();
+    let mut empty = 0;
+    for k in 1..=4 {
+        let shard = format!("{k}/4");
+        let o = rtlint()
+            .current_dir(&d)
+            .args([
+                "check",
+                "--no-cache",
+                "--deny-warnings",
+                "--shard",
+                &shard,
+                "s",
+            ])
+            .output()
+            .unwrap();
+        assert_eq!(o.status.code(), Some(0), "{shard}: {}", text(&o));
+        if text(&o).contains("this shard got none of the 1 input;") {
+            empty += 1;
+        }
+    }
+    assert_eq!(empty, 3);
+    let o = check(
+        &d,
+        &["--no-cache", "--deny-warnings", "--shard", "2/4", "nothing"],
+    );
+    assert_eq!(o.status.code(), Some(2), "{}", text(&o));
+    assert!(text(&o).contains("no files to lint"), "{}", text(&o));
+}
+
+/// A folder whose description names GLSL shaders: cold, glslang compiles
+/// each shader once (it was three times: as an input, to find what the
+/// description names, for the pipeline); warm, not at all; editing the
+/// shared header compiles both again. Counted through a wrapper named by
+/// RTLINT_GLSLANG.
+#[test]
+fn compiled_glsl_is_cached_by_content_and_includes() {
+    if std::process::Command::new("glslangValidator")
+        .arg("--version")
+        .output()
+        .is_err()
+    {
+        rtlint_testkit::require("glslangValidator", Err::<(), _>("not on PATH"));
+        return;
+    }
+    let d = scratch("glsl-modules");
+    let s = d.join("s");
+    std::fs::create_dir_all(&s).unwrap();
+    std::fs::write(
+        s.join("payload.glsl"),
+        "struct Payload {\n    vec4 color;\n};\n",
+    )
+    .unwrap();
+    let head = "#version 460\n#extension GL_EXT_ray_tracing : require\n#extension GL_GOOGLE_include_directive : require\n#include \"payload.glsl\"\n";
+    std::fs::write(
+        s.join("raytrace.rgen"),
+        format!("{head}layout(location = 0) rayPayloadEXT Payload p;\nlayout(binding = 0) uniform accelerationStructureEXT tlas;\nlayout(binding = 1, rgba8) uniform image2D img;\nvoid main() {{\n    traceRayEXT(tlas, 0, 0xFF, 0, 1, 0, vec3(0.0), 0.001, vec3(0.0, 0.0, 1.0), 100.0, 0);\n    imageStore(img, ivec2(gl_LaunchIDEXT.xy), p.color);\n}}\n"),
+    )
+    .unwrap();
+    std::fs::write(
+        s.join("raytrace.rmiss"),
+        format!("{head}layout(location = 0) rayPayloadInEXT Payload p;\nvoid main() {{ p.color = vec4(1.0); }}\n"),
+    )
+    .unwrap();
+    std::fs::write(
+        s.join("scene.pipeline.toml"),
+        "max_recursion_depth = 1\n\n[[raygen]]\nfile = \"raytrace.rgen\"\nentry = \"main\"\n\n[[miss]]\nfile = \"raytrace.rmiss\"\nentry = \"main\"\n",
+    )
+    .unwrap();
+    let log = d.join("calls.log");
+    let wrapper = d.join("glslang.sh");
+    std::fs::write(
+        &wrapper,
+        format!(
+            "#!/bin/sh\ncase \"$1\" in --version) ;; *) echo \"$*\" >> '{}' ;; esac\nexec glslangValidator \"$@\"\n",
+            log.display()
+        ),
+    )
+    .unwrap();
+    use std::os::unix::fs::PermissionsExt;
+    std::fs::set_permissions(&wrapper, std::fs::Permissions::from_mode(0o755)).unwrap();
+    let calls = || {
+        std::fs::read_to_string(&log)
+            .unwrap_or_default()
+            .lines()
+            .count()
+    };
+    let run = || {
+        let o = rtlint()
+            .current_dir(&d)
+            .args(["check", "--format", "concise", "--cache-dir", "c", "s"])
+            .env("RTLINT_GLSLANG", &wrapper)
+            .output()
+            .unwrap();
+        assert_ne!(o.status.code(), Some(2), "{}", text(&o));
+        sorted_lines(&o)
+    };
+    let cold = run();
+    assert_eq!(calls(), 2, "cold: each shader once");
+    let warm = run();
+    assert_eq!(calls(), 2, "warm: glslang not run");
+    assert_eq!(cold, warm);
+    std::fs::write(
+        s.join("payload.glsl"),
+        "struct Payload {\n    vec4 color;\n    vec4 extra;\n};\n",
+    )
+    .unwrap();
+    run();
+    assert_eq!(calls(), 4, "the header changed: both again");
+}

@@ -374,3 +374,63 @@ fn github_and_sarif_formats() {
         4
     );
 }
+
+/// What `cargo install` builds is lean: the release profile keeps no debug
+/// info (an 80 MB binary with it); profiling has its own profile with line
+/// tables, and the docs that profile name it.
+#[test]
+fn the_release_profile_is_lean_and_profiling_has_its_own() {
+    let manifest: toml::Table =
+        toml::from_str(&std::fs::read_to_string(common::root().join("Cargo.toml")).unwrap())
+            .unwrap();
+    let profiles = manifest["profile"].as_table().unwrap();
+    let release = profiles["release"].as_table().unwrap();
+    let off = |v: Option<&toml::Value>| match v {
+        None => true,
+        Some(toml::Value::Boolean(b)) => !b,
+        Some(toml::Value::Integer(n)) => *n == 0,
+        Some(toml::Value::String(s)) => s == "none",
+        Some(_) => false,
+    };
+    assert!(off(release.get("debug")), "{release:?}");
+    let profiling = profiles["profiling"].as_table().unwrap();
+    assert_eq!(profiling["inherits"].as_str(), Some("release"));
+    assert!(!off(profiling.get("debug")), "{profiling:?}");
+    let perf = std::fs::read_to_string(common::root().join("docs/performance.md")).unwrap();
+    assert!(perf.contains("--profile profiling"));
+}
+
+/// `rtlint rules` is a table: every column starts at the same place on
+/// every line, however long a rule's name.
+#[test]
+fn the_rules_table_is_aligned() {
+    let text = stdout(&run(&["rules"]));
+    let starts = |line: &str| -> Vec<usize> {
+        let mut v = Vec::new();
+        let b = line.as_bytes();
+        for i in 1..b.len() {
+            if b[i] != b' ' && b[i - 1] == b' ' && i >= 2 && b[i - 2] == b' ' {
+                v.push(line[..i].chars().count());
+            }
+        }
+        v.truncate(4);
+        v
+    };
+    let lines: Vec<&str> = text.lines().collect();
+    assert_eq!(lines.len(), rtlint::rules::RULES.len());
+    let first = starts(lines[0]);
+    assert_eq!(first.len(), 4, "{}", lines[0]);
+    for l in &lines {
+        assert_eq!(starts(l), first, "`{l}`");
+    }
+}
+
+/// `verify --help` says what `--out` receives: every case's GPU image, not
+/// only failed cases' (src/verify writes `CASE-gpu.png` for each case).
+#[test]
+fn verify_help_says_every_case_writes_its_image() {
+    let help = stdout(&run(&["verify", "--help"])).replace(char::is_whitespace, " ");
+    let help = help.split_whitespace().collect::<Vec<_>>().join(" ");
+    assert!(help.contains("each case's GPU image"), "{help}");
+    assert!(!help.contains("images of failed cases"), "{help}");
+}

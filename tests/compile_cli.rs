@@ -381,3 +381,23 @@ fn a_library_profile_without_an_entry_is_the_whole_library() {
         "{err}"
     );
 }
+
+/// `-o newdir/` names a folder that does not exist yet: it is created.
+#[test]
+fn a_missing_output_folder_is_created() {
+    let d = scratch("newdir").join("new/sub");
+    let o = rtlint()
+        .args(["compile", "tests/hlsl/pipeline.hlsl", "-o"])
+        .arg(format!("{}/", d.display()))
+        .output()
+        .unwrap();
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    for entry in ["RayGen", "Miss", "ShadowMiss", "ClosestHit"] {
+        assert!(d.join(format!("{entry}.spv")).is_file(), "{entry}");
+    }
+}

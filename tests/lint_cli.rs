@@ -116,6 +116,76 @@ fn wgsl_filters_and_comments_suppress() {
     );
 }
 
+/// An HLSL raygen tracing two 48-byte payloads declared on lines 1 and 2.
+const TWO_FAT_HLSL: &str = "struct Fat { float4 a; float4 b; float4 c; };\n\
+struct Big { float4 a; float4 b; float4 c; };\n\
+RaytracingAccelerationStructure tlas : register(t0);\n\
+RWTexture2D<float4> image : register(u1);\n\
+[shader(\"raygeneration\")]\n\
+void Gen()\n\
+{\n\
+    RayDesc ray;\n\
+    ray.Origin = float3(0.0, 0.0, 0.0);\n\
+    ray.Direction = float3(0.0, 0.0, 1.0);\n\
+    ray.TMin = 0.001;\n\
+    ray.TMax = 10.0;\n\
+    Fat p = (Fat)0;\n\
+    Big q = (Big)0;\n\
+    TraceRay(tlas, RAY_FLAG_FORCE_OPAQUE, 0xFF, 0, 1, 0, ray, p);\n\
+    TraceRay(tlas, RAY_FLAG_FORCE_OPAQUE, 0xFF, 0, 1, 0, ray, q);\n\
+    image[DispatchRaysIndex().xy] = p.a + q.a;\n\
+}\n";
+
+/// A suppression after code covers its own line only; one alone on its line
+/// covers the next; a selector that names nothing is an input error at the
+/// name, in comments and in WGSL filters alike.
+#[test]
+fn suppressions_cover_their_line_and_unknown_selectors_are_errors() {
+    let d = scratch("suppress-lines");
+    let end_of_line = TWO_FAT_HLSL.replacen("};\n", "}; // rtlint: allow(RT001)\n", 1);
+    std::fs::write(d.join("eol.hlsl"), &end_of_line).unwrap();
+    std::fs::write(
+        d.join("above.hlsl"),
+        TWO_FAT_HLSL.replacen("struct Big", "// rtlint: allow(RT001)\nstruct Big", 1),
+    )
+    .unwrap();
+    let o = check_in(&d, &["--no-cache", "eol.hlsl", "above.hlsl"]);
+    assert_eq!(
+        findings(&o),
+        [
+            "above.hlsl:1:8: warning[RT001]",
+            "eol.hlsl:2:8: warning[RT001]"
+        ],
+        "{}",
+        text(&o)
+    );
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o));
+
+    std::fs::write(
+        d.join("unknown.hlsl"),
+        end_of_line.replace("allow(RT001)", "allow(RT999, RT001)"),
+    )
+    .unwrap();
+    std::fs::write(
+        d.join("unknown.wgsl"),
+        FAT_WGSL.replacen(";\n", ";\ndiagnostic(off, rtlint.no_such_rule);\n", 1),
+    )
+    .unwrap();
+    let o = check_in(&d, &["--no-cache", "unknown.hlsl", "unknown.wgsl"]);
+    let t = text(&o);
+    assert_eq!(o.status.code(), Some(2), "{t}");
+    assert!(
+        t.contains("unknown.hlsl:1:64: error[invalid-suppression] suppression names unknown rule or group `RT999`"),
+        "{t}"
+    );
+    assert!(
+        t.contains("unknown.wgsl:2:24: error[invalid-suppression]"),
+        "{t}"
+    );
+    // The known selector beside the unknown one still applies.
+    assert!(!t.contains("unknown.hlsl:1:8"), "{t}");
+}
+
 /// A GLSL raygen with the same 48-byte payload; the suppression names the
 /// rule by name on the line above.
 const FAT_GLSL: &str = "#version 460\n\
@@ -673,4 +743,227 @@ fn sixteen_bit_types_follow_the_flag_and_the_config() {
     };
     assert!(!compile(&[]));
     assert!(compile(&["--enable-16bit-types"]));
+}
+
+/// `--statistics` speaks each format: JSON's `statistics`, SARIF's run
+/// properties (also through `-o x.sarif`), a GitHub notice and job summary;
+/// the counts are those of the findings a plain run lists.
+#[test]
+fn statistics_in_every_format() {
+    let d = scratch("statistics");
+    std::fs::write(d.join("a.wgsl"), FAT_WGSL).unwrap();
+    std::fs::write(d.join("b.wgsl"), FAT_WGSL).unwrap();
+    let plain = check_in(&d, &["--no-cache", "."]);
+    let listed = findings(&plain).len();
+    assert_eq!(listed, 2, "{}", text(&plain));
+    let run = |args: &[&str]| {
+        rtlint()
+            .current_dir(&d)
+            .args(["check", "--no-cache", "--statistics"])
+            .args(args)
+            .arg(".")
+            .env("GITHUB_STEP_SUMMARY", d.join("summary.md"))
+            .output()
+            .unwrap()
+    };
+    let o = run(&["--format", "json"]);
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).expect("JSON");
+    assert_eq!(v["statistics"][0]["code"], "RT001", "{v}");
+    assert_eq!(v["statistics"][0]["count"], listed, "{v}");
+    assert_eq!(v["diagnostics"].as_array().unwrap().len(), 0, "{v}");
+
+    let o = run(&["--format", "sarif", "-o", "x.sarif"]);
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o));
+    let v: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(d.join("x.sarif")).unwrap()).expect("SARIF");
+    assert_eq!(v["version"], "2.1.0");
+    let run0 = &v["runs"][0];
+    assert_eq!(run0["results"].as_array().unwrap().len(), 0);
+    assert_eq!(run0["properties"]["statistics"][0]["ruleId"], "RT001");
+    assert_eq!(run0["properties"]["statistics"][0]["count"], listed);
+
+    let o = run(&["--format", "github"]);
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert_eq!(
+        out,
+        format!("::notice title=rtlint statistics::{listed} RT001 payload-over-budget\n")
+    );
+    let summary = std::fs::read_to_string(d.join("summary.md")).unwrap();
+    assert!(
+        summary.contains(&format!("| {listed} | RT001 | payload-over-budget |")),
+        "{summary}"
+    );
+}
+
+/// Two traces with the same invalid interval in a module without debug
+/// info: two findings, not one (they are two places, even without lines).
+#[test]
+fn alike_findings_without_positions_stay_apart() {
+    let d = scratch("alike");
+    let src = d.join("two.rgen");
+    std::fs::write(
+        &src,
+        "#version 460\n#extension GL_EXT_ray_tracing : require\n\
+layout(location = 0) rayPayloadEXT vec4 p;\n\
+layout(binding = 0) uniform accelerationStructureEXT tlas;\n\
+layout(binding = 1, rgba8) uniform image2D img;\n\
+void main() {\n\
+    traceRayEXT(tlas, 0, 0xFF, 0, 1, 0, vec3(0.0), 10.0, vec3(0.0, 0.0, 1.0), 1.0, 0);\n\
+    vec4 a = p;\n\
+    traceRayEXT(tlas, 0, 0xFF, 0, 1, 0, vec3(1.0), 10.0, vec3(0.0, 0.0, 1.0), 1.0, 0);\n\
+    imageStore(img, ivec2(gl_LaunchIDEXT.xy), p + a);\n\
+}\n",
+    )
+    .unwrap();
+    let compiled = Command::new("glslangValidator")
+        .args(["-V", "--target-env", "vulkan1.2", "-o"])
+        .arg(d.join("two.spv"))
+        .arg(&src)
+        .output()
+        .map_err(|e| e.to_string())
+        .and_then(|g| {
+            if g.status.success() {
+                Ok(())
+            } else {
+                Err(text(&g))
+            }
+        });
+    if require("glslangValidator", compiled).is_none() {
+        return;
+    }
+    let o = check_in(&d, &["--no-cache", "--select", "RT035", "two.spv"]);
+    assert_eq!(
+        findings(&o),
+        ["two.spv: error[RT035]", "two.spv: error[RT035]"],
+        "{}",
+        text(&o)
+    );
+    let o = check_in(&d, &["--no-cache", "--select", "RT035", "two.rgen"]);
+    assert_eq!(
+        findings(&o),
+        ["two.rgen:7: error[RT035]", "two.rgen:9: error[RT035]"],
+        "{}",
+        text(&o)
+    );
+}
+
+/// A struct in a header two `-g` modules include is one finding at the
+/// header, also when the header is found twice (the copy beside the
+/// modules and the original their debug info names): the copies' identical
+/// declarations are one place, not an ambiguity that loses the position
+/// and gives one finding per module.
+#[test]
+fn a_header_struct_in_g_modules_is_reported_once() {
+    let d = scratch("g-header");
+    std::fs::create_dir_all(d.join("src")).unwrap();
+    std::fs::create_dir_all(d.join("out")).unwrap();
+    let header = "struct Fat { vec4 a; vec4 b; vec4 c; };\n";
+    std::fs::write(d.join("src/fat.glsl"), header).unwrap();
+    std::fs::write(d.join("out/fat.glsl"), header).unwrap();
+    for (name, origin) in [("a", "0.0"), ("b", "1.0")] {
+        std::fs::write(
+            d.join(format!("src/{name}.rgen")),
+            format!("#version 460\n#extension GL_EXT_ray_tracing : require\n#extension GL_GOOGLE_include_directive : require\n#include \"fat.glsl\"\nlayout(location = 0) rayPayloadEXT Fat p;\nlayout(binding = 0) uniform accelerationStructureEXT tlas;\nlayout(binding = 1, rgba8) uniform image2D img;\nvoid main() {{\n    traceRayEXT(tlas, 0, 0xFF, 0, 1, 0, vec3({origin}), 0.001, vec3(0.0, 0.0, 1.0), 100.0, 0);\n    imageStore(img, ivec2(gl_LaunchIDEXT.xy), p.a);\n}}\n"),
+        )
+        .unwrap();
+        let g = Command::new("glslangValidator")
+            .current_dir(&d)
+            .args(["-V", "--target-env", "vulkan1.2", "-g", "-o"])
+            .arg(format!("out/{name}.spv"))
+            .arg(format!("src/{name}.rgen"))
+            .output()
+            .map_err(|e| e.to_string())
+            .and_then(|g| {
+                if g.status.success() {
+                    Ok(())
+                } else {
+                    Err(text(&g))
+                }
+            });
+        if require("glslangValidator", g).is_none() {
+            return;
+        }
+    }
+    let o = check_in(&d, &["--no-cache", "--select", "RT001", "out"]);
+    assert_eq!(
+        findings(&o),
+        ["out/fat.glsl:1:8: warning[RT001]"],
+        "{}",
+        text(&o)
+    );
+}
+
+/// A payload struct in a GLSL header two shaders include: one finding (one
+/// SARIF result, one annotation) at the header, listing both includers'
+/// traces as evidence.
+#[test]
+fn a_glsl_header_finding_lists_every_includer() {
+    let d = scratch("glsl-header");
+    std::fs::write(
+        d.join("fat.glsl"),
+        "struct Fat { vec4 a; vec4 b; vec4 c; };\n",
+    )
+    .unwrap();
+    for (name, origin) in [("a", "0.0"), ("b", "1.0")] {
+        std::fs::write(
+            d.join(format!("{name}.rgen")),
+            format!("#version 460\n#extension GL_EXT_ray_tracing : require\n#extension GL_GOOGLE_include_directive : require\n#include \"fat.glsl\"\nlayout(location = 0) rayPayloadEXT Fat p;\nlayout(binding = 0) uniform accelerationStructureEXT tlas;\nlayout(binding = 1, rgba8) uniform image2D img;\nvoid main() {{\n    traceRayEXT(tlas, 0, 0xFF, 0, 1, 0, vec3({origin}), 0.001, vec3(0.0, 0.0, 1.0), 100.0, 0);\n    imageStore(img, ivec2(gl_LaunchIDEXT.xy), p.a);\n}}\n"),
+        )
+        .unwrap();
+    }
+    let have = Command::new("glslangValidator")
+        .arg("--version")
+        .output()
+        .map(|_| ())
+        .map_err(|e| e.to_string());
+    if require("glslangValidator", have).is_none() {
+        return;
+    }
+    let o = rtlint()
+        .current_dir(d.parent().unwrap())
+        .args([
+            "check",
+            "--no-cache",
+            "--select",
+            "RT001",
+            "--format",
+            "sarif",
+        ])
+        .arg(d.file_name().unwrap())
+        .output()
+        .unwrap();
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).expect("SARIF");
+    let results = v["runs"][0]["results"].as_array().unwrap();
+    assert_eq!(results.len(), 1, "{v}");
+    let related: Vec<String> = results[0]["relatedLocations"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|l| {
+            let uri = l["physicalLocation"]["artifactLocation"]["uri"]
+                .as_str()
+                .unwrap();
+            uri.rsplit('/').next().unwrap().to_string()
+        })
+        .collect();
+    assert_eq!(related, ["a.rgen", "b.rgen"], "{v}");
+    let o = rtlint()
+        .current_dir(d.parent().unwrap())
+        .args([
+            "check",
+            "--no-cache",
+            "--select",
+            "RT001",
+            "--format",
+            "github",
+        ])
+        .arg(d.file_name().unwrap())
+        .output()
+        .unwrap();
+    assert_eq!(
+        String::from_utf8_lossy(&o.stdout).lines().count(),
+        1,
+        "{}",
+        text(&o)
+    );
 }

@@ -132,3 +132,16 @@ fn pages_have_the_sections_and_groups_set_levels() {
     assert_eq!(Group::Correctness.level().as_str(), "error");
     assert!(!Group::Pedantic.on_by_default());
 }
+
+/// docs/configuration.md lists every rule option with its default, so a
+/// new option cannot go undocumented.
+#[test]
+fn configuration_docs_list_every_rule_option() {
+    let docs = std::fs::read_to_string(root().join("docs/configuration.md")).unwrap();
+    for r in rtlint::rules::RULES {
+        for o in r.options {
+            let row = format!("| `[rules.{}]` | `{}` | {} |", r.code, o.name, o.default);
+            assert!(docs.contains(&row), "docs/configuration.md lacks `{row}`");
+        }
+    }
+}

@@ -274,10 +274,14 @@ fn driver_creates_every_pipeline_without_a_validation_error() {
         .output()
         .unwrap();
     let stderr = String::from_utf8_lossy(&o.stderr);
-    assert_eq!(o.status.code(), Some(0), "{stderr}");
     assert!(!stderr.contains("validation"), "{stderr}");
     let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     let reports = v["pipelines"].as_array().unwrap();
+    // Exit 1 exactly when a pipeline declares too small a depth (the RT021
+    // fixtures do on purpose).
+    let shallow = reports.iter().any(|r| !r["raise_depth_to"].is_null());
+    assert!(shallow);
+    assert_eq!(o.status.code(), Some(1), "{stderr}");
     assert_eq!(reports.len(), pipelines.len());
     assert_eq!(v["errors"].as_array().map(Vec::len), Some(0));
     for r in reports {
@@ -407,19 +411,31 @@ fn driver_numbers_from_the_measurement_csv() {
 /// its own shaders; the driver's child process rebuilds it from the library.
 #[test]
 fn stack_of_a_library_described_by_its_subobjects() {
-    let out = json(&[
-        "stack",
-        "--driver",
-        "--format",
-        "json",
-        "fixtures/RT021/bad.hlsl",
-    ]);
+    let o = rtlint()
+        .args([
+            "stack",
+            "--driver",
+            "--format",
+            "json",
+            "fixtures/RT021/bad.hlsl",
+        ])
+        .output()
+        .unwrap();
+    // It declares depth 1 and needs 3: the run fails.
+    assert_eq!(
+        o.status.code(),
+        Some(1),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    let out: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     let reports = out["pipelines"].as_array().unwrap();
     assert_eq!(reports.len(), 1, "{out}");
     let r = &reports[0];
     assert_eq!(r["pipeline"], "fixtures/RT021/bad.hlsl (DXR subobjects)");
     assert_eq!(r["declared_depth"], 1);
     assert_eq!(r["required_depth"], 3);
+    assert_eq!(r["raise_depth_to"], 3);
     let shaders: Vec<(&str, &str)> = r["shaders"]
         .as_array()
         .unwrap()
@@ -714,8 +730,122 @@ fn unbounded_recursion_gives_a_conditional_recommendation() {
     let lines = concise(&["--select", "RT024", "fixtures/RT024/bad.pipeline.toml"]);
     assert!(
         lines.iter().any(|l| l.contains(
-            "is unbounded at compile time: the trace at fixtures/pipelines/recursive/reflect.rchit:26 has no depth bound"
+            "is unbounded at compile time: the trace at fixtures/pipelines/recursive/reflect.rchit:25 has no depth bound"
         )),
         "{lines:#?}"
     );
+}
+
+/// A declared depth below the deepest chain: the report says to raise it
+/// (and to what) beside the size, JSON says `raise_depth_to`, and the run
+/// fails (exit 1) as RT021's error does; a sufficient depth passes.
+#[test]
+fn a_too_small_declared_depth_must_be_raised_and_fails_the_run() {
+    let o = rtlint()
+        .args(["stack", "fixtures/RT021/bad.pipeline.toml"])
+        .output()
+        .unwrap();
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert_eq!(o.status.code(), Some(1), "{text}");
+    assert!(
+        text.contains("the declared depth 3 is too small: raise it to 5"),
+        "{text}"
+    );
+    assert!(
+        text.contains("once the declared depth is raised to 5: set both, the depth and this size"),
+        "{text}"
+    );
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap_or_default();
+    assert!(v.is_null(), "human output is not JSON");
+    let o = rtlint()
+        .args([
+            "stack",
+            "--format",
+            "json",
+            "fixtures/RT021/bad.pipeline.toml",
+        ])
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(1));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(v["pipelines"][0]["raise_depth_to"], 5);
+    let v = json(&[
+        "stack",
+        "--format",
+        "json",
+        "fixtures/RT021/good.pipeline.toml",
+    ]);
+    assert!(v["pipelines"][0]["raise_depth_to"].is_null());
+}
+
+/// Every column of the table is explained in words under it, once.
+#[test]
+fn the_stack_columns_are_explained() {
+    let o = rtlint()
+        .args(["stack", "fixtures/RT021/good.pipeline.toml"])
+        .output()
+        .unwrap();
+    let text = String::from_utf8_lossy(&o.stdout);
+    let header = text
+        .lines()
+        .find(|l| l.starts_with("shader "))
+        .expect("a table header");
+    let legend = rtlint::report::stack::COLUMNS;
+    assert_eq!(text.matches(legend).count(), 1, "{text}");
+    for column in header.split_whitespace().skip(2) {
+        let column = column.trim_end_matches('*');
+        assert!(
+            legend
+                .lines()
+                .any(|l| l.trim_start().starts_with(&format!("{column} "))
+                    || l.trim_start().starts_with(&format!("{column}* "))),
+            "column `{column}` unexplained"
+        );
+    }
+}
+
+/// Compute shaders with ray queries have no pipeline stack to set.
+#[test]
+fn a_ray_query_compute_shader_gets_no_stack_size_call() {
+    let o = rtlint()
+        .args(["stack", "fixtures/RT062/good.comp"])
+        .output()
+        .unwrap();
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert_eq!(o.status.code(), Some(0), "{text}");
+    assert!(
+        !text.contains("vkCmdSetRayTracingPipelineStackSizeKHR"),
+        "{text}"
+    );
+    assert!(text.contains("recommended: nothing to set"), "{text}");
+    let v = json(&["stack", "--format", "json", "fixtures/RT062/good.comp"]);
+    assert!(v["pipelines"][0]["recommended"].is_null(), "{v}");
+}
+
+/// `stack DIR`: shaders a description names are in its pipeline only, and
+/// the others form one loose pipeline per folder, not one across folders.
+#[test]
+fn loose_pipelines_leave_out_described_shaders_and_keep_to_one_folder() {
+    let v = json(&["stack", "--format", "json", "fixtures/pipelines"]);
+    let list = v["pipelines"].as_array().unwrap();
+    let files = |p: &serde_json::Value| -> Vec<PathBuf> {
+        p["shaders"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|s| std::fs::canonicalize(s["file"].as_str().unwrap()).unwrap())
+            .collect()
+    };
+    let described: Vec<PathBuf> = list
+        .iter()
+        .filter(|p| !p["pipeline"].is_null())
+        .flat_map(files)
+        .collect();
+    let loose: Vec<&serde_json::Value> = list.iter().filter(|p| p["pipeline"].is_null()).collect();
+    assert!(!loose.is_empty(), "{v}");
+    for p in loose {
+        let f = files(p);
+        assert!(f.iter().all(|x| !described.contains(x)), "{f:?}");
+        assert!(f.iter().all(|x| x.parent() == f[0].parent()), "{f:?}");
+    }
 }

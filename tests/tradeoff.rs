@@ -152,8 +152,13 @@ fn quick_sweep_writes_a_true_front_and_error_falls_with_rays_per_pixel() {
     drop(ctx);
     let out = std::env::temp_dir().join(format!("rtlint-tradeoff-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&out);
+    // From a folder with no `shaders/`, as an installed binary runs: the
+    // reference shaders come from the binary.
+    let elsewhere =
+        std::env::temp_dir().join(format!("rtlint-tradeoff-cwd-{}", std::process::id()));
+    std::fs::create_dir_all(&elsewhere).unwrap();
     let o = common::rtlint()
-        .current_dir(common::root())
+        .current_dir(&elsewhere)
         .args(["tradeoff", "--quick", "--out"])
         .arg(&out)
         .output()
@@ -267,4 +272,45 @@ fn quick_sweep_writes_a_true_front_and_error_falls_with_rays_per_pixel() {
         .contains("Pareto front"));
     assert!(out.join("reference.png").is_file());
     let _ = std::fs::remove_dir_all(&out);
+}
+
+/// The docs and `--help` follow the knob table: the quick sweep's number of
+/// settings in docs/tradeoff.md is the one the code builds, `--help` names
+/// every knob, and the progress bar counts to settings × rounds (children
+/// that fail at once stand in for the device here).
+#[test]
+fn docs_help_and_the_bar_follow_the_knob_table() {
+    let shaders = common::root().join("shaders");
+    let manifest = rtlint::verify::Manifest::load(&shaders).unwrap();
+    let quick = rtlint::tradeoff::settings(&manifest, &shaders, "showcase", true)
+        .unwrap()
+        .len();
+    let docs = std::fs::read_to_string(common::root().join("docs/tradeoff.md")).unwrap();
+    assert!(
+        docs.contains(&format!("`--quick`: {quick} settings")),
+        "docs/tradeoff.md should say {quick} quick settings"
+    );
+    let help = common::rtlint()
+        .args(["tradeoff", "--help"])
+        .output()
+        .unwrap();
+    let help = String::from_utf8_lossy(&help.stdout);
+    for k in rtlint::tradeoff::KNOBS {
+        assert!(help.contains(k.name), "`tradeoff --help` omits {}", k.name);
+    }
+    let out = std::env::temp_dir().join(format!("rtlint-tradeoff-bar-{}", std::process::id()));
+    let fail = |_: &str, _: &std::path::Path| std::process::Command::new("false");
+    let options = rtlint::tradeoff::Options {
+        shaders: shaders.clone(),
+        out,
+        scene: "showcase".into(),
+        quick: true,
+        child: &fail,
+    };
+    let mut seen = Vec::new();
+    let report =
+        rtlint::tradeoff::run(&options, |done, total, _| seen.push((done, total))).unwrap();
+    assert_eq!(report.rows.len(), quick);
+    assert!(seen.iter().all(|&(d, t)| t == quick && d <= t), "{seen:?}");
+    assert_eq!(seen.last(), Some(&(quick, quick)));
 }

@@ -54,7 +54,13 @@ fn reference_shaders_pass_and_the_shallow_pipeline_fails_as_expected() {
     };
     drop(ctx);
     let out = out_dir("bundled");
+    // As an installed binary runs: from a folder with no `shaders/`, the
+    // reference shaders taken from the binary (written to a fresh cache).
+    let elsewhere = out_dir("elsewhere");
+    std::fs::create_dir_all(&elsewhere).unwrap();
     let o = common::rtlint()
+        .current_dir(&elsewhere)
+        .env("XDG_CACHE_HOME", elsewhere.join("cache"))
         .args(["verify", "--out"])
         .arg(&out)
         .output()
@@ -129,7 +135,8 @@ fn reference_shaders_pass_and_the_shallow_pipeline_fails_as_expected() {
         let line = stdout.lines().find(|l| l.starts_with(&note));
         assert!(
             line.is_some_and(|l| l.contains("reflecting pixels traced a ray")
-                && l.ends_with("paths differ from the CPU's on 0")),
+                && l.contains("paths differ from the CPU's on 0 (")
+                && l.ends_with(&format!("({})", rtlint::verify::measure::HYBRID_LEGEND))),
             "{stdout}"
         );
         assert!(out.join(format!("{shader}_{scene}-paths.png")).is_file());
@@ -309,4 +316,47 @@ fn extremes_matrix() {
         "{md}"
     );
     std::fs::remove_dir_all(&out).unwrap();
+}
+
+/// The shaders built into the binary are the repository's `shaders/`, file
+/// for file and byte for byte, and the folder they are written to holds
+/// exactly them (a changed file there is put back).
+#[test]
+fn the_bundled_shaders_are_the_shaders_folder() {
+    let root = common::root().join("shaders");
+    let mut on_disk = Vec::new();
+    let mut stack = vec![root.clone()];
+    while let Some(dir) = stack.pop() {
+        for e in std::fs::read_dir(&dir).unwrap() {
+            let p = e.unwrap().path();
+            if p.is_dir() {
+                stack.push(p);
+            } else {
+                let rel = p
+                    .strip_prefix(&root)
+                    .unwrap()
+                    .to_string_lossy()
+                    .replace('\\', "/");
+                on_disk.push((rel, std::fs::read(&p).unwrap()));
+            }
+        }
+    }
+    on_disk.sort();
+    let mut bundled: Vec<(String, Vec<u8>)> = rtlint::verify::bundled::files()
+        .iter()
+        .map(|(r, b)| (r.to_string(), b.to_vec()))
+        .collect();
+    bundled.sort();
+    assert_eq!(
+        bundled.iter().map(|f| &f.0).collect::<Vec<_>>(),
+        on_disk.iter().map(|f| &f.0).collect::<Vec<_>>()
+    );
+    assert!(bundled == on_disk, "a bundled file differs from shaders/");
+    let base = out_dir("bundled-cache");
+    let dir = rtlint::verify::bundled::folder_in(&base).unwrap();
+    std::fs::write(dir.join("verify.toml"), "tampered").unwrap();
+    let again = rtlint::verify::bundled::folder_in(&base).unwrap();
+    let manifest = std::fs::read(again.join("verify.toml")).unwrap();
+    assert_eq!(manifest, std::fs::read(root.join("verify.toml")).unwrap());
+    assert!(rtlint::verify::Manifest::load(&again).is_ok());
 }

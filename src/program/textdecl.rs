@@ -162,10 +162,19 @@ pub fn fill(program: &mut Program) {
         let Some(name) = program.names.get(&id).cloned() else {
             continue;
         };
-        let mut hits = scanned
+        let hits: Vec<_> = scanned
             .iter()
-            .filter_map(|(f, text, s, at)| find_struct(s, at, &name).map(|h| (*f, *text, s, h)));
-        let (Some((file, text, s, (at, body, end))), None) = (hits.next(), hits.next()) else {
+            .filter_map(|(f, text, s, at)| find_struct(s, at, &name).map(|h| (*f, *text, s, h)))
+            .collect();
+        // One declaration; or copies of one header (the embedded text and
+        // the same file found on disk elsewhere): the first, which debug
+        // info named, stands for them.
+        let same = |a: &(u32, &String, &Vec<u8>, (usize, usize, usize))| {
+            a.1 == hits[0].1 && a.3 == hits[0].3
+        };
+        let Some(&(file, text, s, (at, body, end))) =
+            hits.first().filter(|_| hits.iter().all(same))
+        else {
             continue;
         };
         let pos = |offset: usize, len: usize| {

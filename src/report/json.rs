@@ -83,3 +83,19 @@ pub fn render(diagnostics: &[Diagnostic], summary: &Summary) -> String {
     });
     serde_json::to_string_pretty(&value).unwrap_or_default()
 }
+
+/// `--statistics`: counts per rule instead of findings; input errors are
+/// still listed in full under `diagnostics`.
+pub fn render_statistics(diagnostics: &[Diagnostic], summary: &Summary) -> String {
+    let value = serde_json::json!({
+        "version": 1,
+        "statistics": super::counts(diagnostics),
+        "diagnostics": diagnostics
+            .iter()
+            .filter(|d| d.code.is_none())
+            .map(diagnostic)
+            .collect::<Vec<_>>(),
+        "summary": summary,
+    });
+    serde_json::to_string_pretty(&value).unwrap_or_default()
+}

@@ -195,24 +195,87 @@ pub fn concise(diagnostics: &[Diagnostic]) -> String {
     out
 }
 
-/// Findings counted per rule, most frequent first (`--statistics`).
-pub fn statistics(diagnostics: &[Diagnostic]) -> String {
-    let mut counts: Vec<(&str, &str, usize)> = Vec::new();
+/// How many findings one rule (or input errors of one kind: `code` none)
+/// produced.
+#[derive(Clone, Debug, PartialEq, Eq, serde::Serialize)]
+pub struct RuleCount<'a> {
+    pub code: Option<&'a str>,
+    pub name: &'a str,
+    pub count: usize,
+}
+
+/// Findings counted per rule, most frequent first (`--statistics`, in
+/// every format).
+pub fn counts(diagnostics: &[Diagnostic]) -> Vec<RuleCount<'_>> {
+    let mut counts: Vec<RuleCount> = Vec::new();
     for d in diagnostics {
-        let code = d.code.unwrap_or("input");
         match counts
             .iter_mut()
-            .find(|(c, n, _)| *c == code && *n == d.name)
+            .find(|c| c.code == d.code && c.name == d.name)
         {
-            Some(e) => e.2 += 1,
-            None => counts.push((code, d.name, 1)),
+            Some(e) => e.count += 1,
+            None => counts.push(RuleCount {
+                code: d.code,
+                name: d.name,
+                count: 1,
+            }),
         }
     }
-    counts.sort_by(|a, b| b.2.cmp(&a.2).then(a.0.cmp(b.0)).then(a.1.cmp(b.1)));
+    counts.sort_by(|a, b| {
+        b.count
+            .cmp(&a.count)
+            .then(a.code.unwrap_or("input").cmp(b.code.unwrap_or("input")))
+            .then(a.name.cmp(b.name))
+    });
     counts
+}
+
+/// `--statistics` as text: count, code (`input` for input errors), name.
+pub fn statistics(diagnostics: &[Diagnostic]) -> String {
+    counts(diagnostics)
         .iter()
-        .map(|(c, n, k)| format!("{k:>6}  {c:<6} {n}\n"))
+        .map(|c| {
+            format!(
+                "{:>6}  {:<6} {}\n",
+                c.count,
+                c.code.unwrap_or("input"),
+                c.name
+            )
+        })
         .collect()
+}
+
+/// `--statistics --format github`: one notice annotation holding the
+/// counts, and the same as a Markdown table for the job summary.
+pub fn github_statistics(diagnostics: &[Diagnostic]) -> (String, String) {
+    let counts = counts(diagnostics);
+    let lines: Vec<String> = counts
+        .iter()
+        .map(|c| format!("{} {} {}", c.count, c.code.unwrap_or("input"), c.name))
+        .collect();
+    let message = if lines.is_empty() {
+        "no findings".to_string()
+    } else {
+        lines.join("\n")
+    };
+    let notice = format!(
+        "::notice title=rtlint statistics::{}\n",
+        escape_data(&message)
+    );
+    let mut table =
+        String::from("### rtlint statistics\n\n| count | code | rule |\n| ---: | --- | --- |\n");
+    for c in &counts {
+        table.push_str(&format!(
+            "| {} | {} | {} |\n",
+            c.count,
+            c.code.unwrap_or("input"),
+            c.name
+        ));
+    }
+    if counts.is_empty() {
+        table.push_str("| 0 | | no findings |\n");
+    }
+    (notice, table)
 }
 
 /// `::warning title=rtlint (RT001),file=…,line=…,col=…::message` lines.

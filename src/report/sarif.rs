@@ -11,6 +11,16 @@ use std::path::Path;
 const SRCROOT: &str = "%SRCROOT%";
 
 pub fn render(diagnostics: &[Diagnostic]) -> String {
+    serde_json::to_string_pretty(&document(diagnostics, false)).unwrap_or_default()
+}
+
+/// `--statistics`: no results, the counts per rule in the run's
+/// `properties.statistics` (and input errors as notifications, as always).
+pub fn render_statistics(diagnostics: &[Diagnostic]) -> String {
+    serde_json::to_string_pretty(&document(diagnostics, true)).unwrap_or_default()
+}
+
+fn document(diagnostics: &[Diagnostic], statistics: bool) -> Value {
     let rules: Vec<Value> = RULES
         .iter()
         .map(|r| {
@@ -31,7 +41,7 @@ pub fn render(diagnostics: &[Diagnostic]) -> String {
         .collect();
     let results: Vec<Value> = diagnostics
         .iter()
-        .filter(|d| d.code.is_some())
+        .filter(|d| d.code.is_some() && !statistics)
         .map(|d| {
             let mut text = d.message.clone();
             if let Some(s) = d.subject.as_ref().filter(|_| d.primary.is_none()) {
@@ -85,7 +95,7 @@ pub fn render(diagnostics: &[Diagnostic]) -> String {
             })
         })
         .collect();
-    let doc = json!({
+    let mut doc = json!({
         "$schema": "https://json.schemastore.org/sarif-2.1.0.json",
         "version": "2.1.0",
         "runs": [{
@@ -105,7 +115,16 @@ pub fn render(diagnostics: &[Diagnostic]) -> String {
             "results": results,
         }],
     });
-    serde_json::to_string_pretty(&doc).unwrap_or_default()
+    if statistics {
+        let counts: Vec<Value> = super::counts(diagnostics)
+            .iter()
+            .map(
+                |c| json!({ "ruleId": c.code.unwrap_or(c.name), "name": c.name, "count": c.count }),
+            )
+            .collect();
+        doc["runs"][0]["properties"] = json!({ "statistics": counts });
+    }
+    doc
 }
 
 /// A rule page's address, when the package says where its repository is.

@@ -3,10 +3,29 @@
 use crate::analysis::stack::{vulkan_default, Formulas, StackReport, StageMax};
 use crate::explain;
 
+/// The depth the pipeline must declare when it declares less than its
+/// deepest chain needs (RT021's error: the pipeline fails on the device).
+pub fn raise_depth_to(r: &StackReport) -> Option<u32> {
+    match (r.declared_depth, r.required_depth) {
+        (Some(d), Some(req)) if d < req => Some(req),
+        _ => None,
+    }
+}
+
+/// Whether the shaders form a ray-tracing pipeline at all (compute shaders
+/// with ray queries have no pipeline stack size to set).
+fn has_pipeline_stages(r: &StackReport) -> bool {
+    r.shaders.iter().any(|s| s.stage.is_ray_tracing())
+}
+
 /// The JSON form: the report's data with the chain and assumptions in words.
 pub fn json(r: &StackReport) -> serde_json::Value {
     let mut v = serde_json::to_value(r).unwrap_or_default();
     if let Some(o) = v.as_object_mut() {
+        o.insert("raise_depth_to".into(), raise_depth_to(r).into());
+        if !has_pipeline_stages(r) {
+            o.insert("recommended".into(), serde_json::Value::Null);
+        }
         o.insert("depth_chain".into(), explain::stack_chain(r).into());
         o.insert(
             "assumptions".into(),
@@ -15,6 +34,19 @@ pub fn json(r: &StackReport) -> serde_json::Value {
     }
     v
 }
+
+/// What the table's columns mean, said once under it.
+pub const COLUMNS: &str = "  bytes per thread, per shader:
+    model     what rtlint reserves for it: every live value kept, plus a safety margin
+    driver*   what the NVIDIA driver is modelled to report for it
+    live      state kept across a trace or call that cannot be recomputed after it
+    arrays    function-local arrays (kept in memory, not registers)
+    payload   the largest ray payload the shader traces with (its outgoing payload)
+    in        the payload it receives (hit and miss shaders)
+    attrs     the hit attributes it reads or reports
+    callable  the largest callable data it passes to a callable shader
+    query     the driver's own figure, with --driver
+";
 
 fn formula_text(m: &StageMax, depth: u32) -> String {
     format!(
@@ -59,6 +91,14 @@ pub fn human(r: &StackReport) -> String {
     let chain = explain::stack_chain(r);
     if !chain.is_empty() {
         let _ = writeln!(s, "  deepest chain: {chain}");
+    }
+    if let (Some(req), Some(d)) = (raise_depth_to(r), r.declared_depth) {
+        let _ = writeln!(
+            s,
+            "  error: the declared depth {d} is too small: raise it to {req} \
+             (maxPipelineRayRecursionDepth / MaxTraceRecursionDepth); a trace \
+             beyond the declared depth fails on the device (RT021)"
+        );
     }
     let _ = writeln!(s);
     let names: Vec<String> = r
@@ -111,10 +151,7 @@ pub fn human(r: &StackReport) -> String {
             sh.driver_bytes.map_or("—".into(), |d| d.to_string()),
         );
     }
-    let _ = writeln!(
-        s,
-        "  (bytes; model = every live value kept, plus a safety margin; driver* = what the NVIDIA driver is modelled to report; live = state across traces that cannot be recomputed; query = the driver's own figure with --driver)"
-    );
+    let _ = write!(s, "{COLUMNS}");
     let _ = writeln!(s);
     let mut block = |title: &str, f: &Formulas| {
         let _ = writeln!(s, "{title}:");
@@ -148,6 +185,12 @@ pub fn human(r: &StackReport) -> String {
     }
     let _ = writeln!(s);
     match r.recommended {
+        _ if !has_pipeline_stages(r) => {
+            let _ = writeln!(
+                s,
+                "recommended: nothing to set (no ray-tracing pipeline: ray queries in compute shaders use no pipeline stack)"
+            );
+        }
         Some(v) if r.assumed_depth.is_some() => {
             let d = r.assumed_depth.unwrap_or_default();
             let whose = if r.declared_depth == Some(d) {
@@ -169,6 +212,12 @@ pub fn human(r: &StackReport) -> String {
                 s,
                 "recommended: vkCmdSetRayTracingPipelineStackSizeKHR(cmd, {v}) / SetPipelineStackSize({v})"
             );
+            if let Some(req) = raise_depth_to(r) {
+                let _ = writeln!(
+                    s,
+                    "  once the declared depth is raised to {req}: set both, the depth and this size"
+                );
+            }
             if let Some(d) = r.vulkan_default {
                 if d > v {
                     let _ = writeln!(

@@ -795,7 +795,9 @@ pub fn run(
         .collect::<Result<Vec<_>, _>>()?;
     std::fs::create_dir_all(&options.out)
         .map_err(|e| format!("cannot create {}: {e}", options.out.display()))?;
-    let total = settings.len() * sweep.rounds as usize + 1;
+    // The bar counts GPU runs (settings × rounds); the CPU reference is
+    // the message at the end, not one more step.
+    let total = settings.len() * sweep.rounds as usize;
     // The GPU runs come first and alone: on lavapipe the "GPU" is these
     // CPU cores, and CPU work beside a child would slow its timings.
     // Rounds over the whole sweep, so that a stretch of load from other
@@ -864,7 +866,7 @@ pub fn run(
             *pixels = image;
         }
     }
-    progress(total - 1, total, "converged reference (CPU)");
+    progress(total, total, "converged reference (CPU)");
     let reference = converged(&scene, &sweep);
     let mut rows = Vec::new();
     for ((setting, p), run) in settings.into_iter().zip(&prepared).zip(runs) {

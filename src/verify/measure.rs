@@ -110,11 +110,25 @@ pub fn cpu_render(scene: &Scene, params: &Params, method: Method) -> CpuRender {
 
 /// A multi-pass case's measurements, in words, and a picture of its counts.
 pub struct Measured {
+    /// Ends with the picture's legend ([`HYBRID_LEGEND`], [`ADAPTIVE_LEGEND`]).
     pub note: String,
-    /// RGBA8: hybrid: grey none, green screen space, red ray; adaptive:
-    /// brighter for more paths.
+    /// RGBA8: hybrid: [`HYBRID_COLOURS`]; adaptive: brighter for more paths.
     pub picture: Option<Vec<u32>>,
 }
+
+/// The hybrid shader's `CASE-paths.png`: each reflection path's colour
+/// (RGBA8 packed little-endian: red in the low byte).
+pub const HYBRID_COLOURS: [(ReflectionPath, u32); 3] = [
+    (ReflectionPath::None, 0xFF40_4040),
+    (ReflectionPath::Screen, 0xFF00_C000),
+    (ReflectionPath::Ray, 0xFF00_00E0),
+];
+
+/// The legends the notes end with (and docs/verify.md quotes).
+pub const HYBRID_LEGEND: &str =
+    "paths.png: grey no reflection, green found on screen, red traced a ray";
+pub const ADAPTIVE_LEGEND: &str =
+    "paths.png: grey level = paths traced, black none, white the most";
 
 /// `gpu` holds the GPU's per-pixel counts; `differ` how many disagree with
 /// the CPU's.
@@ -137,7 +151,8 @@ pub fn measure(cpu: &CpuRender, gpu: &[u32], differ: usize) -> Measured {
             note: format!(
                 "{traced} paths instead of {full} for {max} fixed passes ({:.1} % saved; \
                  rays {} instead of {}, {:.1} % saved); RMSE against {CONVERGED_PATHS} \
-                 independent paths: adaptive {:.4}, fixed {max} {:.4}; counts differ from the CPU's on {differ}",
+                 independent paths: adaptive {:.4}, fixed {max} {:.4}; counts differ from the CPU's on {differ} \
+                 ({ADAPTIVE_LEGEND})",
                 100.0 * (1.0 - traced as f64 / full as f64),
                 stats.rays,
                 stats.fixed_rays,
@@ -153,20 +168,73 @@ pub fn measure(cpu: &CpuRender, gpu: &[u32], differ: usize) -> Measured {
     let reflecting = (screen + ray).max(1);
     let picture = gpu
         .iter()
-        .map(|&c| match c {
-            1 => 0xFF00_C000,
-            2 => 0xFF00_00E0,
-            _ => 0xFF40_4040,
+        .map(|&c| {
+            HYBRID_COLOURS
+                .iter()
+                .find(|(k, _)| *k as u32 == c)
+                .map_or(HYBRID_COLOURS[0].1, |(_, colour)| *colour)
         })
         .collect();
     Measured {
         note: format!(
             "{ray} of {} reflecting pixels traced a ray ({:.1} %; {:.1} % of all {pixels}), \
-             {screen} found their reflection on screen; paths differ from the CPU's on {differ}",
+             {screen} found their reflection on screen; paths differ from the CPU's on {differ} \
+             ({HYBRID_LEGEND})",
             screen + ray,
             100.0 * ray as f64 / reflecting as f64,
             100.0 * ray as f64 / pixels as f64,
         ),
         picture: Some(picture),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The legend says each colour the picture uses, by the channel that
+    /// dominates it, and docs/verify.md quotes both legends.
+    #[test]
+    fn the_path_pictures_have_their_legend() {
+        for (path, colour) in HYBRID_COLOURS {
+            let [r, g, b, _] = colour.to_le_bytes().map(u32::from);
+            let word = if r > 2 * g.max(b) {
+                "red"
+            } else if g > 2 * r.max(b) {
+                "green"
+            } else {
+                "grey"
+            };
+            let meaning = match path {
+                ReflectionPath::None => "no reflection",
+                ReflectionPath::Screen => "found on screen",
+                ReflectionPath::Ray => "traced a ray",
+            };
+            assert!(
+                HYBRID_LEGEND.contains(&format!("{word} {meaning}")),
+                "{word} {meaning}"
+            );
+        }
+        let docs = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/docs/verify.md"))
+            .unwrap()
+            .split_whitespace()
+            .collect::<Vec<_>>()
+            .join(" ");
+        assert!(docs.contains(HYBRID_LEGEND) && docs.contains(ADAPTIVE_LEGEND));
+        let m = measure(
+            &CpuRender {
+                image: Vec::new(),
+                margins: Vec::new(),
+                counts: None,
+                adaptive: None,
+            },
+            &[0, 1, 2],
+            0,
+        );
+        assert!(
+            m.note.ends_with(&format!("({HYBRID_LEGEND})")),
+            "{}",
+            m.note
+        );
     }
 }

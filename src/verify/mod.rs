@@ -11,6 +11,7 @@
 //! declared with less recursion depth than it needs, which passes when the
 //! child's crash is caught.
 
+pub mod bundled;
 pub mod compare;
 pub mod gpu;
 pub mod measure;
