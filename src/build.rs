@@ -691,7 +691,8 @@ mod tests {
                 "closesthit.ClosestHit.spv",
                 "layouts.rs",
                 "miss.Miss.spv",
-                "raygen.RayGen.spv"
+                "raygen.RayGen.spv",
+                OUTPUTS,
             ]
         );
         let spv = std::fs::read(out.join("miss.Miss.spv")).unwrap();
@@ -899,7 +900,7 @@ mod tests {
         assert!(lines.contains("trace.rgen\n"), "{lines}");
         // The included file too, as glslang's debug info names it.
         assert!(lines.contains("payload.glsl\n"), "{lines}");
-        let spv = std::fs::read(dir.join("trace.main.spv")).unwrap();
+        let spv = std::fs::read(dir.join("trace.rgen.spv")).unwrap();
         assert_eq!(&spv[..4], &crate::program::MAGIC.to_le_bytes());
         let text = std::fs::read_to_string(dir.join("layouts.rs")).unwrap();
         // std140: the vec3 and the float share a row, the mat4 is a glam Mat4.

@@ -841,7 +841,7 @@ void main() {\n\
     let o = check_in(&d, &["--no-cache", "--select", "RT035", "two.rgen"]);
     assert_eq!(
         findings(&o),
-        ["two.rgen:7: error[RT035]", "two.rgen:9: error[RT035]"],
+        ["two.rgen:7:1: error[RT035]", "two.rgen:9:1: error[RT035]"],
         "{}",
         text(&o)
     );

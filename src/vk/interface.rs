@@ -475,7 +475,10 @@ mod tests {
         let e = reflect(&Pipeline::from_programs(programs)).unwrap_err();
         let _ = std::fs::remove_dir_all(&dir);
         assert!(e.contains("binding 0"), "{e}");
-        assert!(e.contains("× 1") && e.contains("a runtime array"), "{e}");
+        assert!(
+            e.contains("a storage image for `img`") && e.contains("a storage buffer for `buf`"),
+            "{e}"
+        );
         assert!(!e.contains("Fixed") && !e.contains("Runtime"), "{e}");
     }
 
