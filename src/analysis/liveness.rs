@@ -230,6 +230,8 @@ fn compute_live_sites(program: &Program, described: bool) -> Vec<LiveSite> {
     let mut seen: HashSet<Id> = HashSet::default();
     let mut places = SitePlaces::default();
     let mut carried = SitePlaces::default();
+    let mut rewritten = SitePlaces::default();
+    let mut rewritten_next = SitePlaces::default();
     for (site, kind, e, chain) in jobs {
         let entry = &program.entry_points[e];
         let mut values: Vec<LiveValue> = Vec::new();
@@ -238,6 +240,10 @@ fn compute_live_sites(program: &Program, described: bool) -> Vec<LiveSite> {
         // it still needs after the site: the caller's memory, counted
         // where the caller passes it.
         carried.clear();
+        // The previous level's pointer parameters' parts it writes on
+        // every path after the site: the caller's arguments there hold
+        // nothing kept across it.
+        rewritten.clear();
         // Levels: the site in its own function, then each call upwards.
         for p in std::iter::once(site.inst).chain(chain.iter().rev().copied()) {
             let Some(fi) = program.function_of(p) else {
@@ -260,6 +266,7 @@ fn compute_live_sites(program: &Program, described: bool) -> Vec<LiveSite> {
             let fl = &built[slot[fi] as usize];
             places.clear();
             fl.places_after(program, p, &mut places);
+            fl.drop_rewritten(p, &rewritten, &mut places);
             fl.arguments_of(p, &carried, &mut places);
             // A set: sorted, each place once.
             places.sort();
@@ -269,6 +276,8 @@ fn compute_live_sites(program: &Program, described: bool) -> Vec<LiveSite> {
                 }
             });
             fl.param_parts_across(program, &places, &mut carried);
+            fl.params_written_after(program, p, &rewritten, &mut rewritten_next);
+            std::mem::swap(&mut rewritten, &mut rewritten_next);
         }
         // The query object is the site's own state, like a payload.
         values.retain(|v| Some(v.id) != site.payload);
@@ -1650,18 +1659,41 @@ impl FnLiveness {
     /// from the function's entry to a return writes: stores of exactly
     /// that part, and the writes of calls that pass it.
     fn written_on_every_path(&self, program: &Program, var: Id) -> Vec<Vec<u32>> {
+        self.written_on_every_path_from(program, var, None, &[])
+    }
+
+    /// [`FnLiveness::written_on_every_path`] from just after instruction
+    /// `from` (`None`: the entry), with `seed` written there already: what
+    /// a caller's part passed for `var` is sure to hold anew once the
+    /// function returns, whatever it held while suspended at `from`.
+    fn written_on_every_path_from(
+        &self,
+        program: &Program,
+        var: Id,
+        from: Option<usize>,
+        seed: &[Vec<u32>],
+    ) -> Vec<Vec<u32>> {
         let f = self.function(program);
         let n = f.blocks.len();
-        // Only an instruction that mentions `var` can write it.
-        let Some(mentions) = self.mentions(program, var) else {
-            return Vec::new();
+        let start = match from {
+            Some(i) => match block_at(f, i) {
+                Some(b) => Some((b, i)),
+                None => return Vec::new(),
+            },
+            None => None,
         };
+        // Only an instruction that mentions `var` can write it.
+        let mentions = self.mentions(program, var);
+        if mentions.is_none() && seed.is_empty() {
+            return Vec::new();
+        }
         // Every part written somewhere, once (an index each), and the
-        // (block, index) of each write: the analysis below runs on bit
-        // rows of those indices, not on hash sets of paths per block.
+        // (block, index, instruction) of each write: the analysis below
+        // runs on bit rows of those indices, not on hash sets of paths per
+        // block.
         let mut parts: Vec<Vec<u32>> = Vec::new();
-        let mut writes: Vec<(usize, usize)> = Vec::new();
-        let mut add = |b: usize, path: &[u32]| {
+        let mut writes: Vec<(usize, usize, usize)> = Vec::new();
+        let mut add = |b: usize, i: usize, path: &[u32]| {
             let k = match parts.iter().position(|q| same_path(q, path)) {
                 Some(k) => k,
                 None => {
@@ -1669,9 +1701,9 @@ impl FnLiveness {
                     parts.len() - 1
                 }
             };
-            writes.push((b, k));
+            writes.push((b, k, i));
         };
-        for &i in mentions.iter() {
+        for &i in mentions.iter().flat_map(|m| m.iter()) {
             let Some(b) = block_at(f, i) else {
                 continue;
             };
@@ -1679,7 +1711,7 @@ impl FnLiveness {
                 Op::Store => {
                     let t = self.body.first(i).and_then(|t| self.roots.get(&t));
                     if let Some(t) = t.filter(|t| t.var == var && t.exact) {
-                        add(b, self.path(t));
+                        add(b, i, self.path(t));
                     }
                 }
                 Op::FunctionCall => {
@@ -1689,24 +1721,45 @@ impl FnLiveness {
                         };
                         let e = self.call_reads.get(&i).and_then(|e| e.get(k - 1));
                         for x in e.map(|e| e.writes.as_slice()).unwrap_or_default() {
-                            with_joined(self.path(t), x, |path| add(b, path));
+                            with_joined(self.path(t), x, |path| add(b, i, path));
                         }
                     }
                 }
                 _ => {}
             }
         }
+        // The seed: written at the start, before anything else.
+        let seeded: Vec<usize> = seed
+            .iter()
+            .map(|path| match parts.iter().position(|q| same_path(q, path)) {
+                Some(k) => k,
+                None => {
+                    parts.push(path.clone());
+                    parts.len() - 1
+                }
+            })
+            .collect();
         // Nothing written here at all: nothing written on every path.
-        if writes.is_empty() {
+        if writes.is_empty() && seeded.is_empty() {
             return Vec::new();
         }
         let w = parts.len().div_ceil(64);
         let mut own = vec![0u64; n * w];
-        for (b, k) in writes {
+        // From `from`: the seed, then the writes after it in its block.
+        let mut first = vec![0u64; w];
+        for &k in &seeded {
+            first[k / 64] |= 1 << (k % 64);
+        }
+        for &(b, k, i) in &writes {
             own[b * w + k / 64] |= 1 << (k % 64);
+            if start.is_some_and(|(b0, at)| b == b0 && i > at) {
+                first[k / 64] |= 1 << (k % 64);
+            }
         }
         // Forward must-analysis, in rounds over the blocks in order; an
-        // unreached block's set is "everything".
+        // unreached block's set is "everything". From `from`, its block's
+        // successors start from `first`, and the block itself counts
+        // again only when a path comes back to it.
         let mut out = vec![0u64; n * w];
         let mut reached = vec![false; n];
         let mut set = vec![0u64; w];
@@ -1716,18 +1769,22 @@ impl FnLiveness {
             changed = false;
             rounds += 1;
             for b in 0..n {
-                let mut any = b == 0;
+                let mut any = start.is_none() && b == 0;
                 set.fill(0);
-                for &p in &self.preds[b] {
-                    if !reached[p] {
-                        continue;
-                    }
-                    let o = &out[p * w..(p + 1) * w];
-                    if any {
+                let mut meet = |o: &[u64], any: &mut bool| {
+                    if *any {
                         set.iter_mut().zip(o).for_each(|(s, o)| *s &= o);
                     } else {
                         set.copy_from_slice(o);
-                        any = true;
+                        *any = true;
+                    }
+                };
+                for &p in &self.preds[b] {
+                    if start.is_some_and(|(b0, _)| p == b0) {
+                        meet(&first, &mut any);
+                    }
+                    if reached[p] {
+                        meet(&out[p * w..(p + 1) * w], &mut any);
                     }
                 }
                 if !any {
@@ -1746,6 +1803,12 @@ impl FnLiveness {
         // Written on every path to every return (one not reached writes
         // nothing).
         let mut must: Option<Vec<u64>> = None;
+        let mut meet_return = |o: &[u64]| {
+            let m = must.get_or_insert_with(|| vec![u64::MAX; w]);
+            for (k, m) in m.iter_mut().enumerate() {
+                *m &= o.get(k).copied().unwrap_or(0);
+            }
+        };
         for (b, block) in f.blocks.iter().enumerate() {
             if !matches!(
                 program.insts[block.end].class.opcode,
@@ -1753,15 +1816,21 @@ impl FnLiveness {
             ) {
                 continue;
             }
+            if start.is_some_and(|(b0, _)| b == b0) {
+                meet_return(&first);
+                if !reached[b] {
+                    continue;
+                }
+            } else if start.is_some() && !reached[b] {
+                // A return no path from `from` reaches says nothing.
+                continue;
+            }
             let o = if reached[b] {
                 &out[b * w..(b + 1) * w]
             } else {
                 &[][..]
             };
-            let m = must.get_or_insert_with(|| vec![u64::MAX; w]);
-            for (k, m) in m.iter_mut().enumerate() {
-                *m &= o.get(k).copied().unwrap_or(0);
-            }
+            meet_return(o);
         }
         let must = must.unwrap_or_default();
         let mut v: Vec<Vec<u32>> = parts
@@ -2645,6 +2714,84 @@ impl FnLiveness {
                 out.push_joined(root.var, self.path(root), params.path(k));
             } else {
                 out.push(root.var, self.path(root));
+            }
+        }
+    }
+
+    /// The caller's parts that call `call` passes for the callee's
+    /// parameter parts in `written` (parameter index, path), each as
+    /// (variable, path): only exact ones (a part reached through a
+    /// variable index may be another).
+    fn rewritten_arguments(&self, call: usize, written: &SitePlaces) -> Vec<(Id, Vec<u32>)> {
+        if self.body.op(call) != Op::FunctionCall {
+            return Vec::new();
+        }
+        let args = &self.body.ids(call)[1..];
+        let mut out = Vec::new();
+        for (k, &(param, _, _)) in written.list.iter().enumerate() {
+            let Some(root) = args.get(param as usize).and_then(|a| self.roots.get(a)) else {
+                continue;
+            };
+            if root.exact {
+                let mut path = self.path(root).to_vec();
+                path.extend_from_slice(written.path(k));
+                out.push((root.var, path));
+            }
+        }
+        out
+    }
+
+    /// Drops from `places` (live just after call `call`) the parts the
+    /// callee writes on every path from its site to its return (`written`,
+    /// by parameter index): they get a new value before anything reads
+    /// them, so what they held during the site is not kept (glslang's
+    /// `out` temporaries, an `inout` payload copied back).
+    fn drop_rewritten(&self, call: usize, written: &SitePlaces, places: &mut SitePlaces) {
+        if written.list.is_empty() {
+            return;
+        }
+        let parts = self.rewritten_arguments(call, written);
+        let paths = &places.paths;
+        places.list.retain(|&(id, from, to)| {
+            let q = &paths[from as usize..to as usize];
+            !parts
+                .iter()
+                .any(|(var, path)| *var == id && has_prefix(q, path))
+        });
+    }
+
+    /// `out` := the parts of this function's pointer parameters written on
+    /// every path from instruction `at` to a return, by parameter index;
+    /// with call `at`'s callee writing `written` (by its parameter index)
+    /// after the site below it.
+    fn params_written_after(
+        &self,
+        program: &Program,
+        at: usize,
+        written: &SitePlaces,
+        out: &mut SitePlaces,
+    ) {
+        out.clear();
+        let f = self.function(program);
+        if !f
+            .params
+            .iter()
+            .any(|p| self.roots.get(p).is_some_and(|r| r.var == *p))
+        {
+            return;
+        }
+        let seeds = self.rewritten_arguments(at, written);
+        for (k, &param) in f.params.iter().enumerate() {
+            if self.roots.get(&param).is_none_or(|r| r.var != param) {
+                continue;
+            }
+            let seed: Vec<Vec<u32>> = seeds
+                .iter()
+                .filter(|(v, _)| *v == param)
+                .map(|(_, p)| p.clone())
+                .collect();
+            for path in self.written_on_every_path_from(program, param, Some(at), &seed) {
+                out.push(k as Id, &path);
             }
         }
     }
@@ -3950,6 +4097,76 @@ mod tests {
             assert!(kept.contains(&(24, "Ray")), "{rel}: {kept:?}");
         }
     }
+    /// Bytes that must be kept across the one site of `rel` (live and not
+    /// recomputable), and all live bytes.
+    fn kept_and_live(rel: &str) -> (u64, u64) {
+        let s = one_site(rel);
+        (s.live_bytes - s.rematerializable_bytes, s.live_bytes)
+    }
+
+    /// A helper and the same code written inline keep the same bytes
+    /// across the trace (`kept`); with `same_live`, the same live bytes
+    /// too (naga loads a resource once per function, so its WGSL pairs
+    /// differ in recomputable bytes only).
+    fn same_as_inline(pairs: &[(&str, &str, bool)], kept: u64) {
+        for &(helper, inline, same_live) in pairs {
+            let (h, i) = (kept_and_live(helper), kept_and_live(inline));
+            assert_eq!(h.0, kept, "{helper}: {:?}", one_site(helper));
+            assert_eq!(i.0, kept, "{inline}: {:?}", one_site(inline));
+            if same_live {
+                assert_eq!(h.1, i.1, "{helper} vs {inline}");
+            }
+        }
+    }
+
+    /// A helper that writes its `out` parameters on every path after its
+    /// trace: the caller's parts passed for them (glslang's and rtlint's
+    /// temporaries, WGSL's pointers) are not live across it (were 16 B
+    /// more).
+    #[test]
+    fn parts_a_callee_rewrites_after_its_trace_are_not_live() {
+        same_as_inline(
+            &[
+                (
+                    "fixtures/live/out_after.rgen.spv",
+                    "fixtures/live/out_after_inline.rgen.spv",
+                    true,
+                ),
+                (
+                    "fixtures/live/out_after.hlsl",
+                    "fixtures/live/out_after_inline.hlsl",
+                    true,
+                ),
+            ],
+            16,
+        );
+        // naga's loop guard (`loop_bound`, 8 B) is kept as well.
+        same_as_inline(
+            &[(
+                "fixtures/live/out_after.wgsl",
+                "fixtures/live/out_after_inline.wgsl",
+                false,
+            )],
+            24,
+        );
+    }
+
+    /// An HLSL helper tracing with the `inout` payload it is passed: the
+    /// caller's copy is the payload, written back after the trace, not
+    /// live state (was 16 B).
+    #[test]
+    fn an_inout_payload_through_a_helper_is_not_live() {
+        same_as_inline(
+            &[(
+                "fixtures/live/inout_payload.hlsl",
+                "fixtures/live/inout_payload_inline.hlsl",
+                true,
+            )],
+            0,
+        );
+        assert_eq!(kept_and_live("fixtures/live/inout_payload.hlsl").1, 0);
+    }
+
     /// The stack model's undescribed sites carry the same bytes, values and
     /// recomputability as the described ones, and nothing that describes.
     #[test]
