@@ -33,6 +33,8 @@ type HashSet<T> = rustc_hash::FxHashSet<T>;
 use std::path::PathBuf;
 
 mod body;
+mod private;
+use private::PrivateUse;
 
 /// What suspends the shader.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Serialize)]
@@ -1436,6 +1438,12 @@ impl RematMemo {
 /// Liveness facts of one function.
 pub struct FnLiveness {
     func: usize,
+    /// The module's `Private` variables this function and its callees
+    /// touch (tracked here like locals: see `private`).
+    private: std::sync::Arc<PrivateUse>,
+    /// Whether the function is an entry point's (no caller wrote its
+    /// `Private` variables before it).
+    is_entry: bool,
     /// The function's instructions, decoded once.
     body: Body,
     /// The constant index paths of `roots`, one after another.
@@ -1865,6 +1873,8 @@ impl FnLiveness {
         // One walk decodes each instruction and classifies its result.
         let mut body = Body::begin(program, f);
         let (lo, hi) = (body.lo, body.hi);
+        let private = PrivateUse::of(program);
+        let is_entry = program.entry_points.iter().any(|e| e.function == f.id);
         let mut vars = IdSet::new(lo, hi);
         let mut roots: IdMap<LocalPtr> = IdMap::new(lo, hi);
         // Room made once (growing these was a good part of the allocations):
@@ -1900,6 +1910,26 @@ impl FnLiveness {
                 continue;
             };
             let ids = body.ids_from(from);
+            if !private.all.is_empty() {
+                // A `Private` variable mentioned here, or touched by the
+                // callee, is tracked like a local of this function.
+                let callee = (op == Op::FunctionCall)
+                    .then(|| ids.first().and_then(|&c| program.function_index(c)))
+                    .flatten();
+                let touched_by_callee = callee
+                    .into_iter()
+                    .flat_map(|c| private.reads[c].iter().chain(&private.writes[c]));
+                for &v in ids
+                    .iter()
+                    .filter(|&&id| private.is_private(id))
+                    .chain(touched_by_callee)
+                {
+                    if !roots.contains_key(&v) {
+                        roots.insert_whole(v);
+                        vars.add(v);
+                    }
+                }
+            }
             let touches = worked_out_each_time(op)
                 || matches!(op, Op::FunctionParameter | Op::Phi)
                 || ids.iter().any(|id| roots.contains_key(id));
@@ -2020,6 +2050,8 @@ impl FnLiveness {
         }
         let mut fl = FnLiveness {
             func,
+            private,
+            is_entry,
             body,
             paths,
             vars,
@@ -2106,6 +2138,18 @@ impl FnLiveness {
                 }
                 if let Some(p) = root.filter(|_| !derives) {
                     pool.push(places.intern(p.var, &self.paths[p.path_range()]));
+                }
+            }
+            // A call mentions the `Private` variables its callee touches.
+            let callee = (!self.private.all.is_empty() && op == Op::FunctionCall)
+                .then(|| body.first(at).and_then(|c| program.function_index(c)))
+                .flatten();
+            if let Some(c) = callee {
+                let private = &self.private;
+                for v in private.reads[c].iter().chain(&private.writes[c]) {
+                    if let Some(p) = self.roots.get(v) {
+                        mentions.add_root(at, p.root);
+                    }
                 }
             }
             others += other as usize;
@@ -2373,6 +2417,24 @@ impl FnLiveness {
                 }
             }
         }
+        // A call may read the `Private` variables its callee reads (and
+        // is not taken to overwrite any: the safe side).
+        if let Some(c) = self.private_callee(program, at) {
+            for v in &self.private.reads[c] {
+                if self.roots.contains_key(v) {
+                    live.insert(places.intern(*v, &[]));
+                }
+            }
+        }
+    }
+
+    /// The callee of call `at` when the module has `Private` variables.
+    #[inline]
+    fn private_callee(&self, program: &Program, at: usize) -> Option<usize> {
+        if self.private.all.is_empty() || self.body.op(at) != Op::FunctionCall {
+            return None;
+        }
+        self.body.first(at).and_then(|c| program.function_index(c))
     }
 
     /// A write of exactly part `path` of `var`: that part and everything
@@ -2673,6 +2735,20 @@ impl FnLiveness {
         false
     }
 
+    /// [`FnLiveness::written_before`], but for a `Private` variable in a
+    /// function a caller may have written it before: whether anything in
+    /// the module writes it.
+    fn written_before_here(&self, program: &Program, var: Id, inst: usize) -> bool {
+        if !self.is_entry && self.private.is_private(var) {
+            return self
+                .private
+                .writes
+                .iter()
+                .any(|w| w.binary_search(&var).is_ok());
+        }
+        self.written_before(program, var, inst)
+    }
+
     /// Whether instruction `i`, which mentions variable `var`, may write it
     /// (as [`FnLiveness::writes`] says): without looking through its
     /// operands again, since mentioning `var` is having an operand in it
@@ -2687,6 +2763,13 @@ impl FnLiveness {
             // `var` as well as mentioning it, looked at in full.
             Op::Variable => self.writes_var(program, i, var),
             _ if body.result(i) == Some(var) => self.writes_var(program, i, var),
+            // A `Private` variable a call mentions only through its callee.
+            Op::FunctionCall
+                if self.private.is_private(var) && !self.writes_var(program, i, var) =>
+            {
+                self.private_callee(program, i)
+                    .is_some_and(|c| self.private.writes(c, var))
+            }
             _ => true,
         }
     }
@@ -2835,7 +2918,7 @@ impl FnLiveness {
                 continue;
             }
             let is_var = self.vars.contains(&id);
-            if is_var && !self.written_before(program, id, inst) {
+            if is_var && !self.written_before_here(program, id, inst) {
                 continue;
             }
             let ty = if is_var {
@@ -2927,7 +3010,7 @@ impl FnLiveness {
         }
     }
 
-    fn reads(&self, i: usize, id: Id) -> bool {
+    fn reads(&self, program: &Program, i: usize, id: Id) -> bool {
         let body = &self.body;
         if body.debug(i) {
             return false;
@@ -2940,6 +3023,9 @@ impl FnLiveness {
             match body.op(i) {
                 Op::Load | Op::FunctionCall | Op::CopyMemory | Op::ExtInst => {
                     ids.iter().any(|&x| self.root(x) == Some(id))
+                        || self
+                            .private_callee(program, i)
+                            .is_some_and(|c| self.private.reads(c, id))
                 }
                 _ => false,
             }
@@ -2959,8 +3045,9 @@ impl FnLiveness {
     ) -> Option<Location> {
         let f = self.function(program);
         let b0 = block_at(f, inst)?;
-        let reads =
-            |k: usize| only.is_none_or(|m| m.binary_search(&k).is_ok()) && self.reads(k, id);
+        let reads = |k: usize| {
+            only.is_none_or(|m| m.binary_search(&k).is_ok()) && self.reads(program, k, id)
+        };
         let mut found = None;
         for k in inst + 1..=f.blocks[b0].end {
             if reads(k) {
@@ -3133,6 +3220,11 @@ impl FnLiveness {
         parts: impl Iterator<Item = &'a [u32]> + Clone,
         depth: u32,
     ) -> bool {
+        // A `Private` variable outside an entry point's function holds what
+        // a caller stored: not known here, unless only ever one constant.
+        if !self.is_entry && self.private.is_private(var) {
+            return self.private.is_constant(var);
+        }
         // The parts in order, flattened at the end of the pool (see
         // `RematAnswers`); the callers' come sorted.
         let slot = {
@@ -3436,7 +3528,12 @@ impl FnLiveness {
             }
             if b == 0 {
                 // The entry block holds the variables and their initializers.
-                if let Some(&d) = program.defs.get(&var) {
+                // (A module-scope variable's is outside the function.)
+                if let Some(&d) = program
+                    .defs
+                    .get(&var)
+                    .filter(|&&d| f.start <= d && d <= f.end)
+                {
                     if whole(d) == Some(true) {
                         found.push(d);
                     }
@@ -4149,6 +4246,41 @@ mod tests {
             )],
             24,
         );
+    }
+
+    /// Module-scope `Private` variables (GLSL globals, HLSL `static`, WGSL
+    /// `var<private>`) written before a trace and read after it are live,
+    /// as the same state in locals is (were 0 B: the 68 B of `seed` and
+    /// `xf` were missed).
+    #[test]
+    fn module_scope_private_variables_are_live() {
+        same_as_inline(
+            &[
+                (
+                    "fixtures/live/private_state.rgen.spv",
+                    "fixtures/live/private_state_local.rgen.spv",
+                    true,
+                ),
+                (
+                    "fixtures/live/private_state.hlsl",
+                    "fixtures/live/private_state_local.hlsl",
+                    true,
+                ),
+                (
+                    "fixtures/live/private_state.wgsl",
+                    "fixtures/live/private_state_local.wgsl",
+                    true,
+                ),
+            ],
+            68,
+        );
+        // Written by the entry point, read by the helper after its trace;
+        // a table only ever holding its initializer is recomputable.
+        let s = one_site("fixtures/live/private_helper.rgen.spv");
+        let vals = names(&s);
+        assert!(vals.contains(&("seed", 4, false)), "{vals:?}");
+        assert!(vals.contains(&("table", 24, true)), "{vals:?}");
+        assert_eq!(s.live_bytes - s.rematerializable_bytes, 4);
     }
 
     /// An HLSL helper tracing with the `inout` payload it is passed: the
