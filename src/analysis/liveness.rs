@@ -281,6 +281,17 @@ fn compute_live_sites(program: &Program, described: bool) -> Vec<LiveSite> {
             fl.params_written_after(program, p, &rewritten, &mut rewritten_next);
             std::mem::swap(&mut rewritten, &mut rewritten_next);
         }
+        // A value parameter (naga passes structs by value) is what the
+        // caller passed: recomputable when that is.
+        let levels: Vec<usize> = std::iter::once(site.inst)
+            .chain(chain.iter().rev().copied())
+            .collect();
+        for v in values
+            .iter_mut()
+            .filter(|v| !v.rematerializable && v.storage == Storage::Ssa)
+        {
+            v.rematerializable = argument_remat(program, &built, &slot, &levels, v.id);
+        }
         // The query object is the site's own state, like a payload.
         values.retain(|v| Some(v.id) != site.payload);
         // Largest first; what counts before what can be recomputed;
@@ -320,6 +331,60 @@ fn compute_live_sites(program: &Program, described: bool) -> Vec<LiveSite> {
         });
     }
     out
+}
+
+/// Whether SSA parameter `param` of a function on the site's `levels`
+/// (the site, then each call upwards) is recomputable where the call
+/// above passes it: the argument there, followed up while it is a
+/// parameter itself. `false` for any other value.
+fn argument_remat(
+    program: &Program,
+    built: &[FnLiveness],
+    slot: &[u32],
+    levels: &[usize],
+    mut param: Id,
+) -> bool {
+    for _ in 0..levels.len() {
+        let Some(&d) = program.defs.get(&param) else {
+            return false;
+        };
+        if program.insts[d].class.opcode != Op::FunctionParameter {
+            return false;
+        }
+        let Some(fi) = program.function_of(d) else {
+            return false;
+        };
+        let Some(k) = program.functions[fi]
+            .params
+            .iter()
+            .position(|&p| p == param)
+        else {
+            return false;
+        };
+        // The call above the level in function `fi`.
+        let Some(j) = levels
+            .iter()
+            .position(|&i| program.function_of(i) == Some(fi))
+        else {
+            return false;
+        };
+        let Some(&call) = levels.get(j + 1) else {
+            return false;
+        };
+        let arg = id_operands(&program.insts[call]).nth(1 + k);
+        let (Some(arg), Some(caller)) = (arg, program.function_of(call)) else {
+            return false;
+        };
+        let Some(fl) = slot.get(caller).and_then(|&s| built.get(s as usize)) else {
+            return false;
+        };
+        if program.def(arg).map(|i| i.class.opcode) == Some(Op::FunctionParameter) {
+            param = arg;
+            continue;
+        }
+        return fl.remat_ssa(program, arg, 0);
+    }
+    false
 }
 
 fn payload_info(program: &Program, id: Id) -> PayloadInfo {
@@ -976,6 +1041,9 @@ struct ParamEffect {
     reads: Option<Vec<Vec<u32>>>,
     /// The parts it writes on every path to its return.
     writes: Vec<Vec<u32>>,
+    /// Whether it writes no part at all, on any path (`false` when not
+    /// known): a caller's variable passed for it keeps its value.
+    never_writes: bool,
 }
 
 /// Per parameter of a function.
@@ -1658,6 +1726,7 @@ impl FnLiveness {
                 ParamEffect {
                     reads: Some(reads),
                     writes: self.written_on_every_path(program, *p),
+                    never_writes: self.never_writes(program, *p),
                 }
             })
             .collect()
@@ -1668,6 +1737,47 @@ impl FnLiveness {
     /// that part, and the writes of calls that pass it.
     fn written_on_every_path(&self, program: &Program, var: Id) -> Vec<Vec<u32>> {
         self.written_on_every_path_from(program, var, None, &[])
+    }
+
+    /// Whether nothing here may write any part of pointer parameter (or
+    /// variable) `var`: it is only loaded, indexed, or passed to callees
+    /// that never write it.
+    fn never_writes(&self, program: &Program, var: Id) -> bool {
+        let Some(mentions) = self.mentions(program, var) else {
+            return true;
+        };
+        let body = &self.body;
+        mentions.iter().all(|&i| match body.op(i) {
+            Op::Load | Op::AccessChain | Op::InBoundsAccessChain | Op::PtrAccessChain => true,
+            _ if body.debug(i) => true,
+            Op::FunctionCall => self.call_never_writes(program, i, var),
+            _ => false,
+        })
+    }
+
+    /// Whether call `i` leaves variable `var` as it was: each argument
+    /// pointing into it goes to a parameter its callee never writes.
+    fn call_never_writes(&self, program: &Program, i: usize, var: Id) -> bool {
+        // A `Private` variable the callee may write without being passed it.
+        if self.private.is_private(var)
+            && self
+                .private_callee(program, i)
+                .is_none_or(|c| self.private.writes(c, var))
+        {
+            return false;
+        }
+        let effects = self.call_reads.get(&i);
+        self.body
+            .ids(i)
+            .iter()
+            .enumerate()
+            .skip(1)
+            .filter(|(_, a)| self.root(**a) == Some(var))
+            .all(|(k, _)| {
+                effects
+                    .and_then(|e| e.get(k - 1))
+                    .is_some_and(|e| e.never_writes)
+            })
     }
 
     /// [`FnLiveness::written_on_every_path`] from just after instruction
@@ -3335,6 +3445,9 @@ impl FnLiveness {
                     stored.push((range, value));
                 }
                 Op::Load => {}
+                // A callee given its address that never writes through it
+                // (a struct passed by value) leaves the value as it was.
+                Op::FunctionCall if self.call_never_writes(program, i, var) => {}
                 Op::AccessChain | Op::InBoundsAccessChain | Op::PtrAccessChain => {
                     if !ids
                         .iter()
@@ -4281,6 +4394,48 @@ mod tests {
         assert!(vals.contains(&("seed", 4, false)), "{vals:?}");
         assert!(vals.contains(&("table", 24, true)), "{vals:?}");
         assert_eq!(s.live_bytes - s.rematerializable_bytes, 4);
+    }
+
+    /// A constant-buffer struct passed by value to a helper that reads it
+    /// after its trace is recomputable (a load from the buffer again):
+    /// through glslang's and rtlint's temporaries, which the callee never
+    /// writes, and naga's value parameters, followed to the caller's
+    /// argument (were 64 B and 80 B kept).
+    #[test]
+    fn a_constant_buffer_struct_by_value_is_recomputable() {
+        same_as_inline(
+            &[
+                (
+                    "fixtures/live/cbuffer_arg.rgen.spv",
+                    "fixtures/live/cbuffer_arg_inline.rgen.spv",
+                    false,
+                ),
+                (
+                    "fixtures/live/cbuffer_arg.hlsl",
+                    "fixtures/live/cbuffer_arg_inline.hlsl",
+                    false,
+                ),
+                (
+                    "fixtures/live/cbuffer_arg.wgsl",
+                    "fixtures/live/cbuffer_arg_inline.wgsl",
+                    false,
+                ),
+            ],
+            0,
+        );
+        for rel in [
+            "fixtures/live/cbuffer_arg.rgen.spv",
+            "fixtures/live/cbuffer_arg.hlsl",
+            "fixtures/live/cbuffer_arg.wgsl",
+        ] {
+            let s = one_site(rel);
+            assert!(
+                s.values
+                    .iter()
+                    .any(|v| v.ty == "Camera" && v.size >= 64 && v.rematerializable),
+                "{rel}: {s:?}"
+            );
+        }
     }
 
     /// An HLSL helper tracing with the `inout` payload it is passed: the
