@@ -269,7 +269,7 @@ fn compute_live_sites(program: &Program, described: bool) -> Vec<LiveSite> {
             places.clear();
             fl.places_after(program, p, &mut places);
             fl.drop_rewritten(p, &rewritten, &mut places);
-            fl.arguments_of(p, &carried, &mut places);
+            fl.arguments_of(program, p, &carried, &mut places);
             // A set: sorted, each place once.
             places.sort();
             fl.live_across(program, p, &places, described, |v| {
@@ -292,6 +292,21 @@ fn compute_live_sites(program: &Program, described: bool) -> Vec<LiveSite> {
         {
             v.rematerializable = argument_remat(program, &built, &slot, &levels, v.id);
         }
+        // A value parameter loaded from a caller's variable that is itself
+        // counted whole holds the same value: counted once (naga passes
+        // structs by value).
+        let same: Vec<Id> = values
+            .iter()
+            .filter(|v| v.storage == Storage::Ssa)
+            .filter_map(|v| {
+                let src = argument_source(program, &built, &slot, &levels, v.id)?;
+                values
+                    .iter()
+                    .any(|w| w.id == src && w.storage == Storage::Variable && w.size >= v.size)
+                    .then_some(v.id)
+            })
+            .collect();
+        values.retain(|v| !same.contains(&v.id));
         // The query object is the site's own state, like a payload.
         values.retain(|v| Some(v.id) != site.payload);
         // Largest first; what counts before what can be recomputed;
@@ -385,6 +400,56 @@ fn argument_remat(
         return fl.remat_ssa(program, arg, 0);
     }
     false
+}
+
+/// When SSA parameter `param` of a function on the site's `levels` is,
+/// at the call above, a load of a whole local variable of the caller made
+/// in the call's block with no write of the variable between: that
+/// variable.
+fn argument_source(
+    program: &Program,
+    built: &[FnLiveness],
+    slot: &[u32],
+    levels: &[usize],
+    param: Id,
+) -> Option<Id> {
+    let d = *program.defs.get(&param)?;
+    if program.insts[d].class.opcode != Op::FunctionParameter {
+        return None;
+    }
+    let fi = program.function_of(d)?;
+    let k = program.functions[fi]
+        .params
+        .iter()
+        .position(|&p| p == param)?;
+    let j = levels
+        .iter()
+        .position(|&i| program.function_of(i) == Some(fi))?;
+    let call = *levels.get(j + 1)?;
+    let arg = id_operands(&program.insts[call]).nth(1 + k)?;
+    let caller = program.function_of(call)?;
+    let fl = built.get(*slot.get(caller)? as usize)?;
+    let load = *program.defs.get(&arg)?;
+    if program.insts[load].class.opcode != Op::Load {
+        return None;
+    }
+    let f = &program.functions[caller];
+    if block_at(f, load)? != block_at(f, call)? || load > call {
+        return None;
+    }
+    let root = fl.roots.get(&id_operands(&program.insts[load]).next()?)?;
+    if !root.exact
+        || !fl.path(root).is_empty()
+        || !fl.vars.contains(&root.var)
+        || fl.private.is_private(root.var)
+    {
+        return None;
+    }
+    let mentions = fl.mentions(program, root.var)?;
+    let written = mentions
+        .iter()
+        .any(|&i| load < i && i <= call && fl.mention_writes(program, i, root.var));
+    (!written).then_some(root.var)
 }
 
 fn payload_info(program: &Program, id: Id) -> PayloadInfo {
@@ -2894,7 +2959,13 @@ impl FnLiveness {
 
     /// Adds to `out` the places in this function that call `call` passes
     /// for the callee's parameter parts in `params` (parameter index, path).
-    fn arguments_of(&self, call: usize, params: &SitePlaces, out: &mut SitePlaces) {
+    fn arguments_of(
+        &self,
+        program: &Program,
+        call: usize,
+        params: &SitePlaces,
+        out: &mut SitePlaces,
+    ) {
         if self.body.op(call) != Op::FunctionCall {
             return;
         }
@@ -2903,12 +2974,72 @@ impl FnLiveness {
             let Some(root) = args.get(param as usize).and_then(|a| self.roots.get(a)) else {
                 continue;
             };
-            if root.exact {
+            // A copy the callee only reads holds what its source does
+            // while the callee runs: the source's part, counted once.
+            let never_writes = self
+                .call_reads
+                .get(&call)
+                .and_then(|e| e.get(param as usize))
+                .is_some_and(|e| e.never_writes);
+            let source = (root.exact && never_writes)
+                .then(|| self.copied_from(program, call, root.var))
+                .flatten();
+            if let Some((src, src_path)) = source {
+                let mut path = src_path.to_vec();
+                path.extend_from_slice(self.path(root));
+                out.push_joined(src, &path, params.path(k));
+            } else if root.exact {
                 out.push_joined(root.var, self.path(root), params.path(k));
             } else {
                 out.push(root.var, self.path(root));
             }
         }
+    }
+
+    /// When local variable `tmp` holds, at call `call`, a whole copy of a
+    /// part of another local variable made just before in the same block
+    /// (glslang's and rtlint's temporary for an argument passed by value),
+    /// with neither written since and the source not passed to the call:
+    /// that source and its path.
+    fn copied_from(&self, program: &Program, call: usize, tmp: Id) -> Option<(Id, &[u32])> {
+        if !self.vars.contains(&tmp) || self.private.is_private(tmp) {
+            return None;
+        }
+        let f = self.function(program);
+        let b = block_at(f, call)?;
+        let mentions = self.mentions(program, tmp)?;
+        let before = mentions.partition_point(|&i| i < call);
+        // The last mention of the temporary before the call: the copy.
+        let store = *mentions[..before].last()?;
+        if store < f.blocks[b].start {
+            return None;
+        }
+        let Copy::Store(load) = self.copy_at(store) else {
+            return None;
+        };
+        let dst = self.roots.get(&self.body.first(store)?)?;
+        if dst.var != tmp || !self.path(dst).is_empty() {
+            return None;
+        }
+        let src = self.roots.get(&self.body.first(load as usize)?)?;
+        if !src.exact
+            || src.var == tmp
+            || !self.vars.contains(&src.var)
+            || self.private.is_private(src.var)
+        {
+            return None;
+        }
+        // Neither written between the copy and the call; the source not
+        // given to the call.
+        let src_mentions = self.mentions(program, src.var)?;
+        let between = |i: usize| load as usize <= i && i < call;
+        if src_mentions.iter().any(|&i| {
+            (between(i) && i != load as usize && self.mention_writes(program, i, src.var))
+                || i == call
+        }) {
+            return None;
+        }
+        Some((src.var, self.path(src)))
     }
 
     /// The caller's parts that call `call` passes for the callee's
@@ -4436,6 +4567,34 @@ mod tests {
                 "{rel}: {s:?}"
             );
         }
+    }
+
+    /// A struct passed by value to a helper that reads it after its trace,
+    /// while the caller reads it after the call: the callee's copy
+    /// (glslang's and rtlint's temporary, naga's value parameter) and the
+    /// caller's original are kept once (were 12 B and 24 B more).
+    #[test]
+    fn an_in_struct_argument_is_not_counted_twice() {
+        same_as_inline(
+            &[
+                (
+                    "fixtures/live/in_struct.rgen.spv",
+                    "fixtures/live/in_struct_inline.rgen.spv",
+                    true,
+                ),
+                (
+                    "fixtures/live/in_struct.hlsl",
+                    "fixtures/live/in_struct_inline.hlsl",
+                    true,
+                ),
+                (
+                    "fixtures/live/in_struct.wgsl",
+                    "fixtures/live/in_struct_inline.wgsl",
+                    true,
+                ),
+            ],
+            24,
+        );
     }
 
     /// An HLSL helper tracing with the `inout` payload it is passed: the
