@@ -563,6 +563,7 @@ mod tests {
                 "RT004 hit-attributes-over-limit",
                 "RT005 ray-query-null-constant",
                 "RT006 payload-member-unused",
+                "RT007 two-incoming-payloads",
                 "RT008 attributes-larger-than-written",
                 "RT010 live-state-over-budget",
                 "RT020 recursive-trace",
