@@ -509,7 +509,11 @@ pub struct VisibilityTrace {
     pub program: usize,
     pub inst: usize,
     pub location: Option<Location>,
+    /// The flags every choice sets (all of them when the flags are one
+    /// constant).
     pub flags: u64,
+    /// The constants the flags may be (one, or a choice on branches).
+    pub flag_choices: Vec<u64>,
     /// The payload variable's type.
     pub payload_ty: Option<Id>,
     /// Entry points of the closest-hit shaders it runs.
@@ -569,6 +573,32 @@ pub fn trace_flags(pipeline: &Pipeline, graph: &TraceGraph, t: &TraceTargets) ->
     ops.ray_flags.constant()
 }
 
+/// The constants the ray flags of the trace at `inst` may be as `from`
+/// reaches it (one when they fold; a `select`, phi or variable assigned on
+/// branches gives several: see `Program::fold_choices_in`).
+pub fn trace_flag_choices(
+    pipeline: &Pipeline,
+    graph: &TraceGraph,
+    t: &TraceTargets,
+) -> Option<Vec<u64>> {
+    if let Some(f) = trace_flags(pipeline, graph, t) {
+        return Some(vec![f]);
+    }
+    let shader = &graph.nodes.get(t.from)?.shader;
+    let program = pipeline.programs.get(t.program)?;
+    let site = program.sites.iter().find(|s| s.inst == t.inst)?;
+    let f = program.functions.get(site.function)?;
+    let chain = crate::program::cfg::call_chains(program, shader.function, f.id, 1)
+        .into_iter()
+        .next()
+        .unwrap_or_default();
+    let id = match program.insts[site.inst].operands.get(1) {
+        Some(rspirv::dr::Operand::IdRef(x)) => *x,
+        _ => return None,
+    };
+    program.fold_choices_in(id, &chain)
+}
+
 /// The payload type a trace passes.
 pub fn trace_payload_ty(program: &Program, inst: usize) -> Option<Id> {
     let site = program.sites.iter().find(|s| s.inst == inst)?;
@@ -592,9 +622,10 @@ pub fn visibility_traces(pipeline: &Pipeline, graph: &TraceGraph) -> Vec<Visibil
         let Some(program) = pipeline.programs.get(t.program) else {
             continue;
         };
-        let Some(flags) = trace_flags(pipeline, graph, &t) else {
+        let Some(flag_choices) = trace_flag_choices(pipeline, graph, &t) else {
             continue;
         };
+        let flags = flag_choices.iter().fold(u64::MAX, |a, &f| a & f);
         let payload_ty = trace_payload_ty(program, t.inst);
         let sig = payload_ty.map(|ty| signature(program, ty));
         let mut written = BTreeSet::new();
@@ -653,6 +684,7 @@ pub fn visibility_traces(pipeline: &Pipeline, graph: &TraceGraph) -> Vec<Visibil
             inst: t.inst,
             location: t.location.clone(),
             flags,
+            flag_choices,
             payload_ty,
             closest_hits,
             recording_closest_hits: recording,
