@@ -12,6 +12,10 @@ use spirv::{Op, StorageClass};
 pub(super) struct PrivateUse {
     pub reads: Vec<Vec<Id>>,
     pub writes: Vec<Vec<Id>>,
+    /// Those it writes whole before anything can branch: stored in its
+    /// first block, or by a call there to a function that does (so on
+    /// every path; a call to it overwrites them).
+    pub must: Vec<Vec<Id>>,
     /// Every `Private` variable of the module, sorted (empty: nothing to do).
     pub all: Vec<Id>,
     /// The variables only ever written whole with one constant (GLSL's
@@ -38,6 +42,7 @@ impl PrivateUse {
             return PrivateUse {
                 reads: vec![Vec::new(); n],
                 writes: vec![Vec::new(); n],
+                must: vec![Vec::new(); n],
                 all,
                 constant: Vec::new(),
             };
@@ -45,13 +50,18 @@ impl PrivateUse {
         let mut reads = vec![Vec::new(); n];
         let mut writes = vec![Vec::new(); n];
         let mut calls: Vec<Vec<usize>> = vec![Vec::new(); n];
+        let mut must: Vec<Vec<Id>> = vec![Vec::new(); n];
+        // Calls in each function's first block, in order.
+        let mut first_calls: Vec<Vec<usize>> = vec![Vec::new(); n];
         // Per variable: the one constant stored whole so far (`Some`), or
         // another write met (`None`).
         let mut stored: rustc_hash::FxHashMap<Id, Option<Id>> = Default::default();
         for (fi, f) in program.functions.iter().enumerate() {
             // Pointers into a `Private` variable, by the variable.
             let mut into: rustc_hash::FxHashMap<Id, Id> = Default::default();
-            for inst in &program.insts[f.start..=f.end] {
+            let first_end = f.blocks.first().map_or(f.start, |b| b.end);
+            for (at, inst) in program.insts[f.start..=f.end].iter().enumerate() {
+                let in_first = f.start + at <= first_end;
                 if program.is_debug_inst(inst) {
                     continue;
                 }
@@ -87,6 +97,14 @@ impl PrivateUse {
                     Op::FunctionCall => {
                         if let Some(c) = ids.first().and_then(|&c| program.function_index(c)) {
                             calls[fi].push(c);
+                            if in_first {
+                                first_calls[fi].push(c);
+                            }
+                        }
+                    }
+                    Op::Store if in_first => {
+                        if let Some(&v) = ids.first().filter(|v| all.binary_search(v).is_ok()) {
+                            must[fi].push(v);
                         }
                     }
                     _ => {}
@@ -143,7 +161,34 @@ impl PrivateUse {
                 }
             }
         }
-        for set in reads.iter_mut().chain(writes.iter_mut()) {
+        // Whole writes through calls in the first block, to a fixpoint.
+        let mut changed = true;
+        let mut rounds = 0;
+        while changed && rounds <= n {
+            changed = false;
+            rounds += 1;
+            for fi in 0..n {
+                for &c in &first_calls[fi] {
+                    if c == fi {
+                        continue;
+                    }
+                    let more: Vec<Id> = must[c]
+                        .iter()
+                        .copied()
+                        .filter(|v| !must[fi].contains(v))
+                        .collect();
+                    if !more.is_empty() {
+                        must[fi].extend(more);
+                        changed = true;
+                    }
+                }
+            }
+        }
+        for set in reads
+            .iter_mut()
+            .chain(writes.iter_mut())
+            .chain(must.iter_mut())
+        {
             set.sort_unstable();
             set.dedup();
         }
@@ -155,6 +200,7 @@ impl PrivateUse {
         PrivateUse {
             reads,
             writes,
+            must,
             all,
             constant,
         }
