@@ -565,6 +565,7 @@ mod tests {
                 "RT006 payload-member-unused",
                 "RT007 two-incoming-payloads",
                 "RT008 attributes-larger-than-written",
+                "RT009 payload-mismatch",
                 "RT010 live-state-over-budget",
                 "RT020 recursive-trace",
                 "RT021 depth-exceeds-declared",
