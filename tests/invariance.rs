@@ -455,6 +455,18 @@ const KNOWN_ACROSS_COMPILERS: &[(&str, &str, &str, &str)] = &[
          only its origin (12 B); all recomputable, so the bytes that count agree",
     ),
     (
+        "fixtures/RT030/bad_choice.hlsl",
+        "ShadowHit",
+        "layouts",
+        "rtlint declares the unused `attr` parameter as a hit-attribute variable; Slang drops it",
+    ),
+    (
+        "fixtures/RT030/good_choice.hlsl",
+        "ShadowHit",
+        "layouts",
+        "rtlint declares the unused `attr` parameter as a hit-attribute variable; Slang drops it",
+    ),
+    (
         "fixtures/live/cbuffer_arg.hlsl",
         "RayGen",
         "live bytes",

@@ -623,100 +623,30 @@ pub fn incoming_payload_var(program: &Program, function: Id) -> Option<Id> {
         })
 }
 
-/// The `layout(location = N)` a GLSL payload variable is declared with:
-/// SPIR-V keeps no location for payloads (a trace names its variable), so
-/// it is read from the one source line declaring the variable
-/// `rayPayloadEXT` or `rayPayloadInEXT` (the text embedded by `-g`, else
-/// the file).
-pub fn declared_payload_location(program: &Program, var: Id) -> Option<u32> {
-    let name = program.name(var).filter(|n| !n.is_empty())?;
-    let is_word = |c: Option<char>| c.is_some_and(|c| c.is_alphanumeric() || c == '_');
-    let mut found = None;
-    for f in &program.files {
-        let Some(text) = f
-            .text
-            .clone()
-            .or_else(|| std::fs::read_to_string(&f.path).ok())
-        else {
-            continue;
-        };
-        for line in text.lines() {
-            let code = line.split("//").next().unwrap_or("");
-            if !code.contains("rayPayload") {
-                continue;
-            }
-            let named = code.match_indices(name).any(|(k, _)| {
-                !is_word(code[..k].chars().last())
-                    && !is_word(code[k + name.len()..].chars().next())
-            });
-            if !named {
-                continue;
-            }
-            let at = code.find("location")?;
-            let rest = code[at + "location".len()..]
-                .trim_start()
-                .strip_prefix('=')?;
-            let digits: String = rest
-                .trim_start()
-                .chars()
-                .take_while(|c| c.is_ascii_digit())
-                .collect();
-            let n: u32 = digits.parse().ok()?;
-            if found.is_some_and(|m| m != n) {
-                return None;
-            }
-            found = Some(n);
-        }
-    }
-    found
-}
-
 /// The hit and miss shaders (graph nodes) trace `t` would run whatever
-/// their payload: with a description, those it connects; without, in
-/// Vulkan (GLSL, SPIR-V), those whose incoming payload is declared at the
-/// location of the trace's payload (the convention a project follows to
-/// pair them), among every hit and miss shader; HLSL and WGSL give none (without a description only the
-/// payload type pairs a trace with its shaders). The one place a payload
-/// question asks which shaders a trace reaches regardless of payload.
+/// their payload: with a description, those it connects. Without one,
+/// none: a folder's loose pipeline pairs a trace with the shaders whose
+/// payload type matches (so none differs), and pairing by the GLSL
+/// `layout(location)` would need the source, which SPIR-V without debug
+/// info does not carry (an analysis answers the same whatever the debug
+/// info). The one place a payload question asks which shaders a trace
+/// reaches regardless of payload: the reach analysis can answer here.
 pub fn reached_ignoring_payload(
     pipeline: &Pipeline,
     graph: &TraceGraph,
     t: &TraceTargets,
 ) -> Vec<usize> {
-    let Some(program) = pipeline.programs.get(t.program) else {
-        return Vec::new();
-    };
-    let stages = |n: &usize| {
-        matches!(
-            graph.nodes[*n].shader.stage,
-            Stage::ClosestHit | Stage::AnyHit | Stage::Miss
-        )
-    };
-    if pipeline.described() {
-        return t.targets.iter().copied().filter(stages).collect();
-    }
-    if !matches!(
-        program.language,
-        crate::shader::Language::Glsl | crate::shader::Language::Spirv
-    ) {
+    if !pipeline.described() {
         return Vec::new();
     }
-    let location = |p: &Program, v: Id| declared_payload_location(p, v);
-    let Some(site) = program.sites.iter().find(|s| s.inst == t.inst) else {
-        return Vec::new();
-    };
-    let Some(at) = site.payload.and_then(|v| location(program, v)) else {
-        return Vec::new();
-    };
-    // (Every hit and miss shader of the folder: the graph's own edges
-    // already leave out those whose payload type differs.)
-    (0..graph.nodes.len())
-        .filter(stages)
+    t.targets
+        .iter()
+        .copied()
         .filter(|&n| {
-            let shader = &graph.nodes[n].shader;
-            pipeline.program(shader).is_some_and(|p| {
-                incoming_payload_var(p, shader.function).and_then(|v| location(p, v)) == Some(at)
-            })
+            matches!(
+                graph.nodes[n].shader.stage,
+                Stage::ClosestHit | Stage::AnyHit | Stage::Miss
+            )
         })
         .collect()
 }

@@ -7,15 +7,13 @@ super::declare_rule! {
     /// ## What it does
     ///
     /// Finds a trace whose payload differs in type or size from the incoming
-    /// payload of a hit or miss shader it runs. Which shaders a trace runs,
-    /// whatever their payload: those a pipeline description connects to it;
-    /// without a description, in Vulkan (GLSL, SPIR-V), those whose
-    /// `rayPayloadInEXT` is declared at the location of the trace's
-    /// `rayPayloadEXT` (the convention projects use to pair them). HLSL and
-    /// WGSL shaders without a description are not judged: only the payload
-    /// type pairs a trace with its shaders there. A folder of unrelated
-    /// shaders (test shaders, several samples) pairs by location shaders
-    /// no pipeline combines: a warning, not an error, for that reason.
+    /// payload of a hit or miss shader that a pipeline description connects
+    /// to it (the hit groups and miss shaders its SBT operands can select).
+    ///
+    /// Without a description the rule does not judge: a folder's shaders
+    /// are paired with a trace only when their payload type matches, and
+    /// the GLSL `layout(location)` that pairs them in a project is not in
+    /// the SPIR-V (a module without debug info would answer differently).
     ///
     /// ## Why is this bad?
     ///
@@ -24,7 +22,8 @@ super::declare_rule! {
     /// a 60-byte raygen payload writes past it; a closest hit whose payload
     /// is 56 bytes leaves the caller's last member as it was, or reads
     /// members at other offsets. The Vulkan specification requires the
-    /// types to match; drivers do not check.
+    /// types to match; drivers do not check. A warning: a description may
+    /// connect shaders the application never pairs at run time.
     ///
     /// ## Example
     ///
