@@ -466,6 +466,33 @@ const KNOWN_ACROSS_COMPILERS: &[(&str, &str, &str, &str)] = &[
          only its origin (12 B); all recomputable, so the bytes that count agree",
     ),
     (
+        "fixtures/RT030/bad_choice.hlsl",
+        "ShadowHit",
+        "layouts",
+        "rtlint declares the unused `attr` parameter as a hit-attribute variable; Slang drops it",
+    ),
+    (
+        "fixtures/RT030/good_choice.hlsl",
+        "ShadowHit",
+        "layouts",
+        "rtlint declares the unused `attr` parameter as a hit-attribute variable; Slang drops it",
+    ),
+    (
+        "fixtures/live/cbuffer_arg.hlsl",
+        "RayGen",
+        "live bytes",
+        "rtlint passes `cam` to `Shade` through a temporary and counts it (recomputable: a \
+         copy of the constant buffer); Slang inlines `Shade` and loads the buffer after the \
+         trace; the kept bytes agree (0)",
+    ),
+    (
+        "fixtures/live/cbuffer_arg_inline.hlsl",
+        "RayGen",
+        "live bytes",
+        "rtlint keeps the constant `d` in a local (recomputable), Slang folds it; the kept \
+         bytes agree (0)",
+    ),
+    (
         "fixtures/live/param_state.hlsl",
         "RayGen",
         "kept bytes",

@@ -33,6 +33,8 @@ type HashSet<T> = rustc_hash::FxHashSet<T>;
 use std::path::PathBuf;
 
 mod body;
+mod private;
+use private::PrivateUse;
 
 /// What suspends the shader.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Serialize)]
@@ -230,6 +232,8 @@ fn compute_live_sites(program: &Program, described: bool) -> Vec<LiveSite> {
     let mut seen: HashSet<Id> = HashSet::default();
     let mut places = SitePlaces::default();
     let mut carried = SitePlaces::default();
+    let mut rewritten = SitePlaces::default();
+    let mut rewritten_next = SitePlaces::default();
     for (site, kind, e, chain) in jobs {
         let entry = &program.entry_points[e];
         let mut values: Vec<LiveValue> = Vec::new();
@@ -238,6 +242,10 @@ fn compute_live_sites(program: &Program, described: bool) -> Vec<LiveSite> {
         // it still needs after the site: the caller's memory, counted
         // where the caller passes it.
         carried.clear();
+        // The previous level's pointer parameters' parts it writes on
+        // every path after the site: the caller's arguments there hold
+        // nothing kept across it.
+        rewritten.clear();
         // Levels: the site in its own function, then each call upwards.
         for p in std::iter::once(site.inst).chain(chain.iter().rev().copied()) {
             let Some(fi) = program.function_of(p) else {
@@ -260,7 +268,8 @@ fn compute_live_sites(program: &Program, described: bool) -> Vec<LiveSite> {
             let fl = &built[slot[fi] as usize];
             places.clear();
             fl.places_after(program, p, &mut places);
-            fl.arguments_of(p, &carried, &mut places);
+            fl.drop_rewritten(p, &rewritten, &mut places);
+            fl.arguments_of(program, p, &carried, &mut places);
             // A set: sorted, each place once.
             places.sort();
             fl.live_across(program, p, &places, described, |v| {
@@ -269,7 +278,35 @@ fn compute_live_sites(program: &Program, described: bool) -> Vec<LiveSite> {
                 }
             });
             fl.param_parts_across(program, &places, &mut carried);
+            fl.params_written_after(program, p, &rewritten, &mut rewritten_next);
+            std::mem::swap(&mut rewritten, &mut rewritten_next);
         }
+        // A value parameter (naga passes structs by value) is what the
+        // caller passed: recomputable when that is.
+        let levels: Vec<usize> = std::iter::once(site.inst)
+            .chain(chain.iter().rev().copied())
+            .collect();
+        for v in values
+            .iter_mut()
+            .filter(|v| !v.rematerializable && v.storage == Storage::Ssa)
+        {
+            v.rematerializable = argument_remat(program, &built, &slot, &levels, v.id);
+        }
+        // A value parameter loaded from a caller's variable that is itself
+        // counted whole holds the same value: counted once (naga passes
+        // structs by value).
+        let same: Vec<Id> = values
+            .iter()
+            .filter(|v| v.storage == Storage::Ssa)
+            .filter_map(|v| {
+                let src = argument_source(program, &built, &slot, &levels, v.id)?;
+                values
+                    .iter()
+                    .any(|w| w.id == src && w.storage == Storage::Variable && w.size >= v.size)
+                    .then_some(v.id)
+            })
+            .collect();
+        values.retain(|v| !same.contains(&v.id));
         // The query object is the site's own state, like a payload.
         values.retain(|v| Some(v.id) != site.payload);
         // Largest first; what counts before what can be recomputed;
@@ -309,6 +346,110 @@ fn compute_live_sites(program: &Program, described: bool) -> Vec<LiveSite> {
         });
     }
     out
+}
+
+/// Whether SSA parameter `param` of a function on the site's `levels`
+/// (the site, then each call upwards) is recomputable where the call
+/// above passes it: the argument there, followed up while it is a
+/// parameter itself. `false` for any other value.
+fn argument_remat(
+    program: &Program,
+    built: &[FnLiveness],
+    slot: &[u32],
+    levels: &[usize],
+    mut param: Id,
+) -> bool {
+    for _ in 0..levels.len() {
+        let Some(&d) = program.defs.get(&param) else {
+            return false;
+        };
+        if program.insts[d].class.opcode != Op::FunctionParameter {
+            return false;
+        }
+        let Some(fi) = program.function_of(d) else {
+            return false;
+        };
+        let Some(k) = program.functions[fi]
+            .params
+            .iter()
+            .position(|&p| p == param)
+        else {
+            return false;
+        };
+        // The call above the level in function `fi`.
+        let Some(j) = levels
+            .iter()
+            .position(|&i| program.function_of(i) == Some(fi))
+        else {
+            return false;
+        };
+        let Some(&call) = levels.get(j + 1) else {
+            return false;
+        };
+        let arg = id_operands(&program.insts[call]).nth(1 + k);
+        let (Some(arg), Some(caller)) = (arg, program.function_of(call)) else {
+            return false;
+        };
+        let Some(fl) = slot.get(caller).and_then(|&s| built.get(s as usize)) else {
+            return false;
+        };
+        if program.def(arg).map(|i| i.class.opcode) == Some(Op::FunctionParameter) {
+            param = arg;
+            continue;
+        }
+        return fl.remat_ssa(program, arg, 0);
+    }
+    false
+}
+
+/// When SSA parameter `param` of a function on the site's `levels` is,
+/// at the call above, a load of a whole local variable of the caller made
+/// in the call's block with no write of the variable between: that
+/// variable.
+fn argument_source(
+    program: &Program,
+    built: &[FnLiveness],
+    slot: &[u32],
+    levels: &[usize],
+    param: Id,
+) -> Option<Id> {
+    let d = *program.defs.get(&param)?;
+    if program.insts[d].class.opcode != Op::FunctionParameter {
+        return None;
+    }
+    let fi = program.function_of(d)?;
+    let k = program.functions[fi]
+        .params
+        .iter()
+        .position(|&p| p == param)?;
+    let j = levels
+        .iter()
+        .position(|&i| program.function_of(i) == Some(fi))?;
+    let call = *levels.get(j + 1)?;
+    let arg = id_operands(&program.insts[call]).nth(1 + k)?;
+    let caller = program.function_of(call)?;
+    let fl = built.get(*slot.get(caller)? as usize)?;
+    let load = *program.defs.get(&arg)?;
+    if program.insts[load].class.opcode != Op::Load {
+        return None;
+    }
+    let f = &program.functions[caller];
+    if block_at(f, load)? != block_at(f, call)? || load > call {
+        return None;
+    }
+    let root = fl.roots.get(&id_operands(&program.insts[load]).next()?)?;
+    if !root.exact
+        || !fl.path(root).is_empty()
+        || !fl.vars.contains(&root.var)
+        || fl.private.is_private(root.var)
+    {
+        return None;
+    }
+    let mentions = fl.mentions(program, root.var)?;
+    let written = mentions
+        .iter()
+        .any(|&i| load < i && i <= call && fl.mention_writes(program, i, root.var));
+    (!written).then_some(root.var)
 }
 
 fn payload_info(program: &Program, id: Id) -> PayloadInfo {
@@ -965,6 +1106,9 @@ struct ParamEffect {
     reads: Option<Vec<Vec<u32>>>,
     /// The parts it writes on every path to its return.
     writes: Vec<Vec<u32>>,
+    /// Whether it writes no part at all, on any path (`false` when not
+    /// known): a caller's variable passed for it keeps its value.
+    never_writes: bool,
 }
 
 /// Per parameter of a function.
@@ -1427,6 +1571,12 @@ impl RematMemo {
 /// Liveness facts of one function.
 pub struct FnLiveness {
     func: usize,
+    /// The module's `Private` variables this function and its callees
+    /// touch (tracked here like locals: see `private`).
+    private: std::sync::Arc<PrivateUse>,
+    /// Whether the function is an entry point's (no caller wrote its
+    /// `Private` variables before it).
+    is_entry: bool,
     /// The function's instructions, decoded once.
     body: Body,
     /// The constant index paths of `roots`, one after another.
@@ -1641,6 +1791,7 @@ impl FnLiveness {
                 ParamEffect {
                     reads: Some(reads),
                     writes: self.written_on_every_path(program, *p),
+                    never_writes: self.never_writes(program, *p),
                 }
             })
             .collect()
@@ -1650,18 +1801,82 @@ impl FnLiveness {
     /// from the function's entry to a return writes: stores of exactly
     /// that part, and the writes of calls that pass it.
     fn written_on_every_path(&self, program: &Program, var: Id) -> Vec<Vec<u32>> {
+        self.written_on_every_path_from(program, var, None, &[])
+    }
+
+    /// Whether nothing here may write any part of pointer parameter (or
+    /// variable) `var`: it is only loaded, indexed, or passed to callees
+    /// that never write it.
+    fn never_writes(&self, program: &Program, var: Id) -> bool {
+        let Some(mentions) = self.mentions(program, var) else {
+            return true;
+        };
+        let body = &self.body;
+        mentions.iter().all(|&i| match body.op(i) {
+            Op::Load | Op::AccessChain | Op::InBoundsAccessChain | Op::PtrAccessChain => true,
+            _ if body.debug(i) => true,
+            Op::FunctionCall => self.call_never_writes(program, i, var),
+            _ => false,
+        })
+    }
+
+    /// Whether call `i` leaves variable `var` as it was: each argument
+    /// pointing into it goes to a parameter its callee never writes.
+    fn call_never_writes(&self, program: &Program, i: usize, var: Id) -> bool {
+        // A `Private` variable the callee may write without being passed it.
+        if self.private.is_private(var)
+            && self
+                .private_callee(program, i)
+                .is_none_or(|c| self.private.writes(c, var))
+        {
+            return false;
+        }
+        let effects = self.call_reads.get(&i);
+        self.body
+            .ids(i)
+            .iter()
+            .enumerate()
+            .skip(1)
+            .filter(|(_, a)| self.root(**a) == Some(var))
+            .all(|(k, _)| {
+                effects
+                    .and_then(|e| e.get(k - 1))
+                    .is_some_and(|e| e.never_writes)
+            })
+    }
+
+    /// [`FnLiveness::written_on_every_path`] from just after instruction
+    /// `from` (`None`: the entry), with `seed` written there already: what
+    /// a caller's part passed for `var` is sure to hold anew once the
+    /// function returns, whatever it held while suspended at `from`.
+    fn written_on_every_path_from(
+        &self,
+        program: &Program,
+        var: Id,
+        from: Option<usize>,
+        seed: &[Vec<u32>],
+    ) -> Vec<Vec<u32>> {
         let f = self.function(program);
         let n = f.blocks.len();
-        // Only an instruction that mentions `var` can write it.
-        let Some(mentions) = self.mentions(program, var) else {
-            return Vec::new();
+        let start = match from {
+            Some(i) => match block_at(f, i) {
+                Some(b) => Some((b, i)),
+                None => return Vec::new(),
+            },
+            None => None,
         };
+        // Only an instruction that mentions `var` can write it.
+        let mentions = self.mentions(program, var);
+        if mentions.is_none() && seed.is_empty() {
+            return Vec::new();
+        }
         // Every part written somewhere, once (an index each), and the
-        // (block, index) of each write: the analysis below runs on bit
-        // rows of those indices, not on hash sets of paths per block.
+        // (block, index, instruction) of each write: the analysis below
+        // runs on bit rows of those indices, not on hash sets of paths per
+        // block.
         let mut parts: Vec<Vec<u32>> = Vec::new();
-        let mut writes: Vec<(usize, usize)> = Vec::new();
-        let mut add = |b: usize, path: &[u32]| {
+        let mut writes: Vec<(usize, usize, usize)> = Vec::new();
+        let mut add = |b: usize, i: usize, path: &[u32]| {
             let k = match parts.iter().position(|q| same_path(q, path)) {
                 Some(k) => k,
                 None => {
@@ -1669,9 +1884,9 @@ impl FnLiveness {
                     parts.len() - 1
                 }
             };
-            writes.push((b, k));
+            writes.push((b, k, i));
         };
-        for &i in mentions.iter() {
+        for &i in mentions.iter().flat_map(|m| m.iter()) {
             let Some(b) = block_at(f, i) else {
                 continue;
             };
@@ -1679,7 +1894,7 @@ impl FnLiveness {
                 Op::Store => {
                     let t = self.body.first(i).and_then(|t| self.roots.get(&t));
                     if let Some(t) = t.filter(|t| t.var == var && t.exact) {
-                        add(b, self.path(t));
+                        add(b, i, self.path(t));
                     }
                 }
                 Op::FunctionCall => {
@@ -1689,24 +1904,45 @@ impl FnLiveness {
                         };
                         let e = self.call_reads.get(&i).and_then(|e| e.get(k - 1));
                         for x in e.map(|e| e.writes.as_slice()).unwrap_or_default() {
-                            with_joined(self.path(t), x, |path| add(b, path));
+                            with_joined(self.path(t), x, |path| add(b, i, path));
                         }
                     }
                 }
                 _ => {}
             }
         }
+        // The seed: written at the start, before anything else.
+        let seeded: Vec<usize> = seed
+            .iter()
+            .map(|path| match parts.iter().position(|q| same_path(q, path)) {
+                Some(k) => k,
+                None => {
+                    parts.push(path.clone());
+                    parts.len() - 1
+                }
+            })
+            .collect();
         // Nothing written here at all: nothing written on every path.
-        if writes.is_empty() {
+        if writes.is_empty() && seeded.is_empty() {
             return Vec::new();
         }
         let w = parts.len().div_ceil(64);
         let mut own = vec![0u64; n * w];
-        for (b, k) in writes {
+        // From `from`: the seed, then the writes after it in its block.
+        let mut first = vec![0u64; w];
+        for &k in &seeded {
+            first[k / 64] |= 1 << (k % 64);
+        }
+        for &(b, k, i) in &writes {
             own[b * w + k / 64] |= 1 << (k % 64);
+            if start.is_some_and(|(b0, at)| b == b0 && i > at) {
+                first[k / 64] |= 1 << (k % 64);
+            }
         }
         // Forward must-analysis, in rounds over the blocks in order; an
-        // unreached block's set is "everything".
+        // unreached block's set is "everything". From `from`, its block's
+        // successors start from `first`, and the block itself counts
+        // again only when a path comes back to it.
         let mut out = vec![0u64; n * w];
         let mut reached = vec![false; n];
         let mut set = vec![0u64; w];
@@ -1716,18 +1952,22 @@ impl FnLiveness {
             changed = false;
             rounds += 1;
             for b in 0..n {
-                let mut any = b == 0;
+                let mut any = start.is_none() && b == 0;
                 set.fill(0);
-                for &p in &self.preds[b] {
-                    if !reached[p] {
-                        continue;
-                    }
-                    let o = &out[p * w..(p + 1) * w];
-                    if any {
+                let mut meet = |o: &[u64], any: &mut bool| {
+                    if *any {
                         set.iter_mut().zip(o).for_each(|(s, o)| *s &= o);
                     } else {
                         set.copy_from_slice(o);
-                        any = true;
+                        *any = true;
+                    }
+                };
+                for &p in &self.preds[b] {
+                    if start.is_some_and(|(b0, _)| p == b0) {
+                        meet(&first, &mut any);
+                    }
+                    if reached[p] {
+                        meet(&out[p * w..(p + 1) * w], &mut any);
                     }
                 }
                 if !any {
@@ -1746,6 +1986,12 @@ impl FnLiveness {
         // Written on every path to every return (one not reached writes
         // nothing).
         let mut must: Option<Vec<u64>> = None;
+        let mut meet_return = |o: &[u64]| {
+            let m = must.get_or_insert_with(|| vec![u64::MAX; w]);
+            for (k, m) in m.iter_mut().enumerate() {
+                *m &= o.get(k).copied().unwrap_or(0);
+            }
+        };
         for (b, block) in f.blocks.iter().enumerate() {
             if !matches!(
                 program.insts[block.end].class.opcode,
@@ -1753,15 +1999,21 @@ impl FnLiveness {
             ) {
                 continue;
             }
+            if start.is_some_and(|(b0, _)| b == b0) {
+                meet_return(&first);
+                if !reached[b] {
+                    continue;
+                }
+            } else if start.is_some() && !reached[b] {
+                // A return no path from `from` reaches says nothing.
+                continue;
+            }
             let o = if reached[b] {
                 &out[b * w..(b + 1) * w]
             } else {
                 &[][..]
             };
-            let m = must.get_or_insert_with(|| vec![u64::MAX; w]);
-            for (k, m) in m.iter_mut().enumerate() {
-                *m &= o.get(k).copied().unwrap_or(0);
-            }
+            meet_return(o);
         }
         let must = must.unwrap_or_default();
         let mut v: Vec<Vec<u32>> = parts
@@ -1796,6 +2048,8 @@ impl FnLiveness {
         // One walk decodes each instruction and classifies its result.
         let mut body = Body::begin(program, f);
         let (lo, hi) = (body.lo, body.hi);
+        let private = PrivateUse::of(program);
+        let is_entry = program.entry_points.iter().any(|e| e.function == f.id);
         let mut vars = IdSet::new(lo, hi);
         let mut roots: IdMap<LocalPtr> = IdMap::new(lo, hi);
         // Room made once (growing these was a good part of the allocations):
@@ -1831,6 +2085,26 @@ impl FnLiveness {
                 continue;
             };
             let ids = body.ids_from(from);
+            if !private.all.is_empty() {
+                // A `Private` variable mentioned here, or touched by the
+                // callee, is tracked like a local of this function.
+                let callee = (op == Op::FunctionCall)
+                    .then(|| ids.first().and_then(|&c| program.function_index(c)))
+                    .flatten();
+                let touched_by_callee = callee
+                    .into_iter()
+                    .flat_map(|c| private.reads[c].iter().chain(&private.writes[c]));
+                for &v in ids
+                    .iter()
+                    .filter(|&&id| private.is_private(id))
+                    .chain(touched_by_callee)
+                {
+                    if !roots.contains_key(&v) {
+                        roots.insert_whole(v);
+                        vars.add(v);
+                    }
+                }
+            }
             let touches = worked_out_each_time(op)
                 || matches!(op, Op::FunctionParameter | Op::Phi)
                 || ids.iter().any(|id| roots.contains_key(id));
@@ -1951,6 +2225,8 @@ impl FnLiveness {
         }
         let mut fl = FnLiveness {
             func,
+            private,
+            is_entry,
             body,
             paths,
             vars,
@@ -2037,6 +2313,18 @@ impl FnLiveness {
                 }
                 if let Some(p) = root.filter(|_| !derives) {
                     pool.push(places.intern(p.var, &self.paths[p.path_range()]));
+                }
+            }
+            // A call mentions the `Private` variables its callee touches.
+            let callee = (!self.private.all.is_empty() && op == Op::FunctionCall)
+                .then(|| body.first(at).and_then(|c| program.function_index(c)))
+                .flatten();
+            if let Some(c) = callee {
+                let private = &self.private;
+                for v in private.reads[c].iter().chain(&private.writes[c]) {
+                    if let Some(p) = self.roots.get(v) {
+                        mentions.add_root(at, p.root);
+                    }
                 }
             }
             others += other as usize;
@@ -2304,6 +2592,30 @@ impl FnLiveness {
                 }
             }
         }
+        // A call overwrites the `Private` variables its callee writes
+        // whole before anything can branch, and may read those it reads
+        // (others it writes are not taken as overwritten: the safe side).
+        if let Some(c) = self.private_callee(program, at) {
+            for v in &self.private.must[c] {
+                if self.roots.contains_key(v) {
+                    self.kill(program, places, live, *v, &[]);
+                }
+            }
+            for v in &self.private.reads[c] {
+                if self.roots.contains_key(v) {
+                    live.insert(places.intern(*v, &[]));
+                }
+            }
+        }
+    }
+
+    /// The callee of call `at` when the module has `Private` variables.
+    #[inline]
+    fn private_callee(&self, program: &Program, at: usize) -> Option<usize> {
+        if self.private.all.is_empty() || self.body.op(at) != Op::FunctionCall {
+            return None;
+        }
+        self.body.first(at).and_then(|c| program.function_index(c))
     }
 
     /// A write of exactly part `path` of `var`: that part and everything
@@ -2604,6 +2916,20 @@ impl FnLiveness {
         false
     }
 
+    /// [`FnLiveness::written_before`], but for a `Private` variable in a
+    /// function a caller may have written it before: whether anything in
+    /// the module writes it.
+    fn written_before_here(&self, program: &Program, var: Id, inst: usize) -> bool {
+        if !self.is_entry && self.private.is_private(var) {
+            return self
+                .private
+                .writes
+                .iter()
+                .any(|w| w.binary_search(&var).is_ok());
+        }
+        self.written_before(program, var, inst)
+    }
+
     /// Whether instruction `i`, which mentions variable `var`, may write it
     /// (as [`FnLiveness::writes`] says): without looking through its
     /// operands again, since mentioning `var` is having an operand in it
@@ -2618,6 +2944,13 @@ impl FnLiveness {
             // `var` as well as mentioning it, looked at in full.
             Op::Variable => self.writes_var(program, i, var),
             _ if body.result(i) == Some(var) => self.writes_var(program, i, var),
+            // A `Private` variable a call mentions only through its callee.
+            Op::FunctionCall
+                if self.private.is_private(var) && !self.writes_var(program, i, var) =>
+            {
+                self.private_callee(program, i)
+                    .is_some_and(|c| self.private.writes(c, var))
+            }
             _ => true,
         }
     }
@@ -2632,7 +2965,13 @@ impl FnLiveness {
 
     /// Adds to `out` the places in this function that call `call` passes
     /// for the callee's parameter parts in `params` (parameter index, path).
-    fn arguments_of(&self, call: usize, params: &SitePlaces, out: &mut SitePlaces) {
+    fn arguments_of(
+        &self,
+        program: &Program,
+        call: usize,
+        params: &SitePlaces,
+        out: &mut SitePlaces,
+    ) {
         if self.body.op(call) != Op::FunctionCall {
             return;
         }
@@ -2641,10 +2980,148 @@ impl FnLiveness {
             let Some(root) = args.get(param as usize).and_then(|a| self.roots.get(a)) else {
                 continue;
             };
-            if root.exact {
+            // A copy the callee only reads holds what its source does
+            // while the callee runs: the source's part, counted once.
+            let never_writes = self
+                .call_reads
+                .get(&call)
+                .and_then(|e| e.get(param as usize))
+                .is_some_and(|e| e.never_writes);
+            let source = (root.exact && never_writes)
+                .then(|| self.copied_from(program, call, root.var))
+                .flatten();
+            if let Some((src, src_path)) = source {
+                let mut path = src_path.to_vec();
+                path.extend_from_slice(self.path(root));
+                out.push_joined(src, &path, params.path(k));
+            } else if root.exact {
                 out.push_joined(root.var, self.path(root), params.path(k));
             } else {
                 out.push(root.var, self.path(root));
+            }
+        }
+    }
+
+    /// When local variable `tmp` holds, at call `call`, a whole copy of a
+    /// part of another local variable made just before in the same block
+    /// (glslang's and rtlint's temporary for an argument passed by value),
+    /// with neither written since and the source not passed to the call:
+    /// that source and its path.
+    fn copied_from(&self, program: &Program, call: usize, tmp: Id) -> Option<(Id, &[u32])> {
+        if !self.vars.contains(&tmp) || self.private.is_private(tmp) {
+            return None;
+        }
+        let f = self.function(program);
+        let b = block_at(f, call)?;
+        let mentions = self.mentions(program, tmp)?;
+        let before = mentions.partition_point(|&i| i < call);
+        // The last mention of the temporary before the call: the copy.
+        let store = *mentions[..before].last()?;
+        if store < f.blocks[b].start {
+            return None;
+        }
+        let Copy::Store(load) = self.copy_at(store) else {
+            return None;
+        };
+        let dst = self.roots.get(&self.body.first(store)?)?;
+        if dst.var != tmp || !self.path(dst).is_empty() {
+            return None;
+        }
+        let src = self.roots.get(&self.body.first(load as usize)?)?;
+        if !src.exact
+            || src.var == tmp
+            || !self.vars.contains(&src.var)
+            || self.private.is_private(src.var)
+        {
+            return None;
+        }
+        // Neither written between the copy and the call; the source not
+        // given to the call.
+        let src_mentions = self.mentions(program, src.var)?;
+        let between = |i: usize| load as usize <= i && i < call;
+        if src_mentions.iter().any(|&i| {
+            (between(i) && i != load as usize && self.mention_writes(program, i, src.var))
+                || i == call
+        }) {
+            return None;
+        }
+        Some((src.var, self.path(src)))
+    }
+
+    /// The caller's parts that call `call` passes for the callee's
+    /// parameter parts in `written` (parameter index, path), each as
+    /// (variable, path): only exact ones (a part reached through a
+    /// variable index may be another).
+    fn rewritten_arguments(&self, call: usize, written: &SitePlaces) -> Vec<(Id, Vec<u32>)> {
+        if self.body.op(call) != Op::FunctionCall {
+            return Vec::new();
+        }
+        let args = &self.body.ids(call)[1..];
+        let mut out = Vec::new();
+        for (k, &(param, _, _)) in written.list.iter().enumerate() {
+            let Some(root) = args.get(param as usize).and_then(|a| self.roots.get(a)) else {
+                continue;
+            };
+            if root.exact {
+                let mut path = self.path(root).to_vec();
+                path.extend_from_slice(written.path(k));
+                out.push((root.var, path));
+            }
+        }
+        out
+    }
+
+    /// Drops from `places` (live just after call `call`) the parts the
+    /// callee writes on every path from its site to its return (`written`,
+    /// by parameter index): they get a new value before anything reads
+    /// them, so what they held during the site is not kept (glslang's
+    /// `out` temporaries, an `inout` payload copied back).
+    fn drop_rewritten(&self, call: usize, written: &SitePlaces, places: &mut SitePlaces) {
+        if written.list.is_empty() {
+            return;
+        }
+        let parts = self.rewritten_arguments(call, written);
+        let paths = &places.paths;
+        places.list.retain(|&(id, from, to)| {
+            let q = &paths[from as usize..to as usize];
+            !parts
+                .iter()
+                .any(|(var, path)| *var == id && has_prefix(q, path))
+        });
+    }
+
+    /// `out` := the parts of this function's pointer parameters written on
+    /// every path from instruction `at` to a return, by parameter index;
+    /// with call `at`'s callee writing `written` (by its parameter index)
+    /// after the site below it.
+    fn params_written_after(
+        &self,
+        program: &Program,
+        at: usize,
+        written: &SitePlaces,
+        out: &mut SitePlaces,
+    ) {
+        out.clear();
+        let f = self.function(program);
+        if !f
+            .params
+            .iter()
+            .any(|p| self.roots.get(p).is_some_and(|r| r.var == *p))
+        {
+            return;
+        }
+        let seeds = self.rewritten_arguments(at, written);
+        for (k, &param) in f.params.iter().enumerate() {
+            if self.roots.get(&param).is_none_or(|r| r.var != param) {
+                continue;
+            }
+            let seed: Vec<Vec<u32>> = seeds
+                .iter()
+                .filter(|(v, _)| *v == param)
+                .map(|(_, p)| p.clone())
+                .collect();
+            for path in self.written_on_every_path_from(program, param, Some(at), &seed) {
+                out.push(k as Id, &path);
             }
         }
     }
@@ -2688,7 +3165,7 @@ impl FnLiveness {
                 continue;
             }
             let is_var = self.vars.contains(&id);
-            if is_var && !self.written_before(program, id, inst) {
+            if is_var && !self.written_before_here(program, id, inst) {
                 continue;
             }
             let ty = if is_var {
@@ -2780,7 +3257,7 @@ impl FnLiveness {
         }
     }
 
-    fn reads(&self, i: usize, id: Id) -> bool {
+    fn reads(&self, program: &Program, i: usize, id: Id) -> bool {
         let body = &self.body;
         if body.debug(i) {
             return false;
@@ -2793,6 +3270,9 @@ impl FnLiveness {
             match body.op(i) {
                 Op::Load | Op::FunctionCall | Op::CopyMemory | Op::ExtInst => {
                     ids.iter().any(|&x| self.root(x) == Some(id))
+                        || self
+                            .private_callee(program, i)
+                            .is_some_and(|c| self.private.reads(c, id))
                 }
                 _ => false,
             }
@@ -2812,8 +3292,9 @@ impl FnLiveness {
     ) -> Option<Location> {
         let f = self.function(program);
         let b0 = block_at(f, inst)?;
-        let reads =
-            |k: usize| only.is_none_or(|m| m.binary_search(&k).is_ok()) && self.reads(k, id);
+        let reads = |k: usize| {
+            only.is_none_or(|m| m.binary_search(&k).is_ok()) && self.reads(program, k, id)
+        };
         let mut found = None;
         for k in inst + 1..=f.blocks[b0].end {
             if reads(k) {
@@ -2986,6 +3467,11 @@ impl FnLiveness {
         parts: impl Iterator<Item = &'a [u32]> + Clone,
         depth: u32,
     ) -> bool {
+        // A `Private` variable outside an entry point's function holds what
+        // a caller stored: not known here, unless only ever one constant.
+        if !self.is_entry && self.private.is_private(var) {
+            return self.private.is_constant(var);
+        }
         // The parts in order, flattened at the end of the pool (see
         // `RematAnswers`); the callers' come sorted.
         let slot = {
@@ -3096,6 +3582,9 @@ impl FnLiveness {
                     stored.push((range, value));
                 }
                 Op::Load => {}
+                // A callee given its address that never writes through it
+                // (a struct passed by value) leaves the value as it was.
+                Op::FunctionCall if self.call_never_writes(program, i, var) => {}
                 Op::AccessChain | Op::InBoundsAccessChain | Op::PtrAccessChain => {
                     if !ids
                         .iter()
@@ -3289,7 +3778,12 @@ impl FnLiveness {
             }
             if b == 0 {
                 // The entry block holds the variables and their initializers.
-                if let Some(&d) = program.defs.get(&var) {
+                // (A module-scope variable's is outside the function.)
+                if let Some(&d) = program
+                    .defs
+                    .get(&var)
+                    .filter(|&&d| f.start <= d && d <= f.end)
+                {
                     if whole(d) == Some(true) {
                         found.push(d);
                     }
@@ -3951,6 +4445,185 @@ mod tests {
             assert!(kept.contains(&(24, "Ray")), "{rel}: {kept:?}");
         }
     }
+    /// Bytes that must be kept across the one site of `rel` (live and not
+    /// recomputable), and all live bytes.
+    fn kept_and_live(rel: &str) -> (u64, u64) {
+        let s = one_site(rel);
+        (s.live_bytes - s.rematerializable_bytes, s.live_bytes)
+    }
+
+    /// A helper and the same code written inline keep the same bytes
+    /// across the trace (`kept`); with `same_live`, the same live bytes
+    /// too (naga loads a resource once per function, so its WGSL pairs
+    /// differ in recomputable bytes only).
+    fn same_as_inline(pairs: &[(&str, &str, bool)], kept: u64) {
+        for &(helper, inline, same_live) in pairs {
+            let (h, i) = (kept_and_live(helper), kept_and_live(inline));
+            assert_eq!(h.0, kept, "{helper}: {:?}", one_site(helper));
+            assert_eq!(i.0, kept, "{inline}: {:?}", one_site(inline));
+            if same_live {
+                assert_eq!(h.1, i.1, "{helper} vs {inline}");
+            }
+        }
+    }
+
+    /// A helper that writes its `out` parameters on every path after its
+    /// trace: the caller's parts passed for them (glslang's and rtlint's
+    /// temporaries, WGSL's pointers) are not live across it (were 16 B
+    /// more).
+    #[test]
+    fn parts_a_callee_rewrites_after_its_trace_are_not_live() {
+        same_as_inline(
+            &[
+                (
+                    "fixtures/live/out_after.rgen.spv",
+                    "fixtures/live/out_after_inline.rgen.spv",
+                    true,
+                ),
+                (
+                    "fixtures/live/out_after.hlsl",
+                    "fixtures/live/out_after_inline.hlsl",
+                    true,
+                ),
+            ],
+            16,
+        );
+        // naga's loop guard (`loop_bound`, 8 B) is kept as well.
+        same_as_inline(
+            &[(
+                "fixtures/live/out_after.wgsl",
+                "fixtures/live/out_after_inline.wgsl",
+                false,
+            )],
+            24,
+        );
+    }
+
+    /// Module-scope `Private` variables (GLSL globals, HLSL `static`, WGSL
+    /// `var<private>`) written before a trace and read after it are live,
+    /// as the same state in locals is (were 0 B: the 68 B of `seed` and
+    /// `xf` were missed).
+    #[test]
+    fn module_scope_private_variables_are_live() {
+        same_as_inline(
+            &[
+                (
+                    "fixtures/live/private_state.rgen.spv",
+                    "fixtures/live/private_state_local.rgen.spv",
+                    true,
+                ),
+                (
+                    "fixtures/live/private_state.hlsl",
+                    "fixtures/live/private_state_local.hlsl",
+                    true,
+                ),
+                (
+                    "fixtures/live/private_state.wgsl",
+                    "fixtures/live/private_state_local.wgsl",
+                    true,
+                ),
+            ],
+            68,
+        );
+        // Written by the entry point, read by the helper after its trace;
+        // a table only ever holding its initializer is recomputable.
+        let s = one_site("fixtures/live/private_helper.rgen.spv");
+        let vals = names(&s);
+        assert!(vals.contains(&("seed", 4, false)), "{vals:?}");
+        assert!(vals.contains(&("table", 24, true)), "{vals:?}");
+        assert_eq!(s.live_bytes - s.rematerializable_bytes, 4);
+        // A helper called after the trace overwrites the variable before
+        // anything reads it (was 16 B more).
+        let s = one_site("fixtures/live/private_rewritten.rgen.spv");
+        assert_eq!(names(&s), [("i", 4, false)]);
+    }
+
+    /// A constant-buffer struct passed by value to a helper that reads it
+    /// after its trace is recomputable (a load from the buffer again):
+    /// through glslang's and rtlint's temporaries, which the callee never
+    /// writes, and naga's value parameters, followed to the caller's
+    /// argument (were 64 B and 80 B kept).
+    #[test]
+    fn a_constant_buffer_struct_by_value_is_recomputable() {
+        same_as_inline(
+            &[
+                (
+                    "fixtures/live/cbuffer_arg.rgen.spv",
+                    "fixtures/live/cbuffer_arg_inline.rgen.spv",
+                    false,
+                ),
+                (
+                    "fixtures/live/cbuffer_arg.hlsl",
+                    "fixtures/live/cbuffer_arg_inline.hlsl",
+                    false,
+                ),
+                (
+                    "fixtures/live/cbuffer_arg.wgsl",
+                    "fixtures/live/cbuffer_arg_inline.wgsl",
+                    false,
+                ),
+            ],
+            0,
+        );
+        for rel in [
+            "fixtures/live/cbuffer_arg.rgen.spv",
+            "fixtures/live/cbuffer_arg.hlsl",
+            "fixtures/live/cbuffer_arg.wgsl",
+        ] {
+            let s = one_site(rel);
+            assert!(
+                s.values
+                    .iter()
+                    .any(|v| v.ty == "Camera" && v.size >= 64 && v.rematerializable),
+                "{rel}: {s:?}"
+            );
+        }
+    }
+
+    /// A struct passed by value to a helper that reads it after its trace,
+    /// while the caller reads it after the call: the callee's copy
+    /// (glslang's and rtlint's temporary, naga's value parameter) and the
+    /// caller's original are kept once (were 12 B and 24 B more).
+    #[test]
+    fn an_in_struct_argument_is_not_counted_twice() {
+        same_as_inline(
+            &[
+                (
+                    "fixtures/live/in_struct.rgen.spv",
+                    "fixtures/live/in_struct_inline.rgen.spv",
+                    true,
+                ),
+                (
+                    "fixtures/live/in_struct.hlsl",
+                    "fixtures/live/in_struct_inline.hlsl",
+                    true,
+                ),
+                (
+                    "fixtures/live/in_struct.wgsl",
+                    "fixtures/live/in_struct_inline.wgsl",
+                    true,
+                ),
+            ],
+            24,
+        );
+    }
+
+    /// An HLSL helper tracing with the `inout` payload it is passed: the
+    /// caller's copy is the payload, written back after the trace, not
+    /// live state (was 16 B).
+    #[test]
+    fn an_inout_payload_through_a_helper_is_not_live() {
+        same_as_inline(
+            &[(
+                "fixtures/live/inout_payload.hlsl",
+                "fixtures/live/inout_payload_inline.hlsl",
+                true,
+            )],
+            0,
+        );
+        assert_eq!(kept_and_live("fixtures/live/inout_payload.hlsl").1, 0);
+    }
+
     /// The stack model's undescribed sites carry the same bytes, values and
     /// recomputability as the described ones, and nothing that describes.
     #[test]

@@ -475,7 +475,11 @@ pub struct VisibilityTrace {
     pub program: usize,
     pub inst: usize,
     pub location: Option<Location>,
+    /// The flags every choice sets (all of them when the flags are one
+    /// constant).
     pub flags: u64,
+    /// The constants the flags may be (one, or a choice on branches).
+    pub flag_choices: Vec<u64>,
     /// The payload variable's type.
     pub payload_ty: Option<Id>,
     /// Entry points of the closest-hit shaders it runs.
@@ -540,6 +544,84 @@ pub fn trace_flags(pipeline: &Pipeline, graph: &TraceGraph, t: &TraceTargets) ->
     ops.ray_flags.constant()
 }
 
+/// The constants the ray flags of the trace at `inst` may be as `from`
+/// reaches it (one when they fold; a `select`, phi or variable assigned on
+/// branches gives several: see `Program::fold_choices_in`).
+pub fn trace_flag_choices(
+    pipeline: &Pipeline,
+    graph: &TraceGraph,
+    t: &TraceTargets,
+) -> Option<Vec<u64>> {
+    if let Some(f) = trace_flags(pipeline, graph, t) {
+        return Some(vec![f]);
+    }
+    let shader = &graph.nodes.get(t.from)?.shader;
+    let program = pipeline.programs.get(t.program)?;
+    let site = program.sites.iter().find(|s| s.inst == t.inst)?;
+    let f = program.functions.get(site.function)?;
+    let chain = crate::program::cfg::call_chains(program, shader.function, f.id, 1)
+        .into_iter()
+        .next()
+        .unwrap_or_default();
+    let id = match program.insts[site.inst].operands.get(1) {
+        Some(rspirv::dr::Operand::IdRef(x)) => *x,
+        _ => return None,
+    };
+    program.fold_choices_in(id, &chain)
+}
+
+/// The `IncomingRayPayloadKHR` variable shader `function` uses (the first
+/// a function it reaches names), if any.
+pub fn incoming_payload_var(program: &Program, function: Id) -> Option<Id> {
+    let incoming: Vec<Id> = program
+        .globals_in(StorageClass::IncomingRayPayloadKHR)
+        .map(|g| g.id)
+        .collect();
+    if incoming.is_empty() {
+        return None;
+    }
+    let reached = program.reached_functions(function);
+    program
+        .functions
+        .iter()
+        .enumerate()
+        .filter(|(k, _)| reached.get(*k).copied().unwrap_or(false))
+        .flat_map(|(_, f)| program.insts[f.start..=f.end].iter())
+        .flat_map(|inst| inst.operands.iter())
+        .find_map(|o| match o {
+            Operand::IdRef(x) if incoming.contains(x) => Some(*x),
+            _ => None,
+        })
+}
+
+/// The hit and miss shaders (graph nodes) trace `t` would run whatever
+/// their payload: with a description, those it connects. Without one,
+/// none: a folder's loose pipeline pairs a trace with the shaders whose
+/// payload type matches (so none differs), and pairing by the GLSL
+/// `layout(location)` would need the source, which SPIR-V without debug
+/// info does not carry (an analysis answers the same whatever the debug
+/// info). The one place a payload question asks which shaders a trace
+/// reaches regardless of payload: the reach analysis can answer here.
+pub fn reached_ignoring_payload(
+    pipeline: &Pipeline,
+    graph: &TraceGraph,
+    t: &TraceTargets,
+) -> Vec<usize> {
+    if !pipeline.described() {
+        return Vec::new();
+    }
+    t.targets
+        .iter()
+        .copied()
+        .filter(|&n| {
+            matches!(
+                graph.nodes[n].shader.stage,
+                Stage::ClosestHit | Stage::AnyHit | Stage::Miss
+            )
+        })
+        .collect()
+}
+
 /// The payload type a trace passes.
 pub fn trace_payload_ty(program: &Program, inst: usize) -> Option<Id> {
     let site = program.sites.iter().find(|s| s.inst == inst)?;
@@ -563,9 +645,10 @@ pub fn visibility_traces(pipeline: &Pipeline, graph: &TraceGraph) -> Vec<Visibil
         let Some(program) = pipeline.programs.get(t.program) else {
             continue;
         };
-        let Some(flags) = trace_flags(pipeline, graph, &t) else {
+        let Some(flag_choices) = trace_flag_choices(pipeline, graph, &t) else {
             continue;
         };
+        let flags = flag_choices.iter().fold(u64::MAX, |a, &f| a & f);
         let payload_ty = trace_payload_ty(program, t.inst);
         let mut written = BTreeSet::new();
         let mut closest_hits = Vec::new();
@@ -620,6 +703,7 @@ pub fn visibility_traces(pipeline: &Pipeline, graph: &TraceGraph) -> Vec<Visibil
             inst: t.inst,
             location: t.location.clone(),
             flags,
+            flag_choices,
             payload_ty,
             closest_hits,
             recording_closest_hits: recording,

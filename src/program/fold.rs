@@ -14,6 +14,9 @@ use spirv::{Op, StorageClass};
 /// How deep folding follows operands.
 const MAX_DEPTH: u32 = 16;
 
+/// The most constants [`Program::fold_choices_in`] lists for one value.
+pub const MAX_CHOICES: usize = 8;
+
 impl Program {
     /// The value of integer (or boolean) `id` when it folds to a constant:
     /// a constant, a local variable holding one constant, or integer
@@ -29,6 +32,124 @@ impl Program {
     /// fold per caller.
     pub fn fold_in(&self, id: Id, chain: &[usize]) -> Option<u64> {
         self.fold_at(id, chain, 0)
+    }
+
+    /// The constants integer `id` may be through `chain` when it is a
+    /// choice between foldable values: a `select`, a phi, a local variable
+    /// whose every write stores one (`flags = RAY_FLAG_FORCE_OPAQUE;` on one
+    /// branch), and ORs and ANDs of those; sorted, each once, at most
+    /// [`MAX_CHOICES`]. `None` when any part is not known.
+    pub fn fold_choices_in(&self, id: Id, chain: &[usize]) -> Option<Vec<u64>> {
+        let mut v = self.choices_at(id, chain, 0)?;
+        v.sort_unstable();
+        v.dedup();
+        Some(v)
+    }
+
+    fn choices_at(&self, id: Id, chain: &[usize], depth: u32) -> Option<Vec<u64>> {
+        if let Some(v) = self.fold_at(id, chain, depth) {
+            return Some(vec![v]);
+        }
+        if depth > MAX_DEPTH {
+            return None;
+        }
+        let inst = self.def(id)?;
+        let ids: Vec<Id> = inst
+            .operands
+            .iter()
+            .filter_map(|o| match o {
+                Operand::IdRef(x) => Some(*x),
+                _ => None,
+            })
+            .collect();
+        let of = |x: Id| self.choices_at(x, chain, depth + 1);
+        let union = |parts: &mut dyn Iterator<Item = Id>| -> Option<Vec<u64>> {
+            let mut out = Vec::new();
+            for x in parts {
+                out.extend(of(x)?);
+                out.sort_unstable();
+                out.dedup();
+                if out.len() > MAX_CHOICES {
+                    return None;
+                }
+            }
+            Some(out)
+        };
+        let pairs = |f: fn(u64, u64) -> u64| -> Option<Vec<u64>> {
+            let (a, b) = (of(*ids.first()?)?, of(*ids.get(1)?)?);
+            let mut out: Vec<u64> = a
+                .iter()
+                .flat_map(|&x| b.iter().map(move |&y| f(x, y)))
+                .collect();
+            out.sort_unstable();
+            out.dedup();
+            (out.len() <= MAX_CHOICES).then_some(out)
+        };
+        match inst.class.opcode {
+            // The condition is not folded (else `fold_at` would have).
+            Op::Select => union(&mut ids.iter().skip(1).copied()),
+            // Values and parent blocks alternate.
+            Op::Phi => union(&mut ids.iter().step_by(2).copied()),
+            Op::BitwiseOr => pairs(|x, y| x | y),
+            Op::BitwiseAnd => pairs(|x, y| x & y),
+            Op::CopyObject | Op::Bitcast | Op::UConvert | Op::SConvert => of(*ids.first()?),
+            Op::FunctionParameter => {
+                let (arg, outer) = self.argument(id, chain)?;
+                self.choices_at(arg, outer, depth + 1)
+            }
+            Op::Load => self.stored_choices(*ids.first()?, chain, depth + 1),
+            _ => None,
+        }
+    }
+
+    /// The values the writes to local variable `ptr` store, when each is a
+    /// choice of constants and nothing else writes it (see
+    /// [`Program::fold_choices_in`]).
+    fn stored_choices(&self, ptr: Id, chain: &[usize], depth: u32) -> Option<Vec<u64>> {
+        let var = self.def(ptr)?;
+        let local = var.class.opcode == Op::Variable
+            && matches!(
+                var.operands.first(),
+                Some(Operand::StorageClass(StorageClass::Function))
+            );
+        if !local {
+            return None;
+        }
+        let f = self
+            .functions
+            .get(self.function_of(*self.defs.get(&ptr)?)?)?;
+        let mut out: Vec<u64> = match var.operands.get(1) {
+            Some(Operand::IdRef(init)) => self.choices_at(*init, chain, depth)?,
+            _ => Vec::new(),
+        };
+        for inst in &self.insts[f.start..=f.end] {
+            let mut uses = inst
+                .operands
+                .iter()
+                .enumerate()
+                .filter(|(_, o)| matches!(o, Operand::IdRef(x) if *x == ptr));
+            let Some((k, _)) = uses.next() else { continue };
+            if self.is_debug_inst(inst) {
+                continue;
+            }
+            match inst.class.opcode {
+                Op::Load => {}
+                Op::Store if k == 0 && uses.next().is_none() => {
+                    let Some(Operand::IdRef(stored)) = inst.operands.get(1) else {
+                        return None;
+                    };
+                    out.extend(self.choices_at(*stored, chain, depth)?);
+                    out.sort_unstable();
+                    out.dedup();
+                    if out.len() > MAX_CHOICES {
+                        return None;
+                    }
+                }
+                // An access chain, a call or anything else may write it.
+                _ => return None,
+            }
+        }
+        (!out.is_empty()).then_some(out)
     }
 
     /// The bits of integer `id` that are set whatever its dynamic parts

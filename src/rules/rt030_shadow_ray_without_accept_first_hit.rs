@@ -9,8 +9,11 @@ super::declare_rule! {
     /// Finds visibility traces — every closest-hit, any-hit and miss shader the
     /// trace can run writes only constants to the payload (or nothing) and
     /// traces nothing, so the payload can only say "hit" or "missed" — whose
-    /// constant ray flags lack `AcceptFirstHitAndEndSearch`
+    /// ray flags lack `AcceptFirstHitAndEndSearch`
     /// (`gl_RayFlagsTerminateOnFirstHitEXT`, `RAY_FLAG_ACCEPT_FIRST_HIT_AND_END_SEARCH`, WGSL `RAY_FLAG_TERMINATE_ON_FIRST_HIT`, 0x4).
+    /// Flags that are a choice between constants (a `?:`, or a variable
+    /// assigned on branches) are judged by every choice: one without the
+    /// flag is reported.
     ///
     /// Without a pipeline description every trace may reach every shader of
     /// its folder (or file) whose incoming payload has the trace's payload
@@ -70,11 +73,28 @@ fn check(ctx: &PipelineContext) -> Vec<Diagnostic> {
             "visibility trace searches for the closest hit",
         )
         .with_code(CODE)
-        .with_primary(v.location.clone(), "no `AcceptFirstHitAndEndSearch` flag")
-        .with_note(format!(
-            "its shaders only record whether the ray hit; ray flags are {:#x}",
-            v.flags
-        ))
+        .with_primary(
+            v.location.clone(),
+            if v.flag_choices.len() > 1 {
+                "a choice of flags without `AcceptFirstHitAndEndSearch`"
+            } else {
+                "no `AcceptFirstHitAndEndSearch` flag"
+            },
+        )
+        .with_note(match v.flag_choices.as_slice() {
+            [_, _, ..] => format!(
+                "its shaders only record whether the ray hit; ray flags are one of {}",
+                v.flag_choices
+                    .iter()
+                    .map(|f| format!("{f:#x}"))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            ),
+            _ => format!(
+                "its shaders only record whether the ray hit; ray flags are {:#x}",
+                v.flags
+            ),
+        })
         .with_help(format!("add `{}` to the ray flags", flag_name(program.language)));
         if reported.first(v.program, v.inst, &v.location) {
             out.push(d);
