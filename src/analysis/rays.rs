@@ -594,32 +594,38 @@ pub fn incoming_payload_var(program: &Program, function: Id) -> Option<Id> {
         })
 }
 
-/// The hit and miss shaders (graph nodes) trace `t` would run whatever
-/// their payload: with a description, those it connects. Without one,
-/// none: a folder's loose pipeline pairs a trace with the shaders whose
-/// payload type matches (so none differs), and pairing by the GLSL
-/// `layout(location)` would need the source, which SPIR-V without debug
-/// info does not carry (an analysis answers the same whatever the debug
-/// info). The one place a payload question asks which shaders a trace
-/// reaches regardless of payload: the reach analysis can answer here.
-pub fn reached_ignoring_payload(
+/// The traces whose SBT operands select hit or miss shaders (graph nodes)
+/// that the reach analysis left out because their incoming payload differs:
+/// per site (program, instruction, its location), those shaders. Only with
+/// a description: a folder's loose pipeline joins every trace to every
+/// shader, so a shader with another payload there is another ray type, not
+/// a mismatch (and pairing by the GLSL `layout(location)` would need the
+/// source, which SPIR-V without debug info does not carry).
+pub fn mismatched_targets(
     pipeline: &Pipeline,
     graph: &TraceGraph,
-    t: &TraceTargets,
-) -> Vec<usize> {
+) -> Vec<((usize, usize, Option<Location>), Vec<usize>)> {
+    let mut out: Vec<((usize, usize, Option<Location>), Vec<usize>)> = Vec::new();
     if !pipeline.described() {
-        return Vec::new();
+        return out;
     }
-    t.targets
-        .iter()
-        .copied()
-        .filter(|&n| {
-            matches!(
-                graph.nodes[n].shader.stage,
-                Stage::ClosestHit | Stage::AnyHit | Stage::Miss
-            )
-        })
-        .collect()
+    for e in &graph.mismatched {
+        if !matches!(
+            graph.nodes[e.to].shader.stage,
+            Stage::ClosestHit | Stage::AnyHit | Stage::Miss
+        ) {
+            continue;
+        }
+        match out
+            .iter_mut()
+            .find(|(k, _)| k.0 == e.program && k.1 == e.inst)
+        {
+            Some((_, v)) if !v.contains(&e.to) => v.push(e.to),
+            Some(_) => {}
+            None => out.push(((e.program, e.inst, e.location.clone()), vec![e.to])),
+        }
+    }
+    out
 }
 
 /// The payload type a trace passes.

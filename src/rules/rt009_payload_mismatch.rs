@@ -64,17 +64,19 @@ fn check(ctx: &PipelineContext) -> Vec<Diagnostic> {
     let mut out: Vec<Diagnostic> = Vec::new();
     let mut reported = super::Reported::default();
     let graph = &ctx.recursion.graph;
-    for t in rays::trace_targets(graph) {
-        let Some(program) = ctx.pipeline.programs.get(t.program) else {
+    // The reach analysis keeps the shaders a trace's SBT operands select
+    // but whose payload has another shape: those are the mismatches.
+    for ((site_program, inst, location), targets) in rays::mismatched_targets(ctx.pipeline, graph)
+    {
+        let Some(program) = ctx.pipeline.programs.get(site_program) else {
             continue;
         };
-        let Some(ty) = rays::trace_payload_ty(program, t.inst) else {
+        let Some(ty) = rays::trace_payload_ty(program, inst) else {
             continue;
         };
-        let sig = rays::signature(program, ty);
         let size = scalar_size(program, ty);
         let mut differ: Vec<String> = Vec::new();
-        for n in rays::reached_ignoring_payload(ctx.pipeline, graph, &t) {
+        for n in targets {
             let shader = &graph.nodes[n].shader;
             let Some(callee) = ctx.pipeline.program(shader) else {
                 continue;
@@ -93,9 +95,6 @@ fn check(ctx: &PipelineContext) -> Vec<Diagnostic> {
                 continue;
             };
             let their_size = scalar_size(callee, their);
-            if rays::signature(callee, their) == sig && their_size == size {
-                continue;
-            }
             let file = shader
                 .file
                 .file_name()
@@ -129,10 +128,10 @@ fn check(ctx: &PipelineContext) -> Vec<Diagnostic> {
             ),
         )
         .with_code(CODE)
-        .with_primary(t.location.clone(), "traced with this payload")
+        .with_primary(location.clone(), "traced with this payload")
         .with_note(differ.join("; "))
         .with_help("declare the payload once in a header every stage includes");
-        if reported.first(t.program, t.inst, &t.location) {
+        if reported.first(site_program, inst, &location) {
             out.push(d);
         }
     }
