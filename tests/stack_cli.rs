@@ -695,7 +695,7 @@ fn unbounded_recursion_gives_a_conditional_recommendation() {
         "{t}"
     );
     assert!(
-        t.contains("the trace at fixtures/pipelines/recursive/reflect.rchit:25 closes a cycle"),
+        t.contains("the trace at fixtures/pipelines/recursive/reflect.rchit:25:9 closes a cycle"),
         "{t}"
     );
     // No declared depth: the device's limit (31) is assumed, and the

@@ -609,7 +609,10 @@ pub fn mismatched_targets(
     if !pipeline.described() {
         return out;
     }
-    for e in &graph.mismatched {
+    // A trace no miss shader takes keeps the refused ones as fallback edges
+    // (its level counts): those differ too.
+    let refused = graph.edges.iter().filter(|e| e.fallback);
+    for e in graph.mismatched.iter().chain(refused) {
         if !matches!(
             graph.nodes[e.to].shader.stage,
             Stage::ClosestHit | Stage::AnyHit | Stage::Miss

@@ -194,13 +194,14 @@ mod tests {
         );
         assert_eq!(d[0].notes[0], "no exit compares a counter with a bound");
         // The message names the trace that makes the depth unbounded.
-        assert!(
-            d[1].message.starts_with(
-                "recursion through closesthit `main` (hit group 0) is unbounded at compile time: the trace at "
-            ) && d[1].message.ends_with("the trace in closesthit `main` (hit group 0) has no depth bound"),
-            "{}",
-            d[1].message
+        assert_eq!(
+            d[1].message,
+            "recursion through closesthit `main` (hit group 0) is unbounded at compile time: the trace in closesthit `main` (hit group 0) has no depth bound"
         );
+        // Its line is the label's, where debug info gives one.
+        let at = &d[1].primary.as_ref().unwrap().location;
+        assert!(at.path.ends_with("fixtures/pipelines/recursive/reflect.rchit"), "{at:?}");
+        assert_eq!(at.line, 25);
         assert!(
             d[1].notes[0].contains("pushConst.maxDepth"),
             "{:?}",

@@ -448,8 +448,14 @@ impl Gen {
         self.n_miss = stages.iter().filter(|s| **s == Stage::Miss).count() as u32;
         self.n_callable = stages.iter().filter(|s| **s == Stage::Callable).count() as u32;
 
+        // One payload type for every trace and every hit and miss shader:
+        // rtlint joins a trace only to the shaders whose incoming payload has
+        // its shape, and the generator's own graph (the depth bounds the
+        // checks compare with) knows the SBT operands, not payload types.
+        // Reach by payload has tests of its own.
+        let payload_ty = random_struct(src);
         for k in 0..1 + src.below(3) {
-            let t = random_struct(src);
+            let t = payload_ty.clone();
             let v = self.global(StorageClass::RayPayloadKHR, &t, &format!("payload{k}"));
             self.payloads.push((v, t));
         }
@@ -504,7 +510,7 @@ impl Gen {
             *c += 1;
             let incoming = match stage {
                 Stage::ClosestHit | Stage::Miss | Stage::AnyHit => {
-                    let t = random_struct(src);
+                    let t = payload_ty.clone();
                     Some((
                         self.global(
                             StorageClass::IncomingRayPayloadKHR,
