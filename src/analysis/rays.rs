@@ -594,6 +594,9 @@ pub fn incoming_payload_var(program: &Program, function: Id) -> Option<Id> {
         })
 }
 
+/// A trace site: index of the program, of the instruction, and where it is.
+pub type TraceSite = (usize, usize, Option<Location>);
+
 /// The traces whose SBT operands select hit or miss shaders (graph nodes)
 /// that the reach analysis left out because their incoming payload differs:
 /// per site (program, instruction, its location), those shaders. Only with
@@ -601,11 +604,8 @@ pub fn incoming_payload_var(program: &Program, function: Id) -> Option<Id> {
 /// shader, so a shader with another payload there is another ray type, not
 /// a mismatch (and pairing by the GLSL `layout(location)` would need the
 /// source, which SPIR-V without debug info does not carry).
-pub fn mismatched_targets(
-    pipeline: &Pipeline,
-    graph: &TraceGraph,
-) -> Vec<((usize, usize, Option<Location>), Vec<usize>)> {
-    let mut out: Vec<((usize, usize, Option<Location>), Vec<usize>)> = Vec::new();
+pub fn mismatched_targets(pipeline: &Pipeline, graph: &TraceGraph) -> Vec<(TraceSite, Vec<usize>)> {
+    let mut out: Vec<(TraceSite, Vec<usize>)> = Vec::new();
     if !pipeline.described() {
         return out;
     }
