@@ -849,3 +849,17 @@ fn loose_pipelines_leave_out_described_shaders_and_keep_to_one_folder() {
         assert!(f.iter().all(|x| x.parent() == f[0].parent()), "{f:?}");
     }
 }
+
+/// A closest hit the description selects with a constant SBT offset runs
+/// even when its payload differs from the trace's (a public sample ships
+/// this): its level counts, so the depth is never under-stated, and RT009
+/// reports the mismatch.
+#[test]
+fn a_selected_shader_with_another_payload_still_counts_its_level() {
+    let p = "tests/pipelines/payload_mismatch.pipeline.toml";
+    let r = json(&["stack", "--format", "json", p])["pipelines"][0].clone();
+    assert_eq!(r["required_depth"], 2, "{r}");
+    let lines = concise(&["--select", "RT009,RT021", p]);
+    assert_eq!(lines.len(), 1, "{lines:#?}");
+    assert!(lines[0].contains("[RT009]"), "{lines:#?}");
+}

@@ -344,6 +344,15 @@ pub fn trace_graph(pipeline: &Pipeline) -> TraceGraph {
                     }
                     a.reaches()
                 });
+                // Groups the description and constant SBT operands select
+                // exactly run whatever their payload (a mismatch is RT009's
+                // finding, undefined behaviour that real samples ship): the
+                // level counts, on the safe side. Payload shape prunes only
+                // where the selection is not known.
+                if groups.is_some() {
+                    fallback.extend_from_slice(&mismatched);
+                    targets.append(&mut mismatched);
+                }
                 let mut why = admitted.iter().find_map(|(_, a)| match a {
                     Admit::Assumed(w) => Some(*w),
                     _ => None,
@@ -397,14 +406,16 @@ pub fn trace_graph(pipeline: &Pipeline) -> TraceGraph {
                 // shader given takes its payload, the one it runs is missing
                 // (a folder without the shadow miss) or mismatched: keep the
                 // candidates so the level counts, and say so.
-                if !refused.is_empty()
-                    && !targets
-                        .iter()
-                        .any(|&n| matches!(g.nodes[n].slot, Slot::Miss(_)))
-                {
+                // The same for a miss shader the index selects exactly.
+                let no_miss_takes = !targets
+                    .iter()
+                    .any(|&n| matches!(g.nodes[n].slot, Slot::Miss(_)));
+                if !refused.is_empty() && (no_miss_takes || miss.is_some()) {
                     fallback.extend_from_slice(&refused);
                     targets.extend(refused);
-                    why.get_or_insert(Ambiguity::NoMissTakesPayload);
+                    if no_miss_takes {
+                        why.get_or_insert(Ambiguity::NoMissTakesPayload);
+                    }
                 } else {
                     mismatched.extend(refused);
                 }
@@ -595,11 +606,14 @@ mod tests {
         ));
     }
 
-    /// With a description the payload removes edges the SBT allows: the
-    /// shadow trace's record (hit group 1) made a copy of the radiance group
+    /// With a description and constant SBT operands, a record that selects a
+    /// shader taking another payload still runs it: the edge stays, marked
+    /// as one that only counts the level (rules that judge what the shader
+    /// does leave it out; RT009 reports the mismatch). Here the shadow
+    /// trace's record (hit group 1), made a copy of the radiance group,
     /// selects a closest hit that takes another payload.
     #[test]
-    fn description_edges_removed_by_payload() {
+    fn description_edges_with_another_payload_count_the_level() {
         let mut p = pipeline("fixtures/reach/scene.pipeline.toml");
         p.hit_groups[1] = p.hit_groups[0].clone();
         let g = trace_graph(&p);
@@ -608,15 +622,17 @@ mod tests {
                 && g.nodes[e.to].shader.stage == Stage::ClosestHit
                 && g.nodes[e.to].slot == Slot::HitGroup(1)
         };
-        assert!(!g.edges.iter().any(shadow_hit), "{:?}", g.edges);
-        // Once from each of the two nodes of the closest hit (groups 0, 1).
-        assert_eq!(g.mismatched.iter().filter(|e| shadow_hit(e)).count(), 2);
-        // The reflection still reaches group 0 and nothing had to be assumed.
-        assert!(g
-            .edges
-            .iter()
-            .any(|e| g.nodes[e.from].shader.stage == Stage::ClosestHit
-                && g.nodes[e.to].slot == Slot::HitGroup(0)));
+        // Once from each of the two nodes of the closest hit (groups 0, 1),
+        // and only as level-counting edges.
+        let kept: Vec<&Edge> = g.edges.iter().filter(|e| shadow_hit(e)).collect();
+        assert_eq!(kept.len(), 2, "{:?}", g.edges);
+        assert!(kept.iter().all(|e| e.fallback), "{kept:?}");
+        assert!(!g.mismatched.iter().any(shadow_hit), "{:?}", g.mismatched);
+        // The reflection still reaches group 0 as a real edge, and nothing
+        // had to be assumed.
+        assert!(g.edges.iter().any(|e| !e.fallback
+            && g.nodes[e.from].shader.stage == Stage::ClosestHit
+            && g.nodes[e.to].slot == Slot::HitGroup(0)));
         assert!(g.assumptions.is_empty(), "{:?}", g.assumptions);
     }
 
