@@ -106,6 +106,22 @@ impl Program {
     /// choice of constants and nothing else writes it (see
     /// [`Program::fold_choices_in`]).
     fn stored_choices(&self, ptr: Id, chain: &[usize], depth: u32) -> Option<Vec<u64>> {
+        let mut out: Vec<u64> = Vec::new();
+        for stored in self.local_writes(ptr)? {
+            out.extend(self.choices_at(stored, chain, depth)?);
+            out.sort_unstable();
+            out.dedup();
+            if out.len() > MAX_CHOICES {
+                return None;
+            }
+        }
+        (!out.is_empty()).then_some(out)
+    }
+
+    /// What local variable `ptr` is written with: its initialiser, then the
+    /// value of each whole store, in order; `None` when it is no local of a
+    /// function or something else may write it (an access chain, a call).
+    fn local_writes(&self, ptr: Id) -> Option<Vec<Id>> {
         let var = self.def(ptr)?;
         let local = var.class.opcode == Op::Variable
             && matches!(
@@ -118,8 +134,8 @@ impl Program {
         let f = self
             .functions
             .get(self.function_of(*self.defs.get(&ptr)?)?)?;
-        let mut out: Vec<u64> = match var.operands.get(1) {
-            Some(Operand::IdRef(init)) => self.choices_at(*init, chain, depth)?,
+        let mut out: Vec<Id> = match var.operands.get(1) {
+            Some(Operand::IdRef(init)) => vec![*init],
             _ => Vec::new(),
         };
         for inst in &self.insts[f.start..=f.end] {
@@ -134,22 +150,15 @@ impl Program {
             }
             match inst.class.opcode {
                 Op::Load => {}
-                Op::Store if k == 0 && uses.next().is_none() => {
-                    let Some(Operand::IdRef(stored)) = inst.operands.get(1) else {
-                        return None;
-                    };
-                    out.extend(self.choices_at(*stored, chain, depth)?);
-                    out.sort_unstable();
-                    out.dedup();
-                    if out.len() > MAX_CHOICES {
-                        return None;
-                    }
-                }
+                Op::Store if k == 0 && uses.next().is_none() => match inst.operands.get(1) {
+                    Some(Operand::IdRef(stored)) => out.push(*stored),
+                    _ => return None,
+                },
                 // An access chain, a call or anything else may write it.
                 _ => return None,
             }
         }
-        (!out.is_empty()).then_some(out)
+        Some(out)
     }
 
     /// The bits of integer `id` that are set whatever its dynamic parts
@@ -192,49 +201,14 @@ impl Program {
 
     /// The bits every write to local variable `ptr` sets.
     fn stored_ones(&self, ptr: Id, chain: &[usize], depth: u32) -> u64 {
-        let Some(var) = self.def(ptr) else { return 0 };
-        let local = var.class.opcode == Op::Variable
-            && matches!(
-                var.operands.first(),
-                Some(Operand::StorageClass(StorageClass::Function))
-            );
-        let Some(f) = self
-            .defs
-            .get(&ptr)
-            .and_then(|&d| self.function_of(d))
-            .and_then(|k| self.functions.get(k))
-            .filter(|_| local)
-        else {
-            return 0;
-        };
-        let mut ones: Option<u64> = match var.operands.get(1) {
-            Some(Operand::IdRef(init)) => Some(self.known_ones_at(*init, chain, depth)),
-            _ => None,
-        };
-        for inst in &self.insts[f.start..=f.end] {
-            let mut uses = inst
-                .operands
-                .iter()
-                .enumerate()
-                .filter(|(_, o)| matches!(o, Operand::IdRef(x) if *x == ptr));
-            let Some((k, _)) = uses.next() else { continue };
-            if self.is_debug_inst(inst) {
-                continue;
-            }
-            match inst.class.opcode {
-                Op::Load => {}
-                Op::Store if k == 0 && uses.next().is_none() => {
-                    let Some(Operand::IdRef(stored)) = inst.operands.get(1) else {
-                        return 0;
-                    };
-                    let v = self.known_ones_at(*stored, chain, depth);
-                    ones = Some(ones.map_or(v, |w| w & v));
-                }
-                // An access chain, a call or anything else may write it.
-                _ => return 0,
-            }
-        }
-        ones.unwrap_or(0)
+        self.local_writes(ptr)
+            .and_then(|writes| {
+                writes
+                    .into_iter()
+                    .map(|stored| self.known_ones_at(stored, chain, depth))
+                    .reduce(|a, b| a & b)
+            })
+            .unwrap_or(0)
     }
 
     /// A trace's operands as the given call chain reaches it.
